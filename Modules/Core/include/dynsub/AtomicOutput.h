@@ -1,0 +1,34 @@
+#pragma once
+// Writes an output file so that it either appears complete or not at all: the
+// content goes to a temporary file beside the target, which is renamed onto the
+// target by commit(). If commit() is never called (an exception, a failed
+// check), the destructor removes the temporary file and the target is untouched.
+#include <string>
+
+namespace dynsub {
+
+class AtomicOutput {
+ public:
+  explicit AtomicOutput(std::string target);
+  ~AtomicOutput();
+  AtomicOutput(const AtomicOutput&) = delete;
+  AtomicOutput& operator=(const AtomicOutput&) = delete;
+
+  // Where to write the content; same directory and extension as the target so
+  // that writers choosing a format by extension still work.
+  const std::string& temporaryPath() const { return temporary_; }
+  const std::string& target() const { return target_; }
+  // Renames the temporary file onto the target; throws dynsub::Error naming the
+  // target if the temporary file is missing or the rename fails.
+  void commit();
+
+ private:
+  std::string target_;
+  std::string temporary_;
+  bool committed_ = false;
+};
+
+// Throws dynsub::Error naming `path` unless its directory exists and is writable.
+void requireWritableDirectoryFor(const std::string& path);
+
+}  // namespace dynsub

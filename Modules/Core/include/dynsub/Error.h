@@ -1,0 +1,17 @@
+#pragma once
+// The one exception type of DynSub. Its message is meant for the person running
+// the tool: it names the file or value at fault and what was expected, e.g.
+// "cube.obj: line 12: face 7 uses vertex 130, but the file has 98 vertices".
+#include <stdexcept>
+#include <string>
+
+namespace dynsub {
+
+class Error : public std::runtime_error {
+ public:
+  explicit Error(const std::string& message);
+  // "<source>: <message>", the form used for every error about a file.
+  Error(const std::string& source, const std::string& message);
+};
+
+}  // namespace dynsub

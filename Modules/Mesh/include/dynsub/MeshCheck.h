@@ -1,0 +1,21 @@
+#pragma once
+// Validity checks on raw polygon data, run before a control mesh is built (a
+// halfedge structure cannot even represent most of the defects checked here).
+#include <string>
+#include <vector>
+
+#include "dynsub/Types.h"
+
+namespace dynsub {
+
+// Throws dynsub::Error("<source>: <problem>") for the first problem found:
+// no vertices or no faces; a coordinate that is NaN or infinite; a face with
+// fewer than 3 vertices, a vertex index out of range, a repeated vertex, or
+// (near-)zero area (below 1e-12 of the squared bounding-box diagonal); an
+// isolated vertex; an edge with more than two faces (non-manifold edge); a
+// vertex whose faces form more than one fan (non-manifold vertex); two faces
+// traversing an edge in the same direction (inconsistent orientation).
+void checkPolygonMesh(const Matrix3X& points, const std::vector<std::vector<int>>& faces,
+                      const std::string& source);
+
+}  // namespace dynsub

@@ -1,0 +1,131 @@
+#include "dynsub/MeshCheck.h"
+
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <string>
+
+#include "dynsub/Error.h"
+
+namespace dynsub {
+
+namespace {
+
+std::string edgeName(int a, int b) {
+  return "(" + std::to_string(a) + ", " + std::to_string(b) + ")";
+}
+
+// Number of fans the faces around one vertex form: faces are in one fan when
+// they are linked through edges incident to the vertex.
+int fanCount(int vertex, const std::vector<int>& incidentFaces,
+             const std::vector<std::vector<int>>& faces) {
+  std::vector<int> parent(incidentFaces.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&parent](int i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  // Neighbour vertex across an edge at `vertex` -> first incident face seen.
+  std::map<int, int> firstFaceAtNeighbour;
+  for (size_t i = 0; i < incidentFaces.size(); ++i) {
+    const std::vector<int>& face = faces[incidentFaces[i]];
+    const size_t n = face.size();
+    for (size_t k = 0; k < n; ++k) {
+      if (face[k] != vertex) continue;
+      for (int neighbour : {face[(k + 1) % n], face[(k + n - 1) % n]}) {
+        auto [it, inserted] = firstFaceAtNeighbour.emplace(neighbour, static_cast<int>(i));
+        if (!inserted) parent[find(static_cast<int>(i))] = find(it->second);
+      }
+    }
+  }
+  int count = 0;
+  for (size_t i = 0; i < parent.size(); ++i) count += find(static_cast<int>(i)) == static_cast<int>(i);
+  return count;
+}
+
+}  // namespace
+
+void checkPolygonMesh(const Matrix3X& points, const std::vector<std::vector<int>>& faces,
+                      const std::string& source) {
+  const int vertexCount = static_cast<int>(points.rows());
+  if (vertexCount == 0) throw Error(source, "the mesh has no vertices");
+  if (faces.empty()) throw Error(source, "the mesh has no faces");
+  for (int v = 0; v < vertexCount; ++v) {
+    if (!points.row(v).allFinite()) {
+      throw Error(source, "vertex " + std::to_string(v) + " has a coordinate that is NaN or infinite");
+    }
+  }
+  const double diagonal = (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm();
+  const double minimumArea = 1e-12 * diagonal * diagonal;
+
+  std::vector<std::vector<int>> vertexFaces(vertexCount);
+  std::map<std::pair<int, int>, int> directedEdgeFace;  // (from, to) -> face
+  std::map<std::pair<int, int>, int> edgeFaceCount;     // (min, max) -> #faces
+  // Reported after the edge counts: an edge with three faces always repeats a
+  // direction, and "not manifold" is then the truer message.
+  std::string orientationProblem;
+  for (size_t f = 0; f < faces.size(); ++f) {
+    const std::vector<int>& face = faces[f];
+    const std::string faceName = "face " + std::to_string(f);
+    if (face.size() < 3) {
+      throw Error(source, faceName + " has " + std::to_string(face.size()) +
+                              " vertices; a face needs at least 3");
+    }
+    for (int v : face) {
+      if (v < 0 || v >= vertexCount) {
+        throw Error(source, faceName + " uses vertex " + std::to_string(v) + ", but the mesh has " +
+                                std::to_string(vertexCount) + " vertices");
+      }
+    }
+    for (size_t i = 0; i < face.size(); ++i) {
+      for (size_t j = i + 1; j < face.size(); ++j) {
+        if (face[i] == face[j]) {
+          throw Error(source, faceName + " is degenerate: it uses vertex " + std::to_string(face[i]) +
+                                  " twice");
+        }
+      }
+    }
+    // Newell's vector area: exact for planar polygons, robust for others.
+    Vector3 area = Vector3::Zero();
+    for (size_t k = 0; k < face.size(); ++k) {
+      const Vector3 a = points.row(face[k]).transpose();
+      const Vector3 b = points.row(face[(k + 1) % face.size()]).transpose();
+      area += a.cross(b);
+    }
+    if (0.5 * area.norm() <= minimumArea) {
+      throw Error(source, faceName + " is degenerate: its area is zero");
+    }
+    for (size_t k = 0; k < face.size(); ++k) {
+      const int a = face[k];
+      const int b = face[(k + 1) % face.size()];
+      vertexFaces[a].push_back(static_cast<int>(f));
+      auto [it, inserted] = directedEdgeFace.emplace(std::make_pair(a, b), static_cast<int>(f));
+      if (!inserted && orientationProblem.empty()) {
+        orientationProblem = "faces " + std::to_string(it->second) + " and " + std::to_string(f) +
+                             " both run along edge " + edgeName(a, b) +
+                             " in the same direction: the orientation is inconsistent "
+                             "(or a face is repeated)";
+      }
+      ++edgeFaceCount[{std::min(a, b), std::max(a, b)}];
+    }
+  }
+  for (const auto& [edge, count] : edgeFaceCount) {
+    if (count > 2) {
+      throw Error(source, "edge " + edgeName(edge.first, edge.second) + " is shared by " +
+                              std::to_string(count) + " faces: the mesh is not manifold");
+    }
+  }
+  if (!orientationProblem.empty()) throw Error(source, orientationProblem);
+  for (int v = 0; v < vertexCount; ++v) {
+    if (vertexFaces[v].empty()) {
+      throw Error(source, "vertex " + std::to_string(v) + " is isolated: no face uses it");
+    }
+    const int fans = fanCount(v, vertexFaces[v], faces);
+    if (fans > 1) {
+      throw Error(source, "vertex " + std::to_string(v) + " joins " + std::to_string(fans) +
+                              " separate fans of faces: the mesh is not manifold there");
+    }
+  }
+}
+
+}  // namespace dynsub

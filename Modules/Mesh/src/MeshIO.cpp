@@ -1,0 +1,345 @@
+#include "dynsub/MeshIO.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "dynsub/AtomicOutput.h"
+#include "dynsub/Error.h"
+
+namespace dynsub {
+
+namespace {
+
+std::string lowerExtension(const std::string& path) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension;
+}
+
+std::ifstream openForReading(const std::string& path) {
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) throw Error(path, "no such file");
+  if (std::filesystem::is_directory(path, error)) throw Error(path, "is a directory, not a mesh file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path, "cannot open the file for reading");
+  return in;
+}
+
+Matrix3X toMatrix(const std::vector<Vector3>& points) {
+  Matrix3X result(points.size(), 3);
+  for (size_t i = 0; i < points.size(); ++i) result.row(i) = points[i].transpose();
+  return result;
+}
+
+// Parses one number of a text record; throws naming the file and line.
+double parseNumber(const std::string& token, const std::string& path, int line) {
+  try {
+    size_t used = 0;
+    const double value = std::stod(token, &used);
+    if (used != token.size()) throw std::invalid_argument(token);
+    return value;
+  } catch (const std::exception&) {
+    throw Error(path, "line " + std::to_string(line) + ": '" + token + "' is not a number");
+  }
+}
+
+long parseInteger(const std::string& token, const std::string& path, int line) {
+  try {
+    size_t used = 0;
+    const long value = std::stol(token, &used);
+    if (used != token.size()) throw std::invalid_argument(token);
+    return value;
+  } catch (const std::exception&) {
+    throw Error(path, "line " + std::to_string(line) + ": '" + token + "' is not an integer");
+  }
+}
+
+PolygonData readObj(const std::string& path) {
+  std::ifstream in = openForReading(path);
+  std::vector<Vector3> points;
+  PolygonData data;
+  std::string text;
+  int line = 0;
+  while (std::getline(in, text)) {
+    ++line;
+    std::istringstream record(text);
+    std::string keyword;
+    if (!(record >> keyword)) continue;
+    if (keyword == "v") {
+      std::string x, y, z;
+      if (!(record >> x >> y >> z)) {
+        throw Error(path, "line " + std::to_string(line) + ": a vertex needs x y z");
+      }
+      points.emplace_back(parseNumber(x, path, line), parseNumber(y, path, line),
+                          parseNumber(z, path, line));
+    } else if (keyword == "f") {
+      Polygon face;
+      std::string corner;
+      while (record >> corner) {
+        // "v", "v/vt", "v//vn" or "v/vt/vn": only the vertex index matters here.
+        const long index = parseInteger(corner.substr(0, corner.find('/')), path, line);
+        // OBJ indices start at 1; negative ones count back from the last vertex read.
+        const long resolved = index > 0 ? index - 1 : static_cast<long>(points.size()) + index;
+        if (index == 0 || resolved < 0) {
+          throw Error(path, "line " + std::to_string(line) + ": vertex index " +
+                                std::to_string(index) + " is out of range");
+        }
+        face.push_back(static_cast<int>(resolved));
+      }
+      data.faces.push_back(std::move(face));
+    }
+  }
+  data.points = toMatrix(points);
+  return data;
+}
+
+// Reads the next non-empty, non-comment line of an OFF file as tokens.
+std::vector<std::string> nextOffRecord(std::istream& in, const std::string& path, int& line,
+                                       const char* expected) {
+  std::string text;
+  while (std::getline(in, text)) {
+    ++line;
+    text = text.substr(0, text.find('#'));
+    std::istringstream record(text);
+    std::vector<std::string> tokens;
+    for (std::string token; record >> token;) tokens.push_back(token);
+    if (!tokens.empty()) return tokens;
+  }
+  throw Error(path, std::string("the file ends before ") + expected + " (truncated?)");
+}
+
+PolygonData readOff(const std::string& path) {
+  std::ifstream in = openForReading(path);
+  int line = 0;
+  std::vector<std::string> tokens = nextOffRecord(in, path, line, "the OFF header");
+  if (tokens[0] != "OFF") throw Error(path, "line 1: expected the keyword OFF, found '" + tokens[0] + "'");
+  tokens.erase(tokens.begin());
+  if (tokens.empty()) tokens = nextOffRecord(in, path, line, "the vertex and face counts");
+  if (tokens.size() < 2) throw Error(path, "line " + std::to_string(line) + ": expected vertex and face counts");
+  const long vertexCount = parseInteger(tokens[0], path, line);
+  const long faceCount = parseInteger(tokens[1], path, line);
+  if (vertexCount < 0 || faceCount < 0) throw Error(path, "line " + std::to_string(line) + ": negative counts");
+  PolygonData data;
+  data.points.resize(vertexCount, 3);
+  for (long v = 0; v < vertexCount; ++v) {
+    tokens = nextOffRecord(in, path, line, "all vertices are read");
+    if (tokens.size() < 3) throw Error(path, "line " + std::to_string(line) + ": a vertex needs x y z");
+    for (int c = 0; c < 3; ++c) data.points(v, c) = parseNumber(tokens[c], path, line);
+  }
+  for (long f = 0; f < faceCount; ++f) {
+    tokens = nextOffRecord(in, path, line, "all faces are read");
+    const long n = parseInteger(tokens[0], path, line);
+    if (n < 0 || static_cast<long>(tokens.size()) < n + 1) {
+      throw Error(path, "line " + std::to_string(line) + ": the face lists fewer vertices than it declares");
+    }
+    Polygon face;
+    for (long k = 0; k < n; ++k) face.push_back(static_cast<int>(parseInteger(tokens[k + 1], path, line)));
+    data.faces.push_back(std::move(face));
+  }
+  return data;
+}
+
+// ---- PLY ----
+
+struct PlyProperty {
+  std::string name;
+  std::string type;       // scalar type, or the item type of a list
+  std::string countType;  // non-empty for lists
+};
+
+struct PlyElement {
+  std::string name;
+  long count = 0;
+  std::vector<PlyProperty> properties;
+};
+
+int plyTypeSize(const std::string& type, const std::string& path) {
+  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
+  if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+  if (type == "int" || type == "uint" || type == "int32" || type == "uint32" || type == "float" ||
+      type == "float32")
+    return 4;
+  if (type == "double" || type == "float64") return 8;
+  throw Error(path, "unknown PLY property type '" + type + "'");
+}
+
+class PlyValueReader {
+ public:
+  PlyValueReader(std::istream& in, const std::string& format, const std::string& path)
+      : in_(in), path_(path), ascii_(format == "ascii"),
+        swap_(format == "binary_big_endian") {}
+
+  double read(const std::string& type) {
+    if (ascii_) {
+      std::string token;
+      if (!(in_ >> token)) throw Error(path_, "the file ends before all PLY elements are read (truncated?)");
+      try {
+        return std::stod(token);
+      } catch (const std::exception&) {
+        throw Error(path_, "'" + token + "' is not a number");
+      }
+    }
+    const int size = plyTypeSize(type, path_);
+    unsigned char bytes[8];
+    if (!in_.read(reinterpret_cast<char*>(bytes), size)) {
+      throw Error(path_, "the file ends before all PLY elements are read (truncated?)");
+    }
+    if (swap_) std::reverse(bytes, bytes + size);
+    auto as = [&bytes](auto value) {
+      std::memcpy(&value, bytes, sizeof(value));
+      return static_cast<double>(value);
+    };
+    if (type == "char" || type == "int8") return as(std::int8_t{});
+    if (type == "uchar" || type == "uint8") return as(std::uint8_t{});
+    if (type == "short" || type == "int16") return as(std::int16_t{});
+    if (type == "ushort" || type == "uint16") return as(std::uint16_t{});
+    if (type == "int" || type == "int32") return as(std::int32_t{});
+    if (type == "uint" || type == "uint32") return as(std::uint32_t{});
+    if (type == "float" || type == "float32") return as(float{});
+    return as(double{});
+  }
+
+ private:
+  std::istream& in_;
+  std::string path_;
+  bool ascii_;
+  bool swap_;
+};
+
+PolygonData readPly(const std::string& path) {
+  std::ifstream in = openForReading(path);
+  std::string text;
+  if (!std::getline(in, text) || text.substr(0, 3) != "ply") throw Error(path, "not a PLY file (no 'ply' magic line)");
+  std::string format;
+  std::vector<PlyElement> elements;
+  bool headerEnded = false;
+  while (std::getline(in, text)) {
+    if (!text.empty() && text.back() == '\r') text.pop_back();
+    std::istringstream record(text);
+    std::string keyword;
+    record >> keyword;
+    if (keyword == "format") {
+      record >> format;
+      if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian") {
+        throw Error(path, "unknown PLY format '" + format + "'");
+      }
+    } else if (keyword == "element") {
+      PlyElement element;
+      record >> element.name >> element.count;
+      if (!record || element.count < 0) throw Error(path, "malformed PLY element line '" + text + "'");
+      elements.push_back(element);
+    } else if (keyword == "property") {
+      if (elements.empty()) throw Error(path, "PLY property before any element");
+      PlyProperty property;
+      std::string type;
+      record >> type;
+      if (type == "list") record >> property.countType >> property.type >> property.name;
+      else {
+        property.type = type;
+        record >> property.name;
+      }
+      if (!record) throw Error(path, "malformed PLY property line '" + text + "'");
+      elements.back().properties.push_back(property);
+    } else if (keyword == "end_header") {
+      headerEnded = true;
+      break;
+    }
+  }
+  if (!headerEnded) throw Error(path, "the PLY header has no end_header line");
+  if (format.empty()) throw Error(path, "the PLY header has no format line");
+
+  PolygonData data;
+  PlyValueReader reader(in, format, path);
+  bool sawVertices = false;
+  for (const PlyElement& element : elements) {
+    if (element.name == "vertex") {
+      sawVertices = true;
+      data.points.resize(element.count, 3);
+      int axes[3] = {-1, -1, -1};
+      for (size_t p = 0; p < element.properties.size(); ++p) {
+        const std::string& name = element.properties[p].name;
+        if (name == "x") axes[0] = static_cast<int>(p);
+        if (name == "y") axes[1] = static_cast<int>(p);
+        if (name == "z") axes[2] = static_cast<int>(p);
+      }
+      if (axes[0] < 0 || axes[1] < 0 || axes[2] < 0) throw Error(path, "the PLY vertices have no x, y, z properties");
+      for (long v = 0; v < element.count; ++v) {
+        for (size_t p = 0; p < element.properties.size(); ++p) {
+          const PlyProperty& property = element.properties[p];
+          if (!property.countType.empty()) {
+            const long n = static_cast<long>(reader.read(property.countType));
+            for (long k = 0; k < n; ++k) reader.read(property.type);
+            continue;
+          }
+          const double value = reader.read(property.type);
+          for (int c = 0; c < 3; ++c) {
+            if (axes[c] == static_cast<int>(p)) data.points(v, c) = value;
+          }
+        }
+      }
+    } else {
+      const bool isFace = element.name == "face";
+      for (long i = 0; i < element.count; ++i) {
+        for (const PlyProperty& property : element.properties) {
+          const bool indices = isFace && (property.name == "vertex_indices" || property.name == "vertex_index");
+          if (property.countType.empty()) {
+            reader.read(property.type);
+            continue;
+          }
+          const long n = static_cast<long>(reader.read(property.countType));
+          if (n < 0) throw Error(path, "negative list length in PLY element '" + element.name + "'");
+          Polygon face;
+          for (long k = 0; k < n; ++k) face.push_back(static_cast<int>(reader.read(property.type)));
+          if (indices) data.faces.push_back(std::move(face));
+        }
+      }
+    }
+  }
+  if (!sawVertices) throw Error(path, "the PLY file has no vertex element");
+  return data;
+}
+
+}  // namespace
+
+PolygonData readPolygonData(const std::string& path) {
+  const std::string extension = lowerExtension(path);
+  if (extension == ".obj") return readObj(path);
+  if (extension == ".off") return readOff(path);
+  if (extension == ".ply") return readPly(path);
+  throw Error(path, "unknown mesh format '" + extension + "' (expected .obj, .off or .ply)");
+}
+
+ControlMesh readControlMesh(const std::string& path) {
+  const PolygonData data = readPolygonData(path);
+  return ControlMesh::fromPolygons(data.points, data.faces, path);
+}
+
+void writeObj(const ControlMesh& mesh, const std::string& path) {
+  AtomicOutput output(path);
+  {
+    std::ofstream out(output.temporaryPath());
+    if (!out) throw Error(path, "cannot open the file for writing");
+    out.precision(17);  // round-trips every double
+    out << "# DynSub control mesh: " << mesh.vertexCount() << " vertices, " << mesh.faceCount()
+        << " faces\n";
+    const Matrix3X points = mesh.points();
+    for (Eigen::Index v = 0; v < points.rows(); ++v) {
+      out << "v " << points(v, 0) << ' ' << points(v, 1) << ' ' << points(v, 2) << '\n';
+    }
+    for (const Polygon& face : mesh.faces()) {
+      out << 'f';
+      for (int v : face) out << ' ' << v + 1;
+      out << '\n';
+    }
+    if (!out.flush()) throw Error(path, "writing failed (disk full?)");
+  }
+  output.commit();
+}
+
+}  // namespace dynsub

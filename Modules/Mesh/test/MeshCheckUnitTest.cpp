@@ -1,0 +1,85 @@
+// Unit tests (no rendering): each defect is rejected with a message naming it.
+#include <gtest/gtest.h>
+
+#include "dynsub/ControlMesh.h"
+#include "dynsub/Error.h"
+
+namespace {
+
+using dynsub::ControlMesh;
+using dynsub::Matrix3X;
+using dynsub::Polygon;
+
+// Expects fromPolygons to throw an error whose message contains `fragment`.
+void expectRejected(const Matrix3X& points, const std::vector<Polygon>& faces, const std::string& fragment) {
+  try {
+    ControlMesh::fromPolygons(points, faces, "test.obj");
+    FAIL() << "accepted a mesh that should fail with: " << fragment;
+  } catch (const dynsub::Error& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("test.obj"), std::string::npos) << message;
+    EXPECT_NE(message.find(fragment), std::string::npos) << message;
+  }
+}
+
+Matrix3X gridPoints(int columns, int rows) {
+  Matrix3X points(columns * rows, 3);
+  for (int j = 0; j < rows; ++j)
+    for (int i = 0; i < columns; ++i) points.row(j * columns + i) << i, j, 0;
+  return points;
+}
+
+TEST(MeshCheck, AcceptsAnOpenQuadGrid) {
+  const ControlMesh mesh = ControlMesh::fromPolygons(gridPoints(3, 2), {{0, 1, 4, 3}, {1, 2, 5, 4}});
+  EXPECT_EQ(mesh.vertexCount(), 6);
+  EXPECT_EQ(mesh.faceCount(), 2);
+  EXPECT_EQ(mesh.boundaryLoopCount(), 1);
+  EXPECT_FALSE(mesh.isClosed());
+}
+
+TEST(MeshCheck, FacesKeepTheirVertexOrder) {
+  const std::vector<Polygon> faces{{4, 3, 0, 1}, {1, 2, 5, 4}};
+  const ControlMesh mesh = ControlMesh::fromPolygons(gridPoints(3, 2), faces);
+  EXPECT_EQ(mesh.faces(), faces);
+}
+
+TEST(MeshCheck, RejectsEmptyMeshes) {
+  expectRejected(Matrix3X(0, 3), {}, "no vertices");
+  expectRejected(gridPoints(2, 2), {}, "no faces");
+}
+
+TEST(MeshCheck, RejectsBadFaces) {
+  expectRejected(gridPoints(2, 2), {{0, 1}}, "at least 3");
+  expectRejected(gridPoints(2, 2), {{0, 1, 7}}, "uses vertex 7");
+  expectRejected(gridPoints(2, 2), {{0, 1, 1, 2}}, "twice");
+  expectRejected(gridPoints(3, 1), {{0, 1, 2}}, "area is zero");
+}
+
+TEST(MeshCheck, RejectsNonFiniteCoordinates) {
+  Matrix3X points = gridPoints(2, 2);
+  points(2, 1) = std::numeric_limits<double>::quiet_NaN();
+  expectRejected(points, {{0, 1, 3, 2}}, "NaN");
+}
+
+TEST(MeshCheck, RejectsIsolatedVertices) {
+  expectRejected(gridPoints(3, 2), {{0, 1, 4, 3}}, "vertex 2 is isolated");
+}
+
+TEST(MeshCheck, RejectsNonManifoldEdges) {
+  Matrix3X points(5, 3);
+  points << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1;
+  expectRejected(points, {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}}, "shared by 3 faces");
+}
+
+TEST(MeshCheck, RejectsNonManifoldVertices) {
+  // Two triangles touching at vertex 0 only (a bowtie).
+  Matrix3X points(5, 3);
+  points << 0, 0, 0, 1, 0, 0, 1, 1, 0, -1, 0, 0, -1, -1, 0;
+  expectRejected(points, {{0, 1, 2}, {0, 3, 4}}, "separate fans");
+}
+
+TEST(MeshCheck, RejectsInconsistentOrientation) {
+  expectRejected(gridPoints(3, 2), {{0, 1, 4, 3}, {1, 4, 5, 2}}, "orientation is inconsistent");
+}
+
+}  // namespace

@@ -1,0 +1,123 @@
+// Unit tests (no rendering): every reader gives back the same mesh, and broken
+// files are rejected with their name and problem.
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "dynsub/Error.h"
+#include "dynsub/MeshIO.h"
+#include "dynsub/StandardMeshes.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / "dynsub-meshio";
+  fs::create_directories(dir);
+  return dir / name;
+}
+
+void writeText(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
+
+void expectError(const std::string& path, const std::string& fragment) {
+  try {
+    dynsub::readControlMesh(path);
+    FAIL() << "no error for " << path;
+  } catch (const dynsub::Error& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find(path), std::string::npos) << message;
+    EXPECT_NE(message.find(fragment), std::string::npos) << message;
+  }
+}
+
+TEST(MeshIO, ObjRoundTripIsExact) {
+  const dynsub::ControlMesh torus = dynsub::makeTorus32();
+  const std::string path = scratch("torus.obj").string();
+  dynsub::writeObj(torus, path);
+  const dynsub::ControlMesh back = dynsub::readControlMesh(path);
+  EXPECT_EQ(back.faces(), torus.faces());
+  EXPECT_EQ((back.points() - torus.points()).cwiseAbs().maxCoeff(), 0.0);
+}
+
+TEST(MeshIO, ObjAcceptsTextureNormalAndNegativeIndices) {
+  const std::string path = scratch("square.obj").string();
+  writeText(path, "# square\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nf -4/1/1 2//1 3/3 4\n");
+  const dynsub::ControlMesh mesh = dynsub::readControlMesh(path);
+  EXPECT_EQ(mesh.faces(), (std::vector<dynsub::Polygon>{{0, 1, 2, 3}}));
+}
+
+TEST(MeshIO, OffAndAsciiPlyReadTheSameMesh) {
+  const std::string off = scratch("tri.off").string();
+  writeText(off, "OFF\n# comment\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n");
+  const std::string ply = scratch("tri.ply").string();
+  writeText(ply,
+            "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+            "element face 2\nproperty list uchar int vertex_indices\nend_header\n"
+            "0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n");
+  const dynsub::ControlMesh a = dynsub::readControlMesh(off);
+  const dynsub::ControlMesh b = dynsub::readControlMesh(ply);
+  EXPECT_EQ(a.faces(), b.faces());
+  EXPECT_EQ(a.points(), b.points());
+}
+
+TEST(MeshIO, BinaryPlyInBothByteOrders) {
+  for (const std::string order : {"binary_little_endian", "binary_big_endian"}) {
+    const std::string path = scratch("quad-" + order + ".ply").string();
+    std::ofstream out(path, std::ios::binary);
+    out << "ply\nformat " << order << " 1.0\nelement vertex 4\nproperty double x\nproperty double y\n"
+        << "property double z\nproperty uchar red\nelement face 1\nproperty list uchar int vertex_indices\n"
+        << "end_header\n";
+    const bool swap = order == "binary_big_endian";
+    auto put = [&out, swap](auto value) {
+      char bytes[sizeof(value)];
+      std::memcpy(bytes, &value, sizeof(value));
+      if (swap) std::reverse(bytes, bytes + sizeof(value));
+      out.write(bytes, sizeof(value));
+    };
+    const double xy[4][2] = {{0, 0}, {2, 0}, {2, 2}, {0, 2}};
+    for (const auto& p : xy) {
+      put(p[0]);
+      put(p[1]);
+      put(0.5);
+      put(std::uint8_t{255});
+    }
+    put(std::uint8_t{4});
+    for (std::int32_t v : {0, 1, 2, 3}) put(v);
+    out.close();
+    const dynsub::ControlMesh mesh = dynsub::readControlMesh(path);
+    EXPECT_EQ(mesh.vertexCount(), 4) << order;
+    EXPECT_EQ(mesh.points()(2, 0), 2.0) << order;
+    EXPECT_EQ(mesh.points()(3, 2), 0.5) << order;
+  }
+}
+
+TEST(MeshIO, BrokenFilesAreNamed) {
+  expectError(scratch("missing.obj").string(), "no such file");
+  const std::string unknown = scratch("mesh.stl").string();
+  writeText(unknown, "solid");
+  expectError(unknown, "unknown mesh format");
+  const std::string badNumber = scratch("bad.obj").string();
+  writeText(badNumber, "v 0 0 0\nv 1 x 0\n");
+  expectError(badNumber, "line 2");
+  const std::string truncated = scratch("truncated.off").string();
+  writeText(truncated, "OFF\n4 1 0\n0 0 0\n1 0 0\n");
+  expectError(truncated, "truncated");
+  const std::string truncatedPly = scratch("truncated.ply").string();
+  writeText(truncatedPly, "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+                          "property float y\nproperty float z\nend_header\n\x01\x02");
+  expectError(truncatedPly, "truncated");
+  const std::string empty = scratch("empty.obj").string();
+  writeText(empty, "");
+  expectError(empty, "no vertices");
+}
+
+TEST(MeshIO, FailedWriteLeavesNoFile) {
+  EXPECT_THROW(dynsub::writeObj(dynsub::makeCube98(), "/nonexistent-dynsub/cube.obj"), dynsub::Error);
+  EXPECT_FALSE(fs::exists("/nonexistent-dynsub/cube.obj"));
+}
+
+}  // namespace

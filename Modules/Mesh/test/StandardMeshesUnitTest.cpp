@@ -1,0 +1,63 @@
+// Unit tests (no rendering): the papers' initial meshes have the stated counts,
+// topology and orientation, and the copies in Data/Meshes are identical.
+#include <gtest/gtest.h>
+
+#include "dynsub/MeshIO.h"
+#include "dynsub/StandardMeshes.h"
+
+namespace {
+
+int countValence(const dynsub::ControlMesh& mesh, int valence) {
+  int count = 0;
+  for (auto v : mesh.polyMesh().vertices()) count += static_cast<int>(mesh.polyMesh().valence(v)) == valence;
+  return count;
+}
+
+// Signed volume by the divergence theorem (fan triangulation of each face):
+// positive when faces are oriented outward.
+double signedVolume(const dynsub::ControlMesh& mesh) {
+  const dynsub::Matrix3X p = mesh.points();
+  double volume = 0;
+  for (const dynsub::Polygon& face : mesh.faces()) {
+    for (size_t k = 1; k + 1 < face.size(); ++k) {
+      volume += p.row(face[0]).dot(p.row(face[k]).cross(p.row(face[k + 1]))) / 6.0;
+    }
+  }
+  return volume;
+}
+
+TEST(StandardMeshes, CubeHasThePapersCounts) {
+  const dynsub::ControlMesh cube = dynsub::makeCube98();
+  EXPECT_EQ(cube.vertexCount(), 98);
+  EXPECT_EQ(cube.faceCount(), 96);
+  EXPECT_EQ(countValence(cube, 3), 8);
+  EXPECT_EQ(countValence(cube, 4), 90);
+  EXPECT_TRUE(cube.isClosed());
+  EXPECT_EQ(cube.genus(), 0);
+  EXPECT_NEAR(signedVolume(cube), 8.0, 1e-12);
+}
+
+TEST(StandardMeshes, TorusAndSheet) {
+  const dynsub::ControlMesh torus = dynsub::makeTorus32();
+  EXPECT_EQ(torus.vertexCount(), 32);
+  EXPECT_EQ(torus.faceCount(), 32);
+  EXPECT_EQ(torus.genus(), 1);
+  EXPECT_GT(signedVolume(torus), 0.0);
+  const dynsub::ControlMesh sheet = dynsub::makeSheet81();
+  EXPECT_EQ(sheet.vertexCount(), 81);
+  EXPECT_EQ(sheet.faceCount(), 64);
+  EXPECT_EQ(sheet.boundaryLoopCount(), 1);
+  EXPECT_EQ(countValence(sheet, 2), 4);
+}
+
+TEST(StandardMeshes, DataFilesMatchTheConstructedMeshes) {
+  for (const std::string& name : dynsub::standardMeshNames()) {
+    const dynsub::ControlMesh built = dynsub::makeStandardMesh(name);
+    const dynsub::ControlMesh stored =
+        dynsub::readControlMesh(std::string(DYNSUB_DATA_DIR) + "/Meshes/" + name + ".obj");
+    EXPECT_EQ(stored.faces(), built.faces()) << name;
+    EXPECT_EQ(stored.points(), built.points()) << name;
+  }
+}
+
+}  // namespace

@@ -1,0 +1,116 @@
+#pragma once
+// The exact limit surface s = J p of a Catmull-Clark control mesh of any
+// topology (TVCG 1998 §2.2-2.4; ICCV 1998 §2.1-2.3), as values and as sparse
+// linear operators over the control vertices.
+//
+// Isolation (TVCG §2.4.2). While the mesh has a face that is not a quad, or a
+// quad with more than one irregular vertex, it is refined globally (at most
+// twice). The quads of the result, the *base mesh*, are the elements:
+//  - a normal element has four regular corners (Topology::isRegularVertex): one
+//    bicubic B-spline patch over its 16-vertex neighbourhood; across a boundary
+//    the missing neighbours are mirrored ghosts (2 b - i), which reproduces the
+//    boundary rules of CatmullClark.h exactly (a corner ghost is 4c - 2b1 - 2b2 + d);
+//  - a special element has one irregular corner (an extraordinary vertex, inside
+//    or on the boundary). It is the infinite family of B-spline patches of TVCG
+//    §2.3 / §3.1.2: local subdivision of its neighbourhood n times leaves the
+//    point in one of three regular subpatches of size 2^-n, with n finite for
+//    every (u, v) != the extraordinary corner. Nothing is truncated; the first
+//    24 levels are tabulated at construction, deeper ones computed on demand.
+//    At the extraordinary vertex itself: the exact limit position mask, and the
+//    tangent masks (interior: Halstead et al. 1993; boundary: the crease tangent
+//    along the boundary and Biermann et al. 2000 across it). There the
+//    parameterization is singular (|s_u| -> 0 for valence 3, -> infinity for
+//    valence >= 5), so s_u and s_v are the tangent-mask vectors, scaled to equal
+//    the B-spline derivatives at a regular vertex; they span the exact tangent
+//    plane and give the exact normal; second derivatives there are returned as 0.
+//
+// Parameters. An element is a quad (c0, c1, c2, c3) of the base mesh with
+// (u, v) in [0,1]^2: c0 at (0,0), c1 at (1,0), c2 at (1,1), c3 at (0,1); so
+// s_u x s_v points to the side from which the corners run counter-clockwise
+// (outward for an outward-oriented mesh). A SurfacePoint names a point by the
+// control mesh's own *parametric faces* (Ptex numbering): a quad is one
+// parametric face with the same convention; an n-gon is n of them, the k-th
+// being the quad (corner k, midpoint of edge k, centre, midpoint of edge k-1).
+// Derivatives are taken with respect to the parameters of the point's kind.
+//
+// Cost: construction is O(#control vertices) plus a fixed table per special
+// element; evaluating a point is O(1). Nothing is invalidated by moving control
+// points: only the topology is baked in.
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "dynsub/Types.h"
+
+namespace dynsub {
+
+class ControlMesh;
+class Topology;
+
+enum class ElementType { Normal = 0, Special = 1 };
+
+struct ElementPoint {
+  int element = 0;
+  double u = 0;
+  double v = 0;
+};
+
+struct SurfacePoint {
+  int face = 0;  // parametric face of the control mesh
+  double u = 0;
+  double v = 0;
+};
+
+// Position, derivatives and unit normal at one point (mm, and mm per unit of
+// parameter). The normal is zero only where s_u x s_v vanishes.
+struct LimitSample {
+  Vector3 position, du, dv, duu, duv, dvv, normal;
+};
+
+// Rows: points; columns: control vertices; s = J * p for each coordinate.
+// Rows of J sum to 1, rows of the derivative operators to 0.
+struct LimitOperators {
+  SparseMatrix J, Ju, Jv, Juu, Juv, Jvv;
+};
+
+class LimitSurface {
+ public:
+  // Throws dynsub::Error if the mesh's topology is unusable (it cannot be for
+  // a ControlMesh, which is checked on construction).
+  explicit LimitSurface(const ControlMesh& mesh);
+  ~LimitSurface();
+  LimitSurface(LimitSurface&&) noexcept;
+  LimitSurface& operator=(LimitSurface&&) noexcept;
+
+  int controlVertexCount() const;
+  // Global refinements done to isolate extraordinary vertices: 0, 1 or 2.
+  int isolationLevels() const;
+  // The base mesh (the elements are its faces) and its vertices as a linear
+  // blend of the control vertices (#base vertices by #control vertices).
+  const Topology& baseTopology() const;
+  const SparseMatrix& isolationMatrix() const;
+
+  int elementCount() const;
+  ElementType elementType(int element) const;
+  // The control-mesh face the element lies in.
+  int elementControlFace(int element) const;
+  int parametricFaceCount() const;
+  // The element and element parameters of a point given on a parametric face.
+  // Throws dynsub::Error if the face or the parameters are out of range.
+  ElementPoint toElementPoint(const SurfacePoint& point) const;
+
+  LimitSample evaluate(const ElementPoint& point, const Matrix3X& controlPoints) const;
+  LimitSample evaluate(const SurfacePoint& point, const Matrix3X& controlPoints) const;
+  LimitOperators operators(const std::vector<ElementPoint>& points) const;
+  LimitOperators operators(const std::vector<SurfacePoint>& points) const;
+
+  // Row i gives the limit position of control vertex i (#control by #control).
+  SparseMatrix controlVertexLimitOperator() const;
+
+  struct Impl;
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace dynsub

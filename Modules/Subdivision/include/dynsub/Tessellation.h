@@ -1,0 +1,25 @@
+#pragma once
+// A triangle mesh of the limit surface: each element (LimitSurface.h) is cut
+// into N x N parameter squares of two triangles each, at parameters i/N. Samples
+// on shared element edges and corners are shared, so a closed control mesh gives
+// a closed, consistently oriented triangle mesh (normals point where s_u x s_v
+// points: outward for an outward-oriented control mesh).
+#include <array>
+#include <vector>
+
+#include "dynsub/LimitSurface.h"
+
+namespace dynsub {
+
+struct TriangleSurface {
+  Matrix3X points;   // mm
+  Matrix3X normals;  // unit limit normals at the points
+  std::vector<std::array<int, 3>> triangles;
+  std::vector<int> triangleElement;           // the element each triangle lies in
+  std::vector<ElementType> triangleType;      // that element's type
+};
+
+// N = segmentsPerElement >= 1. Throws dynsub::Error for N < 1 or N > 1024.
+TriangleSurface tessellate(const LimitSurface& surface, const Matrix3X& controlPoints, int segmentsPerElement);
+
+}  // namespace dynsub

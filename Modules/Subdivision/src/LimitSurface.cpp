@@ -1,0 +1,390 @@
+#include "dynsub/LimitSurface.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "PatchRules.h"
+#include "dynsub/CatmullClark.h"
+#include "dynsub/ControlMesh.h"
+#include "dynsub/Error.h"
+
+namespace dynsub {
+
+using detail::LevelPatches;
+using detail::LocalMesh;
+using detail::SmallStencil;
+
+namespace {
+
+// Special elements tabulate this many levels of subpatches at construction
+// (points closer than 2^-24 to the extraordinary corner are computed on demand).
+constexpr int kTabulatedLevels = 24;
+
+using GridMatrix = Eigen::Matrix<double, 16, Eigen::Dynamic>;
+using SampleWeights = Eigen::Matrix<double, 6, Eigen::Dynamic>;  // s, su, sv, suu, suv, svv
+
+bool needsIsolation(const Topology& topology) {
+  for (int f = 0; f < topology.faceCount(); ++f) {
+    if (topology.faceSize(f) != 4) return true;
+    int irregular = 0;
+    for (int v : topology.face(f)) irregular += !topology.isRegularVertex(v);
+    if (irregular > 1) return true;
+  }
+  return false;
+}
+
+// Rewrites derivative rows taken in parameters (a, b) into parameters (u, v),
+// given T = d(a, b)/d(u, v): gradient T^T g, Hessian T^T H T.
+void applyChainRule(SampleWeights& w, const Eigen::Matrix2d& t) {
+  const Eigen::RowVectorXd da = w.row(1), db = w.row(2);
+  const Eigen::RowVectorXd daa = w.row(3), dab = w.row(4), dbb = w.row(5);
+  w.row(1) = t(0, 0) * da + t(1, 0) * db;
+  w.row(2) = t(0, 1) * da + t(1, 1) * db;
+  w.row(3) = t(0, 0) * t(0, 0) * daa + 2.0 * t(0, 0) * t(1, 0) * dab + t(1, 0) * t(1, 0) * dbb;
+  w.row(4) = t(0, 0) * t(0, 1) * daa + (t(0, 0) * t(1, 1) + t(1, 0) * t(0, 1)) * dab + t(1, 0) * t(1, 1) * dbb;
+  w.row(5) = t(0, 1) * t(0, 1) * daa + 2.0 * t(0, 1) * t(1, 1) * dab + t(1, 1) * t(1, 1) * dbb;
+}
+
+// Quadrant of (u, v) in a quad: the child of CatmullClark.h's numbering.
+int quadrant(double u, double v) {
+  if (u < 0.5) return v < 0.5 ? 0 : 3;
+  return v < 0.5 ? 1 : 2;
+}
+
+}  // namespace
+
+struct LimitSurface::Impl {
+  struct Element {
+    ElementType type = ElementType::Normal;
+    int controlFace = -1;
+    int corner = -1;   // special: corner of the extraordinary vertex
+    int special = -1;  // index into specials
+    std::vector<int> columns;
+    GridMatrix grid;  // normal: 16 B-spline control points over `columns`
+  };
+  struct Special {
+    std::vector<int> columns;
+    std::vector<LevelPatches> levels;  // levels[n - 1]: subpatches at level n
+    LocalMesh deepest;                 // the neighbourhood after the last level
+    Eigen::Matrix<double, 3, Eigen::Dynamic> vertexMasks;  // limit position, tangent u, tangent v
+  };
+
+  int controlVertexCount = 0;
+  int isolationLevels = 0;
+  Topology base;
+  SparseMatrix isolation;                         // base vertices <- control vertices
+  std::vector<std::vector<int>> childFaceOffset;  // per isolation level
+  std::vector<int> parametricFaceOffset;          // per control face, plus the total
+  std::vector<int> controlFaceSize;
+  std::vector<Element> elements;
+  std::vector<Special> specials;
+
+  // Control-vertex columns and dense weights of a set of base-mesh stencils.
+  std::vector<int> columnsOf(const std::vector<int>& baseVertices) const {
+    std::vector<int> columns;
+    for (int b : baseVertices) {
+      for (SparseMatrix::InnerIterator it(isolation, b); it; ++it) columns.push_back(static_cast<int>(it.col()));
+    }
+    std::sort(columns.begin(), columns.end());
+    columns.erase(std::unique(columns.begin(), columns.end()), columns.end());
+    return columns;
+  }
+  Eigen::RowVectorXd rowOver(const std::vector<int>& columns, int baseVertex) const {
+    Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(columns.size());
+    for (SparseMatrix::InnerIterator it(isolation, baseVertex); it; ++it) {
+      const auto position = std::lower_bound(columns.begin(), columns.end(), static_cast<int>(it.col()));
+      row(position - columns.begin()) += it.value();
+    }
+    return row;
+  }
+
+  void buildNormal(Element& element, int face) {
+    std::array<SmallStencil, 16> grid;
+    if (!detail::gatherRegularPatch(base, face, grid)) throw Error("internal: normal element is not regular");
+    std::vector<int> baseVertices;
+    for (const SmallStencil& s : grid) {
+      for (const auto& [v, w] : s) baseVertices.push_back(v);
+    }
+    element.columns = columnsOf(baseVertices);
+    element.grid.setZero(16, element.columns.size());
+    for (int s = 0; s < 16; ++s) {
+      for (const auto& [v, w] : grid[s]) element.grid.row(s) += w * rowOver(element.columns, v);
+    }
+  }
+
+  void buildSpecial(Element& element, int face) {
+    const int x = base.face(face)[element.corner];
+    detail::Neighbourhood neighbourhood = detail::extractNeighbourhood(base, x, face);
+    Special special;
+    special.columns = columnsOf(neighbourhood.parentVertex);
+    LocalMesh local;
+    local.weights.resize(neighbourhood.parentVertex.size(), special.columns.size());
+    for (size_t i = 0; i < neighbourhood.parentVertex.size(); ++i) {
+      local.weights.row(i) = rowOver(special.columns, neighbourhood.parentVertex[i]);
+    }
+    local.topology = std::move(neighbourhood.topology);
+    local.face = neighbourhood.face;
+
+    const detail::VertexMasks masks = detail::vertexMasks(local.topology, local.topology.face(local.face)[0], local.face);
+    special.vertexMasks.setZero(3, special.columns.size());
+    const SmallStencil* rows[3] = {&masks.position, &masks.tangentU, &masks.tangentV};
+    for (int r = 0; r < 3; ++r) {
+      for (const auto& [v, w] : *rows[r]) special.vertexMasks.row(r) += w * local.weights.row(v);
+    }
+    for (int level = 1; level <= kTabulatedLevels; ++level) {
+      special.levels.push_back(detail::subdivideAroundCorner(local));
+    }
+    special.deepest = std::move(local);
+    element.columns = special.columns;
+    element.special = static_cast<int>(specials.size());
+    specials.push_back(std::move(special));
+  }
+
+  // Weights of s and its derivatives at an element point, over element.columns.
+  SampleWeights weights(const ElementPoint& point) const {
+    if (point.element < 0 || point.element >= static_cast<int>(elements.size())) {
+      throw Error("element " + std::to_string(point.element) + " does not exist (the surface has " +
+                  std::to_string(elements.size()) + " elements)");
+    }
+    if (!(point.u >= 0.0 && point.u <= 1.0 && point.v >= 0.0 && point.v <= 1.0)) {
+      throw Error("parameters (" + std::to_string(point.u) + ", " + std::to_string(point.v) +
+                  ") of element " + std::to_string(point.element) + " are outside [0,1]^2");
+    }
+    const Element& element = elements[point.element];
+    if (element.type == ElementType::Normal) return detail::bsplineWeights(point.u, point.v) * element.grid;
+
+    const Special& special = specials[element.special];
+    // Parameters with the extraordinary vertex at the origin.
+    const auto [a, b] = detail::cornerFrame(element.corner, point.u, point.v);
+    const Eigen::Matrix2d toCorner = detail::cornerFrameJacobian(element.corner);
+    SampleWeights w;
+    if (a == 0.0 && b == 0.0) {
+      w.setZero(6, special.columns.size());
+      w.topRows(3) = special.vertexMasks;
+      applyChainRule(w, toCorner);
+      return w;
+    }
+    // The level n >= 1 at which the point lies in a regular subpatch: the
+    // smallest n with max(a, b) >= 2^-n.
+    int exponent = 0;
+    std::frexp(std::max(a, b), &exponent);
+    const int level = std::max(1, 1 - exponent);
+    const double x = std::ldexp(a, level - 1);  // exact scaling into [0,1]^2
+    const double y = std::ldexp(b, level - 1);
+    const int child = quadrant(x, y);
+    auto [childU, childV] = detail::cornerFrame(child, x, y);
+    childU = std::min(1.0, 2.0 * childU);
+    childV = std::min(1.0, 2.0 * childV);
+    const GridMatrix* patch = nullptr;
+    LevelPatches deeper;
+    if (level <= kTabulatedLevels) {
+      patch = &special.levels[level - 1][child - 1];
+    } else {
+      LocalMesh local = special.deepest;
+      for (int n = kTabulatedLevels + 1; n <= level; ++n) deeper = detail::subdivideAroundCorner(local);
+      patch = &deeper[child - 1];
+    }
+    w = detail::bsplineWeights(childU, childV) * (*patch);
+    const Eigen::Matrix2d jacobian = std::ldexp(1.0, level) * detail::cornerFrameJacobian(child) * toCorner;
+    applyChainRule(w, jacobian);
+    return w;
+  }
+
+  // The element point of a surface point and d(element u, v)/d(surface u, v).
+  ElementPoint locate(const SurfacePoint& point, Eigen::Matrix2d& jacobian) const {
+    if (point.face < 0 || point.face >= parametricFaceOffset.back()) {
+      throw Error("parametric face " + std::to_string(point.face) + " does not exist (the control mesh has " +
+                  std::to_string(parametricFaceOffset.back()) + ")");
+    }
+    if (!(point.u >= 0.0 && point.u <= 1.0 && point.v >= 0.0 && point.v <= 1.0)) {
+      throw Error("parameters (" + std::to_string(point.u) + ", " + std::to_string(point.v) + ") of face " +
+                  std::to_string(point.face) + " are outside [0,1]^2");
+    }
+    const int controlFace = static_cast<int>(std::upper_bound(parametricFaceOffset.begin(),
+                                                              parametricFaceOffset.end(), point.face) -
+                                             parametricFaceOffset.begin()) - 1;
+    jacobian.setIdentity();
+    ElementPoint result{controlFace, point.u, point.v};
+    for (int level = 0; level < isolationLevels; ++level) {
+      int child = 0;
+      if (level == 0 && controlFaceSize[controlFace] != 4) {
+        child = point.face - parametricFaceOffset[controlFace];
+      } else {
+        child = quadrant(result.u, result.v);
+        const auto [a, b] = detail::cornerFrame(child, result.u, result.v);
+        result.u = std::min(1.0, 2.0 * a);
+        result.v = std::min(1.0, 2.0 * b);
+        jacobian = 2.0 * detail::cornerFrameJacobian(child) * jacobian;
+      }
+      result.element = childFaceOffset[level][result.element] + child;
+    }
+    return result;
+  }
+
+  const std::vector<int>& columnsOf(int element) const { return elements[element].columns; }
+};
+
+LimitSurface::LimitSurface(const ControlMesh& mesh) : impl_(std::make_unique<Impl>()) {
+  Impl& s = *impl_;
+  s.controlVertexCount = mesh.vertexCount();
+  s.base = topologyOf(mesh);
+  for (int f = 0; f < s.base.faceCount(); ++f) s.controlFaceSize.push_back(s.base.faceSize(f));
+  s.parametricFaceOffset.push_back(0);
+  for (int size : s.controlFaceSize) s.parametricFaceOffset.push_back(s.parametricFaceOffset.back() + (size == 4 ? 1 : size));
+
+  s.isolation.resize(s.controlVertexCount, s.controlVertexCount);
+  s.isolation.setIdentity();
+  std::vector<int> controlFaceOf(s.base.faceCount());
+  for (int f = 0; f < s.base.faceCount(); ++f) controlFaceOf[f] = f;
+  while (needsIsolation(s.base)) {
+    // One step isolates every extraordinary vertex of an all-quad mesh; a second
+    // one those at the centres of former n-gons.
+    if (s.isolationLevels == 2) throw Error("internal: extraordinary vertices are not isolated after two steps");
+    Refinement refinement = refine(s.base);
+    s.isolation = refinement.subdivisionMatrix * s.isolation;
+    std::vector<int> childControlFace(refinement.topology.faceCount());
+    for (int f = 0; f < s.base.faceCount(); ++f) {
+      for (int k = 0; k < s.base.faceSize(f); ++k) childControlFace[refinement.childFaceOffset[f] + k] = controlFaceOf[f];
+    }
+    controlFaceOf = std::move(childControlFace);
+    s.childFaceOffset.push_back(std::move(refinement.childFaceOffset));
+    s.base = std::move(refinement.topology);
+    ++s.isolationLevels;
+  }
+  s.isolation.makeCompressed();
+
+  s.elements.resize(s.base.faceCount());
+  for (int f = 0; f < s.base.faceCount(); ++f) {
+    Impl::Element& element = s.elements[f];
+    element.controlFace = controlFaceOf[f];
+    for (int k = 0; k < 4; ++k) {
+      if (!s.base.isRegularVertex(s.base.face(f)[k])) element.corner = k;
+    }
+    if (element.corner < 0) {
+      s.buildNormal(element, f);
+    } else {
+      element.type = ElementType::Special;
+      s.buildSpecial(element, f);
+    }
+  }
+}
+
+LimitSurface::~LimitSurface() = default;
+LimitSurface::LimitSurface(LimitSurface&&) noexcept = default;
+LimitSurface& LimitSurface::operator=(LimitSurface&&) noexcept = default;
+
+int LimitSurface::controlVertexCount() const { return impl_->controlVertexCount; }
+int LimitSurface::isolationLevels() const { return impl_->isolationLevels; }
+const Topology& LimitSurface::baseTopology() const { return impl_->base; }
+const SparseMatrix& LimitSurface::isolationMatrix() const { return impl_->isolation; }
+int LimitSurface::elementCount() const { return static_cast<int>(impl_->elements.size()); }
+ElementType LimitSurface::elementType(int element) const { return impl_->elements.at(element).type; }
+int LimitSurface::elementControlFace(int element) const { return impl_->elements.at(element).controlFace; }
+int LimitSurface::parametricFaceCount() const { return impl_->parametricFaceOffset.back(); }
+
+ElementPoint LimitSurface::toElementPoint(const SurfacePoint& point) const {
+  Eigen::Matrix2d jacobian;
+  return impl_->locate(point, jacobian);
+}
+
+namespace {
+
+LimitSample sampleFrom(const SampleWeights& w, const std::vector<int>& columns, const Matrix3X& controlPoints) {
+  const Eigen::Matrix<double, 6, 3> values = w * controlPoints(columns, Eigen::all);
+  LimitSample sample;
+  sample.position = values.row(0).transpose();
+  sample.du = values.row(1).transpose();
+  sample.dv = values.row(2).transpose();
+  sample.duu = values.row(3).transpose();
+  sample.duv = values.row(4).transpose();
+  sample.dvv = values.row(5).transpose();
+  const Vector3 normal = sample.du.cross(sample.dv);
+  const double length = normal.norm();
+  sample.normal = length > 0.0 ? Vector3(normal / length) : Vector3::Zero();
+  return sample;
+}
+
+void checkPoints(const Matrix3X& controlPoints, int expected) {
+  if (controlPoints.rows() != expected) {
+    throw Error("got " + std::to_string(controlPoints.rows()) + " control points for a surface of " +
+                std::to_string(expected) + " control vertices");
+  }
+}
+
+}  // namespace
+
+LimitSample LimitSurface::evaluate(const ElementPoint& point, const Matrix3X& controlPoints) const {
+  checkPoints(controlPoints, impl_->controlVertexCount);
+  return sampleFrom(impl_->weights(point), impl_->columnsOf(point.element), controlPoints);
+}
+
+LimitSample LimitSurface::evaluate(const SurfacePoint& point, const Matrix3X& controlPoints) const {
+  checkPoints(controlPoints, impl_->controlVertexCount);
+  Eigen::Matrix2d jacobian;
+  const ElementPoint elementPoint = impl_->locate(point, jacobian);
+  SampleWeights w = impl_->weights(elementPoint);
+  applyChainRule(w, jacobian);
+  return sampleFrom(w, impl_->columnsOf(elementPoint.element), controlPoints);
+}
+
+namespace {
+
+LimitOperators assemble(int rows, int columns,
+                        const std::vector<std::pair<const std::vector<int>*, SampleWeights>>& samples) {
+  std::array<std::vector<Triplet>, 6> triplets;
+  for (size_t r = 0; r < samples.size(); ++r) {
+    const std::vector<int>& cols = *samples[r].first;
+    const SampleWeights& w = samples[r].second;
+    for (int q = 0; q < 6; ++q) {
+      for (size_t c = 0; c < cols.size(); ++c) {
+        if (w(q, c) != 0.0) triplets[q].emplace_back(static_cast<int>(r), cols[c], w(q, c));
+      }
+    }
+  }
+  LimitOperators result;
+  SparseMatrix* targets[6] = {&result.J, &result.Ju, &result.Jv, &result.Juu, &result.Juv, &result.Jvv};
+  for (int q = 0; q < 6; ++q) {
+    targets[q]->resize(rows, columns);
+    targets[q]->setFromTriplets(triplets[q].begin(), triplets[q].end());
+  }
+  return result;
+}
+
+}  // namespace
+
+LimitOperators LimitSurface::operators(const std::vector<ElementPoint>& points) const {
+  std::vector<std::pair<const std::vector<int>*, SampleWeights>> samples;
+  samples.reserve(points.size());
+  for (const ElementPoint& point : points) samples.emplace_back(&impl_->columnsOf(point.element), impl_->weights(point));
+  return assemble(static_cast<int>(points.size()), impl_->controlVertexCount, samples);
+}
+
+LimitOperators LimitSurface::operators(const std::vector<SurfacePoint>& points) const {
+  std::vector<std::pair<const std::vector<int>*, SampleWeights>> samples;
+  samples.reserve(points.size());
+  for (const SurfacePoint& point : points) {
+    Eigen::Matrix2d jacobian;
+    const ElementPoint elementPoint = impl_->locate(point, jacobian);
+    SampleWeights w = impl_->weights(elementPoint);
+    applyChainRule(w, jacobian);
+    samples.emplace_back(&impl_->columnsOf(elementPoint.element), std::move(w));
+  }
+  return assemble(static_cast<int>(points.size()), impl_->controlVertexCount, samples);
+}
+
+SparseMatrix LimitSurface::controlVertexLimitOperator() const {
+  const Impl& s = *impl_;
+  std::vector<Triplet> triplets;
+  // Control vertex i is vertex i of the base mesh (refinement keeps vertex numbers).
+  for (int i = 0; i < s.controlVertexCount; ++i) {
+    const detail::VertexMasks masks = detail::vertexMasks(s.base, i, s.base.vertexFaces(i).front());
+    for (const auto& [b, w] : masks.position) {
+      for (SparseMatrix::InnerIterator it(s.isolation, b); it; ++it) triplets.emplace_back(i, it.col(), w * it.value());
+    }
+  }
+  SparseMatrix result(s.controlVertexCount, s.controlVertexCount);
+  result.setFromTriplets(triplets.begin(), triplets.end());
+  return result;
+}
+
+}  // namespace dynsub

@@ -1,0 +1,64 @@
+#pragma once
+// Internal building blocks of LimitSurface: the 16-point neighbourhood of a
+// regular quad, the uniform bicubic B-spline basis, the limit and tangent masks
+// at a vertex, and one step of local subdivision around an extraordinary vertex.
+#include <array>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "dynsub/Topology.h"
+
+namespace dynsub::detail {
+
+// A point as a weighted sum of mesh vertices: (vertex, weight) pairs.
+using SmallStencil = std::vector<std::pair<int, double>>;
+
+// Grid slot i + 4 j holds the control point of B-spline index i along u
+// (corner 0 -> corner 1) and j along v (corner 0 -> corner 3); the quad is the
+// cell between slots (1,1) and (2,2). Missing neighbours across a boundary are
+// mirrored ghosts. Returns false unless `face` is a quad with four regular
+// corners whose neighbours are quads.
+bool gatherRegularPatch(const Topology& topology, int face, std::array<SmallStencil, 16>& grid);
+
+// Rows: s, s_u, s_v, s_uu, s_uv, s_vv; columns: the 16 grid slots.
+Eigen::Matrix<double, 6, 16> bsplineWeights(double u, double v);
+
+// The limit position of vertex x and the two limit tangents along the edges
+// from x to the next and to the previous corner of face f (f contains x; all
+// faces around x are quads). See LimitSurface.h for the conventions.
+struct VertexMasks {
+  SmallStencil position, tangentU, tangentV;
+};
+VertexMasks vertexMasks(const Topology& topology, int x, int f);
+
+// The faces touching any face at vertex x, renumbered; `face` is f with its
+// corners rotated so that x is corner 0; parentVertex maps local to original.
+struct Neighbourhood {
+  Topology topology;
+  std::vector<int> parentVertex;
+  int face = -1;
+};
+Neighbourhood extractNeighbourhood(const Topology& topology, int x, int f);
+
+// A neighbourhood whose vertices are blends (rows of `weights`) of a fixed set
+// of control vertices, with the extraordinary vertex at corner 0 of `face`.
+struct LocalMesh {
+  Topology topology;
+  Eigen::MatrixXd weights;
+  int face = -1;
+};
+// Three regular subpatches of `face` after one local subdivision, children
+// 1, 2, 3 (each in its own corner frame), as 16 grid rows over the columns of
+// `weights`. Advances `mesh` to the next level (the child at corner 0).
+using LevelPatches = std::array<Eigen::Matrix<double, 16, Eigen::Dynamic>, 3>;
+LevelPatches subdivideAroundCorner(LocalMesh& mesh);
+
+// (u, v) in the frame whose origin is corner k of a quad and whose u axis runs
+// to corner k+1: k = 0: (u, v); 1: (v, 1-u); 2: (1-u, 1-v); 3: (1-v, u).
+std::pair<double, double> cornerFrame(int k, double u, double v);
+// d(frame)/d(u, v) of cornerFrame (rows: frame u, frame v).
+Eigen::Matrix2d cornerFrameJacobian(int k);
+
+}  // namespace dynsub::detail

@@ -1,0 +1,67 @@
+#include "OpenSubdivReference.h"
+
+#include <memory>
+
+#include <opensubdiv/far/stencilTableFactory.h>
+#include <opensubdiv/far/topologyDescriptor.h>
+#include <opensubdiv/far/topologyRefinerFactory.h>
+
+namespace dynsub::testing {
+
+using namespace OpenSubdiv;
+
+std::vector<ReferenceSample> openSubdivLimit(const ControlMesh& mesh, const std::vector<SurfacePoint>& points,
+                                             int isolationLevel) {
+  std::vector<int> faceSizes, faceVertices;
+  for (const Polygon& face : mesh.faces()) {
+    faceSizes.push_back(static_cast<int>(face.size()));
+    faceVertices.insert(faceVertices.end(), face.begin(), face.end());
+  }
+  Far::TopologyDescriptor descriptor;
+  descriptor.numVertices = mesh.vertexCount();
+  descriptor.numFaces = static_cast<int>(faceSizes.size());
+  descriptor.numVertsPerFace = faceSizes.data();
+  descriptor.vertIndicesPerFace = faceVertices.data();
+
+  Sdc::Options rules;
+  rules.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER);
+  using Factory = Far::TopologyRefinerFactory<Far::TopologyDescriptor>;
+  std::unique_ptr<Far::TopologyRefiner> refiner(
+      Factory::Create(descriptor, Factory::Options(Sdc::SCHEME_CATMARK, rules)));
+  refiner->RefineAdaptive(Far::TopologyRefiner::AdaptiveOptions(isolationLevel));
+
+  // One location array per point keeps the bookkeeping trivial.
+  std::vector<double> s(points.size()), t(points.size());
+  Far::LimitStencilTableFactoryReal<double>::LocationArrayVec locations;
+  for (size_t i = 0; i < points.size(); ++i) {
+    s[i] = points[i].u;
+    t[i] = points[i].v;
+    Far::LimitStencilTableFactoryReal<double>::LocationArray location;
+    location.ptexIdx = points[i].face;
+    location.numLocations = 1;
+    location.s = &s[i];
+    location.t = &t[i];
+    locations.push_back(location);
+  }
+  std::unique_ptr<const Far::LimitStencilTableReal<double>> table(
+      Far::LimitStencilTableFactoryReal<double>::Create(*refiner, locations));
+
+  const Matrix3X control = mesh.points();
+  std::vector<ReferenceSample> result(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Far::LimitStencilReal<double> stencil = table->GetLimitStencil(static_cast<Far::Index>(i));
+    ReferenceSample& sample = result[i];
+    sample.position.setZero();
+    sample.du.setZero();
+    sample.dv.setZero();
+    for (int k = 0; k < stencil.GetSize(); ++k) {
+      const Vector3 p = control.row(stencil.GetVertexIndices()[k]).transpose();
+      sample.position += stencil.GetWeights()[k] * p;
+      sample.du += stencil.GetDuWeights()[k] * p;
+      sample.dv += stencil.GetDvWeights()[k] * p;
+    }
+  }
+  return result;
+}
+
+}  // namespace dynsub::testing
