@@ -28,6 +28,7 @@
 #include "OpenSubdivReference.h"
 #include "TestMeshes.h"
 #include "dynsub/LimitSurface.h"
+#include "dynsub/Tessellation.h"
 
 namespace {
 
@@ -124,6 +125,49 @@ TEST_P(OracleTest, LimitSurfaceMatchesOpenSubdiv) {
   std::printf("%-12s %5d points: max position error %.2e, derivative error %.2e (of diagonal), "
               "normal angle at corners %.2e rad\n",
               GetParam().name.c_str(), compared, positionError / diagonal, derivativeError / diagonal, normalAngle);
+}
+
+// What `dynsub limit` writes: every point of the tessellation, located back on
+// the control mesh's Ptex faces, against OpenSubdiv (N = 5 gives parameters
+// that are not powers of two; N = 8 puts points at 1/8 from extraordinary vertices).
+TEST_P(OracleTest, TessellationMatchesOpenSubdivAtEveryOutputPoint) {
+  const dynsub::ControlMesh& mesh = GetParam().mesh;
+  const dynsub::Matrix3X control = mesh.points();
+  const double diagonal = (control.colwise().maxCoeff() - control.colwise().minCoeff()).norm();
+  const dynsub::LimitSurface surface(mesh);
+  for (int n : {5, 8}) {
+    const dynsub::TriangleSurface triangles = dynsub::tessellate(surface, control, n);
+    std::vector<SurfacePoint> located;
+    std::vector<int> row;
+    std::vector<char> seen(triangles.points.rows(), 0);
+    for (size_t t = 0; t < triangles.triangles.size(); ++t) {
+      // Recover each point's element parameters from its place in the element grid.
+      const int element = triangles.triangleElement[t];
+      const int square = static_cast<int>(t % (2 * n * n)) / 2;
+      const int i = square % n, j = square / n;
+      const bool upper = t % 2 == 1;
+      const std::array<std::pair<int, int>, 3> corners =
+          upper ? std::array<std::pair<int, int>, 3>{{{i, j}, {i + 1, j + 1}, {i, j + 1}}}
+                : std::array<std::pair<int, int>, 3>{{{i, j}, {i + 1, j}, {i + 1, j + 1}}};
+      for (int k = 0; k < 3; ++k) {
+        const int id = triangles.triangles[t][k];
+        if (seen[id]) continue;
+        seen[id] = 1;
+        located.push_back(surface.toSurfacePoint(
+            {element, static_cast<double>(corners[k].first) / n, static_cast<double>(corners[k].second) / n}));
+        row.push_back(id);
+      }
+    }
+    ASSERT_EQ(located.size(), static_cast<size_t>(triangles.points.rows()));
+    const auto reference = dynsub::testing::openSubdivLimit(mesh, located);
+    double worst = 0;
+    for (size_t k = 0; k < located.size(); ++k) {
+      worst = std::max(worst, (triangles.points.row(row[k]).transpose() - reference[k].position).norm());
+    }
+    EXPECT_LE(worst, 1e-6 * diagonal) << GetParam().name << " N = " << n;
+    std::printf("%-12s N=%d: %zu output points, max distance to OpenSubdiv %.2e of diagonal\n",
+                GetParam().name.c_str(), n, located.size(), worst / diagonal);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(AllMeshes, OracleTest, ::testing::ValuesIn(dynsub::testing::allTestMeshes()),

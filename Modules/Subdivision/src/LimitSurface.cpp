@@ -74,6 +74,8 @@ struct LimitSurface::Impl {
   Topology base;
   SparseMatrix isolation;                         // base vertices <- control vertices
   std::vector<std::vector<int>> childFaceOffset;  // per isolation level
+  // Per isolation level, for each child face: its parent face and child index.
+  std::vector<std::vector<std::pair<int, int>>> parentOf;
   std::vector<int> parametricFaceOffset;          // per control face, plus the total
   std::vector<int> controlFaceSize;
   std::vector<Element> elements;
@@ -247,6 +249,11 @@ LimitSurface::LimitSurface(const ControlMesh& mesh) : impl_(std::make_unique<Imp
       for (int k = 0; k < s.base.faceSize(f); ++k) childControlFace[refinement.childFaceOffset[f] + k] = controlFaceOf[f];
     }
     controlFaceOf = std::move(childControlFace);
+    std::vector<std::pair<int, int>> parents(refinement.topology.faceCount());
+    for (int f = 0; f < s.base.faceCount(); ++f) {
+      for (int k = 0; k < s.base.faceSize(f); ++k) parents[refinement.childFaceOffset[f] + k] = {f, k};
+    }
+    s.parentOf.push_back(std::move(parents));
     s.childFaceOffset.push_back(std::move(refinement.childFaceOffset));
     s.base = std::move(refinement.topology);
     ++s.isolationLevels;
@@ -285,6 +292,28 @@ int LimitSurface::parametricFaceCount() const { return impl_->parametricFaceOffs
 ElementPoint LimitSurface::toElementPoint(const SurfacePoint& point) const {
   Eigen::Matrix2d jacobian;
   return impl_->locate(point, jacobian);
+}
+
+SurfacePoint LimitSurface::toSurfacePoint(const ElementPoint& point) const {
+  const Impl& s = *impl_;
+  if (point.element < 0 || point.element >= elementCount()) {
+    throw Error("element " + std::to_string(point.element) + " does not exist");
+  }
+  int face = point.element;
+  double u = point.u, v = point.v;
+  for (int level = s.isolationLevels - 1; level >= 0; --level) {
+    const auto [parent, child] = s.parentOf[level][face];
+    face = parent;
+    if (level == 0 && s.controlFaceSize[parent] != 4) {
+      // A Ptex sub-face of an n-gon: same parameters.
+      return SurfacePoint{s.parametricFaceOffset[parent] + child, u, v};
+    }
+    // Undo (u, v) = 2 cornerFrame(child, U, V); cornerFrame(4 - child) inverts cornerFrame(child).
+    const auto [a, b] = detail::cornerFrame((4 - child) % 4, 0.5 * u, 0.5 * v);
+    u = a;
+    v = b;
+  }
+  return SurfacePoint{s.parametricFaceOffset[face], u, v};
 }
 
 namespace {

@@ -98,6 +98,8 @@ class LimitSurface {
   // The element and element parameters of a point given on a parametric face.
   // Throws dynsub::Error if the face or the parameters are out of range.
   ElementPoint toElementPoint(const SurfacePoint& point) const;
+  // The inverse: where an element point lies on the control mesh's parametric faces.
+  SurfacePoint toSurfacePoint(const ElementPoint& point) const;
 
   LimitSample evaluate(const ElementPoint& point, const Matrix3X& controlPoints) const;
   LimitSample evaluate(const SurfacePoint& point, const Matrix3X& controlPoints) const;

@@ -1,0 +1,13 @@
+#pragma once
+// The subcommands of `dynsub`: each adds itself to the application and runs
+// when selected. Errors are thrown as dynsub::Error and reported by main().
+namespace CLI {
+class App;
+}
+
+namespace dynsub::app {
+
+void addLimitCommand(CLI::App& app);
+void addMeshCommand(CLI::App& app);
+
+}  // namespace dynsub::app

@@ -1,0 +1,58 @@
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "Commands.h"
+#include "dynsub/LimitSurface.h"
+#include "dynsub/MeshIO.h"
+#include "dynsub/SurfaceWriter.h"
+#include "dynsub/Tessellation.h"
+
+namespace dynsub::app {
+
+namespace {
+
+struct LimitOptions {
+  std::string mesh;
+  std::string out;
+  int samplesPerFace = 8;
+};
+
+void runLimit(const LimitOptions& options) {
+  const ControlMesh mesh = readControlMesh(options.mesh);
+  const LimitSurface surface(mesh);
+  const TriangleSurface triangles = tessellate(surface, mesh.points(), options.samplesPerFace);
+  writeTriangleSurface(triangles, options.out);
+  int special = 0;
+  for (int e = 0; e < surface.elementCount(); ++e) special += surface.elementType(e) == ElementType::Special;
+  std::cout << "control mesh: " << mesh.vertexCount() << " vertices, " << mesh.faceCount() << " faces, genus "
+            << mesh.genus() << (mesh.isClosed() ? ", closed" : ", with boundary") << '\n'
+            << "limit surface: " << surface.elementCount() << " elements (" << surface.elementCount() - special
+            << " normal, " << special << " special) after " << surface.isolationLevels()
+            << " isolating subdivision(s)\n"
+            << "wrote " << options.out << ": " << triangles.points.rows() << " points, " << triangles.triangles.size()
+            << " triangles\n";
+}
+
+}  // namespace
+
+void addLimitCommand(CLI::App& app) {
+  auto options = std::make_shared<LimitOptions>();
+  CLI::App* command = app.add_subcommand(
+      "limit",
+      "Evaluate the exact limit surface of a control mesh and write it as a triangle mesh.\n"
+      "Each element (a face of the control mesh, or of its refinement when the mesh has non-quads or "
+      "adjacent extraordinary vertices) is sampled on an N x N grid of parameter squares.\n"
+      "Output formats by extension: .vtp (with point normals and the cell data ElementType: 0 normal, "
+      "1 special element, and Element), .obj, .ply, .stl.");
+  command->add_option("MESH", options->mesh, "Control mesh (.obj, .off or .ply), closed or with boundaries")
+      ->required();
+  command->add_option("--out", options->out, "Output surface file (.vtp, .obj, .ply or .stl)")->required();
+  command->add_option("--samples-per-face", options->samplesPerFace,
+                      "N: parameter squares along each side of an element (1 to 1024)")
+      ->default_val(8)
+      ->check(CLI::Range(1, 1024));
+  command->callback([options] { runLimit(*options); });
+}
+
+}  // namespace dynsub::app

@@ -1,0 +1,35 @@
+// dynsub: segmentation and shape recovery with dynamic Catmull-Clark
+// subdivision surfaces. Exit codes: 0 success, 1 an error in the input or the
+// run (the message names the file and problem), 2 a usage error.
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "Commands.h"
+#include "dynsub/Error.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "DynSub: dynamic Catmull-Clark subdivision surfaces for segmenting 3D medical images and "
+      "recovering shapes.\n"
+      "A smooth surface of any genus, defined by a small control mesh, moves under Lagrangian "
+      "dynamics toward image edges and expert landmarks, and refines itself until it fits.\n"
+      "Coordinates are in mm. Run 'dynsub COMMAND --help' for each command.",
+      "dynsub"};
+  app.require_subcommand(1);
+  dynsub::app::addLimitCommand(app);
+  dynsub::app::addMeshCommand(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    const int code = app.exit(error);
+    return code == 0 ? 0 : 2;
+  } catch (const dynsub::Error& error) {
+    std::cerr << "dynsub: error: " << error.what() << '\n';
+    return 1;
+  } catch (const std::exception& error) {
+    std::cerr << "dynsub: unexpected error: " << error.what() << '\n';
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,85 @@
+// Unit tests (no rendering): written surfaces read back through VTK's readers
+// with the same points, triangles and element tags.
+#include <filesystem>
+
+#include <gtest/gtest.h>
+#include <vtkCellData.h>
+#include <vtkDataArray.h>
+#include <vtkNew.h>
+#include <vtkOBJReader.h>
+#include <vtkPLYReader.h>
+#include <vtkPolyData.h>
+#include <vtkSTLReader.h>
+#include <vtkXMLPolyDataReader.h>
+
+#include "dynsub/Error.h"
+#include "dynsub/StandardMeshes.h"
+#include "dynsub/SurfaceWriter.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+dynsub::TriangleSurface cubeSurface() {
+  const dynsub::ControlMesh cube = dynsub::makeCube98();
+  const dynsub::LimitSurface limit(cube);
+  return dynsub::tessellate(limit, cube.points(), 2);
+}
+
+std::string scratch(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / "dynsub-surfaceio";
+  fs::create_directories(dir);
+  return (dir / name).string();
+}
+
+TEST(SurfaceWriter, VtpKeepsGeometryAndElementTags) {
+  const dynsub::TriangleSurface surface = cubeSurface();
+  const std::string path = scratch("cube.vtp");
+  dynsub::writeTriangleSurface(surface, path);
+  vtkNew<vtkXMLPolyDataReader> reader;
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  vtkPolyData* data = reader->GetOutput();
+  ASSERT_EQ(data->GetNumberOfPoints(), surface.points.rows());
+  ASSERT_EQ(data->GetNumberOfCells(), static_cast<vtkIdType>(surface.triangles.size()));
+  double p[3];
+  data->GetPoint(17, p);
+  EXPECT_EQ(p[0], surface.points(17, 0));
+  vtkDataArray* type = data->GetCellData()->GetArray("ElementType");
+  ASSERT_NE(type, nullptr);
+  int special = 0;
+  for (vtkIdType c = 0; c < type->GetNumberOfTuples(); ++c) special += type->GetTuple1(c) == 1.0;
+  // 8 valence-3 vertices x 3 special elements x 2 x 2 squares x 2 triangles.
+  EXPECT_EQ(special, 8 * 3 * 2 * 2 * 2);
+}
+
+TEST(SurfaceWriter, ObjPlyStlReadBack) {
+  const dynsub::TriangleSurface surface = cubeSurface();
+  const std::string obj = scratch("cube.obj"), ply = scratch("cube.ply"), stl = scratch("cube.stl");
+  for (const std::string& path : {obj, ply, stl}) dynsub::writeTriangleSurface(surface, path);
+  vtkNew<vtkOBJReader> objReader;
+  objReader->SetFileName(obj.c_str());
+  objReader->Update();
+  EXPECT_EQ(objReader->GetOutput()->GetNumberOfCells(), static_cast<vtkIdType>(surface.triangles.size()));
+  vtkNew<vtkPLYReader> plyReader;
+  plyReader->SetFileName(ply.c_str());
+  plyReader->Update();
+  EXPECT_EQ(plyReader->GetOutput()->GetNumberOfPoints(), surface.points.rows());
+  vtkNew<vtkSTLReader> stlReader;
+  stlReader->SetFileName(stl.c_str());
+  stlReader->Update();
+  EXPECT_EQ(stlReader->GetOutput()->GetNumberOfCells(), static_cast<vtkIdType>(surface.triangles.size()));
+}
+
+TEST(SurfaceWriter, BadTargetsLeaveNoFile) {
+  const dynsub::TriangleSurface surface = cubeSurface();
+  EXPECT_THROW(dynsub::writeTriangleSurface(surface, scratch("cube.xyz")), dynsub::Error);
+  EXPECT_FALSE(fs::exists(scratch("cube.xyz")));
+  EXPECT_THROW(dynsub::writeTriangleSurface(surface, "/nonexistent-dynsub/cube.vtp"), dynsub::Error);
+  dynsub::TriangleSurface broken = surface;
+  broken.points(3, 1) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(dynsub::writeTriangleSurface(broken, scratch("nan.vtp")), dynsub::Error);
+  EXPECT_FALSE(fs::exists(scratch("nan.vtp")));
+}
+
+}  // namespace
