@@ -15,9 +15,7 @@
 //    vertex the point lies ~lambda_n^log2(1/t) away, e.g. 2.4e-4 for n = 8,
 //    t = 1e-5). Both describe nearly the same surface, at different parameters,
 //    so those points are not compared; DynSub's own tests check them exactly.
-//  - At the corner itself both give the exact limit position, and the normal from
-//    the limit tangent masks; at boundary extraordinary vertices the two
-//    tangent rules differ (see kBoundaryCornerNormalTolerance).
+//  - At the corner itself both give the exact limit position and normal.
 //  - OpenSubdiv's derivatives on the Ptex sub-faces of an n-gon (n != 4) are
 //    taken in the n-gon's own half-scale parameter, twice DynSub's; they are
 //    halved before comparing.
@@ -48,13 +46,8 @@ std::vector<SurfacePoint> samplePoints(int parametricFaces) {
   return points;
 }
 
-// A normal at a boundary extraordinary vertex (only there) is allowed to differ
-// by this much: the Biermann et al. cross-tangent mask used at the vertex does
-// not span exactly the tangent plane of the standard boundary rules (a known
-// limitation, measured 1.8e-2 rad with 3 faces and 2.4e-2 rad with 5).
-constexpr double kBoundaryCornerNormalTolerance = 3e-2;
-// Elsewhere at corners: OpenSubdiv's Gregory end-cap tangents agree with the
-// exact masks to ~2e-6 rad (measured at n-gon centres); 1e-5 rad leaves margin.
+// At corners: OpenSubdiv's Gregory end-cap tangents agree with the exact
+// tangents to ~5e-6 rad (measured at n-gon centres); 1e-5 rad leaves margin.
 constexpr double kNormalTolerance = 1e-5;  // radians
 
 double distanceToCorner(const SurfacePoint& p) {
@@ -66,12 +59,6 @@ bool insideEndCap(const SurfacePoint& p) {
   return d > 0.0 && d < std::ldexp(1.0, -9);
 }
 
-bool hasBoundaryExtraordinaryVertex(const dynsub::ControlMesh& mesh) {
-  for (auto v : mesh.polyMesh().vertices()) {
-    if (v.is_boundary() && mesh.polyMesh().valence(v) > 3) return true;  // > 2 faces
-  }
-  return false;
-}
 
 class OracleTest : public ::testing::TestWithParam<dynsub::testing::NamedMesh> {};
 
@@ -91,8 +78,6 @@ TEST_P(OracleTest, LimitSurfaceMatchesOpenSubdiv) {
   for (const dynsub::Polygon& face : mesh.faces()) {
     for (size_t k = 0; k < (face.size() == 4 ? 1 : face.size()); ++k) subFace.push_back(face.size() != 4);
   }
-  const double cornerNormalTolerance =
-      hasBoundaryExtraordinaryVertex(mesh) ? kBoundaryCornerNormalTolerance : kNormalTolerance;
 
   double positionError = 0, derivativeError = 0, normalAngle = 0;
   int compared = 0;
@@ -117,7 +102,7 @@ TEST_P(OracleTest, LimitSurfaceMatchesOpenSubdiv) {
       const dynsub::Vector3 normal = reference[i].du.cross(reference[i].dv).normalized();
       const double angle = std::acos(std::clamp(normal.dot(sample.normal), -1.0, 1.0));
       normalAngle = std::max(normalAngle, angle);
-      EXPECT_LE(angle, cornerNormalTolerance) << GetParam().name << " face " << p.face << " corner (" << p.u << ", "
+      EXPECT_LE(angle, kNormalTolerance) << GetParam().name << " face " << p.face << " corner (" << p.u << ", "
                                               << p.v << ")";
     }
   }

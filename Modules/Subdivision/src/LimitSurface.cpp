@@ -19,6 +19,24 @@ namespace {
 // Special elements tabulate this many levels of subpatches at construction
 // (points closer than 2^-24 to the extraordinary corner are computed on demand).
 constexpr int kTabulatedLevels = 24;
+// The cross-boundary tangent at a boundary extraordinary vertex is read at this
+// level (see setBoundaryTangents).
+constexpr int kCrossTangentLevel = 48;
+
+// Displacements from the limit point have rows summing to exactly 0; removing
+// the rounding residual at each level keeps it from being amplified 2^level-fold
+// in derivatives.
+void zeroRowSums(Eigen::MatrixXd& displacements) {
+  const Eigen::VectorXd mean = displacements.rowwise().sum() / static_cast<double>(displacements.cols());
+  displacements.colwise() -= mean;
+}
+
+// One level deeper around the extraordinary vertex, keeping row sums at 0.
+LevelPatches subdivideDisplacements(LocalMesh& mesh) {
+  LevelPatches patches = detail::subdivideAroundCorner(mesh);
+  zeroRowSums(mesh.weights);
+  return patches;
+}
 
 using GridMatrix = Eigen::Matrix<double, 16, Eigen::Dynamic>;
 using SampleWeights = Eigen::Matrix<double, 6, Eigen::Dynamic>;  // s, su, sv, suu, suv, svv
@@ -67,6 +85,7 @@ struct LimitSurface::Impl {
     std::vector<LevelPatches> levels;  // levels[n - 1]: subpatches at level n
     LocalMesh deepest;                 // the neighbourhood after the last level
     Eigen::Matrix<double, 3, Eigen::Dynamic> vertexMasks;  // limit position, tangent u, tangent v
+    // levels and deepest hold displacements from the limit position (row 0 of vertexMasks).
   };
 
   int controlVertexCount = 0;
@@ -127,20 +146,59 @@ struct LimitSurface::Impl {
     local.topology = std::move(neighbourhood.topology);
     local.face = neighbourhood.face;
 
-    const detail::VertexMasks masks = detail::vertexMasks(local.topology, local.topology.face(local.face)[0], local.face);
+    const int localX = local.topology.face(local.face)[0];
+    const detail::VertexMasks masks = detail::vertexMasks(local.topology, localX, local.face);
     special.vertexMasks.setZero(3, special.columns.size());
     const SmallStencil* rows[3] = {&masks.position, &masks.tangentU, &masks.tangentV};
     for (int r = 0; r < 3; ++r) {
       for (const auto& [v, w] : *rows[r]) special.vertexMasks.row(r) += w * local.weights.row(v);
     }
+    // NB: the neighbourhood is carried as displacements from the limit point
+    // (every row minus the limit mask). Subdivision maps displacements to
+    // displacements (rows of A sum to 1, and the limit point is invariant), and
+    // they shrink like lambda^level, so their relative accuracy survives any
+    // depth; carried as plain weights, rounding of 1e-16 would be amplified
+    // 2^level-fold in the derivatives.
+    levelZeroRows = local.weights;
+    local.weights.rowwise() -= special.vertexMasks.row(0);
+    zeroRowSums(local.weights);
     for (int level = 1; level <= kTabulatedLevels; ++level) {
-      special.levels.push_back(detail::subdivideAroundCorner(local));
+      special.levels.push_back(subdivideDisplacements(local));
     }
     special.deepest = std::move(local);
+    if (masks.boundary) setBoundaryTangents(special, masks);
     element.columns = special.columns;
     element.special = static_cast<int>(specials.size());
     specials.push_back(std::move(special));
   }
+
+  // Tangents at a boundary extraordinary vertex. Along the boundary the
+  // boundary curve's tangent is exact. Across it no closed-form mask fits the
+  // standard boundary rules (the Biermann et al. mask, made for modified rules,
+  // is off by up to 2e-2 rad here), so the cross tangent is read from the
+  // subdivision itself: the displacement of an interior neighbour of the vertex
+  // at the deepest tabulated level, scaled by 2^level. Its part across the
+  // boundary converges to the subdominant eigen-direction like
+  // (lambda3/lambda2)^level (measured: 7e-5 rad at level 24 for a boundary
+  // vertex of 5 faces), so it is read at level 48. Still a fixed linear mask,
+  // so J_u and J_v stay linear operators.
+  void setBoundaryTangents(Special& special, const detail::VertexMasks& masks) {
+    LocalMesh deep = special.deepest;
+    for (int level = kTabulatedLevels; level < kCrossTangentLevel; ++level) subdivideDisplacements(deep);
+    const Polygon& face = deep.topology.face(deep.face);
+    const int x = face[0];
+    const int interior = !deep.topology.isBoundaryEdge(deep.topology.findEdge(x, face[1])) ? face[1] : face[3];
+    Eigen::RowVectorXd across = std::ldexp(1.0, kCrossTangentLevel) * deep.weights.row(interior);
+    // `along` is a mask over the level-0 local vertices: map it as the position was.
+    Eigen::RowVectorXd along = Eigen::RowVectorXd::Zero(special.columns.size());
+    for (const auto& [v, w] : masks.along) along += w * levelZeroRows.row(v);
+    const double theta = M_PI / masks.faces;
+    special.vertexMasks.row(1) = std::cos(masks.position_in_fan * theta) * along +
+                                 std::sin(masks.position_in_fan * theta) * across;
+    special.vertexMasks.row(2) = std::cos((masks.position_in_fan + 1) * theta) * along +
+                                 std::sin((masks.position_in_fan + 1) * theta) * across;
+  }
+  Eigen::MatrixXd levelZeroRows;  // scratch: level-0 weights of the special being built
 
   // Weights of s and its derivatives at an element point, over element.columns.
   SampleWeights weights(const ElementPoint& point) const {
@@ -183,10 +241,11 @@ struct LimitSurface::Impl {
       patch = &special.levels[level - 1][child - 1];
     } else {
       LocalMesh local = special.deepest;
-      for (int n = kTabulatedLevels + 1; n <= level; ++n) deeper = detail::subdivideAroundCorner(local);
+      for (int n = kTabulatedLevels + 1; n <= level; ++n) deeper = subdivideDisplacements(local);
       patch = &deeper[child - 1];
     }
     w = detail::bsplineWeights(childU, childV) * (*patch);
+    w.row(0) += special.vertexMasks.row(0);  // the patch holds displacements from the limit point
     const Eigen::Matrix2d jacobian = std::ldexp(1.0, level) * detail::cornerFrameJacobian(child) * toCorner;
     applyChainRule(w, jacobian);
     return w;

@@ -202,37 +202,10 @@ VertexMasks vertexMasks(const Topology& topology, int x, int f) {
     return masks;
   }
   masks.position = {{x, 4.0 / 6.0}, {first, 1.0 / 6.0}, {last, 1.0 / 6.0}};
-  // Along the boundary (towards the first edge) and across it into the surface.
-  SmallStencil along{{first, 0.5}, {last, -0.5}};
-  SmallStencil across;
-  if (n == 2) {
-    // Regular: the uniform B-spline cross derivative.
-    across = {{x, -4.0 / 6.0}, {first, -1.0 / 6.0}, {edgeNeighbour[1], 4.0 / 6.0}, {last, -1.0 / 6.0},
-              {opposite[0], 1.0 / 6.0}, {opposite[1], 1.0 / 6.0}};
-  } else {
-    // Biermann, Levin and Zorin (2000), as OpenSubdiv uses for creases.
-    const double k = n;
-    const double theta = M_PI / k;
-    const double denominator = k * (3.0 + std::cos(theta));
-    const double r = (std::cos(theta) + 1.0) / std::sin(theta);
-    across.emplace_back(x, 4.0 * r * (std::cos(theta) - 1.0) / denominator);
-    across.emplace_back(first, -r * (1.0 + 2.0 * std::cos(theta)) / denominator);
-    across.emplace_back(last, -r * (1.0 + 2.0 * std::cos(theta)) / denominator);
-    for (int i = 0; i < n; ++i) {
-      across.emplace_back(opposite[i], (std::sin(i * theta) + std::sin((i + 1) * theta)) / denominator);
-      if (i > 0) across.emplace_back(edgeNeighbour[i], 4.0 * std::sin(i * theta) / denominator);
-    }
-  }
-  // Face `position` spans the angles position*pi/n .. (position+1)*pi/n.
-  const double theta = M_PI / n;
-  auto blend = [&](double angle) {
-    SmallStencil result;
-    for (const auto& [v, w] : along) result.emplace_back(v, std::cos(angle) * w);
-    for (const auto& [v, w] : across) result.emplace_back(v, std::sin(angle) * w);
-    return result;
-  };
-  masks.tangentU = blend(position * theta);
-  masks.tangentV = blend((position + 1) * theta);
+  masks.boundary = true;
+  masks.faces = n;
+  masks.position_in_fan = position;
+  masks.along = {{first, 0.5}, {last, -0.5}};
   return masks;
 }
 

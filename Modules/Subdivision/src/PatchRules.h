@@ -25,11 +25,19 @@ bool gatherRegularPatch(const Topology& topology, int face, std::array<SmallSten
 // Rows: s, s_u, s_v, s_uu, s_uv, s_vv; columns: the 16 grid slots.
 Eigen::Matrix<double, 6, 16> bsplineWeights(double u, double v);
 
-// The limit position of vertex x and the two limit tangents along the edges
-// from x to the next and to the previous corner of face f (f contains x; all
-// faces around x are quads). See LimitSurface.h for the conventions.
+// The limit position of vertex x and, for an interior or corner vertex, the
+// two limit tangents along the edges from x to the next and to the previous
+// corner of face f (f contains x; all faces around x are quads). For a boundary
+// vertex with >= 2 faces the tangents are left empty: `along` is the exact
+// tangent of the boundary curve (towards the first boundary edge), and f spans
+// the angles position*pi/faces .. (position+1)*pi/faces of the fan, so the
+// caller can blend it with a cross-boundary tangent. See LimitSurface.h.
 struct VertexMasks {
   SmallStencil position, tangentU, tangentV;
+  bool boundary = false;
+  int faces = 0;
+  int position_in_fan = 0;
+  SmallStencil along;
 };
 VertexMasks vertexMasks(const Topology& topology, int x, int f);
 

@@ -1,1 +1,232 @@
+// Unit tests (no rendering): properties of the exact limit surface with exact
+// answers, checked over meshes covering every case (TestMeshes.h).
+#include <cmath>
+#include <random>
+
 #include <gtest/gtest.h>
+
+#include "TestMeshes.h"
+#include "dynsub/CatmullClark.h"
+#include "dynsub/Error.h"
+#include "dynsub/LimitSurface.h"
+#include "dynsub/StandardMeshes.h"
+#include "dynsub/Topology.h"
+
+namespace {
+
+using dynsub::ElementPoint;
+using dynsub::LimitSurface;
+using dynsub::SurfacePoint;
+
+// Parameters that reach deep special-element levels (1e-9 needs level 30,
+// beyond the 24 tabulated ones) as well as ordinary ones.
+const std::vector<double> kParameters = {0.0, 1e-9, 1e-6, 1e-3, 0.1, 0.25, 0.5, 0.6180339887, 0.9, 1.0};
+
+double diagonalOf(const dynsub::Matrix3X& points) {
+  return (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm();
+}
+
+class LimitSurfaceProperties : public ::testing::TestWithParam<dynsub::testing::NamedMesh> {};
+
+// The uniform cubic B-spline in matrix form, written independently of the
+// implementation's basis functions.
+dynsub::Vector3 bicubic(const std::array<dynsub::Vector3, 16>& grid, double u, double v) {
+  Eigen::Matrix4d m;
+  m << -1, 3, -3, 1, 3, -6, 3, 0, -3, 0, 3, 0, 1, 4, 1, 0;
+  m /= 6.0;
+  const Eigen::RowVector4d bu = Eigen::RowVector4d(u * u * u, u * u, u, 1) * m;
+  const Eigen::RowVector4d bv = Eigen::RowVector4d(v * v * v, v * v, v, 1) * m;
+  dynsub::Vector3 s = dynsub::Vector3::Zero();
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 4; ++i) s += bu(i) * bv(j) * grid[i + 4 * j];
+  return s;
+}
+
+TEST(LimitSurface, RegularGridReproducesTheBicubicBSpline) {
+  // A 7 x 7 vertex grid with random heights; its centre face has a full
+  // regular neighbourhood of interior valence-4 vertices.
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> height(-1.0, 1.0);
+  constexpr int n = 7;
+  dynsub::Matrix3X points(n * n, 3);
+  std::vector<dynsub::Polygon> faces;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) points.row(j * n + i) << i + 0.1 * height(random), j, height(random);
+  for (int j = 0; j + 1 < n; ++j)
+    for (int i = 0; i + 1 < n; ++i) faces.push_back({j * n + i, j * n + i + 1, (j + 1) * n + i + 1, (j + 1) * n + i});
+  const dynsub::ControlMesh grid = dynsub::ControlMesh::fromPolygons(points, faces);
+  const LimitSurface surface(grid);
+  const int face = 2 * (n - 1) + 2;  // cell (2, 2): vertices 2..3 in each direction
+  ASSERT_EQ(surface.elementType(face), dynsub::ElementType::Normal);
+  std::array<dynsub::Vector3, 16> control;
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 4; ++i) control[i + 4 * j] = points.row((j + 1) * n + (i + 1)).transpose();
+  for (double u : kParameters) {
+    for (double v : kParameters) {
+      const dynsub::LimitSample sample = surface.evaluate(ElementPoint{face, u, v}, points);
+      EXPECT_LE((sample.position - bicubic(control, u, v)).norm(), 1e-12) << u << ", " << v;
+    }
+  }
+}
+
+TEST_P(LimitSurfaceProperties, OperatorRowsArePartitionsOfUnity) {
+  const dynsub::ControlMesh& mesh = GetParam().mesh;
+  const LimitSurface surface(mesh);
+  std::vector<ElementPoint> points;
+  for (int e = 0; e < surface.elementCount(); ++e)
+    for (double u : kParameters)
+      for (double v : {0.0, 1e-6, 0.3, 1.0}) points.push_back({e, u, v});
+  const dynsub::LimitOperators ops = surface.operators(points);
+  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(mesh.vertexCount());
+  EXPECT_LE(((ops.J * ones).array() - 1.0).abs().maxCoeff(), 1e-12);
+  // Derivatives grow like (2 lambda)^level near valence >= 5 vertices: the
+  // zero-sum tolerance scales with each row's size.
+  for (const dynsub::SparseMatrix* d : {&ops.Ju, &ops.Jv}) {
+    const Eigen::VectorXd sums = *d * ones;
+    const Eigen::VectorXd sizes = d->cwiseAbs() * ones;
+    for (Eigen::Index r = 0; r < sums.size(); ++r) EXPECT_LE(std::abs(sums(r)), 1e-12 * (1.0 + sizes(r)));
+  }
+  // Second derivatives at parameter t from an extraordinary vertex cancel terms
+  // ~2^level larger than themselves (level ~ log2(1/t)); they are checked where
+  // t >= 1e-3 (level <= 10), and lose accuracy closer in (measured: row sums up
+  // to 5e-5 at t = 1e-9 next to boundary extraordinary vertices).
+  for (const dynsub::SparseMatrix* d : {&ops.Juu, &ops.Juv, &ops.Jvv}) {
+    const Eigen::VectorXd sums = *d * ones;
+    const Eigen::VectorXd sizes = d->cwiseAbs() * ones;
+    for (Eigen::Index r = 0; r < sums.size(); ++r) {
+      const double t = std::max({std::min(points[r].u, 1 - points[r].u), std::min(points[r].v, 1 - points[r].v)});
+      if (t == 0.0 || t >= 1e-3) EXPECT_LE(std::abs(sums(r)), 1e-10 * (1.0 + sizes(r)));
+    }
+  }
+  // The operators and direct evaluation agree.
+  const dynsub::Matrix3X control = mesh.points();
+  const dynsub::Matrix3X positions = ops.J * control;
+  for (size_t k = 0; k < points.size(); k += 7) {
+    EXPECT_LE((positions.row(k).transpose() - surface.evaluate(points[k], control).position).norm(), 1e-12);
+  }
+}
+
+TEST_P(LimitSurfaceProperties, RefinementPreservesTheLimitSurface) {
+  const dynsub::ControlMesh& mesh = GetParam().mesh;
+  const dynsub::SubdividedMesh refined = dynsub::subdivide(mesh);
+  const LimitSurface coarse(mesh);
+  const LimitSurface fine(refined.mesh);
+  const dynsub::Matrix3X coarsePoints = mesh.points();
+  const dynsub::Matrix3X finePoints = refined.mesh.points();
+  const double tolerance = 1e-10 * diagonalOf(coarsePoints);
+  const dynsub::Topology topology = dynsub::topologyOf(mesh);
+  int parametricFace = 0;
+  int childOffset = 0;
+  for (int f = 0; f < topology.faceCount(); ++f) {
+    const int n = topology.faceSize(f);
+    for (int sub = 0; sub < (n == 4 ? 1 : n); ++sub, ++parametricFace) {
+      for (double u : kParameters) {
+        for (double v : kParameters) {
+          // The same point on the refined mesh: child k of a quad covers
+          // quadrant k (CatmullClark.h); an n-gon's sub-face is its child.
+          SurfacePoint finePoint{childOffset + sub, u, v};
+          if (n == 4) {
+            const int k = u < 0.5 ? (v < 0.5 ? 0 : 3) : (v < 0.5 ? 1 : 2);
+            const double frames[4][2] = {{u, v}, {v, 1 - u}, {1 - u, 1 - v}, {1 - v, u}};
+            finePoint = {childOffset + k, std::min(1.0, 2 * frames[k][0]), std::min(1.0, 2 * frames[k][1])};
+          }
+          const dynsub::LimitSample a = coarse.evaluate(SurfacePoint{parametricFace, u, v}, coarsePoints);
+          const dynsub::LimitSample b = fine.evaluate(finePoint, finePoints);
+          EXPECT_LE((a.position - b.position).norm(), tolerance)
+              << GetParam().name << " face " << parametricFace << " (" << u << ", " << v << ")";
+          EXPECT_GE(a.normal.dot(b.normal), 1.0 - 1e-9)
+              << GetParam().name << " face " << parametricFace << " (" << u << ", " << v << ")";
+        }
+      }
+    }
+    childOffset += n;
+  }
+}
+
+TEST_P(LimitSurfaceProperties, PositionsAndNormalsAgreeAcrossSharedEdges) {
+  const dynsub::ControlMesh& mesh = GetParam().mesh;
+  const LimitSurface surface(mesh);
+  const dynsub::Topology& base = surface.baseTopology();
+  const dynsub::Matrix3X control = mesh.points();
+  const double tolerance = 1e-12 * diagonalOf(control);
+  // Point at parameter t along side k of an element, from corner k to k+1.
+  auto along = [](int element, int side, double t) {
+    const double corners[5][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}, {0, 0}};
+    return ElementPoint{element, (1 - t) * corners[side][0] + t * corners[side + 1][0],
+                        (1 - t) * corners[side][1] + t * corners[side + 1][1]};
+  };
+  for (int e = 0; e < base.edgeCount(); ++e) {
+    if (base.isBoundaryEdge(e)) continue;
+    const auto [f, g] = base.edgeFaces(e);
+    int sideF = 0, sideG = 0;
+    while (base.faceEdge(f, sideF) != e) ++sideF;
+    while (base.faceEdge(g, sideG) != e) ++sideG;
+    for (double t : {1e-7, 0.2, 0.5, 0.77, 1.0 - 1e-7}) {
+      // The neighbour runs along the shared edge the other way.
+      const dynsub::LimitSample a = surface.evaluate(along(f, sideF, t), control);
+      const dynsub::LimitSample b = surface.evaluate(along(g, sideG, 1.0 - t), control);
+      EXPECT_LE((a.position - b.position).norm(), tolerance) << GetParam().name << " edge " << e << " t " << t;
+      EXPECT_GE(a.normal.dot(b.normal), 1.0 - 1e-10) << GetParam().name << " edge " << e << " t " << t;
+    }
+  }
+}
+
+TEST_P(LimitSurfaceProperties, ParametricFacesMapToElementsAndBack) {
+  const LimitSurface surface(GetParam().mesh);
+  for (int f = 0; f < surface.parametricFaceCount(); ++f) {
+    for (double u : {0.0, 0.3, 0.5, 0.8}) {
+      for (double v : {0.1, 0.5, 0.7, 1.0}) {
+        const SurfacePoint back = surface.toSurfacePoint(surface.toElementPoint({f, u, v}));
+        EXPECT_EQ(back.face, f);
+        EXPECT_NEAR(back.u, u, 1e-15);
+        EXPECT_NEAR(back.v, v, 1e-15);
+      }
+    }
+  }
+}
+
+TEST_P(LimitSurfaceProperties, ControlVertexLimitsLieOnTheSurface) {
+  const dynsub::ControlMesh& mesh = GetParam().mesh;
+  const LimitSurface surface(mesh);
+  const dynsub::Matrix3X control = mesh.points();
+  const dynsub::Matrix3X limits = surface.controlVertexLimitOperator() * control;
+  const dynsub::Topology& base = surface.baseTopology();
+  // Control vertex i is base vertex i, a corner of its elements.
+  for (int v = 0; v < mesh.vertexCount(); ++v) {
+    const int element = base.vertexFaces(v).front();
+    const int corner = base.corner(element, v);
+    const double at[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    const dynsub::LimitSample sample = surface.evaluate(ElementPoint{element, at[corner][0], at[corner][1]}, control);
+    EXPECT_LE((limits.row(v).transpose() - sample.position).norm(), 1e-12 * diagonalOf(control));
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(AllMeshes, LimitSurfaceProperties, ::testing::ValuesIn(dynsub::testing::allTestMeshes()),
+                         [](const auto& info) { return info.param.name; });
+
+TEST(LimitSurface, CubeHasThePapersElements) {
+  const LimitSurface surface(dynsub::makeCube98());
+  int special = 0;
+  for (int e = 0; e < surface.elementCount(); ++e) special += surface.elementType(e) == dynsub::ElementType::Special;
+  EXPECT_EQ(surface.isolationLevels(), 0);
+  EXPECT_EQ(surface.elementCount(), 96);
+  EXPECT_EQ(special, 24);  // 8 extraordinary vertices x 3 faces
+}
+
+TEST(LimitSurface, TrianglesAndPentagonsAreIsolatedByRefinement) {
+  EXPECT_EQ(LimitSurface(dynsub::testing::makeTetrahedron()).isolationLevels(), 2);
+  EXPECT_EQ(LimitSurface(dynsub::testing::makePrism(5)).isolationLevels(), 2);
+  EXPECT_EQ(LimitSurface(dynsub::testing::makeFan(5, true)).isolationLevels(), 0);
+}
+
+TEST(LimitSurface, BadParametersAreRejected) {
+  const dynsub::ControlMesh cube = dynsub::makeCube98();
+  const LimitSurface surface(cube);
+  EXPECT_THROW(surface.evaluate(ElementPoint{96, 0.5, 0.5}, cube.points()), dynsub::Error);
+  EXPECT_THROW(surface.evaluate(ElementPoint{0, 1.5, 0.5}, cube.points()), dynsub::Error);
+  EXPECT_THROW(surface.evaluate(ElementPoint{0, std::nan(""), 0.5}, cube.points()), dynsub::Error);
+  EXPECT_THROW(surface.evaluate(SurfacePoint{-1, 0.5, 0.5}, cube.points()), dynsub::Error);
+  EXPECT_THROW(surface.evaluate(ElementPoint{0, 0.5, 0.5}, cube.points().topRows(10)), dynsub::Error);
+}
+
+}  // namespace
