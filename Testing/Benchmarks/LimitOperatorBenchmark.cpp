@@ -8,9 +8,8 @@
 
 #include <benchmark/benchmark.h>
 #include <opensubdiv/far/stencilTableFactory.h>
-#include <opensubdiv/far/topologyDescriptor.h>
-#include <opensubdiv/far/topologyRefinerFactory.h>
 
+#include "OpenSubdivReference.h"
 #include "dynsub/CatmullClark.h"
 #include "dynsub/LimitSurface.h"
 #include "dynsub/StandardMeshes.h"
@@ -59,24 +58,6 @@ void DynSubApplyOperators(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * ops.J.rows());
 }
 
-std::unique_ptr<Far::TopologyRefiner> openSubdivRefiner(const dynsub::ControlMesh& mesh, std::vector<int>& sizes,
-                                                        std::vector<int>& indices) {
-  for (const dynsub::Polygon& face : mesh.faces()) {
-    sizes.push_back(static_cast<int>(face.size()));
-    indices.insert(indices.end(), face.begin(), face.end());
-  }
-  Far::TopologyDescriptor descriptor;
-  descriptor.numVertices = mesh.vertexCount();
-  descriptor.numFaces = static_cast<int>(sizes.size());
-  descriptor.numVertsPerFace = sizes.data();
-  descriptor.vertIndicesPerFace = indices.data();
-  Sdc::Options rules;
-  rules.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER);
-  using Factory = Far::TopologyRefinerFactory<Far::TopologyDescriptor>;
-  return std::unique_ptr<Far::TopologyRefiner>(
-      Factory::Create(descriptor, Factory::Options(Sdc::SCHEME_CATMARK, rules)));
-}
-
 Far::LimitStencilTableFactoryReal<double>::LocationArrayVec locationsOf(const std::vector<dynsub::SurfacePoint>& points,
                                                                         std::vector<double>& s, std::vector<double>& t) {
   // Points come 16 per face, so one location array per face.
@@ -102,8 +83,7 @@ void OpenSubdivBuildStencils(benchmark::State& state) {
   std::vector<double> s, t;
   const auto locations = locationsOf(points, s, t);
   for (auto _ : state) {
-    std::vector<int> sizes, indices;
-    auto refiner = openSubdivRefiner(mesh, sizes, indices);
+    auto refiner = dynsub::testing::openSubdivRefiner(mesh);
     refiner->RefineAdaptive(Far::TopologyRefiner::AdaptiveOptions(10));
     std::unique_ptr<const Far::LimitStencilTableReal<double>> table(
         Far::LimitStencilTableFactoryReal<double>::Create(*refiner, locations));
@@ -117,8 +97,7 @@ void OpenSubdivApplyStencils(benchmark::State& state) {
   const std::vector<dynsub::SurfacePoint> points = samples(mesh.faceCount());
   std::vector<double> s, t;
   const auto locations = locationsOf(points, s, t);
-  std::vector<int> sizes, indices;
-  auto refiner = openSubdivRefiner(mesh, sizes, indices);
+  auto refiner = dynsub::testing::openSubdivRefiner(mesh);
   refiner->RefineAdaptive(Far::TopologyRefiner::AdaptiveOptions(10));
   std::unique_ptr<const Far::LimitStencilTableReal<double>> table(
       Far::LimitStencilTableFactoryReal<double>::Create(*refiner, locations));

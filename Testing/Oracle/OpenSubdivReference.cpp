@@ -10,8 +10,7 @@ namespace dynsub::testing {
 
 using namespace OpenSubdiv;
 
-std::vector<ReferenceSample> openSubdivLimit(const ControlMesh& mesh, const std::vector<SurfacePoint>& points,
-                                             int isolationLevel) {
+std::unique_ptr<Far::TopologyRefiner> openSubdivRefiner(const ControlMesh& mesh) {
   std::vector<int> faceSizes, faceVertices;
   for (const Polygon& face : mesh.faces()) {
     faceSizes.push_back(static_cast<int>(face.size()));
@@ -22,12 +21,17 @@ std::vector<ReferenceSample> openSubdivLimit(const ControlMesh& mesh, const std:
   descriptor.numFaces = static_cast<int>(faceSizes.size());
   descriptor.numVertsPerFace = faceSizes.data();
   descriptor.vertIndicesPerFace = faceVertices.data();
-
   Sdc::Options rules;
   rules.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER);
   using Factory = Far::TopologyRefinerFactory<Far::TopologyDescriptor>;
-  std::unique_ptr<Far::TopologyRefiner> refiner(
+  // The factory copies the topology, so the arrays may go out of scope.
+  return std::unique_ptr<Far::TopologyRefiner>(
       Factory::Create(descriptor, Factory::Options(Sdc::SCHEME_CATMARK, rules)));
+}
+
+std::vector<ReferenceSample> openSubdivLimit(const ControlMesh& mesh, const std::vector<SurfacePoint>& points,
+                                             int isolationLevel) {
+  std::unique_ptr<Far::TopologyRefiner> refiner = openSubdivRefiner(mesh);
   refiner->RefineAdaptive(Far::TopologyRefiner::AdaptiveOptions(isolationLevel));
 
   // One location array per point keeps the bookkeeping trivial.

@@ -2,7 +2,10 @@
 // OpenSubdiv's limit surface at given Ptex locations, in double precision, with
 // the boundary rules DynSub uses (boundary edges and corners sharp). A test
 // oracle only: DynSub does not use OpenSubdiv.
+#include <memory>
 #include <vector>
+
+#include <opensubdiv/far/topologyRefiner.h>
 
 #include "dynsub/ControlMesh.h"
 #include "dynsub/LimitSurface.h"
@@ -12,6 +15,10 @@ namespace dynsub::testing {
 struct ReferenceSample {
   Vector3 position, du, dv;
 };
+
+// An OpenSubdiv refiner for the mesh's topology with DynSub's boundary rules
+// (Catmull-Clark; boundary edges and corners sharp), not yet refined.
+std::unique_ptr<OpenSubdiv::Far::TopologyRefiner> openSubdivRefiner(const ControlMesh& mesh);
 
 // isolationLevel: OpenSubdiv's adaptive refinement depth (at most 10); points
 // within 2^-isolationLevel of an extraordinary vertex lie on its end-cap patches.

@@ -1,7 +1,6 @@
 #include "dynsub/MeshIO.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -10,17 +9,12 @@
 
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
+#include "dynsub/FileNames.h"
 
 namespace dynsub {
 
 namespace {
 
-std::string lowerExtension(const std::string& path) {
-  std::string extension = std::filesystem::path(path).extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return extension;
-}
 
 std::ifstream openForReading(const std::string& path) {
   std::error_code error;
@@ -308,7 +302,7 @@ PolygonData readPly(const std::string& path) {
 }  // namespace
 
 PolygonData readPolygonData(const std::string& path) {
-  const std::string extension = lowerExtension(path);
+  const std::string extension = lowerCaseExtension(path);
   if (extension == ".obj") return readObj(path);
   if (extension == ".off") return readOff(path);
   if (extension == ".ply") return readPly(path);

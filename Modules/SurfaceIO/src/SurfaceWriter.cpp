@@ -1,7 +1,6 @@
 #include "dynsub/SurfaceWriter.h"
 
 #include <algorithm>
-#include <cctype>
 #include <filesystem>
 
 #include <vtkCellArray.h>
@@ -20,17 +19,12 @@
 
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
+#include "dynsub/FileNames.h"
 
 namespace dynsub {
 
 namespace {
 
-std::string lowerExtension(const std::string& path) {
-  std::string extension = std::filesystem::path(path).extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return extension;
-}
 
 vtkNew<vtkPolyData> toPolyData(const TriangleSurface& surface) {
   vtkNew<vtkPoints> points;
@@ -69,7 +63,7 @@ vtkNew<vtkPolyData> toPolyData(const TriangleSurface& surface) {
 std::vector<std::string> triangleSurfaceExtensions() { return {".vtp", ".obj", ".ply", ".stl"}; }
 
 void writeTriangleSurface(const TriangleSurface& surface, const std::string& path) {
-  const std::string extension = lowerExtension(path);
+  const std::string extension = lowerCaseExtension(path);
   const std::vector<std::string> known = triangleSurfaceExtensions();
   if (std::find(known.begin(), known.end(), extension) == known.end()) {
     throw Error(path, "unknown surface format '" + extension + "' (expected .vtp, .obj, .ply or .stl)");
