@@ -159,14 +159,17 @@ struct LimitSurface::Impl {
     // they shrink like lambda^level, so their relative accuracy survives any
     // depth; carried as plain weights, rounding of 1e-16 would be amplified
     // 2^level-fold in the derivatives.
-    levelZeroRows = local.weights;
+    // `along` is a mask over the level-0 local vertices: map it before they
+    // become displacements.
+    Eigen::RowVectorXd along = Eigen::RowVectorXd::Zero(special.columns.size());
+    for (const auto& [v, w] : masks.along) along += w * local.weights.row(v);
     local.weights.rowwise() -= special.vertexMasks.row(0);
     zeroRowSums(local.weights);
     for (int level = 1; level <= kTabulatedLevels; ++level) {
       special.levels.push_back(subdivideDisplacements(local));
     }
     special.deepest = std::move(local);
-    if (masks.boundary) setBoundaryTangents(special, masks);
+    if (masks.boundary) setBoundaryTangents(special, masks, along);
     element.columns = special.columns;
     element.special = static_cast<int>(specials.size());
     specials.push_back(std::move(special));
@@ -182,23 +185,19 @@ struct LimitSurface::Impl {
   // (lambda3/lambda2)^level (measured: 7e-5 rad at level 24 for a boundary
   // vertex of 5 faces), so it is read at level 48. Still a fixed linear mask,
   // so J_u and J_v stay linear operators.
-  void setBoundaryTangents(Special& special, const detail::VertexMasks& masks) {
+  void setBoundaryTangents(Special& special, const detail::VertexMasks& masks, const Eigen::RowVectorXd& along) {
     LocalMesh deep = special.deepest;
     for (int level = kTabulatedLevels; level < kCrossTangentLevel; ++level) subdivideDisplacements(deep);
     const Polygon& face = deep.topology.face(deep.face);
     const int x = face[0];
     const int interior = !deep.topology.isBoundaryEdge(deep.topology.findEdge(x, face[1])) ? face[1] : face[3];
     Eigen::RowVectorXd across = std::ldexp(1.0, kCrossTangentLevel) * deep.weights.row(interior);
-    // `along` is a mask over the level-0 local vertices: map it as the position was.
-    Eigen::RowVectorXd along = Eigen::RowVectorXd::Zero(special.columns.size());
-    for (const auto& [v, w] : masks.along) along += w * levelZeroRows.row(v);
     const double theta = M_PI / masks.faces;
-    special.vertexMasks.row(1) = std::cos(masks.position_in_fan * theta) * along +
-                                 std::sin(masks.position_in_fan * theta) * across;
-    special.vertexMasks.row(2) = std::cos((masks.position_in_fan + 1) * theta) * along +
-                                 std::sin((masks.position_in_fan + 1) * theta) * across;
+    special.vertexMasks.row(1) = std::cos(masks.fanPosition * theta) * along +
+                                 std::sin(masks.fanPosition * theta) * across;
+    special.vertexMasks.row(2) = std::cos((masks.fanPosition + 1) * theta) * along +
+                                 std::sin((masks.fanPosition + 1) * theta) * across;
   }
-  Eigen::MatrixXd levelZeroRows;  // scratch: level-0 weights of the special being built
 
   // Weights of s and its derivatives at an element point, over element.columns.
   SampleWeights weights(const ElementPoint& point) const {

@@ -204,7 +204,7 @@ VertexMasks vertexMasks(const Topology& topology, int x, int f) {
   masks.position = {{x, 4.0 / 6.0}, {first, 1.0 / 6.0}, {last, 1.0 / 6.0}};
   masks.boundary = true;
   masks.faces = n;
-  masks.position_in_fan = position;
+  masks.fanPosition = position;
   masks.along = {{first, 0.5}, {last, -0.5}};
   return masks;
 }

@@ -36,7 +36,7 @@ struct VertexMasks {
   SmallStencil position, tangentU, tangentV;
   bool boundary = false;
   int faces = 0;
-  int position_in_fan = 0;
+  int fanPosition = 0;
   SmallStencil along;
 };
 VertexMasks vertexMasks(const Topology& topology, int x, int f);
