@@ -9,5 +9,7 @@ namespace dynsub::app {
 
 void addLimitCommand(CLI::App& app);
 void addMeshCommand(CLI::App& app);
+void addFitCommand(CLI::App& app);
+void addDeformCommand(CLI::App& app);
 
 }  // namespace dynsub::app

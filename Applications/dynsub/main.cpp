@@ -19,6 +19,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   dynsub::app::addLimitCommand(app);
   dynsub::app::addMeshCommand(app);
+  dynsub::app::addFitCommand(app);
+  dynsub::app::addDeformCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

@@ -210,7 +210,9 @@ struct LimitSurface::Impl {
                   ") of element " + std::to_string(point.element) + " are outside [0,1]^2");
     }
     const Element& element = elements[point.element];
-    if (element.type == ElementType::Normal) return detail::bsplineWeights(point.u, point.v) * element.grid;
+    // NB: lazyProduct: these products are too small for Eigen's blocked GEMM,
+    // whose packing and allocation dominated closest-point searches.
+    if (element.type == ElementType::Normal) return detail::bsplineWeights(point.u, point.v).lazyProduct(element.grid);
 
     const Special& special = specials[element.special];
     // Parameters with the extraordinary vertex at the origin.
@@ -243,7 +245,7 @@ struct LimitSurface::Impl {
       for (int n = kTabulatedLevels + 1; n <= level; ++n) deeper = subdivideDisplacements(local);
       patch = &deeper[child - 1];
     }
-    w = detail::bsplineWeights(childU, childV) * (*patch);
+    w = detail::bsplineWeights(childU, childV).lazyProduct(*patch);
     w.row(0) += special.vertexMasks.row(0);  // the patch holds displacements from the limit point
     const Eigen::Matrix2d jacobian = std::ldexp(1.0, level) * detail::cornerFrameJacobian(child) * toCorner;
     applyChainRule(w, jacobian);
@@ -377,7 +379,8 @@ SurfacePoint LimitSurface::toSurfacePoint(const ElementPoint& point) const {
 namespace {
 
 LimitSample sampleFrom(const SampleWeights& w, const std::vector<int>& columns, const Matrix3X& controlPoints) {
-  const Eigen::Matrix<double, 6, 3> values = w * controlPoints(columns, Eigen::all);
+  Eigen::Matrix<double, 6, 3> values = Eigen::Matrix<double, 6, 3>::Zero();
+  for (size_t c = 0; c < columns.size(); ++c) values.noalias() += w.col(c) * controlPoints.row(columns[c]);
   LimitSample sample;
   sample.position = values.row(0).transpose();
   sample.du = values.row(1).transpose();
@@ -457,6 +460,40 @@ LimitOperators LimitSurface::operators(const std::vector<SurfacePoint>& points) 
     samples.emplace_back(&impl_->columnsOf(elementPoint.element), std::move(w));
   }
   return assemble(static_cast<int>(points.size()), impl_->controlVertexCount, samples);
+}
+
+Eigen::Matrix<double, 6, 16> bicubicBsplineWeights(double a, double b) { return detail::bsplineWeights(a, b); }
+
+ElementPieces LimitSurface::elementPieces(int element, int levels) const {
+  const Impl& s = *impl_;
+  if (element < 0 || element >= elementCount()) throw Error("element " + std::to_string(element) + " does not exist");
+  if (levels < 1 || levels > 60) throw Error("special elements are split into 1..60 levels, not " + std::to_string(levels));
+  const Impl::Element& e = s.elements[element];
+  ElementPieces result;
+  result.columns = e.columns;
+  if (e.type == ElementType::Normal) {
+    result.pieces.push_back(BsplinePiece{e.grid, Eigen::RowVectorXd::Zero(e.columns.size()), 1.0, false});
+    return result;
+  }
+  const Impl::Special& special = s.specials[e.special];
+  const Eigen::Matrix2d toCorner = detail::cornerFrameJacobian(e.corner);
+  LocalMesh local = special.deepest;
+  LevelPatches deeper;
+  for (int level = 1; level <= levels; ++level) {
+    if (level > kTabulatedLevels) deeper = subdivideDisplacements(local);
+    const LevelPatches& patches = level <= kTabulatedLevels ? special.levels[level - 1] : deeper;
+    for (int child = 1; child <= 3; ++child) {
+      BsplinePiece piece;
+      piece.grid = patches[child - 1];
+      piece.offset = special.vertexMasks.row(0);
+      piece.size = std::ldexp(1.0, -level);
+      // d(piece a, b)/d(element u, v) is a signed permutation: a follows u unless it is swapped.
+      const Eigen::Matrix2d turn = detail::cornerFrameJacobian(child) * toCorner;
+      piece.swapped = turn(0, 0) == 0.0;
+      result.pieces.push_back(std::move(piece));
+    }
+  }
+  return result;
 }
 
 SparseMatrix LimitSurface::controlVertexLimitOperator() const {

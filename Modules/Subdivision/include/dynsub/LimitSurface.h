@@ -68,6 +68,31 @@ struct LimitSample {
   Vector3 position, du, dv, duu, duv, dvv, normal;
 };
 
+// An element as bicubic B-spline patches (TVCG §3.1, eq. 26): the patch with
+// corner grid `grid` (16 rows in the slot order of a regular patch, over the
+// element's columns) covers a square of side `size` (element parameter units)
+// of the element. Its own parameters (a, b) map to the element's by a scaling
+// 1/size and a quarter turn: with `swapped`, a runs along the element's v.
+// The control points are the rows of `grid` each plus `offset`, so
+// s = B(a, b) * (grid + 1 offset) * p on the piece. For a special element grid
+// holds displacements from the extraordinary vertex's limit point (rows sum to
+// 0) and offset its limit mask: derivatives need only grid, which keeps their
+// relative accuracy on deep, small pieces.
+struct BsplinePiece {
+  Eigen::Matrix<double, 16, Eigen::Dynamic> grid;
+  Eigen::RowVectorXd offset;
+  double size = 1;
+  bool swapped = false;
+};
+// The uniform bicubic B-spline basis on a piece: rows s, s_a, s_b, s_aa, s_ab,
+// s_bb; columns the 16 grid slots (slot i + 4 j: index i along a, j along b).
+Eigen::Matrix<double, 6, 16> bicubicBsplineWeights(double a, double b);
+
+struct ElementPieces {
+  std::vector<int> columns;  // control vertices the element depends on
+  std::vector<BsplinePiece> pieces;
+};
+
 // Rows: points; columns: control vertices; s = J * p for each coordinate.
 // Rows of J sum to 1, rows of the derivative operators to 0.
 struct LimitOperators {
@@ -106,6 +131,12 @@ class LimitSurface {
   LimitSample evaluate(const SurfacePoint& point, const Matrix3X& controlPoints) const;
   LimitOperators operators(const std::vector<ElementPoint>& points) const;
   LimitOperators operators(const std::vector<SurfacePoint>& points) const;
+
+  // A normal element is one piece of size 1. A special element is the three
+  // regular pieces of each local-subdivision level 1..levels (size 2^-level);
+  // the square of side 2^-levels at the extraordinary corner is left out
+  // (levels in 1..60; levels > 24 are computed on demand).
+  ElementPieces elementPieces(int element, int levels) const;
 
   // Row i gives the limit position of control vertex i (#control by #control).
   SparseMatrix controlVertexLimitOperator() const;

@@ -1,0 +1,170 @@
+// dynsub deform: modeling by forces (TVCG §4.1, Fig. 6): springs from points in
+// space to the nearest points of the limit surface pull it to a new equilibrium.
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "Commands.h"
+#include "Reporting.h"
+#include "dynsub/Error.h"
+#include "dynsub/ForceModel.h"
+#include "dynsub/LimitSurface.h"
+#include "dynsub/MeshIO.h"
+#include "dynsub/SurfaceWriter.h"
+#include "dynsub/Tessellation.h"
+#include "dynsub/Topology.h"
+#include "dynsub/CatmullClark.h"
+
+namespace dynsub::app {
+
+namespace {
+
+struct DeformOptions {
+  std::string mesh;
+  std::string springs;
+  std::string out;
+  double stiffness = 10.0;
+  bool fixBoundary = false;
+  SimulationArguments simulation;
+};
+
+struct SpringFile {
+  Matrix3X targets;
+  Eigen::VectorXd stiffness;
+};
+
+// Lines "x y z" or "x y z k" (spaces, tabs or commas), '#' comments.
+SpringFile readSprings(const std::string& path, double defaultStiffness) {
+  std::ifstream in(path);
+  if (!std::filesystem::exists(path)) throw Error(path, "no such file");
+  if (!in) throw Error(path, "cannot be opened");
+  std::vector<Eigen::Vector4d> rows;
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    const size_t comment = line.find('#');
+    if (comment != std::string::npos) line.erase(comment);
+    for (char& c : line) {
+      if (c == ',' || c == ';' || c == '\t' || c == '\r') c = ' ';
+    }
+    std::istringstream fields(line);
+    std::vector<double> values;
+    std::string field;
+    while (fields >> field) {
+      try {
+        size_t used = 0;
+        values.push_back(std::stod(field, &used));
+        if (used != field.size()) throw std::invalid_argument(field);
+      } catch (const std::exception&) {
+        throw Error(path, "line " + std::to_string(number) + ": '" + field + "' is not a number");
+      }
+    }
+    if (values.empty()) continue;
+    if (values.size() != 3 && values.size() != 4) {
+      throw Error(path, "line " + std::to_string(number) + ": expected x y z or x y z stiffness");
+    }
+    const Eigen::Vector4d row(values[0], values[1], values[2], values.size() == 4 ? values[3] : defaultStiffness);
+    if (!row.allFinite()) throw Error(path, "line " + std::to_string(number) + ": a value is not finite");
+    if (!(row(3) > 0.0)) throw Error(path, "line " + std::to_string(number) + ": stiffness must be > 0");
+    rows.push_back(row);
+  }
+  if (rows.empty()) throw Error(path, "has no springs");
+  SpringFile result{Matrix3X(rows.size(), 3), Eigen::VectorXd(rows.size())};
+  for (size_t i = 0; i < rows.size(); ++i) {
+    result.targets.row(i) = rows[i].head<3>().transpose();
+    result.stiffness(i) = rows[i](3);
+  }
+  return result;
+}
+
+void runDeform(DeformOptions o) {
+  const ControlMesh mesh = readControlMesh(o.mesh);
+  const SpringFile springs = readSprings(o.springs, o.stiffness);
+  const std::filesystem::path dir(o.out);
+  prepareOutputDirectory(dir);
+  SimulationOptions options = o.simulation.apply(o.simulation.values);
+
+  std::vector<int> fixed;
+  if (o.fixBoundary) {
+    const Topology topology = topologyOf(mesh);
+    for (int v = 0; v < mesh.vertexCount(); ++v) {
+      if (topology.isBoundaryVertex(v)) fixed.push_back(v);
+    }
+    if (fixed.empty()) throw Error(o.mesh, "--fix-boundary was given, but the mesh is closed");
+  }
+  SpringForceModel model(springs.targets, springs.stiffness, SpringForceModel::Attach::NearestAtLevelStart);
+  ProgressLine line;
+  const SimulationResult result = simulate(mesh, {&model}, fixed, options, nullptr, line.callback());
+  line.finish();
+
+  const LimitSurface surface(result.mesh);
+  const Matrix3X control = result.mesh.points();
+  if (!control.allFinite()) throw Error("internal: the deformed control points are not finite");
+  const TriangleSurface triangles = tessellate(surface, control, 8);
+  const Eigen::VectorXd& lengths = model.lengths();
+  double seconds = 0.0;
+  for (const LevelSummary& l : result.levels) seconds += l.seconds;
+
+  nlohmann::ordered_json report;
+  report["input"] = o.mesh;
+  report["springs_file"] = o.springs;
+  report["springs"] = springs.targets.rows();
+  report["fixed_control_vertices"] = fixed.size();
+  report["control_vertices"] = result.mesh.vertexCount();
+  report["levels"] = result.levels.back().level;
+  report["iterations"] = result.steps;
+  report["equilibrium"] = result.levels.back().converged;
+  report["max_spring_length_mm"] = lengths.size() ? lengths.maxCoeff() : 0.0;
+  report["mean_spring_length_mm"] = lengths.size() ? lengths.mean() : 0.0;
+  report["seconds"] = seconds;
+  nlohmann::ordered_json levels = nlohmann::ordered_json::array();
+  for (const LevelSummary& l : result.levels) levels.push_back(levelJson(l, -1, -1));
+  report["per_level"] = levels;
+  nlohmann::ordered_json parameters = simulationJson(options);
+  parameters["default_spring_stiffness"] = o.stiffness;
+  parameters["fix_boundary"] = o.fixBoundary;
+  report["parameters"] = parameters;
+
+  OutputSet outputs(dir);
+  writeTriangleSurface(triangles, outputs.add("surface.vtp"));
+  writeObj(result.mesh, outputs.add("control_mesh.obj"));
+  writeJson(report, outputs.add("report.json"));
+  outputs.commit();
+  std::cout << std::fixed << std::setprecision(3) << "deformed " << o.mesh << " with " << springs.targets.rows()
+            << " springs: " << (result.levels.back().converged ? "equilibrium" : "step limit reached") << " after "
+            << result.steps << " steps, " << std::setprecision(2) << seconds << " s; largest spring length "
+            << std::setprecision(3) << (lengths.size() ? lengths.maxCoeff() : 0.0) << " mm\n"
+            << "wrote " << (dir / "surface.vtp").string() << ", control_mesh.obj, report.json\n";
+}
+
+}  // namespace
+
+void addDeformCommand(CLI::App& app) {
+  auto o = std::make_shared<DeformOptions>();
+  CLI::App* command = app.add_subcommand(
+      "deform",
+      "Model a surface by pulling on it: springs from points in space attach to the nearest points of the "
+      "limit surface, and the surface moves under its dynamics to equilibrium.\n"
+      "Writes DIR/surface.vtp, DIR/control_mesh.obj and DIR/report.json.");
+  command->add_option("MESH", o->mesh, "Control mesh (.obj, .off or .ply), open or closed")->required();
+  command->add_option("--springs", o->springs,
+                      "Spring file: one spring per line, 'x y z' or 'x y z stiffness' (mm, N/mm)")
+      ->required();
+  command->add_option("--out", o->out, "Output directory (created if missing; its parent must exist)")->required();
+  command->add_option("--stiffness", o->stiffness, "Stiffness of springs that do not give one, N/mm")
+      ->default_val(o->stiffness)
+      ->check(CLI::PositiveNumber);
+  command->add_flag("--fix-boundary", o->fixBoundary, "Hold the boundary control vertices of an open mesh in place");
+  SimulationOptions defaults;
+  defaults.maxLevel = 0;
+  o->simulation.addOptions(*command, defaults);
+  command->callback([o] { runDeform(*o); });
+}
+
+}  // namespace dynsub::app

@@ -1,0 +1,152 @@
+// dynsub fit: shape recovery from range data (ShapeRecovery.h).
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "Commands.h"
+#include "Reporting.h"
+#include "dynsub/AtomicOutput.h"
+#include "dynsub/Error.h"
+#include "dynsub/LimitSurface.h"
+#include "dynsub/MeshIO.h"
+#include "dynsub/PointCloudIO.h"
+#include "dynsub/ShapeRecovery.h"
+#include "dynsub/SurfaceWriter.h"
+#include "dynsub/Tessellation.h"
+
+namespace dynsub::app {
+
+namespace {
+
+struct FitCommandOptions {
+  std::string points;
+  std::string out;
+  std::string init = "auto";
+  int genus = -1;
+  FitOptions fit;
+  SimulationArguments simulation;
+};
+
+ControlMesh chooseInitialModel(const FitCommandOptions& o, const Matrix3X& data) {
+  ControlMesh mesh;
+  if (o.init == "auto" || o.init == "sphere") {
+    mesh = initialModel(data, InitialShape::Sphere);
+  } else if (o.init == "torus") {
+    mesh = initialModel(data, InitialShape::Torus);
+  } else {
+    mesh = readControlMesh(o.init);
+    if (!mesh.isClosed()) {
+      throw Error(o.init, "the initial model must be closed, but it has " + std::to_string(mesh.boundaryLoopCount()) +
+                              " boundary loop(s)");
+    }
+  }
+  if (o.genus >= 0 && mesh.genus() != o.genus) {
+    throw Error(o.init == "auto" ? std::string("--init auto") : o.init,
+                "the initial model has genus " + std::to_string(mesh.genus()) + " but --genus " +
+                    std::to_string(o.genus) + " was asked for" +
+                    (o.genus == 1 ? " (use --init torus or a control mesh of genus 1)"
+                                  : " (give a control mesh of that genus with --init MESH)"));
+  }
+  return mesh;
+}
+
+void runFit(FitCommandOptions o) {
+  const Matrix3X data = readPointCloud(o.points);
+  checkPointCloud(data, o.points);
+  const ControlMesh initial = chooseInitialModel(o, data);
+  const std::filesystem::path dir(o.out);
+  prepareOutputDirectory(dir);
+  o.fit.simulation = o.simulation.apply(o.fit.simulation);
+
+  ProgressLine line;
+  const FitResult result = fitPointCloud(data, initial, o.fit, line.callback());
+  line.finish();
+
+  const LimitSurface surface(result.mesh);
+  const Matrix3X control = result.mesh.points();
+  if (!control.allFinite()) throw Error("internal: the fitted control points are not finite");
+  const TriangleSurface triangles = tessellate(surface, control, 8);
+
+  nlohmann::ordered_json report;
+  report["input"] = o.points;
+  report["points"] = data.rows();
+  report["max_error_percent"] = result.error.maxPercent;
+  report["rms_error_percent"] = result.error.rmsPercent;
+  report["tolerance_percent"] = o.fit.tolerancePercent;
+  report["converged"] = result.error.maxPercent <= o.fit.tolerancePercent;
+  report["enclosing_sphere"] = {{"center_mm", {result.enclosingSphere.center(0), result.enclosingSphere.center(1),
+                                                result.enclosingSphere.center(2)}},
+                                {"diameter_mm", 2.0 * result.enclosingSphere.radius},
+                                {"method", "smallest enclosing sphere (Welzl's algorithm, exact)"}};
+  report["control_vertices"] = result.mesh.vertexCount();
+  report["control_faces"] = result.mesh.faceCount();
+  report["genus"] = result.mesh.genus();
+  report["levels"] = result.levels.back().level;
+  report["iterations"] = result.steps;
+  report["seconds"] = result.seconds;
+  nlohmann::ordered_json levels = nlohmann::ordered_json::array();
+  for (size_t i = 0; i < result.levels.size(); ++i) {
+    levels.push_back(levelJson(result.levels[i], result.levelErrors[i].maxPercent, result.levelErrors[i].rmsPercent));
+  }
+  report["per_level"] = levels;
+  nlohmann::ordered_json parameters = simulationJson(o.fit.simulation);
+  parameters["init"] = o.init;
+  parameters["data_stiffness"] = o.fit.dataStiffness;
+  report["parameters"] = parameters;
+
+  OutputSet outputs(dir);
+  writeTriangleSurface(triangles, outputs.add("surface.vtp"));
+  writeObj(result.mesh, outputs.add("control_mesh.obj"));
+  writeJson(report, outputs.add("report.json"));
+  outputs.commit();
+
+  std::cout << std::fixed << std::setprecision(3) << "fitted " << data.rows() << " points with "
+            << result.mesh.vertexCount() << " control vertices (" << result.levels.back().level
+            << " refinement(s), " << result.steps << " steps) in " << std::setprecision(1) << result.seconds
+            << " s\n"
+            << std::setprecision(3) << "max error " << result.error.maxPercent << " %, rms error "
+            << result.error.rmsPercent << " % of the enclosing sphere's diameter ("
+            << 2.0 * result.enclosingSphere.radius << " mm)"
+            << (result.error.maxPercent <= o.fit.tolerancePercent ? "" : " -- above the tolerance") << '\n'
+            << "wrote " << (dir / "surface.vtp").string() << ", control_mesh.obj, report.json\n";
+}
+
+}  // namespace
+
+void addFitCommand(CLI::App& app) {
+  auto o = std::make_shared<FitCommandOptions>();
+  CLI::App* command = app.add_subcommand(
+      "fit",
+      "Recover a smooth surface from a point cloud (range data) with a dynamic subdivision surface.\n"
+      "Springs pull the limit surface toward the data; at equilibrium the control mesh is refined until the "
+      "largest distance from a data point to the surface is below the tolerance (percent of the diameter of "
+      "the smallest sphere enclosing the data).\n"
+      "Writes DIR/surface.vtp, DIR/control_mesh.obj and DIR/report.json.");
+  command->add_option("POINTS", o->points, "Point cloud: .xyz/.txt, .csv, .ply, .off, .obj or .vtp (mm)")
+      ->required();
+  command->add_option("--out", o->out, "Output directory (created if missing; its parent must exist)")->required();
+  command->add_option("--init", o->init,
+                      "Initial model: auto or sphere (the 98-vertex cube inside the data's PCA ellipsoid), torus "
+                      "(the 32-vertex torus, for genus 1), or a closed control mesh file of the data's genus")
+      ->default_val("auto");
+  command->add_option("--genus", o->genus, "Genus the data is known to have; the initial model must match")
+      ->check(CLI::Range(0, 100));
+  command->add_option("--tolerance", o->fit.tolerancePercent, "Max error to reach, in percent")
+      ->default_val(1.0)
+      ->check(CLI::PositiveNumber);
+  command->add_option("--data-stiffness", o->fit.dataStiffness,
+                      "Spring stiffness of the data, N/mm per unit parametric area, shared by all points")
+      ->default_val(o->fit.dataStiffness)
+      ->check(CLI::PositiveNumber);
+  o->simulation.addOptions(*command, FitOptions::defaultSimulation());
+  command->callback([o] { runFit(*o); });
+}
+
+}  // namespace dynsub::app

@@ -1,0 +1,71 @@
+#pragma once
+// What the commands that run a simulation share: the physics and solver
+// options, a progress line on a terminal, and writing a set of outputs into a
+// directory all together or not at all.
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "dynsub/Simulation.h"
+
+namespace CLI {
+class App;
+}
+
+namespace dynsub {
+class AtomicOutput;
+}
+
+namespace dynsub::app {
+
+// Command-line options for SimulationOptions (material, integrator, levels).
+struct SimulationArguments {
+  std::string scheme, solver;
+  SimulationOptions values;
+  void addOptions(CLI::App& command, const SimulationOptions& defaults);
+  // `base` with the options given on the command line; throws dynsub::Error on bad values.
+  SimulationOptions apply(SimulationOptions base) const;
+};
+
+nlohmann::ordered_json simulationJson(const SimulationOptions& options);
+nlohmann::ordered_json levelJson(const LevelSummary& level, double maxErrorPercent, double rmsErrorPercent);
+
+// "\rlevel L  step S  energy E" on stderr while stderr is a terminal; silent otherwise.
+class ProgressLine {
+ public:
+  ProgressLine();
+  ProgressCallback callback();
+  void finish();
+
+ private:
+  bool terminal_;
+  bool written_ = false;
+};
+
+// Throws dynsub::Error unless `dir` is a directory or can be created (its parent exists).
+void prepareOutputDirectory(const std::filesystem::path& dir);
+
+// Files in one directory that appear together: each is written to a temporary
+// file, and commit() renames them all; before that nothing is visible (a
+// directory this created is removed again if commit() is never reached).
+class OutputSet {
+ public:
+  explicit OutputSet(std::filesystem::path dir);
+  ~OutputSet();
+  // The temporary path to write `name` to.
+  std::string add(const std::string& name);
+  void commit();
+
+ private:
+  std::filesystem::path dir_;
+  bool created_ = false;
+  bool committed_ = false;
+  std::vector<std::unique_ptr<AtomicOutput>> outputs_;
+};
+
+void writeJson(const nlohmann::ordered_json& json, const std::string& path);
+
+}  // namespace dynsub::app

@@ -1,0 +1,86 @@
+#pragma once
+// Forces a simulation re-evaluates every time step (Simulation.h), built on
+// the functions of Forces.h.
+#include <memory>
+#include <vector>
+
+#include "dynsub/Forces.h"
+
+namespace dynsub {
+
+class ClosestPointLocator;
+
+class ForceModel {
+ public:
+  virtual ~ForceModel() = default;
+  // A level starts: the control mesh (and so the surface and its quadrature)
+  // changed. The references stay valid until the next beginLevel.
+  virtual void beginLevel(const LimitSurface& surface, const SurfaceQuadrature& quadrature,
+                          const Matrix3X& controlPoints) = 0;
+  // f_p at the control points (#control x 3); adds the force's potential
+  // energy (N mm) to `potential` where it has one.
+  virtual Matrix3X generalizedForce(const Matrix3X& controlPoints, double& potential) = 0;
+  // A stiffness S >= 0 of the force near the current state, used only to
+  // stabilize time integration (Integrator.h); empty (0 x 0) if none.
+  virtual SparseMatrix stabilizingStiffness(const Matrix3X& controlPoints);
+};
+
+// Springs from fixed points in space to the surface (TVCG eq. 27).
+//  - NearestEachStep: every step each spring re-attaches to the point of the
+//    limit surface nearest its target (shape recovery, §4.2);
+//  - NearestAtLevelStart: springs attach to the nearest points when a level
+//    starts and then pull those surface points (modeling, §4.1).
+class SpringForceModel final : public ForceModel {
+ public:
+  enum class Attach { NearestEachStep, NearestAtLevelStart };
+  // targets: #springs x 3 (mm); stiffness: one per spring (N/mm), > 0.
+  SpringForceModel(Matrix3X targets, Eigen::VectorXd stiffness, Attach attach);
+  ~SpringForceModel() override;
+
+  void beginLevel(const LimitSurface& surface, const SurfaceQuadrature& quadrature,
+                  const Matrix3X& controlPoints) override;
+  Matrix3X generalizedForce(const Matrix3X& controlPoints, double& potential) override;
+  SparseMatrix stabilizingStiffness(const Matrix3X& controlPoints) override;
+
+  // Spring lengths (distances target - attachment, mm) at the last evaluation.
+  const Eigen::VectorXd& lengths() const { return lengths_; }
+
+ private:
+  void attach(const Matrix3X& controlPoints);
+
+  Matrix3X targets_;
+  Eigen::VectorXd stiffness_;
+  Attach attach_;
+  const LimitSurface* surface_ = nullptr;
+  std::unique_ptr<ClosestPointLocator> locator_;
+  std::vector<Spring> springs_;
+  Eigen::VectorXd lengths_;
+};
+
+// A pressure (N/mm^2) along the limit normal; positive inflates an outward-oriented surface.
+class InflationForceModel final : public ForceModel {
+ public:
+  explicit InflationForceModel(double pressure);
+  void beginLevel(const LimitSurface& surface, const SurfaceQuadrature& quadrature,
+                  const Matrix3X& controlPoints) override;
+  Matrix3X generalizedForce(const Matrix3X& controlPoints, double& potential) override;
+
+ private:
+  double pressure_;
+  const SurfaceQuadrature* quadrature_ = nullptr;
+};
+
+// An external force-density field (N/mm^2), e.g. image forces; not owned.
+class FieldForceModel final : public ForceModel {
+ public:
+  explicit FieldForceModel(const ForceField& field) : field_(field) {}
+  void beginLevel(const LimitSurface& surface, const SurfaceQuadrature& quadrature,
+                  const Matrix3X& controlPoints) override;
+  Matrix3X generalizedForce(const Matrix3X& controlPoints, double& potential) override;
+
+ private:
+  const ForceField& field_;
+  const SurfaceQuadrature* quadrature_ = nullptr;
+};
+
+}  // namespace dynsub

@@ -1,0 +1,54 @@
+#pragma once
+// Applied forces turned into generalized forces on the control vertices by
+// virtual work (TVCG 1998 eq. 21, §3.2; ICCV 1998 eq. 17):
+//   f_p = ∫∫ J^T f(u, v) du dv  ≈  sum_q w_q J_q^T f(s_q).
+// Every function returns f_p as #control vertices x 3 (N), with points in mm.
+//
+// - Springs (eq. 27): a spring of stiffness k (N/mm) from a point d to the
+//   surface point s(u0, v0) pulls with k (d - s); a point force, not a density.
+// - Inflation: a pressure P (N/mm^2) along the limit normal, integrated over
+//   the true surface area: f = P s_u x s_v per unit parametric area.
+// - A force field (eq. 28 for images): a force per unit surface area (N/mm^2)
+//   sampled at points in mm, integrated like the inflation.
+#include <vector>
+
+#include "dynsub/LimitSurface.h"
+
+namespace dynsub {
+
+struct Spring {
+  ElementPoint attachment;
+  Vector3 target;          // mm
+  double stiffness = 1.0;  // N/mm
+};
+
+// Gauss points over every element with the limit operators there (built once
+// per control-mesh topology; moving control points does not invalidate it).
+struct SurfaceQuadrature {
+  std::vector<ElementPoint> points;
+  Eigen::VectorXd weights;  // parametric area per point (sums to elements x elementSize^2)
+  SparseMatrix J, Ju, Jv;
+};
+// n x n Gauss-Legendre points per element (n in 1..16).
+SurfaceQuadrature makeSurfaceQuadrature(const LimitSurface& surface, int pointsPerDirection = 3,
+                                        double elementSize = 1.0);
+
+// A force density field in physical space: N points in mm -> N forces (N/mm^2).
+// Must return finite values for every point it is given.
+class ForceField {
+ public:
+  virtual ~ForceField() = default;
+  virtual Matrix3X forcesAt(const Matrix3X& points) const = 0;
+};
+
+// Generalized spring forces; `energy` (if given) receives sum k |d - s|^2 / 2 (N mm).
+Matrix3X springForces(const LimitSurface& surface, const Matrix3X& controlPoints, const std::vector<Spring>& springs,
+                      double* energy = nullptr);
+// sum k J_s^T J_s over the springs (#control by #control): minus the
+// derivative of the spring forces with the attachments held fixed.
+SparseMatrix springStiffness(const LimitSurface& surface, const std::vector<Spring>& springs);
+
+Matrix3X inflationForces(const SurfaceQuadrature& quadrature, const Matrix3X& controlPoints, double pressure);
+Matrix3X fieldForces(const SurfaceQuadrature& quadrature, const Matrix3X& controlPoints, const ForceField& field);
+
+}  // namespace dynsub

@@ -1,0 +1,92 @@
+#pragma once
+// Multilevel dynamics (TVCG 1998 §2.5.1, §3.3-3.4; ICCV 1998 §3): the control
+// points evolve under M p'' + D p' + K p = f_p, integrated implicitly
+// (Integrator.h), until equilibrium; then, unless the caller accepts the fit,
+// the control mesh is replaced by its global Catmull-Clark refinement
+// (p' = A p: the limit surface is unchanged), the matrices are rebuilt and the
+// evolution goes on, up to `maxLevel` refinements.
+//
+// Equilibrium: over the last `window` steps, every step changed the total
+// energy (kinetic + elastic + force potentials) by at most `energyTolerance`
+// of its magnitude and moved no control point by more than `motionTolerance`
+// of the model's size (bounding-box diagonal of the control points at the
+// level start). A level that reaches `maxSteps` first ends unconverged (and is
+// reported so).
+//
+// Stabilizer updates: the forces' stiffness that stabilizes the integration
+// (Integrator.h) is frozen when a level starts; when the energy rises for 3
+// steps in a row (springs re-attached elsewhere have made it stale) it is
+// frozen anew at the current state and the left-hand matrix refactored.
+//
+// Divergence: a non-finite state, an energy above 1e3 times the largest seen
+// in the level's first step, or a step moving a point by more than the model's
+// size restarts the level from its initial state with half the time step (and
+// a fresh stabilizing stiffness); after `maxTimeStepHalvings` the simulation
+// stops with a dynsub::Error.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "dynsub/ControlMesh.h"
+#include "dynsub/ForceModel.h"
+#include "dynsub/Integrator.h"
+#include "dynsub/PhysicalMatrices.h"
+
+namespace dynsub {
+
+struct EquilibriumOptions {
+  double energyTolerance = 1e-4;  // relative change per step
+  double motionTolerance = 1e-4;  // per step, fraction of the model size
+  int window = 5;                 // steps
+  int maxSteps = 1000;            // per level
+};
+
+struct SimulationOptions {
+  Material material;
+  AssemblyOptions assembly;  // elementSize is set per level by the simulation
+  IntegratorOptions integrator;
+  EquilibriumOptions equilibrium;
+  int maxLevel = 0;  // global refinements allowed
+  int maxTimeStepHalvings = 8;
+  int quadraturePoints = 3;  // per direction per element, for distributed forces
+};
+
+struct LevelSummary {
+  int level = 0;  // global refinements of the initial control mesh
+  int controlVertices = 0;
+  int steps = 0;
+  bool converged = false;
+  double timeStep = 0;
+  double energy = 0;    // N mm, at the end of the level
+  double seconds = 0;   // wall time of the level, assembly included
+  int solverIterations = 0;
+  int stabilizerUpdates = 0;  // times the forces' stiffness was re-frozen (see simulate)
+};
+
+struct SimulationResult {
+  ControlMesh mesh;  // the final control mesh (points at the final state)
+  std::vector<LevelSummary> levels;
+  int steps = 0;  // over all levels
+};
+
+struct Progress {
+  int level = 0;
+  int step = 0;
+  double energy = 0;
+  double motion = 0;  // largest control-point move of the step, mm
+};
+
+// Decides at an equilibrium whether the fit is good enough (true: stop).
+using AcceptFit = std::function<bool(const LimitSurface& surface, const Matrix3X& controlPoints)>;
+using ProgressCallback = std::function<void(const Progress&)>;
+
+// forces are not owned. fixed: control vertices of the initial mesh that do not
+// move (they keep their numbers through refinement). Throws dynsub::Error on
+// bad options or unrecoverable divergence.
+SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceModel*>& forces,
+                          const std::vector<int>& fixed, const SimulationOptions& options,
+                          const AcceptFit& accept = nullptr, const ProgressCallback& progress = nullptr);
+
+void checkSimulationOptions(const SimulationOptions& options);
+
+}  // namespace dynsub

@@ -1,0 +1,168 @@
+#include "dynsub/ClosestPoint.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <nanoflann.hpp>
+
+#include "dynsub/Error.h"
+
+namespace dynsub {
+
+namespace {
+
+struct SampleCloud {
+  Matrix3X points;
+  size_t kdtree_get_point_count() const { return static_cast<size_t>(points.rows()); }
+  double kdtree_get_pt(size_t i, size_t d) const { return points(static_cast<Eigen::Index>(i), d); }
+  template <class Box>
+  bool kdtree_get_bbox(Box&) const {
+    return false;
+  }
+};
+
+using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, SampleCloud>, SampleCloud, 3>;
+
+}  // namespace
+
+struct ClosestPointLocator::Impl {
+  const LimitSurface* surface = nullptr;
+  int candidates = 6;
+  std::vector<ElementPoint> samples;
+  SparseMatrix sampleOperator;
+  SampleCloud cloud;
+  std::unique_ptr<Tree> tree;
+  Matrix3X controlPoints;
+
+  // Newton's method for min |s(u, v) - q|^2 on one element, from (u, v), kept in [0,1]^2.
+  ClosestPoint refine(ElementPoint p, const Vector3& q) const {
+    LimitSample s = surface->evaluate(p, controlPoints);
+    double best = (s.position - q).squaredNorm();
+    for (int iteration = 0; iteration < 30; ++iteration) {
+      const Vector3 r = s.position - q;
+      const Eigen::Vector2d gradient(s.du.dot(r), s.dv.dot(r));
+      Eigen::Matrix2d hessian;
+      hessian << s.du.dot(s.du) + s.duu.dot(r), s.du.dot(s.dv) + s.duv.dot(r), s.du.dot(s.dv) + s.duv.dot(r),
+          s.dv.dot(s.dv) + s.dvv.dot(r);
+      // Where the full Hessian is not positive definite (far from the surface,
+      // near a ridge of the distance), fall back to Gauss-Newton.
+      if (!(hessian.determinant() > 0.0 && hessian(0, 0) > 0.0)) {
+        hessian << s.du.dot(s.du), s.du.dot(s.dv), s.du.dot(s.dv), s.dv.dot(s.dv);
+        hessian.diagonal().array() += 1e-12 * (hessian.trace() + 1e-300);
+      }
+      Eigen::Vector2d step = -hessian.ldlt().solve(gradient);
+      // Coordinates pinned on the border with the gradient pushing outward stay.
+      const double uv[2] = {p.u, p.v};
+      for (int k = 0; k < 2; ++k) {
+        if ((uv[k] <= 0.0 && gradient(k) > 0.0) || (uv[k] >= 1.0 && gradient(k) < 0.0)) step(k) = 0.0;
+      }
+      if (!step.allFinite() || step.norm() < 1e-12) break;
+      bool improved = false;
+      for (int halving = 0; halving < 20; ++halving) {
+        ElementPoint trial{p.element, std::clamp(p.u + step(0), 0.0, 1.0), std::clamp(p.v + step(1), 0.0, 1.0)};
+        const LimitSample t = surface->evaluate(trial, controlPoints);
+        const double d = (t.position - q).squaredNorm();
+        if (d <= best) {
+          improved = (best - d) > 0.0 || std::abs(trial.u - p.u) + std::abs(trial.v - p.v) > 0.0;
+          best = d;
+          p = trial;
+          s = t;
+          break;
+        }
+        step *= 0.5;
+      }
+      if (!improved) break;
+    }
+    return ClosestPoint{p, s.position, std::sqrt(best)};
+  }
+};
+
+ClosestPointLocator::ClosestPointLocator(const LimitSurface& surface, int samplesPerElement, int candidates)
+    : impl_(std::make_unique<Impl>()) {
+  if (samplesPerElement < 2 || samplesPerElement > 64) {
+    throw Error("closest-point search takes 2..64 samples per element side, got " + std::to_string(samplesPerElement));
+  }
+  if (candidates < 1 || candidates > 64) throw Error("closest-point candidates must be 1..64");
+  impl_->surface = &surface;
+  impl_->candidates = candidates;
+  // Samples at the centres of a grid of cells, so no two lie on a shared edge.
+  for (int e = 0; e < surface.elementCount(); ++e) {
+    for (int j = 0; j < samplesPerElement; ++j) {
+      for (int i = 0; i < samplesPerElement; ++i) {
+        impl_->samples.push_back(
+            ElementPoint{e, (i + 0.5) / samplesPerElement, (j + 0.5) / samplesPerElement});
+      }
+    }
+  }
+  impl_->sampleOperator = surface.operators(impl_->samples).J;
+}
+
+ClosestPointLocator::~ClosestPointLocator() = default;
+ClosestPointLocator::ClosestPointLocator(ClosestPointLocator&&) noexcept = default;
+ClosestPointLocator& ClosestPointLocator::operator=(ClosestPointLocator&&) noexcept = default;
+
+void ClosestPointLocator::update(const Matrix3X& controlPoints) {
+  if (controlPoints.rows() != impl_->surface->controlVertexCount()) {
+    throw Error("closest-point search got " + std::to_string(controlPoints.rows()) + " control points for " +
+                std::to_string(impl_->surface->controlVertexCount()));
+  }
+  if (!controlPoints.allFinite()) throw Error("closest-point search got non-finite control points");
+  impl_->controlPoints = controlPoints;
+  impl_->cloud.points = impl_->sampleOperator * controlPoints;
+  impl_->tree = std::make_unique<Tree>(3, impl_->cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+}
+
+ClosestPoint ClosestPointLocator::find(const Vector3& query) const {
+  const Impl& s = *impl_;
+  if (!s.tree) throw Error("internal: closest-point search used before update()");
+  if (!query.allFinite()) throw Error("closest-point query is not finite");
+  const size_t k = std::min<size_t>(s.candidates, s.samples.size());
+  std::vector<uint32_t> index(k);
+  std::vector<double> squared(k);
+  const size_t found = s.tree->knnSearch(query.data(), k, index.data(), squared.data());
+  ClosestPoint best;
+  best.distance = std::numeric_limits<double>::infinity();
+  std::vector<int> tried;
+  for (size_t i = 0; i < found; ++i) {
+    const ElementPoint start = s.samples[index[i]];
+    if (std::find(tried.begin(), tried.end(), start.element) != tried.end()) continue;
+    tried.push_back(start.element);
+    const ClosestPoint c = s.refine(start, query);
+    if (c.distance < best.distance) best = c;
+  }
+  return best;
+}
+
+ClosestPoint ClosestPointLocator::find(const Vector3& query, const ElementPoint& hint) const {
+  const Impl& s = *impl_;
+  if (!s.tree) throw Error("internal: closest-point search used before update()");
+  if (!query.allFinite()) throw Error("closest-point query is not finite");
+  if (hint.element < 0 || hint.element >= s.surface->elementCount()) return find(query);
+  const ClosestPoint tracked = s.refine(hint, query);
+  uint32_t index = 0;
+  double squared = 0.0;
+  s.tree->knnSearch(query.data(), 1, &index, &squared);
+  if (tracked.distance <= std::sqrt(squared)) return tracked;
+  const ClosestPoint searched = find(query);
+  return searched.distance < tracked.distance ? searched : tracked;
+}
+
+std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries) const {
+  std::vector<ClosestPoint> result(queries.rows());
+  // Each query is independent, so the result does not depend on the threads.
+#pragma omp parallel for schedule(dynamic, 64)
+  for (Eigen::Index i = 0; i < queries.rows(); ++i) result[i] = find(queries.row(i).transpose());
+  return result;
+}
+
+std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries,
+                                                       const std::vector<ElementPoint>& hints) const {
+  if (hints.size() != static_cast<size_t>(queries.rows())) throw Error("internal: one hint per query expected");
+  std::vector<ClosestPoint> result(queries.rows());
+#pragma omp parallel for schedule(dynamic, 64)
+  for (Eigen::Index i = 0; i < queries.rows(); ++i) result[i] = find(queries.row(i).transpose(), hints[i]);
+  return result;
+}
+
+}  // namespace dynsub

@@ -1,0 +1,86 @@
+#include "dynsub/ForceModel.h"
+
+#include <cmath>
+#include <string>
+
+#include "dynsub/ClosestPoint.h"
+#include "dynsub/Error.h"
+
+namespace dynsub {
+
+SparseMatrix ForceModel::stabilizingStiffness(const Matrix3X&) { return SparseMatrix(); }
+
+SpringForceModel::SpringForceModel(Matrix3X targets, Eigen::VectorXd stiffness, Attach attach)
+    : targets_(std::move(targets)), stiffness_(std::move(stiffness)), attach_(attach) {
+  if (targets_.rows() != stiffness_.size()) {
+    throw Error("got " + std::to_string(stiffness_.size()) + " spring stiffnesses for " +
+                std::to_string(targets_.rows()) + " springs");
+  }
+  if (!targets_.allFinite()) throw Error("a spring target is not finite");
+  for (Eigen::Index i = 0; i < stiffness_.size(); ++i) {
+    if (!(std::isfinite(stiffness_(i)) && stiffness_(i) > 0.0)) {
+      throw Error("spring " + std::to_string(i) + " has stiffness " + std::to_string(stiffness_(i)) +
+                  " (expected a finite value > 0)");
+    }
+  }
+}
+
+SpringForceModel::~SpringForceModel() = default;
+
+void SpringForceModel::beginLevel(const LimitSurface& surface, const SurfaceQuadrature&,
+                                  const Matrix3X& controlPoints) {
+  surface_ = &surface;
+  locator_ = std::make_unique<ClosestPointLocator>(surface);
+  springs_.clear();  // attachments of the previous level mean nothing on the new surface
+  attach(controlPoints);
+}
+
+void SpringForceModel::attach(const Matrix3X& controlPoints) {
+  locator_->update(controlPoints);
+  // Track last step's attachments where there are some (same level).
+  std::vector<ElementPoint> hints;
+  for (const Spring& s : springs_) hints.push_back(s.attachment);
+  const std::vector<ClosestPoint> nearest =
+      hints.size() == static_cast<size_t>(targets_.rows()) ? locator_->findAll(targets_, hints)
+                                                           : locator_->findAll(targets_);
+  springs_.resize(nearest.size());
+  for (size_t i = 0; i < nearest.size(); ++i) {
+    springs_[i] = Spring{nearest[i].point, targets_.row(i).transpose(), stiffness_(i)};
+  }
+}
+
+Matrix3X SpringForceModel::generalizedForce(const Matrix3X& controlPoints, double& potential) {
+  if (attach_ == Attach::NearestEachStep) attach(controlPoints);
+  std::vector<ElementPoint> at;
+  at.reserve(springs_.size());
+  for (const Spring& s : springs_) at.push_back(s.attachment);
+  const SparseMatrix J = surface_->operators(at).J;
+  const Matrix3X stretch = targets_ - J * controlPoints;  // d - s per spring
+  lengths_ = stretch.rowwise().norm();
+  potential += 0.5 * stiffness_.dot(lengths_.cwiseAbs2());
+  return J.transpose() * (stiffness_.asDiagonal() * stretch);
+}
+
+SparseMatrix SpringForceModel::stabilizingStiffness(const Matrix3X&) { return springStiffness(*surface_, springs_); }
+
+InflationForceModel::InflationForceModel(double pressure) : pressure_(pressure) {
+  if (!std::isfinite(pressure)) throw Error("inflation pressure is not finite");
+}
+
+void InflationForceModel::beginLevel(const LimitSurface&, const SurfaceQuadrature& quadrature, const Matrix3X&) {
+  quadrature_ = &quadrature;
+}
+
+Matrix3X InflationForceModel::generalizedForce(const Matrix3X& controlPoints, double&) {
+  return inflationForces(*quadrature_, controlPoints, pressure_);
+}
+
+void FieldForceModel::beginLevel(const LimitSurface&, const SurfaceQuadrature& quadrature, const Matrix3X&) {
+  quadrature_ = &quadrature;
+}
+
+Matrix3X FieldForceModel::generalizedForce(const Matrix3X& controlPoints, double&) {
+  return fieldForces(*quadrature_, controlPoints, field_);
+}
+
+}  // namespace dynsub

@@ -1,0 +1,95 @@
+#include "dynsub/Forces.h"
+
+#include <cmath>
+#include <string>
+
+#include "dynsub/Error.h"
+#include "dynsub/GaussLegendre.h"
+
+namespace dynsub {
+
+SurfaceQuadrature makeSurfaceQuadrature(const LimitSurface& surface, int pointsPerDirection, double elementSize) {
+  if (pointsPerDirection < 1 || pointsPerDirection > 16) {
+    throw Error("surface quadrature takes 1..16 points per direction, got " + std::to_string(pointsPerDirection));
+  }
+  const QuadratureRule rule = gaussLegendre(pointsPerDirection);
+  SurfaceQuadrature q;
+  const int perElement = pointsPerDirection * pointsPerDirection;
+  q.weights.resize(static_cast<Eigen::Index>(surface.elementCount()) * perElement);
+  for (int e = 0; e < surface.elementCount(); ++e) {
+    for (int j = 0; j < pointsPerDirection; ++j) {
+      for (int i = 0; i < pointsPerDirection; ++i) {
+        q.weights(static_cast<Eigen::Index>(q.points.size())) =
+            rule.weights[i] * rule.weights[j] * elementSize * elementSize;
+        q.points.push_back(ElementPoint{e, rule.nodes[i], rule.nodes[j]});
+      }
+    }
+  }
+  LimitOperators operators = surface.operators(q.points);
+  q.J = std::move(operators.J);
+  q.Ju = std::move(operators.Ju);
+  q.Jv = std::move(operators.Jv);
+  return q;
+}
+
+Matrix3X springForces(const LimitSurface& surface, const Matrix3X& controlPoints, const std::vector<Spring>& springs,
+                      double* energy) {
+  std::vector<ElementPoint> at;
+  at.reserve(springs.size());
+  for (const Spring& s : springs) at.push_back(s.attachment);
+  const SparseMatrix J = surface.operators(at).J;
+  Matrix3X pull = J * controlPoints;  // s at the attachments
+  double total = 0.0;
+  for (size_t i = 0; i < springs.size(); ++i) {
+    const Vector3 stretch = springs[i].target - pull.row(i).transpose();
+    total += 0.5 * springs[i].stiffness * stretch.squaredNorm();
+    pull.row(i) = springs[i].stiffness * stretch.transpose();
+  }
+  if (energy) *energy = total;
+  return J.transpose() * pull;
+}
+
+SparseMatrix springStiffness(const LimitSurface& surface, const std::vector<Spring>& springs) {
+  std::vector<ElementPoint> at;
+  Eigen::VectorXd k(springs.size());
+  for (size_t i = 0; i < springs.size(); ++i) {
+    at.push_back(springs[i].attachment);
+    k(i) = springs[i].stiffness;
+  }
+  const SparseMatrix J = surface.operators(at).J;
+  return SparseMatrix(J.transpose() * k.asDiagonal() * J);
+}
+
+namespace {
+
+// sum_q w_q J_q^T (f_q |s_u x s_v|_q) with f given per point, or P n for inflation.
+Matrix3X integrate(const SurfaceQuadrature& q, const Matrix3X& densityTimesArea) {
+  return q.J.transpose() * (q.weights.asDiagonal() * densityTimesArea);
+}
+
+}  // namespace
+
+Matrix3X inflationForces(const SurfaceQuadrature& q, const Matrix3X& controlPoints, double pressure) {
+  if (!std::isfinite(pressure)) throw Error("inflation pressure is not finite");
+  const Matrix3X su = q.Ju * controlPoints, sv = q.Jv * controlPoints;
+  Matrix3X area(su.rows(), 3);
+  for (Eigen::Index i = 0; i < su.rows(); ++i) {
+    area.row(i) = pressure * su.row(i).cross(sv.row(i));
+  }
+  return integrate(q, area);
+}
+
+Matrix3X fieldForces(const SurfaceQuadrature& q, const Matrix3X& controlPoints, const ForceField& field) {
+  const Matrix3X positions = q.J * controlPoints;
+  const Matrix3X su = q.Ju * controlPoints, sv = q.Jv * controlPoints;
+  Matrix3X forces = field.forcesAt(positions);
+  if (forces.rows() != positions.rows()) {
+    throw Error("force field returned " + std::to_string(forces.rows()) + " forces for " +
+                std::to_string(positions.rows()) + " points");
+  }
+  if (!forces.allFinite()) throw Error("force field returned a non-finite force");
+  for (Eigen::Index i = 0; i < forces.rows(); ++i) forces.row(i) *= su.row(i).cross(sv.row(i)).norm();
+  return integrate(q, forces);
+}
+
+}  // namespace dynsub

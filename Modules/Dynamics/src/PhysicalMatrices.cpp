@@ -1,0 +1,146 @@
+#include "dynsub/PhysicalMatrices.h"
+
+#include <cmath>
+#include <string>
+
+#include "dynsub/Error.h"
+#include "dynsub/GaussLegendre.h"
+#include "dynsub/LimitSurface.h"
+
+namespace dynsub {
+
+namespace {
+
+using Matrix16 = Eigen::Matrix<double, 16, 16>;
+
+// ∫∫ over the unit square of B^T B for the six basis rows (s, s_a, s_b, s_aa, s_ab, s_bb).
+struct UnitIntegrals {
+  std::array<Matrix16, 6> rows;
+};
+
+UnitIntegrals unitIntegrals(int points) {
+  const QuadratureRule rule = gaussLegendre(points);
+  UnitIntegrals result;
+  for (Matrix16& m : result.rows) m.setZero();
+  for (int i = 0; i < points; ++i) {
+    for (int j = 0; j < points; ++j) {
+      const Eigen::Matrix<double, 6, 16> w = bicubicBsplineWeights(rule.nodes[i], rule.nodes[j]);
+      const double weight = rule.weights[i] * rule.weights[j];
+      for (int r = 0; r < 6; ++r) result.rows[r].noalias() += weight * w.row(r).transpose() * w.row(r);
+    }
+  }
+  return result;
+}
+
+bool finiteNonNegative(double x) { return std::isfinite(x) && x >= 0.0; }
+
+void checkOptions(const AssemblyOptions& options) {
+  if (!(std::isfinite(options.elementSize) && options.elementSize > 0.0)) {
+    throw Error("element size must be positive, got " + std::to_string(options.elementSize));
+  }
+  if (options.levels < 1 || options.levels > 60) {
+    throw Error("special elements take 1..60 levels, got " + std::to_string(options.levels));
+  }
+  if (options.plateLevels < 0 || options.plateLevels > options.levels) {
+    throw Error("plate levels must be in 0.." + std::to_string(options.levels) + ", got " +
+                std::to_string(options.plateLevels));
+  }
+  if (options.quadraturePoints < 4 || options.quadraturePoints > 64) {
+    throw Error("B-spline pieces need 4..64 quadrature points per direction to be exact, got " +
+                std::to_string(options.quadraturePoints));
+  }
+}
+
+}  // namespace
+
+void checkMaterial(const Material& m) {
+  const double values[] = {m.mass, m.damping, m.tensionU, m.tensionV, m.rigidityUU, m.rigidityUV, m.rigidityVV};
+  const char* names[] = {"mass", "damping", "tension u", "tension v", "rigidity uu", "rigidity uv", "rigidity vv"};
+  for (int i = 0; i < 7; ++i) {
+    if (!finiteNonNegative(values[i])) {
+      throw Error(std::string("material ") + names[i] + " must be finite and >= 0, got " + std::to_string(values[i]));
+    }
+  }
+}
+
+ElementIntegrals integrateElement(const LimitSurface& surface, int element, const AssemblyOptions& options) {
+  checkOptions(options);
+  // NB: the unit integrals depend only on the quadrature order; cache the default.
+  static const UnitIntegrals exact = unitIntegrals(4);
+  const UnitIntegrals unit = options.quadraturePoints == 4 ? exact : unitIntegrals(options.quadraturePoints);
+
+  const bool special = surface.elementType(element) == ElementType::Special;
+  const ElementPieces pieces = surface.elementPieces(element, special ? options.levels : 1);
+  const int n = static_cast<int>(pieces.columns.size());
+  ElementIntegrals result;
+  result.columns = pieces.columns;
+  for (Eigen::MatrixXd* m : {&result.mass, &result.tensionU, &result.tensionV, &result.plateUU, &result.plateUV,
+                             &result.plateVV}) {
+    m->setZero(n, n);
+  }
+  for (size_t k = 0; k < pieces.pieces.size(); ++k) {
+    const BsplinePiece& piece = pieces.pieces[k];
+    const int level = special ? static_cast<int>(k / 3) + 1 : 0;
+    const double side = piece.size * options.elementSize;
+    const auto& grid = piece.grid;  // the derivatives see only the displacements
+    const Eigen::MatrixXd points = grid.rowwise() + piece.offset;
+    // Element u is the piece's a unless the piece is turned a quarter.
+    const int firstU = piece.swapped ? 2 : 1, firstV = piece.swapped ? 1 : 2;
+    const int secondUU = piece.swapped ? 5 : 3, secondVV = piece.swapped ? 3 : 5;
+    result.mass.noalias() += side * side * (points.transpose() * unit.rows[0] * points);
+    result.tensionU.noalias() += grid.transpose() * unit.rows[firstU] * grid;
+    result.tensionV.noalias() += grid.transpose() * unit.rows[firstV] * grid;
+    if (!special || level <= options.plateLevels) {
+      const double scale = 1.0 / (side * side);
+      result.plateUU.noalias() += scale * (grid.transpose() * unit.rows[secondUU] * grid);
+      result.plateUV.noalias() += scale * (grid.transpose() * unit.rows[4] * grid);
+      result.plateVV.noalias() += scale * (grid.transpose() * unit.rows[secondVV] * grid);
+    }
+  }
+  return result;
+}
+
+PhysicalMatrices assemblePhysicalMatrices(const LimitSurface& surface, const std::vector<Material>& materials,
+                                          const AssemblyOptions& options) {
+  checkOptions(options);
+  const int elements = surface.elementCount();
+  if (materials.size() != 1 && static_cast<int>(materials.size()) != elements) {
+    throw Error("got " + std::to_string(materials.size()) + " materials for a surface of " +
+                std::to_string(elements) + " elements (give one, or one per element)");
+  }
+  for (const Material& m : materials) checkMaterial(m);
+
+  std::vector<Eigen::Triplet<double>> mass, damping, stiffness;
+  for (int e = 0; e < elements; ++e) {
+    const Material& m = materials.size() == 1 ? materials[0] : materials[e];
+    const ElementIntegrals integrals = integrateElement(surface, e, options);
+    const Eigen::MatrixXd k = m.tensionU * integrals.tensionU + m.tensionV * integrals.tensionV +
+                              m.rigidityUU * integrals.plateUU + m.rigidityUV * integrals.plateUV +
+                              m.rigidityVV * integrals.plateVV;
+    const int n = static_cast<int>(integrals.columns.size());
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) {
+        const int row = integrals.columns[i], column = integrals.columns[j];
+        mass.emplace_back(row, column, m.mass * integrals.mass(i, j));
+        damping.emplace_back(row, column, m.damping * integrals.mass(i, j));
+        stiffness.emplace_back(row, column, k(i, j));
+      }
+    }
+  }
+  const int vertices = surface.controlVertexCount();
+  PhysicalMatrices result;
+  result.mass.resize(vertices, vertices);
+  result.damping.resize(vertices, vertices);
+  result.stiffness.resize(vertices, vertices);
+  result.mass.setFromTriplets(mass.begin(), mass.end());
+  result.damping.setFromTriplets(damping.begin(), damping.end());
+  result.stiffness.setFromTriplets(stiffness.begin(), stiffness.end());
+  return result;
+}
+
+PhysicalMatrices assemblePhysicalMatrices(const LimitSurface& surface, const Material& material,
+                                          const AssemblyOptions& options) {
+  return assemblePhysicalMatrices(surface, std::vector<Material>{material}, options);
+}
+
+}  // namespace dynsub

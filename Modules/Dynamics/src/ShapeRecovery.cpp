@@ -1,0 +1,146 @@
+#include "dynsub/ShapeRecovery.h"
+
+#include <chrono>
+#include <cmath>
+#include <string>
+
+#include <Eigen/Eigenvalues>
+
+#include "dynsub/ClosestPoint.h"
+#include "dynsub/Error.h"
+#include "dynsub/LimitSurface.h"
+#include "dynsub/StandardMeshes.h"
+
+namespace dynsub {
+
+namespace {
+
+struct Principal {
+  Vector3 mean;
+  Eigen::Matrix3d axes;    // columns: unit eigenvectors, decreasing variance, right-handed
+  Vector3 variances;       // decreasing
+};
+
+Principal principalAxes(const Matrix3X& points) {
+  Principal p;
+  p.mean = points.colwise().mean().transpose();
+  const Matrix3X centred = points.rowwise() - p.mean.transpose();
+  const Eigen::Matrix3d covariance = centred.transpose() * centred / static_cast<double>(points.rows());
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+  for (int i = 0; i < 3; ++i) {
+    p.variances(i) = std::max(0.0, solver.eigenvalues()(2 - i));
+    p.axes.col(i) = solver.eigenvectors().col(2 - i);
+  }
+  if (p.axes.determinant() < 0.0) p.axes.col(2) *= -1.0;  // keep orientation (outward normals)
+  return p;
+}
+
+Matrix3X limitPositions(const ControlMesh& mesh) {
+  const LimitSurface surface(mesh);
+  return surface.controlVertexLimitOperator() * mesh.points();
+}
+
+}  // namespace
+
+void checkPointCloud(const Matrix3X& points, const std::string& source) {
+  if (points.rows() < 4) {
+    throw Error(source, "has " + std::to_string(points.rows()) + " points; a surface needs at least 4");
+  }
+  for (Eigen::Index i = 0; i < points.rows(); ++i) {
+    if (!points.row(i).allFinite()) throw Error(source, "point " + std::to_string(i + 1) + " is not finite");
+  }
+  const Principal p = principalAxes(points);
+  if (!(p.variances(0) > 0.0)) throw Error(source, "all points coincide");
+  // Relative to the largest spread; 1e-12 of the variance is 1e-6 of the size.
+  if (p.variances(2) <= 1e-12 * p.variances(0)) {
+    throw Error(source, p.variances(1) <= 1e-12 * p.variances(0) ? "all points lie on a line"
+                                                                  : "all points lie on a plane");
+  }
+}
+
+ControlMesh initialModel(const Matrix3X& points, InitialShape shape) {
+  const Principal p = principalAxes(points);
+  if (shape == InitialShape::Sphere) {
+    ControlMesh cube = makeCube98();
+    // The cube's limit surface spans [-h, h]^3 around the origin.
+    const double h = limitPositions(cube).cwiseAbs().maxCoeff();
+    Vector3 scale;
+    for (int i = 0; i < 3; ++i) scale(i) = 0.5 * std::sqrt(3.0 * p.variances(i)) / h;
+    const Matrix3X placed = ((cube.points() * scale.asDiagonal()) * p.axes.transpose()).rowwise() + p.mean.transpose();
+    cube.setPoints(placed);
+    return cube;
+  }
+  // Torus: axis along the least-variance direction (third axis).
+  const Matrix3X local = (points.rowwise() - p.mean.transpose()) * p.axes;
+  const Eigen::VectorXd rho = local.leftCols(2).rowwise().norm();
+  const double ring = rho.mean();
+  const double tube = std::sqrt(((rho.array() - ring).square() + local.col(2).array().square()).mean());
+  ControlMesh torus = makeTorus32();
+  // The standard torus: ring radius 1, tube 0.5 (control mesh); measure its limit.
+  const Matrix3X limit = limitPositions(torus);
+  const Eigen::VectorXd limitRho = limit.leftCols(2).rowwise().norm();
+  const double limitRing = limitRho.mean();
+  const double limitTube = std::sqrt(((limitRho.array() - limitRing).square() + limit.col(2).array().square()).mean());
+  Matrix3X control = torus.points();
+  for (Eigen::Index i = 0; i < control.rows(); ++i) {
+    const double r = control.row(i).head<2>().norm();
+    const double radial = ring + (r - limitRing) * 0.5 * tube / limitTube;
+    const double height = control(i, 2) * 0.5 * tube / limitTube;
+    control.row(i).head<2>() *= radial / r;
+    control(i, 2) = height;
+  }
+  torus.setPoints((control * p.axes.transpose()).rowwise() + p.mean.transpose());
+  return torus;
+}
+
+SimulationOptions FitOptions::defaultSimulation() {
+  SimulationOptions o;
+  o.maxLevel = 2;
+  return o;
+}
+
+FitError measureFitError(const LimitSurface& surface, const Matrix3X& controlPoints, const Matrix3X& data,
+                         double diameter) {
+  ClosestPointLocator locator(surface, 8, 8);
+  locator.update(controlPoints);
+  const std::vector<ClosestPoint> nearest = locator.findAll(data);
+  double worst = 0.0, squares = 0.0;
+  for (const ClosestPoint& c : nearest) {
+    worst = std::max(worst, c.distance);
+    squares += c.distance * c.distance;
+  }
+  return FitError{100.0 * worst / diameter, 100.0 * std::sqrt(squares / nearest.size()) / diameter};
+}
+
+FitResult fitPointCloud(const Matrix3X& data, const ControlMesh& initial, const FitOptions& options,
+                        const ProgressCallback& progress) {
+  const auto started = std::chrono::steady_clock::now();
+  checkPointCloud(data, "point cloud");
+  if (!initial.isClosed()) throw Error("the initial model must be a closed surface (it has boundaries)");
+  if (!(options.tolerancePercent > 0.0)) throw Error("the fit tolerance must be > 0 percent");
+  if (!(std::isfinite(options.dataStiffness) && options.dataStiffness > 0.0)) {
+    throw Error("the data stiffness must be finite and > 0");
+  }
+  FitResult result;
+  result.enclosingSphere = smallestEnclosingSphere(data);
+  const double diameter = 2.0 * result.enclosingSphere.radius;
+  const double area = LimitSurface(initial).elementCount();
+  const Eigen::VectorXd stiffness =
+      Eigen::VectorXd::Constant(data.rows(), options.dataStiffness * area / static_cast<double>(data.rows()));
+  SpringForceModel springs(data, stiffness, SpringForceModel::Attach::NearestEachStep);
+
+  AcceptFit accept = [&](const LimitSurface& surface, const Matrix3X& points) {
+    const FitError e = measureFitError(surface, points, data, diameter);
+    result.levelErrors.push_back(e);
+    return e.maxPercent <= options.tolerancePercent;
+  };
+  SimulationResult simulation = simulate(initial, {&springs}, {}, options.simulation, accept, progress);
+  result.mesh = std::move(simulation.mesh);
+  result.levels = std::move(simulation.levels);
+  result.steps = simulation.steps;
+  result.error = result.levelErrors.back();
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return result;
+}
+
+}  // namespace dynsub

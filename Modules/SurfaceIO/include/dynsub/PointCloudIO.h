@@ -1,0 +1,20 @@
+#pragma once
+// Point clouds (range data, landmarks as points) in mm, read by extension:
+//   .xyz, .txt  one point per line, the first three whitespace-separated
+//               numbers (more columns, e.g. normals, are ignored); '#' comments
+//   .csv        comma- or semicolon-separated, the first three columns; one
+//               header line of names is skipped
+//   .ply .off .obj  the vertices (faces, if any, are ignored)
+//   .vtp        the points of VTK XML polydata
+#include <string>
+
+#include "dynsub/Types.h"
+
+namespace dynsub {
+
+// Throws dynsub::Error naming the file (and line) for a missing, empty,
+// truncated or malformed file or an unknown extension. Coordinates are not
+// checked for finiteness here (see checkPointCloud in ShapeRecovery.h).
+Matrix3X readPointCloud(const std::string& path);
+
+}  // namespace dynsub
