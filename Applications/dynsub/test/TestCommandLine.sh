@@ -48,5 +48,58 @@ expect_error "impossible sample count" 2 "samples-per-face" "$work/g.vtp" \
   "$DYNSUB" limit "$DATA/Meshes/cube.obj" --samples-per-face 0 --out "$work/g.vtp"
 expect_error "unknown standard mesh" 2 "NAME" "$work/h.obj" "$DYNSUB" mesh sphere --out "$work/h.obj"
 
+# --- fit: shape recovery from a point cloud -------------------------------
+# 400 points on a sphere of radius 30 mm around (5, -2, 7), from awk's seeded generator.
+awk 'BEGIN { srand(3); for (i = 0; i < 400; i++) { z = 2 * rand() - 1; t = 6.283185307 * rand(); r = sqrt(1 - z * z);
+  printf "%.6f %.6f %.6f\n", 5 + 30 * r * cos(t), -2 + 30 * r * sin(t), 7 + 30 * z } }' >"$work/sphere.xyz"
+"$DYNSUB" fit "$work/sphere.xyz" --out "$work/fit" >"$work/stdout" 2>"$work/stderr"
+check "fit succeeds" test $? -eq 0
+for name in surface.vtp control_mesh.obj report.json; do check "fit writes $name" test -s "$work/fit/$name"; done
+for key in max_error_percent rms_error_percent control_vertices levels iterations seconds parameters; do
+  check "report.json has $key" grep -q "\"$key\"" "$work/fit/report.json"
+done
+error=$(sed -n 's/.*"max_error_percent": \([0-9.eE+-]*\).*/\1/p' "$work/fit/report.json" | head -1)
+check "fit reaches 1 % (got $error)" awk -v e="$error" 'BEGIN { exit !(e <= 1.0) }'
+check "fit says how long it took" grep -q " s$" <(head -1 "$work/stdout")
+awk 'NR <= 120 { print $1 "," $2 "," $3 }' "$work/sphere.xyz" | sed '1i x,y,z' >"$work/sphere.csv"
+"$DYNSUB" fit "$work/sphere.csv" --out "$work/fitcsv" --max-level 0 >/dev/null 2>&1
+check "fit reads .csv with a header" test -s "$work/fitcsv/report.json"
+
+printf '1 2 3\n4 5 6\n7 8 9.5\n' >"$work/three.xyz"
+expect_error "too few points" 1 "at least 4" "$work/o1" "$DYNSUB" fit "$work/three.xyz" --out "$work/o1"
+printf '0 0 0\n1 0 0\n0 1 0\n0 0 nan\n1 1 1\n' >"$work/nan.xyz"
+expect_error "NaN coordinate" 1 "nan.xyz" "$work/o2" "$DYNSUB" fit "$work/nan.xyz" --out "$work/o2"
+printf '1 1 1\n1 1 1\n1 1 1\n1 1 1\n1 1 1\n' >"$work/same.xyz"
+expect_error "coincident points" 1 "coincide" "$work/o3" "$DYNSUB" fit "$work/same.xyz" --out "$work/o3"
+awk 'BEGIN { srand(4); for (i = 0; i < 50; i++) printf "%f %f 2\n", rand(), rand() }' >"$work/flat.xyz"
+expect_error "coplanar points" 1 "plane" "$work/o4" "$DYNSUB" fit "$work/flat.xyz" --out "$work/o4"
+expect_error "wrong genus" 1 "genus" "$work/o5" "$DYNSUB" fit "$work/sphere.xyz" --init torus --genus 0 --out "$work/o5"
+expect_error "open initial model" 1 "closed" "$work/o6" \
+  "$DYNSUB" fit "$work/sphere.xyz" --init "$DATA/Meshes/sheet.obj" --out "$work/o6"
+expect_error "missing point cloud" 1 "no such file" "$work/o7" "$DYNSUB" fit "$work/none.xyz" --out "$work/o7"
+printf 'x y z\n' >"$work/words.xyz"
+expect_error "malformed point cloud" 1 "line 1" "$work/o8" "$DYNSUB" fit "$work/words.xyz" --out "$work/o8"
+expect_error "impossible tolerance" 2 "tolerance" "$work/o9" \
+  "$DYNSUB" fit "$work/sphere.xyz" --tolerance -1 --out "$work/o9"
+expect_error "missing output parent" 1 "does not exist" "$work/no/o10" \
+  "$DYNSUB" fit "$work/sphere.xyz" --out "$work/no/o10"
+
+# --- deform: modeling by forces -------------------------------------------
+"$DYNSUB" deform "$DATA/Meshes/sheet.obj" --springs "$DATA/Deform/sheet_hat.springs" --fix-boundary \
+  --out "$work/hat" >"$work/stdout" 2>&1
+check "deform pulls the sheet into a hat" grep -q "equilibrium" "$work/stdout"
+for name in surface.vtp control_mesh.obj report.json; do check "deform writes $name" test -s "$work/hat/$name"; done
+# The crown rises toward the springs (z = 0.85-0.9) while the brim stays at z = 0.
+crown=$(awk '$1 == "v" { n++ } n == 41 { print $4; exit }' "$work/hat/control_mesh.obj")  # vertex 41: the centre
+check "the crown rises (z = $crown)" awk -v z="$crown" 'BEGIN { exit !(z > 0.7) }'
+check "the brim stays" grep -q "^v -1 -1 0$" "$work/hat/control_mesh.obj"
+"$DYNSUB" deform "$DATA/Meshes/torus.obj" --springs "$DATA/Deform/torus_pull.springs" --out "$work/torus" >/dev/null 2>&1
+check "deform pulls the torus" test -s "$work/torus/report.json"
+printf '0 0 1 -5\n' >"$work/bad.springs"
+expect_error "negative spring stiffness" 1 "stiffness" "$work/o11" \
+  "$DYNSUB" deform "$DATA/Meshes/sheet.obj" --springs "$work/bad.springs" --out "$work/o11"
+expect_error "fix-boundary on a closed mesh" 1 "closed" "$work/o12" \
+  "$DYNSUB" deform "$DATA/Meshes/torus.obj" --springs "$DATA/Deform/torus_pull.springs" --fix-boundary --out "$work/o12"
+
 if [ "$failures" -gt 0 ]; then echo "$failures check(s) failed"; exit 1; fi
 echo "all command-line checks passed"

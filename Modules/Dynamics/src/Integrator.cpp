@@ -115,7 +115,10 @@ Integrator::Integrator(const PhysicalMatrices& matrices, const SymmetricMatrix& 
   switch (options.solver) {
     case LinearSolver::Cholesky:
       s.cholesky.compute(s.lhsFree);
-      if (s.cholesky.info() != Eigen::Success || (s.cholesky.vectorD().array() <= 0.0).any()) {
+      // NB: a singular matrix (K alone: translations cost nothing) factors with
+      // pivots at rounding level rather than failing; treat those as zero.
+      if (s.cholesky.info() != Eigen::Success ||
+          (s.cholesky.vectorD().array() <= 1e-12 * s.cholesky.vectorD().cwiseAbs().maxCoeff()).any()) {
         throw Error("the left-hand matrix of the time step is not positive definite (is the surface anchored? "
                     "first-order integration needs damping > 0)");
       }

@@ -38,7 +38,7 @@ LinearSolver parseLinearSolver(const std::string& text);
 struct IntegratorOptions {
   IntegrationScheme scheme = IntegrationScheme::FirstOrder;
   LinearSolver solver = LinearSolver::Cholesky;
-  double timeStep = 0.1;           // s
+  double timeStep = 0.5;           // s
   double solverTolerance = 1e-10;  // relative residual of the iterative solvers
   int solverMaxIterations = 5000;
 };

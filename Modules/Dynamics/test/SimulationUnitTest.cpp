@@ -1,0 +1,271 @@
+// The dynamics end to end, against answers known without it: a pure-spring
+// problem's equilibrium is the direct least-squares solution; solvers agree;
+// refinement keeps the surface; smallest enclosing spheres against brute force;
+// analytic point clouds (sphere, 3:2:1 ellipsoid, torus) are recovered to the
+// papers' 1 % tolerance; runs are repeatable; bad input is refused.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include <Eigen/SparseCholesky>
+
+#include "dynsub/CatmullClark.h"
+#include "dynsub/ClosestPoint.h"
+#include "dynsub/EnclosingSphere.h"
+#include "dynsub/Error.h"
+#include "dynsub/ForceModel.h"
+#include "dynsub/Integrator.h"
+#include "dynsub/LimitSurface.h"
+#include "dynsub/ShapeRecovery.h"
+#include "dynsub/Simulation.h"
+#include "dynsub/StandardMeshes.h"
+#include "dynsub/Tessellation.h"
+
+namespace dynsub {
+namespace {
+
+Vector3 randomDirection(std::mt19937_64& random) {
+  std::normal_distribution<double> normal;
+  Vector3 v;
+  do {
+    v = Vector3(normal(random), normal(random), normal(random));
+  } while (v.norm() < 1e-6);
+  return v.normalized();
+}
+
+Matrix3X ellipsoidPoints(int n, const Vector3& axes, unsigned seed) {
+  std::mt19937_64 random(seed);
+  Matrix3X points(n, 3);
+  for (int i = 0; i < n; ++i) points.row(i) = randomDirection(random).cwiseProduct(axes).transpose();
+  return points;
+}
+
+Matrix3X torusPoints(int n, double ring, double tube, unsigned seed) {
+  std::mt19937_64 random(seed);
+  std::uniform_real_distribution<double> angle(0.0, 2.0 * M_PI);
+  Matrix3X points(n, 3);
+  for (int i = 0; i < n; ++i) {
+    const double theta = angle(random), phi = angle(random);
+    const double r = ring + tube * std::cos(phi);
+    points.row(i) << r * std::cos(theta), r * std::sin(theta), tube * std::sin(phi);
+  }
+  return points;
+}
+
+// Springs from targets near the cube's surface, attached once: at equilibrium
+// K p = sum k J^T (d - J p), i.e. (K + J^T k J) p = J^T k d, solved directly.
+class PureSpringTest : public ::testing::TestWithParam<std::tuple<IntegrationScheme, LinearSolver>> {};
+
+TEST_P(PureSpringTest, EquilibriumIsTheDirectLeastSquaresSolution) {
+  const ControlMesh cube = makeCube98();
+  const LimitSurface surface(cube);
+  std::mt19937_64 random(7);
+  std::uniform_real_distribution<double> jitter(-0.2, 0.2);
+  const TriangleSurface samples = tessellate(surface, cube.points(), 2);
+  Matrix3X targets = samples.points;
+  for (Eigen::Index i = 0; i < targets.rows(); ++i) targets.row(i) += Vector3(jitter(random), jitter(random), jitter(random)).transpose() + 0.3 * samples.normals.row(i);
+  const Eigen::VectorXd stiffness = Eigen::VectorXd::Constant(targets.rows(), 5.0);
+  SpringForceModel springs(targets, stiffness, SpringForceModel::Attach::NearestAtLevelStart);
+
+  SimulationOptions options;
+  options.integrator.scheme = std::get<0>(GetParam());
+  options.integrator.solver = std::get<1>(GetParam());
+  options.integrator.timeStep = 0.5;
+  options.equilibrium.energyTolerance = 1e-14;
+  options.equilibrium.motionTolerance = 1e-11;
+  options.equilibrium.maxSteps = 5000;
+  const SimulationResult result = simulate(cube, {&springs}, {}, options);
+  ASSERT_TRUE(result.levels.back().converged);
+
+  // The attachments the springs used: nearest points to the initial surface.
+  ClosestPointLocator locator(surface);
+  locator.update(cube.points());
+  std::vector<Spring> attached;
+  for (const ClosestPoint& c : locator.findAll(targets)) attached.push_back(Spring{c.point, Vector3::Zero(), 5.0});
+  for (size_t i = 0; i < attached.size(); ++i) attached[i].target = targets.row(i).transpose();
+  const PhysicalMatrices m = assemblePhysicalMatrices(surface, options.material);
+  const SymmetricMatrix lhs = m.stiffness + SymmetricMatrix(springStiffness(surface, attached));
+  Eigen::SimplicialLDLT<SymmetricMatrix> direct(lhs);
+  ASSERT_EQ(direct.info(), Eigen::Success);
+  const Matrix3X zeros = Matrix3X::Zero(cube.vertexCount(), 3);
+  const Matrix3X rhs = springForces(surface, zeros, attached);  // J^T k d
+  const Matrix3X expected = direct.solve(Eigen::MatrixXd(rhs));
+  // The dynamics stop when steps move points by < 1e-11 of the size (~3.5);
+  // the remaining distance to equilibrium is of that order.
+  EXPECT_LT((result.mesh.points() - expected).cwiseAbs().maxCoeff(), 1e-7);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    AllSchemesAndSolvers, PureSpringTest,
+    ::testing::Combine(::testing::Values(IntegrationScheme::FirstOrder, IntegrationScheme::SecondOrder),
+                       ::testing::Values(LinearSolver::Cholesky, LinearSolver::ConjugateGradient,
+                                         LinearSolver::PreconditionedConjugateGradient)),
+    [](const auto& info) {
+      return std::string(std::get<0>(info.param) == IntegrationScheme::FirstOrder ? "FirstOrder" : "SecondOrder") +
+             (std::get<1>(info.param) == LinearSolver::Cholesky ? "Cholesky"
+              : std::get<1>(info.param) == LinearSolver::ConjugateGradient ? "CG" : "PCG");
+    });
+
+TEST(Integrator, SolversTakeTheSameStep) {
+  const ControlMesh cube = makeCube98();
+  const LimitSurface surface(cube);
+  const PhysicalMatrices m = assemblePhysicalMatrices(surface, Material{});
+  const Matrix3X p = cube.points();
+  const Matrix3X previous = 0.99 * p;
+  const Matrix3X force = 0.1 * p;
+  for (IntegrationScheme scheme : {IntegrationScheme::FirstOrder, IntegrationScheme::SecondOrder}) {
+    IntegratorOptions options;
+    options.scheme = scheme;
+    options.solver = LinearSolver::Cholesky;
+    const Matrix3X reference = Integrator(m, SymmetricMatrix(), {0, 5}, options).step(previous, p, force);
+    EXPECT_EQ(reference.row(0), p.row(0));  // fixed vertices stay
+    EXPECT_EQ(reference.row(5), p.row(5));
+    for (LinearSolver solver : {LinearSolver::ConjugateGradient, LinearSolver::PreconditionedConjugateGradient}) {
+      options.solver = solver;
+      Integrator integrator(m, SymmetricMatrix(), {0, 5}, options);
+      // Relative residual 1e-10 on a system of condition ~1e3.
+      EXPECT_LT((integrator.step(previous, p, force) - reference).cwiseAbs().maxCoeff(), 1e-7);
+      EXPECT_GT(integrator.lastIterations(), 0);
+    }
+  }
+}
+
+TEST(Integrator, RefusesASingularSystem) {
+  const LimitSurface surface(makeCube98());
+  Material material;
+  material.damping = 0.0;
+  const PhysicalMatrices m = assemblePhysicalMatrices(surface, material);
+  IntegratorOptions options;  // first order: D + 2 dt K, singular for translations when D = 0
+  EXPECT_THROW(Integrator(m, SymmetricMatrix(), {}, options), Error);
+}
+
+TEST(Refinement, LeavesTheLimitSurfaceUnchanged) {
+  for (const char* name : {"cube", "torus"}) {
+    const ControlMesh mesh = makeStandardMesh(name);
+    const SubdividedMesh refined = subdivide(mesh);
+    const LimitSurface coarse(mesh), fine(refined.mesh);
+    const TriangleSurface samples = tessellate(fine, refined.mesh.points(), 3);
+    ClosestPointLocator locator(coarse, 8, 8);
+    locator.update(mesh.points());
+    double worst = 0.0;
+    for (const ClosestPoint& c : locator.findAll(samples.points)) worst = std::max(worst, c.distance);
+    // Exact in theory; Newton stops at steps of 1e-12 in parameters.
+    EXPECT_LT(worst, 1e-9) << name;
+  }
+}
+
+TEST(EnclosingSphere, MatchesBruteForce) {
+  std::mt19937_64 random(11);
+  std::uniform_real_distribution<double> coordinate(-1.0, 1.0);
+  for (int trial = 0; trial < 5; ++trial) {
+    const int n = 14;
+    Matrix3X points(n, 3);
+    for (int i = 0; i < n; ++i) points.row(i) << coordinate(random), 2.0 * coordinate(random), coordinate(random);
+    const Sphere s = smallestEnclosingSphere(points);
+    for (int i = 0; i < n; ++i) EXPECT_LE((points.row(i).transpose() - s.center).norm(), s.radius * (1 + 1e-9));
+    // The smallest sphere is determined by 2, 3 or 4 points on it: try them all.
+    double best = std::numeric_limits<double>::infinity();
+    auto consider = [&](const Vector3& c) {
+      double r = 0.0;
+      for (int i = 0; i < n; ++i) r = std::max(r, (points.row(i).transpose() - c).norm());
+      best = std::min(best, r);
+    };
+    for (int a = 0; a < n; ++a) {
+      for (int b = a + 1; b < n; ++b) {
+        consider(0.5 * (points.row(a) + points.row(b)).transpose());
+        for (int c = b + 1; c < n; ++c) {
+          Matrix3X three(3, 3);
+          three << points.row(a), points.row(b), points.row(c);
+          // The smallest sphere of 3 points, computed by the same routine, is their circle or a pair.
+          consider(smallestEnclosingSphere(three).center);
+          for (int d = c + 1; d < n; ++d) {
+            Eigen::Matrix3d m;
+            m << points.row(b) - points.row(a), points.row(c) - points.row(a), points.row(d) - points.row(a);
+            const Vector3 rhs(0.5 * (points.row(b) - points.row(a)).squaredNorm(),
+                              0.5 * (points.row(c) - points.row(a)).squaredNorm(),
+                              0.5 * (points.row(d) - points.row(a)).squaredNorm());
+            consider(points.row(a).transpose() + m.fullPivLu().solve(rhs));
+          }
+        }
+      }
+    }
+    EXPECT_NEAR(s.radius, best, 1e-9 * best);
+  }
+}
+
+TEST(EnclosingSphere, OfPointsOnASphere) {
+  const Matrix3X points = ellipsoidPoints(5000, Vector3(3.0, 3.0, 3.0), 3);
+  const Sphere s = smallestEnclosingSphere(points);
+  EXPECT_NEAR(s.radius, 3.0, 1e-3);  // 5000 random points leave no cap wider than ~0.05 rad uncovered
+  EXPECT_LT(s.center.norm(), 2e-3);
+}
+
+TEST(PointCloudChecks, RefuseDegenerateData) {
+  EXPECT_THROW(checkPointCloud(Matrix3X::Random(3, 3), "three.xyz"), Error);
+  Matrix3X nan = Matrix3X::Random(10, 3);
+  nan(4, 1) = std::nan("");
+  EXPECT_THROW(checkPointCloud(nan, "nan.xyz"), Error);
+  EXPECT_THROW(checkPointCloud(Matrix3X::Ones(10, 3), "same.xyz"), Error);
+  Matrix3X flat = Matrix3X::Random(10, 3);
+  flat.col(2).setConstant(4.0);
+  try {
+    checkPointCloud(flat, "flat.xyz");
+    FAIL() << "coplanar points were accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("flat.xyz: all points lie on a plane"), std::string::npos) << e.what();
+  }
+  Matrix3X line(10, 3);
+  for (int i = 0; i < 10; ++i) line.row(i) << i, 2 * i, -i;
+  EXPECT_THROW(checkPointCloud(line, "line.xyz"), Error);
+  EXPECT_NO_THROW(checkPointCloud(Matrix3X::Random(10, 3), "fine.xyz"));
+}
+
+TEST(ShapeRecovery, RefusesAnOpenInitialModel) {
+  const Matrix3X points = ellipsoidPoints(200, Vector3(2, 2, 2), 5);
+  EXPECT_THROW(fitPointCloud(points, makeSheet81(), FitOptions{}), Error);
+}
+
+struct RecoveryCase {
+  std::string name;
+  Matrix3X points;
+  InitialShape init;
+  int maxControlVertices;
+};
+
+class ShapeRecoveryTest : public ::testing::TestWithParam<int> {};
+
+RecoveryCase recoveryCase(int index) {
+  switch (index) {
+    case 0: return {"sphere", ellipsoidPoints(1000, Vector3(40, 40, 40), 1), InitialShape::Sphere, 386};
+    case 1: return {"ellipsoid321", ellipsoidPoints(1500, Vector3(60, 40, 20), 2), InitialShape::Sphere, 386};
+    default: return {"torus", torusPoints(1500, 40, 15, 3), InitialShape::Torus, 2048};
+  }
+}
+
+// The ICCV tolerance: max distance from a data point to the limit surface
+// <= 1 % of the diameter of the smallest enclosing sphere.
+TEST_P(ShapeRecoveryTest, RecoversAnalyticShapesToOnePercent) {
+  const RecoveryCase c = recoveryCase(GetParam());
+  const ControlMesh initial = initialModel(c.points, c.init);
+  const FitResult result = fitPointCloud(c.points, initial, FitOptions{});
+  EXPECT_LE(result.error.maxPercent, 1.0) << c.name;
+  EXPECT_LE(result.mesh.vertexCount(), c.maxControlVertices) << c.name;
+  EXPECT_LT(result.mesh.vertexCount(), c.points.rows()) << c.name;
+  EXPECT_TRUE(result.mesh.points().allFinite());
+}
+
+INSTANTIATE_TEST_SUITE_P(Analytic, ShapeRecoveryTest, ::testing::Values(0, 1, 2),
+                         [](const auto& info) { return recoveryCase(info.param).name; });
+
+TEST(ShapeRecovery, SameInputGivesIdenticalOutput) {
+  const Matrix3X points = torusPoints(800, 30, 10, 9);
+  const ControlMesh initial = initialModel(points, InitialShape::Torus);
+  const FitResult a = fitPointCloud(points, initial, FitOptions{});
+  const FitResult b = fitPointCloud(points, initial, FitOptions{});
+  EXPECT_EQ(a.steps, b.steps);
+  EXPECT_TRUE((a.mesh.points().array() == b.mesh.points().array()).all());
+  EXPECT_EQ(a.error.maxPercent, b.error.maxPercent);
+}
+
+}  // namespace
+}  // namespace dynsub
