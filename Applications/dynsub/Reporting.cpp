@@ -74,6 +74,7 @@ nlohmann::ordered_json simulationJson(const SimulationOptions& o) {
                    {"tension_u", o.material.tensionU},  {"tension_v", o.material.tensionV},
                    {"rigidity_uu", o.material.rigidityUU}, {"rigidity_uv", o.material.rigidityUV},
                    {"rigidity_vv", o.material.rigidityVV}};
+  j["elasticity_per_level"] = o.elasticityPerLevel;
   j["plate_levels"] = o.assembly.plateLevels;
   j["equilibrium"] = {{"energy_tolerance", o.equilibrium.energyTolerance},
                       {"motion_tolerance", o.equilibrium.motionTolerance},

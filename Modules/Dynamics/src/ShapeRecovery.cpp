@@ -95,7 +95,10 @@ ControlMesh initialModel(const Matrix3X& points, InitialShape shape) {
 
 SimulationOptions FitOptions::defaultSimulation() {
   SimulationOptions o;
-  o.maxLevel = 2;
+  o.maxLevel = 3;
+  // The data springs do not stiffen with refinement; weakening the surface's
+  // elasticity 4-fold per level lets the finer levels follow the data closer.
+  o.elasticityPerLevel = 0.25;
   return o;
 }
 

@@ -36,6 +36,9 @@ void checkSimulationOptions(const SimulationOptions& o) {
   }
   if (o.maxLevel < 0 || o.maxLevel > 6) throw Error("the maximum level must be in 0..6, got " + std::to_string(o.maxLevel));
   if (o.maxTimeStepHalvings < 0) throw Error("time-step halvings must be >= 0");
+  if (!(o.elasticityPerLevel > 0.0 && o.elasticityPerLevel <= 1.0)) {
+    throw Error("the elasticity factor per level must be in (0, 1], got " + std::to_string(o.elasticityPerLevel));
+  }
   if (!(std::isfinite(o.integrator.timeStep) && o.integrator.timeStep > 0.0)) {
     throw Error("time step must be positive, got " + std::to_string(o.integrator.timeStep));
   }
@@ -70,7 +73,13 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
     state.elementSize = std::ldexp(1.0, initialIsolation - (state.level + surface.isolationLevels()));
     AssemblyOptions assembly = options.assembly;
     assembly.elementSize = state.elementSize;
-    const PhysicalMatrices matrices = assemblePhysicalMatrices(surface, options.material, assembly);
+    Material material = options.material;
+    const double elasticity = std::pow(options.elasticityPerLevel, state.level);
+    for (double* m : {&material.tensionU, &material.tensionV, &material.rigidityUU, &material.rigidityUV,
+                      &material.rigidityVV}) {
+      *m *= elasticity;
+    }
+    const PhysicalMatrices matrices = assemblePhysicalMatrices(surface, material, assembly);
     const SurfaceQuadrature quadrature =
         makeSurfaceQuadrature(surface, options.quadraturePoints, state.elementSize);
     const Matrix3X start = state.mesh.points();

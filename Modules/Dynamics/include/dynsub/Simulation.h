@@ -47,6 +47,10 @@ struct SimulationOptions {
   IntegratorOptions integrator;
   EquilibriumOptions equilibrium;
   int maxLevel = 0;  // global refinements allowed
+  // Tension and rigidity at level g are multiplied by elasticityPerLevel^g.
+  // 1 keeps the physics of the initial model (the energy of a surface does not
+  // depend on the level); < 1 lets each refinement trade smoothing for detail.
+  double elasticityPerLevel = 1.0;
   int maxTimeStepHalvings = 8;
   int quadraturePoints = 3;  // per direction per element, for distributed forces
 };
