@@ -13,10 +13,7 @@
 #include "Reporting.h"
 #include "dynsub/Error.h"
 #include "dynsub/ForceModel.h"
-#include "dynsub/LimitSurface.h"
 #include "dynsub/MeshIO.h"
-#include "dynsub/SurfaceWriter.h"
-#include "dynsub/Tessellation.h"
 #include "dynsub/Topology.h"
 #include "dynsub/CatmullClark.h"
 
@@ -103,10 +100,6 @@ void runDeform(DeformOptions o) {
   const SimulationResult result = simulate(mesh, {&model}, fixed, options, nullptr, line.callback());
   line.finish();
 
-  const LimitSurface surface(result.mesh);
-  const Matrix3X control = result.mesh.points();
-  if (!control.allFinite()) throw Error("internal: the deformed control points are not finite");
-  const TriangleSurface triangles = tessellate(surface, control, 8);
   const Eigen::VectorXd& lengths = model.lengths();
   double seconds = 0.0;
   for (const LevelSummary& l : result.levels) seconds += l.seconds;
@@ -131,11 +124,7 @@ void runDeform(DeformOptions o) {
   parameters["fix_boundary"] = o.fixBoundary;
   report["parameters"] = parameters;
 
-  OutputSet outputs(dir);
-  writeTriangleSurface(triangles, outputs.add("surface.vtp"));
-  writeObj(result.mesh, outputs.add("control_mesh.obj"));
-  writeJson(report, outputs.add("report.json"));
-  outputs.commit();
+  writeModelOutputs(dir, result.mesh, report);
   std::cout << std::fixed << std::setprecision(3) << "deformed " << o.mesh << " with " << springs.targets.rows()
             << " springs: " << (result.levels.back().converged ? "equilibrium" : "step limit reached") << " after "
             << result.steps << " steps, " << std::setprecision(2) << seconds << " s; largest spring length "

@@ -1,9 +1,5 @@
 // dynsub fit: shape recovery from range data (ShapeRecovery.h).
-#include <unistd.h>
-
-#include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 
@@ -12,14 +8,10 @@
 
 #include "Commands.h"
 #include "Reporting.h"
-#include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
-#include "dynsub/LimitSurface.h"
 #include "dynsub/MeshIO.h"
 #include "dynsub/PointCloudIO.h"
 #include "dynsub/ShapeRecovery.h"
-#include "dynsub/SurfaceWriter.h"
-#include "dynsub/Tessellation.h"
 
 namespace dynsub::app {
 
@@ -69,11 +61,6 @@ void runFit(FitCommandOptions o) {
   const FitResult result = fitPointCloud(data, initial, o.fit, line.callback());
   line.finish();
 
-  const LimitSurface surface(result.mesh);
-  const Matrix3X control = result.mesh.points();
-  if (!control.allFinite()) throw Error("internal: the fitted control points are not finite");
-  const TriangleSurface triangles = tessellate(surface, control, 8);
-
   nlohmann::ordered_json report;
   report["input"] = o.points;
   report["points"] = data.rows();
@@ -101,11 +88,7 @@ void runFit(FitCommandOptions o) {
   parameters["data_stiffness"] = o.fit.dataStiffness;
   report["parameters"] = parameters;
 
-  OutputSet outputs(dir);
-  writeTriangleSurface(triangles, outputs.add("surface.vtp"));
-  writeObj(result.mesh, outputs.add("control_mesh.obj"));
-  writeJson(report, outputs.add("report.json"));
-  outputs.commit();
+  writeModelOutputs(dir, result.mesh, report);
 
   std::cout << std::fixed << std::setprecision(3) << "fitted " << data.rows() << " points with "
             << result.mesh.vertexCount() << " control vertices (" << result.levels.back().level

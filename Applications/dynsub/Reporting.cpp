@@ -10,6 +10,10 @@
 
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
+#include "dynsub/LimitSurface.h"
+#include "dynsub/MeshIO.h"
+#include "dynsub/SurfaceWriter.h"
+#include "dynsub/Tessellation.h"
 
 namespace dynsub::app {
 
@@ -162,6 +166,18 @@ void writeJson(const nlohmann::ordered_json& json, const std::string& path) {
   std::ofstream out(path);
   out << json.dump(2) << '\n';
   if (!out) throw Error(path, "could not be written");
+}
+
+void writeModelOutputs(const std::filesystem::path& dir, const ControlMesh& mesh,
+                       const nlohmann::ordered_json& report) {
+  const Matrix3X control = mesh.points();
+  if (!control.allFinite()) throw Error("internal: the control points are not finite; nothing was written");
+  const TriangleSurface triangles = tessellate(LimitSurface(mesh), control, 8);
+  OutputSet outputs(dir);
+  writeTriangleSurface(triangles, outputs.add("surface.vtp"));
+  writeObj(mesh, outputs.add("control_mesh.obj"));
+  writeJson(report, outputs.add("report.json"));
+  outputs.commit();
 }
 
 }  // namespace dynsub::app

@@ -68,4 +68,10 @@ class OutputSet {
 
 void writeJson(const nlohmann::ordered_json& json, const std::string& path);
 
+// The outputs of a simulation, all or none: DIR/surface.vtp (the limit
+// surface, 8 x 8 squares per element), DIR/control_mesh.obj, DIR/report.json.
+// Throws dynsub::Error if the control points are not finite.
+void writeModelOutputs(const std::filesystem::path& dir, const ControlMesh& mesh,
+                       const nlohmann::ordered_json& report);
+
 }  // namespace dynsub::app

@@ -64,12 +64,13 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
   LevelState state{initial, 0, 1.0};
   // Element sides are measured in elements of the initial model: a base mesh
   // that is `b` global refinements past the initial one has side 2^-b.
-  const int initialIsolation = LimitSurface(initial).isolationLevels();
+  int initialIsolation = 0;  // set from the first level's surface
   double timeStep = options.integrator.timeStep;
 
   for (;;) {
     const auto started = std::chrono::steady_clock::now();
     const LimitSurface surface(state.mesh);
+    if (state.level == 0) initialIsolation = surface.isolationLevels();
     state.elementSize = std::ldexp(1.0, initialIsolation - (state.level + surface.isolationLevels()));
     AssemblyOptions assembly = options.assembly;
     assembly.elementSize = state.elementSize;
