@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# Shape recovery from real data the fits were never tuned on, one genus each:
+# CGAL's sample data (Debian package libcgal-demo): the bear (13 826 points,
+# genus 0, automatic initial model), the kitten range scan (5 210 points,
+# genus 1) and the figure eight (315 points, genus 2), the last two from the
+# control meshes in Data/Meshes. Each must reach the papers' tolerance,
+# max_error_percent <= 1, with several times fewer control vertices than points.
+# Needs DYNSUB (the executable) and DATA.
+set -u
+archive=/usr/share/doc/libcgal-dev/data.tar.gz
+if [ ! -f "$archive" ]; then
+  echo "FAILED: $archive is missing (install the Debian package libcgal-demo; ./run does)"
+  exit 1
+fi
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+tar xzf "$archive" -C "$work" data/meshes/bear.off data/points_3/kitten.xyz data/meshes/eight.off
+
+failures=0
+check() {  # check NAME CONDITION...
+  local name=$1; shift
+  if "$@"; then echo "ok: $name"; else echo "FAILED: $name"; failures=$((failures + 1)); fi
+}
+value() {  # value REPORT KEY: a top-level number from report.json
+  sed -n "s/^  \"$2\": \([-0-9.e+]*\),\{0,1\}$/\1/p" "$1"
+}
+# fit_scan NAME POINTS GENUS MAX_CONTROL_VERTICES FIT_OPTIONS...
+fit_scan() {
+  local name=$1 points=$2 genus=$3 max_vertices=$4; shift 4
+  "$DYNSUB" fit "$points" --out "$work/$name" "$@" >"$work/$name.log" 2>&1
+  check "$name: fit succeeds" test $? -eq 0
+  cat "$work/$name.log"
+  local report=$work/$name/report.json
+  [ -f "$report" ] || return
+  local error vertices
+  error=$(value "$report" max_error_percent)
+  vertices=$(value "$report" control_vertices)
+  check "$name: max_error_percent $error <= 1" awk -v e="$error" 'BEGIN { exit !(e != "" && e <= 1.0) }'
+  check "$name: genus $genus" test "$(value "$report" genus)" = "$genus"
+  check "$name: $vertices control vertices <= $max_vertices" test "$vertices" -le "$max_vertices"
+}
+
+fit_scan bear "$work/data/meshes/bear.off" 0 1538
+fit_scan kitten "$work/data/points_3/kitten.xyz" 1 772 --init "$DATA/Meshes/kitten_genus1.obj"
+fit_scan eight "$work/data/meshes/eight.off" 2 48 --init "$DATA/Meshes/eight_genus2.obj"
+
+echo "$failures failure(s)"
+test "$failures" -eq 0
