@@ -1,0 +1,25 @@
+#pragma once
+// Reading volumes and writing labelmaps through ITK, in physical LPS mm with
+// the file's origin, spacing and direction (NIfTI's RAS qform/sform is turned
+// into LPS by ITK when reading and back when writing).
+//
+// Readable: NIfTI (.nii, .nii.gz), NRRD (.nrrd, .nhdr), MetaImage (.mha,
+// .mhd) and DICOM series (a directory holding one series, via GDCM). Any pixel
+// type is read as float; an image that is not 3D (a single slice counts as 2D)
+// or has no voxels is refused.
+#include <string>
+
+#include "dynsub/Volume.h"
+
+namespace dynsub {
+
+// Throws dynsub::Error naming the path when it is missing, unreadable,
+// truncated, of an unknown format, not 3D or empty.
+Volume readVolume(const std::string& path);
+
+// Writes a mask as an unsigned 8-bit labelmap (1 = structure) on its grid, in
+// any format ITK writes by extension (.nii.gz for ITK-SNAP and 3D Slicer). The
+// file appears complete or not at all.
+void writeMask(const Mask& mask, const std::string& path);
+
+}  // namespace dynsub

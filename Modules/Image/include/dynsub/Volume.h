@@ -1,0 +1,69 @@
+#pragma once
+// 3D images as plain buffers with their geometry, so that the rest of DynSub
+// never includes ITK. Physical space is LPS mm, as in ITK and DICOM:
+//   x_mm = origin + direction * diag(spacing) * index,
+// with index (i, j, k) of a voxel centre and i varying fastest in memory.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "dynsub/Types.h"
+
+namespace dynsub {
+
+using Matrix3 = Eigen::Matrix3d;
+
+struct ImageGeometry {
+  std::array<int, 3> size{0, 0, 0};
+  Vector3 spacing = Vector3::Ones();  // mm
+  Vector3 origin = Vector3::Zero();   // mm, centre of voxel (0, 0, 0)
+  Matrix3 direction = Matrix3::Identity();  // columns: the i, j, k axes in LPS
+
+  long long voxelCount() const { return static_cast<long long>(size[0]) * size[1] * size[2]; }
+  long long offset(int i, int j, int k) const {
+    return i + static_cast<long long>(size[0]) * (j + static_cast<long long>(size[1]) * k);
+  }
+  bool contains(int i, int j, int k) const {
+    return i >= 0 && j >= 0 && k >= 0 && i < size[0] && j < size[1] && k < size[2];
+  }
+  // Continuous index <-> physical point (mm).
+  Vector3 toPhysical(const Vector3& index) const;
+  Vector3 toIndex(const Vector3& point) const;
+  // The same grid on the index box [first, first + size).
+  ImageGeometry region(const std::array<int, 3>& first, const std::array<int, 3>& regionSize) const;
+};
+
+// An intensity image (any pixel type read as float).
+struct Volume {
+  ImageGeometry geometry;
+  std::vector<float> voxels;
+
+  float at(int i, int j, int k) const { return voxels[geometry.offset(i, j, k)]; }
+  // Trilinear interpolation at a continuous index; clamped to the image.
+  double interpolate(const Vector3& index) const;
+};
+
+// A binary image: 1 inside the structure, 0 outside.
+struct Mask {
+  ImageGeometry geometry;
+  std::vector<std::uint8_t> voxels;
+
+  long long count() const;
+};
+
+// The voxels of `labels` whose value is one of `values`.
+Mask selectLabels(const Volume& labels, const std::vector<int>& values);
+
+// The sub-image on an index box (clamped to the image).
+Volume cropVolume(const Volume& volume, const std::array<int, 3>& first, const std::array<int, 3>& size);
+
+// The smallest index box, grown by `margin` mm on every side and clamped to the
+// image, that contains the given physical points. Returns {first, size}.
+std::pair<std::array<int, 3>, std::array<int, 3>> boundingRegion(const ImageGeometry& geometry,
+                                                                 const Matrix3X& points, double margin);
+
+// A mask on `region` (a sub-grid of `full`, as from ImageGeometry::region)
+// pasted into an empty mask on the full grid.
+Mask pasteMask(const Mask& part, const ImageGeometry& full, const std::array<int, 3>& first);
+
+}  // namespace dynsub

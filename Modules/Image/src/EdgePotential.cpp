@@ -1,0 +1,158 @@
+#include "dynsub/EdgePotential.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "dynsub/Error.h"
+#include "BridgeGeometry.h"
+
+namespace dynsub {
+namespace {
+
+// Gradient (LPS, per mm) of the image smoothed by a Gaussian of sigma mm.
+std::vector<Vector3> smoothedGradient(const Volume& image, double sigma) {
+  const std::vector<float> raw = itkbridge::recursiveGaussianGradient(toBridge(image.geometry), image.voxels, sigma);
+  std::vector<Vector3> gradient(image.voxels.size());
+  for (std::size_t v = 0; v < gradient.size(); ++v) gradient[v] = Vector3(raw[3 * v], raw[3 * v + 1], raw[3 * v + 2]);
+  return gradient;
+}
+
+Volume magnitudeOf(const ImageGeometry& geometry, const std::vector<Vector3>& gradient) {
+  Volume magnitude{geometry, std::vector<float>(gradient.size())};
+  for (std::size_t v = 0; v < gradient.size(); ++v) magnitude.voxels[v] = static_cast<float>(gradient[v].norm());
+  return magnitude;
+}
+
+double percentile(std::vector<float> values, double fraction) {
+  if (values.empty()) return 0;
+  const auto at = values.begin() + static_cast<long>(fraction * (values.size() - 1));
+  std::nth_element(values.begin(), at, values.end());
+  return *at;
+}
+
+// Steps 2 and 3 of the header: non-maximum suppression along the gradient, then hysteresis.
+Mask edgeMap(const Volume& magnitude, const std::vector<Vector3>& gradient, const EdgeOptions& options) {
+  const ImageGeometry& g = magnitude.geometry;
+  const double scale = percentile(magnitude.voxels, 0.99);
+  Mask edges{g, std::vector<std::uint8_t>(magnitude.voxels.size(), 0)};
+  if (!(scale > 0)) return edges;  // a constant image has no edges
+  const double low = options.lowThreshold * scale, high = options.highThreshold * scale;
+  // A physical direction d moves the continuous index by (D^-1 d) / spacing; one
+  // step is the smallest spacing long.
+  const Matrix3 toIndex = g.spacing.cwiseInverse().asDiagonal() * g.direction.inverse();
+  const double step = g.spacing.minCoeff();
+
+  std::vector<std::uint8_t> candidate(magnitude.voxels.size(), 0);
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i) {
+        const long long v = g.offset(i, j, k);
+        const double m = magnitude.voxels[v];
+        if (m < low) continue;
+        const Vector3 ahead = toIndex * (gradient[v] / m * step);
+        const Vector3 here(i, j, k);
+        if (m >= magnitude.interpolate(here + ahead) && m >= magnitude.interpolate(here - ahead)) candidate[v] = 1;
+      }
+
+  std::vector<long long> stack;
+  for (long long v = 0; v < static_cast<long long>(candidate.size()); ++v)
+    if (candidate[v] && magnitude.voxels[v] >= high) {
+      edges.voxels[v] = 1;
+      stack.push_back(v);
+    }
+  while (!stack.empty()) {
+    const long long v = stack.back();
+    stack.pop_back();
+    const int i = static_cast<int>(v % g.size[0]);
+    const int j = static_cast<int>((v / g.size[0]) % g.size[1]);
+    const int k = static_cast<int>(v / (static_cast<long long>(g.size[0]) * g.size[1]));
+    for (int dk = -1; dk <= 1; ++dk)
+      for (int dj = -1; dj <= 1; ++dj)
+        for (int di = -1; di <= 1; ++di) {
+          if (!g.contains(i + di, j + dj, k + dk)) continue;
+          const long long n = g.offset(i + di, j + dj, k + dk);
+          if (candidate[n] && !edges.voxels[n]) {
+            edges.voxels[n] = 1;
+            stack.push_back(n);
+          }
+        }
+  }
+  return edges;
+}
+
+// Central-difference gradient of a potential, in LPS per mm, normalized;
+// zero where the gradient vanishes or `keep` is false.
+void normalizedGradient(const Volume& potential, const std::vector<std::uint8_t>& keep, Volume components[3]) {
+  const ImageGeometry& g = potential.geometry;
+  // d/dx_phys = D^-T (d/dindex / spacing).
+  const Matrix3 toPhysical = g.direction.inverse().transpose();
+  for (int a = 0; a < 3; ++a) components[a] = Volume{g, std::vector<float>(potential.voxels.size(), 0.0f)};
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i) {
+        const long long v = g.offset(i, j, k);
+        if (!keep[v]) continue;
+        const int at[3] = {i, j, k};
+        Vector3 derivative;
+        for (int a = 0; a < 3; ++a) {
+          int lo[3] = {i, j, k}, hi[3] = {i, j, k};
+          lo[a] = std::max(at[a] - 1, 0);
+          hi[a] = std::min(at[a] + 1, g.size[a] - 1);
+          const int span = hi[a] - lo[a];
+          derivative[a] = span == 0 ? 0.0
+                                    : (potential.at(hi[0], hi[1], hi[2]) - potential.at(lo[0], lo[1], lo[2])) /
+                                          (span * g.spacing[a]);
+        }
+        const Vector3 gradient = toPhysical * derivative;
+        const double norm = gradient.norm();
+        if (!(norm > 1e-12)) continue;
+        for (int a = 0; a < 3; ++a) components[a].voxels[v] = static_cast<float>(gradient[a] / norm);
+      }
+}
+
+}  // namespace
+
+void checkEdgeOptions(const EdgeOptions& options) {
+  if (!(options.sigma > 0) || !std::isfinite(options.sigma))
+    throw Error("edge sigma must be a positive number of mm (got " + std::to_string(options.sigma) + ")");
+  if (!(options.lowThreshold >= 0 && options.lowThreshold <= options.highThreshold && options.highThreshold <= 1))
+    throw Error("edge thresholds must satisfy 0 <= low <= high <= 1 (got " + std::to_string(options.lowThreshold) +
+                ", " + std::to_string(options.highThreshold) + ")");
+  if (!(options.captureRange > 0) || !std::isfinite(options.captureRange))
+    throw Error("capture range must be a positive number of mm (got " + std::to_string(options.captureRange) + ")");
+}
+
+DirectionField::DirectionField(const Volume& image, const EdgeOptions& options) : geometry_(image.geometry) {
+  checkEdgeOptions(options);
+  const std::vector<Vector3> gradient = smoothedGradient(image, options.sigma);
+  const Volume magnitude = magnitudeOf(image.geometry, gradient);
+  if (options.method == EdgeMethod::GradientMagnitude) {
+    potential_ = magnitude;
+    normalizedGradient(potential_, std::vector<std::uint8_t>(magnitude.voxels.size(), 1), components_);
+    return;
+  }
+  edges_ = edgeMap(magnitude, gradient, options);
+  const Volume distance{image.geometry, itkbridge::distanceMap(toBridge(image.geometry), edges_.voxels)};
+  potential_ = distance;
+  std::vector<std::uint8_t> keep(distance.voxels.size());
+  for (std::size_t v = 0; v < keep.size(); ++v) {
+    potential_.voxels[v] = -distance.voxels[v];
+    keep[v] = distance.voxels[v] <= options.captureRange ? 1 : 0;
+  }
+  normalizedGradient(potential_, keep, components_);
+}
+
+Matrix3X DirectionField::sample(const Matrix3X& points) const {
+  Matrix3X result = Matrix3X::Zero(points.rows(), 3);
+  for (Eigen::Index p = 0; p < points.rows(); ++p) {
+    const Vector3 index = geometry_.toIndex(points.row(p).transpose());
+    bool inside = true;
+    for (int a = 0; a < 3; ++a) inside = inside && index[a] >= 0 && index[a] <= geometry_.size[a] - 1;
+    if (!inside) continue;
+    for (int a = 0; a < 3; ++a) result(p, a) = components_[a].interpolate(index);
+  }
+  return result;
+}
+
+}  // namespace dynsub

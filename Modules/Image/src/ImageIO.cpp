@@ -1,0 +1,34 @@
+#include "dynsub/ImageIO.h"
+
+#include <filesystem>
+
+#include "BridgeGeometry.h"
+#include "dynsub/AtomicOutput.h"
+#include "dynsub/Error.h"
+
+namespace dynsub {
+
+Volume readVolume(const std::string& path) {
+  std::error_code ignored;
+  if (!std::filesystem::exists(path, ignored)) throw Error(path, "no such file or directory");
+  itkbridge::Geometry raw;
+  Volume volume;
+  itkbridge::readImage(path, raw, volume.voxels);
+  volume.geometry = fromBridge(raw);
+  for (int a = 0; a < 3; ++a)
+    if (volume.geometry.size[a] < 2)
+      throw Error(path, "not a 3D image (" + std::to_string(volume.geometry.size[a]) + " voxel(s) along axis " +
+                            std::to_string(a) + ")");
+  if (!(std::abs(volume.geometry.direction.determinant()) > 1e-6)) throw Error(path, "singular direction matrix");
+  if (!(volume.geometry.spacing.minCoeff() > 0)) throw Error(path, "spacing must be positive");
+  return volume;
+}
+
+void writeMask(const Mask& mask, const std::string& path) {
+  requireWritableDirectoryFor(path);
+  AtomicOutput output(path);
+  itkbridge::writeLabels(toBridge(mask.geometry), mask.voxels, output.temporaryPath());
+  output.commit();
+}
+
+}  // namespace dynsub

@@ -1,0 +1,35 @@
+#pragma once
+// Private to the Image module: the only door to ITK. Its interface uses plain
+// arrays, not Eigen, because ITK 5.2 bundles its own Eigen (3.3) whose headers
+// cannot share a translation unit with the Eigen 3.4 the rest of DynSub uses;
+// so ITK is included by ItkBridge.cpp alone.
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace dynsub::itkbridge {
+
+struct Geometry {
+  std::array<int, 3> size{};
+  std::array<double, 3> spacing{};
+  std::array<double, 3> origin{};
+  std::array<double, 9> direction{};  // row-major, columns are the index axes
+};
+
+// A file (any format ITK reads) or a directory holding one DICOM series, as
+// float. Throws dynsub::Error naming the path.
+void readImage(const std::string& path, Geometry& geometry, std::vector<float>& voxels);
+
+// An 8-bit labelmap, compressed when the format allows; throws dynsub::Error.
+void writeLabels(const Geometry& geometry, const std::vector<std::uint8_t>& voxels, const std::string& path);
+
+// Gradient (physical LPS axes, per mm) of the image smoothed by a Gaussian of
+// sigma mm, with Deriche's recursive filters; three components per voxel.
+std::vector<float> recursiveGaussianGradient(const Geometry& geometry, const std::vector<float>& voxels,
+                                             double sigma);
+
+// Euclidean distance (mm) from every voxel centre to the nearest non-zero voxel.
+std::vector<float> distanceMap(const Geometry& geometry, const std::vector<std::uint8_t>& mask);
+
+}  // namespace dynsub::itkbridge

@@ -1,0 +1,104 @@
+#include "dynsub/Volume.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace dynsub {
+
+Vector3 ImageGeometry::toPhysical(const Vector3& index) const {
+  return origin + direction * spacing.cwiseProduct(index);
+}
+
+Vector3 ImageGeometry::toIndex(const Vector3& point) const {
+  return (direction.inverse() * (point - origin)).cwiseQuotient(spacing);
+}
+
+ImageGeometry ImageGeometry::region(const std::array<int, 3>& first, const std::array<int, 3>& regionSize) const {
+  ImageGeometry result = *this;
+  result.size = regionSize;
+  result.origin = toPhysical(Vector3(first[0], first[1], first[2]));
+  return result;
+}
+
+double Volume::interpolate(const Vector3& index) const {
+  const auto& n = geometry.size;
+  int base[3];
+  double t[3];
+  for (int a = 0; a < 3; ++a) {
+    const double x = std::clamp(index[a], 0.0, static_cast<double>(n[a] - 1));
+    base[a] = std::min(static_cast<int>(std::floor(x)), std::max(n[a] - 2, 0));
+    t[a] = x - base[a];
+  }
+  double sum = 0;
+  for (int corner = 0; corner < 8; ++corner) {
+    double weight = 1;
+    int at[3];
+    for (int a = 0; a < 3; ++a) {
+      const int high = (corner >> a) & 1;
+      weight *= high ? t[a] : 1 - t[a];
+      at[a] = std::min(base[a] + high, n[a] - 1);
+    }
+    if (weight != 0) sum += weight * this->at(at[0], at[1], at[2]);
+  }
+  return sum;
+}
+
+long long Mask::count() const {
+  return std::count(voxels.begin(), voxels.end(), std::uint8_t{1});
+}
+
+Mask selectLabels(const Volume& labels, const std::vector<int>& values) {
+  Mask mask{labels.geometry, std::vector<std::uint8_t>(labels.voxels.size(), 0)};
+  for (std::size_t v = 0; v < labels.voxels.size(); ++v) {
+    const int label = static_cast<int>(std::lround(labels.voxels[v]));
+    mask.voxels[v] = std::find(values.begin(), values.end(), label) != values.end() ? 1 : 0;
+  }
+  return mask;
+}
+
+Volume cropVolume(const Volume& volume, const std::array<int, 3>& first, const std::array<int, 3>& size) {
+  Volume result;
+  result.geometry = volume.geometry.region(first, size);
+  result.voxels.resize(result.geometry.voxelCount());
+  long long out = 0;
+  for (int k = 0; k < size[2]; ++k)
+    for (int j = 0; j < size[1]; ++j)
+      for (int i = 0; i < size[0]; ++i) result.voxels[out++] = volume.at(first[0] + i, first[1] + j, first[2] + k);
+  return result;
+}
+
+std::pair<std::array<int, 3>, std::array<int, 3>> boundingRegion(const ImageGeometry& geometry,
+                                                                 const Matrix3X& points, double margin) {
+  Vector3 low = Vector3::Constant(1e300), high = Vector3::Constant(-1e300);
+  // The margin is in mm along every axis: grow the physical box's corners.
+  Vector3 lowPoint = points.colwise().minCoeff().transpose() - Vector3::Constant(margin);
+  Vector3 highPoint = points.colwise().maxCoeff().transpose() + Vector3::Constant(margin);
+  for (int corner = 0; corner < 8; ++corner) {
+    Vector3 p;
+    for (int a = 0; a < 3; ++a) p[a] = ((corner >> a) & 1) ? highPoint[a] : lowPoint[a];
+    const Vector3 index = geometry.toIndex(p);
+    low = low.cwiseMin(index);
+    high = high.cwiseMax(index);
+  }
+  std::array<int, 3> first{}, size{};
+  for (int a = 0; a < 3; ++a) {
+    const int begin = std::clamp(static_cast<int>(std::floor(low[a])), 0, geometry.size[a] - 1);
+    const int end = std::clamp(static_cast<int>(std::ceil(high[a])), begin, geometry.size[a] - 1);
+    first[a] = begin;
+    size[a] = end - begin + 1;
+  }
+  return {first, size};
+}
+
+Mask pasteMask(const Mask& part, const ImageGeometry& full, const std::array<int, 3>& first) {
+  Mask result{full, std::vector<std::uint8_t>(full.voxelCount(), 0)};
+  const auto& n = part.geometry.size;
+  long long in = 0;
+  for (int k = 0; k < n[2]; ++k)
+    for (int j = 0; j < n[1]; ++j)
+      for (int i = 0; i < n[0]; ++i, ++in)
+        if (part.voxels[in]) result.voxels[full.offset(first[0] + i, first[1] + j, first[2] + k)] = 1;
+  return result;
+}
+
+}  // namespace dynsub

@@ -1,0 +1,71 @@
+#include "dynsub/Voxelize.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "dynsub/Error.h"
+
+namespace dynsub {
+
+Mask voxelizeSurface(const Matrix3X& points, const std::vector<std::array<int, 3>>& triangles,
+                     const ImageGeometry& grid) {
+  std::map<std::pair<int, int>, int> edgeUses;
+  for (const auto& t : triangles)
+    for (int e = 0; e < 3; ++e) {
+      const int a = t[e], b = t[(e + 1) % 3];
+      if (a < 0 || b < 0 || a >= points.rows() || b >= points.rows())
+        throw Error("cannot voxelize: a triangle names point " + std::to_string(std::max(a, b)) + " of " +
+                    std::to_string(points.rows()));
+      ++edgeUses[{std::min(a, b), std::max(a, b)}];
+    }
+  for (const auto& [edge, uses] : edgeUses)
+    if (uses != 2)
+      throw Error("cannot voxelize: the surface is not closed (edge " + std::to_string(edge.first) + "-" +
+                  std::to_string(edge.second) + " is shared by " + std::to_string(uses) + " triangle(s))");
+
+  Mask mask{grid, std::vector<std::uint8_t>(grid.voxelCount(), 0)};
+  const int rowsJ = grid.size[1], rowsK = grid.size[2];
+  std::vector<std::vector<double>> crossings(static_cast<std::size_t>(rowsJ) * rowsK);
+  // The row through voxel centres (j, k) is shifted by this much, see the header.
+  const double shiftJ = 1.0e-6, shiftK = 1.7e-6;
+
+  Matrix3X index(points.rows(), 3);
+  for (Eigen::Index p = 0; p < points.rows(); ++p) index.row(p) = grid.toIndex(points.row(p).transpose()).transpose();
+
+  for (const auto& t : triangles) {
+    const Vector3 a = index.row(t[0]), b = index.row(t[1]), c = index.row(t[2]);
+    const int j0 = std::max(0, static_cast<int>(std::ceil(std::min({a[1], b[1], c[1]}) - shiftJ)));
+    const int j1 = std::min(rowsJ - 1, static_cast<int>(std::floor(std::max({a[1], b[1], c[1]}) - shiftJ)));
+    const int k0 = std::max(0, static_cast<int>(std::ceil(std::min({a[2], b[2], c[2]}) - shiftK)));
+    const int k1 = std::min(rowsK - 1, static_cast<int>(std::floor(std::max({a[2], b[2], c[2]}) - shiftK)));
+    // Barycentric coordinates of the row's (j, k) in the triangle's projection.
+    const double det = (b[1] - a[1]) * (c[2] - a[2]) - (c[1] - a[1]) * (b[2] - a[2]);
+    if (det == 0) continue;  // parallel to the rows: crossed by none
+    for (int k = k0; k <= k1; ++k)
+      for (int j = j0; j <= j1; ++j) {
+        const double y = j + shiftJ - a[1], z = k + shiftK - a[2];
+        const double s = (y * (c[2] - a[2]) - (c[1] - a[1]) * z) / det;
+        const double r = ((b[1] - a[1]) * z - y * (b[2] - a[2])) / det;
+        if (s < 0 || r < 0 || s + r > 1) continue;
+        crossings[static_cast<std::size_t>(k) * rowsJ + j].push_back(a[0] + s * (b[0] - a[0]) + r * (c[0] - a[0]));
+      }
+  }
+
+  for (int k = 0; k < rowsK; ++k)
+    for (int j = 0; j < rowsJ; ++j) {
+      auto& row = crossings[static_cast<std::size_t>(k) * rowsJ + j];
+      // A closed surface is crossed an even number of times; an odd count means a
+      // crossing was lost at a tangency, and the row is left out rather than filled wrongly.
+      if (row.size() % 2 != 0) continue;
+      std::sort(row.begin(), row.end());
+      for (std::size_t c = 0; c + 1 < row.size(); c += 2) {
+        const int first = std::max(0, static_cast<int>(std::ceil(row[c])));
+        const int last = std::min(grid.size[0] - 1, static_cast<int>(std::floor(row[c + 1])));
+        for (int i = first; i <= last; ++i) mask.voxels[grid.offset(i, j, k)] = 1;
+      }
+    }
+  return mask;
+}
+
+}  // namespace dynsub

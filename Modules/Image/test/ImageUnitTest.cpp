@@ -1,0 +1,247 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "dynsub/EdgePotential.h"
+#include "dynsub/Error.h"
+#include "dynsub/ImageIO.h"
+#include "dynsub/Metrics.h"
+#include "dynsub/Voxelize.h"
+
+namespace dynsub {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A rotation about a skew axis: no axis of the grid is aligned with LPS.
+Matrix3 skewDirection() {
+  return Eigen::AngleAxisd(0.5, Vector3(1, 2, 3).normalized()).toRotationMatrix();
+}
+
+ImageGeometry grid(std::array<int, 3> size, Vector3 spacing, Vector3 origin, Matrix3 direction) {
+  ImageGeometry g;
+  g.size = size;
+  g.spacing = spacing;
+  g.origin = origin;
+  g.direction = direction;
+  return g;
+}
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::path(DYNSUB_BINARY_DIR) / "Testing" / "Temporary" / "Image";
+  fs::create_directories(dir);
+  return dir / name;
+}
+
+// A closed UV sphere (triangles oriented outward).
+void uvSphere(const Vector3& centre, double radius, Matrix3X& points, std::vector<std::array<int, 3>>& triangles) {
+  const int rings = 60, sectors = 120;
+  points.resize(2 + (rings - 1) * sectors, 3);
+  points.row(0) = (centre + Vector3(0, 0, radius)).transpose();
+  points.row(1) = (centre - Vector3(0, 0, radius)).transpose();
+  for (int r = 1; r < rings; ++r)
+    for (int s = 0; s < sectors; ++s) {
+      const double theta = M_PI * r / rings, phi = 2 * M_PI * s / sectors;
+      points.row(2 + (r - 1) * sectors + s) =
+          (centre + radius * Vector3(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                                     std::cos(theta)))
+              .transpose();
+    }
+  auto at = [&](int r, int s) { return 2 + (r - 1) * sectors + (s % sectors); };
+  triangles.clear();
+  for (int s = 0; s < sectors; ++s) {
+    triangles.push_back({0, at(1, s), at(1, s + 1)});
+    triangles.push_back({1, at(rings - 1, s + 1), at(rings - 1, s)});
+    for (int r = 1; r + 1 < rings; ++r) {
+      triangles.push_back({at(r, s), at(r + 1, s), at(r + 1, s + 1)});
+      triangles.push_back({at(r, s), at(r + 1, s + 1), at(r, s + 1)});
+    }
+  }
+}
+
+TEST(ImageGeometry, IndexAndPhysicalAreInverse) {
+  const ImageGeometry g = grid({10, 20, 30}, Vector3(0.5, 1.0, 2.0), Vector3(-3, 4, 5), skewDirection());
+  const Vector3 index(1.5, -2.25, 7.0);
+  EXPECT_LT((g.toIndex(g.toPhysical(index)) - index).norm(), 1e-12);
+  // One step along k moves 2 mm along the direction's third column.
+  EXPECT_LT((g.toPhysical(Vector3(0, 0, 1)) - g.origin - 2.0 * g.direction.col(2)).norm(), 1e-12);
+}
+
+TEST(ImageIO, MaskRoundTripKeepsGeometryAndVoxels) {
+  Mask mask{grid({7, 5, 4}, Vector3(0.7, 1.1, 2.5), Vector3(12, -30, 8), skewDirection()), {}};
+  mask.voxels.resize(mask.geometry.voxelCount());
+  for (std::size_t v = 0; v < mask.voxels.size(); ++v) mask.voxels[v] = (v * 7919) % 3 == 0;
+  const fs::path path = scratch("roundtrip.nii.gz");
+  writeMask(mask, path.string());
+  const Volume read = readVolume(path.string());
+  EXPECT_EQ(read.geometry.size, mask.geometry.size);
+  // NIfTI stores spacing and the affine in single precision.
+  EXPECT_LT((read.geometry.spacing - mask.geometry.spacing).norm(), 1e-5);
+  EXPECT_LT((read.geometry.origin - mask.geometry.origin).norm(), 1e-4);
+  EXPECT_LT((read.geometry.direction - mask.geometry.direction).norm(), 1e-5);
+  for (std::size_t v = 0; v < mask.voxels.size(); ++v) ASSERT_EQ(read.voxels[v], mask.voxels[v]) << v;
+}
+
+TEST(ImageIO, BadFilesAreRefusedWithTheirName) {
+  EXPECT_THROW(readVolume(scratch("missing.nii.gz").string()), Error);
+  // One slice: not a 3D image.
+  Mask slice{grid({8, 8, 1}, Vector3::Ones(), Vector3::Zero(), Matrix3::Identity()), {}};
+  slice.voxels.assign(64, 1);
+  writeMask(slice, scratch("slice.nii.gz").string());
+  try {
+    readVolume(scratch("slice.nii.gz").string());
+    FAIL() << "a single slice was read as a volume";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("not a 3D image"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("slice.nii.gz"), std::string::npos) << e.what();
+  }
+  // Truncated: the header survives, the voxels do not.
+  Mask big{grid({40, 40, 40}, Vector3::Ones(), Vector3::Zero(), Matrix3::Identity()), {}};
+  big.voxels.assign(big.geometry.voxelCount(), 1);
+  for (const std::string name : {"whole.nii", "whole.nii.gz", "whole.nrrd", "whole.mha"}) {
+    const fs::path whole = scratch(name);
+    writeMask(big, whole.string());
+    fs::resize_file(whole, fs::file_size(whole) / 2);
+    EXPECT_THROW(readVolume(whole.string()), Error) << name;
+  }
+  std::ofstream(scratch("text.nii").string()) << "not an image\n";
+  EXPECT_THROW(readVolume(scratch("text.nii").string()), Error);
+}
+
+TEST(Voxelize, SphereOnAnAnisotropicRotatedGrid) {
+  const ImageGeometry g = grid({48, 40, 24}, Vector3(0.6, 0.8, 1.5), Vector3(-14, -15, -16), skewDirection());
+  const Vector3 centre = g.toPhysical(Vector3(23.5, 19.5, 11.5));
+  const double radius = 10.0;
+  Matrix3X points;
+  std::vector<std::array<int, 3>> triangles;
+  uvSphere(centre, radius, points, triangles);
+  const Mask mask = voxelizeSurface(points, triangles, g);
+  // Every voxel centre clearly inside or outside the sphere is classified so;
+  // the polygon lies within radius (1 - cos(pi/60)) ~ 0.014 mm of the sphere.
+  long long inside = 0;
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i) {
+        const double r = (g.toPhysical(Vector3(i, j, k)) - centre).norm();
+        const bool set = mask.voxels[g.offset(i, j, k)];
+        if (r < radius - 0.02) {
+          ASSERT_TRUE(set) << i << ' ' << j << ' ' << k;
+        }
+        if (r > radius + 0.02) {
+          ASSERT_FALSE(set) << i << ' ' << j << ' ' << k;
+        }
+        inside += set;
+      }
+  const double volume = inside * g.spacing.prod(), exact = 4.0 / 3.0 * M_PI * radius * radius * radius;
+  EXPECT_NEAR(volume / exact, 1.0, 0.02);
+}
+
+TEST(Voxelize, OpenSurfaceIsRefused) {
+  const ImageGeometry g = grid({20, 20, 20}, Vector3::Ones(), Vector3::Zero(), Matrix3::Identity());
+  Matrix3X points;
+  std::vector<std::array<int, 3>> triangles;
+  uvSphere(Vector3(10, 10, 10), 5, points, triangles);
+  triangles.pop_back();
+  EXPECT_THROW(voxelizeSurface(points, triangles, g), Error);
+}
+
+Mask box(const ImageGeometry& g, std::array<int, 3> first, std::array<int, 3> last) {
+  Mask m{g, std::vector<std::uint8_t>(g.voxelCount(), 0)};
+  for (int k = first[2]; k <= last[2]; ++k)
+    for (int j = first[1]; j <= last[1]; ++j)
+      for (int i = first[0]; i <= last[0]; ++i) m.voxels[g.offset(i, j, k)] = 1;
+  return m;
+}
+
+TEST(Metrics, ShiftedCubesByHand) {
+  // Two 10^3 cubes, the second shifted by one voxel (0.5 mm) along i.
+  const ImageGeometry g = grid({16, 14, 14}, Vector3(0.5, 1.0, 2.0), Vector3::Zero(), Matrix3::Identity());
+  const Mask a = box(g, {2, 2, 2}, {11, 11, 11}), b = box(g, {3, 2, 2}, {12, 11, 11});
+  const OverlapMetrics m = compareMasks(a, b);
+  EXPECT_DOUBLE_EQ(m.dice, 2.0 * 900 / 2000);
+  EXPECT_DOUBLE_EQ(m.jaccard, 900.0 / 1100);
+  EXPECT_DOUBLE_EQ(m.volumeDifferencePercent, 0.0);
+  EXPECT_DOUBLE_EQ(m.volumeA, 1000 * 1.0);
+  // Of each cube's 488 boundary voxels, 164 lie one voxel (0.5 mm) from the
+  // other's boundary (its whole leading face and the 8 x 8 inside of its
+  // trailing face); the rest are on it.
+  EXPECT_NEAR(m.meanSurfaceDistance, 0.5 * 164.0 / 488.0, 1e-6);
+  EXPECT_NEAR(m.hausdorff, 0.5, 1e-6);
+  EXPECT_NEAR(m.hd95, 0.5, 1e-6);
+
+  const OverlapMetrics same = compareMasks(a, a);
+  EXPECT_DOUBLE_EQ(same.dice, 1.0);
+  EXPECT_DOUBLE_EQ(same.hausdorff, 0.0);
+  const Mask smaller = box(g, {2, 2, 2}, {6, 11, 11});
+  EXPECT_DOUBLE_EQ(compareMasks(smaller, a).volumeDifferencePercent, -50.0);
+  EXPECT_THROW(compareMasks(box(g, {0, 0, 0}, {-1, -1, -1}), a), Error);
+}
+
+// A bright ball of radius 8 mm on a dark background, anisotropic and rotated.
+Volume ballPhantom(const ImageGeometry& g, const Vector3& centre, double radius) {
+  Volume v{g, std::vector<float>(g.voxelCount())};
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i)
+        v.voxels[g.offset(i, j, k)] = (g.toPhysical(Vector3(i, j, k)) - centre).norm() < radius ? 100.0f : 20.0f;
+  return v;
+}
+
+TEST(EdgePotential, ForcesPointToTheBallsSurface) {
+  const ImageGeometry g = grid({40, 36, 30}, Vector3(0.8, 0.9, 1.1), Vector3(5, -7, 3), skewDirection());
+  const Vector3 centre = g.toPhysical(Vector3(19.5, 17.5, 14.5));
+  const double radius = 8.0;
+  const DirectionField field(ballPhantom(g, centre, radius), EdgeOptions{});
+  // Edges: every edge voxel within a voxel of the sphere.
+  long long edgeCount = 0;
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i)
+        if (field.edges().voxels[g.offset(i, j, k)]) {
+          ++edgeCount;
+          EXPECT_NEAR((g.toPhysical(Vector3(i, j, k)) - centre).norm(), radius, 1.1);
+        }
+  EXPECT_GT(edgeCount, 500);
+  // Forces 3 mm inside point outward, 3 mm outside point inward (within 30 degrees).
+  Matrix3X probes(2 * 26, 3);
+  std::vector<Vector3> radial;
+  int row = 0;
+  for (int x = -1; x <= 1; ++x)
+    for (int y = -1; y <= 1; ++y)
+      for (int z = -1; z <= 1; ++z) {
+        if (!x && !y && !z) continue;
+        const Vector3 u = Vector3(x, y, z).normalized();
+        probes.row(row++) = (centre + (radius - 3) * u).transpose();
+        probes.row(row++) = (centre + (radius + 3) * u).transpose();
+        radial.push_back(u);
+        radial.push_back(-u);
+      }
+  const Matrix3X forces = field.sample(probes);
+  for (int p = 0; p < probes.rows(); ++p) {
+    EXPECT_NEAR(forces.row(p).norm(), 1.0, 0.05) << p;
+    EXPECT_GT(forces.row(p).dot(radial[p].transpose()), std::cos(M_PI / 6)) << p;
+  }
+  // Beyond the capture range, and outside the image, no force.
+  Matrix3X far(2, 3);
+  far.row(0) = centre.transpose();  // 8 mm from every edge > 6 mm
+  far.row(1) = (centre + Vector3(500, 0, 0)).transpose();
+  EXPECT_LT(field.sample(far).norm(), 1e-12);
+}
+
+TEST(EdgePotential, BadOptionsAreRefused) {
+  EdgeOptions options;
+  options.sigma = std::nan("");
+  EXPECT_THROW(checkEdgeOptions(options), Error);
+  options = EdgeOptions{};
+  options.lowThreshold = 0.5;
+  options.highThreshold = 0.2;
+  EXPECT_THROW(checkEdgeOptions(options), Error);
+  options = EdgeOptions{};
+  options.captureRange = -1;
+  EXPECT_THROW(checkEdgeOptions(options), Error);
+}
+
+}  // namespace
+}  // namespace dynsub

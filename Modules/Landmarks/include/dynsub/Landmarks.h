@@ -1,0 +1,38 @@
+#pragma once
+// Landmarks: named points in physical LPS mm (ITK's and DICOM's convention),
+// read from and written to the files 3D Slicer and spreadsheets use:
+//  - 3D Slicer markups JSON (.mrk.json): "coordinateSystem" "LPS" (the
+//    default when absent) or "RAS"; every control point whose positionStatus
+//    is "defined" (or absent) is read, from every fiducial markup in the file.
+//  - Legacy 3D Slicer fiducials (.fcsv): the "# CoordinateSystem =" header
+//    gives LPS or RAS (also the old 1 = LPS, 0 = RAS); columns id,x,y,z,...,label.
+//  - CSV (.csv): a header line naming columns x, y, z (and optionally label),
+//    one point per line, LPS mm.
+// RAS -> LPS negates x and y.
+#include <string>
+#include <vector>
+
+#include "dynsub/Types.h"
+
+namespace dynsub {
+
+struct Landmark {
+  std::string label;
+  Vector3 position;  // LPS mm
+};
+
+enum class CoordinateSystem { LPS, RAS };
+
+// Throws dynsub::Error naming the file for a missing file, an unknown format,
+// a malformed entry (with its line or index) or a non-finite coordinate.
+std::vector<Landmark> readLandmarks(const std::string& path);
+
+// Format by extension (.mrk.json, .fcsv, .csv); `system` applies to .mrk.json
+// and .fcsv (CSV is always LPS). The file appears complete or not at all.
+void writeLandmarks(const std::vector<Landmark>& landmarks, const std::string& path,
+                    CoordinateSystem system = CoordinateSystem::LPS);
+
+// Positions as an N x 3 matrix.
+Matrix3X landmarkPositions(const std::vector<Landmark>& landmarks);
+
+}  // namespace dynsub

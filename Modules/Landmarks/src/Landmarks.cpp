@@ -1,0 +1,245 @@
+#include "dynsub/Landmarks.h"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "dynsub/AtomicOutput.h"
+#include "dynsub/Error.h"
+
+namespace dynsub {
+namespace {
+
+bool endsWith(const std::string& text, const std::string& suffix) {
+  if (text.size() < suffix.size()) return false;
+  std::string tail = text.substr(text.size() - suffix.size());
+  for (char& c : tail) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return tail == suffix;
+}
+
+enum class Format { MarkupsJson, Fcsv, Csv };
+
+Format formatOf(const std::string& path) {
+  if (endsWith(path, ".mrk.json") || endsWith(path, ".json")) return Format::MarkupsJson;
+  if (endsWith(path, ".fcsv")) return Format::Fcsv;
+  if (endsWith(path, ".csv")) return Format::Csv;
+  throw Error(path, "unknown landmark format (expected .mrk.json, .fcsv or .csv)");
+}
+
+// RAS <-> LPS is its own inverse.
+Vector3 flipXY(const Vector3& p) { return Vector3(-p.x(), -p.y(), p.z()); }
+
+std::vector<std::string> splitCsv(const std::string& line) {
+  std::vector<std::string> fields;
+  std::string field;
+  bool quoted = false;
+  for (char c : line) {
+    if (c == '"') quoted = !quoted;
+    else if (c == ',' && !quoted) {
+      fields.push_back(field);
+      field.clear();
+    } else if (c != '\r') field += c;
+  }
+  fields.push_back(field);
+  for (auto& f : fields) {
+    const auto begin = f.find_first_not_of(" \t"), end = f.find_last_not_of(" \t");
+    f = begin == std::string::npos ? std::string() : f.substr(begin, end - begin + 1);
+  }
+  return fields;
+}
+
+double parseNumber(const std::string& text, const std::string& path, int line) {
+  std::size_t used = 0;
+  double value = 0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || !std::isfinite(value))
+    throw Error(path, "line " + std::to_string(line) + ": '" + text + "' is not a finite number");
+  return value;
+}
+
+std::vector<Landmark> readMarkupsJson(const std::string& path, std::ifstream& in) {
+  nlohmann::json document;
+  try {
+    in >> document;
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(path, std::string("not valid JSON: ") + e.what());
+  }
+  if (!document.contains("markups") || !document["markups"].is_array())
+    throw Error(path, "no \"markups\" list (not a 3D Slicer markups file)");
+  std::vector<Landmark> landmarks;
+  for (const auto& markup : document["markups"]) {
+    const std::string system = markup.value("coordinateSystem", "LPS");
+    if (system != "LPS" && system != "RAS") throw Error(path, "unknown coordinateSystem \"" + system + "\"");
+    if (markup.contains("coordinateUnits") && markup["coordinateUnits"] != "mm")
+      throw Error(path, "coordinateUnits must be mm");
+    if (!markup.contains("controlPoints")) continue;
+    int index = 0;
+    for (const auto& point : markup["controlPoints"]) {
+      ++index;
+      if (point.value("positionStatus", "defined") != "defined") continue;
+      const auto& position = point.contains("position") ? point["position"] : nlohmann::json();
+      if (!position.is_array() || position.size() != 3 || !position[0].is_number() || !position[1].is_number() ||
+          !position[2].is_number())
+        throw Error(path, "control point " + std::to_string(index) + " has no [x, y, z] position");
+      Vector3 p(position[0].get<double>(), position[1].get<double>(), position[2].get<double>());
+      if (!p.allFinite()) throw Error(path, "control point " + std::to_string(index) + " is not finite");
+      landmarks.push_back({point.value("label", "F-" + std::to_string(index)), system == "RAS" ? flipXY(p) : p});
+    }
+  }
+  return landmarks;
+}
+
+std::vector<Landmark> readFcsv(const std::string& path, std::ifstream& in) {
+  CoordinateSystem system = CoordinateSystem::LPS;
+  std::vector<std::string> columns = {"id", "x", "y", "z", "ow", "ox", "oy", "oz", "vis", "sel", "lock", "label"};
+  std::vector<Landmark> landmarks;
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (line.empty() || line == "\r") continue;
+    if (line[0] == '#') {
+      const auto equals = line.find('=');
+      if (equals == std::string::npos) continue;
+      const std::string key = line.substr(0, equals), value = splitCsv(line.substr(equals + 1))[0];
+      if (key.find("CoordinateSystem") != std::string::npos) {
+        if (value == "LPS" || value == "1") system = CoordinateSystem::LPS;
+        else if (value == "RAS" || value == "0") system = CoordinateSystem::RAS;
+        else throw Error(path, "line " + std::to_string(number) + ": unknown coordinate system '" + value + "'");
+      } else if (key.find("columns") != std::string::npos) {
+        columns = splitCsv(line.substr(equals + 1));
+      }
+      continue;
+    }
+    const auto fields = splitCsv(line);
+    auto column = [&](const std::string& name) -> int {
+      for (std::size_t c = 0; c < columns.size(); ++c)
+        if (columns[c] == name) return static_cast<int>(c);
+      return -1;
+    };
+    const int x = column("x"), y = column("y"), z = column("z"), label = column("label");
+    if (x < 0 || y < 0 || z < 0) throw Error(path, "the columns header names no x, y and z");
+    if (static_cast<int>(fields.size()) <= std::max({x, y, z}))
+      throw Error(path, "line " + std::to_string(number) + ": too few fields");
+    Vector3 p(parseNumber(fields[x], path, number), parseNumber(fields[y], path, number),
+              parseNumber(fields[z], path, number));
+    const std::string name = label >= 0 && label < static_cast<int>(fields.size()) ? fields[label] : "";
+    landmarks.push_back({name, system == CoordinateSystem::RAS ? flipXY(p) : p});
+  }
+  return landmarks;
+}
+
+std::vector<Landmark> readCsv(const std::string& path, std::ifstream& in) {
+  std::string line;
+  int number = 0;
+  std::vector<std::string> header;
+  while (header.empty() && std::getline(in, line)) {
+    ++number;
+    if (!line.empty() && line != "\r") header = splitCsv(line);
+  }
+  int x = -1, y = -1, z = -1, label = -1;
+  for (std::size_t c = 0; c < header.size(); ++c) {
+    std::string name = header[c];
+    for (char& ch : name) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    if (name == "x") x = static_cast<int>(c);
+    if (name == "y") y = static_cast<int>(c);
+    if (name == "z") z = static_cast<int>(c);
+    if (name == "label") label = static_cast<int>(c);
+  }
+  if (x < 0 || y < 0 || z < 0) throw Error(path, "the first line must name the columns x, y and z (LPS mm)");
+  std::vector<Landmark> landmarks;
+  while (std::getline(in, line)) {
+    ++number;
+    if (line.empty() || line == "\r") continue;
+    const auto fields = splitCsv(line);
+    if (static_cast<int>(fields.size()) <= std::max({x, y, z}))
+      throw Error(path, "line " + std::to_string(number) + ": too few fields");
+    landmarks.push_back({label >= 0 && label < static_cast<int>(fields.size()) ? fields[label] : "",
+                         Vector3(parseNumber(fields[x], path, number), parseNumber(fields[y], path, number),
+                                 parseNumber(fields[z], path, number))});
+  }
+  return landmarks;
+}
+
+std::string labelOf(const std::vector<Landmark>& landmarks, std::size_t i) {
+  return landmarks[i].label.empty() ? "F-" + std::to_string(i + 1) : landmarks[i].label;
+}
+
+}  // namespace
+
+std::vector<Landmark> readLandmarks(const std::string& path) {
+  const Format format = formatOf(path);
+  std::ifstream in(path);
+  if (!in) throw Error(path, "no such file or not readable");
+  std::vector<Landmark> landmarks;
+  switch (format) {
+    case Format::MarkupsJson: landmarks = readMarkupsJson(path, in); break;
+    case Format::Fcsv: landmarks = readFcsv(path, in); break;
+    case Format::Csv: landmarks = readCsv(path, in); break;
+  }
+  return landmarks;
+}
+
+void writeLandmarks(const std::vector<Landmark>& landmarks, const std::string& path, CoordinateSystem system) {
+  const Format format = formatOf(path);
+  requireWritableDirectoryFor(path);
+  for (const auto& landmark : landmarks)
+    if (!landmark.position.allFinite()) throw Error(path, "landmark '" + landmark.label + "' is not finite");
+  const bool ras = system == CoordinateSystem::RAS && format != Format::Csv;
+  auto stored = [&](const Landmark& l) { return ras ? flipXY(l.position) : l.position; };
+
+  AtomicOutput output(path);
+  {
+    std::ofstream out(output.temporaryPath());
+    out.precision(17);
+    if (format == Format::MarkupsJson) {
+      nlohmann::json points = nlohmann::json::array();
+      for (std::size_t i = 0; i < landmarks.size(); ++i) {
+        const Vector3 p = stored(landmarks[i]);
+        points.push_back({{"id", std::to_string(i + 1)}, {"label", labelOf(landmarks, i)}, {"description", ""},
+                          {"position", {p.x(), p.y(), p.z()}},
+                          {"orientation", {-1.0, -0.0, -0.0, -0.0, -1.0, -0.0, 0.0, 0.0, 1.0}},
+                          {"selected", true}, {"locked", false}, {"visibility", true},
+                          {"positionStatus", "defined"}});
+      }
+      nlohmann::json document = {
+          {"@schema",
+           "https://raw.githubusercontent.com/slicer/slicer/master/Modules/Loadable/Markups/Resources/Schema/"
+           "markups-schema-v1.0.3.json#"},
+          {"markups",
+           {{{"type", "Fiducial"}, {"coordinateSystem", ras ? "RAS" : "LPS"}, {"coordinateUnits", "mm"},
+             {"controlPoints", points}}}}};
+      out << document.dump(4) << '\n';
+    } else if (format == Format::Fcsv) {
+      out << "# Markups fiducial file version = 4.13\n# CoordinateSystem = " << (ras ? "RAS" : "LPS")
+          << "\n# columns = id,x,y,z,ow,ox,oy,oz,vis,sel,lock,label,desc,associatedNodeID\n";
+      for (std::size_t i = 0; i < landmarks.size(); ++i) {
+        const Vector3 p = stored(landmarks[i]);
+        out << i + 1 << ',' << p.x() << ',' << p.y() << ',' << p.z() << ",0,0,0,1,1,1,0," << labelOf(landmarks, i)
+            << ",,\n";
+      }
+    } else {
+      out << "x,y,z,label\n";
+      for (std::size_t i = 0; i < landmarks.size(); ++i) {
+        const Vector3 p = stored(landmarks[i]);
+        out << p.x() << ',' << p.y() << ',' << p.z() << ',' << labelOf(landmarks, i) << '\n';
+      }
+    }
+    if (!out) throw Error(path, "write failed");
+  }
+  output.commit();
+}
+
+Matrix3X landmarkPositions(const std::vector<Landmark>& landmarks) {
+  Matrix3X points(landmarks.size(), 3);
+  for (std::size_t i = 0; i < landmarks.size(); ++i) points.row(i) = landmarks[i].position.transpose();
+  return points;
+}
+
+}  // namespace dynsub
