@@ -11,5 +11,6 @@ void addLimitCommand(CLI::App& app);
 void addMeshCommand(CLI::App& app);
 void addFitCommand(CLI::App& app);
 void addDeformCommand(CLI::App& app);
+void addSegmentCommand(CLI::App& app);
 
 }  // namespace dynsub::app

@@ -3,6 +3,7 @@
 // options, a progress line on a terminal, and writing a set of outputs into a
 // directory all together or not at all.
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -71,7 +72,9 @@ void writeJson(const nlohmann::ordered_json& json, const std::string& path);
 // The outputs of a simulation, all or none: DIR/surface.vtp (the limit
 // surface, 8 x 8 squares per element), DIR/control_mesh.obj, DIR/report.json.
 // Throws dynsub::Error if the control points are not finite.
+// `extra` may add further files to the same set (e.g. a labelmap).
 void writeModelOutputs(const std::filesystem::path& dir, const ControlMesh& mesh,
-                       const nlohmann::ordered_json& report);
+                       const nlohmann::ordered_json& report,
+                       const std::function<void(OutputSet&)>& extra = nullptr);
 
 }  // namespace dynsub::app

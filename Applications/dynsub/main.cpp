@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   dynsub::app::addMeshCommand(app);
   dynsub::app::addFitCommand(app);
   dynsub::app::addDeformCommand(app);
+  dynsub::app::addSegmentCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

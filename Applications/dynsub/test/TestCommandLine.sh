@@ -101,5 +101,35 @@ expect_error "negative spring stiffness" 1 "stiffness" "$work/o11" \
 expect_error "fix-boundary on a closed mesh" 1 "closed" "$work/o12" \
   "$DYNSUB" deform "$DATA/Meshes/torus.obj" --springs "$DATA/Deform/torus_pull.springs" --fix-boundary --out "$work/o12"
 
+# --- segment: the caudate of the Colin27 MRI (mricron-data) ------------------
+mri=/usr/share/mricron/templates
+"$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" \
+  --reference "$mri/aal.nii.gz" --reference-label 71 --out "$work/caudate" >"$work/stdout" 2>&1
+check "segment succeeds" test $? -eq 0
+for name in surface.vtp control_mesh.obj labelmap.nii.gz report.json; do
+  check "segment writes $name" test -s "$work/caudate/$name"
+done
+for key in dice jaccard volume_difference_percent mean_surface_distance_mm hd95_mm hausdorff_mm stage_seconds \
+  landmark_residuals final_energy; do
+  check "segment report has $key" grep -q "\"$key\"" "$work/caudate/report.json"
+done
+expect_error "missing image" 1 "no such file" "$work/s1" \
+  "$DYNSUB" segment "$work/none.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --out "$work/s1"
+printf 'x,y,z\n500,0,0\n10,10,10\n12,10,10\n10,12,10\n10,10,12\n' >"$work/outside.csv"
+expect_error "landmark outside the image" 1 "outside the image" "$work/s2" \
+  "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/outside.csv" --out "$work/s2"
+printf '1 2 3\n' >"$work/points.txt"
+expect_error "unknown landmark format" 1 "unknown landmark format" "$work/s3" \
+  "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/points.txt" --out "$work/s3"
+expect_error "init outside the image" 1 "outside the image" "$work/s4" \
+  "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:900,0,0,10 --out "$work/s4"
+expect_error "NaN image force" 1 "image force" "$work/s5" \
+  "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:-10,10,10,5 --image-force nan --out "$work/s5"
+expect_error "reference label absent" 1 "no voxel" "$work/s6" \
+  "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:-10,10,10,5 --reference "$mri/aal.nii.gz" \
+  --reference-label 250 --out "$work/s6"
+expect_error "not an image" 1 "text.nii" "$work/s7" \
+  bash -c "echo hello >'$work/text.nii'; '$DYNSUB' segment '$work/text.nii' --init sphere:0,0,0,5 --out '$work/s7'"
+
 if [ "$failures" -gt 0 ]; then echo "$failures check(s) failed"; exit 1; fi
 echo "all command-line checks passed"

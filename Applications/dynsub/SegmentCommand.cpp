@@ -1,0 +1,202 @@
+// dynsub segment: a structure in a 3D image from image forces and expert landmarks (Segmentation.h).
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "Commands.h"
+#include "Reporting.h"
+#include "dynsub/Error.h"
+#include "dynsub/ImageIO.h"
+#include "dynsub/MeshIO.h"
+#include "dynsub/Metrics.h"
+#include "dynsub/Segmentation.h"
+
+namespace dynsub::app {
+
+namespace {
+
+struct SegmentCommandOptions {
+  std::string image;
+  std::string out;
+  std::string landmarks;
+  std::string init = "auto";
+  std::string reference;
+  std::vector<int> referenceLabels;
+  std::string potential = "edges";
+  SegmentOptions segment;
+  SimulationArguments simulation;
+};
+
+ControlMesh chooseInitialModel(const SegmentCommandOptions& o, const std::vector<Landmark>& landmarks) {
+  if (o.init == "auto") {
+    if (landmarks.size() < 4)
+      throw Error("--init auto builds the initial model from the landmarks: give at least 4 with --landmarks, "
+                  "or use --init sphere:x,y,z,r or --init MESH");
+    return initialFromLandmarks(landmarks);
+  }
+  if (o.init.rfind("sphere:", 0) == 0) {
+    std::stringstream in(o.init.substr(7));
+    double v[4];
+    char comma = ',';
+    for (int i = 0; i < 4; ++i)
+      if (!(in >> v[i]) || (i < 3 && !(in >> comma)) || comma != ',')
+        throw Error("--init " + o.init + ": expected sphere:x,y,z,r (LPS mm)");
+    return initialSphere(Vector3(v[0], v[1], v[2]), v[3]);
+  }
+  ControlMesh mesh = readControlMesh(o.init);
+  if (!mesh.isClosed()) throw Error(o.init, "the initial model must be a closed control mesh");
+  return mesh;
+}
+
+nlohmann::ordered_json metricsJson(const OverlapMetrics& m) {
+  return {{"dice", m.dice},
+          {"jaccard", m.jaccard},
+          {"volume_difference_percent", m.volumeDifferencePercent},
+          {"mean_surface_distance_mm", m.meanSurfaceDistance},
+          {"hd95_mm", m.hd95},
+          {"hausdorff_mm", m.hausdorff},
+          {"volume_mm3", m.volumeA},
+          {"reference_volume_mm3", m.volumeB}};
+}
+
+void runSegment(SegmentCommandOptions o) {
+  if (o.potential == "gradient") o.segment.edges.method = EdgeMethod::GradientMagnitude;
+  o.segment.simulation = o.simulation.apply(o.segment.simulation);
+  checkSegmentOptions(o.segment);
+  if (!o.reference.empty() && o.referenceLabels.empty())
+    throw Error("--reference needs --reference-label N[,M...]: the label value(s) of the structure");
+
+  // Every input is read and checked before anything is written.
+  const Volume image = readVolume(o.image);
+  const std::vector<Landmark> landmarks = o.landmarks.empty() ? std::vector<Landmark>{} : readLandmarks(o.landmarks);
+  Mask reference;
+  if (!o.reference.empty()) {
+    const Volume labels = readVolume(o.reference);
+    if (labels.geometry.size != image.geometry.size ||
+        (labels.geometry.origin - image.geometry.origin).norm() > 1e-3 ||
+        (labels.geometry.spacing - image.geometry.spacing).norm() > 1e-5 ||
+        (labels.geometry.direction - image.geometry.direction).norm() > 1e-5)
+      throw Error(o.reference, "the reference is not on the image's grid (size, origin, spacing or direction differ)");
+    reference = selectLabels(labels, o.referenceLabels);
+    if (reference.count() == 0) throw Error(o.reference, "no voxel has the reference label(s)");
+  }
+  const ControlMesh initial = chooseInitialModel(o, landmarks);
+  const std::filesystem::path dir(o.out);
+  prepareOutputDirectory(dir);
+
+  const auto start = std::chrono::steady_clock::now();
+  ProgressLine line;
+  const SegmentResult result = segment(image, landmarks, initial, o.segment, line.callback());
+  line.finish();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  nlohmann::ordered_json report;
+  report["image"] = o.image;
+  report["landmarks"] = o.landmarks;
+  report["landmark_count"] = landmarks.size();
+  report["init"] = o.init;
+  OverlapMetrics metrics;
+  if (!o.reference.empty()) {
+    metrics = compareMasks(result.labelmap, reference);
+    report["reference"] = o.reference;
+    report["reference_labels"] = o.referenceLabels;
+    const nlohmann::ordered_json measured = metricsJson(metrics);
+    for (const auto& [key, value] : measured.items()) report[key] = value;
+  } else {
+    report["volume_mm3"] = result.labelmap.count() * image.geometry.spacing.prod();
+  }
+  report["control_vertices"] = result.mesh.vertexCount();
+  report["levels"] = result.levels.back().level;
+  report["iterations"] = result.steps;
+  report["final_energy"] = result.levels.back().energy;
+  report["seconds"] = seconds;
+  report["stage_seconds"] = {{"crop", result.seconds.crop},
+                             {"edge_potential", result.seconds.potential},
+                             {"evolution", result.seconds.evolution},
+                             {"voxelize", result.seconds.voxelize}};
+  report["region_of_interest"] = {{"first_voxel", result.regionFirst}, {"size_voxels", result.regionSize}};
+  nlohmann::ordered_json residuals = nlohmann::ordered_json::array();
+  for (std::size_t i = 0; i < landmarks.size(); ++i)
+    residuals.push_back({{"label", landmarks[i].label},
+                         {"position_lps_mm", {landmarks[i].position.x(), landmarks[i].position.y(),
+                                              landmarks[i].position.z()}},
+                         {"distance_mm", result.landmarkDistances[i]}});
+  report["landmark_residuals"] = residuals;
+  nlohmann::ordered_json levels = nlohmann::ordered_json::array();
+  for (const auto& level : result.levels) levels.push_back(levelJson(level, -1, -1));  // no fit error in segmentation
+  report["per_level"] = levels;
+  nlohmann::ordered_json parameters = simulationJson(o.segment.simulation);
+  parameters["potential"] = o.potential;
+  parameters["sigma_mm"] = o.segment.edges.sigma;
+  parameters["edge_low"] = o.segment.edges.lowThreshold;
+  parameters["edge_high"] = o.segment.edges.highThreshold;
+  parameters["capture_range_mm"] = o.segment.edges.captureRange;
+  parameters["image_force"] = o.segment.imageForce;
+  parameters["landmark_stiffness"] = o.segment.landmarkStiffness;
+  parameters["inflation"] = o.segment.inflation;
+  parameters["margin_mm"] = o.segment.margin;
+  report["parameters"] = parameters;
+
+  writeModelOutputs(dir, result.mesh, report,
+                    [&](OutputSet& outputs) { writeMask(result.labelmap, outputs.add("labelmap.nii.gz")); });
+
+  std::cout << std::fixed << std::setprecision(1) << "segmented " << result.labelmap.count() * image.geometry.spacing.prod()
+            << " mm^3 with " << result.mesh.vertexCount() << " control vertices (" << result.levels.back().level
+            << " refinement(s), " << result.steps << " steps) in " << seconds << " s\n";
+  if (!o.reference.empty())
+    std::cout << std::setprecision(3) << "Dice " << metrics.dice << ", mean surface distance "
+              << metrics.meanSurfaceDistance << " mm, HD95 " << metrics.hd95 << " mm against " << o.reference
+              << '\n';
+  std::cout << "wrote " << (dir / "surface.vtp").string() << ", control_mesh.obj, labelmap.nii.gz, report.json\n";
+}
+
+}  // namespace
+
+void addSegmentCommand(CLI::App& app) {
+  auto o = std::make_shared<SegmentCommandOptions>();
+  CLI::App* command = app.add_subcommand(
+      "segment",
+      "Segment a structure in a 3D image with a dynamic subdivision surface pulled by image edges and by "
+      "springs to landmarks an expert placed on its boundary; the surface is refined at equilibrium.\n"
+      "Writes DIR/surface.vtp (LPS mm), DIR/control_mesh.obj, DIR/labelmap.nii.gz (on the image's grid) and "
+      "DIR/report.json.");
+  command->add_option("IMAGE", o->image, "3D image: .nii/.nii.gz, .nrrd, .mha/.mhd, or a DICOM series directory")
+      ->required();
+  command->add_option("--out", o->out, "Output directory (created if missing; its parent must exist)")->required();
+  command->add_option("--landmarks", o->landmarks, "Boundary points: .mrk.json, .fcsv or .csv (x,y,z in LPS mm)");
+  command->add_option("--init", o->init,
+                      "Initial model: auto (the 98-vertex cube inside the landmarks' PCA ellipsoid), "
+                      "sphere:x,y,z,r (LPS mm), or a closed control mesh file in LPS mm")
+      ->default_val("auto");
+  command->add_option("--reference", o->reference, "Reference labelmap on the image's grid, for Dice and distances");
+  command->add_option("--reference-label", o->referenceLabels, "Label value(s) of the structure in --reference")
+      ->delimiter(',');
+  command->add_option("--potential", o->potential, "edges (Monga-Deriche edge distance) or gradient (|grad I|)")
+      ->check(CLI::IsMember({"edges", "gradient"}))
+      ->default_val("edges");
+  command->add_option("--sigma", o->segment.edges.sigma, "Gaussian smoothing of the edge detector, mm")
+      ->default_val(o->segment.edges.sigma);
+  command->add_option("--edge-low", o->segment.edges.lowThreshold,
+                      "Hysteresis low threshold, fraction of the 99th-percentile gradient")
+      ->default_val(o->segment.edges.lowThreshold);
+  command->add_option("--edge-high", o->segment.edges.highThreshold, "Hysteresis high threshold, same unit")
+      ->default_val(o->segment.edges.highThreshold);
+  command->add_option("--capture-range", o->segment.edges.captureRange, "Distance from edges with a force, mm")
+      ->default_val(o->segment.edges.captureRange);
+  command->add_option("--image-force", o->segment.imageForce, "Image force k, N/mm^2 of surface")
+      ->default_val(o->segment.imageForce);
+  command->add_option("--landmark-stiffness", o->segment.landmarkStiffness, "Spring stiffness per landmark, N/mm")
+      ->default_val(o->segment.landmarkStiffness);
+  command->add_option("--inflation", o->segment.inflation, "Pressure along the normal, N/mm^2 (> 0 grows)")
+      ->default_val(o->segment.inflation);
+  command->add_option("--margin", o->segment.margin, "Region of interest around the model and landmarks, mm")
+      ->default_val(o->segment.margin);
+  o->simulation.addOptions(*command, SegmentOptions::defaultSimulation());
+  command->callback([o] { runSegment(*o); });
+}
+
+}  // namespace dynsub::app

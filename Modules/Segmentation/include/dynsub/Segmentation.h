@@ -1,0 +1,62 @@
+#pragma once
+// Segmenting a structure in a 3D image (TVCG 1998 §3.2, §4.3): the dynamic
+// surface moves under the image force of EdgePotential.h (k times the unit
+// direction towards the nearest edge, a force per unit area) and springs from
+// the expert's landmarks to their nearest surface points, with multilevel
+// refinement at equilibrium (the papers' 98 -> 386 control vertices).
+//
+// The work is confined to a region of interest: the bounding box of the
+// initial model and the landmarks, grown by `margin` mm (enough for the
+// surface to reach edges beyond them); the edge potential is built there only.
+// The result is voxelized on the input image's full grid.
+#include <string>
+#include <vector>
+
+#include "dynsub/ControlMesh.h"
+#include "dynsub/EdgePotential.h"
+#include "dynsub/Landmarks.h"
+#include "dynsub/Simulation.h"
+#include "dynsub/Volume.h"
+
+namespace dynsub {
+
+struct SegmentOptions {
+  EdgeOptions edges;
+  double imageForce = 0.05;        // k, N/mm^2 of surface
+  double landmarkStiffness = 10.0;  // N/mm per landmark
+  double inflation = 0.0;          // N/mm^2 along the normal (> 0 grows)
+  double margin = 8.0;             // mm around the model and the landmarks
+  SimulationOptions simulation = defaultSimulation();
+
+  static SimulationOptions defaultSimulation();
+};
+
+struct StageSeconds {
+  double crop = 0, potential = 0, evolution = 0, voxelize = 0;
+};
+
+struct SegmentResult {
+  ControlMesh mesh;
+  Mask labelmap;  // on the input's grid
+  std::vector<LevelSummary> levels;
+  int steps = 0;
+  StageSeconds seconds;
+  std::vector<double> landmarkDistances;  // mm, final distance of each landmark to the surface
+  std::array<int, 3> regionFirst{}, regionSize{};  // the region of interest (voxel box)
+};
+
+// The papers' cube placed inside the landmarks' PCA ellipsoid (half its
+// semi-axes). Throws dynsub::Error for fewer than 4 landmarks or flat ones.
+ControlMesh initialFromLandmarks(const std::vector<Landmark>& landmarks);
+
+// The cube's limit surface as a sphere of `radius` mm around `centre`.
+ControlMesh initialSphere(const Vector3& centre, double radius);
+
+// Throws dynsub::Error when the initial model or a landmark lies outside the
+// image, or for impossible options.
+SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmarks, const ControlMesh& initial,
+                      const SegmentOptions& options, const ProgressCallback& progress = nullptr);
+
+void checkSegmentOptions(const SegmentOptions& options);
+
+}  // namespace dynsub

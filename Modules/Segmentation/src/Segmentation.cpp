@@ -1,0 +1,145 @@
+#include "dynsub/Segmentation.h"
+
+#include <chrono>
+#include <cmath>
+
+#include "dynsub/ClosestPoint.h"
+#include "dynsub/Error.h"
+#include "dynsub/ShapeRecovery.h"
+#include "dynsub/StandardMeshes.h"
+#include "dynsub/Tessellation.h"
+#include "dynsub/Voxelize.h"
+
+namespace dynsub {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// eq. 28: k grad(P) / |grad(P)|, as a force per unit area.
+class ImageForceField final : public ForceField {
+ public:
+  ImageForceField(const DirectionField& directions, double strength) : directions_(directions), strength_(strength) {}
+  Matrix3X forcesAt(const Matrix3X& points) const override { return strength_ * directions_.sample(points); }
+
+ private:
+  const DirectionField& directions_;
+  double strength_;
+};
+
+bool insideImage(const ImageGeometry& geometry, const Vector3& point) {
+  const Vector3 index = geometry.toIndex(point);
+  for (int a = 0; a < 3; ++a)
+    if (!(index[a] >= -0.5 && index[a] <= geometry.size[a] - 0.5)) return false;
+  return true;
+}
+
+Matrix3X limitPoints(const ControlMesh& mesh, int segments) {
+  const LimitSurface surface(mesh);
+  return tessellate(surface, mesh.points(), segments).points;
+}
+
+}  // namespace
+
+SimulationOptions SegmentOptions::defaultSimulation() {
+  SimulationOptions o;
+  o.maxLevel = 1;  // the papers' 98 -> 386 control vertices
+  o.elasticityPerLevel = 0.25;
+  return o;
+}
+
+void checkSegmentOptions(const SegmentOptions& options) {
+  checkEdgeOptions(options.edges);
+  auto finiteNonNegative = [](double value, const std::string& name) {
+    if (!(value >= 0) || !std::isfinite(value))
+      throw Error(name + " must be a finite number >= 0 (got " + std::to_string(value) + ")");
+  };
+  finiteNonNegative(options.imageForce, "image force");
+  finiteNonNegative(options.landmarkStiffness, "landmark stiffness");
+  finiteNonNegative(options.margin, "margin");
+  if (!std::isfinite(options.inflation)) throw Error("inflation must be finite");
+  checkSimulationOptions(options.simulation);
+}
+
+ControlMesh initialFromLandmarks(const std::vector<Landmark>& landmarks) {
+  const Matrix3X points = landmarkPositions(landmarks);
+  checkPointCloud(points, "the landmarks");
+  return initialModel(points, InitialShape::Sphere);
+}
+
+ControlMesh initialSphere(const Vector3& centre, double radius) {
+  if (!(radius > 0) || !std::isfinite(radius) || !centre.allFinite())
+    throw Error("the initial sphere needs a finite centre and a radius > 0 mm");
+  ControlMesh cube = makeCube98();
+  const Matrix3X limit = limitPoints(cube, 4);
+  const double scale = radius / limit.rowwise().norm().mean();
+  cube.setPoints((cube.points() * scale).rowwise() + centre.transpose());
+  return cube;
+}
+
+SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmarks, const ControlMesh& initial,
+                      const SegmentOptions& options, const ProgressCallback& progress) {
+  checkSegmentOptions(options);
+  if (!initial.isClosed()) throw Error("the initial model must be a closed control mesh");
+  const ImageGeometry& grid = image.geometry;
+  for (const auto& landmark : landmarks)
+    if (!insideImage(grid, landmark.position))
+      throw Error("landmark '" + landmark.label + "' at (" + std::to_string(landmark.position.x()) + ", " +
+                  std::to_string(landmark.position.y()) + ", " + std::to_string(landmark.position.z()) +
+                  ") mm LPS lies outside the image");
+  const Matrix3X start = limitPoints(initial, 2);
+  for (Eigen::Index p = 0; p < start.rows(); ++p)
+    if (!insideImage(grid, start.row(p).transpose())) throw Error("the initial model reaches outside the image");
+
+  SegmentResult result;
+  auto clock = Clock::now();
+  const Matrix3X landmarkPoints = landmarkPositions(landmarks);
+  Matrix3X extent(start.rows() + landmarkPoints.rows(), 3);
+  extent << start, landmarkPoints;
+  const auto [first, size] = boundingRegion(grid, extent, options.margin);
+  result.regionFirst = first;
+  result.regionSize = size;
+  const Volume region = cropVolume(image, first, size);
+  result.seconds.crop = secondsSince(clock);
+
+  clock = Clock::now();
+  const DirectionField directions(region, options.edges);
+  result.seconds.potential = secondsSince(clock);
+
+  clock = Clock::now();
+  const ImageForceField field(directions, options.imageForce);
+  FieldForceModel imageForces(field);
+  Eigen::VectorXd stiffness = Eigen::VectorXd::Constant(landmarkPoints.rows(), options.landmarkStiffness);
+  SpringForceModel springs(landmarkPoints, stiffness, SpringForceModel::Attach::NearestEachStep);
+  InflationForceModel inflation(options.inflation);
+  std::vector<ForceModel*> forces = {&imageForces};
+  if (landmarkPoints.rows() > 0 && options.landmarkStiffness > 0) forces.push_back(&springs);
+  if (options.inflation != 0) forces.push_back(&inflation);
+  SimulationResult simulation = simulate(initial, forces, {}, options.simulation, nullptr, progress);
+  result.mesh = simulation.mesh;
+  result.levels = simulation.levels;
+  result.steps = simulation.steps;
+  result.seconds.evolution = secondsSince(clock);
+
+  clock = Clock::now();
+  const LimitSurface surface(result.mesh);
+  const TriangleSurface triangles = tessellate(surface, result.mesh.points(), 8);
+  if (!triangles.points.allFinite()) throw Error("the evolution produced a non-finite surface");
+  // Voxelize on the part of the grid the final surface covers (it may have left the region).
+  const auto [outFirst, outSize] = boundingRegion(grid, triangles.points, 2.0);
+  const Mask part = voxelizeSurface(triangles.points, triangles.triangles, grid.region(outFirst, outSize));
+  result.labelmap = pasteMask(part, grid, outFirst);
+  result.seconds.voxelize = secondsSince(clock);
+
+  if (landmarkPoints.rows() > 0) {
+    ClosestPointLocator locator(surface);
+    locator.update(result.mesh.points());
+    for (const auto& closest : locator.findAll(landmarkPoints)) result.landmarkDistances.push_back(closest.distance);
+  }
+  return result;
+}
+
+}  // namespace dynsub
