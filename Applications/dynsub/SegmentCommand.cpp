@@ -76,10 +76,7 @@ void runSegment(SegmentCommandOptions o) {
   Mask reference;
   if (!o.reference.empty()) {
     const Volume labels = readVolume(o.reference);
-    if (labels.geometry.size != image.geometry.size ||
-        (labels.geometry.origin - image.geometry.origin).norm() > 1e-3 ||
-        (labels.geometry.spacing - image.geometry.spacing).norm() > 1e-5 ||
-        (labels.geometry.direction - image.geometry.direction).norm() > 1e-5)
+    if (!labels.geometry.sameGridAs(image.geometry))
       throw Error(o.reference, "the reference is not on the image's grid (size, origin, spacing or direction differ)");
     reference = selectLabels(labels, o.referenceLabels);
     if (reference.count() == 0) throw Error(o.reference, "no voxel has the reference label(s)");

@@ -40,7 +40,7 @@ Mask edgeMap(const Volume& magnitude, const std::vector<Vector3>& gradient, cons
   const double low = options.lowThreshold * scale, high = options.highThreshold * scale;
   // A physical direction d moves the continuous index by (D^-1 d) / spacing; one
   // step is the smallest spacing long.
-  const Matrix3 toIndex = g.spacing.cwiseInverse().asDiagonal() * g.direction.inverse();
+  const Matrix3 toIndex = g.indexFromPhysical();
   const double step = g.spacing.minCoeff();
 
   std::vector<std::uint8_t> candidate(magnitude.voxels.size(), 0);
@@ -128,25 +128,25 @@ DirectionField::DirectionField(const Volume& image, const EdgeOptions& options) 
   const std::vector<Vector3> gradient = smoothedGradient(image, options.sigma);
   const Volume magnitude = magnitudeOf(image.geometry, gradient);
   if (options.method == EdgeMethod::GradientMagnitude) {
-    potential_ = magnitude;
-    normalizedGradient(potential_, std::vector<std::uint8_t>(magnitude.voxels.size(), 1), components_);
+    normalizedGradient(magnitude, std::vector<std::uint8_t>(magnitude.voxels.size(), 1), components_);
     return;
   }
   edges_ = edgeMap(magnitude, gradient, options);
-  const Volume distance{image.geometry, itkbridge::distanceMap(toBridge(image.geometry), edges_.voxels)};
-  potential_ = distance;
-  std::vector<std::uint8_t> keep(distance.voxels.size());
+  // P = -distance to the nearest edge (see the header).
+  Volume potential{image.geometry, itkbridge::distanceMap(toBridge(image.geometry), edges_.voxels)};
+  std::vector<std::uint8_t> keep(potential.voxels.size());
   for (std::size_t v = 0; v < keep.size(); ++v) {
-    potential_.voxels[v] = -distance.voxels[v];
-    keep[v] = distance.voxels[v] <= options.captureRange ? 1 : 0;
+    keep[v] = potential.voxels[v] <= options.captureRange ? 1 : 0;
+    potential.voxels[v] = -potential.voxels[v];
   }
-  normalizedGradient(potential_, keep, components_);
+  normalizedGradient(potential, keep, components_);
 }
 
 Matrix3X DirectionField::sample(const Matrix3X& points) const {
   Matrix3X result = Matrix3X::Zero(points.rows(), 3);
+  const Matrix3 toIndex = geometry_.indexFromPhysical();
   for (Eigen::Index p = 0; p < points.rows(); ++p) {
-    const Vector3 index = geometry_.toIndex(points.row(p).transpose());
+    const Vector3 index = toIndex * (points.row(p).transpose() - geometry_.origin);
     bool inside = true;
     for (int a = 0; a < 3; ++a) inside = inside && index[a] >= 0 && index[a] <= geometry_.size[a] - 1;
     if (!inside) continue;

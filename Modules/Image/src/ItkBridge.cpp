@@ -1,7 +1,6 @@
 #include "ItkBridge.h"
 
 #include <algorithm>
-#include <cctype>
 #include <filesystem>
 
 #include <itkGDCMImageIO.h>
@@ -16,6 +15,7 @@
 #include <itkSignedMaurerDistanceMapImageFilter.h>
 
 #include "dynsub/Error.h"
+#include "dynsub/FileNames.h"
 
 namespace dynsub::itkbridge {
 namespace {
@@ -60,25 +60,18 @@ Geometry geometryOf(const FloatImage* image) {
 
 long long countOf(const Geometry& g) { return static_cast<long long>(g.size[0]) * g.size[1] * g.size[2]; }
 
-// Dimension check before reading the pixels: a 2D file would otherwise be read
-// as a one-slice volume without complaint.
-void checkDimension(const std::string& path) {
+// A clear message for a file ITK has no reader for, and a size check ITK
+// leaves out (the number of dimensions is checked by readVolume, for files and
+// DICOM series alike).
+void inspectFile(const std::string& path) {
   auto io = itk::ImageIOFactory::CreateImageIO(path.c_str(), itk::ImageIOFactory::FileModeEnum::ReadMode);
   if (!io) throw Error(path, "unknown or unreadable image format");
   io->SetFileName(path);
   io->ReadImageInformation();
-  int dimensions = 0;
-  for (unsigned a = 0; a < io->GetNumberOfDimensions(); ++a)
-    if (io->GetDimensions(a) > 1) ++dimensions;
-  if (io->GetNumberOfDimensions() < 3 || dimensions < 3)
-    throw Error(path, "not a 3D image (" + std::to_string(io->GetNumberOfDimensions()) + " dimension(s), " +
-                          std::to_string(dimensions) + " with more than one voxel)");
   // NB: ITK's NIfTI reader fills a truncated uncompressed .nii with zeros
   // without complaint (compressed files fail in zlib), so the size is checked:
   // a NIfTI header is at least 348 bytes.
-  std::string lower = path;
-  for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (lower.size() > 4 && lower.compare(lower.size() - 4, 4, ".nii") == 0) {
+  if (lowerCaseExtension(path) == ".nii") {
     const auto needed = static_cast<std::uintmax_t>(io->GetImageSizeInBytes()) + 348;
     const auto actual = fs::file_size(path);
     if (actual < needed)
@@ -107,7 +100,7 @@ void readImage(const std::string& path, Geometry& geometry, std::vector<float>& 
       reader->Update();
       image = reader->GetOutput();
     } else {
-      checkDimension(path);
+      inspectFile(path);
       auto reader = itk::ImageFileReader<FloatImage>::New();
       reader->SetFileName(path);
       reader->Update();

@@ -9,12 +9,6 @@
 namespace dynsub {
 namespace {
 
-bool sameGrid(const ImageGeometry& a, const ImageGeometry& b) {
-  return a.size == b.size && (a.spacing - b.spacing).norm() <= 1e-6 * a.spacing.norm() &&
-         (a.origin - b.origin).norm() <= 1e-6 * (1 + a.origin.norm()) &&
-         (a.direction - b.direction).norm() <= 1e-6;
-}
-
 Mask boundaryOf(const Mask& mask) {
   const ImageGeometry& g = mask.geometry;
   Mask boundary{g, std::vector<std::uint8_t>(mask.voxels.size(), 0)};
@@ -38,7 +32,7 @@ Mask boundaryOf(const Mask& mask) {
 }  // namespace
 
 OverlapMetrics compareMasks(const Mask& a, const Mask& b) {
-  if (!sameGrid(a.geometry, b.geometry)) throw Error("cannot compare masks on different grids");
+  if (!a.geometry.sameGridAs(b.geometry)) throw Error("cannot compare masks on different grids");
   OverlapMetrics m;
   long long both = 0;
   for (std::size_t v = 0; v < a.voxels.size(); ++v) {

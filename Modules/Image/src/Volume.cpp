@@ -9,8 +9,16 @@ Vector3 ImageGeometry::toPhysical(const Vector3& index) const {
   return origin + direction * spacing.cwiseProduct(index);
 }
 
-Vector3 ImageGeometry::toIndex(const Vector3& point) const {
-  return (direction.inverse() * (point - origin)).cwiseQuotient(spacing);
+Vector3 ImageGeometry::toIndex(const Vector3& point) const { return indexFromPhysical() * (point - origin); }
+
+Matrix3 ImageGeometry::indexFromPhysical() const {
+  return spacing.cwiseInverse().asDiagonal() * direction.inverse();
+}
+
+bool ImageGeometry::sameGridAs(const ImageGeometry& other) const {
+  return size == other.size && (spacing - other.spacing).norm() <= 1e-6 * spacing.norm() &&
+         (origin - other.origin).norm() <= 1e-6 * (1 + origin.norm()) &&
+         (direction - other.direction).norm() <= 1e-6;
 }
 
 ImageGeometry ImageGeometry::region(const std::array<int, 3>& first, const std::array<int, 3>& regionSize) const {

@@ -30,8 +30,7 @@ Mask voxelizeSurface(const Matrix3X& points, const std::vector<std::array<int, 3
   // The row through voxel centres (j, k) is shifted by this much, see the header.
   const double shiftJ = 1.0e-6, shiftK = 1.7e-6;
 
-  Matrix3X index(points.rows(), 3);
-  for (Eigen::Index p = 0; p < points.rows(); ++p) index.row(p) = grid.toIndex(points.row(p).transpose()).transpose();
+  const Matrix3X index = (points.rowwise() - grid.origin.transpose()) * grid.indexFromPhysical().transpose();
 
   for (const auto& t : triangles) {
     const Vector3 a = index.row(t[0]), b = index.row(t[1]), c = index.row(t[2]);

@@ -53,14 +53,12 @@ class DirectionField {
   // N points in mm -> N unit (or zero) vectors, trilinearly interpolated.
   Matrix3X sample(const Matrix3X& points) const;
 
-  const Mask& edges() const { return edges_; }      // MongaDeriche only (else empty)
-  const Volume& potential() const { return potential_; }
+  const Mask& edges() const { return edges_; }  // MongaDeriche only (else empty)
 
  private:
   ImageGeometry geometry_;
   Volume components_[3];
   Mask edges_;
-  Volume potential_;
 };
 
 }  // namespace dynsub

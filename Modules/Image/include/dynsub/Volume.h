@@ -29,6 +29,12 @@ struct ImageGeometry {
   // Continuous index <-> physical point (mm).
   Vector3 toPhysical(const Vector3& index) const;
   Vector3 toIndex(const Vector3& point) const;
+  // The linear part of toIndex, index = indexFromPhysical() * (point - origin),
+  // for loops over many points (it holds a 3 x 3 inverse).
+  Matrix3 indexFromPhysical() const;
+  // Same size, and origin, spacing and direction equal to within 1e-6 (relative
+  // for origin and spacing): the two images' voxels are the same places.
+  bool sameGridAs(const ImageGeometry& other) const;
   // The same grid on the index box [first, first + size).
   ImageGeometry region(const std::array<int, 3>& first, const std::array<int, 3>& regionSize) const;
 };
