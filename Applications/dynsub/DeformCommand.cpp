@@ -12,6 +12,7 @@
 #include "Commands.h"
 #include "Reporting.h"
 #include "dynsub/Error.h"
+#include "dynsub/TextFields.h"
 #include "dynsub/ForceModel.h"
 #include "dynsub/MeshIO.h"
 #include "dynsub/Topology.h"
@@ -54,13 +55,10 @@ SpringFile readSprings(const std::string& path, double defaultStiffness) {
     std::vector<double> values;
     std::string field;
     while (fields >> field) {
-      try {
-        size_t used = 0;
-        values.push_back(std::stod(field, &used));
-        if (used != field.size()) throw std::invalid_argument(field);
-      } catch (const std::exception&) {
+      double value = 0;
+      if (!parseNumber(field, value))
         throw Error(path, "line " + std::to_string(number) + ": '" + field + "' is not a number");
-      }
+      values.push_back(value);
     }
     if (values.empty()) continue;
     if (values.size() != 3 && values.size() != 4) {

@@ -1,5 +1,6 @@
 #include "dynsub/Landmarks.h"
 
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -8,23 +9,20 @@
 
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
+#include "dynsub/FileNames.h"
+#include "dynsub/TextFields.h"
 
 namespace dynsub {
 namespace {
 
-bool endsWith(const std::string& text, const std::string& suffix) {
-  if (text.size() < suffix.size()) return false;
-  std::string tail = text.substr(text.size() - suffix.size());
-  for (char& c : tail) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return tail == suffix;
-}
-
 enum class Format { MarkupsJson, Fcsv, Csv };
 
+// .mrk.json (3D Slicer's name) ends in .json.
 Format formatOf(const std::string& path) {
-  if (endsWith(path, ".mrk.json") || endsWith(path, ".json")) return Format::MarkupsJson;
-  if (endsWith(path, ".fcsv")) return Format::Fcsv;
-  if (endsWith(path, ".csv")) return Format::Csv;
+  const std::string extension = lowerCaseExtension(path);
+  if (extension == ".json") return Format::MarkupsJson;
+  if (extension == ".fcsv") return Format::Fcsv;
+  if (extension == ".csv") return Format::Csv;
   throw Error(path, "unknown landmark format (expected .mrk.json, .fcsv or .csv)");
 }
 
@@ -50,15 +48,9 @@ std::vector<std::string> splitCsv(const std::string& line) {
   return fields;
 }
 
-double parseNumber(const std::string& text, const std::string& path, int line) {
-  std::size_t used = 0;
+double finiteNumber(const std::string& text, const std::string& path, int line) {
   double value = 0;
-  try {
-    value = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text.size() || !std::isfinite(value))
+  if (!parseNumber(text, value) || !std::isfinite(value))
     throw Error(path, "line " + std::to_string(line) + ": '" + text + "' is not a finite number");
   return value;
 }
@@ -127,8 +119,8 @@ std::vector<Landmark> readFcsv(const std::string& path, std::ifstream& in) {
     if (x < 0 || y < 0 || z < 0) throw Error(path, "the columns header names no x, y and z");
     if (static_cast<int>(fields.size()) <= std::max({x, y, z}))
       throw Error(path, "line " + std::to_string(number) + ": too few fields");
-    Vector3 p(parseNumber(fields[x], path, number), parseNumber(fields[y], path, number),
-              parseNumber(fields[z], path, number));
+    Vector3 p(finiteNumber(fields[x], path, number), finiteNumber(fields[y], path, number),
+              finiteNumber(fields[z], path, number));
     const std::string name = label >= 0 && label < static_cast<int>(fields.size()) ? fields[label] : "";
     landmarks.push_back({name, system == CoordinateSystem::RAS ? flipXY(p) : p});
   }
@@ -161,8 +153,8 @@ std::vector<Landmark> readCsv(const std::string& path, std::ifstream& in) {
     if (static_cast<int>(fields.size()) <= std::max({x, y, z}))
       throw Error(path, "line " + std::to_string(number) + ": too few fields");
     landmarks.push_back({label >= 0 && label < static_cast<int>(fields.size()) ? fields[label] : "",
-                         Vector3(parseNumber(fields[x], path, number), parseNumber(fields[y], path, number),
-                                 parseNumber(fields[z], path, number))});
+                         Vector3(finiteNumber(fields[x], path, number), finiteNumber(fields[y], path, number),
+                                 finiteNumber(fields[z], path, number))});
   }
   return landmarks;
 }

@@ -11,6 +11,7 @@
 #include <vtkXMLPolyDataReader.h>
 
 #include "dynsub/Error.h"
+#include "dynsub/TextFields.h"
 #include "dynsub/FileNames.h"
 #include "dynsub/MeshIO.h"
 
@@ -27,14 +28,7 @@ bool parseXyz(std::string line, const std::string& separators, Vector3& point) {
   std::istringstream in(line);
   std::string field;
   for (int i = 0; i < 3; ++i) {
-    if (!(in >> field)) return false;
-    try {
-      size_t used = 0;
-      point(i) = std::stod(field, &used);
-      if (used != field.size()) return false;
-    } catch (const std::exception&) {
-      return false;
-    }
+    if (!(in >> field) || !parseNumber(field, point(i))) return false;
   }
   return true;
 }
