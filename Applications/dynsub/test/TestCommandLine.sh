@@ -4,11 +4,7 @@
 set -u
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-failures=0
-check() {  # check NAME CONDITION...
-  local name=$1; shift
-  if "$@"; then echo "ok: $name"; else echo "FAILED: $name"; failures=$((failures + 1)); fi
-}
+source "$(dirname "${BASH_SOURCE[0]}")/Checks.sh"
 # expect_error NAME EXPECTED_CODE MESSAGE_FRAGMENT OUTPUT_FILE COMMAND...
 expect_error() {
   local name=$1 code=$2 fragment=$3 output=$4; shift 4

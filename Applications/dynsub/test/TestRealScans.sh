@@ -16,11 +16,7 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 tar xzf "$archive" -C "$work" data/meshes/bear.off data/points_3/kitten.xyz data/meshes/eight.off
 
-failures=0
-check() {  # check NAME CONDITION...
-  local name=$1; shift
-  if "$@"; then echo "ok: $name"; else echo "FAILED: $name"; failures=$((failures + 1)); fi
-}
+source "$(dirname "${BASH_SOURCE[0]}")/Checks.sh"
 value() {  # value REPORT KEY: a top-level number from report.json
   sed -n "s/^  \"$2\": \([-0-9.e+]*\),\{0,1\}$/\1/p" "$1"
 }

@@ -169,23 +169,23 @@ Matrix3X Integrator::step(const Matrix3X& previous, const Matrix3X& current, con
 
   Eigen::MatrixXd solution(free, 3);
   s.iterations = 0;
+  // x, y and z one after the other, each from last step's solution.
+  auto iterate = [&](auto& solver, const char* name) {
+    for (int c = 0; c < 3; ++c) {
+      solution.col(c) = solver.solveWithGuess(rhsFree.col(c), guess.col(c));
+      s.iterations += static_cast<int>(solver.iterations());
+      if (solver.info() != Eigen::Success) throw Error(std::string(name) + " did not converge");
+    }
+  };
   switch (s.options.solver) {
     case LinearSolver::Cholesky:
       solution = s.cholesky.solve(rhsFree);
       break;
     case LinearSolver::ConjugateGradient:
-      for (int c = 0; c < 3; ++c) {
-        solution.col(c) = s.cg.solveWithGuess(rhsFree.col(c), guess.col(c));
-        s.iterations += static_cast<int>(s.cg.iterations());
-        if (s.cg.info() != Eigen::Success) throw Error("conjugate gradients did not converge");
-      }
+      iterate(s.cg, "conjugate gradients");
       break;
     case LinearSolver::PreconditionedConjugateGradient:
-      for (int c = 0; c < 3; ++c) {
-        solution.col(c) = s.pcg.solveWithGuess(rhsFree.col(c), guess.col(c));
-        s.iterations += static_cast<int>(s.pcg.iterations());
-        if (s.pcg.info() != Eigen::Success) throw Error("preconditioned conjugate gradients did not converge");
-      }
+      iterate(s.pcg, "preconditioned conjugate gradients");
       break;
   }
   for (int i = 0; i < free; ++i) next.row(s.freeVertices[i]) = solution.row(i);
