@@ -134,6 +134,7 @@ void runSegment(SegmentCommandOptions o) {
   parameters["capture_range_mm"] = o.segment.edges.captureRange;
   parameters["image_force"] = o.segment.imageForce;
   parameters["landmark_stiffness"] = o.segment.landmarkStiffness;
+  parameters["landmark_tolerance_mm"] = o.segment.landmarkTolerance;
   parameters["inflation"] = o.segment.inflation;
   parameters["margin_mm"] = o.segment.margin;
   report["parameters"] = parameters;
@@ -188,6 +189,9 @@ void addSegmentCommand(CLI::App& app) {
       ->default_val(o->segment.imageForce);
   command->add_option("--landmark-stiffness", o->segment.landmarkStiffness, "Spring stiffness per landmark, N/mm")
       ->default_val(o->segment.landmarkStiffness);
+  command->add_option("--landmark-tolerance", o->segment.landmarkTolerance,
+                      "Refine at equilibrium while a landmark is farther than this from the surface, mm")
+      ->default_val(o->segment.landmarkTolerance);
   command->add_option("--inflation", o->segment.inflation, "Pressure along the normal, N/mm^2 (> 0 grows)")
       ->default_val(o->segment.inflation);
   command->add_option("--margin", o->segment.margin, "Region of interest around the model and landmarks, mm")

@@ -83,4 +83,10 @@ Matrix3X FieldForceModel::generalizedForce(const Matrix3X& controlPoints, double
   return fieldForces(*quadrature_, controlPoints, field_);
 }
 
+SparseMatrix FieldForceModel::stabilizingStiffness(const Matrix3X& controlPoints) {
+  const double slope = field_.slopeBound();
+  if (!(slope > 0.0)) return SparseMatrix();
+  return fieldStiffness(*quadrature_, controlPoints, slope);
+}
+
 }  // namespace dynsub

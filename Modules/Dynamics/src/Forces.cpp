@@ -92,4 +92,11 @@ Matrix3X fieldForces(const SurfaceQuadrature& q, const Matrix3X& controlPoints, 
   return integrate(q, forces);
 }
 
+SparseMatrix fieldStiffness(const SurfaceQuadrature& q, const Matrix3X& controlPoints, double slope) {
+  const Matrix3X su = q.Ju * controlPoints, sv = q.Jv * controlPoints;
+  Eigen::VectorXd weights(su.rows());
+  for (Eigen::Index i = 0; i < su.rows(); ++i) weights(i) = slope * q.weights(i) * su.row(i).cross(sv.row(i)).norm();
+  return SparseMatrix(q.J.transpose() * weights.asDiagonal() * q.J);
+}
+
 }  // namespace dynsub

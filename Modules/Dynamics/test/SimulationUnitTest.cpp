@@ -5,6 +5,7 @@
 // papers' 1 % tolerance; runs are repeatable; bad input is refused.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include <Eigen/SparseCholesky>
@@ -137,6 +138,63 @@ TEST(Integrator, RefusesASingularSystem) {
   const PhysicalMatrices m = assemblePhysicalMatrices(surface, material);
   IntegratorOptions options;  // first order: D + 2 dt K, singular for translations when D = 0
   EXPECT_THROW(Integrator(m, SymmetricMatrix(), {}, options), Error);
+}
+
+// A radial well like an image force across an edge: k times the unit
+// direction towards the sphere of radius R, falling linearly to zero over the
+// last `width` mm. Its slope is k / width.
+class RadialWell final : public ForceField {
+ public:
+  RadialWell(double radius, double strength, double width) : radius_(radius), strength_(strength), width_(width) {}
+  Matrix3X forcesAt(const Matrix3X& points) const override {
+    Matrix3X forces(points.rows(), 3);
+    for (Eigen::Index i = 0; i < points.rows(); ++i) {
+      const double r = points.row(i).norm();
+      const double towards = std::clamp((radius_ - r) / width_, -1.0, 1.0);
+      forces.row(i) = strength_ * towards * points.row(i) / r;
+    }
+    return forces;
+  }
+  double slopeBound() const override { return strength_ / width_; }
+
+ private:
+  double radius_, strength_, width_;
+};
+
+TEST(FieldForces, StiffnessIntegratesTheSlopeOverTheArea) {
+  // A rigid translation u of the whole surface: u^T S u = slope * area * |u|^2.
+  const ControlMesh cube = makeCube98();
+  const LimitSurface surface(cube);
+  const SurfaceQuadrature quadrature = makeSurfaceQuadrature(surface, 4);
+  const SparseMatrix stiffness = fieldStiffness(quadrature, cube.points(), 3.0);
+  const Matrix3X su = quadrature.Ju * cube.points(), sv = quadrature.Jv * cube.points();
+  double area = 0.0;
+  for (Eigen::Index i = 0; i < su.rows(); ++i) area += quadrature.weights(i) * su.row(i).cross(sv.row(i)).norm();
+  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(cube.vertexCount());
+  EXPECT_NEAR(ones.dot(stiffness * ones), 3.0 * area, 1e-9 * area);
+}
+
+TEST(FieldForces, AReversingFieldSettlesOnItsEdge) {
+  // The well is 0.2 mm wide and 20 times stronger than the surface's tension
+  // at that radius: explicit, its force would swing the surface across the
+  // edge every step. Stabilized by its slope bound, the level must reach
+  // equilibrium, with the surface on the edge to within the well's width plus
+  // the small inward pull of tension (k r / tension ~ 0.1 mm).
+  ControlMesh cube = makeCube98();
+  cube.setPoints(cube.points() * 3.0);  // limit surface radius about 2 mm
+  const RadialWell well(4.0, 1.0, 0.2);
+  FieldForceModel field(well);
+  SimulationOptions options;
+  options.material.tensionU = options.material.tensionV = 0.05;
+  options.material.rigidityUU = options.material.rigidityVV = options.material.rigidityUV = 0.0;
+  const SimulationResult result = simulate(cube, {&field}, {}, options);
+  ASSERT_EQ(result.levels.size(), 1u);
+  EXPECT_TRUE(result.levels[0].converged);
+  const LimitSurface surface(result.mesh);
+  const Matrix3X points = tessellate(surface, result.mesh.points(), 4).points;
+  const Eigen::VectorXd radii = points.rowwise().norm();
+  EXPECT_GT(radii.minCoeff(), 4.0 - 0.35);
+  EXPECT_LT(radii.maxCoeff(), 4.0 + 0.2);
 }
 
 TEST(Refinement, LeavesTheLimitSurfaceUnchanged) {

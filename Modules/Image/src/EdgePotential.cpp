@@ -142,6 +142,8 @@ DirectionField::DirectionField(const Volume& image, const EdgeOptions& options) 
   normalizedGradient(potential, keep, components_);
 }
 
+double DirectionField::slopeBound() const { return 2.0 / geometry_.spacing.minCoeff(); }
+
 Matrix3X DirectionField::sample(const Matrix3X& points) const {
   Matrix3X result = Matrix3X::Zero(points.rows(), 3);
   const Matrix3 toIndex = geometry_.indexFromPhysical();

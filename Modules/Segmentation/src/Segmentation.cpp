@@ -24,6 +24,7 @@ class ImageForceField final : public ForceField {
  public:
   ImageForceField(const DirectionField& directions, double strength) : directions_(directions), strength_(strength) {}
   Matrix3X forcesAt(const Matrix3X& points) const override { return strength_ * directions_.sample(points); }
+  double slopeBound() const override { return strength_ * directions_.slopeBound(); }
 
  private:
   const DirectionField& directions_;
@@ -60,6 +61,7 @@ void checkSegmentOptions(const SegmentOptions& options) {
   finiteNonNegative(options.imageForce, "image force");
   finiteNonNegative(options.landmarkStiffness, "landmark stiffness");
   finiteNonNegative(options.margin, "margin");
+  finiteNonNegative(options.landmarkTolerance, "landmark tolerance");
   if (!std::isfinite(options.inflation)) throw Error("inflation must be finite");
   checkSimulationOptions(options.simulation);
 }
@@ -118,7 +120,16 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
   std::vector<ForceModel*> forces = {&imageForces};
   if (landmarkPoints.rows() > 0 && options.landmarkStiffness > 0) forces.push_back(&springs);
   if (options.inflation != 0) forces.push_back(&inflation);
-  SimulationResult simulation = simulate(initial, forces, {}, options.simulation, nullptr, progress);
+  // Refine while a landmark is farther than the tolerance (see the header).
+  auto landmarksFit = [&](const LimitSurface& surface, const Matrix3X& controlPoints) {
+    if (landmarkPoints.rows() == 0) return false;
+    ClosestPointLocator locator(surface);
+    locator.update(controlPoints);
+    for (const auto& closest : locator.findAll(landmarkPoints))
+      if (closest.distance > options.landmarkTolerance) return false;
+    return true;
+  };
+  SimulationResult simulation = simulate(initial, forces, {}, options.simulation, landmarksFit, progress);
   result.mesh = simulation.mesh;
   result.levels = simulation.levels;
   result.steps = simulation.steps;

@@ -77,6 +77,10 @@ class FieldForceModel final : public ForceModel {
   void beginLevel(const LimitSurface& surface, const SurfaceQuadrature& quadrature,
                   const Matrix3X& controlPoints) override;
   Matrix3X generalizedForce(const Matrix3X& controlPoints, double& potential) override;
+  // fieldStiffness with the field's slopeBound: a field that reverses across
+  // an edge is a stiff explicit force, which the papers' schemes would let
+  // oscillate about the edge instead of settling on it.
+  SparseMatrix stabilizingStiffness(const Matrix3X& controlPoints) override;
 
  private:
   const ForceField& field_;

@@ -39,6 +39,9 @@ class ForceField {
  public:
   virtual ~ForceField() = default;
   virtual Matrix3X forcesAt(const Matrix3X& points) const = 0;
+  // An upper bound of |df/dx| (N/mm^3) wherever the field changes fastest, or
+  // 0 if unknown; it only serves to stabilize time integration (Integrator.h).
+  virtual double slopeBound() const { return 0.0; }
 };
 
 // Generalized spring forces; `energy` (if given) receives sum k |d - s|^2 / 2 (N mm).
@@ -50,5 +53,9 @@ SparseMatrix springStiffness(const LimitSurface& surface, const std::vector<Spri
 
 Matrix3X inflationForces(const SurfaceQuadrature& quadrature, const Matrix3X& controlPoints, double pressure);
 Matrix3X fieldForces(const SurfaceQuadrature& quadrature, const Matrix3X& controlPoints, const ForceField& field);
+// slope * sum_q w_q |s_u x s_v|_q J_q^T J_q (#control by #control): the
+// stiffness of a field whose force changes by `slope` N/mm^3 in every
+// direction, integrated over the surface at `controlPoints`.
+SparseMatrix fieldStiffness(const SurfaceQuadrature& quadrature, const Matrix3X& controlPoints, double slope);
 
 }  // namespace dynsub

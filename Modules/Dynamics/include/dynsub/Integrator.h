@@ -10,7 +10,8 @@
 // are evaluated at the current state, which is unstable for stiff springs (for
 // eq. 32 whenever a spring is stiffer than the surface in some mode, at any
 // dt). So a stiffness S of the forces (for springs sum k J^T J at the
-// attachments when the integrator was built) is moved to the left side:
+// attachments when the integrator was built; for a force field, the bound of
+// its slope integrated as sum w |s_u x s_v| J^T J) is moved to the left side:
 // K is replaced by K + S and S p(t) is added to f_p. At an equilibrium the two
 // S terms cancel, so equilibria are those of the papers' equations; only the
 // path to them is damped. An empty S gives the papers' schemes unchanged.

@@ -5,6 +5,12 @@
 // the expert's landmarks to their nearest surface points, with multilevel
 // refinement at equilibrium (the papers' 98 -> 386 control vertices).
 //
+// Refinement: at each level's equilibrium the fit is accepted when every
+// landmark lies within `landmarkTolerance` mm of the surface; otherwise the
+// control mesh is subdivided, up to `simulation.maxLevel` times. Without
+// landmarks there is no misfit to measure, and the model is refined to
+// maxLevel.
+//
 // The work is confined to a region of interest: the bounding box of the
 // initial model and the landmarks, grown by `margin` mm (enough for the
 // surface to reach edges beyond them); the edge potential is built there only.
@@ -24,6 +30,7 @@ struct SegmentOptions {
   EdgeOptions edges;
   double imageForce = 0.05;        // k, N/mm^2 of surface
   double landmarkStiffness = 10.0;  // N/mm per landmark
+  double landmarkTolerance = 0.5;   // mm, largest landmark distance accepted without refining
   double inflation = 0.0;          // N/mm^2 along the normal (> 0 grows)
   double margin = 8.0;             // mm around the model and the landmarks
   SimulationOptions simulation = defaultSimulation();
