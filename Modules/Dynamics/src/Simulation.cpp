@@ -142,7 +142,10 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
           // The motion is dissipative and re-attaching springs only lowers
           // their energy, so an energy that keeps rising means the forces'
           // stiffness has drifted from the one the integrator was built with.
-          rises = energy > lastEnergy ? rises + 1 : 0;
+          // Changes within the equilibrium tolerance are not rises: near an
+          // equilibrium they are noise (and forces without a potential, like
+          // image forces, make the counted energy wander by that much).
+          rises = change > options.equilibrium.energyTolerance && energy > lastEnergy ? rises + 1 : 0;
           if (rises >= 3) {
             integrator = makeIntegrator(current);
             ++summary.stabilizerUpdates;

@@ -14,9 +14,10 @@
 // reported so).
 //
 // Stabilizer updates: the forces' stiffness that stabilizes the integration
-// (Integrator.h) is frozen when a level starts; when the energy rises for 3
-// steps in a row (springs re-attached elsewhere have made it stale) it is
-// frozen anew at the current state and the left-hand matrix refactored.
+// (Integrator.h) is frozen when a level starts; when the energy rises by more
+// than energyTolerance for 3 steps in a row (springs re-attached elsewhere
+// have made it stale) it is frozen anew at the current state and the
+// left-hand matrix refactored.
 //
 // Divergence: a non-finite state, an energy above 1e3 times the largest seen
 // in the level's first step, or a step moving a point by more than the model's
