@@ -1,0 +1,117 @@
+// DynSub's segmentation beside ITK's geodesic active contour, in one run, on
+// the same cropped region of the same MRI from the same landmarks:
+//   build/bin/SegmentationComparison [IMAGE LABELS LANDMARKS LABEL]
+// (defaults: the demo's left caudate of Colin27 against AAL label 71).
+// DynSub uses the landmarks as springs; the level set cannot, so it starts
+// from DynSub's own initial model (voxelized) and reads its speed image's
+// edge level at the landmarks. Prints Dice, distances and seconds for each,
+// DynSub's stage seconds, and the process's peak memory after each method.
+#include <sys/resource.h>
+
+#include <cstdio>
+#include <exception>
+#include <string>
+
+#include "ItkGeodesicActiveContour.h"
+#include "dynsub/ImageIO.h"
+#include "dynsub/LimitSurface.h"
+#include "dynsub/Metrics.h"
+#include "dynsub/Segmentation.h"
+#include "dynsub/Tessellation.h"
+#include "dynsub/Voxelize.h"
+
+namespace {
+
+using namespace dynsub;
+
+double peakMegabytes() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;
+}
+
+itkbaseline::Grid toGrid(const ImageGeometry& g) {
+  itkbaseline::Grid grid;
+  for (int a = 0; a < 3; ++a) {
+    grid.size[a] = g.size[a];
+    grid.spacing[a] = g.spacing[a];
+    grid.origin[a] = g.origin[a];
+    for (int b = 0; b < 3; ++b) grid.direction[3 * a + b] = g.direction(a, b);
+  }
+  return grid;
+}
+
+void printRow(const char* method, const OverlapMetrics& m, double seconds, const std::string& extra) {
+  std::printf("%-34s Dice %.3f  Jaccard %.3f  volume %+6.1f %%  MSD %.2f mm  HD95 %.2f mm  %7.2f s  %s\n", method,
+              m.dice, m.jaccard, m.volumeDifferencePercent, m.meanSurfaceDistance, m.hd95, seconds, extra.c_str());
+}
+
+int run(int argc, char** argv) {
+  const std::string templates = "/usr/share/mricron/templates/";
+  const std::string imagePath = argc > 1 ? argv[1] : templates + "ch2.nii.gz";
+  const std::string labelsPath = argc > 2 ? argv[2] : templates + "aal.nii.gz";
+  const std::string landmarksPath = argc > 3 ? argv[3] : std::string(DYNSUB_DATA_DIR) + "/Landmarks/caudate_left.mrk.json";
+  const int label = argc > 4 ? std::stoi(argv[4]) : 71;
+
+  const Volume image = readVolume(imagePath);
+  const Mask reference = selectLabels(readVolume(labelsPath), {label});
+  const std::vector<Landmark> landmarks = readLandmarks(landmarksPath);
+  const ControlMesh initial = initialFromLandmarks(landmarks);
+  std::printf("%s, label %d, %zu landmarks from %s\n", imagePath.c_str(), label, landmarks.size(),
+              landmarksPath.c_str());
+
+  const SegmentResult dynsub = segment(image, landmarks, initial, SegmentOptions());
+  const double dynsubSeconds =
+      dynsub.seconds.crop + dynsub.seconds.potential + dynsub.seconds.evolution + dynsub.seconds.voxelize;
+  const double dynsubPeak = peakMegabytes();
+  const ImageGeometry region = image.geometry.region(dynsub.regionFirst, dynsub.regionSize);
+  std::printf("region of interest %d x %d x %d voxels\n", region.size[0], region.size[1], region.size[2]);
+
+  // The level set on the same region, from the same initial model.
+  const Volume cropped = cropVolume(image, dynsub.regionFirst, dynsub.regionSize);
+  const LimitSurface surface(initial);
+  const TriangleSurface start = tessellate(surface, initial.points(), 8);
+  const Mask initialMask = voxelizeSurface(start.points, start.triangles, region);
+  std::vector<std::array<int, 3>> edgeVoxels;
+  for (const Landmark& l : landmarks) {
+    const Vector3 index = region.toIndex(l.position);
+    edgeVoxels.push_back({static_cast<int>(std::lround(index[0])), static_cast<int>(std::lround(index[1])),
+                          static_cast<int>(std::lround(index[2]))});
+  }
+
+  printRow("dynsub segment (defaults)", compareMasks(dynsub.labelmap, reference), dynsubSeconds,
+           std::to_string(dynsub.levels.back().controlVertices) + " control vertices, peak " +
+               std::to_string(static_cast<int>(dynsubPeak)) + " MB");
+  std::printf("  stages: crop %.4f s, edge potential %.3f s, evolution %.3f s, voxelize %.3f s\n",
+              dynsub.seconds.crop, dynsub.seconds.potential, dynsub.seconds.evolution, dynsub.seconds.voxelize);
+  printRow("initial model (both methods)", compareMasks(pasteMask(initialMask, image.geometry, dynsub.regionFirst),
+                                                        reference), 0.0, "");
+  for (double propagation : {0.5, 1.0, 2.0}) {
+    itkbaseline::GacOptions options;
+    options.propagation = propagation;
+    const itkbaseline::GacResult gac =
+        itkbaseline::geodesicActiveContour(toGrid(region), cropped.voxels, initialMask.voxels, edgeVoxels, options);
+    Mask mask{region, gac.mask};
+    char name[64], extra[128];
+    std::snprintf(name, sizeof name, "ITK GAC, propagation %.1f", propagation);
+    std::snprintf(extra, sizeof extra, "%d iterations, sigmoid alpha %.2f beta %.2f, peak %d MB",
+                  gac.elapsedIterations, gac.alpha, gac.beta, static_cast<int>(peakMegabytes()));
+    if (mask.count() == 0) {
+      std::printf("%-34s empty result (the contour vanished)\n", name);
+      continue;
+    }
+    printRow(name, compareMasks(pasteMask(mask, image.geometry, dynsub.regionFirst), reference), gac.seconds, extra);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "SegmentationComparison: %s\n", e.what());
+    return 1;
+  }
+}
