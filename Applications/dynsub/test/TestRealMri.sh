@@ -31,6 +31,34 @@ segment_structure() {
 }
 
 segment_structure caudate_left "$DATA/Landmarks/caudate_left.mrk.json" 71
+
+# The labelmap must sit where the MRI does in any viewer: read without ITK,
+# its dimensions, voxel sizes and sform equal the MRI's, and its qform (which
+# ITK-SNAP and 3D Slicer prefer when set) is the same transform.
+check "caudate_left: labelmap header places it on the MRI's grid" python3 - "$templates/ch2.nii.gz" \
+  "$work/caudate_left/labelmap.nii.gz" <<'PY'
+import gzip, math, struct, sys
+def header(path):
+    h = gzip.open(path).read()[:348]
+    quatern = struct.unpack_from("<6f", h, 256)
+    b, c, d = quatern[:3]
+    a = math.sqrt(max(0.0, 1 - b * b - c * c - d * d))
+    rotation = [[a*a+b*b-c*c-d*d, 2*(b*c-a*d), 2*(b*d+a*c)], [2*(b*c+a*d), a*a+c*c-b*b-d*d, 2*(c*d-a*b)],
+                [2*(b*d-a*c), 2*(c*d+a*b), a*a+d*d-c*c-b*b]]
+    pixdim = struct.unpack_from("<8f", h, 76)
+    qfac = -1.0 if pixdim[0] < 0 else 1.0
+    qform = [rotation[r][0] * pixdim[1] for r in range(3)], [rotation[r][1] * pixdim[2] for r in range(3)], \
+            [rotation[r][2] * pixdim[3] * qfac for r in range(3)]
+    qmatrix = [[qform[col][r] for col in range(3)] + [quatern[3 + r]] for r in range(3)]
+    sform = struct.unpack_from("<12f", h, 280)
+    return (struct.unpack_from("<4h", h, 40), pixdim[1:4], struct.unpack_from("<h", h, 252)[0],
+            [list(sform[4 * r:4 * r + 4]) for r in range(3)], qmatrix)
+mri, labels = header(sys.argv[1]), header(sys.argv[2])
+close = lambda m, n: all(abs(x - y) < 1e-4 for r, s in zip(m, n) for x, y in zip(r, s))
+ok = mri[0] == labels[0] and mri[1] == labels[1] and close(mri[3], labels[3])
+ok = ok and (labels[2] == 0 or close(labels[4], mri[3]))
+sys.exit(0 if ok else 1)
+PY
 segment_structure cerebellum "$DATA/Landmarks/cerebellum.mrk.json" $(seq 91 116)
 for structure in thalamus_left:77 putamen_left:73; do
   name=${structure%:*} label=${structure#*:}
