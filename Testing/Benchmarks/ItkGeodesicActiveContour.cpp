@@ -1,4 +1,5 @@
 #include "ItkGeodesicActiveContour.h"
+#include "ItkImages.h"
 
 #include <chrono>
 #include <stdexcept>
@@ -7,42 +8,16 @@
 #include <itkCurvatureAnisotropicDiffusionImageFilter.h>
 #include <itkGeodesicActiveContourLevelSetImageFilter.h>
 #include <itkGradientMagnitudeRecursiveGaussianImageFilter.h>
-#include <itkImage.h>
-#include <itkImportImageFilter.h>
 #include <itkSigmoidImageFilter.h>
 #include <itkSignedMaurerDistanceMapImageFilter.h>
 
 namespace itkbaseline {
-namespace {
 
-using FloatImage = itk::Image<float, 3>;
-using ByteImage = itk::Image<std::uint8_t, 3>;
+using dynsub::itkbridge::FloatImage;
+using dynsub::itkbridge::makeImage;
+using ByteImage = dynsub::itkbridge::MaskImage;
 
-template <typename Image, typename Pixel>
-typename Image::Pointer makeImage(const Grid& grid, const std::vector<Pixel>& voxels) {
-  auto image = Image::New();
-  typename Image::RegionType region;
-  typename Image::SpacingType spacing;
-  typename Image::PointType origin;
-  typename Image::DirectionType direction;
-  for (int a = 0; a < 3; ++a) {
-    region.SetSize(a, grid.size[a]);
-    spacing[a] = grid.spacing[a];
-    origin[a] = grid.origin[a];
-    for (int b = 0; b < 3; ++b) direction(a, b) = grid.direction[3 * a + b];
-  }
-  image->SetRegions(region);
-  image->SetSpacing(spacing);
-  image->SetOrigin(origin);
-  image->SetDirection(direction);
-  image->Allocate();
-  std::copy(voxels.begin(), voxels.end(), image->GetBufferPointer());
-  return image;
-}
-
-}  // namespace
-
-GacResult geodesicActiveContour(const Grid& grid, const std::vector<float>& voxels,
+GacResult geodesicActiveContour(const Geometry& grid, const std::vector<float>& voxels,
                                 const std::vector<std::uint8_t>& initialMask,
                                 const std::vector<std::array<int, 3>>& edgeVoxels, const GacOptions& options) {
   const auto started = std::chrono::steady_clock::now();

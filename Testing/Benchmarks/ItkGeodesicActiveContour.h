@@ -7,13 +7,11 @@
 #include <cstdint>
 #include <vector>
 
+#include "ItkBridge.h"
+
 namespace itkbaseline {
 
-struct Grid {
-  std::array<int, 3> size{};
-  std::array<double, 3> spacing{}, origin{};
-  std::array<double, 9> direction{};  // row-major
-};
+using dynsub::itkbridge::Geometry;
 
 struct GacOptions {
   double sigma = 1.0;          // mm, gradient-magnitude smoothing
@@ -38,7 +36,7 @@ struct GacResult {
 // magnitude at `edgeVoxels` (the landmarks), `inside` its mean inside the
 // initial mask. The initial level set is the signed distance to the initial
 // mask's boundary.
-GacResult geodesicActiveContour(const Grid& grid, const std::vector<float>& image,
+GacResult geodesicActiveContour(const Geometry& grid, const std::vector<float>& image,
                                 const std::vector<std::uint8_t>& initialMask,
                                 const std::vector<std::array<int, 3>>& edgeVoxels, const GacOptions& options);
 

@@ -12,6 +12,7 @@
 #include <exception>
 #include <string>
 
+#include "BridgeGeometry.h"
 #include "ItkGeodesicActiveContour.h"
 #include "dynsub/ImageIO.h"
 #include "dynsub/LimitSurface.h"
@@ -28,17 +29,6 @@ double peakMegabytes() {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   return usage.ru_maxrss / 1024.0;
-}
-
-itkbaseline::Grid toGrid(const ImageGeometry& g) {
-  itkbaseline::Grid grid;
-  for (int a = 0; a < 3; ++a) {
-    grid.size[a] = g.size[a];
-    grid.spacing[a] = g.spacing[a];
-    grid.origin[a] = g.origin[a];
-    for (int b = 0; b < 3; ++b) grid.direction[3 * a + b] = g.direction(a, b);
-  }
-  return grid;
 }
 
 void printRow(const char* method, const OverlapMetrics& m, double seconds, const std::string& extra) {
@@ -90,7 +80,7 @@ int run(int argc, char** argv) {
     itkbaseline::GacOptions options;
     options.propagation = propagation;
     const itkbaseline::GacResult gac =
-        itkbaseline::geodesicActiveContour(toGrid(region), cropped.voxels, initialMask.voxels, edgeVoxels, options);
+        itkbaseline::geodesicActiveContour(toBridge(region), cropped.voxels, initialMask.voxels, edgeVoxels, options);
     Mask mask{region, gac.mask};
     char name[64], extra[128];
     std::snprintf(name, sizeof name, "ITK GAC, propagation %.1f", propagation);

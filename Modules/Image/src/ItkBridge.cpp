@@ -1,4 +1,5 @@
 #include "ItkBridge.h"
+#include "ItkImages.h"
 
 #include <algorithm>
 #include <filesystem>
@@ -21,31 +22,7 @@ namespace dynsub::itkbridge {
 namespace {
 
 namespace fs = std::filesystem;
-using FloatImage = itk::Image<float, 3>;
-using MaskImage = itk::Image<unsigned char, 3>;
 using GradientImage = itk::Image<itk::CovariantVector<float, 3>, 3>;
-
-template <typename Image, typename Pixel>
-typename Image::Pointer makeImage(const Geometry& g, const std::vector<Pixel>& voxels) {
-  auto image = Image::New();
-  typename Image::RegionType region;
-  typename Image::SpacingType spacing;
-  typename Image::PointType origin;
-  typename Image::DirectionType direction;
-  for (int a = 0; a < 3; ++a) {
-    region.SetSize(a, g.size[a]);
-    spacing[a] = g.spacing[a];
-    origin[a] = g.origin[a];
-    for (int b = 0; b < 3; ++b) direction(a, b) = g.direction[3 * a + b];
-  }
-  image->SetRegions(region);
-  image->SetSpacing(spacing);
-  image->SetOrigin(origin);
-  image->SetDirection(direction);
-  image->Allocate();
-  std::copy(voxels.begin(), voxels.end(), image->GetBufferPointer());
-  return image;
-}
 
 Geometry geometryOf(const FloatImage* image) {
   Geometry g;
