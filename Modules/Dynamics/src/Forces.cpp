@@ -67,6 +67,14 @@ Matrix3X integrate(const SurfaceQuadrature& q, const Matrix3X& densityTimesArea)
   return q.J.transpose() * (q.weights.asDiagonal() * densityTimesArea);
 }
 
+// |s_u x s_v| at every quadrature point: surface area per unit parametric area.
+Eigen::VectorXd areaElements(const SurfaceQuadrature& q, const Matrix3X& controlPoints) {
+  const Matrix3X su = q.Ju * controlPoints, sv = q.Jv * controlPoints;
+  Eigen::VectorXd area(su.rows());
+  for (Eigen::Index i = 0; i < su.rows(); ++i) area(i) = su.row(i).cross(sv.row(i)).norm();
+  return area;
+}
+
 }  // namespace
 
 Matrix3X inflationForces(const SurfaceQuadrature& q, const Matrix3X& controlPoints, double pressure) {
@@ -81,21 +89,17 @@ Matrix3X inflationForces(const SurfaceQuadrature& q, const Matrix3X& controlPoin
 
 Matrix3X fieldForces(const SurfaceQuadrature& q, const Matrix3X& controlPoints, const ForceField& field) {
   const Matrix3X positions = q.J * controlPoints;
-  const Matrix3X su = q.Ju * controlPoints, sv = q.Jv * controlPoints;
   Matrix3X forces = field.forcesAt(positions);
   if (forces.rows() != positions.rows()) {
     throw Error("force field returned " + std::to_string(forces.rows()) + " forces for " +
                 std::to_string(positions.rows()) + " points");
   }
   if (!forces.allFinite()) throw Error("force field returned a non-finite force");
-  for (Eigen::Index i = 0; i < forces.rows(); ++i) forces.row(i) *= su.row(i).cross(sv.row(i)).norm();
-  return integrate(q, forces);
+  return integrate(q, areaElements(q, controlPoints).asDiagonal() * forces);
 }
 
 SparseMatrix fieldStiffness(const SurfaceQuadrature& q, const Matrix3X& controlPoints, double slope) {
-  const Matrix3X su = q.Ju * controlPoints, sv = q.Jv * controlPoints;
-  Eigen::VectorXd weights(su.rows());
-  for (Eigen::Index i = 0; i < su.rows(); ++i) weights(i) = slope * q.weights(i) * su.row(i).cross(sv.row(i)).norm();
+  const Eigen::VectorXd weights = slope * q.weights.cwiseProduct(areaElements(q, controlPoints));
   return SparseMatrix(q.J.transpose() * weights.asDiagonal() * q.J);
 }
 

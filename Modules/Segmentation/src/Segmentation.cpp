@@ -38,6 +38,16 @@ bool insideImage(const ImageGeometry& geometry, const Vector3& point) {
   return true;
 }
 
+// Distance (mm) from each landmark to the limit surface of `controlPoints`.
+std::vector<double> distancesToSurface(const LimitSurface& surface, const Matrix3X& controlPoints,
+                                       const Matrix3X& landmarkPoints) {
+  ClosestPointLocator locator(surface);
+  locator.update(controlPoints);
+  std::vector<double> distances;
+  for (const auto& closest : locator.findAll(landmarkPoints)) distances.push_back(closest.distance);
+  return distances;
+}
+
 Matrix3X limitPoints(const ControlMesh& mesh, int segments) {
   const LimitSurface surface(mesh);
   return tessellate(surface, mesh.points(), segments).points;
@@ -123,10 +133,8 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
   // Refine while a landmark is farther than the tolerance (see the header).
   auto landmarksFit = [&](const LimitSurface& surface, const Matrix3X& controlPoints) {
     if (landmarkPoints.rows() == 0) return false;
-    ClosestPointLocator locator(surface);
-    locator.update(controlPoints);
-    for (const auto& closest : locator.findAll(landmarkPoints))
-      if (closest.distance > options.landmarkTolerance) return false;
+    for (double distance : distancesToSurface(surface, controlPoints, landmarkPoints))
+      if (distance > options.landmarkTolerance) return false;
     return true;
   };
   SimulationResult simulation = simulate(initial, forces, {}, options.simulation, landmarksFit, progress);
@@ -145,11 +153,8 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
   result.labelmap = pasteMask(part, grid, outFirst);
   result.seconds.voxelize = secondsSince(clock);
 
-  if (landmarkPoints.rows() > 0) {
-    ClosestPointLocator locator(surface);
-    locator.update(result.mesh.points());
-    for (const auto& closest : locator.findAll(landmarkPoints)) result.landmarkDistances.push_back(closest.distance);
-  }
+  if (landmarkPoints.rows() > 0)
+    result.landmarkDistances = distancesToSurface(surface, result.mesh.points(), landmarkPoints);
   return result;
 }
 

@@ -121,7 +121,8 @@ void expectAccurate(const SegmentResult& result, const Phantom& phantom, double 
   EXPECT_LE(m.meanSurfaceDistance, halfVoxel);
   for (double d : result.landmarkDistances) EXPECT_LT(d, 1.0);
   for (const LevelSummary& level : result.levels)
-    EXPECT_TRUE(level.converged) << "level " << level.level << " steps " << level.steps << " stabilizer " << level.stabilizerUpdates;
+    EXPECT_TRUE(level.converged) << "level " << level.level << " ended unconverged after " << level.steps
+                                 << " steps";
   std::printf("dice %.4f  mean surface distance %.3f mm  hd95 %.2f mm  levels %zu  control vertices %d\n", m.dice,
               m.meanSurfaceDistance, m.hd95, result.levels.size(), result.levels.back().controlVertices);
 }

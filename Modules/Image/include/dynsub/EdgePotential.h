@@ -52,8 +52,9 @@ class DirectionField {
 
   // N points in mm -> N unit (or zero) vectors, trilinearly interpolated.
   Matrix3X sample(const Matrix3X& points) const;
-  // How fast the sampled unit vectors can change, per mm: they reverse (+1 to
-  // -1) across an edge over two voxels, so 1 / (smallest spacing).
+  // How fast the sampled unit vectors can change, per mm: they can reverse
+  // (+1 to -1) between neighbouring voxels (across an edge two voxels thick,
+  // or the ridge midway between two edges), so 2 / (smallest spacing).
   double slopeBound() const;
 
   const Mask& edges() const { return edges_; }  // MongaDeriche only (else empty)
