@@ -121,6 +121,8 @@ expect_error "init outside the image" 1 "outside the image" "$work/s4" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:900,0,0,10 --out "$work/s4"
 expect_error "NaN image force" 1 "image force" "$work/s5" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:-10,10,10,5 --image-force nan --out "$work/s5"
+expect_error "negative landmark tolerance" 1 "landmark tolerance" "$work/s8" \
+  "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:-10,10,10,5 --landmark-tolerance -1 --out "$work/s8"
 expect_error "reference label absent" 1 "no voxel" "$work/s6" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:-10,10,10,5 --reference "$mri/aal.nii.gz" \
   --reference-label 250 --out "$work/s6"
