@@ -12,5 +12,6 @@ void addMeshCommand(CLI::App& app);
 void addFitCommand(CLI::App& app);
 void addDeformCommand(CLI::App& app);
 void addSegmentCommand(CLI::App& app);
+void addRenderCommand(CLI::App& app);
 
 }  // namespace dynsub::app

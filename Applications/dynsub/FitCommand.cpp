@@ -7,7 +7,9 @@
 #include <nlohmann/json.hpp>
 
 #include "Commands.h"
+#include "FigureOutputs.h"
 #include "Reporting.h"
+#include "dynsub/EnclosingSphere.h"
 #include "dynsub/Error.h"
 #include "dynsub/MeshIO.h"
 #include "dynsub/PointCloudIO.h"
@@ -24,6 +26,7 @@ struct FitCommandOptions {
   int genus = -1;
   FitOptions fit;
   SimulationArguments simulation;
+  FigureOptions figures;
 };
 
 ControlMesh chooseInitialModel(const FitCommandOptions& o, const Matrix3X& data) {
@@ -58,7 +61,15 @@ void runFit(FitCommandOptions o) {
   o.fit.simulation = o.simulation.apply(o.fit.simulation);
 
   ProgressLine line;
-  const FitResult result = fitPointCloud(data, initial, o.fit, line.callback());
+  // The papers' max error every 10 steps (a closest-point search per data point).
+  const double diameter = 2.0 * smallestEnclosingSphere(data).radius;
+  ConvergenceRecorder recorder(
+      "max error (% of diameter)",
+      [&](const LimitSurface& surface, const Matrix3X& controlPoints) {
+        return measureFitError(surface, controlPoints, data, diameter).maxPercent;
+      },
+      10);
+  const FitResult result = fitPointCloud(data, initial, o.fit, recorder.callback(line.callback()));
   line.finish();
 
   nlohmann::ordered_json report;
@@ -88,7 +99,9 @@ void runFit(FitCommandOptions o) {
   parameters["data_stiffness"] = o.fit.dataStiffness;
   report["parameters"] = parameters;
 
-  writeModelOutputs(dir, result.mesh, report);
+  writeModelOutputs(dir, result.mesh, report, [&](OutputSet& outputs) {
+    addFigureOutputs(outputs, o.figures, result.mesh, recorder.history(), nullptr, {}, data);
+  });
 
   std::cout << std::fixed << std::setprecision(3) << "fitted " << data.rows() << " points with "
             << result.mesh.vertexCount() << " control vertices (" << result.levels.back().level
@@ -98,7 +111,8 @@ void runFit(FitCommandOptions o) {
             << result.error.rmsPercent << " % of the enclosing sphere's diameter ("
             << 2.0 * result.enclosingSphere.radius << " mm)"
             << (result.error.maxPercent <= o.fit.tolerancePercent ? "" : " -- above the tolerance") << '\n'
-            << "wrote " << (dir / "surface.vtp").string() << ", control_mesh.obj, report.json\n";
+            << "wrote " << (dir / "surface.vtp").string() << ", control_mesh.obj, report.json, convergence.csv"
+            << (o.figures.figures ? " and the figures that could be rendered" : "") << '\n';
 }
 
 }  // namespace
@@ -111,7 +125,8 @@ void addFitCommand(CLI::App& app) {
       "Springs pull the limit surface toward the data; at equilibrium the control mesh is refined until the "
       "largest distance from a data point to the surface is below the tolerance (percent of the diameter of "
       "the smallest sphere enclosing the data).\n"
-      "Writes DIR/surface.vtp, DIR/control_mesh.obj and DIR/report.json.");
+      "Writes DIR/surface.vtp, DIR/control_mesh.obj, DIR/report.json, DIR/convergence.csv and the figures "
+      "DIR/slices.png, DIR/surface3d.png and DIR/convergence.png.");
   command->add_option("POINTS", o->points, "Point cloud: .xyz/.txt, .csv, .ply, .off, .obj or .vtp (mm)")
       ->required();
   command->add_option("--out", o->out, "Output directory (created if missing; its parent must exist)")->required();
@@ -129,6 +144,7 @@ void addFitCommand(CLI::App& app) {
       ->default_val(o->fit.dataStiffness)
       ->check(CLI::PositiveNumber);
   o->simulation.addOptions(*command, FitOptions::defaultSimulation());
+  o->figures.addOptions(*command);
   command->callback([o] { runFit(*o); });
 }
 

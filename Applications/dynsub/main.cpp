@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   dynsub::app::addFitCommand(app);
   dynsub::app::addDeformCommand(app);
   dynsub::app::addSegmentCommand(app);
+  dynsub::app::addRenderCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

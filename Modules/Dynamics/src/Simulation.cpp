@@ -176,7 +176,7 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
         previous = std::move(current);
         current = std::move(next);
         summary.steps = step;
-        if (progress) progress(Progress{state.level, step, energy, motion});
+        if (progress) progress(Progress{state.level, step, energy, motion, &surface, &current});
       }
       if (!diverged) break;
       timeStep *= 0.5;

@@ -79,6 +79,11 @@ struct Progress {
   int step = 0;
   double energy = 0;
   double motion = 0;  // largest control-point move of the step, mm
+  // The state after the step, for observers that measure a fit or draw the
+  // surface. Valid only during the callback; the callback may throw to stop
+  // the simulation (the exception propagates out of simulate).
+  const LimitSurface* surface = nullptr;
+  const Matrix3X* controlPoints = nullptr;
 };
 
 // Decides at an equilibrium whether the fit is good enough (true: stop).

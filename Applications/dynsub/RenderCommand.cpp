@@ -1,0 +1,79 @@
+// dynsub render: the figures of segment and fit (Figures.h) from saved results.
+#include <filesystem>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+#include <vtkPolyData.h>
+#include <vtkRenderWindow.h>
+
+#include "Commands.h"
+#include "Reporting.h"
+#include "dynsub/Error.h"
+#include "dynsub/Figures.h"
+#include "dynsub/ImageIO.h"
+#include "dynsub/Landmarks.h"
+#include "dynsub/MeshIO.h"
+#include "dynsub/PointCloudIO.h"
+#include "dynsub/SurfacePolyData.h"
+#include "dynsub/SurfaceView.h"
+
+namespace dynsub::app {
+
+namespace {
+
+struct RenderCommandOptions {
+  std::string surface, image, landmarks, points, convergence, controlMesh, out;
+};
+
+void runRender(const RenderCommandOptions& o) {
+  std::string why;
+  if (!displayAvailable(&why)) throw Error("rendering needs an X display: " + why);
+  // Every input is read and checked before anything is written.
+  const vtkSmartPointer<vtkPolyData> surface = readSurfacePolyData(o.surface);
+  Volume image;
+  if (!o.image.empty()) image = readVolume(o.image);
+  FigureScene scene;
+  scene.surface = surface;
+  if (!o.image.empty()) scene.image = &image;
+  if (!o.landmarks.empty())
+    for (const Landmark& l : readLandmarks(o.landmarks)) scene.landmarks.push_back(l.position);
+  if (!o.points.empty()) scene.dataPoints = readPointCloud(o.points);
+  vtkSmartPointer<vtkPolyData> wireframe;
+  if (!o.controlMesh.empty()) {
+    wireframe = controlMeshWireframe(readControlMesh(o.controlMesh));
+    scene.controlMesh = wireframe;
+  }
+  ConvergenceHistory history;
+  if (!o.convergence.empty()) history = readConvergenceCsv(o.convergence);
+
+  const std::filesystem::path dir(o.out);
+  prepareOutputDirectory(dir);
+  OutputSet outputs(dir);
+  writePng(slicesFigure(scene), outputs.add("slices.png"));
+  writePng(surfaceFigure(scene), outputs.add("surface3d.png"));
+  if (!o.convergence.empty()) writePng(convergenceFigure(history), outputs.add("convergence.png"));
+  outputs.commit();
+  std::cout << "wrote " << (dir / "slices.png").string() << ", surface3d.png"
+            << (o.convergence.empty() ? "" : ", convergence.png") << '\n';
+}
+
+}  // namespace
+
+void addRenderCommand(CLI::App& app) {
+  auto o = std::make_shared<RenderCommandOptions>();
+  CLI::App* command = app.add_subcommand(
+      "render",
+      "Make the figures of segment and fit from saved results: DIR/slices.png (slices through the surface with "
+      "its contour and the landmarks), DIR/surface3d.png and, with --convergence, DIR/convergence.png.\n"
+      "Needs an X display (xvfb-run provides one on a machine without a screen).");
+  command->add_option("--surface", o->surface, "Limit surface: surface.vtp (or .obj, .ply, .stl), mm")->required();
+  command->add_option("--image", o->image, "The image the surface was segmented in (slices show it)");
+  command->add_option("--landmarks", o->landmarks, "Landmarks: .mrk.json, .fcsv or .csv");
+  command->add_option("--points", o->points, "Range data the surface was fitted to");
+  command->add_option("--control-mesh", o->controlMesh, "Control mesh to draw as a wireframe in the 3D figure");
+  command->add_option("--convergence", o->convergence, "convergence.csv written by segment or fit");
+  command->add_option("--out", o->out, "Output directory (created if missing; its parent must exist)")->required();
+  command->callback([o] { runRender(*o); });
+}
+
+}  // namespace dynsub::app

@@ -1,0 +1,23 @@
+#pragma once
+// The tessellated limit surface as VTK polydata, the form SurfaceWriter.h
+// writes and the Visualization module draws: triangles with point data
+// "Normals" and cell data "ElementType" (0 normal element, 1 special element)
+// and "Element". Coordinates in mm (LPS for images).
+#include <string>
+
+#include <vtkSmartPointer.h>
+
+#include "dynsub/Tessellation.h"
+
+class vtkPolyData;
+
+namespace dynsub {
+
+vtkSmartPointer<vtkPolyData> toPolyData(const TriangleSurface& surface);
+
+// Reads a triangle surface (.vtp, .obj, .ply or .stl, by extension). Throws
+// dynsub::Error naming the file when it is missing, unreadable, has no
+// triangles, or has non-finite coordinates.
+vtkSmartPointer<vtkPolyData> readSurfacePolyData(const std::string& path);
+
+}  // namespace dynsub

@@ -1,0 +1,117 @@
+#include "dynsub/SurfacePolyData.h"
+
+#include <cmath>
+#include <filesystem>
+
+#include <vtkCallbackCommand.h>
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkDoubleArray.h>
+#include <vtkIntArray.h>
+#include <vtkNew.h>
+#include <vtkOBJReader.h>
+#include <vtkPLYReader.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkSTLReader.h>
+#include <vtkUnsignedCharArray.h>
+#include <vtkXMLPolyDataReader.h>
+
+#include "dynsub/Error.h"
+#include "dynsub/FileNames.h"
+
+namespace dynsub {
+
+vtkSmartPointer<vtkPolyData> toPolyData(const TriangleSurface& surface) {
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(surface.points.rows());
+  vtkNew<vtkDoubleArray> normals;
+  normals->SetName("Normals");
+  normals->SetNumberOfComponents(3);
+  normals->SetNumberOfTuples(surface.points.rows());
+  for (Eigen::Index i = 0; i < surface.points.rows(); ++i) {
+    points->SetPoint(i, surface.points(i, 0), surface.points(i, 1), surface.points(i, 2));
+    normals->SetTuple3(i, surface.normals(i, 0), surface.normals(i, 1), surface.normals(i, 2));
+  }
+  vtkNew<vtkCellArray> triangles;
+  vtkNew<vtkUnsignedCharArray> type;
+  type->SetName("ElementType");
+  vtkNew<vtkIntArray> element;
+  element->SetName("Element");
+  for (size_t t = 0; t < surface.triangles.size(); ++t) {
+    const vtkIdType ids[3] = {surface.triangles[t][0], surface.triangles[t][1], surface.triangles[t][2]};
+    triangles->InsertNextCell(3, ids);
+    type->InsertNextValue(static_cast<unsigned char>(surface.triangleType[t]));
+    element->InsertNextValue(surface.triangleElement[t]);
+  }
+  auto polyData = vtkSmartPointer<vtkPolyData>::New();
+  polyData->SetPoints(points);
+  polyData->SetPolys(triangles);
+  polyData->GetPointData()->SetNormals(normals);
+  polyData->GetCellData()->AddArray(type);
+  polyData->GetCellData()->AddArray(element);
+  return polyData;
+}
+
+namespace {
+
+// Collects VTK's error messages instead of letting them go to stderr unnamed.
+struct ErrorCatcher {
+  std::string message;
+  vtkNew<vtkCallbackCommand> command;
+  ErrorCatcher() {
+    command->SetClientData(this);
+    command->SetCallback([](vtkObject*, unsigned long, void* client, void* data) {
+      auto* self = static_cast<ErrorCatcher*>(client);
+      if (self->message.empty() && data) self->message = static_cast<const char*>(data);
+    });
+  }
+};
+
+template <typename Reader>
+vtkSmartPointer<vtkPolyData> readWith(const std::string& path) {
+  vtkNew<Reader> reader;
+  ErrorCatcher errors;
+  reader->AddObserver(vtkCommand::ErrorEvent, errors.command);
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  if (!errors.message.empty()) {
+    // The first line is enough: VTK's messages carry source locations after it.
+    const std::string first = errors.message.substr(0, errors.message.find('\n'));
+    throw Error(path, "VTK could not read the surface: " + first);
+  }
+  auto polyData = vtkSmartPointer<vtkPolyData>::New();
+  polyData->ShallowCopy(reader->GetOutput());
+  return polyData;
+}
+
+}  // namespace
+
+vtkSmartPointer<vtkPolyData> readSurfacePolyData(const std::string& path) {
+  if (!std::filesystem::is_regular_file(path)) throw Error(path, "no such file");
+  const std::string extension = lowerCaseExtension(path);
+  vtkSmartPointer<vtkPolyData> polyData;
+  if (extension == ".vtp") {
+    polyData = readWith<vtkXMLPolyDataReader>(path);
+  } else if (extension == ".obj") {
+    polyData = readWith<vtkOBJReader>(path);
+  } else if (extension == ".ply") {
+    polyData = readWith<vtkPLYReader>(path);
+  } else if (extension == ".stl") {
+    polyData = readWith<vtkSTLReader>(path);
+  } else {
+    throw Error(path, "unknown surface format '" + extension + "' (expected .vtp, .obj, .ply or .stl)");
+  }
+  if (polyData->GetNumberOfPolys() == 0) throw Error(path, "the file holds no surface polygons");
+  for (vtkIdType i = 0; i < polyData->GetNumberOfPoints(); ++i) {
+    double p[3];
+    polyData->GetPoint(i, p);
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+      throw Error(path, "point " + std::to_string(i) + " has a non-finite coordinate");
+  }
+  return polyData;
+}
+
+}  // namespace dynsub

@@ -1,0 +1,54 @@
+#pragma once
+// The figures `dynsub segment`, `dynsub fit` and `dynsub render` write
+// (TVCG Figs 6, 10, 11):
+//   slices.png       3 rows (axial, coronal, sagittal) x 5 slices through the
+//                    surface: the image, the surface's contour, the landmarks
+//                    on each slice (or the range data near it); 1200 x 720;
+//   surface3d.png    the limit surface coloured by element type, landmarks or
+//                    data, and (with an image) three slices behind the surface
+//                    as a backdrop; 800 x 800;
+//   convergence.png  the convergence plot (ConvergencePlot.h); 900 x 500.
+// Windows are fixed-size, without multisampling, and render off screen, so
+// the same input gives the same pixels (rendering regression tests rely on it).
+//
+// Debian's VTK renders through X11 only: an X display is needed (xvfb-run
+// provides one on a machine without a screen). displayAvailable says whether
+// one can be opened; without it VTK would abort the process.
+#include <string>
+#include <vector>
+
+#include <vtkSmartPointer.h>
+
+#include "dynsub/ConvergenceHistory.h"
+#include "dynsub/Types.h"
+
+class vtkPolyData;
+class vtkRenderWindow;
+
+namespace dynsub {
+
+struct Volume;
+
+struct FigureScene {
+  const Volume* image = nullptr;      // optional
+  vtkPolyData* surface = nullptr;     // the limit surface, required (SurfacePolyData.h)
+  vtkPolyData* controlMesh = nullptr; // optional wireframe (SurfaceView.h), 3D figure only
+  std::vector<Vector3> landmarks;     // LPS mm
+  Matrix3X dataPoints;                // range data, mm
+};
+
+// Throws dynsub::Error when the scene has no surface, or (slices) when the
+// surface lies outside the image.
+vtkSmartPointer<vtkRenderWindow> slicesFigure(const FigureScene& scene);
+vtkSmartPointer<vtkRenderWindow> surfaceFigure(const FigureScene& scene);
+// Throws dynsub::Error for an empty history.
+vtkSmartPointer<vtkRenderWindow> convergenceFigure(const ConvergenceHistory& history);
+
+// Renders the window and writes it as PNG; the file appears complete or not
+// at all. Throws dynsub::Error naming the file.
+void writePng(vtkRenderWindow* window, const std::string& path);
+
+// True when an X display can be opened; otherwise `why` says what is missing.
+bool displayAvailable(std::string* why = nullptr);
+
+}  // namespace dynsub

@@ -1,0 +1,63 @@
+#pragma once
+// One slice view (TVCG Figs 10-11): an image slice in grey, the surface's
+// cross-section on that slice as a contour (vtkCutter; yellow on normal
+// elements, green on special ones, as in the papers), the landmarks that lie
+// on the slice as red dots (the selected one cyan), and optionally range-data
+// points near the slice. Orientation letters mark the screen edges.
+// Everything is in LPS mm (SlicePlanes.h says how the image is placed).
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "dynsub/SlicePlanes.h"
+
+class vtkPolyData;
+class vtkRenderer;
+
+namespace dynsub {
+
+class SliceView {
+ public:
+  explicit SliceView(SliceOrientation orientation);
+  ~SliceView();
+  SliceView(const SliceView&) = delete;
+  SliceView& operator=(const SliceView&) = delete;
+
+  vtkRenderer* renderer() const;
+  SliceOrientation orientation() const;
+
+  // Not owned; must outlive the view. nullptr: no image (planes are then set
+  // with showPlane).
+  void setImage(const ImageSlices* image);
+  // The surface whose cross-section is drawn; the contour follows when the
+  // polydata is modified (live fitting).
+  void setSurface(vtkPolyData* surface);
+  // Landmarks (LPS mm); those within half a slice of the plane are drawn.
+  void setLandmarks(const std::vector<Vector3>& landmarks, int selected = -1);
+  // Range data drawn as small white dots where within half a slice.
+  void setDataPoints(const Matrix3X& points);
+
+  // Show the image's slice `index` (clamped), or any plane.
+  void showSlice(int index);
+  void showPlane(const SlicePlane& plane);
+  const SlicePlane& plane() const;
+  int sliceIndex() const;  // -1 without an image
+
+  // A square of half side `halfSize` mm around `centre` fills the viewport.
+  void frame(const Vector3& centre, double halfSize);
+  // Text in the top-left corner; by default the orientation and slice.
+  void setTitle(const std::string& title);
+
+  // The point of the slice plane under a display position (pixels), and the
+  // display position of a point (valid once the view has been rendered or framed).
+  Vector3 pointAt(double displayX, double displayY) const;
+  Eigen::Vector2d displayPosition(const Vector3& point) const;
+  // Indices of the landmarks drawn on this slice.
+  std::vector<int> landmarksOnSlice() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace dynsub

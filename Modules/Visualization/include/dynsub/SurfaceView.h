@@ -1,0 +1,49 @@
+#pragma once
+// The 3D view: the limit surface lit and coloured by element type (yellow
+// normal, green special elements, as in the papers), optionally translucent;
+// the control mesh as a wireframe; landmarks as red dots; range data as white
+// dots; and the image's three slice planes through a point. LPS mm.
+#include <memory>
+#include <vector>
+
+#include "dynsub/SlicePlanes.h"
+
+class vtkPolyData;
+class vtkRenderer;
+
+namespace dynsub {
+
+class ControlMesh;
+
+// The control mesh's edges as lines (one line per edge), LPS mm.
+vtkSmartPointer<vtkPolyData> controlMeshWireframe(const ControlMesh& mesh);
+
+class SurfaceView {
+ public:
+  SurfaceView();
+  ~SurfaceView();
+  SurfaceView(const SurfaceView&) = delete;
+  SurfaceView& operator=(const SurfaceView&) = delete;
+
+  vtkRenderer* renderer() const;
+
+  void setSurface(vtkPolyData* surface);  // followed when modified
+  void setOpacity(double opacity);        // 1 opaque
+  void setControlMesh(vtkPolyData* wireframe);  // nullptr hides it
+  void setLandmarks(const std::vector<Vector3>& landmarks, int selected = -1);
+  void setDataPoints(const Matrix3X& points);
+  // The three slice planes of `image` (not owned) at the given slice indices
+  // (axial, coronal, sagittal); nullptr hides them.
+  void setImage(const ImageSlices* image);
+  void showSlices(int axial, int coronal, int sagittal);
+
+  // Looks at the surface's bounds from the front, left and above (the
+  // patient's left-anterior-superior side), the whole surface in view.
+  void resetCamera();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace dynsub

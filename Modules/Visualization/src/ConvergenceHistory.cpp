@@ -1,0 +1,81 @@
+#include "dynsub/ConvergenceHistory.h"
+
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+#include "dynsub/AtomicOutput.h"
+#include "dynsub/Error.h"
+
+namespace dynsub {
+
+namespace {
+const char* const kNamePrefix = "# fit_error: ";
+const char* const kHeader = "level,step,energy,fit_error";
+}  // namespace
+
+void ConvergenceHistory::add(const ConvergenceSample& sample) {
+  while (!samples.empty() && samples.back().level == sample.level && samples.back().step >= sample.step)
+    samples.pop_back();
+  samples.push_back(sample);
+}
+
+void writeConvergenceCsv(const ConvergenceHistory& history, const std::string& path) {
+  AtomicOutput output(path);
+  {
+    std::ofstream out(output.temporaryPath());
+    if (!out) throw Error(path, "cannot write the file");
+    out << kNamePrefix << history.fitErrorName << '\n' << kHeader << '\n' << std::setprecision(10);
+    for (const ConvergenceSample& s : history.samples) {
+      out << s.level << ',' << s.step << ',' << s.energy << ',';
+      if (std::isfinite(s.fitError)) out << s.fitError;
+      out << '\n';
+    }
+    if (!out) throw Error(path, "writing the file failed");
+  }
+  output.commit();
+}
+
+ConvergenceHistory readConvergenceCsv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(path, "cannot open the file");
+  ConvergenceHistory history;
+  std::string line;
+  int number = 0;
+  bool header = false;
+  while (std::getline(in, line)) {
+    ++number;
+    if (line.rfind(kNamePrefix, 0) == 0) {
+      history.fitErrorName = line.substr(std::string(kNamePrefix).size());
+      continue;
+    }
+    if (!header) {
+      if (line != kHeader) throw Error(path, "line " + std::to_string(number) + ": expected the header " + kHeader);
+      header = true;
+      continue;
+    }
+    std::stringstream fields(line);
+    std::string level, step, energy, fit;
+    std::getline(fields, level, ',');
+    std::getline(fields, step, ',');
+    std::getline(fields, energy, ',');
+    std::getline(fields, fit, ',');
+    ConvergenceSample s;
+    try {
+      std::size_t used = 0;
+      s.level = std::stoi(level, &used);
+      s.step = std::stoi(step);
+      s.energy = std::stod(energy);
+      if (!fit.empty()) s.fitError = std::stod(fit);
+    } catch (const std::exception&) {
+      throw Error(path, "line " + std::to_string(number) + ": expected level,step,energy,fit_error numbers");
+    }
+    if (!std::isfinite(s.energy)) throw Error(path, "line " + std::to_string(number) + ": the energy is not finite");
+    history.samples.push_back(s);
+  }
+  if (!header) throw Error(path, "not a convergence history (no header " + std::string(kHeader) + ")");
+  return history;
+}
+
+}  // namespace dynsub

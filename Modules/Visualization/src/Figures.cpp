@@ -1,0 +1,170 @@
+#include "dynsub/Figures.h"
+
+#include <X11/Xlib.h>
+
+#include <algorithm>
+#include <cstdlib>
+
+#include <vtkChartXY.h>
+#include <vtkContextActor.h>
+#include <vtkContextScene.h>
+#include <vtkNew.h>
+#include <vtkPNGWriter.h>
+#include <vtkPolyData.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderer.h>
+#include <vtkWindowToImageFilter.h>
+
+#include "dynsub/AtomicOutput.h"
+#include "dynsub/ConvergencePlot.h"
+#include "dynsub/Error.h"
+#include "dynsub/SliceView.h"
+#include "dynsub/SurfaceView.h"
+#include "dynsub/Volume.h"
+
+namespace dynsub {
+
+namespace {
+
+constexpr int kColumns = 5;
+constexpr int kCell = 240;  // pixels per montage cell
+
+vtkSmartPointer<vtkRenderWindow> offScreenWindow(int width, int height) {
+  auto window = vtkSmartPointer<vtkRenderWindow>::New();
+  window->SetOffScreenRendering(1);
+  window->SetMultiSamples(0);
+  window->SetSize(width, height);
+  return window;
+}
+
+void requireSurface(const FigureScene& scene) {
+  if (!scene.surface || scene.surface->GetNumberOfPoints() == 0) throw Error("the figure has no surface to show");
+}
+
+Matrix3X surfacePoints(vtkPolyData* surface) {
+  Matrix3X p(surface->GetNumberOfPoints(), 3);
+  for (vtkIdType i = 0; i < surface->GetNumberOfPoints(); ++i) {
+    double x[3];
+    surface->GetPoint(i, x);
+    p.row(i) << x[0], x[1], x[2];
+  }
+  return p;
+}
+
+}  // namespace
+
+vtkSmartPointer<vtkRenderWindow> slicesFigure(const FigureScene& scene) {
+  requireSurface(scene);
+  const Matrix3X points = surfacePoints(scene.surface);
+  const Vector3 low = points.colwise().minCoeff().transpose(), high = points.colwise().maxCoeff().transpose();
+  const Vector3 centre = 0.5 * (low + high);
+  std::unique_ptr<ImageSlices> image;
+  if (scene.image) {
+    image = std::make_unique<ImageSlices>(*scene.image);
+    const Vector3 index = scene.image->geometry.toIndex(centre);
+    for (int a = 0; a < 3; ++a)
+      if (index[a] < -0.5 || index[a] > scene.image->geometry.size[a] - 0.5)
+        throw Error("the surface lies outside the image: nothing to show on its slices");
+  }
+  const double diagonal = (high - low).norm();
+
+  auto window = offScreenWindow(kColumns * kCell, 3 * kCell);
+  for (int row = 0; row < 3; ++row) {
+    const auto orientation = static_cast<SliceOrientation>(row);
+    // The surface's extent along the slice normal and across the view.
+    SlicePlane axes = image ? image->plane(orientation, 0) : anatomicalPlane(orientation, centre, 0.015 * diagonal);
+    const Eigen::VectorXd along = points * axes.normal;
+    const Eigen::VectorXd across = points * axes.right, upward = points * axes.up;
+    const double halfSize = 0.5 * 1.3 * std::max(across.maxCoeff() - across.minCoeff(), upward.maxCoeff() - upward.minCoeff()) + 3.0;
+    for (int column = 0; column < kColumns; ++column) {
+      SliceView view(orientation);
+      view.setImage(image.get());
+      view.setSurface(scene.surface);
+      // Interior slices, evenly spread: the end slices would only graze it.
+      const double t = along.minCoeff() + (column + 1.0) / (kColumns + 1.0) * (along.maxCoeff() - along.minCoeff());
+      const Vector3 through = centre + (t - centre.dot(axes.normal)) * axes.normal;
+      if (image) {
+        view.showSlice(image->sliceThrough(orientation, through));
+      } else {
+        view.showPlane(anatomicalPlane(orientation, through, axes.thickness));
+      }
+      view.setLandmarks(scene.landmarks);
+      if (scene.dataPoints.rows() > 0) view.setDataPoints(scene.dataPoints);
+      view.frame(centre, halfSize);
+      // Row 0 at the top of the window.
+      view.renderer()->SetViewport(double(column) / kColumns, (2.0 - row) / 3.0, (column + 1.0) / kColumns,
+                                   (3.0 - row) / 3.0);
+      window->AddRenderer(view.renderer());
+    }
+  }
+  return window;
+}
+
+vtkSmartPointer<vtkRenderWindow> surfaceFigure(const FigureScene& scene) {
+  requireSurface(scene);
+  auto window = offScreenWindow(800, 800);
+  SurfaceView view;
+  view.setSurface(scene.surface);
+  if (scene.controlMesh) view.setControlMesh(scene.controlMesh);
+  view.setLandmarks(scene.landmarks);
+  if (scene.dataPoints.rows() > 0) view.setDataPoints(scene.dataPoints);
+  std::unique_ptr<ImageSlices> image;
+  if (scene.image) {
+    // Slices just behind the surface as seen by the camera (which looks from
+    // the left, front and top): its right, back and bottom.
+    image = std::make_unique<ImageSlices>(*scene.image);
+    double b[6];
+    scene.surface->GetBounds(b);
+    const Vector3 corner(b[0], b[3], b[4]);
+    view.setImage(image.get());
+    view.showSlices(image->sliceThrough(SliceOrientation::Axial, corner),
+                    image->sliceThrough(SliceOrientation::Coronal, corner),
+                    image->sliceThrough(SliceOrientation::Sagittal, corner));
+  }
+  view.resetCamera();
+  window->AddRenderer(view.renderer());
+  return window;
+}
+
+vtkSmartPointer<vtkRenderWindow> convergenceFigure(const ConvergenceHistory& history) {
+  auto window = offScreenWindow(900, 500);
+  vtkNew<vtkRenderer> renderer;
+  renderer->SetBackground(1, 1, 1);
+  vtkNew<vtkContextActor> actor;
+  actor->GetScene()->AddItem(convergenceChart(history));
+  renderer->AddActor(actor);
+  window->AddRenderer(renderer);
+  return window;
+}
+
+void writePng(vtkRenderWindow* window, const std::string& path) {
+  AtomicOutput output(path);
+  window->Render();
+  vtkNew<vtkWindowToImageFilter> capture;
+  capture->SetInput(window);
+  capture->ReadFrontBufferOff();
+  capture->Update();
+  vtkNew<vtkPNGWriter> writer;
+  writer->SetInputConnection(capture->GetOutputPort());
+  writer->SetFileName(output.temporaryPath().c_str());
+  writer->Write();
+  if (writer->GetErrorCode() != 0) throw Error(path, "VTK could not write the PNG image");
+  output.commit();
+}
+
+bool displayAvailable(std::string* why) {
+  const char* name = std::getenv("DISPLAY");
+  if (!name || !*name) {
+    if (why) *why = "DISPLAY is not set (run under xvfb-run on a machine without a screen)";
+    return false;
+  }
+  Display* display = XOpenDisplay(nullptr);
+  if (!display) {
+    if (why) *why = std::string("cannot open the X display ") + name;
+    return false;
+  }
+  XCloseDisplay(display);
+  return true;
+}
+
+}  // namespace dynsub

@@ -1,0 +1,67 @@
+#include "SceneStyle.h"
+
+#include <cmath>
+
+#include <vtkActor.h>
+#include <vtkCoordinate.h>
+#include <vtkLookupTable.h>
+#include <vtkNew.h>
+#include <vtkPolyDataMapper.h>
+#include <vtkProperty.h>
+#include <vtkTextActor.h>
+#include <vtkTextProperty.h>
+
+namespace dynsub::style {
+
+void colourByElementType(vtkPolyDataMapper* mapper) {
+  vtkNew<vtkLookupTable> table;
+  table->SetNumberOfTableValues(2);
+  table->SetTableRange(0, 1);
+  table->SetTableValue(0, kNormalElement[0], kNormalElement[1], kNormalElement[2]);
+  table->SetTableValue(1, kSpecialElement[0], kSpecialElement[1], kSpecialElement[2]);
+  table->Build();
+  mapper->SetLookupTable(table);
+  mapper->SetColorModeToMapScalars();  // the array is unsigned char: not colours themselves
+  mapper->SetScalarModeToUseCellFieldData();
+  mapper->SelectColorArray("ElementType");
+  mapper->SetScalarRange(0, 1);
+  mapper->ScalarVisibilityOn();
+}
+
+void pointsAsDots(vtkActor* actor, double pixels) {
+  actor->GetProperty()->SetRepresentationToPoints();
+  actor->GetProperty()->SetPointSize(pixels);
+  actor->GetProperty()->RenderPointsAsSpheresOn();
+  actor->GetProperty()->LightingOff();
+}
+
+void cornerText(vtkTextActor* text, double x, double y, Corner corner, int fontSize) {
+  text->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
+  text->SetPosition(x, y);
+  vtkTextProperty* p = text->GetTextProperty();
+  p->SetFontSize(fontSize);
+  p->SetFontFamilyToArial();
+  p->SetColor(1, 1, 1);
+  p->SetJustificationToCentered();
+  p->SetVerticalJustificationToCentered();
+  switch (corner) {
+    case Corner::TopLeft: p->SetJustificationToLeft(); p->SetVerticalJustificationToTop(); break;
+    case Corner::TopRight: p->SetJustificationToRight(); p->SetVerticalJustificationToTop(); break;
+    case Corner::BottomLeft: p->SetJustificationToLeft(); p->SetVerticalJustificationToBottom(); break;
+    case Corner::Left: p->SetJustificationToLeft(); break;
+    case Corner::Right: p->SetJustificationToRight(); break;
+    case Corner::Top: p->SetVerticalJustificationToTop(); break;
+    case Corner::Bottom: p->SetVerticalJustificationToBottom(); break;
+  }
+}
+
+std::string anatomicalLetter(const Vector3& direction) {
+  int axis = 0;
+  for (int a = 1; a < 3; ++a)
+    if (std::abs(direction[a]) > std::abs(direction[axis])) axis = a;
+  static const char* positive[3] = {"L", "P", "S"};
+  static const char* negative[3] = {"R", "A", "I"};
+  return direction[axis] >= 0 ? positive[axis] : negative[axis];
+}
+
+}  // namespace dynsub::style

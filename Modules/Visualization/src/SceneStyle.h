@@ -1,0 +1,37 @@
+#pragma once
+// The look every view shares: colours, sizes and text placement. Private to
+// the Visualization module.
+#include <array>
+#include <string>
+
+#include "dynsub/Types.h"
+
+class vtkActor;
+class vtkPolyDataMapper;
+class vtkTextActor;
+
+namespace dynsub::style {
+
+// The papers draw normal elements yellow and special ones green.
+constexpr std::array<double, 3> kNormalElement{1.0, 0.85, 0.1};
+constexpr std::array<double, 3> kSpecialElement{0.2, 0.8, 0.3};
+constexpr std::array<unsigned char, 3> kLandmark{230, 40, 40};
+constexpr std::array<unsigned char, 3> kSelectedLandmark{40, 220, 240};
+constexpr double kLandmarkPixels = 9.0;
+constexpr double kDataPixels = 3.0;
+constexpr double kCameraDistance = 1000.0;  // mm, slice views (parallel projection)
+constexpr int kFontSize = 14;
+
+// Colours a mapper's cells by the "ElementType" cell array (SurfacePolyData.h).
+void colourByElementType(vtkPolyDataMapper* mapper);
+// Vertices drawn as round dots of a fixed size in pixels.
+void pointsAsDots(vtkActor* actor, double pixels);
+
+enum class Corner { TopLeft, TopRight, BottomLeft, Left, Right, Top, Bottom };
+// White text at a normalized viewport position, justified towards `corner`.
+void cornerText(vtkTextActor* text, double x, double y, Corner corner, int fontSize = kFontSize);
+
+// The anatomical direction a unit LPS vector points to most: L, R, P, A, S or I.
+std::string anatomicalLetter(const Vector3& direction);
+
+}  // namespace dynsub::style

@@ -1,0 +1,261 @@
+#include "dynsub/SliceView.h"
+
+#include <cmath>
+#include <sstream>
+#include <iomanip>
+
+#include <vtkActor.h>
+#include <vtkCamera.h>
+#include <vtkCellArray.h>
+#include <vtkCutter.h>
+#include <vtkImageProperty.h>
+#include <vtkImageSlice.h>
+#include <vtkImageSliceMapper.h>
+#include <vtkNew.h>
+#include <vtkPlane.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataMapper.h>
+#include <vtkProperty.h>
+#include <vtkRenderer.h>
+#include <vtkTextActor.h>
+#include <vtkTextProperty.h>
+#include <vtkUnsignedCharArray.h>
+
+#include "SceneStyle.h"
+
+namespace dynsub {
+
+struct SliceView::Impl {
+  SliceOrientation orientation;
+  const ImageSlices* image = nullptr;
+  SlicePlane plane;
+  int index = -1;
+  std::vector<Vector3> landmarks;
+  int selected = -1;
+  Matrix3X dataPoints;
+
+  vtkNew<vtkRenderer> renderer;
+  vtkNew<vtkImageSliceMapper> imageMapper;
+  vtkNew<vtkImageSlice> imageActor;
+  vtkNew<vtkPlane> cutPlane;
+  vtkNew<vtkCutter> cutter;
+  vtkNew<vtkPolyDataMapper> contourMapper;
+  vtkNew<vtkActor> contourActor;
+  vtkNew<vtkPolyData> landmarkPoints;
+  vtkNew<vtkActor> landmarkActor;
+  vtkNew<vtkPolyData> dataOnSlice;
+  vtkNew<vtkActor> dataActor;
+  vtkNew<vtkTextActor> title;
+  vtkNew<vtkTextActor> edgeLetters[4];  // left, right, top, bottom
+  bool customTitle = false;
+
+  explicit Impl(SliceOrientation o) : orientation(o) {
+    renderer->SetBackground(0, 0, 0);
+    imageActor->SetMapper(imageMapper);
+    imageActor->VisibilityOff();
+    renderer->AddViewProp(imageActor);
+
+    cutter->SetCutFunction(cutPlane);
+    contourMapper->SetInputConnection(cutter->GetOutputPort());
+    style::colourByElementType(contourMapper);
+    contourActor->SetMapper(contourMapper);
+    contourActor->GetProperty()->SetLineWidth(2.0);
+    contourActor->GetProperty()->LightingOff();
+    contourActor->VisibilityOff();
+    renderer->AddActor(contourActor);
+
+    vtkNew<vtkPolyDataMapper> landmarkMapper;
+    landmarkMapper->SetInputData(landmarkPoints);
+    landmarkActor->SetMapper(landmarkMapper);
+    style::pointsAsDots(landmarkActor, style::kLandmarkPixels);
+    renderer->AddActor(landmarkActor);
+
+    vtkNew<vtkPolyDataMapper> dataMapper;
+    dataMapper->SetInputData(dataOnSlice);
+    dataMapper->ScalarVisibilityOff();
+    dataActor->SetMapper(dataMapper);
+    style::pointsAsDots(dataActor, style::kDataPixels);
+    dataActor->GetProperty()->SetColor(0.85, 0.85, 0.85);
+    renderer->AddActor(dataActor);
+
+    style::cornerText(title, 0.02, 0.97, style::Corner::TopLeft);
+    renderer->AddActor2D(title);
+    const double at[4][2] = {{0.02, 0.5}, {0.98, 0.5}, {0.5, 0.98}, {0.5, 0.02}};
+    const style::Corner corners[4] = {style::Corner::Left, style::Corner::Right, style::Corner::Top,
+                                      style::Corner::Bottom};
+    for (int e = 0; e < 4; ++e) {
+      style::cornerText(edgeLetters[e], at[e][0], at[e][1], corners[e]);
+      edgeLetters[e]->GetTextProperty()->SetColor(0.9, 0.75, 0.2);
+      renderer->AddActor2D(edgeLetters[e]);
+    }
+    plane = anatomicalPlane(orientation, Vector3::Zero(), 1.0);
+  }
+
+  // Overlays sit a little towards the viewer so that the image slice, drawn
+  // exactly on the plane, never hides them.
+  Vector3 overlayShift() const { return 0.05 * plane.thickness * plane.normal; }
+
+  void update() {
+    cutPlane->SetOrigin(plane.origin.x(), plane.origin.y(), plane.origin.z());
+    cutPlane->SetNormal(plane.normal.x(), plane.normal.y(), plane.normal.z());
+    const Vector3 shift = overlayShift();
+    for (vtkActor* overlay : {contourActor.Get(), landmarkActor.Get(), dataActor.Get()})
+      overlay->SetPosition(shift.x(), shift.y(), shift.z());
+
+    // Landmarks on the slice, coloured per point (the selected one differs).
+    vtkNew<vtkPoints> points;
+    vtkNew<vtkCellArray> vertices;
+    vtkNew<vtkUnsignedCharArray> colours;
+    colours->SetNumberOfComponents(3);
+    for (int i = 0; i < static_cast<int>(landmarks.size()); ++i) {
+      if (std::abs(plane.distance(landmarks[i])) > 0.5 * plane.thickness) continue;
+      const vtkIdType id = points->InsertNextPoint(landmarks[i].data());
+      vertices->InsertNextCell(1, &id);
+      const auto& c = i == selected ? style::kSelectedLandmark : style::kLandmark;
+      colours->InsertNextTypedTuple(c.data());
+    }
+    landmarkPoints->SetPoints(points);
+    landmarkPoints->SetVerts(vertices);
+    landmarkPoints->GetPointData()->SetScalars(colours);
+    landmarkPoints->Modified();
+
+    vtkNew<vtkPoints> dataPointsOnSlice;
+    vtkNew<vtkCellArray> dataVertices;
+    for (Eigen::Index i = 0; i < dataPoints.rows(); ++i) {
+      const Vector3 p = dataPoints.row(i).transpose();
+      if (std::abs(plane.distance(p)) > 0.5 * plane.thickness) continue;
+      const vtkIdType id = dataPointsOnSlice->InsertNextPoint(p.data());
+      dataVertices->InsertNextCell(1, &id);
+    }
+    dataOnSlice->SetPoints(dataPointsOnSlice);
+    dataOnSlice->SetVerts(dataVertices);
+    dataOnSlice->Modified();
+
+    // Edge letters: the anatomical direction each screen edge points to.
+    const Vector3 towards[4] = {-plane.right, plane.right, plane.up, -plane.up};
+    for (int e = 0; e < 4; ++e) edgeLetters[e]->SetInput(style::anatomicalLetter(towards[e]).c_str());
+    if (!customTitle) {
+      std::ostringstream text;
+      text << orientationName(orientation);
+      if (image) text << "  " << index + 1 << "/" << image->sliceCount(orientation);
+      // The LPS coordinate the slice fixes (x for sagittal, y coronal, z axial).
+      const int lps = orientation == SliceOrientation::Axial ? 2 : orientation == SliceOrientation::Coronal ? 1 : 0;
+      text << std::fixed << std::setprecision(1) << "\n" << "xyz"[lps] << " = " << plane.origin[lps] << " mm";
+      title->SetInput(text.str().c_str());
+    }
+    placeCamera();
+  }
+
+  void placeCamera() {
+    vtkCamera* camera = renderer->GetActiveCamera();
+    double focal[3];
+    camera->GetFocalPoint(focal);
+    // Keep the framed centre, moved onto the plane.
+    Vector3 centre(focal[0], focal[1], focal[2]);
+    centre -= plane.distance(centre) * plane.normal;
+    const Vector3 eye = centre + style::kCameraDistance * plane.normal;
+    camera->ParallelProjectionOn();
+    camera->SetFocalPoint(centre.data());
+    camera->SetPosition(eye.data());
+    camera->SetViewUp(plane.up.data());
+    camera->SetClippingRange(0.5 * style::kCameraDistance, 1.5 * style::kCameraDistance);
+  }
+};
+
+SliceView::SliceView(SliceOrientation orientation) : impl_(std::make_unique<Impl>(orientation)) {}
+SliceView::~SliceView() = default;
+
+vtkRenderer* SliceView::renderer() const { return impl_->renderer; }
+SliceOrientation SliceView::orientation() const { return impl_->orientation; }
+
+void SliceView::setImage(const ImageSlices* image) {
+  impl_->image = image;
+  if (!image) {
+    impl_->imageActor->VisibilityOff();
+    impl_->index = -1;
+    return;
+  }
+  impl_->imageMapper->SetInputData(image->data());
+  impl_->imageMapper->SetOrientation(image->axis(impl_->orientation));
+  impl_->imageActor->SetUserMatrix(image->indexToWorld());
+  impl_->imageActor->GetProperty()->SetColorWindow(image->window());
+  impl_->imageActor->GetProperty()->SetColorLevel(image->level());
+  impl_->imageActor->GetProperty()->SetInterpolationTypeToNearest();
+  impl_->imageActor->VisibilityOn();
+  showSlice(image->sliceCount(impl_->orientation) / 2);
+}
+
+void SliceView::setSurface(vtkPolyData* surface) {
+  impl_->cutter->SetInputData(surface);
+  impl_->contourActor->SetVisibility(surface != nullptr);
+}
+
+void SliceView::setLandmarks(const std::vector<Vector3>& landmarks, int selected) {
+  impl_->landmarks = landmarks;
+  impl_->selected = selected;
+  impl_->update();
+}
+
+void SliceView::setDataPoints(const Matrix3X& points) {
+  impl_->dataPoints = points;
+  impl_->update();
+}
+
+void SliceView::showSlice(int index) {
+  if (!impl_->image) return;
+  const int count = impl_->image->sliceCount(impl_->orientation);
+  impl_->index = std::clamp(index, 0, count - 1);
+  impl_->imageMapper->SetSliceNumber(impl_->index);
+  impl_->plane = impl_->image->plane(impl_->orientation, impl_->index);
+  impl_->update();
+}
+
+void SliceView::showPlane(const SlicePlane& plane) {
+  impl_->plane = plane;
+  impl_->update();
+}
+
+const SlicePlane& SliceView::plane() const { return impl_->plane; }
+int SliceView::sliceIndex() const { return impl_->index; }
+
+void SliceView::frame(const Vector3& centre, double halfSize) {
+  vtkCamera* camera = impl_->renderer->GetActiveCamera();
+  camera->SetFocalPoint(centre.data());
+  camera->SetParallelScale(halfSize);
+  impl_->placeCamera();
+}
+
+void SliceView::setTitle(const std::string& title) {
+  impl_->customTitle = true;
+  impl_->title->SetInput(title.c_str());
+}
+
+Vector3 SliceView::pointAt(double displayX, double displayY) const {
+  vtkRenderer* renderer = impl_->renderer;
+  renderer->SetDisplayPoint(displayX, displayY, 0.0);
+  renderer->DisplayToWorld();
+  double world[4];
+  renderer->GetWorldPoint(world);
+  Vector3 p(world[0] / world[3], world[1] / world[3], world[2] / world[3]);
+  return p - impl_->plane.distance(p) * impl_->plane.normal;
+}
+
+Eigen::Vector2d SliceView::displayPosition(const Vector3& point) const {
+  vtkRenderer* renderer = impl_->renderer;
+  renderer->SetWorldPoint(point.x(), point.y(), point.z(), 1.0);
+  renderer->WorldToDisplay();
+  double display[3];
+  renderer->GetDisplayPoint(display);
+  return {display[0], display[1]};
+}
+
+std::vector<int> SliceView::landmarksOnSlice() const {
+  std::vector<int> on;
+  for (int i = 0; i < static_cast<int>(impl_->landmarks.size()); ++i)
+    if (std::abs(impl_->plane.distance(impl_->landmarks[i])) <= 0.5 * impl_->plane.thickness) on.push_back(i);
+  return on;
+}
+
+}  // namespace dynsub

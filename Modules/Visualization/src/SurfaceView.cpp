@@ -1,0 +1,197 @@
+#include "dynsub/SurfaceView.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include <vtkActor.h>
+#include <vtkCamera.h>
+#include <vtkCellArray.h>
+#include <vtkImageProperty.h>
+#include <vtkImageSlice.h>
+#include <vtkImageSliceMapper.h>
+#include <vtkMath.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataMapper.h>
+#include <vtkProperty.h>
+#include <vtkRenderer.h>
+#include <vtkUnsignedCharArray.h>
+
+#include "SceneStyle.h"
+#include "dynsub/ControlMesh.h"
+
+namespace dynsub {
+
+vtkSmartPointer<vtkPolyData> controlMeshWireframe(const ControlMesh& mesh) {
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  const Matrix3X p = mesh.points();
+  for (Eigen::Index i = 0; i < p.rows(); ++i) points->InsertNextPoint(p(i, 0), p(i, 1), p(i, 2));
+  vtkNew<vtkCellArray> lines;
+  std::set<std::pair<int, int>> edges;
+  for (const Polygon& face : mesh.faces()) {
+    for (std::size_t i = 0; i < face.size(); ++i) {
+      const int a = face[i], b = face[(i + 1) % face.size()];
+      if (!edges.insert({std::min(a, b), std::max(a, b)}).second) continue;
+      const vtkIdType ids[2] = {a, b};
+      lines->InsertNextCell(2, ids);
+    }
+  }
+  auto wireframe = vtkSmartPointer<vtkPolyData>::New();
+  wireframe->SetPoints(points);
+  wireframe->SetLines(lines);
+  return wireframe;
+}
+
+struct SurfaceView::Impl {
+  vtkNew<vtkRenderer> renderer;
+  vtkNew<vtkPolyDataMapper> surfaceMapper;
+  vtkNew<vtkActor> surfaceActor;
+  vtkNew<vtkPolyDataMapper> wireMapper;
+  vtkNew<vtkActor> wireActor;
+  vtkNew<vtkPolyData> landmarkPoints;
+  vtkNew<vtkActor> landmarkActor;
+  vtkNew<vtkPolyData> dataPoints;
+  vtkNew<vtkActor> dataActor;
+  const ImageSlices* image = nullptr;
+  vtkNew<vtkImageSliceMapper> sliceMappers[3];
+  vtkNew<vtkImageSlice> sliceActors[3];
+
+  Impl() {
+    renderer->SetBackground(0.1, 0.1, 0.12);
+    style::colourByElementType(surfaceMapper);
+    surfaceActor->SetMapper(surfaceMapper);
+    surfaceActor->GetProperty()->SetSpecular(0.2);
+    surfaceActor->GetProperty()->SetSpecularPower(20);
+    surfaceActor->VisibilityOff();
+    renderer->AddActor(surfaceActor);
+
+    wireActor->SetMapper(wireMapper);
+    wireActor->GetProperty()->SetColor(0.6, 0.7, 1.0);
+    wireActor->GetProperty()->LightingOff();
+    wireActor->VisibilityOff();
+    renderer->AddActor(wireActor);
+
+    vtkNew<vtkPolyDataMapper> landmarkMapper;
+    landmarkMapper->SetInputData(landmarkPoints);
+    landmarkActor->SetMapper(landmarkMapper);
+    style::pointsAsDots(landmarkActor, style::kLandmarkPixels);
+    renderer->AddActor(landmarkActor);
+
+    vtkNew<vtkPolyDataMapper> dataMapper;
+    dataMapper->SetInputData(dataPoints);
+    dataMapper->ScalarVisibilityOff();
+    dataActor->SetMapper(dataMapper);
+    style::pointsAsDots(dataActor, style::kDataPixels);
+    dataActor->GetProperty()->SetColor(0.85, 0.85, 0.85);
+    renderer->AddActor(dataActor);
+
+    for (int s = 0; s < 3; ++s) {
+      sliceActors[s]->SetMapper(sliceMappers[s]);
+      sliceActors[s]->VisibilityOff();
+      renderer->AddViewProp(sliceActors[s]);
+    }
+  }
+};
+
+SurfaceView::SurfaceView() : impl_(std::make_unique<Impl>()) {}
+SurfaceView::~SurfaceView() = default;
+
+vtkRenderer* SurfaceView::renderer() const { return impl_->renderer; }
+
+void SurfaceView::setSurface(vtkPolyData* surface) {
+  impl_->surfaceMapper->SetInputData(surface);
+  impl_->surfaceActor->SetVisibility(surface != nullptr);
+}
+
+void SurfaceView::setOpacity(double opacity) { impl_->surfaceActor->GetProperty()->SetOpacity(opacity); }
+
+void SurfaceView::setControlMesh(vtkPolyData* wireframe) {
+  impl_->wireMapper->SetInputData(wireframe);
+  impl_->wireActor->SetVisibility(wireframe != nullptr);
+}
+
+namespace {
+
+vtkSmartPointer<vtkPolyData> vertices(const Matrix3X& p, const std::vector<std::array<unsigned char, 3>>& colours) {
+  vtkNew<vtkPoints> points;
+  vtkNew<vtkCellArray> cells;
+  vtkNew<vtkUnsignedCharArray> scalars;
+  scalars->SetNumberOfComponents(3);
+  for (Eigen::Index i = 0; i < p.rows(); ++i) {
+    const vtkIdType id = points->InsertNextPoint(p(i, 0), p(i, 1), p(i, 2));
+    cells->InsertNextCell(1, &id);
+    if (!colours.empty()) scalars->InsertNextTypedTuple(colours[i].data());
+  }
+  auto data = vtkSmartPointer<vtkPolyData>::New();
+  data->SetPoints(points);
+  data->SetVerts(cells);
+  if (!colours.empty()) data->GetPointData()->SetScalars(scalars);
+  return data;
+}
+
+}  // namespace
+
+void SurfaceView::setLandmarks(const std::vector<Vector3>& landmarks, int selected) {
+  Matrix3X p(landmarks.size(), 3);
+  std::vector<std::array<unsigned char, 3>> colours;
+  for (std::size_t i = 0; i < landmarks.size(); ++i) {
+    p.row(i) = landmarks[i].transpose();
+    colours.push_back(static_cast<int>(i) == selected ? style::kSelectedLandmark : style::kLandmark);
+  }
+  impl_->landmarkPoints->ShallowCopy(vertices(p, colours));
+}
+
+void SurfaceView::setDataPoints(const Matrix3X& points) { impl_->dataPoints->ShallowCopy(vertices(points, {})); }
+
+void SurfaceView::setImage(const ImageSlices* image) {
+  impl_->image = image;
+  for (int s = 0; s < 3; ++s) {
+    impl_->sliceActors[s]->SetVisibility(image != nullptr);
+    if (!image) continue;
+    const auto orientation = static_cast<SliceOrientation>(s);
+    impl_->sliceMappers[s]->SetInputData(image->data());
+    impl_->sliceMappers[s]->SetOrientation(image->axis(orientation));
+    impl_->sliceMappers[s]->SetSliceNumber(image->sliceCount(orientation) / 2);
+    impl_->sliceActors[s]->SetUserMatrix(image->indexToWorld());
+    impl_->sliceActors[s]->GetProperty()->SetColorWindow(image->window());
+    impl_->sliceActors[s]->GetProperty()->SetColorLevel(image->level());
+  }
+}
+
+void SurfaceView::showSlices(int axial, int coronal, int sagittal) {
+  if (!impl_->image) return;
+  const int index[3] = {axial, coronal, sagittal};
+  for (int s = 0; s < 3; ++s) {
+    const auto orientation = static_cast<SliceOrientation>(s);
+    impl_->sliceMappers[s]->SetSliceNumber(std::clamp(index[s], 0, impl_->image->sliceCount(orientation) - 1));
+  }
+}
+
+void SurfaceView::resetCamera() {
+  double bounds[6];
+  vtkPolyData* surface = vtkPolyData::SafeDownCast(impl_->surfaceMapper->GetInput());
+  if (surface && surface->GetNumberOfPoints() > 0) {
+    surface->GetBounds(bounds);
+  } else {
+    impl_->renderer->ComputeVisiblePropBounds(bounds);
+  }
+  const Vector3 centre(0.5 * (bounds[0] + bounds[1]), 0.5 * (bounds[2] + bounds[3]), 0.5 * (bounds[4] + bounds[5]));
+  const double radius =
+      0.5 * Vector3(bounds[1] - bounds[0], bounds[3] - bounds[2], bounds[5] - bounds[4]).norm();
+  // From the patient's left (+x), front (-y) and above (+z).
+  const Vector3 direction = Vector3(1.0, -1.2, 0.8).normalized();
+  vtkCamera* camera = impl_->renderer->GetActiveCamera();
+  camera->ParallelProjectionOff();
+  camera->SetViewAngle(30);
+  camera->SetFocalPoint(centre.data());
+  const Vector3 eye = centre + direction * (radius / std::sin(vtkMath::RadiansFromDegrees(15.0)));
+  camera->SetPosition(eye.data());
+  camera->SetViewUp(0, 0, 1);
+  impl_->renderer->ResetCameraClippingRange();
+}
+
+}  // namespace dynsub
