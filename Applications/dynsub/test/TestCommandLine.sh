@@ -98,13 +98,47 @@ expect_error "fix-boundary on a closed mesh" 1 "closed" "$work/o12" \
   "$DYNSUB" deform "$DATA/Meshes/torus.obj" --springs "$DATA/Deform/torus_pull.springs" --fix-boundary --out "$work/o12"
 
 # --- segment: the caudate of the Colin27 MRI (mricron-data) ------------------
+printf '1 2 3\n' >"$work/points.txt"
 mri=/usr/share/mricron/templates
 "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" \
   --reference "$mri/aal.nii.gz" --reference-label 71 --out "$work/caudate" >"$work/stdout" 2>&1
 check "segment succeeds" test $? -eq 0
-for name in surface.vtp control_mesh.obj labelmap.nii.gz report.json; do
+for name in surface.vtp control_mesh.obj labelmap.nii.gz report.json convergence.csv slices.png surface3d.png \
+  convergence.png; do
   check "segment writes $name" test -s "$work/caudate/$name"
 done
+check "convergence.csv has a step per line" \
+  test "$(grep -c '^[01],' "$work/caudate/convergence.csv")" -ge 10
+check "slices.png is 1200 x 720" python3 -c "
+import struct, sys
+with open(sys.argv[1], 'rb') as f: head = f.read(24)
+sys.exit(0 if head[:8] == b'\x89PNG\r\n\x1a\n' and struct.unpack('>II', head[16:24]) == (1200, 720) else 1)" \
+  "$work/caudate/slices.png"
+
+# --- figures: off on request, skipped without a display, redrawn by render ---
+"$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --init torus --no-figures --out "$work/nofig" >/dev/null 2>&1
+check "--no-figures writes no figure" test ! -e "$work/nofig/slices.png"
+check "--no-figures still writes convergence.csv" test -s "$work/nofig/convergence.csv"
+env -u DISPLAY "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --init torus --out "$work/nodisplay" >/dev/null \
+  2>"$work/stderr"
+check "fit without a display succeeds" test -s "$work/nodisplay/surface.vtp"
+check "fit without a display warns" grep -q "no figures written: DISPLAY is not set" "$work/stderr"
+check "fit without a display writes no figure" test ! -e "$work/nodisplay/slices.png"
+"$DYNSUB" render --surface "$work/caudate/surface.vtp" --image "$mri/ch2.nii.gz" \
+  --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --convergence "$work/caudate/convergence.csv" \
+  --out "$work/rendered" >/dev/null
+for name in slices.png surface3d.png convergence.png; do
+  check "render writes $name" test -s "$work/rendered/$name"
+done
+check "render redraws segment's slices.png pixel for pixel" cmp -s "$work/rendered/slices.png" "$work/caudate/slices.png"
+expect_error "render: missing surface" 1 "no such file" "$work/r1" \
+  "$DYNSUB" render --surface "$work/none.vtp" --out "$work/r1"
+expect_error "render: not a surface" 1 "text.vtp" "$work/r2" \
+  bash -c "echo hello >'$work/text.vtp'; '$DYNSUB' render --surface '$work/text.vtp' --out '$work/r2'"
+expect_error "render: corrupt convergence history" 1 "expected the header" "$work/r3" \
+  "$DYNSUB" render --surface "$work/caudate/surface.vtp" --convergence "$work/points.txt" --out "$work/r3"
+expect_error "render: no display" 1 "X display" "$work/r4" \
+  env -u DISPLAY "$DYNSUB" render --surface "$work/caudate/surface.vtp" --out "$work/r4"
 for key in dice jaccard volume_difference_percent mean_surface_distance_mm hd95_mm hausdorff_mm stage_seconds \
   landmark_residuals final_energy; do
   check "segment report has $key" grep -q "\"$key\"" "$work/caudate/report.json"
@@ -114,7 +148,6 @@ expect_error "missing image" 1 "no such file" "$work/s1" \
 printf 'x,y,z\n500,0,0\n10,10,10\n12,10,10\n10,12,10\n10,10,12\n' >"$work/outside.csv"
 expect_error "landmark outside the image" 1 "outside the image" "$work/s2" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/outside.csv" --out "$work/s2"
-printf '1 2 3\n' >"$work/points.txt"
 expect_error "unknown landmark format" 1 "unknown landmark format" "$work/s3" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/points.txt" --out "$work/s3"
 expect_error "init outside the image" 1 "outside the image" "$work/s4" \
