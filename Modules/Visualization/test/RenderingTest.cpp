@@ -1,0 +1,223 @@
+// Rendering tests (they need an X display: ctest runs under xvfb-run).
+//  - Placement: pixels of a slice view of an oblique, anisotropic phantom are
+//    where the phantom's analytic sphere says, with the contour and landmarks
+//    on top: the image, the surface and the points share one LPS frame.
+//  - Baselines: the figures compared with Testing/Data/Baseline/<TestName>.png
+//    through vtkTesting, which must report PASSED. Threshold 0.15, VTK's own
+//    default: a sum over pixels of per-channel excess over 105 after VTK's
+//    +-2 pixel shift and 3 x 3 averaging, so it tolerates no visible change.
+//    A missing or changed baseline leaves the new image (and a .diff.png) in
+//    build/Testing/Temporary for review.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include <vtkCellData.h>
+#include <vtkImageData.h>
+#include <vtkNew.h>
+#include <vtkPolyData.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderer.h>
+#include <vtkSphereSource.h>
+#include <vtkTesting.h>
+#include <vtkUnsignedCharArray.h>
+#include <vtkWindowToImageFilter.h>
+
+#include "dynsub/ConvergenceHistory.h"
+#include "dynsub/Figures.h"
+#include "dynsub/ImageIO.h"
+#include "dynsub/Landmarks.h"
+#include "dynsub/LimitSurface.h"
+#include "dynsub/MeshIO.h"
+#include "dynsub/SliceView.h"
+#include "dynsub/SurfacePolyData.h"
+#include "dynsub/SurfaceView.h"
+
+namespace dynsub {
+namespace {
+
+const std::string kSource = DYNSUB_SOURCE_DIR;
+const std::string kMri = "/usr/share/mricron/templates/ch2.nii.gz";
+
+class Rendering : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string why;
+    if (!displayAvailable(&why)) FAIL() << "rendering tests need an X display: " << why;
+  }
+};
+
+void expectMatchesBaseline(vtkRenderWindow* window) {
+  const std::string name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  const std::string baseline = kSource + "/Testing/Data/Baseline/" + name + ".png";
+  const std::string temporary = std::string(DYNSUB_BINARY_DIR) + "/Testing/Temporary";
+  std::filesystem::create_directories(temporary);
+  window->Render();
+  vtkNew<vtkTesting> testing;
+  testing->AddArgument("-V");
+  testing->AddArgument(baseline.c_str());
+  testing->AddArgument("-T");
+  testing->AddArgument(temporary.c_str());
+  testing->SetRenderWindow(window);
+  const int result = testing->RegressionTest(0.15);
+  EXPECT_EQ(result, vtkTesting::PASSED) << "against " << baseline << " (new image in " << temporary << ")";
+}
+
+vtkSmartPointer<vtkPolyData> limitSurfaceOf(const std::string& meshFile) {
+  const ControlMesh mesh = readControlMesh(meshFile);
+  return toPolyData(tessellate(LimitSurface(mesh), mesh.points(), 8));
+}
+
+// --- placement ------------------------------------------------------------
+
+// A bright ball (radius 12 mm) in an image whose axes are rotated and tilted,
+// with anisotropic voxels.
+struct Phantom {
+  Volume image;
+  Vector3 centre{4.0, -7.0, 11.0};
+  double radius = 12.0;
+};
+
+Phantom makePhantom() {
+  Phantom p;
+  ImageGeometry& g = p.image.geometry;
+  g.size = {48, 56, 30};
+  g.spacing = Vector3(0.9, 0.8, 1.5);
+  g.direction = (Eigen::AngleAxisd(0.35, Vector3::UnitZ()) * Eigen::AngleAxisd(0.17, Vector3::UnitX()))
+                    .toRotationMatrix() *
+                Vector3(-1, -1, 1).asDiagonal();
+  g.origin = Vector3::Zero();
+  // Centre the grid on the ball.
+  const Vector3 middle(0.5 * (g.size[0] - 1), 0.5 * (g.size[1] - 1), 0.5 * (g.size[2] - 1));
+  g.origin = p.centre - (g.toPhysical(middle) - g.origin);
+  p.image.voxels.resize(g.voxelCount());
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i)
+        p.image.voxels[g.offset(i, j, k)] = (g.toPhysical(Vector3(i, j, k)) - p.centre).norm() <= p.radius ? 100 : 0;
+  return p;
+}
+
+std::array<int, 3> pixel(vtkImageData* image, const Eigen::Vector2d& at) {
+  const int x = static_cast<int>(std::lround(at.x())), y = static_cast<int>(std::lround(at.y()));
+  const auto* rgb = static_cast<unsigned char*>(image->GetScalarPointer(x, y, 0));
+  return {rgb[0], rgb[1], rgb[2]};
+}
+
+TEST_F(Rendering, SliceViewPutsImageContourAndLandmarksInOneFrame) {
+  const Phantom phantom = makePhantom();
+  const ImageSlices slices(phantom.image);
+  vtkNew<vtkSphereSource> sphere;
+  sphere->SetCenter(phantom.centre.data());
+  sphere->SetRadius(phantom.radius);
+  sphere->SetThetaResolution(128);
+  sphere->SetPhiResolution(128);
+  sphere->Update();
+  vtkNew<vtkPolyData> surface;
+  surface->ShallowCopy(sphere->GetOutput());
+  vtkNew<vtkUnsignedCharArray> type;  // all normal elements: yellow
+  type->SetName("ElementType");
+  type->SetNumberOfTuples(surface->GetNumberOfCells());
+  type->FillValue(0);
+  surface->GetCellData()->AddArray(type);
+
+  for (SliceOrientation orientation : {SliceOrientation::Axial, SliceOrientation::Coronal, SliceOrientation::Sagittal}) {
+    SCOPED_TRACE(orientationName(orientation));
+    SliceView view(orientation);
+    view.setImage(&slices);
+    view.setSurface(surface);
+    // A slice 3 voxels off the centre, so the circle is smaller than the ball.
+    view.showSlice(slices.sliceThrough(orientation, phantom.centre) + 3);
+    const SlicePlane& plane = view.plane();
+    const Vector3 circleCentre = phantom.centre - plane.distance(phantom.centre) * plane.normal;
+    const double circleRadius = std::sqrt(std::pow(phantom.radius, 2) - std::pow(plane.distance(phantom.centre), 2));
+    const Vector3 onSlice = circleCentre + 0.5 * circleRadius * plane.right;
+    const Vector3 offSlice = circleCentre - 0.5 * circleRadius * plane.right + 2.0 * plane.thickness * plane.normal;
+    view.setLandmarks({onSlice, offSlice});
+    view.frame(circleCentre, 20.0);
+
+    vtkNew<vtkRenderWindow> window;
+    window->SetOffScreenRendering(1);
+    window->SetMultiSamples(0);
+    window->SetSize(400, 400);
+    window->AddRenderer(view.renderer());
+    window->Render();
+    vtkNew<vtkWindowToImageFilter> capture;
+    capture->SetInput(window);
+    capture->ReadFrontBufferOff();
+    capture->Update();
+    vtkImageData* image = capture->GetOutput();
+
+    // Inside and outside the circle by 2.5 mm (voxels are at most 1.5 mm; the
+    // view shows the nearest voxel) along 12 directions, away from the landmarks.
+    for (int a = 0; a < 12; ++a) {
+      const double angle = (a + 0.5) * M_PI / 6.0;
+      const Vector3 direction = std::cos(angle) * plane.right + std::sin(angle) * plane.up;
+      const auto inside = pixel(image, view.displayPosition(circleCentre + (circleRadius - 2.5) * direction));
+      const auto outside = pixel(image, view.displayPosition(circleCentre + (circleRadius + 2.5) * direction));
+      EXPECT_GT(inside[1], 200) << "angle " << angle << ": the ball's voxels are not inside the circle";
+      EXPECT_LT(outside[1], 50) << "angle " << angle << ": background voxels inside the circle";
+      // The contour (2 px wide, yellow) on the circle: red high, blue low
+      // somewhere within a pixel of the point.
+      const Eigen::Vector2d on = view.displayPosition(circleCentre + circleRadius * direction);
+      bool yellow = false;
+      for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy) {
+          const auto c = pixel(image, on + Eigen::Vector2d(dx, dy));
+          yellow = yellow || (c[0] > 200 && c[1] > 150 && c[2] < 100);
+        }
+      EXPECT_TRUE(yellow) << "angle " << angle << ": no contour on the circle";
+    }
+    const auto landmark = pixel(image, view.displayPosition(onSlice));
+    EXPECT_GT(landmark[0], 180);
+    EXPECT_LT(landmark[1], 90) << "the landmark on the slice is not drawn red where it is";
+    const auto hidden = pixel(image, view.displayPosition(offSlice - plane.distance(offSlice) * plane.normal));
+    EXPECT_GT(hidden[1], 200) << "a landmark two slices away is drawn";
+    EXPECT_EQ(view.landmarksOnSlice(), std::vector<int>{0});
+    // Display -> slice point -> display is the identity.
+    const Vector3 back = view.pointAt(200, 210);
+    EXPECT_NEAR(plane.distance(back), 0.0, 1e-9);
+    EXPECT_NEAR((view.displayPosition(back) - Eigen::Vector2d(200, 210)).norm(), 0.0, 1e-6);
+  }
+}
+
+// --- baselines --------------------------------------------------------------
+
+TEST_F(Rendering, TestCaudateSlices) {
+  const Volume mri = readVolume(kMri);
+  const vtkSmartPointer<vtkPolyData> surface = limitSurfaceOf(kSource + "/Testing/Data/caudate_left_control_mesh.obj");
+  FigureScene scene;
+  scene.image = &mri;
+  scene.surface = surface;
+  for (const Landmark& l : readLandmarks(kSource + "/Data/Landmarks/caudate_left.mrk.json"))
+    scene.landmarks.push_back(l.position);
+  expectMatchesBaseline(slicesFigure(scene));
+}
+
+TEST_F(Rendering, TestCubeElements) {
+  const std::string file = kSource + "/Data/Meshes/cube.obj";
+  FigureScene scene;
+  const vtkSmartPointer<vtkPolyData> surface = limitSurfaceOf(file);
+  const vtkSmartPointer<vtkPolyData> wireframe = controlMeshWireframe(readControlMesh(file));
+  scene.surface = surface;
+  scene.controlMesh = wireframe;
+  expectMatchesBaseline(surfaceFigure(scene));
+}
+
+TEST_F(Rendering, TestTorusElements) {
+  const std::string file = kSource + "/Data/Meshes/torus.obj";
+  FigureScene scene;
+  const vtkSmartPointer<vtkPolyData> surface = limitSurfaceOf(file);
+  const vtkSmartPointer<vtkPolyData> wireframe = controlMeshWireframe(readControlMesh(file));
+  scene.surface = surface;
+  scene.controlMesh = wireframe;
+  expectMatchesBaseline(surfaceFigure(scene));
+}
+
+TEST_F(Rendering, TestConvergencePlot) {
+  expectMatchesBaseline(convergenceFigure(readConvergenceCsv(kSource + "/Testing/Data/caudate_left_convergence.csv")));
+}
+
+}  // namespace
+}  // namespace dynsub
