@@ -13,5 +13,6 @@ void addFitCommand(CLI::App& app);
 void addDeformCommand(CLI::App& app);
 void addSegmentCommand(CLI::App& app);
 void addRenderCommand(CLI::App& app);
+void addViewCommand(CLI::App& app);
 
 }  // namespace dynsub::app

@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   dynsub::app::addDeformCommand(app);
   dynsub::app::addSegmentCommand(app);
   dynsub::app::addRenderCommand(app);
+  dynsub::app::addViewCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

@@ -93,7 +93,8 @@ ControlMesh initialSphere(const Vector3& centre, double radius) {
 }
 
 SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmarks, const ControlMesh& initial,
-                      const SegmentOptions& options, const ProgressCallback& progress) {
+                      const SegmentOptions& options, const ProgressCallback& progress,
+                      const std::vector<ForceModel*>& extraForces) {
   checkSegmentOptions(options);
   if (!initial.isClosed()) throw Error("the initial model must be a closed control mesh");
   const ImageGeometry& grid = image.geometry;
@@ -130,6 +131,7 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
   std::vector<ForceModel*> forces = {&imageForces};
   if (landmarkPoints.rows() > 0 && options.landmarkStiffness > 0) forces.push_back(&springs);
   if (options.inflation != 0) forces.push_back(&inflation);
+  forces.insert(forces.end(), extraForces.begin(), extraForces.end());
   // Refine while a landmark is farther than the tolerance (see the header).
   auto landmarksFit = [&](const LimitSurface& surface, const Matrix3X& controlPoints) {
     if (landmarkPoints.rows() == 0) return false;

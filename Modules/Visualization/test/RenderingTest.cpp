@@ -24,6 +24,7 @@
 #include <vtkUnsignedCharArray.h>
 #include <vtkWindowToImageFilter.h>
 
+#include "BallPhantom.h"
 #include "dynsub/ConvergenceHistory.h"
 #include "dynsub/Figures.h"
 #include "dynsub/ImageIO.h"
@@ -71,34 +72,6 @@ vtkSmartPointer<vtkPolyData> limitSurfaceOf(const std::string& meshFile) {
 
 // --- placement ------------------------------------------------------------
 
-// A bright ball (radius 12 mm) in an image whose axes are rotated and tilted,
-// with anisotropic voxels.
-struct Phantom {
-  Volume image;
-  Vector3 centre{4.0, -7.0, 11.0};
-  double radius = 12.0;
-};
-
-Phantom makePhantom() {
-  Phantom p;
-  ImageGeometry& g = p.image.geometry;
-  g.size = {48, 56, 30};
-  g.spacing = Vector3(0.9, 0.8, 1.5);
-  g.direction = (Eigen::AngleAxisd(0.35, Vector3::UnitZ()) * Eigen::AngleAxisd(0.17, Vector3::UnitX()))
-                    .toRotationMatrix() *
-                Vector3(-1, -1, 1).asDiagonal();
-  g.origin = Vector3::Zero();
-  // Centre the grid on the ball.
-  const Vector3 middle(0.5 * (g.size[0] - 1), 0.5 * (g.size[1] - 1), 0.5 * (g.size[2] - 1));
-  g.origin = p.centre - (g.toPhysical(middle) - g.origin);
-  p.image.voxels.resize(g.voxelCount());
-  for (int k = 0; k < g.size[2]; ++k)
-    for (int j = 0; j < g.size[1]; ++j)
-      for (int i = 0; i < g.size[0]; ++i)
-        p.image.voxels[g.offset(i, j, k)] = (g.toPhysical(Vector3(i, j, k)) - p.centre).norm() <= p.radius ? 100 : 0;
-  return p;
-}
-
 std::array<int, 3> pixel(vtkImageData* image, const Eigen::Vector2d& at) {
   const int x = static_cast<int>(std::lround(at.x())), y = static_cast<int>(std::lround(at.y()));
   const auto* rgb = static_cast<unsigned char*>(image->GetScalarPointer(x, y, 0));
@@ -106,7 +79,7 @@ std::array<int, 3> pixel(vtkImageData* image, const Eigen::Vector2d& at) {
 }
 
 TEST_F(Rendering, SliceViewPutsImageContourAndLandmarksInOneFrame) {
-  const Phantom phantom = makePhantom();
+  const BallPhantom phantom = makeBallPhantom();
   const ImageSlices slices(phantom.image);
   vtkNew<vtkSphereSource> sphere;
   sphere->SetCenter(phantom.centre.data());

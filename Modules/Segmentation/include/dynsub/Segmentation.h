@@ -60,9 +60,12 @@ ControlMesh initialFromLandmarks(const std::vector<Landmark>& landmarks);
 ControlMesh initialSphere(const Vector3& centre, double radius);
 
 // Throws dynsub::Error when the initial model or a landmark lies outside the
-// image, or for impossible options.
+// image, or for impossible options. extraForces (not owned) act besides the
+// image, landmark and inflation forces, e.g. an interactive pull
+// (ForceModel.h); the progress callback may throw to stop the evolution.
 SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmarks, const ControlMesh& initial,
-                      const SegmentOptions& options, const ProgressCallback& progress = nullptr);
+                      const SegmentOptions& options, const ProgressCallback& progress = nullptr,
+                      const std::vector<ForceModel*>& extraForces = {});
 
 void checkSegmentOptions(const SegmentOptions& options);
 

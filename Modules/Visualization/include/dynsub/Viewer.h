@@ -1,0 +1,83 @@
+#pragma once
+// The interactive viewer (`dynsub view`): axial, coronal and sagittal slice
+// views and a 3D view of one image, its landmarks and a surface, with live
+// fitting by the segmentation pipeline (Segmentation.h).
+//
+// Bindings (also on screen behind `h`):
+//   slice views   wheel or Up/Down, Page Up/Page Down: next/previous slice
+//                 left click: place a landmark (on a landmark: select it);
+//                 drag: move the selected landmark within the slice
+//                 right click on a landmark, or Delete/BackSpace: delete it
+//   3D view       left drag: rotate; wheel: zoom; Ctrl + left drag on the
+//                 surface while fitting: pull it (an interactive spring)
+//   keys          space: start, pause or resume fitting; r: stop and reset
+//                 s: save the landmarks (.mrk.json, LPS); l: load them again
+//                 h: show or hide the help; q: quit
+// Fitting runs on a worker thread: it starts from the landmarks' initial
+// model (at least 4 landmarks), and the surface is redrawn in every view as it
+// moves (about 25 times a second). Editing the landmarks while fitting
+// restarts the fit with the new set.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <vtkSmartPointer.h>
+
+#include "dynsub/Landmarks.h"
+#include "dynsub/Segmentation.h"
+#include "dynsub/SlicePlanes.h"
+
+class vtkPolyData;
+class vtkRenderWindow;
+class vtkRenderWindowInteractor;
+class vtkRenderer;
+
+namespace dynsub {
+
+class SliceView;
+class ViewerStyle;
+
+struct ViewerInput {
+  Volume image;
+  std::vector<Landmark> landmarks;
+  std::string landmarksPath = "landmarks.mrk.json";  // where s saves and l loads
+  vtkSmartPointer<vtkPolyData> surface;              // optional, shown until a fit starts
+  SegmentOptions segment;
+  double pullStiffness = 20.0;  // N/mm, the 3D view's pulling spring
+};
+
+class Viewer {
+ public:
+  // Builds the window (1200 x 900) and its interactor; needs an X display.
+  explicit Viewer(ViewerInput input);
+  ~Viewer();
+  Viewer(const Viewer&) = delete;
+  Viewer& operator=(const Viewer&) = delete;
+
+  vtkRenderWindow* window() const;
+  vtkRenderWindowInteractor* interactor() const;
+  // Shows the window and runs the event loop until it closes.
+  void run();
+
+  // What the bindings do, for scripts and tests.
+  SliceView& sliceView(SliceOrientation orientation) const;
+  vtkRenderer* surfaceRenderer() const;
+  const std::vector<Landmark>& landmarks() const;
+  void saveLandmarks();
+  void loadLandmarks();
+  void startOrPauseFitting();
+  void resetFitting();
+  bool fitting() const;  // a fit is running or paused
+  // Processes live updates (and renders) until the fit ends or `seconds`
+  // pass; true if it ended. For tests and scripts without an event loop.
+  bool waitForFit(double seconds);
+  int surfaceUpdates() const;  // times the live surface was redrawn
+  std::string status() const;  // the status line shown in the window
+
+ private:
+  friend class ViewerStyle;  // the interactor style acts on the viewer's state
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace dynsub
