@@ -12,10 +12,14 @@
 
 #include <cmath>
 #include <filesystem>
+#include <iostream>
 
 #include <vtkCellData.h>
+#include <vtkCutter.h>
 #include <vtkImageData.h>
 #include <vtkNew.h>
+#include <vtkPlane.h>
+#include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
@@ -34,6 +38,8 @@
 #include "dynsub/SliceView.h"
 #include "dynsub/SurfacePolyData.h"
 #include "dynsub/SurfaceView.h"
+#include "dynsub/Tessellation.h"
+#include "dynsub/Voxelize.h"
 
 namespace dynsub {
 namespace {
@@ -153,6 +159,65 @@ TEST_F(Rendering, SliceViewPutsImageContourAndLandmarksInOneFrame) {
     EXPECT_NEAR(plane.distance(back), 0.0, 1e-9);
     EXPECT_NEAR((view.displayPosition(back) - Eigen::Vector2d(200, 210)).norm(), 0.0, 1e-6);
   }
+}
+
+// The contour a slice view draws lies on the boundary of the labelmap that
+// segment writes, on the same slice of the real MRI's grid: the figures show
+// the surface on the right slices in the right place. (No rendering needed:
+// the view's cut plane is what it draws.)
+TEST(SliceContours, LieOnTheLabelmapBoundaryOfTheirSlice) {
+  const Volume mri = readVolume(kMri);
+  const ControlMesh mesh = readControlMesh(kSource + "/Testing/Data/caudate_left_control_mesh.obj");
+  const TriangleSurface triangles = tessellate(LimitSurface(mesh), mesh.points(), 8);
+  const Mask labelmap = voxelizeSurface(triangles.points, triangles.triangles, mri.geometry);
+  const vtkSmartPointer<vtkPolyData> surface = toPolyData(triangles);
+  const ImageSlices slices(mri);
+  const ImageGeometry& g = mri.geometry;
+  const Vector3 centre = triangles.points.colwise().mean().transpose();
+  int points = 0, onBoundary = 0;
+  for (SliceOrientation o : {SliceOrientation::Axial, SliceOrientation::Coronal, SliceOrientation::Sagittal}) {
+    const int axis = slices.axis(o);
+    for (int offset = -6; offset <= 6; offset += 3) {
+      SliceView view(o);
+      view.setImage(&slices);
+      view.showSlice(slices.sliceThrough(o, centre) + offset);
+      const SlicePlane& plane = view.plane();
+      vtkNew<vtkPlane> cut;
+      cut->SetOrigin(plane.origin.x(), plane.origin.y(), plane.origin.z());
+      cut->SetNormal(plane.normal.x(), plane.normal.y(), plane.normal.z());
+      vtkNew<vtkCutter> cutter;
+      cutter->SetCutFunction(cut);
+      cutter->SetInputData(surface);
+      cutter->Update();
+      vtkPoints* contour = cutter->GetOutput()->GetPoints();
+      ASSERT_TRUE(contour && contour->GetNumberOfPoints() > 10) << orientationName(o) << " " << offset;
+      for (vtkIdType i = 0; i < contour->GetNumberOfPoints(); ++i) {
+        double p[3];
+        contour->GetPoint(i, p);
+        const Vector3 index = g.toIndex(Vector3(p[0], p[1], p[2]));
+        ASSERT_NEAR(index[axis], view.sliceIndex(), 1e-6) << "the contour is not on the slice shown";
+        // Inside and outside voxels both within one voxel in the slice.
+        bool inside = false, outside = false;
+        const int ci = static_cast<int>(std::lround(index[0])), cj = static_cast<int>(std::lround(index[1])),
+                  ck = static_cast<int>(std::lround(index[2]));
+        for (int di = -1; di <= 1; ++di)
+          for (int dj = -1; dj <= 1; ++dj)
+            for (int dk = -1; dk <= 1; ++dk) {
+              const int d[3] = {di, dj, dk};
+              if (d[axis] != 0) continue;
+              const int i2 = ci + di, j2 = cj + dj, k2 = ck + dk;
+              if (!g.contains(i2, j2, k2)) continue;
+              (labelmap.voxels[g.offset(i2, j2, k2)] ? inside : outside) = true;
+            }
+        ++points;
+        onBoundary += inside && outside;
+      }
+    }
+  }
+  // Where the surface grazes a slice, its contour can pass between voxel
+  // centres without a voxel of each kind next to it: allow 2 % of points.
+  EXPECT_GE(onBoundary, 0.98 * points) << onBoundary << " of " << points << " contour points on the boundary";
+  std::cout << onBoundary << " of " << points << " contour points lie on the labelmap's boundary\n";
 }
 
 // --- baselines --------------------------------------------------------------
