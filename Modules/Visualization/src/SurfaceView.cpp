@@ -179,9 +179,12 @@ void SurfaceView::resetCamera() {
   } else {
     impl_->renderer->ComputeVisiblePropBounds(bounds);
   }
-  const Vector3 centre(0.5 * (bounds[0] + bounds[1]), 0.5 * (bounds[2] + bounds[3]), 0.5 * (bounds[4] + bounds[5]));
-  const double radius =
-      0.5 * Vector3(bounds[1] - bounds[0], bounds[3] - bounds[2], bounds[5] - bounds[4]).norm();
+  frame(Vector3(bounds[0], bounds[2], bounds[4]), Vector3(bounds[1], bounds[3], bounds[5]));
+}
+
+void SurfaceView::frame(const Vector3& low, const Vector3& high) {
+  const Vector3 centre = 0.5 * (low + high);
+  const double radius = std::max(0.5 * (high - low).norm(), 1e-3);
   // From the patient's left (+x), front (-y) and above (+z).
   const Vector3 direction = Vector3(1.0, -1.2, 0.8).normalized();
   vtkCamera* camera = impl_->renderer->GetActiveCamera();

@@ -235,7 +235,7 @@ struct Viewer::Impl {
       for (double d : result.landmarkDistances) worst = std::max(worst, d);
       std::ostringstream text;
       text << "fit done: " << result.mesh.vertexCount() << " control vertices, " << result.levels.back().level
-           << " refinement(s), " << result.steps << " steps; farthest landmark " << std::fixed
+           << " refinement(s), " << result.steps << " steps;\nfarthest landmark " << std::fixed
            << std::setprecision(2) << worst << " mm";
       publish(tessellate(LimitSurface(result.mesh), result.mesh.points(), 8), text.str());
     } catch (const FitCancelled&) {
@@ -509,7 +509,15 @@ Viewer::Impl::Impl(ViewerInput in) : input(std::move(in)), slices(input.image), 
   window->AddRenderer(surface3d.renderer());
   showSlices();
   showLandmarks();
-  surface3d.resetCamera();
+  if (landmarks.size() >= 2) {
+    // The structure the landmarks outline, with room around it.
+    const Matrix3X points = landmarkPositions(landmarks);
+    const Vector3 low = points.colwise().minCoeff().transpose(), high = points.colwise().maxCoeff().transpose();
+    const Vector3 room = 0.25 * (high - low) + Vector3::Constant(5.0);
+    surface3d.frame(low - room, high + room);
+  } else {
+    surface3d.resetCamera();
+  }
 
   overlay->SetLayer(1);
   overlay->InteractiveOff();
@@ -520,6 +528,8 @@ Viewer::Impl::Impl(ViewerInput in) : input(std::move(in)), slices(input.image), 
   helpText->VisibilityOff();
   overlay->AddActor2D(helpText);
   style::cornerText(statusText, 0.51, 0.01, style::Corner::BottomLeft, 13);
+  statusText->GetTextProperty()->SetBackgroundColor(0, 0, 0);
+  statusText->GetTextProperty()->SetBackgroundOpacity(0.6);
   overlay->AddActor2D(statusText);
   window->AddRenderer(overlay);
   message = "h: help";

@@ -26,6 +26,7 @@
 
 #include "BallPhantom.h"
 #include "dynsub/Figures.h"
+#include "dynsub/ImageIO.h"
 #include "dynsub/SliceView.h"
 #include "dynsub/Viewer.h"
 
@@ -246,6 +247,29 @@ TEST_F(ViewerTest, TheSurfaceFitsLiveAndCanBePausedResetAndPulled) {
   const auto [pulledMean, pulledWorst] = radialError(surface, phantom);
   EXPECT_GT(pulledWorst, fittedWorst + 2.0) << "the pull did not draw the surface out";
   std::cout << "pull: farthest point " << pulledWorst << " mm outside the ball (" << fittedWorst << " before)\n";
+}
+
+// The demo's caudate fitted live on the real MRI; the window (with the help
+// shown) is saved to build/Testing/Temporary/ViewerCaudate.png for review.
+TEST_F(ViewerTest, TheCaudateFitsLiveOnTheRealMri) {
+  ViewerInput input;
+  input.image = readVolume("/usr/share/mricron/templates/ch2.nii.gz");
+  input.landmarks = readLandmarks(std::string(DYNSUB_DATA_DIR) + "/Landmarks/caudate_left.mrk.json");
+  input.landmarksPath = path_;
+  Viewer viewer(input);
+  viewer.window()->Render();
+  viewer.startOrPauseFitting();
+  ASSERT_TRUE(viewer.waitForFit(300.0)) << viewer.status();
+  EXPECT_NE(viewer.status().find("fit done: 386 control vertices"), std::string::npos) << viewer.status();
+  EXPECT_GE(viewer.surfaceUpdates(), 10) << "too few redraws to watch the fit";
+  std::cout << "caudate: " << viewer.surfaceUpdates() << " redraws; " << viewer.status() << '\n';
+  SliceView& axial = viewer.sliceView(SliceOrientation::Axial);
+  int* size = axial.renderer()->GetSize();
+  int* origin = axial.renderer()->GetOrigin();
+  play(viewer, {key("h", 'h', Eigen::Vector2d(origin[0] + 0.5 * size[0], origin[1] + 0.5 * size[1]))});
+  const std::string temporary = std::string(DYNSUB_BINARY_DIR) + "/Testing/Temporary";
+  std::filesystem::create_directories(temporary);
+  writePng(viewer.window(), temporary + "/ViewerCaudate.png");
 }
 
 }  // namespace

@@ -40,6 +40,8 @@ class SurfaceView {
   // Looks at the surface's bounds from the front, left and above (the
   // patient's left-anterior-superior side), the whole surface in view.
   void resetCamera();
+  // The same view of the box [low, high] (mm).
+  void frame(const Vector3& low, const Vector3& high);
 
  private:
   struct Impl;
