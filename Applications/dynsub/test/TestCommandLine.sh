@@ -139,6 +139,12 @@ expect_error "render: corrupt convergence history" 1 "expected the header" "$wor
   "$DYNSUB" render --surface "$work/caudate/surface.vtp" --convergence "$work/points.txt" --out "$work/r3"
 expect_error "render: no display" 1 "X display" "$work/r4" \
   env -u DISPLAY "$DYNSUB" render --surface "$work/caudate/surface.vtp" --out "$work/r4"
+expect_error "view: no display" 1 "needs an X display" "$work/v1" \
+  env -u DISPLAY "$DYNSUB" view "$mri/ch2.nii.gz" --landmarks "$work/v1"
+expect_error "view: missing image" 1 "no such file" "$work/v2" \
+  "$DYNSUB" view "$work/none.nii.gz" --landmarks "$work/v2"
+expect_error "view: unreadable landmarks" 1 "unknown landmark format" "$work/v3" \
+  "$DYNSUB" view "$mri/ch2.nii.gz" --landmarks "$work/points.txt" --surface "$work/v3"
 for key in dice jaccard volume_difference_percent mean_surface_distance_mm hd95_mm hausdorff_mm stage_seconds \
   landmark_residuals final_energy; do
   check "segment report has $key" grep -q "\"$key\"" "$work/caudate/report.json"
