@@ -7,7 +7,9 @@
 #include <vtkLookupTable.h>
 #include <vtkNew.h>
 #include <vtkPolyDataMapper.h>
+#include <vtkPolyData.h>
 #include <vtkProperty.h>
+#include <vtkRenderer.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
 
@@ -33,6 +35,24 @@ void pointsAsDots(vtkActor* actor, double pixels) {
   actor->GetProperty()->SetPointSize(pixels);
   actor->GetProperty()->RenderPointsAsSpheresOn();
   actor->GetProperty()->LightingOff();
+}
+
+void showLandmarks(vtkRenderer* renderer, vtkPolyData* points, vtkActor* actor) {
+  vtkNew<vtkPolyDataMapper> mapper;
+  mapper->SetInputData(points);
+  actor->SetMapper(mapper);
+  pointsAsDots(actor, kLandmarkPixels);
+  renderer->AddActor(actor);
+}
+
+void showDataPoints(vtkRenderer* renderer, vtkPolyData* points, vtkActor* actor) {
+  vtkNew<vtkPolyDataMapper> mapper;
+  mapper->SetInputData(points);
+  mapper->ScalarVisibilityOff();
+  actor->SetMapper(mapper);
+  pointsAsDots(actor, kDataPixels);
+  actor->GetProperty()->SetColor(0.85, 0.85, 0.85);
+  renderer->AddActor(actor);
 }
 
 void cornerText(vtkTextActor* text, double x, double y, Corner corner, int fontSize) {

@@ -7,7 +7,9 @@
 #include "dynsub/Types.h"
 
 class vtkActor;
+class vtkPolyData;
 class vtkPolyDataMapper;
+class vtkRenderer;
 class vtkTextActor;
 
 namespace dynsub::style {
@@ -26,6 +28,12 @@ constexpr int kFontSize = 14;
 void colourByElementType(vtkPolyDataMapper* mapper);
 // Vertices drawn as round dots of a fixed size in pixels.
 void pointsAsDots(vtkActor* actor, double pixels);
+
+// Adds `actor` drawing `points` to `renderer`: landmarks as dots coloured by
+// their per-point colours (kLandmark, kSelectedLandmark); range data as small
+// light grey dots.
+void showLandmarks(vtkRenderer* renderer, vtkPolyData* points, vtkActor* actor);
+void showDataPoints(vtkRenderer* renderer, vtkPolyData* points, vtkActor* actor);
 
 enum class Corner { TopLeft, TopRight, BottomLeft, Left, Right, Top, Bottom };
 // White text at a normalized viewport position, justified towards `corner`.

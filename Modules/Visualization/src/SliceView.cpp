@@ -66,19 +66,8 @@ struct SliceView::Impl {
     contourActor->VisibilityOff();
     renderer->AddActor(contourActor);
 
-    vtkNew<vtkPolyDataMapper> landmarkMapper;
-    landmarkMapper->SetInputData(landmarkPoints);
-    landmarkActor->SetMapper(landmarkMapper);
-    style::pointsAsDots(landmarkActor, style::kLandmarkPixels);
-    renderer->AddActor(landmarkActor);
-
-    vtkNew<vtkPolyDataMapper> dataMapper;
-    dataMapper->SetInputData(dataOnSlice);
-    dataMapper->ScalarVisibilityOff();
-    dataActor->SetMapper(dataMapper);
-    style::pointsAsDots(dataActor, style::kDataPixels);
-    dataActor->GetProperty()->SetColor(0.85, 0.85, 0.85);
-    renderer->AddActor(dataActor);
+    style::showLandmarks(renderer, landmarkPoints, landmarkActor);
+    style::showDataPoints(renderer, dataOnSlice, dataActor);
 
     style::cornerText(title, 0.02, 0.97, style::Corner::TopLeft);
     renderer->AddActor2D(title);

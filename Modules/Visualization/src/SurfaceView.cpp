@@ -75,19 +75,8 @@ struct SurfaceView::Impl {
     wireActor->VisibilityOff();
     renderer->AddActor(wireActor);
 
-    vtkNew<vtkPolyDataMapper> landmarkMapper;
-    landmarkMapper->SetInputData(landmarkPoints);
-    landmarkActor->SetMapper(landmarkMapper);
-    style::pointsAsDots(landmarkActor, style::kLandmarkPixels);
-    renderer->AddActor(landmarkActor);
-
-    vtkNew<vtkPolyDataMapper> dataMapper;
-    dataMapper->SetInputData(dataPoints);
-    dataMapper->ScalarVisibilityOff();
-    dataActor->SetMapper(dataMapper);
-    style::pointsAsDots(dataActor, style::kDataPixels);
-    dataActor->GetProperty()->SetColor(0.85, 0.85, 0.85);
-    renderer->AddActor(dataActor);
+    style::showLandmarks(renderer, landmarkPoints, landmarkActor);
+    style::showDataPoints(renderer, dataPoints, dataActor);
 
     for (int s = 0; s < 3; ++s) {
       sliceActors[s]->SetMapper(sliceMappers[s]);

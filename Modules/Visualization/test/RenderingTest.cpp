@@ -233,25 +233,19 @@ TEST_F(Rendering, TestCaudateSlices) {
   expectMatchesBaseline(slicesFigure(scene));
 }
 
-TEST_F(Rendering, TestCubeElements) {
-  const std::string file = kSource + "/Data/Meshes/cube.obj";
+// The 3D figure of a control mesh's limit surface with its wireframe.
+void expectElementsMatchBaseline(const std::string& meshFile) {
   FigureScene scene;
-  const vtkSmartPointer<vtkPolyData> surface = limitSurfaceOf(file);
-  const vtkSmartPointer<vtkPolyData> wireframe = controlMeshWireframe(readControlMesh(file));
+  const vtkSmartPointer<vtkPolyData> surface = limitSurfaceOf(meshFile);
+  const vtkSmartPointer<vtkPolyData> wireframe = controlMeshWireframe(readControlMesh(meshFile));
   scene.surface = surface;
   scene.controlMesh = wireframe;
   expectMatchesBaseline(surfaceFigure(scene));
 }
 
-TEST_F(Rendering, TestTorusElements) {
-  const std::string file = kSource + "/Data/Meshes/torus.obj";
-  FigureScene scene;
-  const vtkSmartPointer<vtkPolyData> surface = limitSurfaceOf(file);
-  const vtkSmartPointer<vtkPolyData> wireframe = controlMeshWireframe(readControlMesh(file));
-  scene.surface = surface;
-  scene.controlMesh = wireframe;
-  expectMatchesBaseline(surfaceFigure(scene));
-}
+TEST_F(Rendering, TestCubeElements) { expectElementsMatchBaseline(kSource + "/Data/Meshes/cube.obj"); }
+
+TEST_F(Rendering, TestTorusElements) { expectElementsMatchBaseline(kSource + "/Data/Meshes/torus.obj"); }
 
 TEST_F(Rendering, TestConvergencePlot) {
   expectMatchesBaseline(convergenceFigure(readConvergenceCsv(kSource + "/Testing/Data/caudate_left_convergence.csv")));
