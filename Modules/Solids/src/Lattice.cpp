@@ -1,0 +1,161 @@
+#include "dynsub/Lattice.h"
+
+#include <algorithm>
+#include <map>
+#include <set>
+
+#include "dynsub/Error.h"
+
+namespace dynsub {
+
+namespace {
+
+std::vector<int> sortedUnique(std::vector<int> v) {
+  std::sort(v.begin(), v.end());
+  v.erase(std::unique(v.begin(), v.end()), v.end());
+  return v;
+}
+
+}  // namespace
+
+Lattice Lattice::fromCells(Matrix3X points, std::vector<std::vector<int>> faces, std::vector<std::vector<int>> cells,
+                           const std::string& source) {
+  if (points.rows() == 0 || cells.empty()) throw Error(source, "the lattice has no points or no cells");
+  if (!points.allFinite()) throw Error(source, "a point has a non-finite coordinate");
+  const int n = static_cast<int>(points.rows());
+  Lattice l;
+  l.points_ = std::move(points);
+  l.faces_ = std::move(faces);
+  l.cells_ = std::move(cells);
+  const int faceCount = l.faceCount();
+
+  std::map<std::pair<int, int>, int> edgeIndex;
+  l.faceEdges_.resize(faceCount);
+  for (int f = 0; f < faceCount; ++f) {
+    const std::vector<int>& loop = l.faces_[f];
+    const std::string name = "face " + std::to_string(f);
+    if (loop.size() < 3) throw Error(source, name + " has fewer than 3 points");
+    for (int p : loop)
+      if (p < 0 || p >= n)
+        throw Error(source, name + " uses point " + std::to_string(p) + ", but the lattice has " + std::to_string(n));
+    if (sortedUnique(loop).size() != loop.size()) throw Error(source, name + " repeats a point");
+    for (std::size_t i = 0; i < loop.size(); ++i) {
+      const int a = std::min(loop[i], loop[(i + 1) % loop.size()]), b = std::max(loop[i], loop[(i + 1) % loop.size()]);
+      auto [it, added] = edgeIndex.try_emplace({a, b}, static_cast<int>(l.edges_.size()));
+      if (added) l.edges_.push_back({a, b});
+      l.faceEdges_[f].push_back(it->second);
+    }
+  }
+
+  l.faceCells_.assign(faceCount, {});
+  l.cellEdges_.resize(l.cellCount());
+  l.cellPoints_.resize(l.cellCount());
+  for (int c = 0; c < l.cellCount(); ++c) {
+    const std::string name = "cell " + std::to_string(c);
+    const std::vector<int>& shell = l.cells_[c];
+    if (shell.size() < 4) throw Error(source, name + " has fewer than 4 faces: it cannot be closed");
+    if (sortedUnique(shell).size() != shell.size()) throw Error(source, name + " lists a face twice");
+    std::map<int, int> edgeUses;
+    for (int f : shell) {
+      if (f < 0 || f >= faceCount)
+        throw Error(source, name + " uses face " + std::to_string(f) + ", but the lattice has " +
+                                std::to_string(faceCount));
+      l.faceCells_[f].push_back(c);
+      for (int e : l.faceEdges_[f]) ++edgeUses[e];
+      l.cellPoints_[c].insert(l.cellPoints_[c].end(), l.faces_[f].begin(), l.faces_[f].end());
+    }
+    for (const auto& [e, uses] : edgeUses) {
+      if (uses != 2)
+        throw Error(source, name + " is not closed: its edge " + std::to_string(l.edges_[e][0]) + "-" +
+                                std::to_string(l.edges_[e][1]) + " lies in " + std::to_string(uses) +
+                                " of its faces (expected 2)");
+      l.cellEdges_[c].push_back(e);
+    }
+    l.cellPoints_[c] = sortedUnique(l.cellPoints_[c]);
+  }
+  for (int f = 0; f < faceCount; ++f) {
+    if (l.faceCells_[f].empty()) throw Error(source, "face " + std::to_string(f) + " dangles: no cell uses it");
+    if (l.faceCells_[f].size() > 2)
+      throw Error(source, "face " + std::to_string(f) + " is shared by " + std::to_string(l.faceCells_[f].size()) +
+                              " cells (at most 2)");
+  }
+
+  l.edgeFaces_.assign(l.edgeCount(), {});
+  l.edgeCells_.assign(l.edgeCount(), {});
+  l.pointEdges_.assign(n, {});
+  l.pointFaces_.assign(n, {});
+  l.pointCells_.assign(n, {});
+  for (int e = 0; e < l.edgeCount(); ++e)
+    for (int p : l.edges_[e]) l.pointEdges_[p].push_back(e);
+  for (int f = 0; f < faceCount; ++f) {
+    for (int e : l.faceEdges_[f]) l.edgeFaces_[e].push_back(f);
+    for (int p : l.faces_[f]) l.pointFaces_[p].push_back(f);
+  }
+  for (int c = 0; c < l.cellCount(); ++c) {
+    for (int e : l.cellEdges_[c]) l.edgeCells_[e].push_back(c);
+    for (int p : l.cellPoints_[c]) l.pointCells_[p].push_back(c);
+  }
+  for (int p = 0; p < n; ++p)
+    if (l.pointCells_[p].empty()) throw Error(source, "point " + std::to_string(p) + " belongs to no cell");
+  return l;
+}
+
+void Lattice::setPoints(const Matrix3X& points) {
+  if (points.rows() != points_.rows() || !points.allFinite())
+    throw Error("the lattice's new points must be " + std::to_string(points_.rows()) + " finite points");
+  points_ = points;
+}
+
+int Lattice::edgeBetween(int a, int b) const {
+  for (int e : pointEdges_[a])
+    if (edges_[e][0] == std::min(a, b) && edges_[e][1] == std::max(a, b)) return e;
+  return -1;
+}
+
+Lattice regularLattice(int nx, int ny, int nz, double size, const std::vector<int>& removed) {
+  if (nx < 1 || ny < 1 || nz < 1) throw Error("a regular lattice needs at least one cell along each axis");
+  const int px = nx + 1, py = ny + 1, pz = nz + 1;
+  auto point = [&](int i, int j, int k) { return i + px * (j + py * k); };
+  Matrix3X points(px * py * pz, 3);
+  for (int k = 0; k < pz; ++k)
+    for (int j = 0; j < py; ++j)
+      for (int i = 0; i < px; ++i) points.row(point(i, j, k)) << i * size, j * size, k * size;
+  const std::set<int> gone(removed.begin(), removed.end());
+  // Faces keyed by their sorted points, so neighbouring cells share them.
+  std::map<std::vector<int>, int> faceIndex;
+  std::vector<std::vector<int>> faces, cells;
+  auto face = [&](std::vector<int> loop) {
+    std::vector<int> key = loop;
+    std::sort(key.begin(), key.end());
+    auto [it, added] = faceIndex.try_emplace(key, static_cast<int>(faces.size()));
+    if (added) faces.push_back(std::move(loop));
+    return it->second;
+  };
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        if (gone.count(i + nx * (j + ny * k))) continue;
+        const int p000 = point(i, j, k), p100 = point(i + 1, j, k), p010 = point(i, j + 1, k),
+                  p110 = point(i + 1, j + 1, k), p001 = point(i, j, k + 1), p101 = point(i + 1, j, k + 1),
+                  p011 = point(i, j + 1, k + 1), p111 = point(i + 1, j + 1, k + 1);
+        // Loops ordered outward (right-handed about the outward normal).
+        cells.push_back({face({p000, p010, p110, p100}), face({p001, p101, p111, p011}),
+                         face({p000, p100, p101, p001}), face({p010, p011, p111, p110}),
+                         face({p000, p001, p011, p010}), face({p100, p110, p111, p101})});
+      }
+  // Points no cell uses are dropped, and the rest renumbered.
+  std::vector<int> renumber(points.rows(), -1);
+  for (const auto& loop : faces)
+    for (int p : loop) renumber[p] = 0;
+  int used = 0;
+  for (int& r : renumber)
+    if (r == 0) r = used++;
+  Matrix3X kept(used, 3);
+  for (int p = 0; p < points.rows(); ++p)
+    if (renumber[p] >= 0) kept.row(renumber[p]) = points.row(p);
+  for (auto& loop : faces)
+    for (int& p : loop) p = renumber[p];
+  return Lattice::fromCells(std::move(kept), std::move(faces), std::move(cells), "regular lattice");
+}
+
+}  // namespace dynsub

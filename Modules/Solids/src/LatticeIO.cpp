@@ -1,0 +1,173 @@
+#include "dynsub/LatticeIO.h"
+
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+#include <vtkCellData.h>
+#include <vtkIdList.h>
+#include <vtkIntArray.h>
+#include <vtkNew.h>
+#include <vtkPoints.h>
+#include <vtkUnstructuredGrid.h>
+#include <vtkXMLUnstructuredGridWriter.h>
+
+#include "dynsub/AtomicOutput.h"
+#include "dynsub/Error.h"
+#include "dynsub/FileNames.h"
+
+namespace dynsub {
+
+namespace {
+
+// Lines without comments and blank lines, with their numbers.
+class LatticeReader {
+ public:
+  explicit LatticeReader(const std::string& path) : path_(path), in_(path) {
+    if (!in_) throw Error(path, "no such file or it cannot be read");
+  }
+
+  std::istringstream next(const char* expecting) {
+    std::string line;
+    while (std::getline(in_, line)) {
+      ++number_;
+      const auto first = line.find_first_not_of(" \t\r");
+      if (first == std::string::npos || line[first] == '#') continue;
+      return std::istringstream(line);
+    }
+    throw Error(path_, "the file ends early: expected " + std::string(expecting));
+  }
+
+  [[noreturn]] void fail(const std::string& message) const {
+    throw Error(path_, "line " + std::to_string(number_) + ": " + message);
+  }
+
+  int count(const char* keyword) {
+    std::istringstream line = next(keyword);
+    std::string word;
+    long long n = -1;
+    if (!(line >> word >> n) || word != keyword || n < 0 || n > 100000000)
+      fail(std::string("expected \"") + keyword + " N\"");
+    return static_cast<int>(n);
+  }
+
+  std::vector<int> indexList(const char* what) {
+    std::istringstream line = next(what);
+    long long k = 0;
+    if (!(line >> k) || k < 1 || k > 1000) fail(std::string("expected a ") + what + ": a count, then indices");
+    std::vector<int> indices(k);
+    for (int& i : indices) {
+      long long v;
+      if (!(line >> v) || v < 0 || v > 2000000000LL) fail(std::string("expected ") + std::to_string(k) + " indices");
+      i = static_cast<int>(v);
+    }
+    std::string extra;
+    if (line >> extra) fail("more indices than the count " + std::to_string(k));
+    return indices;
+  }
+
+ private:
+  std::string path_;
+  std::ifstream in_;
+  int number_ = 0;
+};
+
+}  // namespace
+
+Lattice readLattice(const std::string& path) {
+  if (lowerCaseExtension(path) != ".lattice")
+    throw Error(path, "unknown lattice format '" + lowerCaseExtension(path) + "' (expected .lattice)");
+  LatticeReader reader(path);
+  {
+    std::istringstream header = reader.next("the header \"dynsub-lattice 1\"");
+    std::string word;
+    int version = 0;
+    if (!(header >> word >> version) || word != "dynsub-lattice" || version != 1)
+      reader.fail("expected the header \"dynsub-lattice 1\"");
+  }
+  const int n = reader.count("points");
+  Matrix3X points(n, 3);
+  for (int i = 0; i < n; ++i) {
+    std::istringstream line = reader.next("a point");
+    if (!(line >> points(i, 0) >> points(i, 1) >> points(i, 2))) reader.fail("expected a point \"x y z\"");
+    if (!points.row(i).allFinite()) reader.fail("the point is not finite");
+  }
+  const int f = reader.count("faces");
+  std::vector<std::vector<int>> faces(f);
+  for (auto& face : faces) face = reader.indexList("face");
+  const int c = reader.count("cells");
+  std::vector<std::vector<int>> cells(c);
+  for (auto& cell : cells) cell = reader.indexList("cell");
+  return Lattice::fromCells(std::move(points), std::move(faces), std::move(cells), path);
+}
+
+namespace {
+
+void writeText(const Lattice& l, const std::string& path) {
+  std::ofstream out(path);
+  if (!out) throw Error(path, "cannot write the file");
+  out << "# DynSub control lattice: " << l.pointCount() << " points, " << l.edgeCount() << " edges, "
+      << l.faceCount() << " faces, " << l.cellCount() << " cells\n"
+      << "dynsub-lattice 1\npoints " << l.pointCount() << '\n'
+      << std::setprecision(17);
+  for (int i = 0; i < l.pointCount(); ++i)
+    out << l.points()(i, 0) << ' ' << l.points()(i, 1) << ' ' << l.points()(i, 2) << '\n';
+  out << "faces " << l.faceCount() << '\n';
+  for (const auto& face : l.faces()) {
+    out << face.size();
+    for (int p : face) out << ' ' << p;
+    out << '\n';
+  }
+  out << "cells " << l.cellCount() << '\n';
+  for (const auto& cell : l.cells()) {
+    out << cell.size();
+    for (int f : cell) out << ' ' << f;
+    out << '\n';
+  }
+  if (!out) throw Error(path, "writing the file failed");
+}
+
+void writeVtu(const Lattice& l, const std::string& path, const std::string& name) {
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  for (int i = 0; i < l.pointCount(); ++i) points->InsertNextPoint(l.points()(i, 0), l.points()(i, 1), l.points()(i, 2));
+  vtkNew<vtkUnstructuredGrid> grid;
+  grid->SetPoints(points);
+  vtkNew<vtkIntArray> boundaryFaces;
+  boundaryFaces->SetName("BoundaryFaces");
+  for (int c = 0; c < l.cellCount(); ++c) {
+    vtkNew<vtkIdList> stream;  // faces: count, then each face's size and points
+    int boundary = 0;
+    stream->InsertNextId(static_cast<vtkIdType>(l.cells()[c].size()));
+    for (int f : l.cells()[c]) {
+      boundary += l.isBoundaryFace(f);
+      stream->InsertNextId(static_cast<vtkIdType>(l.faces()[f].size()));
+      for (int p : l.faces()[f]) stream->InsertNextId(p);
+    }
+    grid->InsertNextCell(VTK_POLYHEDRON, stream);
+    boundaryFaces->InsertNextValue(boundary);
+  }
+  grid->GetCellData()->AddArray(boundaryFaces);
+  vtkNew<vtkXMLUnstructuredGridWriter> writer;
+  writer->SetFileName(path.c_str());
+  writer->SetInputData(grid);
+  writer->SetDataModeToAppended();
+  if (writer->Write() != 1) throw Error(name, "VTK could not write the file");
+}
+
+}  // namespace
+
+void writeLattice(const Lattice& lattice, const std::string& path) {
+  const std::string extension = lowerCaseExtension(path);
+  if (extension != ".lattice" && extension != ".vtu")
+    throw Error(path, "unknown lattice format '" + extension + "' (expected .lattice or .vtu)");
+  AtomicOutput output(path);
+  if (extension == ".lattice") {
+    writeText(lattice, output.temporaryPath());
+  } else {
+    writeVtu(lattice, output.temporaryPath(), path);
+  }
+  output.commit();
+}
+
+}  // namespace dynsub

@@ -1,0 +1,210 @@
+// Subdivision solids: Table 1's counts of McDonnell and Qin, tri-cubic
+// B-spline reproduction on a regular lattice, the matrix A, lattice files and
+// the errors for invalid lattices. No rendering.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "dynsub/Error.h"
+#include "dynsub/LatticeIO.h"
+#include "dynsub/SolidSubdivision.h"
+
+namespace dynsub {
+namespace {
+
+struct Counts {
+  int points, edges, faces, cells;
+};
+
+Counts countsOf(const Lattice& l) { return {l.pointCount(), l.edgeCount(), l.faceCount(), l.cellCount()}; }
+
+void expectCounts(const Lattice& l, const Counts& expected, const std::string& what) {
+  const Counts c = countsOf(l);
+  EXPECT_EQ(c.points, expected.points) << what;
+  EXPECT_EQ(c.edges, expected.edges) << what;
+  EXPECT_EQ(c.faces, expected.faces) << what;
+  EXPECT_EQ(c.cells, expected.cells) << what;
+}
+
+// Table 1: initial counts and the counts after the given levels.
+TEST(SolidSubdivision, ReproducesTable1Counts) {
+  const Lattice cube3 = regularLattice(2, 2, 2);
+  expectCounts(cube3, {27, 54, 36, 8}, "Cube (3^3)");
+  expectCounts(subdivideSolid(cube3, 2).lattice, {729, 1944, 1728, 512}, "Cube (3^3), level 2");
+  expectCounts(subdivideSolid(cube3, 3).lattice, {4913, 13872, 13056, 4096}, "Cube (3^3), level 3");
+  const Lattice cube4 = regularLattice(3, 3, 3);
+  expectCounts(cube4, {64, 144, 108, 27}, "Cube (4^3)");
+  expectCounts(subdivideSolid(cube4, 1).lattice, {343, 882, 756, 216}, "Cube (4^3), level 1");
+  expectCounts(subdivideSolid(cube4, 2).lattice, {2197, 6084, 5616, 1728}, "Cube (4^3), level 2");
+  // Cube w/ holes: the 3 x 3 x 3 cube without its centre and face-centre cells.
+  const Lattice holes = regularLattice(3, 3, 3, 1.0, {13, 4, 22, 10, 16, 12, 14});
+  expectCounts(holes, {64, 144, 96, 20}, "Cube w/ holes");
+  expectCounts(subdivideSolid(holes, 2).lattice, {1900, 5040, 4416, 1280}, "Cube w/ holes, level 2");
+}
+
+// The uniform tri-cubic B-spline's refinement along one axis: a fine point at
+// even index 2i is (p[i-1] + 6 p[i] + p[i+1]) / 8, at odd index 2i + 1 it is
+// (p[i] + p[i+1]) / 2.
+std::vector<std::pair<int, double>> bsplineMask(int fine) {
+  if (fine % 2 == 0) return {{fine / 2 - 1, 1.0 / 8}, {fine / 2, 6.0 / 8}, {fine / 2 + 1, 1.0 / 8}};
+  return {{fine / 2, 0.5}, {fine / 2 + 1, 0.5}};
+}
+
+TEST(SolidSubdivision, RegularInteriorIsTheTriCubicBSplineSolid) {
+  const int cells = 6, n = cells + 1;
+  Lattice lattice = regularLattice(cells, cells, cells);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> jitter(-0.3, 0.3);
+  Matrix3X points = lattice.points();
+  for (Eigen::Index i = 0; i < points.rows(); ++i)
+    for (int a = 0; a < 3; ++a) points(i, a) += jitter(random);
+  lattice.setPoints(points);
+  auto grid = [&](int p) { return Eigen::Vector3i(p % n, (p / n) % n, p / (n * n)); };
+
+  const SolidRefinement refined = subdivideSolid(lattice);
+  // Each refined point comes from an element; its fine-grid index is twice the
+  // average grid index of the element's points.
+  std::vector<std::vector<int>> sources;
+  for (int p = 0; p < lattice.pointCount(); ++p) sources.push_back({p});
+  for (const auto& e : lattice.edges()) sources.push_back({e[0], e[1]});
+  for (const auto& f : lattice.faces()) sources.push_back(f);
+  for (const auto& c : lattice.cellPoints()) sources.push_back(c);
+  ASSERT_EQ(static_cast<int>(sources.size()), refined.lattice.pointCount());
+
+  int compared = 0;
+  for (std::size_t r = 0; r < sources.size(); ++r) {
+    Eigen::Vector3i sum = Eigen::Vector3i::Zero();
+    for (int p : sources[r]) sum += grid(p);
+    const Eigen::Vector3i fine = 2 * sum / static_cast<int>(sources[r].size());
+    // Only points whose B-spline stencil lies inside the lattice (the
+    // boundary follows the surface rules instead).
+    bool inside = true;
+    for (int a = 0; a < 3; ++a) inside = inside && fine[a] >= 2 && fine[a] <= 2 * (n - 1) - 2;
+    if (!inside) continue;
+    Vector3 expected = Vector3::Zero();
+    for (const auto& [i, wi] : bsplineMask(fine[0]))
+      for (const auto& [j, wj] : bsplineMask(fine[1]))
+        for (const auto& [k, wk] : bsplineMask(fine[2]))
+          expected += wi * wj * wk * points.row(i + n * (j + n * k)).transpose();
+    EXPECT_LT((refined.lattice.points().row(r).transpose() - expected).norm(), 1e-12) << "refined point " << r;
+    ++compared;
+  }
+  EXPECT_EQ(compared, 9 * 9 * 9);  // fine indices 2..10 on each axis of the 13-point fine grid
+}
+
+TEST(SolidSubdivision, EveryRefinedPointIsAnAffineBlendAndLevelsCompose) {
+  const Lattice holes = regularLattice(3, 3, 3, 2.0, {13, 4, 22, 10, 16, 12, 14});
+  const SolidRefinement two = subdivideSolid(holes, 2);
+  const Eigen::VectorXd rowSums = two.A * Eigen::VectorXd::Ones(holes.pointCount());
+  EXPECT_LT((rowSums - Eigen::VectorXd::Ones(rowSums.size())).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((two.A * holes.points() - two.lattice.points()).cwiseAbs().maxCoeff(), 1e-12);
+  // Translating the lattice translates the solid.
+  Lattice moved = holes;
+  Matrix3X shifted = holes.points();
+  shifted.rowwise() += Eigen::RowVector3d(3, -1, 2);
+  moved.setPoints(shifted);
+  Matrix3X expected = two.lattice.points();
+  expected.rowwise() += Eigen::RowVector3d(3, -1, 2);
+  EXPECT_LT((subdivideSolid(moved, 2).lattice.points() - expected).cwiseAbs().maxCoeff(), 1e-12);
+  // The refined lattice stays valid: each cell closed, each face in 1 or 2 cells.
+  for (const auto& cells : two.lattice.faceCells()) EXPECT_TRUE(cells.size() == 1 || cells.size() == 2);
+}
+
+TEST(SolidSubdivision, TheBoundarySurfaceShrinksTowardsItsLimitButStaysInsideTheHull) {
+  // A cube's boundary follows Catmull-Clark surface rules: the corners pull
+  // in, the face centres stay on the faces.
+  const Lattice cube = regularLattice(1, 1, 1, 2.0);
+  const Lattice fine = subdivideSolid(cube, 3).lattice;
+  const Eigen::RowVector3d low = fine.points().colwise().minCoeff(), high = fine.points().colwise().maxCoeff();
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_GT(low(a), 0.0);
+    EXPECT_LT(high(a), 2.0);
+  }
+}
+
+// --- files and errors ---------------------------------------------------------
+
+class LatticeFiles : public ::testing::Test {
+ protected:
+  std::string file(const std::string& name, const std::string& text) {
+    const std::string path = (std::filesystem::temp_directory_path() / ("dynsub_solids_" + name)).string();
+    std::ofstream(path) << text;
+    paths_.push_back(path);
+    return path;
+  }
+  void TearDown() override {
+    for (const auto& p : paths_) std::filesystem::remove(p);
+  }
+  static std::string message(const std::string& path) {
+    try {
+      readLattice(path);
+    } catch (const Error& e) {
+      return e.what();
+    }
+    return "";
+  }
+  std::vector<std::string> paths_;
+};
+
+// A unit tetrahedron as one cell.
+const char* const kTetrahedron =
+    "dynsub-lattice 1\npoints 4\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n"
+    "faces 4\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n"
+    "cells 1\n4 0 1 2 3\n";
+
+TEST_F(LatticeFiles, RoundTrip) {
+  const Lattice cube4 = regularLattice(3, 3, 3, 1.5);
+  const std::string path = (std::filesystem::temp_directory_path() / "dynsub_solids_roundtrip.lattice").string();
+  paths_.push_back(path);
+  writeLattice(cube4, path);
+  const Lattice back = readLattice(path);
+  EXPECT_EQ(back.faces(), cube4.faces());
+  EXPECT_EQ(back.cells(), cube4.cells());
+  EXPECT_EQ(back.points(), cube4.points());
+  const Lattice tetrahedron = readLattice(file("tet.lattice", kTetrahedron));
+  expectCounts(tetrahedron, {4, 6, 4, 1}, "tetrahedron");
+  // One cell of 4 corners gives 4 hexahedra.
+  expectCounts(subdivideSolid(tetrahedron).lattice, {15, 28, 18, 4}, "tetrahedron, level 1");
+  const std::string vtu = (std::filesystem::temp_directory_path() / "dynsub_solids.vtu").string();
+  paths_.push_back(vtu);
+  writeLattice(cube4, vtu);
+  EXPECT_GT(std::filesystem::file_size(vtu), 1000u);
+}
+
+TEST_F(LatticeFiles, InvalidLatticesAreNamed) {
+  EXPECT_NE(message(file("missing.lattice", "")).find("ends early"), std::string::npos);
+  EXPECT_NE(message("/nonexistent/x.lattice").find("no such file"), std::string::npos);
+  EXPECT_NE(message(file("header.lattice", "lattice 2\n")).find("line 1"), std::string::npos);
+  std::string text = kTetrahedron;
+  EXPECT_NE(message(file("range.lattice", std::string(text).replace(text.find("3 0 2 1"), 7, "3 0 2 9")))
+                .find("face 0 uses point 9"),
+            std::string::npos);
+  // A fifth face nobody uses: dangling.
+  std::string dangling = std::string(text).replace(text.find("faces 4"), 7, "faces 5");
+  dangling.replace(dangling.find("cells 1"), 7, "3 0 1 2\ncells 1");
+  EXPECT_NE(message(file("dangling.lattice", dangling)).find("dangles"), std::string::npos);
+  // A cell missing a face is open.
+  std::string open = std::string(text).replace(text.find("4 0 1 2 3"), 9, "3 0 1 2");
+  EXPECT_NE(message(file("open.lattice", open)).find("fewer than 4 faces"), std::string::npos);
+  EXPECT_THROW(Lattice::fromCells(regularLattice(1, 1, 1).points(),
+                                  {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}},
+                                  {{0, 1, 2, 3, 4}}),
+               Error);  // five faces of a hexahedron: not closed
+  try {
+    Lattice::fromCells(regularLattice(1, 1, 1).points(),
+                       {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}},
+                       {{0, 1, 2, 3, 4}}, "box.lattice");
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("box.lattice: cell 0 is not closed"), std::string::npos) << e.what();
+  }
+  EXPECT_NE(message(file("truncated.lattice", "dynsub-lattice 1\npoints 4\n0 0 0\n1 0 0\n")).find("ends early"),
+            std::string::npos);
+  EXPECT_NE(message(file("nan.lattice", std::string(text).replace(text.find("1 0 0"), 5, "nan 0 0"))).find("line 4"),
+            std::string::npos);
+  EXPECT_THROW(readLattice(file("cube.obj", "v 0 0 0\n")), Error);
+}
+
+}  // namespace
+}  // namespace dynsub
