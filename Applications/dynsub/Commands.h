@@ -14,5 +14,6 @@ void addDeformCommand(CLI::App& app);
 void addSegmentCommand(CLI::App& app);
 void addRenderCommand(CLI::App& app);
 void addViewCommand(CLI::App& app);
+void addSolidCommand(CLI::App& app);
 
 }  // namespace dynsub::app

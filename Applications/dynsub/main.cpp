@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   dynsub::app::addSegmentCommand(app);
   dynsub::app::addRenderCommand(app);
   dynsub::app::addViewCommand(app);
+  dynsub::app::addSolidCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {

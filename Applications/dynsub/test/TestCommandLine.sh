@@ -168,5 +168,23 @@ expect_error "reference label absent" 1 "no voxel" "$work/s6" \
 expect_error "not an image" 1 "text.nii" "$work/s7" \
   bash -c "echo hello >'$work/text.nii'; '$DYNSUB' segment '$work/text.nii' --init sphere:0,0,0,5 --out '$work/s7'"
 
+# --- solids: Table 1's counts, files, bad lattices ------------------------------
+check "solid stats: Cube (3^3) at level 3 as in Table 1" test \
+  "$("$DYNSUB" solid stats "$DATA/Solids/cube3.lattice" --level 3)" = \
+  '{"points":4913,"edges":13872,"faces":13056,"cells":4096}'
+check "solid stats: Cube w/ holes at level 2 as in Table 1" test \
+  "$("$DYNSUB" solid stats "$DATA/Solids/cube_holes.lattice" --level 2)" = \
+  '{"points":1900,"edges":5040,"faces":4416,"cells":1280}'
+"$DYNSUB" solid subdivide "$DATA/Solids/cube4.lattice" --level 1 --out "$work/cube4.vtu" >/dev/null
+check "solid subdivide writes .vtu" grep -q "UnstructuredGrid" "$work/cube4.vtu"
+"$DYNSUB" solid make cube3 --out "$work/cube3.lattice" >/dev/null
+check "solid make cube3 equals Data/Solids/cube3.lattice" cmp -s "$work/cube3.lattice" "$DATA/Solids/cube3.lattice"
+sed 's/^6 0 1 2 3 4 5$/5 0 1 2 3 4/' "$DATA/Solids/cube3.lattice" >"$work/open.lattice"
+expect_error "solid: a cell that is not closed" 1 "cell 0 is not closed" "$work/o20" \
+  "$DYNSUB" solid subdivide "$work/open.lattice" --out "$work/o20"
+sed 's/^4 0 3 4 1$/4 0 3 4 99/' "$DATA/Solids/cube3.lattice" >"$work/range.lattice"
+expect_error "solid: a point index out of range" 1 "uses point 99" "$work/o21.vtu" \
+  "$DYNSUB" solid subdivide "$work/range.lattice" --out "$work/o21.vtu"
+
 if [ "$failures" -gt 0 ]; then echo "$failures check(s) failed"; exit 1; fi
 echo "all command-line checks passed"
