@@ -112,6 +112,87 @@ int Lattice::edgeBetween(int a, int b) const {
   return -1;
 }
 
+Lattice extrudeFace(const Lattice& l, int face) {
+  if (face < 0 || face >= l.faceCount()) throw Error("no face " + std::to_string(face) + " to extrude");
+  if (!l.isBoundaryFace(face))
+    throw Error("face " + std::to_string(face) + " is inside the solid: only boundary faces can be extruded");
+  const std::vector<int>& loop = l.faces()[face];
+  const int cell = l.faceCells()[face][0];
+  Vector3 centroid = Vector3::Zero(), cellCentroid = Vector3::Zero();
+  for (int p : loop) centroid += l.points().row(p).transpose();
+  centroid /= loop.size();
+  for (int p : l.cellPoints()[cell]) cellCentroid += l.points().row(p).transpose();
+  cellCentroid /= l.cellPoints()[cell].size();
+  // Newell's normal of the loop, turned away from the cell.
+  Vector3 normal = Vector3::Zero();
+  for (std::size_t i = 0; i < loop.size(); ++i)
+    normal += Vector3(l.points().row(loop[i]).transpose()).cross(l.points().row(loop[(i + 1) % loop.size()]).transpose());
+  if (!(normal.norm() > 0)) throw Error("face " + std::to_string(face) + " is degenerate: it has no normal");
+  normal.normalize();
+  // The loop runs counter-clockwise seen from outside when its normal points
+  // away from the cell; the new faces follow suit, so the boundary stays
+  // oriented as it was.
+  const bool outward = normal.dot(centroid - cellCentroid) >= 0;
+  if (!outward) normal = -normal;
+  const double height = 2.0 * std::abs(normal.dot(centroid - cellCentroid));
+
+  const int n = l.pointCount(), k = static_cast<int>(loop.size());
+  Matrix3X points(n + k, 3);
+  points.topRows(n) = l.points();
+  for (int i = 0; i < k; ++i) points.row(n + i) = l.points().row(loop[i]) + height * normal.transpose();
+  std::vector<std::vector<int>> faces = l.faces(), cells = l.cells();
+  std::vector<int> shell{face};
+  std::vector<int> top;
+  for (int i = 0; i < k; ++i) top.push_back(n + i);
+  if (!outward) std::reverse(top.begin(), top.end());
+  shell.push_back(static_cast<int>(faces.size()));
+  faces.push_back(top);
+  for (int i = 0; i < k; ++i) {
+    const int j = (i + 1) % k;
+    std::vector<int> side{loop[i], loop[j], n + j, n + i};
+    if (!outward) std::reverse(side.begin(), side.end());
+    shell.push_back(static_cast<int>(faces.size()));
+    faces.push_back(side);
+  }
+  cells.push_back(shell);
+  return Lattice::fromCells(std::move(points), std::move(faces), std::move(cells), "extruded lattice");
+}
+
+Lattice deleteCell(const Lattice& l, int cell, std::vector<int>* kept) {
+  if (cell < 0 || cell >= l.cellCount()) throw Error("no cell " + std::to_string(cell) + " to delete");
+  if (l.cellCount() == 1) throw Error("cell " + std::to_string(cell) + " is the lattice's last: it cannot be deleted");
+  // Faces, then points, still used by the other cells, renumbered in order.
+  std::vector<int> faceNumber(l.faceCount(), -1), pointNumber(l.pointCount(), -1);
+  std::vector<std::vector<int>> cells;
+  for (int c = 0; c < l.cellCount(); ++c)
+    if (c != cell)
+      for (int f : l.cells()[c]) faceNumber[f] = 0;
+  int faces = 0;
+  for (int& f : faceNumber)
+    if (f == 0) f = faces++;
+  std::vector<std::vector<int>> newFaces(faces);
+  for (int f = 0; f < l.faceCount(); ++f)
+    if (faceNumber[f] >= 0)
+      for (int p : l.faces()[f]) pointNumber[p] = 0;
+  int points = 0;
+  for (int& p : pointNumber)
+    if (p == 0) p = points++;
+  Matrix3X newPoints(points, 3);
+  for (int p = 0; p < l.pointCount(); ++p)
+    if (pointNumber[p] >= 0) newPoints.row(pointNumber[p]) = l.points().row(p);
+  for (int f = 0; f < l.faceCount(); ++f) {
+    if (faceNumber[f] < 0) continue;
+    for (int p : l.faces()[f]) newFaces[faceNumber[f]].push_back(pointNumber[p]);
+  }
+  for (int c = 0; c < l.cellCount(); ++c) {
+    if (c == cell) continue;
+    cells.emplace_back();
+    for (int f : l.cells()[c]) cells.back().push_back(faceNumber[f]);
+  }
+  if (kept) *kept = pointNumber;
+  return Lattice::fromCells(std::move(newPoints), std::move(newFaces), std::move(cells), "lattice");
+}
+
 Lattice regularLattice(int nx, int ny, int nz, double size, const std::vector<int>& removed) {
   if (nx < 1 || ny < 1 || nz < 1) throw Error("a regular lattice needs at least one cell along each axis");
   const int px = nx + 1, py = ny + 1, pz = nz + 1;

@@ -124,6 +124,45 @@ TEST(SolidSubdivision, TheBoundarySurfaceShrinksTowardsItsLimitButStaysInsideThe
   }
 }
 
+TEST(SculptingTopology, ExtrudeAddsACellOnABoundaryFaceAndDeleteRemovesOne) {
+  const Lattice cube3 = regularLattice(2, 2, 2);
+  // Face 0 of cell 0 is its bottom (z = 0): a boundary face.
+  ASSERT_TRUE(cube3.isBoundaryFace(0));
+  const Lattice grown = extrudeFace(cube3, 0);
+  expectCounts(grown, {31, 62, 41, 9}, "Cube (3^3) with a face extruded");
+  EXPECT_FALSE(grown.isBoundaryFace(0));
+  // The new points lie one cell below, outside the cube.
+  for (int p = 27; p < 31; ++p) EXPECT_DOUBLE_EQ(grown.points()(p, 2), -1.0);
+  EXPECT_EQ(grown.points().topRows(27), cube3.points());
+  // The new boundary faces face outward, as the cube's own do: each loop's
+  // normal points away from the new cell's centre.
+  const Vector3 cellCentre(0.5, 0.5, -0.5);
+  for (int f = cube3.faceCount(); f < grown.faceCount(); ++f) {
+    const auto& loop = grown.faces()[f];
+    Vector3 normal = Vector3::Zero(), centre = Vector3::Zero();
+    for (std::size_t i = 0; i < loop.size(); ++i) {
+      normal += Vector3(grown.points().row(loop[i]).transpose()).cross(grown.points().row(loop[(i + 1) % loop.size()]).transpose());
+      centre += grown.points().row(loop[i]).transpose() / loop.size();
+    }
+    EXPECT_GT(normal.dot(centre - cellCentre), 0.0) << "new face " << f << " faces inward";
+  }
+  expectCounts(subdivideSolid(grown).lattice, {31 + 62 + 41 + 9, 2 * 62 + 4 * 41 + 6 * 9, 4 * 41 + 12 * 9, 8 * 9},
+               "extruded, level 1");
+  // Deleting the corner cell 0: its corner point, 3 edges and 3 boundary faces go.
+  std::vector<int> kept;
+  const Lattice trimmed = deleteCell(cube3, 0, &kept);
+  expectCounts(trimmed, {26, 51, 33, 7}, "Cube (3^3) without a corner cell");
+  EXPECT_EQ(kept[0], -1);
+  EXPECT_EQ(kept[1], 0);
+  // Deleting the extruded cell gives the cube back.
+  expectCounts(deleteCell(grown, 8), countsOf(cube3), "extruded, then deleted");
+  EXPECT_THROW(extrudeFace(cube3, cube3.faceCount()), Error);
+  int interior = 0;
+  while (cube3.isBoundaryFace(interior)) ++interior;
+  EXPECT_THROW(extrudeFace(cube3, interior), Error);
+  EXPECT_THROW(deleteCell(regularLattice(1, 1, 1), 0), Error);
+}
+
 // --- files and errors ---------------------------------------------------------
 
 class LatticeFiles : public ::testing::Test {

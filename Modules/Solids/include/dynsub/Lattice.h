@@ -66,6 +66,19 @@ class Lattice {
   std::vector<std::vector<int>> faceCells_, edgeFaces_, edgeCells_, pointEdges_, pointFaces_, pointCells_;
 };
 
+// The sculpting tools' changes of topology (§5.4); both return a new valid
+// lattice. Throws dynsub::Error naming the face or cell when the tool does
+// not apply.
+//  - extrudeFace: a new cell on a boundary face, grown along the face's
+//    outward normal by twice the distance from the face's centroid to its
+//    cell's centroid (the cell's own depth there). The lattice's points keep
+//    their numbers; the new ones follow.
+//  - deleteCell: the cell and every face, edge and point only it used go
+//    (not the last cell). `kept` (if given) receives the new number of each
+//    old point, or -1 for a removed one.
+Lattice extrudeFace(const Lattice& lattice, int face);
+Lattice deleteCell(const Lattice& lattice, int cell, std::vector<int>* kept = nullptr);
+
 // A regular lattice of nx x ny x nz hexahedral cells of side `size` (mm),
 // (nx + 1)(ny + 1)(nz + 1) points numbered x fastest, from the origin;
 // the cells listed in `removed` (as x + nx (y + ny z)) are left out (their
