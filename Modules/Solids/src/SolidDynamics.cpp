@@ -114,27 +114,31 @@ void SolidModel::resetRestLengths() {
     springs_->virtualRest.push_back((0.5 * (d.row(a) + d.row(b)) - d.row(m)).norm());
 }
 
-Matrix3X SolidModel::springForces(const Matrix3X& d) const {
+Matrix3X SolidModel::springForces(const Matrix3X& d, double* energy) const {
   Matrix3X f = Matrix3X::Zero(d.rows(), 3);
+  double stored = 0;
   for (std::size_t s = 0; s < springs_->normal.size(); ++s) {
     const auto [a, b] = springs_->normal[s];
     const Eigen::RowVector3d delta = d.row(b) - d.row(a);
-    const double length = delta.norm();
+    const double length = delta.norm(), stretch = length - springs_->normalRest[s];
+    stored += 0.5 * material_.springStiffness * stretch * stretch;
     if (length <= 0) continue;
-    const Eigen::RowVector3d pull = material_.springStiffness * (length - springs_->normalRest[s]) / length * delta;
+    const Eigen::RowVector3d pull = material_.springStiffness * stretch / length * delta;
     f.row(a) += pull;
     f.row(b) -= pull;
   }
   for (std::size_t s = 0; s < springs_->virtuals.size(); ++s) {
     const auto [m, a, b] = springs_->virtuals[s];
     const Eigen::RowVector3d delta = 0.5 * (d.row(a) + d.row(b)) - d.row(m);
-    const double length = delta.norm();
+    const double length = delta.norm(), stretch = length - springs_->virtualRest[s];
+    stored += 0.5 * material_.virtualStiffness * stretch * stretch;
     if (length <= 0) continue;
-    const Eigen::RowVector3d pull = material_.virtualStiffness * (length - springs_->virtualRest[s]) / length * delta;
+    const Eigen::RowVector3d pull = material_.virtualStiffness * stretch / length * delta;
     f.row(m) += pull;
     f.row(a) -= 0.5 * pull;  // the massless virtual point passes its reaction on
     f.row(b) -= 0.5 * pull;
   }
+  if (energy) *energy = stored;
   return f;
 }
 
@@ -169,17 +173,8 @@ double SolidModel::kineticEnergy() const {
 }
 
 double SolidModel::springEnergy() const {
-  const Matrix3X d = dataPoints();
   double energy = 0;
-  for (std::size_t s = 0; s < springs_->normal.size(); ++s) {
-    const auto [a, b] = springs_->normal[s];
-    energy += 0.5 * material_.springStiffness * std::pow((d.row(a) - d.row(b)).norm() - springs_->normalRest[s], 2);
-  }
-  for (std::size_t s = 0; s < springs_->virtuals.size(); ++s) {
-    const auto [m, a, b] = springs_->virtuals[s];
-    energy += 0.5 * material_.virtualStiffness *
-              std::pow((0.5 * (d.row(a) + d.row(b)) - d.row(m)).norm() - springs_->virtualRest[s], 2);
-  }
+  springForces(dataPoints(), &energy);
   return energy;
 }
 

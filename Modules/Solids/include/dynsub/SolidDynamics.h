@@ -73,7 +73,9 @@ class SolidModel {
 
  private:
   struct Springs;
-  Matrix3X springForces(const Matrix3X& d) const;
+  // Forces of the normal and virtual springs on the mass points `d`;
+  // `energy` (if given) receives their stored energy, N mm.
+  Matrix3X springForces(const Matrix3X& d, double* energy = nullptr) const;
   void factor();
 
   Lattice control_;
