@@ -7,6 +7,7 @@
 
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
+#include "dynsub/TextFields.h"
 
 namespace dynsub {
 
@@ -62,15 +63,16 @@ ConvergenceHistory readConvergenceCsv(const std::string& path) {
     std::getline(fields, energy, ',');
     std::getline(fields, fit, ',');
     ConvergenceSample s;
-    try {
-      std::size_t used = 0;
-      s.level = std::stoi(level, &used);
-      s.step = std::stoi(step);
-      s.energy = std::stod(energy);
-      if (!fit.empty()) s.fitError = std::stod(fit);
-    } catch (const std::exception&) {
+    // Level and step: whole numbers a level or a step count can be.
+    auto whole = [](const std::string& field, int& out) {
+      double value = 0;
+      if (!parseNumber(field, value) || value != std::floor(value) || std::abs(value) > 1e9) return false;
+      out = static_cast<int>(value);
+      return true;
+    };
+    if (!whole(level, s.level) || !whole(step, s.step) || !parseNumber(energy, s.energy) ||
+        (!fit.empty() && !parseNumber(fit, s.fitError)))
       throw Error(path, "line " + std::to_string(number) + ": expected level,step,energy,fit_error numbers");
-    }
     if (!std::isfinite(s.energy)) throw Error(path, "line " + std::to_string(number) + ": the energy is not finite");
     history.samples.push_back(s);
   }
