@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <iostream>
+#include <memory>
 
 #include <CLI/CLI.hpp>
 #include <vtkPolyData.h>
@@ -10,6 +11,7 @@
 #include "Reporting.h"
 #include "dynsub/Figures.h"
 #include "dynsub/LimitSurface.h"
+#include "dynsub/SlicePlanes.h"
 #include "dynsub/SurfacePolyData.h"
 #include "dynsub/SurfaceView.h"
 #include "dynsub/Tessellation.h"
@@ -38,7 +40,7 @@ void FigureOptions::addOptions(CLI::App& command) {
 }
 
 void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const ControlMesh& mesh,
-                      const ConvergenceHistory& history, const Volume* image, const std::vector<Vector3>& landmarks,
+                      const ConvergenceHistory& history, const Volume* image, const Matrix3X& landmarks,
                       const Matrix3X& dataPoints) {
   writeConvergenceCsv(history, outputs.add("convergence.csv"));
   if (!options.figures) return;
@@ -48,15 +50,22 @@ void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const Co
     return;
   }
   const vtkSmartPointer<vtkPolyData> surface = toPolyData(tessellate(LimitSurface(mesh), mesh.points(), 8));
-  const vtkSmartPointer<vtkPolyData> wireframe = controlMeshWireframe(mesh);
+  std::unique_ptr<ImageSlices> slices;
+  vtkSmartPointer<vtkPolyData> wireframe;
   FigureScene scene;
-  scene.image = image;
   scene.surface = surface;
   scene.landmarks = landmarks;
   scene.dataPoints = dataPoints;
+  if (image) {
+    slices = std::make_unique<ImageSlices>(*image);
+    scene.image = slices.get();
+  }
   writePng(slicesFigure(scene), outputs.add("slices.png"));
   // Without an image the control mesh shows what the surface is made of.
-  if (!image) scene.controlMesh = wireframe;
+  if (!image) {
+    wireframe = controlMeshWireframe(mesh);
+    scene.controlMesh = wireframe;
+  }
   writePng(surfaceFigure(scene), outputs.add("surface3d.png"));
   writePng(convergenceFigure(history), outputs.add("convergence.png"));
 }

@@ -43,8 +43,9 @@ struct FigureOptions {
 
 // Adds convergence.csv and, if wanted and possible, the three figures to
 // `outputs`. Without a display it says so on stderr and writes no figure.
+// `image` may be null; landmarks and dataPoints are #points x 3 (mm), possibly empty.
 void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const ControlMesh& mesh,
-                      const ConvergenceHistory& history, const Volume* image, const std::vector<Vector3>& landmarks,
+                      const ConvergenceHistory& history, const Volume* image, const Matrix3X& landmarks,
                       const Matrix3X& dataPoints);
 
 }  // namespace dynsub::app

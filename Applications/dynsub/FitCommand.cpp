@@ -100,7 +100,7 @@ void runFit(FitCommandOptions o) {
   report["parameters"] = parameters;
 
   writeModelOutputs(dir, result.mesh, report, [&](OutputSet& outputs) {
-    addFigureOutputs(outputs, o.figures, result.mesh, recorder.history(), nullptr, {}, data);
+    addFigureOutputs(outputs, o.figures, result.mesh, recorder.history(), nullptr, Matrix3X(), data);
   });
 
   std::cout << std::fixed << std::setprecision(3) << "fitted " << data.rows() << " points with "

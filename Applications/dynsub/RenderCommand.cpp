@@ -1,6 +1,7 @@
 // dynsub render: the figures of segment and fit (Figures.h) from saved results.
 #include <filesystem>
 #include <iostream>
+#include <memory>
 
 #include <CLI/CLI.hpp>
 #include <vtkPolyData.h>
@@ -14,6 +15,7 @@
 #include "dynsub/Landmarks.h"
 #include "dynsub/MeshIO.h"
 #include "dynsub/PointCloudIO.h"
+#include "dynsub/SlicePlanes.h"
 #include "dynsub/SurfacePolyData.h"
 #include "dynsub/SurfaceView.h"
 
@@ -30,13 +32,14 @@ void runRender(const RenderCommandOptions& o) {
   if (!displayAvailable(&why)) throw Error("rendering needs an X display: " + why);
   // Every input is read and checked before anything is written.
   const vtkSmartPointer<vtkPolyData> surface = readSurfacePolyData(o.surface);
-  Volume image;
-  if (!o.image.empty()) image = readVolume(o.image);
   FigureScene scene;
   scene.surface = surface;
-  if (!o.image.empty()) scene.image = &image;
-  if (!o.landmarks.empty())
-    for (const Landmark& l : readLandmarks(o.landmarks)) scene.landmarks.push_back(l.position);
+  std::unique_ptr<ImageSlices> image;
+  if (!o.image.empty()) {
+    image = std::make_unique<ImageSlices>(readVolume(o.image));
+    scene.image = image.get();
+  }
+  if (!o.landmarks.empty()) scene.landmarks = landmarkPositions(readLandmarks(o.landmarks));
   if (!o.points.empty()) scene.dataPoints = readPointCloud(o.points);
   vtkSmartPointer<vtkPolyData> wireframe;
   if (!o.controlMesh.empty()) {

@@ -11,7 +11,6 @@
 #include "Commands.h"
 #include "FigureOutputs.h"
 #include "Reporting.h"
-#include "dynsub/ClosestPoint.h"
 #include "dynsub/Error.h"
 #include "dynsub/ImageIO.h"
 #include "dynsub/MeshIO.h"
@@ -98,11 +97,9 @@ void runSegment(SegmentCommandOptions o) {
       "rms landmark distance (mm)",
       landmarks.empty() ? ConvergenceRecorder::FitError()
                         : [&](const LimitSurface& surface, const Matrix3X& controlPoints) {
-                            ClosestPointLocator locator(surface);
-                            locator.update(controlPoints);
                             double squares = 0;
-                            for (const ClosestPoint& c : locator.findAll(landmarkPoints))
-                              squares += c.distance * c.distance;
+                            for (double d : distancesToSurface(surface, controlPoints, landmarkPoints))
+                              squares += d * d;
                             return std::sqrt(squares / landmarkPoints.rows());
                           },
       5);
@@ -158,11 +155,9 @@ void runSegment(SegmentCommandOptions o) {
   parameters["margin_mm"] = o.segment.margin;
   report["parameters"] = parameters;
 
-  std::vector<Vector3> landmarkList;
-  for (const Landmark& l : landmarks) landmarkList.push_back(l.position);
   writeModelOutputs(dir, result.mesh, report, [&](OutputSet& outputs) {
     writeMask(result.labelmap, outputs.add("labelmap.nii.gz"));
-    addFigureOutputs(outputs, o.figures, result.mesh, recorder.history(), &image, landmarkList, Matrix3X());
+    addFigureOutputs(outputs, o.figures, result.mesh, recorder.history(), &image, landmarkPoints, Matrix3X());
   });
 
   std::cout << std::fixed << std::setprecision(1) << "segmented " << result.labelmap.count() * image.geometry.spacing.prod()

@@ -38,16 +38,6 @@ bool insideImage(const ImageGeometry& geometry, const Vector3& point) {
   return true;
 }
 
-// Distance (mm) from each landmark to the limit surface of `controlPoints`.
-std::vector<double> distancesToSurface(const LimitSurface& surface, const Matrix3X& controlPoints,
-                                       const Matrix3X& landmarkPoints) {
-  ClosestPointLocator locator(surface);
-  locator.update(controlPoints);
-  std::vector<double> distances;
-  for (const auto& closest : locator.findAll(landmarkPoints)) distances.push_back(closest.distance);
-  return distances;
-}
-
 Matrix3X limitPoints(const ControlMesh& mesh, int segments) {
   const LimitSurface surface(mesh);
   return tessellate(surface, mesh.points(), segments).points;
@@ -90,6 +80,15 @@ ControlMesh initialSphere(const Vector3& centre, double radius) {
   const double scale = radius / limit.rowwise().norm().mean();
   cube.setPoints((cube.points() * scale).rowwise() + centre.transpose());
   return cube;
+}
+
+std::vector<double> distancesToSurface(const LimitSurface& surface, const Matrix3X& controlPoints,
+                                       const Matrix3X& landmarkPoints) {
+  ClosestPointLocator locator(surface);
+  locator.update(controlPoints);
+  std::vector<double> distances;
+  for (const auto& closest : locator.findAll(landmarkPoints)) distances.push_back(closest.distance);
+  return distances;
 }
 
 SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmarks, const ControlMesh& initial,

@@ -20,7 +20,6 @@
 #include "dynsub/Error.h"
 #include "dynsub/SliceView.h"
 #include "dynsub/SurfaceView.h"
-#include "dynsub/Volume.h"
 
 namespace dynsub {
 
@@ -58,12 +57,11 @@ vtkSmartPointer<vtkRenderWindow> slicesFigure(const FigureScene& scene) {
   const Matrix3X points = surfacePoints(scene.surface);
   const Vector3 low = points.colwise().minCoeff().transpose(), high = points.colwise().maxCoeff().transpose();
   const Vector3 centre = 0.5 * (low + high);
-  std::unique_ptr<ImageSlices> image;
-  if (scene.image) {
-    image = std::make_unique<ImageSlices>(*scene.image);
-    const Vector3 index = scene.image->geometry.toIndex(centre);
+  const ImageSlices* image = scene.image;
+  if (image) {
+    const Vector3 index = image->geometry().toIndex(centre);
     for (int a = 0; a < 3; ++a)
-      if (index[a] < -0.5 || index[a] > scene.image->geometry.size[a] - 0.5)
+      if (index[a] < -0.5 || index[a] > image->geometry().size[a] - 0.5)
         throw Error("the surface lies outside the image: nothing to show on its slices");
   }
   const double diagonal = (high - low).norm();
@@ -78,7 +76,7 @@ vtkSmartPointer<vtkRenderWindow> slicesFigure(const FigureScene& scene) {
     const double halfSize = 0.5 * 1.3 * std::max(across.maxCoeff() - across.minCoeff(), upward.maxCoeff() - upward.minCoeff()) + 3.0;
     for (int column = 0; column < kColumns; ++column) {
       SliceView view(orientation);
-      view.setImage(image.get());
+      view.setImage(image);
       view.setSurface(scene.surface);
       // Interior slices, evenly spread: the end slices would only graze it.
       const double t = along.minCoeff() + (column + 1.0) / (kColumns + 1.0) * (along.maxCoeff() - along.minCoeff());
@@ -108,15 +106,13 @@ vtkSmartPointer<vtkRenderWindow> surfaceFigure(const FigureScene& scene) {
   if (scene.controlMesh) view.setControlMesh(scene.controlMesh);
   view.setLandmarks(scene.landmarks);
   if (scene.dataPoints.rows() > 0) view.setDataPoints(scene.dataPoints);
-  std::unique_ptr<ImageSlices> image;
-  if (scene.image) {
+  if (const ImageSlices* image = scene.image) {
     // Slices just behind the surface as seen by the camera (which looks from
     // the left, front and top): its right, back and bottom.
-    image = std::make_unique<ImageSlices>(*scene.image);
     double b[6];
     scene.surface->GetBounds(b);
     const Vector3 corner(b[0], b[3], b[4]);
-    view.setImage(image.get());
+    view.setImage(image);
     view.showSlices(image->sliceThrough(SliceOrientation::Axial, corner),
                     image->sliceThrough(SliceOrientation::Coronal, corner),
                     image->sliceThrough(SliceOrientation::Sagittal, corner));

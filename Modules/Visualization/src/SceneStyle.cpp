@@ -3,15 +3,19 @@
 #include <cmath>
 
 #include <vtkActor.h>
+#include <vtkCellArray.h>
 #include <vtkCoordinate.h>
 #include <vtkLookupTable.h>
 #include <vtkNew.h>
 #include <vtkPolyDataMapper.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkProperty.h>
 #include <vtkRenderer.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
+#include <vtkUnsignedCharArray.h>
 
 namespace dynsub::style {
 
@@ -35,6 +39,29 @@ void pointsAsDots(vtkActor* actor, double pixels) {
   actor->GetProperty()->SetPointSize(pixels);
   actor->GetProperty()->RenderPointsAsSpheresOn();
   actor->GetProperty()->LightingOff();
+}
+
+vtkSmartPointer<vtkPolyData> dots(const Matrix3X& points, const std::vector<int>& rows, int selected) {
+  vtkNew<vtkPoints> positions;
+  vtkNew<vtkCellArray> vertices;
+  vtkNew<vtkUnsignedCharArray> colours;
+  colours->SetNumberOfComponents(3);
+  for (int r : rows) {
+    const vtkIdType id = positions->InsertNextPoint(points(r, 0), points(r, 1), points(r, 2));
+    vertices->InsertNextCell(1, &id);
+    if (selected >= -1) colours->InsertNextTypedTuple((r == selected ? kSelectedLandmark : kLandmark).data());
+  }
+  auto data = vtkSmartPointer<vtkPolyData>::New();
+  data->SetPoints(positions);
+  data->SetVerts(vertices);
+  if (selected >= -1) data->GetPointData()->SetScalars(colours);
+  return data;
+}
+
+std::vector<int> allRows(const Matrix3X& points) {
+  std::vector<int> rows(points.rows());
+  for (int r = 0; r < static_cast<int>(rows.size()); ++r) rows[r] = r;
+  return rows;
 }
 
 void showLandmarks(vtkRenderer* renderer, vtkPolyData* points, vtkActor* actor) {

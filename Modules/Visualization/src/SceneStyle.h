@@ -3,6 +3,9 @@
 // the Visualization module.
 #include <array>
 #include <string>
+#include <vector>
+
+#include <vtkSmartPointer.h>
 
 #include "dynsub/Types.h"
 
@@ -28,6 +31,12 @@ constexpr int kFontSize = 14;
 void colourByElementType(vtkPolyDataMapper* mapper);
 // Vertices drawn as round dots of a fixed size in pixels.
 void pointsAsDots(vtkActor* actor, double pixels);
+
+// The rows `rows` of `points` as vertices; with `selected` >= -1 they carry
+// landmark colours (kLandmark, and kSelectedLandmark for row `selected`).
+vtkSmartPointer<vtkPolyData> dots(const Matrix3X& points, const std::vector<int>& rows, int selected = -2);
+// Every row of `points`.
+std::vector<int> allRows(const Matrix3X& points);
 
 // Adds `actor` drawing `points` to `renderer`: landmarks as dots coloured by
 // their per-point colours (kLandmark, kSelectedLandmark); range data as small

@@ -6,22 +6,18 @@
 
 #include <vtkActor.h>
 #include <vtkCamera.h>
-#include <vtkCellArray.h>
 #include <vtkCutter.h>
 #include <vtkImageProperty.h>
 #include <vtkImageSlice.h>
 #include <vtkImageSliceMapper.h>
 #include <vtkNew.h>
 #include <vtkPlane.h>
-#include <vtkPointData.h>
-#include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkPolyDataMapper.h>
 #include <vtkProperty.h>
 #include <vtkRenderer.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
-#include <vtkUnsignedCharArray.h>
 
 #include "SceneStyle.h"
 
@@ -32,7 +28,7 @@ struct SliceView::Impl {
   const ImageSlices* image = nullptr;
   SlicePlane plane;
   int index = -1;
-  std::vector<Vector3> landmarks;
+  Matrix3X landmarks;
   int selected = -1;
   Matrix3X dataPoints;
 
@@ -86,6 +82,14 @@ struct SliceView::Impl {
   // exactly on the plane, never hides them.
   Vector3 overlayShift() const { return 0.05 * plane.thickness * plane.normal; }
 
+  // Rows of `points` within half a slice thickness of the plane.
+  std::vector<int> onSlice(const Matrix3X& points) const {
+    std::vector<int> rows;
+    for (int r = 0; r < static_cast<int>(points.rows()); ++r)
+      if (std::abs(plane.distance(points.row(r).transpose())) <= 0.5 * plane.thickness) rows.push_back(r);
+    return rows;
+  }
+
   void update() {
     cutPlane->SetOrigin(plane.origin.x(), plane.origin.y(), plane.origin.z());
     cutPlane->SetNormal(plane.normal.x(), plane.normal.y(), plane.normal.z());
@@ -93,34 +97,8 @@ struct SliceView::Impl {
     for (vtkActor* overlay : {contourActor.Get(), landmarkActor.Get(), dataActor.Get()})
       overlay->SetPosition(shift.x(), shift.y(), shift.z());
 
-    // Landmarks on the slice, coloured per point (the selected one differs).
-    vtkNew<vtkPoints> points;
-    vtkNew<vtkCellArray> vertices;
-    vtkNew<vtkUnsignedCharArray> colours;
-    colours->SetNumberOfComponents(3);
-    for (int i = 0; i < static_cast<int>(landmarks.size()); ++i) {
-      if (std::abs(plane.distance(landmarks[i])) > 0.5 * plane.thickness) continue;
-      const vtkIdType id = points->InsertNextPoint(landmarks[i].data());
-      vertices->InsertNextCell(1, &id);
-      const auto& c = i == selected ? style::kSelectedLandmark : style::kLandmark;
-      colours->InsertNextTypedTuple(c.data());
-    }
-    landmarkPoints->SetPoints(points);
-    landmarkPoints->SetVerts(vertices);
-    landmarkPoints->GetPointData()->SetScalars(colours);
-    landmarkPoints->Modified();
-
-    vtkNew<vtkPoints> dataPointsOnSlice;
-    vtkNew<vtkCellArray> dataVertices;
-    for (Eigen::Index i = 0; i < dataPoints.rows(); ++i) {
-      const Vector3 p = dataPoints.row(i).transpose();
-      if (std::abs(plane.distance(p)) > 0.5 * plane.thickness) continue;
-      const vtkIdType id = dataPointsOnSlice->InsertNextPoint(p.data());
-      dataVertices->InsertNextCell(1, &id);
-    }
-    dataOnSlice->SetPoints(dataPointsOnSlice);
-    dataOnSlice->SetVerts(dataVertices);
-    dataOnSlice->Modified();
+    landmarkPoints->ShallowCopy(style::dots(landmarks, onSlice(landmarks), selected));
+    dataOnSlice->ShallowCopy(style::dots(dataPoints, onSlice(dataPoints)));
 
     // Edge letters: the anatomical direction each screen edge points to.
     const Vector3 towards[4] = {-plane.right, plane.right, plane.up, -plane.up};
@@ -181,7 +159,7 @@ void SliceView::setSurface(vtkPolyData* surface) {
   impl_->contourActor->SetVisibility(surface != nullptr);
 }
 
-void SliceView::setLandmarks(const std::vector<Vector3>& landmarks, int selected) {
+void SliceView::setLandmarks(const Matrix3X& landmarks, int selected) {
   impl_->landmarks = landmarks;
   impl_->selected = selected;
   impl_->update();
@@ -240,11 +218,6 @@ Eigen::Vector2d SliceView::displayPosition(const Vector3& point) const {
   return {display[0], display[1]};
 }
 
-std::vector<int> SliceView::landmarksOnSlice() const {
-  std::vector<int> on;
-  for (int i = 0; i < static_cast<int>(impl_->landmarks.size()); ++i)
-    if (std::abs(impl_->plane.distance(impl_->landmarks[i])) <= 0.5 * impl_->plane.thickness) on.push_back(i);
-  return on;
-}
+std::vector<int> SliceView::landmarksOnSlice() const { return impl_->onSlice(impl_->landmarks); }
 
 }  // namespace dynsub

@@ -12,13 +12,11 @@
 #include <vtkImageSliceMapper.h>
 #include <vtkMath.h>
 #include <vtkNew.h>
-#include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkPolyDataMapper.h>
 #include <vtkProperty.h>
 #include <vtkRenderer.h>
-#include <vtkUnsignedCharArray.h>
 
 #include "SceneStyle.h"
 #include "dynsub/ControlMesh.h"
@@ -103,38 +101,13 @@ void SurfaceView::setControlMesh(vtkPolyData* wireframe) {
   impl_->wireActor->SetVisibility(wireframe != nullptr);
 }
 
-namespace {
-
-vtkSmartPointer<vtkPolyData> vertices(const Matrix3X& p, const std::vector<std::array<unsigned char, 3>>& colours) {
-  vtkNew<vtkPoints> points;
-  vtkNew<vtkCellArray> cells;
-  vtkNew<vtkUnsignedCharArray> scalars;
-  scalars->SetNumberOfComponents(3);
-  for (Eigen::Index i = 0; i < p.rows(); ++i) {
-    const vtkIdType id = points->InsertNextPoint(p(i, 0), p(i, 1), p(i, 2));
-    cells->InsertNextCell(1, &id);
-    if (!colours.empty()) scalars->InsertNextTypedTuple(colours[i].data());
-  }
-  auto data = vtkSmartPointer<vtkPolyData>::New();
-  data->SetPoints(points);
-  data->SetVerts(cells);
-  if (!colours.empty()) data->GetPointData()->SetScalars(scalars);
-  return data;
+void SurfaceView::setLandmarks(const Matrix3X& landmarks, int selected) {
+  impl_->landmarkPoints->ShallowCopy(style::dots(landmarks, style::allRows(landmarks), selected));
 }
 
-}  // namespace
-
-void SurfaceView::setLandmarks(const std::vector<Vector3>& landmarks, int selected) {
-  Matrix3X p(landmarks.size(), 3);
-  std::vector<std::array<unsigned char, 3>> colours;
-  for (std::size_t i = 0; i < landmarks.size(); ++i) {
-    p.row(i) = landmarks[i].transpose();
-    colours.push_back(static_cast<int>(i) == selected ? style::kSelectedLandmark : style::kLandmark);
-  }
-  impl_->landmarkPoints->ShallowCopy(vertices(p, colours));
+void SurfaceView::setDataPoints(const Matrix3X& points) {
+  impl_->dataPoints->ShallowCopy(style::dots(points, style::allRows(points)));
 }
-
-void SurfaceView::setDataPoints(const Matrix3X& points) { impl_->dataPoints->ShallowCopy(vertices(points, {})); }
 
 void SurfaceView::setImage(const ImageSlices* image) {
   impl_->image = image;

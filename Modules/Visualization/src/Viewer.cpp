@@ -112,8 +112,7 @@ struct Viewer::Impl {
   }
 
   void showLandmarks() {
-    std::vector<Vector3> points;
-    for (const Landmark& l : landmarks) points.push_back(l.position);
+    const Matrix3X points = landmarkPositions(landmarks);
     for (auto& v : views) v->setLandmarks(points, selected);
     surface3d.setLandmarks(points, selected);
   }

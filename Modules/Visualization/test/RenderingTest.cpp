@@ -113,7 +113,9 @@ TEST_F(Rendering, SliceViewPutsImageContourAndLandmarksInOneFrame) {
     const double circleRadius = std::sqrt(std::pow(phantom.radius, 2) - std::pow(plane.distance(phantom.centre), 2));
     const Vector3 onSlice = circleCentre + 0.5 * circleRadius * plane.right;
     const Vector3 offSlice = circleCentre - 0.5 * circleRadius * plane.right + 2.0 * plane.thickness * plane.normal;
-    view.setLandmarks({onSlice, offSlice});
+    Matrix3X landmarks(2, 3);
+    landmarks << onSlice.transpose(), offSlice.transpose();
+    view.setLandmarks(landmarks);
     view.frame(circleCentre, 20.0);
 
     vtkNew<vtkRenderWindow> window;
@@ -223,13 +225,12 @@ TEST(SliceContours, LieOnTheLabelmapBoundaryOfTheirSlice) {
 // --- baselines --------------------------------------------------------------
 
 TEST_F(Rendering, TestCaudateSlices) {
-  const Volume mri = readVolume(kMri);
+  const ImageSlices mri(readVolume(kMri));
   const vtkSmartPointer<vtkPolyData> surface = limitSurfaceOf(kSource + "/Testing/Data/caudate_left_control_mesh.obj");
   FigureScene scene;
   scene.image = &mri;
   scene.surface = surface;
-  for (const Landmark& l : readLandmarks(kSource + "/Data/Landmarks/caudate_left.mrk.json"))
-    scene.landmarks.push_back(l.position);
+  scene.landmarks = landmarkPositions(readLandmarks(kSource + "/Data/Landmarks/caudate_left.mrk.json"));
   expectMatchesBaseline(slicesFigure(scene));
 }
 

@@ -69,4 +69,9 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
 
 void checkSegmentOptions(const SegmentOptions& options);
 
+// Distance (mm) from each landmark (row of `landmarkPoints`) to the exact limit
+// surface at `controlPoints`: the misfit the refinement rule and the report use.
+std::vector<double> distancesToSurface(const LimitSurface& surface, const Matrix3X& controlPoints,
+                                       const Matrix3X& landmarkPoints);
+
 }  // namespace dynsub

@@ -15,7 +15,6 @@
 // provides one on a machine without a screen). displayAvailable says whether
 // one can be opened; without it VTK would abort the process.
 #include <string>
-#include <vector>
 
 #include <vtkSmartPointer.h>
 
@@ -27,13 +26,14 @@ class vtkRenderWindow;
 
 namespace dynsub {
 
-struct Volume;
+class ImageSlices;
 
+// Not owned; one ImageSlices (the image's VTK copy) serves every figure.
 struct FigureScene {
-  const Volume* image = nullptr;      // optional
+  const ImageSlices* image = nullptr; // optional (SlicePlanes.h)
   vtkPolyData* surface = nullptr;     // the limit surface, required (SurfacePolyData.h)
   vtkPolyData* controlMesh = nullptr; // optional wireframe (SurfaceView.h), 3D figure only
-  std::vector<Vector3> landmarks;     // LPS mm
+  Matrix3X landmarks;                 // #landmarks x 3, LPS mm
   Matrix3X dataPoints;                // range data, mm
 };
 

@@ -32,8 +32,8 @@ class SliceView {
   // The surface whose cross-section is drawn; the contour follows when the
   // polydata is modified (live fitting).
   void setSurface(vtkPolyData* surface);
-  // Landmarks (LPS mm); those within half a slice of the plane are drawn.
-  void setLandmarks(const std::vector<Vector3>& landmarks, int selected = -1);
+  // Landmarks (#landmarks x 3, LPS mm); those within half a slice of the plane are drawn.
+  void setLandmarks(const Matrix3X& landmarks, int selected = -1);
   // Range data drawn as small white dots where within half a slice.
   void setDataPoints(const Matrix3X& points);
 

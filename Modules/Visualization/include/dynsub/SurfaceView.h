@@ -30,7 +30,7 @@ class SurfaceView {
   void setSurface(vtkPolyData* surface);  // followed when modified
   void setOpacity(double opacity);        // 1 opaque
   void setControlMesh(vtkPolyData* wireframe);  // nullptr hides it
-  void setLandmarks(const std::vector<Vector3>& landmarks, int selected = -1);
+  void setLandmarks(const Matrix3X& landmarks, int selected = -1);  // #landmarks x 3, LPS mm
   void setDataPoints(const Matrix3X& points);
   // The three slice planes of `image` (not owned) at the given slice indices
   // (axial, coronal, sagittal); nullptr hides them.
