@@ -41,6 +41,14 @@ Matrix3X SolidModel::dataPoints() const { return refined_.A * p_; }
 int SolidModel::springCount() const { return static_cast<int>(springs_->normal.size()); }
 int SolidModel::virtualSpringCount() const { return static_cast<int>(springs_->virtuals.size()); }
 
+void SolidModel::setControlPoints(const Matrix3X& points) {
+  if (points.rows() != p_.rows() || !points.allFinite())
+    throw Error("the solid needs " + std::to_string(p_.rows()) + " finite control points (got " +
+                std::to_string(points.rows()) + ")");
+  p_ = points;
+  v_.setZero();
+}
+
 void SolidModel::setMaterial(const SolidMaterial& material) {
   for (double value : {material.mass, material.springStiffness, material.virtualStiffness})
     if (!(std::isfinite(value) && value > 0)) throw Error("the solid's mass and stiffnesses must be finite and > 0");

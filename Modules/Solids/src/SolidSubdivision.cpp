@@ -160,6 +160,9 @@ SolidRefinement subdivideSolid(const Lattice& l) {
   }
 
   SolidRefinement refined;
+  for (int f = 0; f < F; ++f) refined.faceOrigin.insert(refined.faceOrigin.end(), l.faces()[f].size(), f);
+  refined.faceOrigin.resize(faces.size(), -1);
+  for (int c = 0; c < C; ++c) refined.cellOrigin.insert(refined.cellOrigin.end(), l.cellPoints()[c].size(), c);
   refined.A = rows.matrix(P);
   const Matrix3X points = refined.A * l.points();
   refined.lattice = Lattice::fromCells(points, std::move(faces), std::move(cells), "subdivided lattice");
@@ -168,12 +171,19 @@ SolidRefinement subdivideSolid(const Lattice& l) {
 
 SolidRefinement subdivideSolid(const Lattice& lattice, int levels) {
   if (levels < 0) throw Error("the subdivision level must be >= 0 (got " + std::to_string(levels) + ")");
-  SolidRefinement result{lattice, SparseMatrix(lattice.pointCount(), lattice.pointCount())};
+  SolidRefinement result{lattice, SparseMatrix(lattice.pointCount(), lattice.pointCount()), {}, {}};
   result.A.setIdentity();
+  for (int f = 0; f < lattice.faceCount(); ++f) result.faceOrigin.push_back(f);
+  for (int c = 0; c < lattice.cellCount(); ++c) result.cellOrigin.push_back(c);
   for (int level = 0; level < levels; ++level) {
     SolidRefinement next = subdivideSolid(result.lattice);
     result.A = (next.A * result.A).pruned();
     result.lattice = std::move(next.lattice);
+    for (int& f : next.faceOrigin)
+      if (f >= 0) f = result.faceOrigin[f];
+    for (int& c : next.cellOrigin) c = result.cellOrigin[c];
+    result.faceOrigin = std::move(next.faceOrigin);
+    result.cellOrigin = std::move(next.cellOrigin);
   }
   return result;
 }

@@ -44,7 +44,12 @@ class SolidModel {
 
   const Lattice& control() const { return control_; }
   const Lattice& dataLattice() const { return refined_.lattice; }  // topology of the mass points
+  const SolidRefinement& refinement() const { return refined_; }
   const Matrix3X& controlPoints() const { return p_; }
+  // Moves the control points (fixed ones too) and stops all motion; the
+  // springs keep their rest lengths. Throws dynsub::Error for a wrong size or
+  // non-finite points.
+  void setControlPoints(const Matrix3X& points);
   Matrix3X dataPoints() const;  // A p
   int springCount() const;
   int virtualSpringCount() const;
@@ -59,6 +64,8 @@ class SolidModel {
   // The rope tool: a spring from mass point `dataPoint` to `target`.
   void rope(int dataPoint, const Vector3& target, double stiffness);
   void releaseRope();
+  int ropePoint() const { return ropePoint_; }  // -1 without a rope
+  const Vector3& ropeTarget() const { return ropeTarget_; }
   int nearestDataPoint(const Vector3& point) const;  // the paper's linear search
 
   // Springs rest at their current lengths (the current shape becomes the rest shape).

@@ -37,6 +37,10 @@ namespace dynsub {
 struct SolidRefinement {
   Lattice lattice;
   SparseMatrix A;  // #refined points x #points: refined = A * points
+  // Where each refined face and cell lies in the lattice it came from: the
+  // face it is part of (-1 for a face inside a cell), and the cell it is part
+  // of. Picking a refined face or cell finds the control element to sculpt.
+  std::vector<int> faceOrigin, cellOrigin;
 };
 
 SolidRefinement subdivideSolid(const Lattice& lattice);

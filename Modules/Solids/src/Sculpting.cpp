@@ -1,0 +1,133 @@
+#include "dynsub/Sculpting.h"
+
+#include <cmath>
+#include <limits>
+
+#include "dynsub/Error.h"
+
+namespace dynsub {
+
+namespace {
+
+Vector3 centroid(const Matrix3X& points, const std::vector<int>& indices) {
+  Vector3 sum = Vector3::Zero();
+  for (int i : indices) sum += points.row(i).transpose();
+  return sum / static_cast<double>(indices.size());
+}
+
+std::vector<int> fixedPoints(const SolidModel& model) {
+  std::vector<int> fixed;
+  for (int i = 0; i < static_cast<int>(model.fixed().size()); ++i)
+    if (model.fixed()[i]) fixed.push_back(i);
+  return fixed;
+}
+
+}  // namespace
+
+Sculpture::Sculpture(const Lattice& control, const SculptSettings& settings) : settings_(settings), rest_(control) {
+  if (!(std::isfinite(settings.timeStep) && settings.timeStep > 0))
+    throw Error("the sculpting time step must be finite and > 0");
+  if (!(std::isfinite(settings.ropeStiffness) && settings.ropeStiffness > 0))
+    throw Error("the rope's stiffness must be finite and > 0");
+  model_ = std::make_unique<SolidModel>(control, settings.levels, settings.material);
+}
+
+Sculpture::~Sculpture() = default;
+
+Lattice Sculpture::control() const {
+  Lattice lattice = rest_;
+  lattice.setPoints(model_->controlPoints());
+  return lattice;
+}
+
+void Sculpture::rebuild(const Lattice& rest, const Matrix3X& current, const std::vector<int>& fixed) {
+  auto model = std::make_unique<SolidModel>(rest, settings_.levels, settings_.material);
+  model->setControlPoints(current);
+  if (!fixed.empty()) model->fix(fixed);
+  rest_ = rest;
+  model_ = std::move(model);
+}
+
+void Sculpture::grab(const Vector3& near) {
+  if (!near.allFinite()) throw Error("the rope needs a finite point to grab");
+  const int point = model_->nearestDataPoint(near);
+  model_->rope(point, model_->dataPoints().row(point).transpose(), settings_.ropeStiffness);
+}
+
+void Sculpture::pullTo(const Vector3& target) {
+  if (!roped()) throw Error("there is no rope to pull: grab a point first");
+  model_->rope(model_->ropePoint(), target, settings_.ropeStiffness);
+}
+
+void Sculpture::release() { model_->releaseRope(); }
+
+void Sculpture::extrude(int face) {
+  const Lattice current = control();
+  // The same tool on both shapes gives the same numbering; old points keep theirs.
+  const Lattice grown = extrudeFace(current, face);
+  rebuild(extrudeFace(rest_, face), grown.points(), fixedPoints(*model_));
+}
+
+void Sculpture::deleteCell(int cell) {
+  const Lattice current = control();
+  std::vector<int> kept;
+  const Lattice smaller = dynsub::deleteCell(current, cell, &kept);
+  std::vector<int> fixed;
+  for (int i : fixedPoints(*model_))
+    if (kept[i] >= 0) fixed.push_back(kept[i]);
+  rebuild(dynsub::deleteCell(rest_, cell), smaller.points(), fixed);
+}
+
+void Sculpture::fix(const std::vector<int>& points) { model_->fix(points); }
+void Sculpture::unfix(const std::vector<int>& points) { model_->unfix(points); }
+void Sculpture::unfixAll() { model_->unfix(fixedPoints(*model_)); }
+
+void Sculpture::plasticity() {
+  model_->resetRestLengths();
+  rest_.setPoints(model_->controlPoints());
+}
+
+void Sculpture::setMaterial(const SolidMaterial& material) {
+  model_->setMaterial(material);
+  settings_.material = material;
+}
+
+void Sculpture::run(int count) {
+  for (int i = 0; i < count; ++i) {
+    model_->step(settings_.timeStep, settings_.scheme);
+    ++steps_;
+  }
+}
+
+int Sculpture::boundaryFaceNear(const Vector3& point) const {
+  const Lattice& l = rest_;
+  const Matrix3X& p = model_->controlPoints();
+  int best = -1;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (int f = 0; f < l.faceCount(); ++f) {
+    if (!l.isBoundaryFace(f)) continue;
+    const double d = (centroid(p, l.faces()[f]) - point).squaredNorm();
+    if (d < nearest) {
+      nearest = d;
+      best = f;
+    }
+  }
+  return best;
+}
+
+int Sculpture::cellNear(const Vector3& point) const {
+  const Lattice& l = rest_;
+  const Matrix3X& p = model_->controlPoints();
+  int best = -1;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (int c = 0; c < l.cellCount(); ++c) {
+    const double d = (centroid(p, l.cellPoints()[c]) - point).squaredNorm();
+    if (d < nearest) {
+      nearest = d;
+      best = c;
+    }
+  }
+  return best;
+}
+
+}  // namespace dynsub
