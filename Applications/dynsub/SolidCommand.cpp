@@ -1,13 +1,22 @@
-// dynsub solid: Catmull-Clark subdivision solids (Lattice.h, SolidSubdivision.h).
+// dynsub solid: Catmull-Clark subdivision solids (Lattice.h, SolidSubdivision.h)
+// and sculpting them (Sculpting.h, SculptScript.h, Sculptor.h).
+#include <chrono>
+#include <cmath>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
+#include <vtkRenderWindow.h>
 
 #include "Commands.h"
+#include "Reporting.h"
 #include "dynsub/Error.h"
+#include "dynsub/Figures.h"
 #include "dynsub/LatticeIO.h"
+#include "dynsub/SculptScript.h"
+#include "dynsub/Sculptor.h"
 #include "dynsub/SolidSubdivision.h"
+#include "dynsub/SolidView.h"
 
 namespace dynsub::app {
 
@@ -27,6 +36,93 @@ struct SolidOptions {
   std::string lattice, name, out;
   int level = 0;
 };
+
+struct SculptOptions {
+  std::string lattice, script, out = "sculpted", scheme = "semi-implicit";
+  SculptSettings settings;
+  bool figure = true;
+};
+
+nlohmann::ordered_json countsJson(const Lattice& lattice) {
+  return {{"points", lattice.pointCount()},
+          {"edges", lattice.edgeCount()},
+          {"faces", lattice.faceCount()},
+          {"cells", lattice.cellCount()}};
+}
+
+// DIR/sculpted.lattice (the control lattice, to sculpt on later),
+// DIR/sculpted.vtu (the subdivided solid where the mass points are),
+// DIR/sculpted.png (SolidView's figure, with a display) and DIR/report.json,
+// all together or none. Returns what was written.
+std::string writeSculpture(const std::filesystem::path& dir, const Sculpture& sculpture, const SculptOptions& o,
+                           nlohmann::ordered_json report) {
+  prepareOutputDirectory(dir);
+  OutputSet outputs(dir);
+  const Lattice control = sculpture.control();
+  writeLattice(control, outputs.add("sculpted.lattice"));
+  Lattice solid = sculpture.model().dataLattice();
+  solid.setPoints(sculpture.model().dataPoints());
+  writeLattice(solid, outputs.add("sculpted.vtu"));
+  std::string figure;
+  std::string why;
+  if (o.figure && displayAvailable(&why)) {
+    writePng(sculptureFigure(sculpture), outputs.add("sculpted.png"));
+    figure = ", sculpted.png";
+  } else if (o.figure) {
+    std::cerr << "warning: no figure written: " << why << '\n';
+  }
+  const SolidMaterial& m = sculpture.settings().material;
+  int fixed = 0;
+  for (bool f : sculpture.model().fixed()) fixed += f;
+  report["level"] = sculpture.settings().levels;
+  report["time_step_s"] = sculpture.settings().timeStep;
+  report["scheme"] = o.scheme;
+  report["material"] = {{"mass", m.mass},
+                        {"damping_n_s_per_mm", m.damping},
+                        {"spring_stiffness_n_per_mm", m.springStiffness},
+                        {"virtual_stiffness_n_per_mm", m.virtualStiffness},
+                        {"rope_stiffness_n_per_mm", sculpture.settings().ropeStiffness}};
+  report["steps"] = sculpture.steps();
+  report["simulated_seconds"] = sculpture.steps() * sculpture.settings().timeStep;
+  report["control"] = countsJson(control);
+  report["fixed_control_points"] = fixed;
+  report["solid"] = countsJson(solid);
+  report["kinetic_energy_n_mm"] = sculpture.model().kineticEnergy();
+  report["spring_energy_n_mm"] = sculpture.model().springEnergy();
+  writeJson(report, outputs.add("report.json"));
+  outputs.commit();
+  return "saved sculpted.lattice, sculpted.vtu" + figure + ", report.json in " + dir.string();
+}
+
+void runSculpt(const SculptOptions& options) {
+  SculptOptions o = options;
+  o.settings.scheme = o.scheme == "explicit" ? SolidScheme::PaperExplicit : SolidScheme::SemiImplicit;
+  const Lattice lattice = readLattice(o.lattice);
+  nlohmann::ordered_json report = {{"lattice", o.lattice}};
+  if (o.script.empty()) {
+    // The window: s saves to --out.
+    Sculptor sculptor(lattice, o.settings, [o, report](const Sculpture& s) {
+      return writeSculpture(o.out, s, o, report);
+    });
+    std::cout << "dynsub solid sculpt: press h in the window for the mouse and key bindings; s saves to " << o.out
+              << '\n';
+    sculptor.run();
+    return;
+  }
+  // The whole script is checked before the solid moves, and nothing is
+  // written unless every action ran.
+  const std::vector<SculptAction> actions = readSculptScript(o.script);
+  Sculpture sculpture(lattice, o.settings);
+  const auto start = std::chrono::steady_clock::now();
+  runSculptScript(actions, sculpture, o.script, [&](const SculptAction& action) {
+    std::cout << "line " << action.line << ": " << action.text << "  (t = " << sculpture.steps() * o.settings.timeStep
+              << " s, " << sculpture.rest().cellCount() << " cells)\n";
+  });
+  report["script"] = o.script;
+  report["actions"] = actions.size();
+  report["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::cout << writeSculpture(o.out, sculpture, o, report) << '\n';
+}
 
 }  // namespace
 
@@ -58,6 +154,44 @@ void addSolidCommand(CLI::App& app) {
     writeLattice(lattice, o->out);
     std::cout << "wrote " << o->out << ": " << lattice.pointCount() << " points, " << lattice.cellCount()
               << " cells\n";
+  });
+
+  auto so = std::make_shared<SculptOptions>();
+  CLI::App* sculpt = solid->add_subcommand(
+      "sculpt",
+      "Sculpt a lattice as virtual clay: an interactive window (rope: Ctrl + drag; select a face: Shift + click; "
+      "e extrude, d delete its cell, f/u fix/unfix, p plasticity, k/K stiffness, g/G damping, s save; h shows "
+      "all), or with --script a scripted sequence of tool actions (see Documentation/Solids.md). Writes "
+      "DIR/sculpted.lattice, DIR/sculpted.vtu, DIR/sculpted.png and DIR/report.json. Needs an X display for the "
+      "window and the figure");
+  sculpt->add_option("LATTICE", so->lattice, "Control lattice (.lattice)")->required();
+  sculpt->add_option("--script", so->script, "Tool actions to apply, one per line, instead of the window");
+  sculpt->add_option("--out", so->out, "Output directory (with --script: required; in the window: where s saves)")
+      ->default_val(so->out);
+  sculpt->add_option("--level", so->settings.levels, "Subdivisions carrying the mass points")
+      ->default_val(so->settings.levels)
+      ->check(CLI::Range(0, 4));
+  sculpt->add_option("--time-step", so->settings.timeStep, "Time step, s")->default_val(so->settings.timeStep);
+  sculpt->add_option("--scheme", so->scheme, "Integration: semi-implicit (Euler) or explicit (the paper's)")
+      ->default_val(so->scheme)
+      ->check(CLI::IsMember({"semi-implicit", "explicit"}));
+  sculpt->add_option("--mass", so->settings.material.mass, "Mass per mass point")
+      ->default_val(so->settings.material.mass);
+  sculpt->add_option("--damping", so->settings.material.damping, "Damping per mass point, N s/mm")
+      ->default_val(so->settings.material.damping);
+  sculpt->add_option("--stiffness", so->settings.material.springStiffness, "Normal springs, N/mm")
+      ->default_val(so->settings.material.springStiffness);
+  sculpt->add_option("--virtual-stiffness", so->settings.material.virtualStiffness,
+                     "Virtual (angle) springs, N/mm")
+      ->default_val(so->settings.material.virtualStiffness);
+  sculpt->add_option("--rope-stiffness", so->settings.ropeStiffness, "The rope, N/mm")
+      ->default_val(so->settings.ropeStiffness);
+  sculpt->add_flag("!--no-figures", so->figure,
+                   "Do not render sculpted.png (rendering needs an X display; use xvfb-run without a screen)");
+  sculpt->callback([so, sculpt] {
+    if (!so->script.empty() && sculpt->count("--out") == 0)
+      throw Error("--out DIR is required with --script (where the sculpted solid is written)");
+    runSculpt(*so);
   });
 
   CLI::App* make = solid->add_subcommand("make", "Write one of the paper's Table 1 lattices");

@@ -16,6 +16,21 @@ std::vector<int> sortedUnique(std::vector<int> v) {
   return v;
 }
 
+Vector3 centroidOf(const Matrix3X& points, const std::vector<int>& indices) {
+  Vector3 sum = Vector3::Zero();
+  for (int p : indices) sum += points.row(p).transpose();
+  return sum / static_cast<double>(indices.size());
+}
+
+// Newell's normal of a loop: its length is twice the area of a planar loop;
+// it points the way the loop runs counter-clockwise around.
+Vector3 newellNormal(const Matrix3X& points, const std::vector<int>& loop) {
+  Vector3 normal = Vector3::Zero();
+  for (std::size_t i = 0; i < loop.size(); ++i)
+    normal += Vector3(points.row(loop[i]).transpose()).cross(points.row(loop[(i + 1) % loop.size()]).transpose());
+  return normal;
+}
+
 }  // namespace
 
 Lattice Lattice::fromCells(Matrix3X points, std::vector<std::vector<int>> faces, std::vector<std::vector<int>> cells,
@@ -118,20 +133,12 @@ Lattice extrudeFace(const Lattice& l, int face) {
     throw Error("face " + std::to_string(face) + " is inside the solid: only boundary faces can be extruded");
   const std::vector<int>& loop = l.faces()[face];
   const int cell = l.faceCells()[face][0];
-  Vector3 centroid = Vector3::Zero(), cellCentroid = Vector3::Zero();
-  for (int p : loop) centroid += l.points().row(p).transpose();
-  centroid /= loop.size();
-  for (int p : l.cellPoints()[cell]) cellCentroid += l.points().row(p).transpose();
-  cellCentroid /= l.cellPoints()[cell].size();
-  // Newell's normal of the loop, turned away from the cell.
-  Vector3 normal = Vector3::Zero();
-  for (std::size_t i = 0; i < loop.size(); ++i)
-    normal += Vector3(l.points().row(loop[i]).transpose()).cross(l.points().row(loop[(i + 1) % loop.size()]).transpose());
+  const Vector3 centroid = centroidOf(l.points(), loop), cellCentroid = centroidOf(l.points(), l.cellPoints()[cell]);
+  Vector3 normal = newellNormal(l.points(), loop);
   if (!(normal.norm() > 0)) throw Error("face " + std::to_string(face) + " is degenerate: it has no normal");
   normal.normalize();
-  // The loop runs counter-clockwise seen from outside when its normal points
-  // away from the cell; the new faces follow suit, so the boundary stays
-  // oriented as it was.
+  // The new faces run as the extruded face does (counter-clockwise seen from
+  // outside, or not), so the boundary stays oriented as it was.
   const bool outward = normal.dot(centroid - cellCentroid) >= 0;
   if (!outward) normal = -normal;
   const double height = 2.0 * std::abs(normal.dot(centroid - cellCentroid));
@@ -158,6 +165,11 @@ Lattice extrudeFace(const Lattice& l, int face) {
   return Lattice::fromCells(std::move(points), std::move(faces), std::move(cells), "extruded lattice");
 }
 
+bool facesAwayFrom(const Lattice& l, int face, int cell) {
+  const std::vector<int>& loop = l.faces()[face];
+  return newellNormal(l.points(), loop).dot(centroidOf(l.points(), loop) - centroidOf(l.points(), l.cellPoints()[cell])) >= 0;
+}
+
 Lattice deleteCell(const Lattice& l, int cell, std::vector<int>* kept) {
   if (cell < 0 || cell >= l.cellCount()) throw Error("no cell " + std::to_string(cell) + " to delete");
   if (l.cellCount() == 1) throw Error("cell " + std::to_string(cell) + " is the lattice's last: it cannot be deleted");
@@ -182,7 +194,15 @@ Lattice deleteCell(const Lattice& l, int cell, std::vector<int>* kept) {
     if (pointNumber[p] >= 0) newPoints.row(pointNumber[p]) = l.points().row(p);
   for (int f = 0; f < l.faceCount(); ++f) {
     if (faceNumber[f] < 0) continue;
-    for (int p : l.faces()[f]) newFaces[faceNumber[f]].push_back(pointNumber[p]);
+    std::vector<int>& loop = newFaces[faceNumber[f]];
+    for (int p : l.faces()[f]) loop.push_back(pointNumber[p]);
+    // A face the deleted cell shared comes to the surface: it is turned to
+    // run counter-clockwise seen from outside, as boundary faces should.
+    const auto& owners = l.faceCells()[f];
+    if (owners.size() == 2 && (owners[0] == cell || owners[1] == cell)) {
+      const int remaining = owners[0] == cell ? owners[1] : owners[0];
+      if (!facesAwayFrom(l, f, remaining)) std::reverse(loop.begin(), loop.end());
+    }
   }
   for (int c = 0; c < l.cellCount(); ++c) {
     if (c == cell) continue;

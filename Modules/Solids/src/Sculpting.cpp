@@ -61,11 +61,14 @@ void Sculpture::pullTo(const Vector3& target) {
 
 void Sculpture::release() { model_->releaseRope(); }
 
-void Sculpture::extrude(int face) {
+int Sculpture::extrude(int face) {
   const Lattice current = control();
-  // The same tool on both shapes gives the same numbering; old points keep theirs.
+  // The same tool on both shapes gives the same numbering; old points keep
+  // theirs, and the new cell's outer face is the first new face (Lattice.cpp).
   const Lattice grown = extrudeFace(current, face);
+  const int outer = current.faceCount();
   rebuild(extrudeFace(rest_, face), grown.points(), fixedPoints(*model_));
+  return outer;
 }
 
 void Sculpture::deleteCell(int cell) {

@@ -115,7 +115,7 @@ TEST(Sculpting, ExtrudeAndDeleteKeepTheRestShapeAndTheFixedPoints) {
   s.run(500);
   const int top = s.boundaryFaceNear(Vector3(1.5, 1.5, 2.0));
   const Matrix3X heldBefore = s.model().controlPoints();
-  s.extrude(top);
+  const int outer = s.extrude(top);
   EXPECT_FALSE(s.roped()) << "a topology change releases the rope";
   EXPECT_EQ(s.control().cellCount(), 9);
   EXPECT_EQ(s.model().controlPoints().topRows(27), heldBefore) << "extrusion moved the existing points";
@@ -124,8 +124,11 @@ TEST(Sculpting, ExtrudeAndDeleteKeepTheRestShapeAndTheFixedPoints) {
   EXPECT_EQ(s.rest().points(), extrudedRest.points());
   settle(s);
   EXPECT_LT(largestMove(s.model().controlPoints(), extrudedRest.points()), kSettled);
-  // The new cell reaches one cell higher than the cube.
+  // The new cell reaches one cell higher than the cube; its outer face is on top.
   EXPECT_NEAR(s.control().points().col(2).maxCoeff(), 3.0, kSettled);
+  const Lattice grown = s.control();
+  for (int p : grown.faces()[outer]) EXPECT_NEAR(grown.points()(p, 2), 3.0, kSettled);
+  EXPECT_TRUE(grown.isBoundaryFace(outer));
 
   // Delete the cell under the new one's neighbour; the fixed base points it
   // used are renumbered and stay fixed.
@@ -135,6 +138,11 @@ TEST(Sculpting, ExtrudeAndDeleteKeepTheRestShapeAndTheFixedPoints) {
   s.deleteCell(corner);
   EXPECT_EQ(s.control().cellCount(), 8);
   EXPECT_LT(largestMove(s.control().points(), expected.points()), 1e-12);
+  // The faces it shared with its neighbours came to the surface facing out.
+  for (int f = 0; f < expected.faceCount(); ++f) {
+    if (!expected.isBoundaryFace(f)) continue;
+    EXPECT_TRUE(facesAwayFrom(expected, f, expected.faceCells()[f][0])) << "boundary face " << f << " faces inwards";
+  }
   int fixedAfter = 0;
   for (bool f : s.model().fixed()) fixedAfter += f;
   EXPECT_EQ(fixedAfter, 8) << "9 base points less the one only the deleted cell used";

@@ -15,6 +15,7 @@
 #include <vtkRenderer.h>
 #include <vtkWindowToImageFilter.h>
 
+#include "SceneStyle.h"
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/ConvergencePlot.h"
 #include "dynsub/Error.h"
@@ -27,14 +28,6 @@ namespace {
 
 constexpr int kColumns = 5;
 constexpr int kCell = 240;  // pixels per montage cell
-
-vtkSmartPointer<vtkRenderWindow> offScreenWindow(int width, int height) {
-  auto window = vtkSmartPointer<vtkRenderWindow>::New();
-  window->SetOffScreenRendering(1);
-  window->SetMultiSamples(0);
-  window->SetSize(width, height);
-  return window;
-}
 
 void requireSurface(const FigureScene& scene) {
   if (!scene.surface || scene.surface->GetNumberOfPoints() == 0) throw Error("the figure has no surface to show");
@@ -66,7 +59,7 @@ vtkSmartPointer<vtkRenderWindow> slicesFigure(const FigureScene& scene) {
   }
   const double diagonal = (high - low).norm();
 
-  auto window = offScreenWindow(kColumns * kCell, 3 * kCell);
+  auto window = style::offScreenWindow(kColumns * kCell, 3 * kCell);
   for (int row = 0; row < 3; ++row) {
     const auto orientation = static_cast<SliceOrientation>(row);
     // The surface's extent along the slice normal and across the view.
@@ -100,7 +93,7 @@ vtkSmartPointer<vtkRenderWindow> slicesFigure(const FigureScene& scene) {
 
 vtkSmartPointer<vtkRenderWindow> surfaceFigure(const FigureScene& scene) {
   requireSurface(scene);
-  auto window = offScreenWindow(800, 800);
+  auto window = style::offScreenWindow(800, 800);
   SurfaceView view;
   view.setSurface(scene.surface);
   if (scene.controlMesh) view.setControlMesh(scene.controlMesh);
@@ -123,7 +116,7 @@ vtkSmartPointer<vtkRenderWindow> surfaceFigure(const FigureScene& scene) {
 }
 
 vtkSmartPointer<vtkRenderWindow> convergenceFigure(const ConvergenceHistory& history) {
-  auto window = offScreenWindow(900, 500);
+  auto window = style::offScreenWindow(900, 500);
   vtkNew<vtkRenderer> renderer;
   renderer->SetBackground(1, 1, 1);
   vtkNew<vtkContextActor> actor;

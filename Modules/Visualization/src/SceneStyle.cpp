@@ -12,6 +12,7 @@
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkProperty.h>
+#include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
@@ -80,6 +81,14 @@ void showDataPoints(vtkRenderer* renderer, vtkPolyData* points, vtkActor* actor)
   pointsAsDots(actor, kDataPixels);
   actor->GetProperty()->SetColor(0.85, 0.85, 0.85);
   renderer->AddActor(actor);
+}
+
+vtkSmartPointer<vtkRenderWindow> offScreenWindow(int width, int height) {
+  auto window = vtkSmartPointer<vtkRenderWindow>::New();
+  window->SetOffScreenRendering(1);
+  window->SetMultiSamples(0);
+  window->SetSize(width, height);
+  return window;
 }
 
 void cornerText(vtkTextActor* text, double x, double y, Corner corner, int fontSize) {

@@ -12,6 +12,7 @@
 class vtkActor;
 class vtkPolyData;
 class vtkPolyDataMapper;
+class vtkRenderWindow;
 class vtkRenderer;
 class vtkTextActor;
 
@@ -43,6 +44,10 @@ std::vector<int> allRows(const Matrix3X& points);
 // light grey dots.
 void showLandmarks(vtkRenderer* renderer, vtkPolyData* points, vtkActor* actor);
 void showDataPoints(vtkRenderer* renderer, vtkPolyData* points, vtkActor* actor);
+
+// A fixed-size window without multisampling, rendering off screen (figures:
+// the same input gives the same pixels).
+vtkSmartPointer<vtkRenderWindow> offScreenWindow(int width, int height);
 
 enum class Corner { TopLeft, TopRight, BottomLeft, Left, Right, Top, Bottom };
 // White text at a normalized viewport position, justified towards `corner`.

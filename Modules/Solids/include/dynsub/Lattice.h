@@ -71,12 +71,18 @@ class Lattice {
 // not apply.
 //  - extrudeFace: a new cell on a boundary face, grown along the face's
 //    outward normal by twice the distance from the face's centroid to its
-//    cell's centroid (the cell's own depth there). The lattice's points keep
-//    their numbers; the new ones follow.
+//    cell's centroid (the cell's own depth there). The lattice's points,
+//    faces and cells keep their numbers; the new ones follow, the new cell's
+//    outer face (opposite `face`) first.
 //  - deleteCell: the cell and every face, edge and point only it used go
 //    (not the last cell). `kept` (if given) receives the new number of each
-//    old point, or -1 for a removed one.
+//    old point, or -1 for a removed one. The faces it shared come to the
+//    surface turned counter-clockwise seen from outside.
 Lattice extrudeFace(const Lattice& lattice, int face);
+// Whether `face` runs counter-clockwise seen from outside `cell` (its Newell
+// normal points away from the cell's centroid): how a boundary face should run
+// with `cell` its cell.
+bool facesAwayFrom(const Lattice& lattice, int face, int cell);
 Lattice deleteCell(const Lattice& lattice, int cell, std::vector<int>* kept = nullptr);
 
 // A regular lattice of nx x ny x nz hexahedral cells of side `size` (mm),

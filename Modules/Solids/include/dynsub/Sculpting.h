@@ -54,8 +54,9 @@ class Sculpture {
   bool roped() const { return model_->ropePoint() >= 0; }
 
   // Throws dynsub::Error naming the face (not on the boundary) or the cell
-  // (the last one), as Lattice.h's tools do.
-  void extrude(int face);
+  // (the last one), as Lattice.h's tools do. extrude returns the new cell's
+  // outer face (opposite `face`), where extruding again continues the arm.
+  int extrude(int face);
   void deleteCell(int cell);
 
   // Throws dynsub::Error for an index out of range.
