@@ -35,7 +35,9 @@
 #include "dynsub/Landmarks.h"
 #include "dynsub/LimitSurface.h"
 #include "dynsub/MeshIO.h"
+#include "dynsub/Sculpting.h"
 #include "dynsub/SliceView.h"
+#include "dynsub/SolidView.h"
 #include "dynsub/SurfacePolyData.h"
 #include "dynsub/SurfaceView.h"
 #include "dynsub/Tessellation.h"
@@ -250,6 +252,25 @@ TEST_F(Rendering, TestTorusElements) { expectElementsMatchBaseline(kSource + "/D
 
 TEST_F(Rendering, TestConvergencePlot) {
   expectMatchesBaseline(convergenceFigure(readConvergenceCsv(kSource + "/Testing/Data/caudate_left_convergence.csv")));
+}
+
+// Sculpted Cube 3^3: the base fixed (red points), an arm of three extruded
+// cells bent by the rope and kept by plasticity, a cell deleted (its faces now
+// on the surface, lit from outside).
+TEST_F(Rendering, TestSculptedArm) {
+  const Lattice cube3 = regularLattice(2, 2, 2);
+  Sculpture s(cube3);
+  s.fix({0, 1, 2, 3, 4, 5, 6, 7, 8});
+  int face = s.boundaryFaceNear(Vector3(1.5, 1.5, 2));
+  for (int i = 0; i < 3; ++i) face = s.extrude(face);
+  s.grab(Vector3(2, 2, 5));
+  s.pullTo(Vector3(3.5, 2, 5));
+  s.run(600);
+  s.plasticity();
+  s.release();
+  s.run(200);
+  s.deleteCell(s.cellNear(Vector3(0.5, 0.5, 1.5)));
+  expectMatchesBaseline(sculptureFigure(s));
 }
 
 }  // namespace

@@ -15,7 +15,6 @@
 
 #include <vtkActor.h>
 #include <vtkCamera.h>
-#include <vtkInteractorEventRecorder.h>
 #include <vtkMapper.h>
 #include <vtkNew.h>
 #include <vtkPolyData.h>
@@ -25,6 +24,7 @@
 #include <vtkRenderer.h>
 
 #include "BallPhantom.h"
+#include "EventStreams.h"
 #include "dynsub/Figures.h"
 #include "dynsub/ImageIO.h"
 #include "dynsub/SliceView.h"
@@ -46,31 +46,14 @@ class ViewerTest : public ::testing::Test {
   }
   void TearDown() override { std::filesystem::remove(path_); }
 
-  // Plays events; each line "Event x y" with optional modifiers and key.
   static void play(Viewer& viewer, const std::vector<std::string>& lines) {
-    std::ostringstream stream;
-    stream << "# StreamVersion 1.1\n";
-    for (const std::string& line : lines) stream << line << '\n';
-    vtkNew<vtkInteractorEventRecorder> recorder;
-    recorder->SetInteractor(viewer.interactor());
-    recorder->ReadFromInputStringOn();
-    const std::string text = stream.str();
-    recorder->SetInputString(text.c_str());
-    recorder->Play();
-    recorder->Off();
+    events::play(viewer.interactor(), lines);
   }
-
-  // "Event x y modifiers keycode repeat keysym" for a mouse event at a point.
   static std::string mouse(const char* event, const Eigen::Vector2d& at, int modifiers = 0) {
-    std::ostringstream line;
-    line << event << ' ' << std::lround(at.x()) << ' ' << std::lround(at.y()) << ' ' << modifiers << " 0 0 0";
-    return line.str();
+    return events::mouse(event, at, modifiers);
   }
   static std::string key(const char* keySym, char code, const Eigen::Vector2d& at) {
-    std::ostringstream line;
-    line << "KeyPressEvent " << std::lround(at.x()) << ' ' << std::lround(at.y()) << " 0 " << int(code) << " 1 "
-         << keySym;
-    return line.str();
+    return events::key(keySym, code, at);
   }
 
   std::string path_;
