@@ -133,10 +133,13 @@ void addSolidCommand(CLI::App& app) {
 
   CLI::App* stats = solid->add_subcommand(
       "stats", "Print the counts of points, edges, faces and cells after L subdivisions, as JSON");
-  stats->add_option("LATTICE", o->lattice, "Control lattice (.lattice)")->required();
-  stats->add_option("--level", o->level, "Subdivisions")->default_val(0)->check(CLI::Range(0, 6));
-  stats->callback([o] {
-    const Lattice lattice = subdivideSolid(readLattice(o->lattice), o->level).lattice;
+  // Its own options: a default given to a variable another subcommand shares
+  // would be overwritten by that subcommand's default.
+  auto statsOptions = std::make_shared<SolidOptions>();
+  stats->add_option("LATTICE", statsOptions->lattice, "Control lattice (.lattice)")->required();
+  stats->add_option("--level", statsOptions->level, "Subdivisions")->default_val(0)->check(CLI::Range(0, 6));
+  stats->callback([statsOptions] {
+    const Lattice lattice = subdivideSolid(readLattice(statsOptions->lattice), statsOptions->level).lattice;
     nlohmann::ordered_json counts = {{"points", lattice.pointCount()},
                                      {"edges", lattice.edgeCount()},
                                      {"faces", lattice.faceCount()},

@@ -175,6 +175,8 @@ check "solid stats: Cube (3^3) at level 3 as in Table 1" test \
 check "solid stats: Cube w/ holes at level 2 as in Table 1" test \
   "$("$DYNSUB" solid stats "$DATA/Solids/cube_holes.lattice" --level 2)" = \
   '{"points":1900,"edges":5040,"faces":4416,"cells":1280}'
+check "solid stats: level 0 unless told" test \
+  "$("$DYNSUB" solid stats "$DATA/Solids/cube3.lattice")" = '{"points":27,"edges":54,"faces":36,"cells":8}'
 "$DYNSUB" solid subdivide "$DATA/Solids/cube4.lattice" --level 1 --out "$work/cube4.vtu" >/dev/null
 check "solid subdivide writes .vtu" grep -q "UnstructuredGrid" "$work/cube4.vtu"
 "$DYNSUB" solid make cube3 --out "$work/cube3.lattice" >/dev/null
@@ -185,6 +187,49 @@ expect_error "solid: a cell that is not closed" 1 "cell 0 is not closed" "$work/
 sed 's/^4 0 3 4 1$/4 0 3 4 99/' "$DATA/Solids/cube3.lattice" >"$work/range.lattice"
 expect_error "solid: a point index out of range" 1 "uses point 99" "$work/o21.vtu" \
   "$DYNSUB" solid subdivide "$work/range.lattice" --out "$work/o21.vtu"
+
+
+# --- solids: sculpting by script; the window without a display -----------------
+"$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" --script "$DATA/Solids/arm.sculpt" --out "$work/arm" \
+  >"$work/stdout" 2>"$work/stderr"
+check "solid sculpt --script succeeds" test $? -eq 0
+for name in sculpted.lattice sculpted.vtu sculpted.png report.json; do
+  check "solid sculpt writes $name" test -s "$work/arm/$name"
+done
+check "solid sculpt reports each line" grep -q "^line 14: delete at 0.5 0.5 1.5" "$work/stdout"
+check "solid sculpt: 3 extruded, 1 deleted: 10 cells" \
+  grep -q '"cells": 10' <(sed -n '/"control"/,/}/p' "$work/arm/report.json")
+check "solid sculpt: 800 steps" grep -q '"steps": 800' "$work/arm/report.json"
+check "solid sculpt: the PNG is 800 x 800" test "$(od -An -tu1 -j16 -N8 "$work/arm/sculpted.png" | tr -s ' ')" = " 0 0 3 32 0 0 3 32"
+"$DYNSUB" solid stats "$work/arm/sculpted.lattice" >"$work/stdout"
+check "the sculpted lattice reads back" grep -q '"cells":10' "$work/stdout"
+"$DYNSUB" solid sculpt "$work/arm/sculpted.lattice" --script <(echo "run 10") --out "$work/arm2" >/dev/null 2>&1
+check "the sculpted lattice sculpts on" test -s "$work/arm2/sculpted.lattice"
+printf 'run 10\nsqueeze 3\n' >"$work/bad.sculpt"
+expect_error "solid sculpt: an unknown action" 1 "bad.sculpt: line 2: unknown action 'squeeze'" "$work/s30" \
+  "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" --script "$work/bad.sculpt" --out "$work/s30"
+printf 'run 10\nextrude 5\n' >"$work/interior.sculpt"
+expect_error "solid sculpt: extruding an interior face" 1 "line 2 (extrude 5): face 5 is inside the solid" "$work/s31" \
+  "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" --script "$work/interior.sculpt" --out "$work/s31"
+expect_error "solid sculpt: a missing script" 1 "none.sculpt: no such file" "$work/s32" \
+  "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" --script "$work/none.sculpt" --out "$work/s32"
+expect_error "solid sculpt: --script without --out" 1 "--out DIR is required" "$work/sculpted" \
+  "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" --script "$DATA/Solids/arm.sculpt"
+expect_error "solid sculpt: NaN stiffness" 1 "stiffnesses must be finite" "$work/s33" \
+  "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" --script "$DATA/Solids/arm.sculpt" --stiffness nan \
+  --out "$work/s33"
+expect_error "solid sculpt: a bad lattice" 1 "uses point 99" "$work/s34" \
+  "$DYNSUB" solid sculpt "$work/range.lattice" --script "$DATA/Solids/arm.sculpt" --out "$work/s34"
+printf 'rope 2 2 2 to 9 9 9\nrun 50\n' >"$work/wild.sculpt"
+expect_error "solid sculpt: a diverging simulation" 1 "diverged" "$work/s35" \
+  "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" --script "$work/wild.sculpt" --rope-stiffness 1e6 \
+  --time-step 0.5 --out "$work/s35"
+expect_error "solid sculpt: the window without a display" 1 "needs an X display" "$work/sculpted" \
+  env -u DISPLAY "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice"
+env -u DISPLAY "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" --script "$DATA/Solids/arm.sculpt" \
+  --out "$work/arm3" >/dev/null 2>"$work/stderr"
+check "solid sculpt --script without a display writes the rest" test -s "$work/arm3/sculpted.vtu" -a ! -e "$work/arm3/sculpted.png"
+check "solid sculpt --script without a display warns" grep -q "no figure written: DISPLAY is not set" "$work/stderr"
 
 if [ "$failures" -gt 0 ]; then echo "$failures check(s) failed"; exit 1; fi
 echo "all command-line checks passed"
