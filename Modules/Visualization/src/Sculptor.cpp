@@ -85,7 +85,7 @@ struct Sculptor::Impl {
     text << control.cellCount() << " cells, " << control.pointCount() << " control points (" << fixed
          << " fixed)  |  t = " << std::fixed << std::setprecision(1)
          << sculpture.steps() * sculpture.settings().timeStep << " s" << (paused ? " (paused)" : "")
-         << "  |  stiffness " << std::setprecision(3) << m.springStiffness << " / " << m.virtualStiffness
+         << "  |  stiffness " << std::defaultfloat << std::setprecision(3) << m.springStiffness << " / " << m.virtualStiffness
          << " N/mm, damping " << m.damping << " N s/mm";
     if (selected >= 0) text << "  |  face " << selected << " selected";
     if (!message.empty()) text << "\n" << message;

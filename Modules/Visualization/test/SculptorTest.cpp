@@ -3,6 +3,8 @@
 // the sculpture. Needs an X display (ctest runs under xvfb-run).
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
 
@@ -127,6 +129,12 @@ TEST_F(SculptorTest, EveryToolWorksFromTheMouseAndKeys) {
   press(sculptor, "s", 's');
   EXPECT_EQ(saves, 1);
   EXPECT_NE(sculptor.status().find("saved 9 cells"), std::string::npos);
+
+  // The window with its help, for review: build/Testing/Temporary/SculptorWindow.png.
+  press(sculptor, "h", 'h');
+  const std::string temporary = std::string(DYNSUB_BINARY_DIR) + "/Testing/Temporary";
+  std::filesystem::create_directories(temporary);
+  writePng(sculptor.window(), temporary + "/SculptorWindow.png");
 }
 
 TEST_F(SculptorTest, CtrlDragPullsTheSolidByARopeAndReleasingLetsGo) {
