@@ -15,6 +15,22 @@ Vector3 centroid(const Matrix3X& points, const std::vector<int>& indices) {
   return sum / static_cast<double>(indices.size());
 }
 
+// Of the point sets `use` accepts, the one whose centroid is nearest `point`.
+template <typename Use>
+int nearestCentroid(const Matrix3X& points, const std::vector<std::vector<int>>& sets, const Vector3& point, Use use) {
+  int best = -1;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < static_cast<int>(sets.size()); ++i) {
+    if (!use(i)) continue;
+    const double d = (centroid(points, sets[i]) - point).squaredNorm();
+    if (d < nearest) {
+      nearest = d;
+      best = i;
+    }
+  }
+  return best;
+}
+
 std::vector<int> fixedPoints(const SolidModel& model) {
   std::vector<int> fixed;
   for (int i = 0; i < static_cast<int>(model.fixed().size()); ++i)
@@ -103,34 +119,12 @@ void Sculpture::run(int count) {
 }
 
 int Sculpture::boundaryFaceNear(const Vector3& point) const {
-  const Lattice& l = rest_;
-  const Matrix3X& p = model_->controlPoints();
-  int best = -1;
-  double nearest = std::numeric_limits<double>::infinity();
-  for (int f = 0; f < l.faceCount(); ++f) {
-    if (!l.isBoundaryFace(f)) continue;
-    const double d = (centroid(p, l.faces()[f]) - point).squaredNorm();
-    if (d < nearest) {
-      nearest = d;
-      best = f;
-    }
-  }
-  return best;
+  return nearestCentroid(model_->controlPoints(), rest_.faces(), point,
+                         [&](int face) { return rest_.isBoundaryFace(face); });
 }
 
 int Sculpture::cellNear(const Vector3& point) const {
-  const Lattice& l = rest_;
-  const Matrix3X& p = model_->controlPoints();
-  int best = -1;
-  double nearest = std::numeric_limits<double>::infinity();
-  for (int c = 0; c < l.cellCount(); ++c) {
-    const double d = (centroid(p, l.cellPoints()[c]) - point).squaredNorm();
-    if (d < nearest) {
-      nearest = d;
-      best = c;
-    }
-  }
-  return best;
+  return nearestCentroid(model_->controlPoints(), rest_.cellPoints(), point, [](int) { return true; });
 }
 
 }  // namespace dynsub

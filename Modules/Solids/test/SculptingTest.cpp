@@ -23,6 +23,15 @@ std::vector<int> base(const Lattice& lattice) {
   return points;
 }
 
+// Holds the solid by its base and pulls its top corner (2, 2, 2) by the rope
+// towards `target` for `steps` steps.
+void holdAndPull(Sculpture& s, const Vector3& target, int steps) {
+  s.fix(base(s.rest()));
+  s.grab(Vector3(2, 2, 2));
+  s.pullTo(target);
+  s.run(steps);
+}
+
 double largestMove(const Matrix3X& a, const Matrix3X& b) { return (a - b).rowwise().norm().maxCoeff(); }
 
 // 80 s of motion: the default material brings the held cube back to within
@@ -88,10 +97,7 @@ TEST(Sculpting, TheRopePullsAGrabbedPointAndTheFixedBaseStays) {
 TEST(Sculpting, PlasticityKeepsTheSculptedShape) {
   const Lattice cube3 = regularLattice(2, 2, 2);
   Sculpture s(cube3);
-  s.fix(base(cube3));
-  s.grab(Vector3(2, 2, 2));
-  s.pullTo(Vector3(2.5, 2.5, 3.0));
-  s.run(1000);
+  holdAndPull(s, Vector3(2.5, 2.5, 3.0), 1000);
   s.plasticity();
   const Matrix3X sculpted = s.model().controlPoints();
   EXPECT_EQ(s.rest().points(), sculpted);
@@ -106,13 +112,10 @@ TEST(Sculpting, PlasticityKeepsTheSculptedShape) {
 TEST(Sculpting, ExtrudeAndDeleteKeepTheRestShapeAndTheFixedPoints) {
   const Lattice cube3 = regularLattice(2, 2, 2);
   Sculpture s(cube3);
-  s.fix(base(cube3));
   // Extrude the top face of the cell at the far corner while the rope holds
   // the solid out of shape; then let go: the grown solid returns to the
   // extruded rest shape, with the base still where it was.
-  s.grab(Vector3(2, 2, 2));
-  s.pullTo(Vector3(2.6, 2.4, 2.8));
-  s.run(500);
+  holdAndPull(s, Vector3(2.6, 2.4, 2.8), 500);
   const int top = s.boundaryFaceNear(Vector3(1.5, 1.5, 2.0));
   const Matrix3X heldBefore = s.model().controlPoints();
   const int outer = s.extrude(top);
@@ -157,12 +160,7 @@ TEST(Sculpting, ExtrudeAndDeleteKeepTheRestShapeAndTheFixedPoints) {
 TEST(Sculpting, StiffnessAndDampingChangeWhileRunning) {
   const Lattice cube3 = regularLattice(2, 2, 2);
   Sculpture soft(cube3), stiff(cube3);
-  for (Sculpture* s : {&soft, &stiff}) {
-    s->fix(base(cube3));
-    s->grab(Vector3(2, 2, 2));
-    s->pullTo(Vector3(2.5, 2.5, 3.0));
-    s->run(100);
-  }
+  for (Sculpture* s : {&soft, &stiff}) holdAndPull(*s, Vector3(2.5, 2.5, 3.0), 100);
   SolidMaterial m = stiff.settings().material;
   m.springStiffness *= 4;
   m.virtualStiffness *= 4;
