@@ -3,6 +3,14 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <set>
+#include <sstream>
+
+#include <gdcmReader.h>
+#include <gdcmTrace.h>
 
 #include <itkGDCMImageIO.h>
 #include <itkGDCMSeriesFileNames.h>
@@ -13,6 +21,7 @@
 #include <itkImageIOBase.h>
 #include <itkImageIOFactory.h>
 #include <itkImageSeriesReader.h>
+#include <itkMetaDataObject.h>
 #include <itkSignedMaurerDistanceMapImageFilter.h>
 
 #include "dynsub/Error.h"
@@ -57,6 +66,129 @@ void inspectFile(const std::string& path) {
   }
 }
 
+// Whether a file says it is DICOM: "DICM" after the 128-byte preamble.
+bool isDicomFile(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  char magic[4] = {};
+  in.seekg(128);
+  return in.read(magic, 4) && std::string(magic, 4) == "DICM";
+}
+
+// GDCM, as Debian builds it, aborts the process (a failed assertion) on a
+// file cut short before its pixel data. So the elements of each DICOM file
+// are walked first, and each must fit in the file: the meta header (explicit
+// VR, little endian) and a data set in the two uncompressed little-endian
+// transfer syntaxes. The walk stops, trusting GDCM with the rest, at an element
+// of undefined length (a sequence, encapsulated pixel data) or at a data set
+// in another transfer syntax.
+void requireWholeDicomFile(const fs::path& file) {
+  const std::uintmax_t size = fs::file_size(file);
+  std::ifstream in(file, std::ios::binary);
+  auto fail = [&](const std::string& what) { throw Error(file.string(), "a truncated DICOM file: " + what); };
+  auto read = [&](unsigned char* bytes, int n) { return static_cast<bool>(in.read(reinterpret_cast<char*>(bytes), n)); };
+  auto little = [](const unsigned char* b, int n) {
+    std::uintmax_t v = 0;
+    for (int i = n - 1; i >= 0; --i) v = (v << 8) | b[i];
+    return v;
+  };
+  // Explicit VRs with a 4-byte length (after 2 reserved bytes); the others have 2.
+  static const std::set<std::string> longLength = {"OB", "OD", "OF", "OL", "OV", "OW", "SQ",
+                                                   "SV", "UC", "UN", "UR", "UT", "UV"};
+  std::uintmax_t at = 132;
+  bool meta = true, explicitVr = true;
+  std::string syntax;
+  while (at < size) {
+    in.seekg(static_cast<std::streamoff>(at));
+    unsigned char tag[4];
+    if (size - at < 8 || !read(tag, 4)) fail("an element is cut short at byte " + std::to_string(at));
+    const unsigned group = static_cast<unsigned>(little(tag, 2));
+    if (meta && group != 0x0002) {
+      meta = false;
+      if (syntax == "1.2.840.10008.1.2") {
+        explicitVr = false;
+      } else if (syntax != "1.2.840.10008.1.2.1") {
+        return;  // compressed, deflated or big endian: GDCM's alone
+      }
+    }
+    std::uintmax_t length = 0, header = 8;
+    unsigned char rest[8];
+    if (explicitVr) {
+      if (!read(rest, 4)) fail("an element is cut short at byte " + std::to_string(at));
+      const std::string vr(reinterpret_cast<char*>(rest), 2);
+      if (longLength.count(vr)) {
+        unsigned char four[4];
+        if (!read(four, 4)) fail("an element is cut short at byte " + std::to_string(at));
+        length = little(four, 4);
+        header = 12;
+      } else {
+        length = little(rest + 2, 2);
+      }
+    } else {
+      if (!read(rest, 4)) fail("an element is cut short at byte " + std::to_string(at));
+      length = little(rest, 4);
+    }
+    if (length == 0xFFFFFFFFu) return;  // undefined length: GDCM's alone
+    if (at + header + length > size) {
+      char name[16];
+      std::snprintf(name, sizeof name, "(%04x,%04x)", group, static_cast<unsigned>(little(tag + 2, 2)));
+      fail(std::string("element ") + name + " needs " + std::to_string(length) + " bytes, the file has " +
+           std::to_string(size - at - header));
+    }
+    if (meta && little(tag + 2, 2) == 0x0010) {  // (0002,0010) transfer syntax UID
+      std::string value(length, '\0');
+      in.read(value.data(), static_cast<std::streamsize>(length));
+      while (!value.empty() && (value.back() == '\0' || value.back() == ' ')) value.pop_back();
+      syntax = value;
+    }
+    at += header + length;
+  }
+}
+
+// GDCM leaves out of a series the files it cannot parse, and reads a slice
+// whose pixel data is cut short with only a warning: either would silently
+// become a gap or a slice of garbage. So every file of the series must read
+// whole (GDCM's warnings are caught to tell), and every other file of the
+// directory that says it is DICOM ("DICM" after the 128-byte preamble) is an
+// error too.
+void requireWholeSeries(const std::string& directory, const std::vector<std::string>& files) {
+  std::vector<fs::path> inSeries;
+  // ITK turns GDCM's warnings off; they are on, and caught, while checking.
+  const bool warningsWereOn = gdcm::Trace::GetWarningFlag();
+  for (const std::string& file : files) {
+    std::ostringstream warnings;
+    gdcm::Trace::WarningOn();
+    gdcm::Trace::SetWarningStream(warnings);
+    gdcm::Reader reader;
+    reader.SetFileName(file.c_str());
+    const bool read = reader.Read();
+    gdcm::Trace::SetWarningStream(std::cerr);
+    gdcm::Trace::SetWarning(warningsWereOn);
+    if (!read || warnings.str().find("Incomplete Pixel Data") != std::string::npos)
+      throw Error(file, "a DICOM file of the series is truncated or corrupt");
+    inSeries.push_back(fs::weakly_canonical(file));
+  }
+  for (const auto& entry : fs::directory_iterator(directory)) {
+    if (!entry.is_regular_file() || !isDicomFile(entry.path())) continue;
+    if (std::find(inSeries.begin(), inSeries.end(), fs::weakly_canonical(entry.path())) == inSeries.end())
+      throw Error(entry.path().string(), "a DICOM file that cannot be read with the rest of the series "
+                                         "(truncated or corrupt?)");
+  }
+}
+
+// ITK reads slices that are not evenly spaced (a missing slice, a mixed
+// acquisition) onto an even grid, with a warning only: a deviation beyond 1 %
+// of the slice spacing is an error here.
+void requireEvenSlices(const std::string& directory, const FloatImage& image) {
+  double deviation = 0;
+  if (!itk::ExposeMetaData<double>(image.GetMetaDataDictionary(), "ITK_non_uniform_sampling_deviation", deviation))
+    return;
+  const double spacing = image.GetSpacing()[2];
+  if (deviation > 0.01 * spacing)
+    throw Error(directory, "the DICOM slices are not evenly spaced (a slice missing?): they deviate by " +
+                               std::to_string(deviation) + " mm from the spacing of " + std::to_string(spacing) +
+                               " mm");
+}
+
 }  // namespace
 
 void readImage(const std::string& path, Geometry& geometry, std::vector<float>& voxels) {
@@ -64,6 +196,8 @@ void readImage(const std::string& path, Geometry& geometry, std::vector<float>& 
     FloatImage::Pointer image;
     std::error_code ignored;
     if (fs::is_directory(path, ignored)) {
+      for (const auto& entry : fs::directory_iterator(path))
+        if (entry.is_regular_file() && isDicomFile(entry.path())) requireWholeDicomFile(entry.path());
       auto names = itk::GDCMSeriesFileNames::New();
       names->SetUseSeriesDetails(true);
       names->SetDirectory(path);
@@ -71,11 +205,14 @@ void readImage(const std::string& path, Geometry& geometry, std::vector<float>& 
       if (series.empty()) throw Error(path, "directory holds no DICOM series");
       if (series.size() > 1)
         throw Error(path, "directory holds " + std::to_string(series.size()) + " DICOM series; give one series");
+      const std::vector<std::string> files = names->GetFileNames(series.front());
+      requireWholeSeries(path, files);
       auto reader = itk::ImageSeriesReader<FloatImage>::New();
       reader->SetImageIO(itk::GDCMImageIO::New());
-      reader->SetFileNames(names->GetFileNames(series.front()));
+      reader->SetFileNames(files);
       reader->Update();
       image = reader->GetOutput();
+      requireEvenSlices(path, *image);
     } else {
       inspectFile(path);
       auto reader = itk::ImageFileReader<FloatImage>::New();

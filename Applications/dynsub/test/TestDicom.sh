@@ -1,0 +1,80 @@
+#!/usr/bin/env bash
+# Reading DICOM series: a ball phantom on an oblique, anisotropic grid, written
+# as an MR series by DCMTK's dump2dcm (Tools/dicom_phantom.py; a writer DynSub
+# does not use) and as NIfTI, is segmented from both:
+#  - from the series: Dice >= 0.95 and mean surface distance <= 0.375 mm (half
+#    the smallest voxel side) against the analytic ball, and the --reference
+#    labelmap (NIfTI) is accepted as being on the series' grid;
+#  - from the NIfTI: the same labelmap, to within 0.5 % of the ball's voxels
+#    (the NIfTI stores the axes as 32-bit floats, DICOM as decimals, so a few
+#    boundary voxels may fall the other way).
+# And a broken series gets a clear error, exit code 1 and no output: a
+# truncated slice (in its header, in its pixels), a missing slice, two series,
+# no series. Needs DYNSUB, TOOLS and dump2dcm/dcmodify (Debian package dcmtk).
+set -u
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+source "$(dirname "${BASH_SOURCE[0]}")/Checks.sh"
+expect_error() {
+  local name=$1 fragment=$2 output=$3; shift 3
+  "$@" >"$work/stdout" 2>"$work/stderr"
+  local rc=$?
+  check "$name: exit code 1 (got $rc)" test "$rc" -eq 1
+  check "$name: message mentions '$fragment'" grep -q -- "$fragment" "$work/stderr"
+  check "$name: no output" test ! -e "$output"
+}
+
+python3 "$TOOLS/dicom_phantom.py" "$work/phantom" >/dev/null
+check "the phantom series has 32 slices" test "$(ls "$work/phantom/series" | wc -l)" -eq 32
+
+"$DYNSUB" segment "$work/phantom/series" --landmarks "$work/phantom/ball.csv" --reference "$work/phantom/ball.nii.gz" \
+  --reference-label 1 --no-figures --out "$work/dicom" >"$work/dicom.log" 2>&1
+check "segment reads the DICOM series" test $? -eq 0
+cat "$work/dicom.log"
+dice=$(sed -n 's/^  "dice": \([-0-9.e+]*\),$/\1/p' "$work/dicom/report.json")
+distance=$(sed -n 's/^  "mean_surface_distance_mm": \([-0-9.e+]*\),$/\1/p' "$work/dicom/report.json")
+check "DICOM: Dice $dice >= 0.95" awk -v d="$dice" 'BEGIN { exit !(d != "" && d >= 0.95) }'
+check "DICOM: mean surface distance $distance <= 0.375 mm" awk -v d="$distance" 'BEGIN { exit !(d != "" && d <= 0.375) }'
+
+"$DYNSUB" segment "$work/phantom/phantom.nii.gz" --landmarks "$work/phantom/ball.csv" --no-figures \
+  --out "$work/nifti" >/dev/null 2>&1
+check "segment reads the same phantom as NIfTI" test $? -eq 0
+check "the DICOM and NIfTI labelmaps agree" python3 - "$work/dicom/labelmap.nii.gz" "$work/nifti/labelmap.nii.gz" <<'PY'
+import gzip, struct, sys
+def read(path):
+    data = gzip.open(path).read()
+    offset = int(struct.unpack_from("<f", data, 108)[0])
+    return struct.unpack_from("<4h", data, 40), struct.unpack_from("<3f", data, 80), data[offset:]
+(dims_a, spacing_a, a), (dims_b, spacing_b, b) = read(sys.argv[1]), read(sys.argv[2])
+differ = sum(x != y for x, y in zip(a, b))
+inside = sum(1 for x in a if x)
+print(f"{differ} of {inside} labelled voxels differ")
+sys.exit(0 if dims_a == dims_b and spacing_a == spacing_b and len(a) == len(b) and differ <= 0.005 * inside else 1)
+PY
+
+broken() {  # broken NAME: a copy of the series to break
+  cp -r "$work/phantom/series" "$work/$1"
+}
+broken header
+head -c 700 "$work/phantom/series/slice_007.dcm" >"$work/header/slice_007.dcm"
+expect_error "a slice cut short in its header" "slice_007.dcm: a truncated DICOM file" "$work/o1" \
+  "$DYNSUB" segment "$work/header" --landmarks "$work/phantom/ball.csv" --out "$work/o1"
+broken pixels
+head -c 2000 "$work/phantom/series/slice_010.dcm" >"$work/pixels/slice_010.dcm"
+expect_error "a slice cut short in its pixels" "slice_010.dcm: a truncated DICOM file: element (7fe0,0010)" "$work/o2" \
+  "$DYNSUB" segment "$work/pixels" --landmarks "$work/phantom/ball.csv" --out "$work/o2"
+broken gap
+rm "$work/gap/slice_012.dcm"
+expect_error "a missing slice" "not evenly spaced" "$work/o3" \
+  "$DYNSUB" segment "$work/gap" --landmarks "$work/phantom/ball.csv" --out "$work/o3"
+broken two
+dcmodify -nb -m "(0020,000e)=1.2.826.0.1.3680043.10.1347.9" "$work/two/slice_005.dcm"
+expect_error "two series" "holds 2 DICOM series" "$work/o4" \
+  "$DYNSUB" segment "$work/two" --landmarks "$work/phantom/ball.csv" --out "$work/o4"
+mkdir "$work/none"
+echo "not an image" >"$work/none/README.txt"
+expect_error "no series" "holds no DICOM series" "$work/o5" \
+  "$DYNSUB" segment "$work/none" --landmarks "$work/phantom/ball.csv" --out "$work/o5"
+
+echo "$failures failure(s)"
+test "$failures" -eq 0
