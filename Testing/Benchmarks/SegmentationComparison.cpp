@@ -1,10 +1,12 @@
-// DynSub's segmentation beside ITK's geodesic active contour, in one run, on
-// the same cropped region of the same MRI from the same landmarks:
+// DynSub's segmentation beside ITK's geodesic active contour and deformable
+// simplex mesh, in one run, on the same cropped region of the same MRI from the
+// same landmarks:
 //   build/bin/SegmentationComparison [IMAGE LABELS LANDMARKS LABEL]
 // (defaults: the demo's left caudate of Colin27 against AAL label 71).
 // DynSub uses the landmarks as springs; the level set cannot, so it starts
 // from DynSub's own initial model (voxelized) and reads its speed image's
-// edge level at the landmarks. Prints Dice, distances and seconds for each,
+// edge level at the landmarks. The simplex mesh starts from the same initial
+// model's limit surface (as triangles) and cannot use the landmarks either. Prints Dice, distances and seconds for each,
 // DynSub's stage seconds, and the process's peak memory after each method.
 #include <sys/resource.h>
 
@@ -13,6 +15,7 @@
 #include <string>
 
 #include "BridgeGeometry.h"
+#include "ItkDeformableSimplexMesh.h"
 #include "ItkGeodesicActiveContour.h"
 #include "dynsub/ImageIO.h"
 #include "dynsub/LimitSurface.h"
@@ -91,6 +94,39 @@ int run(int argc, char** argv) {
       continue;
     }
     printRow(name, compareMasks(pasteMask(mask, image.geometry, dynsub.regionFirst), reference), gac.seconds, extra);
+  }
+
+  // The simplex mesh, in the region's voxel indices (its only frame).
+  std::vector<std::array<double, 3>> startIndices;
+  for (Eigen::Index p = 0; p < start.points.rows(); ++p) {
+    const Vector3 index = region.toIndex(start.points.row(p).transpose());
+    startIndices.push_back({index[0], index[1], index[2]});
+  }
+  struct SimplexRun {
+    double beta, kappa;
+    int iterations;
+  };
+  for (const SimplexRun& run : std::vector<SimplexRun>{{0.1, 0, 300}, {0.3, 0, 300}, {0.3, 0.01, 300}, {0.3, 0.02, 300}, {0.3, 0.05, 300}}) {
+    itkbaseline::SimplexOptions options;
+    options.beta = run.beta;
+    options.kappa = run.kappa;
+    options.iterations = run.iterations;
+    const itkbaseline::SimplexResult simplex =
+        itkbaseline::deformableSimplexMesh(toBridge(region), cropped.voxels, startIndices, start.triangles, options);
+    Matrix3X points(simplex.points.size(), 3);
+    for (std::size_t p = 0; p < simplex.points.size(); ++p)
+      points.row(p) = region.toPhysical(Vector3(simplex.points[p][0], simplex.points[p][1], simplex.points[p][2])).transpose();
+    char name[64], extra[128];
+    std::snprintf(name, sizeof name, "ITK simplex, beta %.1f, balloon %.2f", run.beta, run.kappa);
+    std::snprintf(extra, sizeof extra, "%zu points, peak %d MB", simplex.points.size(),
+                  static_cast<int>(peakMegabytes()));
+    try {
+      const Mask mask = voxelizeSurface(points, simplex.triangles, region);
+      printRow(name, compareMasks(pasteMask(mask, image.geometry, dynsub.regionFirst), reference), simplex.seconds,
+               extra);
+    } catch (const std::exception& e) {
+      std::printf("%-34s no closed surface to measure: %s\n", name, e.what());
+    }
   }
   return 0;
 }
