@@ -66,6 +66,18 @@ void inspectFile(const std::string& path) {
   }
 }
 
+// ITK's global warning display off for a scope.
+class WarningsOff {
+ public:
+  WarningsOff() : was_(itk::Object::GetGlobalWarningDisplay()) { itk::Object::SetGlobalWarningDisplay(false); }
+  ~WarningsOff() { itk::Object::SetGlobalWarningDisplay(was_); }
+  WarningsOff(const WarningsOff&) = delete;
+  WarningsOff& operator=(const WarningsOff&) = delete;
+
+ private:
+  bool was_;
+};
+
 // Whether a file says it is DICOM: "DICM" after the 128-byte preamble.
 bool isDicomFile(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
@@ -198,6 +210,9 @@ void readImage(const std::string& path, Geometry& geometry, std::vector<float>& 
     if (fs::is_directory(path, ignored)) {
       for (const auto& entry : fs::directory_iterator(path))
         if (entry.is_regular_file() && isDicomFile(entry.path())) requireWholeDicomFile(entry.path());
+      // ITK's warnings (no series, uneven slices) would only repeat, less
+      // clearly, what the checks here report as errors.
+      const WarningsOff quiet;
       auto names = itk::GDCMSeriesFileNames::New();
       names->SetUseSeriesDetails(true);
       names->SetDirectory(path);
