@@ -3,7 +3,9 @@
 DICOM checks (Applications/dynsub/test/TestDicom.sh):
 
   OUT/series/slice_NNN.dcm  the image as a DICOM MR series, one file per slice,
-                            made by DCMTK's dump2dcm (a writer DynSub does not use);
+                            made by DCMTK's dump2dcm (a writer DynSub does not use),
+                            each with a sequence of undefined length (a
+                            referenced image) before its pixels;
   OUT/phantom.nii.gz        the same image as NIfTI (sform and qform);
   OUT/ball.nii.gz           the analytic ball as a labelmap (1 where a voxel
                             centre lies inside it) on the same grid;
@@ -124,6 +126,12 @@ def write_series(directory, image):
             out.write(f"""(0008,0016) UI =MRImageStorage
 (0008,0018) UI [{root}.4.{k + 1}]
 (0008,0060) CS [MR]
+(0008,1140) SQ (Sequence with undefined length #=1)
+  (fffe,e000) na (Item with undefined length #=2)
+    (0008,1150) UI =MRImageStorage
+    (0008,1155) UI [{root}.4.{(k + 1) % SIZE[2] + 1}]
+  (fffe,e00d) na (ItemDelimitationItem)
+(fffe,e0dd) na (SequenceDelimitationItem)
 (0010,0010) PN [Phantom^Ball]
 (0010,0020) LO [BALL1]
 (0020,000d) UI [{study}]
@@ -145,7 +153,9 @@ def write_series(directory, image):
 (0028,0103) US 0
 (7fe0,0010) OW ={pixels}
 """)
-        subprocess.run(["dump2dcm", "--quiet", dump, os.path.join(directory, f"slice_{k:03d}.dcm")], check=True)
+        # Undefined lengths for the sequence and its item, as scanners often write them.
+        subprocess.run(["dump2dcm", "--quiet", "--length-undefined", dump,
+                        os.path.join(directory, f"slice_{k:03d}.dcm")], check=True)
         os.remove(pixels)
         os.remove(dump)
 

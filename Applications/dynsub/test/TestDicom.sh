@@ -8,9 +8,10 @@
 #  - from the NIfTI: the same labelmap, to within 0.5 % of the ball's voxels
 #    (the NIfTI stores the axes as 32-bit floats, DICOM as decimals, so a few
 #    boundary voxels may fall the other way).
-# And a broken series gets a clear error, exit code 1 and no output: a
-# truncated slice (in its header, in its pixels), a missing slice, two series,
-# no series. Needs DYNSUB, TOOLS and dump2dcm/dcmodify (Debian package dcmtk).
+# And a broken series gets a clear error, exit code 1 and no output (not the
+# abort Debian's GDCM gives for some): a truncated slice (in its header, in a
+# sequence of undefined length, after its meta header, in its pixels), a
+# missing slice, two series, no series. Needs DYNSUB, TOOLS and dump2dcm/dcmodify (Debian package dcmtk).
 set -u
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
@@ -59,6 +60,14 @@ broken header
 head -c 700 "$work/phantom/series/slice_007.dcm" >"$work/header/slice_007.dcm"
 expect_error "a slice cut short in its header" "slice_007.dcm: a truncated DICOM file" "$work/o1" \
   "$DYNSUB" segment "$work/header" --landmarks "$work/phantom/ball.csv" --out "$work/o1"
+broken sequence
+head -c 460 "$work/phantom/series/slice_007.dcm" >"$work/sequence/slice_007.dcm"
+expect_error "a slice cut short in a sequence of undefined length" "slice_007.dcm: a truncated DICOM file" "$work/o6" \
+  "$DYNSUB" segment "$work/sequence" --landmarks "$work/phantom/ball.csv" --out "$work/o6"
+broken metaonly
+head -c 320 "$work/phantom/series/slice_007.dcm" >"$work/metaonly/slice_007.dcm"
+expect_error "a slice of nothing but its meta header" "nothing follows the meta header" "$work/o7" \
+  "$DYNSUB" segment "$work/metaonly" --landmarks "$work/phantom/ball.csv" --out "$work/o7"
 broken pixels
 head -c 2000 "$work/phantom/series/slice_010.dcm" >"$work/pixels/slice_010.dcm"
 expect_error "a slice cut short in its pixels" "slice_010.dcm: a truncated DICOM file: element (7fe0,0010)" "$work/o2" \
