@@ -25,6 +25,7 @@ namespace dynsub {
 namespace {
 
 constexpr int kTickMilliseconds = 40;
+constexpr double kPickPixels = 8.0;  // how near a right click must be to a control point
 
 const char* const kHelp =
     "left drag  rotate;  wheel  zoom;  c  reset the view\n"
@@ -32,6 +33,7 @@ const char* const kHelp =
     "Shift + left click on the solid  select a control face\n"
     "e  extrude the selected face;  d, Delete  delete its cell\n"
     "f / u  fix / unfix its control points;  U  unfix all\n"
+    "right click on a control point  fix / unfix it\n"
     "p  plasticity (keep the current shape)\n"
     "k / K  stiffness down / up;  g / G  damping down / up\n"
     "space  pause / resume;  w  control lattice on / off\n"
@@ -185,6 +187,38 @@ struct Sculptor::Impl {
     });
   }
 
+  // The control point drawn within kPickPixels of a display position, or -1.
+  int controlPointAt(int x, int y) {
+    vtkRenderer* r = view.renderer();
+    const Matrix3X& p = sculpture.model().controlPoints();
+    int best = -1;
+    double nearest = kPickPixels;
+    for (int i = 0; i < p.rows(); ++i) {
+      r->SetWorldPoint(p(i, 0), p(i, 1), p(i, 2), 1.0);
+      r->WorldToDisplay();
+      const double* d = r->GetDisplayPoint();
+      const double distance = std::hypot(d[0] - x, d[1] - y);
+      if (distance <= nearest) {
+        nearest = distance;
+        best = i;
+      }
+    }
+    return best;
+  }
+
+  // Fixes a free control point or frees a fixed one; false if none is there.
+  bool toggleFixedAt(int x, int y) {
+    if (!view.controlLatticeShown()) return false;
+    const int point = controlPointAt(x, y);
+    if (point < 0) return false;
+    act([&] {
+      const bool fixed = sculpture.model().fixed()[point];
+      fixed ? sculpture.unfix({point}) : sculpture.fix({point});
+      message = std::string(fixed ? "unfixed" : "fixed") + " control point " + std::to_string(point);
+    });
+    return true;
+  }
+
   void scaleMaterial(double stiffness, double damping) {
     act([&] {
       SolidMaterial m = sculpture.settings().material;
@@ -247,6 +281,13 @@ class SculptorStyle : public vtkInteractorStyleTrackballCamera {
       return;
     }
     vtkInteractorStyleTrackballCamera::OnLeftButtonUp();
+  }
+
+  void OnRightButtonDown() override {
+    int x, y;
+    Interactor->GetEventPosition(x, y);
+    if (sculptor->toggleFixedAt(x, y)) return;
+    vtkInteractorStyleTrackballCamera::OnRightButtonDown();
   }
 
   void OnKeyPress() override {

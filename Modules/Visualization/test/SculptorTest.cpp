@@ -85,6 +85,19 @@ TEST_F(SculptorTest, EveryToolWorksFromTheMouseAndKeys) {
   press(sculptor, "U", 'U');
   EXPECT_EQ(fixedCount(s), 0);
 
+  // A right click on a control point fixes it, a second frees it; elsewhere
+  // it is the trackball's (nothing changes).
+  const Vector3 corner = s.rest().points().row(0).transpose();
+  const Eigen::Vector2d at = displayOf(sculptor, corner);
+  events::play(sculptor.interactor(), {mouse("RightButtonPressEvent", at), mouse("RightButtonReleaseEvent", at)});
+  EXPECT_TRUE(s.model().fixed()[0]);
+  EXPECT_EQ(fixedCount(s), 1);
+  events::play(sculptor.interactor(), {mouse("RightButtonPressEvent", at), mouse("RightButtonReleaseEvent", at)});
+  EXPECT_EQ(fixedCount(s), 0);
+  const Eigen::Vector2d away = at + Eigen::Vector2d(40, 40);
+  events::play(sculptor.interactor(), {mouse("RightButtonPressEvent", away), mouse("RightButtonReleaseEvent", away)});
+  EXPECT_EQ(fixedCount(s), 0);
+
   // d deletes the cell of the selected face (the arm's end); then nothing is selected.
   press(sculptor, "d", 'd');
   EXPECT_EQ(s.rest().cellCount(), 9);

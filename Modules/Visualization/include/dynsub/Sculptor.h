@@ -11,6 +11,7 @@
 //   d, Delete            delete the selected face's cell
 //   f / u                fix / unfix the selected face's control points
 //   U                    unfix all
+//   right click on a control point (within 8 px)   fix it, or unfix a fixed one
 //   p                    plasticity: the current shape becomes the rest shape
 //   k / K                stiffness down / up (x 0.8, x 1.25)
 //   g / G                damping down / up (x 0.8, x 1.25)
