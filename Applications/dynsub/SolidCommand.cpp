@@ -72,8 +72,6 @@ std::string writeSculpture(const std::filesystem::path& dir, const Sculpture& sc
     std::cerr << "warning: no figure written: " << why << '\n';
   }
   const SolidMaterial& m = sculpture.settings().material;
-  int fixed = 0;
-  for (bool f : sculpture.model().fixed()) fixed += f;
   report["level"] = sculpture.settings().levels;
   report["time_step_s"] = sculpture.settings().timeStep;
   report["scheme"] = o.scheme;
@@ -85,7 +83,7 @@ std::string writeSculpture(const std::filesystem::path& dir, const Sculpture& sc
   report["steps"] = sculpture.steps();
   report["simulated_seconds"] = sculpture.steps() * sculpture.settings().timeStep;
   report["control"] = countsJson(control);
-  report["fixed_control_points"] = fixed;
+  report["fixed_control_points"] = sculpture.model().fixedPoints().size();
   report["solid"] = countsJson(solid);
   report["kinetic_energy_n_mm"] = sculpture.model().kineticEnergy();
   report["spring_energy_n_mm"] = sculpture.model().springEnergy();

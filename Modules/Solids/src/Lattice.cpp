@@ -16,12 +16,6 @@ std::vector<int> sortedUnique(std::vector<int> v) {
   return v;
 }
 
-Vector3 centroidOf(const Matrix3X& points, const std::vector<int>& indices) {
-  Vector3 sum = Vector3::Zero();
-  for (int p : indices) sum += points.row(p).transpose();
-  return sum / static_cast<double>(indices.size());
-}
-
 // Newell's normal of a loop: its length is twice the area of a planar loop;
 // it points the way the loop runs counter-clockwise around.
 Vector3 newellNormal(const Matrix3X& points, const std::vector<int>& loop) {
@@ -32,6 +26,12 @@ Vector3 newellNormal(const Matrix3X& points, const std::vector<int>& loop) {
 }
 
 }  // namespace
+
+Vector3 centroidOf(const Matrix3X& points, const std::vector<int>& indices) {
+  Vector3 sum = Vector3::Zero();
+  for (int p : indices) sum += points.row(p).transpose();
+  return sum / static_cast<double>(indices.size());
+}
 
 Lattice Lattice::fromCells(Matrix3X points, std::vector<std::vector<int>> faces, std::vector<std::vector<int>> cells,
                            const std::string& source) {

@@ -9,12 +9,6 @@ namespace dynsub {
 
 namespace {
 
-Vector3 centroid(const Matrix3X& points, const std::vector<int>& indices) {
-  Vector3 sum = Vector3::Zero();
-  for (int i : indices) sum += points.row(i).transpose();
-  return sum / static_cast<double>(indices.size());
-}
-
 // Of the point sets `use` accepts, the one whose centroid is nearest `point`.
 template <typename Use>
 int nearestCentroid(const Matrix3X& points, const std::vector<std::vector<int>>& sets, const Vector3& point, Use use) {
@@ -22,20 +16,13 @@ int nearestCentroid(const Matrix3X& points, const std::vector<std::vector<int>>&
   double nearest = std::numeric_limits<double>::infinity();
   for (int i = 0; i < static_cast<int>(sets.size()); ++i) {
     if (!use(i)) continue;
-    const double d = (centroid(points, sets[i]) - point).squaredNorm();
+    const double d = (centroidOf(points, sets[i]) - point).squaredNorm();
     if (d < nearest) {
       nearest = d;
       best = i;
     }
   }
   return best;
-}
-
-std::vector<int> fixedPoints(const SolidModel& model) {
-  std::vector<int> fixed;
-  for (int i = 0; i < static_cast<int>(model.fixed().size()); ++i)
-    if (model.fixed()[i]) fixed.push_back(i);
-  return fixed;
 }
 
 }  // namespace
@@ -83,7 +70,7 @@ int Sculpture::extrude(int face) {
   // theirs, and the new cell's outer face is the first new face (Lattice.cpp).
   const Lattice grown = extrudeFace(current, face);
   const int outer = current.faceCount();
-  rebuild(extrudeFace(rest_, face), grown.points(), fixedPoints(*model_));
+  rebuild(extrudeFace(rest_, face), grown.points(), model_->fixedPoints());
   return outer;
 }
 
@@ -92,14 +79,14 @@ void Sculpture::deleteCell(int cell) {
   std::vector<int> kept;
   const Lattice smaller = dynsub::deleteCell(current, cell, &kept);
   std::vector<int> fixed;
-  for (int i : fixedPoints(*model_))
+  for (int i : model_->fixedPoints())
     if (kept[i] >= 0) fixed.push_back(kept[i]);
   rebuild(dynsub::deleteCell(rest_, cell), smaller.points(), fixed);
 }
 
 void Sculpture::fix(const std::vector<int>& points) { model_->fix(points); }
 void Sculpture::unfix(const std::vector<int>& points) { model_->unfix(points); }
-void Sculpture::unfixAll() { model_->unfix(fixedPoints(*model_)); }
+void Sculpture::unfixAll() { model_->unfix(model_->fixedPoints()); }
 
 void Sculpture::plasticity() {
   model_->resetRestLengths();

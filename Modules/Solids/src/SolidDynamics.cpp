@@ -75,6 +75,13 @@ void SolidModel::unfix(const std::vector<int>& points) {
   factor();
 }
 
+std::vector<int> SolidModel::fixedPoints() const {
+  std::vector<int> points;
+  for (int i = 0; i < control_.pointCount(); ++i)
+    if (fixed_[i]) points.push_back(i);
+  return points;
+}
+
 void SolidModel::factor() {
   auto solver = std::make_unique<Solver>();
   solver->freeIndex.assign(control_.pointCount(), -1);

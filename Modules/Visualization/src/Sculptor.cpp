@@ -81,8 +81,7 @@ struct Sculptor::Impl {
   void updateStatus() {
     const Lattice& control = sculpture.rest();
     const SolidMaterial& m = sculpture.settings().material;
-    int fixed = 0;
-    for (bool f : sculpture.model().fixed()) fixed += f;
+    const std::size_t fixed = sculpture.model().fixedPoints().size();
     std::ostringstream text;
     text << control.cellCount() << " cells, " << control.pointCount() << " control points (" << fixed
          << " fixed)  |  t = " << std::fixed << std::setprecision(1)

@@ -79,6 +79,9 @@ class Lattice {
 //    old point, or -1 for a removed one. The faces it shared come to the
 //    surface turned counter-clockwise seen from outside.
 Lattice extrudeFace(const Lattice& lattice, int face);
+// The average of the rows `indices` of `points` (a face's or a cell's centre).
+Vector3 centroidOf(const Matrix3X& points, const std::vector<int>& indices);
+
 // Whether `face` runs counter-clockwise seen from outside `cell` (its Newell
 // normal points away from the cell's centroid): how a boundary face should run
 // with `cell` its cell.

@@ -60,6 +60,7 @@ class SolidModel {
   void fix(const std::vector<int>& controlPoints);
   void unfix(const std::vector<int>& controlPoints);
   const std::vector<bool>& fixed() const { return fixed_; }
+  std::vector<int> fixedPoints() const;  // the fixed control points' indices
 
   // The rope tool: a spring from mass point `dataPoint` to `target`.
   void rope(int dataPoint, const Vector3& target, double stiffness);
