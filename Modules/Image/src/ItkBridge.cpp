@@ -93,12 +93,13 @@ bool isDicomFile(const fs::path& file) {
 // little endian), then a data set in either uncompressed little-endian
 // transfer syntax (explicit or implicit VR), sequences and items of undefined
 // length included, and encapsulated pixel data fragment by fragment. A data
-// set in another transfer syntax (deflated, big endian) is left to GDCM.
+// set in another transfer syntax (deflated, big endian) is left to GDCM:
+// run() says whether the whole file was walked.
 class DicomWalk {
  public:
   explicit DicomWalk(const fs::path& file) : file_(file), size_(fs::file_size(file)), in_(file, std::ios::binary) {}
 
-  void run() {
+  bool run() {
     std::uintmax_t at = 132;
     // The meta header: explicit VR little endian, group 0002, first; its
     // length, when given (0002,0000), must be there too.
@@ -111,9 +112,10 @@ class DicomWalk {
     if (syntax_ == "1.2.840.10008.1.2") {
       explicitVr_ = false;
     } else if (syntax_ != "1.2.840.10008.1.2.1" && !isEncapsulated()) {
-      return;  // deflated or big endian: GDCM's alone
+      return false;  // deflated or big endian: GDCM's alone
     }
     elements(at, false);
+    return true;
   }
 
  private:
@@ -214,19 +216,35 @@ class DicomWalk {
   std::string syntax_;
 };
 
-void requireWholeDicomFile(const fs::path& file) { DicomWalk(file).run(); }
+// The files of a directory that say they are DICOM, each walked (DicomWalk)
+// before GDCM sees any of them.
+struct DicomFile {
+  fs::path path, canonical;
+  bool walked;  // wholly checked by the walk (else GDCM must tell)
+};
+
+std::vector<DicomFile> walkDicomFiles(const std::string& directory) {
+  std::vector<DicomFile> files;
+  for (const auto& entry : fs::directory_iterator(directory))
+    if (entry.is_regular_file() && isDicomFile(entry.path()))
+      files.push_back({entry.path(), fs::weakly_canonical(entry.path()), DicomWalk(entry.path()).run()});
+  return files;
+}
 
 // GDCM leaves out of a series the files it cannot parse, and reads a slice
 // whose pixel data is cut short with only a warning: either would silently
-// become a gap or a slice of garbage. So every file of the series must read
-// whole (GDCM's warnings are caught to tell), and every other file of the
-// directory that says it is DICOM ("DICM" after the 128-byte preamble) is an
-// error too.
-void requireWholeSeries(const std::string& directory, const std::vector<std::string>& files) {
+// become a gap or a slice of garbage. So every file of the series must be
+// whole: walked (`dicomFiles`), or else read by GDCM with its warnings caught
+// to tell; and every other DICOM file of the directory is an error.
+void requireWholeSeries(const std::vector<std::string>& files, const std::vector<DicomFile>& dicomFiles) {
   std::vector<fs::path> inSeries;
-  // ITK turns GDCM's warnings off; they are on, and caught, while checking.
-  const bool warningsWereOn = gdcm::Trace::GetWarningFlag();
   for (const std::string& file : files) {
+    inSeries.push_back(fs::weakly_canonical(file));
+    const auto known = std::find_if(dicomFiles.begin(), dicomFiles.end(),
+                                    [&](const DicomFile& d) { return d.canonical == inSeries.back(); });
+    if (known != dicomFiles.end() && known->walked) continue;
+    // ITK turns GDCM's warnings off; they are on, and caught, while checking.
+    const bool warningsWereOn = gdcm::Trace::GetWarningFlag();
     std::ostringstream warnings;
     gdcm::Trace::WarningOn();
     gdcm::Trace::SetWarningStream(warnings);
@@ -237,17 +255,15 @@ void requireWholeSeries(const std::string& directory, const std::vector<std::str
     gdcm::Trace::SetWarning(warningsWereOn);
     if (!read || warnings.str().find("Incomplete Pixel Data") != std::string::npos)
       throw Error(file, "a DICOM file of the series is truncated or corrupt");
-    inSeries.push_back(fs::weakly_canonical(file));
   }
-  for (const auto& entry : fs::directory_iterator(directory)) {
-    if (!entry.is_regular_file() || !isDicomFile(entry.path())) continue;
+  for (const DicomFile& d : dicomFiles) {
     // A media directory (DICOMDIR) indexes the files; it is not part of a series.
-    std::string name = entry.path().filename().string();
+    std::string name = d.path.filename().string();
     std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return std::toupper(c); });
     if (name == "DICOMDIR") continue;
-    if (std::find(inSeries.begin(), inSeries.end(), fs::weakly_canonical(entry.path())) == inSeries.end())
-      throw Error(entry.path().string(), "a DICOM file that cannot be read with the rest of the series "
-                                         "(truncated or corrupt?)");
+    if (std::find(inSeries.begin(), inSeries.end(), d.canonical) == inSeries.end())
+      throw Error(d.path.string(), "a DICOM file that cannot be read with the rest of the series "
+                                   "(truncated or corrupt?)");
   }
 }
 
@@ -272,8 +288,7 @@ void readImage(const std::string& path, Geometry& geometry, std::vector<float>& 
     FloatImage::Pointer image;
     std::error_code ignored;
     if (fs::is_directory(path, ignored)) {
-      for (const auto& entry : fs::directory_iterator(path))
-        if (entry.is_regular_file() && isDicomFile(entry.path())) requireWholeDicomFile(entry.path());
+      const std::vector<DicomFile> dicomFiles = walkDicomFiles(path);
       // ITK's warnings (no series, uneven slices) would only repeat, less
       // clearly, what the checks here report as errors.
       const WarningsOff quiet;
@@ -285,7 +300,7 @@ void readImage(const std::string& path, Geometry& geometry, std::vector<float>& 
       if (series.size() > 1)
         throw Error(path, "directory holds " + std::to_string(series.size()) + " DICOM series; give one series");
       const std::vector<std::string> files = names->GetFileNames(series.front());
-      requireWholeSeries(path, files);
+      requireWholeSeries(files, dicomFiles);
       auto reader = itk::ImageSeriesReader<FloatImage>::New();
       reader->SetImageIO(itk::GDCMImageIO::New());
       reader->SetFileNames(files);
