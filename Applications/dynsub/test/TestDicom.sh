@@ -56,34 +56,31 @@ PY
 broken() {  # broken NAME: a copy of the series to break
   cp -r "$work/phantom/series" "$work/$1"
 }
-broken header
-head -c 700 "$work/phantom/series/slice_007.dcm" >"$work/header/slice_007.dcm"
-expect_error "a slice cut short in its header" "slice_007.dcm: a truncated DICOM file" "$work/o1" \
-  "$DYNSUB" segment "$work/header" --landmarks "$work/phantom/ball.csv" --out "$work/o1"
-broken sequence
-head -c 460 "$work/phantom/series/slice_007.dcm" >"$work/sequence/slice_007.dcm"
-expect_error "a slice cut short in a sequence of undefined length" "slice_007.dcm: a truncated DICOM file" "$work/o6" \
-  "$DYNSUB" segment "$work/sequence" --landmarks "$work/phantom/ball.csv" --out "$work/o6"
-broken metaonly
-head -c 320 "$work/phantom/series/slice_007.dcm" >"$work/metaonly/slice_007.dcm"
-expect_error "a slice of nothing but its meta header" "nothing follows the meta header" "$work/o7" \
-  "$DYNSUB" segment "$work/metaonly" --landmarks "$work/phantom/ball.csv" --out "$work/o7"
-broken pixels
-head -c 2000 "$work/phantom/series/slice_010.dcm" >"$work/pixels/slice_010.dcm"
-expect_error "a slice cut short in its pixels" "slice_010.dcm: a truncated DICOM file: element (7fe0,0010)" "$work/o2" \
-  "$DYNSUB" segment "$work/pixels" --landmarks "$work/phantom/ball.csv" --out "$work/o2"
+rejects() {  # rejects NAME FRAGMENT DIR: segment on $work/DIR fails with FRAGMENT and writes nothing
+  expect_error "$1" "$2" "$work/out_$3" \
+    "$DYNSUB" segment "$work/$3" --landmarks "$work/phantom/ball.csv" --out "$work/out_$3"
+}
+cut() {  # cut NAME SLICE BYTES: a copy of the series with one slice cut to its first BYTES
+  broken "$1"
+  head -c "$3" "$work/phantom/series/$2" >"$work/$1/$2"
+}
+cut header slice_007.dcm 700
+rejects "a slice cut short in its header" "slice_007.dcm: a truncated DICOM file" header
+cut sequence slice_007.dcm 460
+rejects "a slice cut short in a sequence of undefined length" "slice_007.dcm: a truncated DICOM file" sequence
+cut metaonly slice_007.dcm 320
+rejects "a slice of nothing but its meta header" "nothing follows the meta header" metaonly
+cut pixels slice_010.dcm 2000
+rejects "a slice cut short in its pixels" "slice_010.dcm: a truncated DICOM file: element (7fe0,0010)" pixels
 broken gap
 rm "$work/gap/slice_012.dcm"
-expect_error "a missing slice" "not evenly spaced" "$work/o3" \
-  "$DYNSUB" segment "$work/gap" --landmarks "$work/phantom/ball.csv" --out "$work/o3"
+rejects "a missing slice" "not evenly spaced" gap
 broken two
 dcmodify -nb -m "(0020,000e)=1.2.826.0.1.3680043.10.1347.9" "$work/two/slice_005.dcm"
-expect_error "two series" "holds 2 DICOM series" "$work/o4" \
-  "$DYNSUB" segment "$work/two" --landmarks "$work/phantom/ball.csv" --out "$work/o4"
+rejects "two series" "holds 2 DICOM series" two
 mkdir "$work/none"
 echo "not an image" >"$work/none/README.txt"
-expect_error "no series" "holds no DICOM series" "$work/o5" \
-  "$DYNSUB" segment "$work/none" --landmarks "$work/phantom/ball.csv" --out "$work/o5"
+rejects "no series" "holds no DICOM series" none
 
 echo "$failures failure(s)"
 test "$failures" -eq 0
