@@ -29,6 +29,10 @@ struct SegmentCommandOptions {
   std::string reference;
   std::vector<int> referenceLabels;
   std::string potential = "edges";
+  std::string edgeReference = "landmarks";
+  double edgeLow = 0, edgeHigh = 0;  // used only when given (CLI::Option::count)
+  const CLI::Option* edgeLowOption = nullptr;
+  const CLI::Option* edgeHighOption = nullptr;
   SegmentOptions segment;
   SimulationArguments simulation;
   FigureOptions figures;
@@ -66,9 +70,20 @@ nlohmann::ordered_json metricsJson(const OverlapMetrics& m) {
           {"reference_volume_mm3", m.volumeB}};
 }
 
+const char* referenceName(EdgeReference reference) {
+  return reference == EdgeReference::Landmarks ? "landmarks" : "image";
+}
+
 void runSegment(SegmentCommandOptions o) {
   if (o.potential == "gradient") o.segment.edges.method = EdgeMethod::GradientMagnitude;
   o.segment.simulation = o.simulation.apply(o.segment.simulation);
+  // --edge-low / --edge-high are fractions of the reference that will be used.
+  EdgeOptions& edges = o.segment.edges;
+  edges.reference = o.edgeReference == "image" ? EdgeReference::Image : EdgeReference::Landmarks;
+  Hysteresis& thresholds =
+      edges.reference == EdgeReference::Landmarks && !o.landmarks.empty() ? edges.ofLandmarks : edges.ofImage;
+  if (o.edgeLowOption->count()) thresholds.low = o.edgeLow;
+  if (o.edgeHighOption->count()) thresholds.high = o.edgeHigh;
   checkSegmentOptions(o.segment);
   if (!o.reference.empty() && o.referenceLabels.empty())
     throw Error("--reference needs --reference-label N[,M...]: the label value(s) of the structure");
@@ -145,8 +160,13 @@ void runSegment(SegmentCommandOptions o) {
   nlohmann::ordered_json parameters = simulationJson(o.segment.simulation);
   parameters["potential"] = o.potential;
   parameters["sigma_mm"] = o.segment.edges.sigma;
-  parameters["edge_low"] = o.segment.edges.lowThreshold;
-  parameters["edge_high"] = o.segment.edges.highThreshold;
+  if (o.segment.edges.method == EdgeMethod::MongaDeriche) {
+    const EdgeScale& scale = result.edgeScale;
+    parameters["edge_reference"] = referenceName(scale.reference);
+    parameters["edge_reference_magnitude"] = scale.magnitude;
+    parameters["edge_low"] = scale.fractions.low;
+    parameters["edge_high"] = scale.fractions.high;
+  }
   parameters["capture_range_mm"] = o.segment.edges.captureRange;
   parameters["image_force"] = o.segment.imageForce;
   parameters["landmark_stiffness"] = o.segment.landmarkStiffness;
@@ -199,11 +219,23 @@ void addSegmentCommand(CLI::App& app) {
       ->default_val("edges");
   command->add_option("--sigma", o->segment.edges.sigma, "Gaussian smoothing of the edge detector, mm")
       ->default_val(o->segment.edges.sigma);
-  command->add_option("--edge-low", o->segment.edges.lowThreshold,
-                      "Hysteresis low threshold, fraction of the 99th-percentile gradient")
-      ->default_val(o->segment.edges.lowThreshold);
-  command->add_option("--edge-high", o->segment.edges.highThreshold, "Hysteresis high threshold, same unit")
-      ->default_val(o->segment.edges.highThreshold);
+  const EdgeOptions edgeDefaults;
+  command->add_option("--edge-reference", o->edgeReference,
+                      "What the edge thresholds are fractions of: landmarks (the median gradient at the "
+                      "landmarks, the boundary the expert marked; the image's without landmarks) or image "
+                      "(the 99th-percentile gradient)")
+      ->check(CLI::IsMember({"landmarks", "image"}))
+      ->default_val("landmarks");
+  std::ostringstream lowHelp, highHelp;
+  lowHelp << "Hysteresis low threshold, a fraction of the edge reference (default " << edgeDefaults.ofLandmarks.low
+          << " of the landmarks', " << edgeDefaults.ofImage.low << " of the image's)";
+  highHelp << "Hysteresis high threshold, the same unit (default " << edgeDefaults.ofLandmarks.high
+           << " of the landmarks', " << edgeDefaults.ofImage.high << " of the image's)";
+  command->add_option("--edge-landmark-reach", o->segment.edges.landmarkReach,
+                      "With --edge-reference landmarks, a landmark's edge is the strongest gradient this close, mm")
+      ->default_val(o->segment.edges.landmarkReach);
+  o->edgeLowOption = command->add_option("--edge-low", o->edgeLow, lowHelp.str());
+  o->edgeHighOption = command->add_option("--edge-high", o->edgeHigh, highHelp.str());
   command->add_option("--capture-range", o->segment.edges.captureRange, "Distance from edges with a force, mm")
       ->default_val(o->segment.edges.captureRange);
   command->add_option("--image-force", o->segment.imageForce, "Image force k, N/mm^2 of surface")

@@ -146,9 +146,23 @@ expect_error "view: missing image" 1 "no such file" "$work/v2" \
 expect_error "view: unreadable landmarks" 1 "unknown landmark format" "$work/v3" \
   "$DYNSUB" view "$mri/ch2.nii.gz" --landmarks "$work/points.txt" --surface "$work/v3"
 for key in dice jaccard volume_difference_percent mean_surface_distance_mm hd95_mm hausdorff_mm stage_seconds \
-  landmark_residuals final_energy; do
+  landmark_residuals final_energy edge_reference_magnitude; do
   check "segment report has $key" grep -q "\"$key\"" "$work/caudate/report.json"
 done
+check "segment's edge thresholds come from the landmarks" \
+  grep -q '"edge_reference": "landmarks"' "$work/caudate/report.json"
+# --edge-reference image, and no landmarks, use the image's percentile; the
+# thresholds given apply to the reference in use.
+"$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:-12,10,12,5 --max-level 0 --edge-high 0.3 --no-figures \
+  --out "$work/by_image" >/dev/null 2>&1
+check "segment without landmarks: edge thresholds from the image" \
+  grep -q '"edge_reference": "image"' "$work/by_image/report.json"
+check "segment: --edge-high sets the image's fraction" grep -q '"edge_high": 0.3,' "$work/by_image/report.json"
+expect_error "NaN edge threshold" 1 "edge thresholds" "$work/s9" \
+  "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --edge-low nan \
+  --out "$work/s9"
+expect_error "unknown edge reference" 2 "edge-reference" "$work/s10" \
+  "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:-10,10,10,5 --edge-reference scanner --out "$work/s10"
 expect_error "missing image" 1 "no such file" "$work/s1" \
   "$DYNSUB" segment "$work/none.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --out "$work/s1"
 printf 'x,y,z\n500,0,0\n10,10,10\n12,10,10\n10,12,10\n10,10,12\n' >"$work/outside.csv"

@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Segmenting the Colin27 MRI (Debian package mricron-data) against the expert
 # AAL atlas drawn on the same brain, with default parameters:
-#  - the left caudate from the demo's 36 landmarks (the one structure the
+#  - the left caudate from the demo's 36 landmarks (the structure the
 #    defaults were tuned on);
-#  - the cerebellum from 30 landmarks on 5 sagittal slices, and the left
-#    thalamus and left putamen from 36 on 6 coronal slices, none tuned on.
+#  - the cerebellum from 30 landmarks on 5 sagittal slices (looked at, with
+#    others, when the edge thresholds were chosen), and the left thalamus
+#    (not tuned on) and left putamen from 36 on 6 coronal slices.
 # Each must reach Dice >= 0.85 (the bar). Landmarks not in Data/ are
 # made the same way as those in Data/ (Tools/landmarks_from_labels.py).
 # Needs DYNSUB (the executable), DATA and TOOLS.

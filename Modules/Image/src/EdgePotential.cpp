@@ -31,13 +31,45 @@ double percentile(std::vector<float> values, double fraction) {
   return *at;
 }
 
-// Steps 2 and 3 of the header: non-maximum suppression along the gradient, then hysteresis.
-Mask edgeMap(const Volume& magnitude, const std::vector<Vector3>& gradient, const EdgeOptions& options) {
+// The strongest gradient magnitude within `radius` mm of a point: the height
+// of the edge an expert meant when clicking next to it.
+double strongestNear(const Volume& magnitude, const Vector3& point, double radius) {
   const ImageGeometry& g = magnitude.geometry;
-  const double scale = percentile(magnitude.voxels, 0.99);
+  const Vector3 centre = g.toIndex(point);
+  double strongest = 0;
+  int reach[3];
+  for (int a = 0; a < 3; ++a) reach[a] = static_cast<int>(std::ceil(radius / g.spacing[a]));
+  const int ci = static_cast<int>(std::lround(centre[0])), cj = static_cast<int>(std::lround(centre[1])),
+            ck = static_cast<int>(std::lround(centre[2]));
+  for (int k = ck - reach[2]; k <= ck + reach[2]; ++k)
+    for (int j = cj - reach[1]; j <= cj + reach[1]; ++j)
+      for (int i = ci - reach[0]; i <= ci + reach[0]; ++i)
+        if (g.contains(i, j, k) && (g.toPhysical(Vector3(i, j, k)) - point).norm() <= radius)
+          strongest = std::max(strongest, static_cast<double>(magnitude.at(i, j, k)));
+  return strongest;
+}
+
+// The reference magnitude and fractions of step 3 (see the header). Landmarks
+// in a flat part of the image (no gradient at all near them) cannot set a
+// scale; the image's percentile is used then.
+EdgeScale edgeScale(const Volume& magnitude, const EdgeOptions& options, const Matrix3X& landmarks) {
+  if (options.reference == EdgeReference::Landmarks && landmarks.rows() > 0) {
+    std::vector<float> strengths;
+    for (Eigen::Index p = 0; p < landmarks.rows(); ++p)
+      strengths.push_back(
+          static_cast<float>(strongestNear(magnitude, landmarks.row(p).transpose(), options.landmarkReach)));
+    const double median = percentile(strengths, 0.5);
+    if (median > 0) return {EdgeReference::Landmarks, median, options.ofLandmarks};
+  }
+  return {EdgeReference::Image, percentile(magnitude.voxels, 0.99), options.ofImage};
+}
+
+// Steps 2 and 3 of the header: non-maximum suppression along the gradient, then hysteresis.
+Mask edgeMap(const Volume& magnitude, const std::vector<Vector3>& gradient, const EdgeScale& scale) {
+  const ImageGeometry& g = magnitude.geometry;
   Mask edges{g, std::vector<std::uint8_t>(magnitude.voxels.size(), 0)};
-  if (!(scale > 0)) return edges;  // a constant image has no edges
-  const double low = options.lowThreshold * scale, high = options.highThreshold * scale;
+  if (!(scale.magnitude > 0)) return edges;  // a constant image has no edges
+  const double low = scale.fractions.low * scale.magnitude, high = scale.fractions.high * scale.magnitude;
   // A physical direction d moves the continuous index by (D^-1 d) / spacing; one
   // step is the smallest spacing long.
   const Matrix3 toIndex = g.indexFromPhysical();
@@ -116,14 +148,22 @@ void normalizedGradient(const Volume& potential, const std::vector<std::uint8_t>
 void checkEdgeOptions(const EdgeOptions& options) {
   if (!(options.sigma > 0) || !std::isfinite(options.sigma))
     throw Error("edge sigma must be a positive number of mm (got " + std::to_string(options.sigma) + ")");
-  if (!(options.lowThreshold >= 0 && options.lowThreshold <= options.highThreshold && options.highThreshold <= 1))
-    throw Error("edge thresholds must satisfy 0 <= low <= high <= 1 (got " + std::to_string(options.lowThreshold) +
-                ", " + std::to_string(options.highThreshold) + ")");
+  auto checkHysteresis = [](const Hysteresis& h, const std::string& of) {
+    if (!(h.low >= 0 && h.low <= h.high && std::isfinite(h.high)))
+      throw Error("edge thresholds (fractions of " + of + ") must satisfy 0 <= low <= high (got " +
+                  std::to_string(h.low) + ", " + std::to_string(h.high) + ")");
+  };
+  checkHysteresis(options.ofLandmarks, "the landmarks' median gradient");
+  checkHysteresis(options.ofImage, "the image's 99th-percentile gradient");
+  if (!(options.landmarkReach >= 0) || !std::isfinite(options.landmarkReach))
+    throw Error("the landmarks' edge search radius must be a number of mm >= 0 (got " +
+                std::to_string(options.landmarkReach) + ")");
   if (!(options.captureRange > 0) || !std::isfinite(options.captureRange))
     throw Error("capture range must be a positive number of mm (got " + std::to_string(options.captureRange) + ")");
 }
 
-DirectionField::DirectionField(const Volume& image, const EdgeOptions& options) : geometry_(image.geometry) {
+DirectionField::DirectionField(const Volume& image, const EdgeOptions& options, const Matrix3X& landmarks)
+    : geometry_(image.geometry) {
   checkEdgeOptions(options);
   const std::vector<Vector3> gradient = smoothedGradient(image, options.sigma);
   const Volume magnitude = magnitudeOf(image.geometry, gradient);
@@ -131,7 +171,8 @@ DirectionField::DirectionField(const Volume& image, const EdgeOptions& options) 
     normalizedGradient(magnitude, std::vector<std::uint8_t>(magnitude.voxels.size(), 1), components_);
     return;
   }
-  edges_ = edgeMap(magnitude, gradient, options);
+  scale_ = edgeScale(magnitude, options, landmarks);
+  edges_ = edgeMap(magnitude, gradient, scale_);
   // P = -distance to the nearest edge (see the header).
   Volume potential{image.geometry, itkbridge::distanceMap(toBridge(image.geometry), edges_.voxels)};
   std::vector<std::uint8_t> keep(potential.voxels.size());

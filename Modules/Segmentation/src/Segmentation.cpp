@@ -118,7 +118,8 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
   result.seconds.crop = secondsSince(clock);
 
   clock = Clock::now();
-  const DirectionField directions(region, options.edges);
+  const DirectionField directions(region, options.edges, landmarkPoints);
+  result.edgeScale = directions.scale();
   result.seconds.potential = secondsSince(clock);
 
   clock = Clock::now();

@@ -9,10 +9,18 @@
 //  2. 3D non-maximum suppression: a voxel is an edge candidate when its
 //     gradient magnitude is at least the magnitude one voxel-length ahead and
 //     behind along its own gradient direction (trilinear interpolation).
-//  3. Hysteresis: candidates at or above `highThreshold` are edges, and so are
-//     candidates at or above `lowThreshold` 26-connected to an edge. Both are
-//     fractions of the 99th percentile of the gradient magnitude in the image,
-//     so they do not depend on the scanner's intensity scale.
+//  3. Hysteresis: candidates at or above the high threshold are edges, and so
+//     are candidates at or above the low threshold 26-connected to an edge.
+//     Both thresholds are fractions of a reference gradient magnitude, so they
+//     do not depend on the scanner's intensity scale (EdgeReference):
+//     - with landmarks, the median magnitude at them: the strength of the
+//       boundary the expert marked. Edges are kept when they are about as
+//       strong as that boundary (0.75 / 1.25 of it), so the weaker edges
+//       inside a textured structure (the cerebellum's folia, the hippocampus'
+//       layers) do not hold the surface in, and a faint structure (the
+//       caudate against the internal capsule) keeps its faint edges;
+//     - without landmarks, the image's 99th-percentile magnitude (0.10 / 0.25
+//       of it).
 //  4. P = -d, with d the Euclidean distance (mm, the image's spacing) to the
 //     nearest edge voxel (itk::SignedMaurerDistanceMapImageFilter), so that
 //     grad(P) / |grad(P)| is the unit vector towards the nearest edge. It is
@@ -34,12 +42,31 @@ namespace dynsub {
 
 enum class EdgeMethod { MongaDeriche, GradientMagnitude };
 
+// What the hysteresis thresholds are fractions of (step 3 above).
+enum class EdgeReference {
+  Landmarks,  // the median gradient magnitude at the landmarks; the image's when there are none
+  Image,      // the 99th-percentile gradient magnitude in the image
+};
+
+struct Hysteresis {
+  double low, high;  // fractions of the reference magnitude, low <= high
+};
+
 struct EdgeOptions {
   EdgeMethod method = EdgeMethod::MongaDeriche;
-  double sigma = 1.0;           // mm, Gaussian smoothing of the derivative filters
-  double lowThreshold = 0.10;   // hysteresis, fraction of the 99th-percentile gradient magnitude
-  double highThreshold = 0.25;
-  double captureRange = 6.0;    // mm
+  double sigma = 1.0;  // mm, Gaussian smoothing of the derivative filters
+  EdgeReference reference = EdgeReference::Landmarks;
+  Hysteresis ofLandmarks{0.75, 1.0};   // used when the reference is the landmarks' median
+  double landmarkReach = 1.0;          // mm: a landmark's edge is the strongest magnitude this close
+  Hysteresis ofImage{0.10, 0.25};      // used when it is the image's 99th percentile
+  double captureRange = 6.0;           // mm
+};
+
+// The thresholds an edge map was built with, for reports.
+struct EdgeScale {
+  EdgeReference reference = EdgeReference::Image;  // the one used
+  double magnitude = 0;                            // the reference magnitude, intensity per mm
+  Hysteresis fractions{0, 0};
 };
 
 // Throws dynsub::Error for non-finite or impossible options.
@@ -48,7 +75,9 @@ void checkEdgeOptions(const EdgeOptions& options);
 // Unit force directions (LPS) on the image's grid, and the edge map they come from.
 class DirectionField {
  public:
-  DirectionField(const Volume& image, const EdgeOptions& options);
+  // `landmarks` (N x 3, mm) are points on the wanted boundary; they set the
+  // edge thresholds when options.reference is Landmarks (see above).
+  DirectionField(const Volume& image, const EdgeOptions& options, const Matrix3X& landmarks = Matrix3X());
 
   // N points in mm -> N unit (or zero) vectors, trilinearly interpolated.
   Matrix3X sample(const Matrix3X& points) const;
@@ -58,9 +87,11 @@ class DirectionField {
   double slopeBound() const;
 
   const Mask& edges() const { return edges_; }  // MongaDeriche only (else empty)
+  const EdgeScale& scale() const { return scale_; }  // MongaDeriche only
 
  private:
   ImageGeometry geometry_;
+  EdgeScale scale_;
   Volume components_[3];
   Mask edges_;
 };

@@ -48,6 +48,7 @@ struct SegmentResult {
   std::vector<LevelSummary> levels;
   int steps = 0;
   StageSeconds seconds;
+  EdgeScale edgeScale;  // the edge thresholds used
   std::vector<double> landmarkDistances;  // mm, final distance of each landmark to the surface
   std::array<int, 3> regionFirst{}, regionSize{};  // the region of interest (voxel box)
 };
