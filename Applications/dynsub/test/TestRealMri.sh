@@ -8,6 +8,9 @@
 #    (not tuned on) and left putamen from 36 on 6 coronal slices.
 # Each must reach Dice >= 0.85 (the issue's bar). Landmarks not in Data/ are
 # made the same way as those in Data/ (Tools/landmarks_from_labels.py).
+# Below the bar, a guard: the cerebellum from 12 landmarks on 4 sagittal slices
+# measures 0.833 with the edge thresholds set by the landmarks and 0.709 with
+# the image's percentile (Documentation/Segmentation.md); it must stay >= 0.80.
 # Needs DYNSUB (the executable), DATA and TOOLS.
 set -u
 templates=/usr/share/mricron/templates
@@ -19,7 +22,8 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 source "$(dirname "${BASH_SOURCE[0]}")/Checks.sh"
 
-# segment_structure NAME LANDMARKS LABEL...
+# segment_structure NAME LANDMARKS LABEL... (Dice bar: $bar)
+bar=0.85
 segment_structure() {
   local name=$1 landmarks=$2; shift 2
   "$DYNSUB" segment "$templates/ch2.nii.gz" --landmarks "$landmarks" --reference "$templates/aal.nii.gz" \
@@ -28,7 +32,7 @@ segment_structure() {
   cat "$work/$name.log"
   local dice
   dice=$(sed -n 's/^  "dice": \([-0-9.e+]*\),$/\1/p' "$work/$name/report.json" 2>/dev/null)
-  check "$name: Dice $dice >= 0.85" awk -v d="$dice" 'BEGIN { exit !(d != "" && d >= 0.85) }'
+  check "$name: Dice $dice >= $bar" awk -v d="$dice" -v bar="$bar" 'BEGIN { exit !(d != "" && d >= bar) }'
 }
 
 segment_structure caudate_left "$DATA/Landmarks/caudate_left.mrk.json" 71
@@ -66,6 +70,9 @@ for structure in thalamus_left:77 putamen_left:73; do
   python3 "$TOOLS/landmarks_from_labels.py" "$templates/aal.nii.gz" "$label" coronal 6 6 "$work/$name.mrk.json" >/dev/null
   segment_structure "$name" "$work/$name.mrk.json" "$label"
 done
+python3 "$TOOLS/landmarks_from_labels.py" "$templates/aal.nii.gz" "$(seq -s, 91 116)" sagittal 4 3 \
+  "$work/cerebellum12.mrk.json" >/dev/null
+bar=0.80 segment_structure cerebellum_12_points "$work/cerebellum12.mrk.json" $(seq 91 116)
 
 echo "$failures failure(s)"
 test "$failures" -eq 0
