@@ -8,6 +8,8 @@
 #    (not tuned on) and left putamen from 36 on 6 coronal slices.
 # Each must reach Dice >= 0.85 (the bar). Landmarks not in Data/ are
 # made the same way as those in Data/ (Tools/landmarks_from_labels.py).
+# The cerebellum from 15 landmarks (3 on each of 5 sagittal slices, made after
+# the edge thresholds were chosen) must reach the bar too; it measures 0.861.
 # Below the bar, a guard: the cerebellum from 12 landmarks on 4 sagittal slices
 # measures 0.833 with the edge thresholds set by the landmarks and 0.709 with
 # the image's percentile (Documentation/Segmentation.md); it must stay >= 0.80.
@@ -70,6 +72,9 @@ for structure in thalamus_left:77 putamen_left:73; do
   python3 "$TOOLS/landmarks_from_labels.py" "$templates/aal.nii.gz" "$label" coronal 6 6 "$work/$name.mrk.json" >/dev/null
   segment_structure "$name" "$work/$name.mrk.json" "$label"
 done
+python3 "$TOOLS/landmarks_from_labels.py" "$templates/aal.nii.gz" "$(seq -s, 91 116)" sagittal 5 3 \
+  "$work/cerebellum15.mrk.json" >/dev/null
+segment_structure cerebellum_15_points "$work/cerebellum15.mrk.json" $(seq 91 116)
 python3 "$TOOLS/landmarks_from_labels.py" "$templates/aal.nii.gz" "$(seq -s, 91 116)" sagittal 4 3 \
   "$work/cerebellum12.mrk.json" >/dev/null
 bar=0.80 segment_structure cerebellum_12_points "$work/cerebellum12.mrk.json" $(seq 91 116)
