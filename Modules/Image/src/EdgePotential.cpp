@@ -155,8 +155,8 @@ void checkEdgeOptions(const EdgeOptions& options) {
   };
   checkHysteresis(options.ofLandmarks, "the landmarks' median gradient");
   checkHysteresis(options.ofImage, "the image's 99th-percentile gradient");
-  if (!(options.landmarkReach >= 0) || !std::isfinite(options.landmarkReach))
-    throw Error("the landmarks' edge search radius must be a number of mm >= 0 (got " +
+  if (!(options.landmarkReach > 0) || !std::isfinite(options.landmarkReach))
+    throw Error("the landmarks' edge search radius must be a positive number of mm (got " +
                 std::to_string(options.landmarkReach) + ")");
   if (!(options.captureRange > 0) || !std::isfinite(options.captureRange))
     throw Error("capture range must be a positive number of mm (got " + std::to_string(options.captureRange) + ")");

@@ -13,12 +13,13 @@
 //     are candidates at or above the low threshold 26-connected to an edge.
 //     Both thresholds are fractions of a reference gradient magnitude, so they
 //     do not depend on the scanner's intensity scale (EdgeReference):
-//     - with landmarks, the median magnitude at them: the strength of the
-//       boundary the expert marked. Edges are kept when they are about as
-//       strong as that boundary (0.75 / 1.25 of it), so the weaker edges
-//       inside a textured structure (the cerebellum's folia, the hippocampus'
-//       layers) do not hold the surface in, and a faint structure (the
-//       caudate against the internal capsule) keeps its faint edges;
+//     - with landmarks, the median over them of the strongest magnitude within
+//       `landmarkReach` mm (1) of each: the strength of the boundary the
+//       expert marked. Edges are kept when they are about as strong as that
+//       boundary (0.75 / 1.0 of it), so the weaker edges inside a textured
+//       structure (the cerebellum's folia, the hippocampus' layers) do not
+//       hold the surface in, and a faint structure (the caudate against the
+//       internal capsule) keeps its faint edges;
 //     - without landmarks, the image's 99th-percentile magnitude (0.10 / 0.25
 //       of it).
 //  4. P = -d, with d the Euclidean distance (mm, the image's spacing) to the
