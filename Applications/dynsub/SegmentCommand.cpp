@@ -223,9 +223,9 @@ void addSegmentCommand(CLI::App& app) {
       ->default_val(o->segment.edges.sigma);
   const EdgeOptions edgeDefaults;
   command->add_option("--edge-reference", o->edgeReference,
-                      "What the edge thresholds are fractions of: landmarks (the median gradient at the "
-                      "landmarks, the boundary the expert marked; the image's without landmarks) or image "
-                      "(the 99th-percentile gradient)")
+                      "What the edge thresholds are fractions of: landmarks (the median over the landmarks "
+                      "of the strongest gradient within --edge-landmark-reach of each, the boundary the expert "
+                      "marked; the image's without landmarks) or image (the 99th-percentile gradient)")
       ->check(CLI::IsMember({"landmarks", "image"}))
       ->default_val("landmarks");
   std::ostringstream lowHelp, highHelp;

@@ -67,17 +67,20 @@ ok = ok and (labels[2] == 0 or close(labels[4], mri[3]))
 sys.exit(0 if ok else 1)
 PY
 segment_structure cerebellum "$DATA/Landmarks/cerebellum.mrk.json" $(seq 91 116)
-for structure in thalamus_left:77 putamen_left:73; do
-  name=${structure%:*} label=${structure#*:}
-  python3 "$TOOLS/landmarks_from_labels.py" "$templates/aal.nii.gz" "$label" coronal 6 6 "$work/$name.mrk.json" >/dev/null
-  segment_structure "$name" "$work/$name.mrk.json" "$label"
-done
-python3 "$TOOLS/landmarks_from_labels.py" "$templates/aal.nii.gz" "$(seq -s, 91 116)" sagittal 5 3 \
-  "$work/cerebellum15.mrk.json" >/dev/null
-segment_structure cerebellum_15_points "$work/cerebellum15.mrk.json" $(seq 91 116)
-python3 "$TOOLS/landmarks_from_labels.py" "$templates/aal.nii.gz" "$(seq -s, 91 116)" sagittal 4 3 \
-  "$work/cerebellum12.mrk.json" >/dev/null
-bar=0.80 segment_structure cerebellum_12_points "$work/cerebellum12.mrk.json" $(seq 91 116)
+# segment_from_atlas_points NAME VIEW SLICES POINTS LABEL...: landmarks made
+# from the AAL labels' boundary (as Data/Landmarks/README.md says), then segment.
+segment_from_atlas_points() {
+  local name=$1 view=$2 slices=$3 points=$4; shift 4
+  local labels
+  labels=$(IFS=,; echo "$*")
+  python3 "$TOOLS/landmarks_from_labels.py" "$templates/aal.nii.gz" "$labels" "$view" "$slices" "$points" \
+    "$work/$name.mrk.json" >/dev/null
+  segment_structure "$name" "$work/$name.mrk.json" "$@"
+}
+segment_from_atlas_points thalamus_left coronal 6 6 77
+segment_from_atlas_points putamen_left coronal 6 6 73
+segment_from_atlas_points cerebellum_15_points sagittal 5 3 $(seq 91 116)
+bar=0.80 segment_from_atlas_points cerebellum_12_points sagittal 4 3 $(seq 91 116)
 
 echo "$failures failure(s)"
 test "$failures" -eq 0
