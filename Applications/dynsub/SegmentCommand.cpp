@@ -77,7 +77,9 @@ const char* referenceName(EdgeReference reference) {
 void runSegment(SegmentCommandOptions o) {
   if (o.potential == "gradient") o.segment.edges.method = EdgeMethod::GradientMagnitude;
   o.segment.simulation = o.simulation.apply(o.segment.simulation);
-  // --edge-low / --edge-high are fractions of the reference that will be used.
+  // --edge-low / --edge-high are fractions of the reference that will be used:
+  // the landmarks' whenever there are landmarks and it is not --edge-reference
+  // image (landmarks off every edge are an error, not a silent switch).
   EdgeOptions& edges = o.segment.edges;
   edges.reference = o.edgeReference == "image" ? EdgeReference::Image : EdgeReference::Landmarks;
   Hysteresis& thresholds =
@@ -120,7 +122,14 @@ void runSegment(SegmentCommandOptions o) {
                             return std::sqrt(squares / landmarkPoints.rows());
                           },
       25);
-  const SegmentResult result = segment(image, landmarks, initial, o.segment, recorder.callback(line.callback()));
+  const SegmentResult result = [&] {
+    try {
+      return segment(image, landmarks, initial, o.segment, recorder.callback(line.callback()));
+    } catch (const LandmarksOffEdges& error) {
+      // Name the file the points came from, and the options that help.
+      throw Error(o.landmarks, std::string(error.what()) + " (--edge-landmark-reach, --edge-reference image)");
+    }
+  }();
   line.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
@@ -225,7 +234,8 @@ void addSegmentCommand(CLI::App& app) {
   command->add_option("--edge-reference", o->edgeReference,
                       "What the edge thresholds are fractions of: landmarks (the median over the landmarks "
                       "of the strongest gradient within --edge-landmark-reach of each, the boundary the expert "
-                      "marked; the image's without landmarks) or image (the 99th-percentile gradient)")
+                      "marked; the image's without landmarks; an error if the landmarks are on no edge) or image "
+                      "(the 99th-percentile gradient)")
       ->check(CLI::IsMember({"landmarks", "image"}))
       ->default_val("landmarks");
   std::ostringstream lowHelp, highHelp;

@@ -161,6 +161,11 @@ check "segment: --edge-high sets the image's fraction" grep -q '"edge_high": 0.3
 expect_error "NaN edge threshold" 1 "edge thresholds" "$work/s9" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --edge-low nan \
   --out "$work/s9"
+# Six points in the air in front of the face (intensity 0 all around): they
+# cannot set edge thresholds, and saying so beats thresholds of 0.
+printf 'x,y,z\n75,-75,89\n70,-80,94\n65,-75,99\n75,-85,84\n70,-73,91\n65,-83,87\n' >"$work/air.csv"
+expect_error "landmarks off every edge" 1 "air.csv: the 6 landmarks are not on an image edge" "$work/s11" \
+  "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/air.csv" --no-figures --out "$work/s11"
 expect_error "unknown edge reference" 2 "edge-reference" "$work/s10" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:-10,10,10,5 --edge-reference scanner --out "$work/s10"
 expect_error "missing image" 1 "no such file" "$work/s1" \

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <vector>
 
 #include "dynsub/Error.h"
@@ -49,19 +50,29 @@ double strongestNear(const Volume& magnitude, const Vector3& point, double radiu
   return strongest;
 }
 
-// The reference magnitude and fractions of step 3 (see the header). Landmarks
-// in a flat part of the image (no gradient at all near them) cannot set a
-// scale; the image's percentile is used then.
+// The reference magnitude and fractions of step 3 (see the header).
 EdgeScale edgeScale(const Volume& magnitude, const EdgeOptions& options, const Matrix3X& landmarks) {
-  if (options.reference == EdgeReference::Landmarks && landmarks.rows() > 0) {
-    std::vector<float> strengths;
-    for (Eigen::Index p = 0; p < landmarks.rows(); ++p)
-      strengths.push_back(
-          static_cast<float>(strongestNear(magnitude, landmarks.row(p).transpose(), options.landmarkReach)));
-    const double median = percentile(strengths, 0.5);
-    if (median > 0) return {EdgeReference::Landmarks, median, options.ofLandmarks};
+  const double strongEdges = percentile(magnitude.voxels, 0.99);
+  if (options.reference == EdgeReference::Image || landmarks.rows() == 0)
+    return {EdgeReference::Image, strongEdges, options.ofImage};
+  std::vector<float> strengths;
+  for (Eigen::Index p = 0; p < landmarks.rows(); ++p)
+    strengths.push_back(static_cast<float>(strongestNear(magnitude, landmarks.row(p).transpose(), options.landmarkReach)));
+  const double median = percentile(strengths, 0.5);
+  // The faintest boundary segmented here (the pallidum) is at 0.11 of the
+  // 99th percentile; a hundredth of it is flat tissue or off the image, and
+  // thresholds set there would keep every ripple of noise as an edge (or,
+  // in a region with no gradient at all, every voxel).
+  if (!(median > 0 && median >= 0.01 * strongEdges)) {
+    std::ostringstream message;
+    message << "the " << landmarks.rows() << " landmarks are not on an image edge: the median of their strongest "
+            << "gradient within " << options.landmarkReach << " mm is " << median
+            << ", under 1 % of the image's strong edges (99th percentile " << strongEdges
+            << "), so they cannot set the edge thresholds; place them on the structure's boundary, widen the "
+            << "landmarks' edge reach, or take the thresholds from the image";
+    throw LandmarksOffEdges(message.str());
   }
-  return {EdgeReference::Image, percentile(magnitude.voxels, 0.99), options.ofImage};
+  return {EdgeReference::Landmarks, median, options.ofLandmarks};
 }
 
 // Steps 2 and 3 of the header: non-maximum suppression along the gradient, then hysteresis.

@@ -297,11 +297,18 @@ TEST(EdgePotential, LandmarksSetTheEdgeThresholds) {
   EXPECT_GT(edgesNear(innerField, centre, 4.5), 0.9 * inner);
   EXPECT_GT(edgesNear(innerField, centre, 9.0), 0.9 * outer);
 
-  // Points where the image has no gradient (here: off the grid) cannot set a
-  // scale: the image's percentile is used.
-  const DirectionField offField(image, EdgeOptions{}, pointsOnSphere(centre + Vector3(500, 0, 0), 9.0));
-  EXPECT_EQ(offField.scale().reference, EdgeReference::Image);
-  EXPECT_EQ(edgesNear(offField, centre, 4.5), inner);
+  // Points where the image has no edge cannot set the thresholds: off the
+  // grid, and in the flat middle of the core (0.5 mm from the centre, 3 mm
+  // and more from its boundary: the blurred step has fallen to a few % of
+  // its peak there). Both are refused rather than used.
+  const Matrix3X offGrid = pointsOnSphere(centre + Vector3(500, 0, 0), 9.0), flat = pointsOnSphere(centre, 0.5);
+  const EdgeOptions byLandmarks;
+  EXPECT_THROW(DirectionField(image, byLandmarks, offGrid), LandmarksOffEdges);
+  EXPECT_THROW(DirectionField(image, byLandmarks, flat), LandmarksOffEdges);
+  // With the image as the reference the same points are not used at all.
+  const DirectionField flatByImage(image, byImage, flat);
+  EXPECT_EQ(flatByImage.scale().reference, EdgeReference::Image);
+  EXPECT_EQ(edgesNear(flatByImage, centre, 4.5), inner);
 }
 
 TEST(EdgePotential, BadOptionsAreRefused) {

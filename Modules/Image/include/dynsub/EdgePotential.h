@@ -20,6 +20,9 @@
 //       structure (the cerebellum's folia, the hippocampus' layers) do not
 //       hold the surface in, and a faint structure (the caudate against the
 //       internal capsule) keeps its faint edges;
+//       If that median is under 1 % of the image's 99th-percentile magnitude
+//       the landmarks are not on an edge, and LandmarksOffEdges is thrown
+//       rather than thresholds set from flat tissue;
 //     - without landmarks, the image's 99th-percentile magnitude (0.10 / 0.25
 //       of it).
 //  4. P = -d, with d the Euclidean distance (mm, the image's spacing) to the
@@ -37,6 +40,7 @@
 // three components); outside the image it is zero.
 #include <string>
 
+#include "dynsub/Error.h"
 #include "dynsub/Volume.h"
 
 namespace dynsub {
@@ -45,7 +49,7 @@ enum class EdgeMethod { MongaDeriche, GradientMagnitude };
 
 // What the hysteresis thresholds are fractions of (step 3 above).
 enum class EdgeReference {
-  Landmarks,  // the median gradient magnitude at the landmarks; the image's when there are none
+  Landmarks,  // the landmarks' median edge magnitude; the image's when no landmarks are given
   Image,      // the 99th-percentile gradient magnitude in the image
 };
 
@@ -70,6 +74,12 @@ struct EdgeScale {
   Hysteresis fractions{0, 0};
 };
 
+// Landmarks given to set the edge thresholds lie where the image has no edge (step 3).
+class LandmarksOffEdges : public Error {
+ public:
+  using Error::Error;
+};
+
 // Throws dynsub::Error for non-finite or impossible options.
 void checkEdgeOptions(const EdgeOptions& options);
 
@@ -77,7 +87,8 @@ void checkEdgeOptions(const EdgeOptions& options);
 class DirectionField {
  public:
   // `landmarks` (N x 3, mm) are points on the wanted boundary; they set the
-  // edge thresholds when options.reference is Landmarks (see above).
+  // edge thresholds when options.reference is Landmarks (see above); throws
+  // LandmarksOffEdges when they are not on an edge.
   DirectionField(const Volume& image, const EdgeOptions& options, const Matrix3X& landmarks = Matrix3X());
 
   // N points in mm -> N unit (or zero) vectors, trilinearly interpolated.
