@@ -13,6 +13,7 @@
 # Below the bar, a guard: the cerebellum from 12 landmarks on 4 sagittal slices
 # measures 0.833 with the edge thresholds set by the landmarks and 0.709 with
 # the image's percentile (Documentation/Segmentation.md); it must stay >= 0.80.
+# Held out, at the bar: each cerebellar hemisphere from 30 points.
 # Needs DYNSUB (the executable), DATA and TOOLS.
 set -u
 templates=/usr/share/mricron/templates
@@ -81,6 +82,10 @@ segment_from_atlas_points thalamus_left coronal 6 6 77
 segment_from_atlas_points putamen_left coronal 6 6 73
 segment_from_atlas_points cerebellum_15_points sagittal 5 3 $(seq 91 116)
 bar=0.80 segment_from_atlas_points cerebellum_12_points sagittal 4 3 $(seq 91 116)
+# Held out (first run after every choice was made): each cerebellar hemisphere
+# from 30 points on 5 sagittal slices; they measure 0.870 (left) and 0.879.
+segment_from_atlas_points cerebellum_left_hemisphere sagittal 5 6 $(seq 91 2 107)
+segment_from_atlas_points cerebellum_right_hemisphere sagittal 5 6 $(seq 92 2 108)
 
 echo "$failures failure(s)"
 test "$failures" -eq 0
