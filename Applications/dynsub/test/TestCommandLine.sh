@@ -161,6 +161,11 @@ check "segment: --edge-high sets the image's fraction" grep -q '"edge_high": 0.3
 expect_error "NaN edge threshold" 1 "edge thresholds" "$work/s9" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --edge-low nan \
   --out "$work/s9"
+# The MRI cut to half its bytes: the gzip stream ends early (ITK alone read
+# the missing voxels as zeros).
+head -c 1700000 "$mri/ch2.nii.gz" >"$work/cut.nii.gz"
+expect_error "truncated .nii.gz" 1 "cut.nii.gz: truncated or corrupt compressed data" "$work/s12" \
+  "$DYNSUB" segment "$work/cut.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --no-figures --out "$work/s12"
 # Six points in the air in front of the face (intensity 0 all around): they
 # cannot set edge thresholds, and saying so beats thresholds of 0.
 printf 'x,y,z\n75,-75,89\n70,-80,94\n65,-75,99\n75,-85,84\n70,-73,91\n65,-83,87\n' >"$work/air.csv"

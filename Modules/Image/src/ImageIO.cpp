@@ -5,6 +5,7 @@
 #include "BridgeGeometry.h"
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
+#include "dynsub/FileNames.h"
 
 namespace dynsub {
 
@@ -25,6 +26,11 @@ Volume readVolume(const std::string& path) {
 }
 
 void writeMask(const Mask& mask, const std::string& path) {
+  // The file is written under a temporary name and renamed when complete; a
+  // header that names a separate data file would name the temporary one.
+  const std::string extension = lowerCaseExtension(path);
+  if (extension == ".mhd" || extension == ".nhdr" || extension == ".hdr")
+    throw Error(path, "a header with a separate data file is not written; use .nii.gz, .nii, .nrrd or .mha");
   requireWritableDirectoryFor(path);
   AtomicOutput output(path);
   itkbridge::writeLabels(toBridge(mask.geometry), mask.voxels, output.temporaryPath());

@@ -9,6 +9,7 @@
 #include <iostream>
 #include <set>
 #include <sstream>
+#include <vector>
 
 #include <gdcmReader.h>
 #include <gdcmTrace.h>
@@ -24,6 +25,7 @@
 #include <itkImageSeriesReader.h>
 #include <itkMetaDataObject.h>
 #include <itkSignedMaurerDistanceMapImageFilter.h>
+#include <zlib.h>
 
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
@@ -47,6 +49,64 @@ Geometry geometryOf(const FloatImage* image) {
 
 long long countOf(const Geometry& g) { return static_cast<long long>(g.size[0]) * g.size[1] * g.size[2]; }
 
+// The number of bytes a gzip file inflates to. Throws when its stream is cut
+// short or corrupt.
+std::uintmax_t inflatedSize(const std::string& path) {
+  gzFile file = gzopen(path.c_str(), "rb");
+  if (!file) throw Error(path, "cannot be opened");
+  std::vector<char> buffer(1 << 20);
+  std::uintmax_t total = 0;
+  int read = 0;
+  while ((read = gzread(file, buffer.data(), static_cast<unsigned>(buffer.size()))) > 0) total += read;
+  int code = Z_OK;
+  std::string message = gzerror(file, &code);
+  gzclose(file);
+  if (message.rfind(path + ": ", 0) == 0) message.erase(0, path.size() + 2);  // zlib puts the path first
+  if (read < 0 || (code != Z_OK && code != Z_STREAM_END))
+    throw Error(path, "truncated or corrupt compressed data (" + message + ") after " + std::to_string(total) +
+                          " bytes");
+  return total;
+}
+
+// Whether a MetaImage file's data is all there: after its header (LOCAL) or
+// in its data file, CompressedDataSize bytes when compressed, else `voxelBytes`.
+// ITK reads a short compressed .mha without complaint. Lists and patterns of
+// slice files are left to ITK.
+void checkMetaImageSize(const std::string& path, std::uintmax_t voxelBytes) {
+  std::ifstream in(path, std::ios::binary);
+  auto trim = [](const std::string& text) {
+    const auto first = text.find_first_not_of(" \t\r"), last = text.find_last_not_of(" \t\r");
+    return first == std::string::npos ? std::string() : text.substr(first, last - first + 1);
+  };
+  std::string line, dataFile;
+  bool compressed = false;
+  std::uintmax_t compressedSize = 0;
+  while (dataFile.empty() && std::getline(in, line)) {
+    const auto equals = line.find('=');
+    if (equals == std::string::npos) continue;
+    const std::string key = trim(line.substr(0, equals)), value = trim(line.substr(equals + 1));
+    if (key == "CompressedData") compressed = value == "True" || value == "true";
+    if (key == "CompressedDataSize") compressedSize = std::strtoull(value.c_str(), nullptr, 10);
+    if (key == "ElementDataFile") dataFile = value;
+  }
+  std::uintmax_t available = 0;
+  std::string source = path;
+  if (dataFile == "LOCAL") {
+    available = fs::file_size(path) - static_cast<std::uintmax_t>(std::max<std::streamoff>(in.tellg(), 0));
+  } else if (!dataFile.empty() && dataFile.find_first_of("% ") == std::string::npos && dataFile != "LIST") {
+    source = (fs::path(path).parent_path() / dataFile).string();
+    std::error_code error;
+    available = fs::file_size(source, error);
+    if (error) throw Error(path, "its data file " + source + " cannot be read");
+  } else {
+    return;
+  }
+  const std::uintmax_t needed = compressed ? compressedSize : voxelBytes;
+  if (available < needed)
+    throw Error(source, "truncated: " + std::to_string(available) + " bytes of data, the header announces " +
+                            std::to_string(needed));
+}
+
 // A clear message for a file ITK has no reader for, and a size check ITK
 // leaves out (the number of dimensions is checked by readVolume, for files and
 // DICOM series alike).
@@ -55,16 +115,19 @@ void inspectFile(const std::string& path) {
   if (!io) throw Error(path, "unknown or unreadable image format");
   io->SetFileName(path);
   io->ReadImageInformation();
-  // NB: ITK's NIfTI reader fills a truncated uncompressed .nii with zeros
-  // without complaint (compressed files fail in zlib), so the size is checked:
-  // a NIfTI header is at least 348 bytes.
-  if (lowerCaseExtension(path) == ".nii") {
+  // NB: ITK's NIfTI reader fills a truncated .nii, or a .nii.gz whose gzip
+  // stream is cut short, with zeros without complaint. So the (inflated) size
+  // is checked: a NIfTI header is at least 348 bytes.
+  const std::string extension = lowerCaseExtension(path);
+  const bool gzipped = extension == ".gz" && lowerCaseExtension(path.substr(0, path.size() - 3)) == ".nii";
+  if (extension == ".nii" || gzipped) {
     const auto needed = static_cast<std::uintmax_t>(io->GetImageSizeInBytes()) + 348;
-    const auto actual = fs::file_size(path);
+    const auto actual = gzipped ? inflatedSize(path) : fs::file_size(path);
     if (actual < needed)
-      throw Error(path, "truncated: " + std::to_string(actual) + " bytes, the header announces at least " +
-                            std::to_string(needed));
+      throw Error(path, "truncated: " + std::to_string(actual) + (gzipped ? " bytes inflated" : " bytes") +
+                            ", the header announces at least " + std::to_string(needed));
   }
+  if (extension == ".mha" || extension == ".mhd") checkMetaImageSize(path, io->GetImageSizeInBytes());
 }
 
 // ITK's global warning display off for a scope.

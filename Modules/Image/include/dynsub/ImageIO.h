@@ -18,8 +18,9 @@ namespace dynsub {
 Volume readVolume(const std::string& path);
 
 // Writes a mask as an unsigned 8-bit labelmap (1 = structure) on its grid, in
-// any format ITK writes by extension (.nii.gz for ITK-SNAP and 3D Slicer). The
-// file appears complete or not at all.
+// any single-file format ITK writes by extension (.nii.gz for ITK-SNAP and 3D
+// Slicer; .mhd, .nhdr and .hdr, with their separate data file, are refused).
+// The file appears complete or not at all.
 void writeMask(const Mask& mask, const std::string& path);
 
 }  // namespace dynsub
