@@ -57,7 +57,8 @@ EdgeScale edgeScale(const Volume& magnitude, const EdgeOptions& options, const M
     return {EdgeReference::Image, strongEdges, options.ofImage};
   std::vector<float> strengths;
   for (Eigen::Index p = 0; p < landmarks.rows(); ++p)
-    strengths.push_back(static_cast<float>(strongestNear(magnitude, landmarks.row(p).transpose(), options.landmarkReach)));
+    strengths.push_back(
+        static_cast<float>(strongestNear(magnitude, landmarks.row(p).transpose(), options.landmarkReach)));
   const double median = percentile(strengths, 0.5);
   // The faintest boundary segmented here (the pallidum) is at 0.11 of the
   // 99th percentile; a hundredth of it is flat tissue or off the image, and
