@@ -176,7 +176,7 @@ expect_error "unknown edge reference" 2 "edge-reference" "$work/s10" \
 expect_error "missing image" 1 "no such file" "$work/s1" \
   "$DYNSUB" segment "$work/none.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --out "$work/s1"
 printf 'x,y,z\n500,0,0\n10,10,10\n12,10,10\n10,12,10\n10,10,12\n' >"$work/outside.csv"
-expect_error "landmark outside the image" 1 "outside the image" "$work/s2" \
+expect_error "landmark outside the image" 1 "outside.csv: landmark 1 of 5 at (500, 0, 0) mm LPS lies outside" "$work/s2" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/outside.csv" --out "$work/s2"
 expect_error "unknown landmark format" 1 "unknown landmark format" "$work/s3" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/points.txt" --out "$work/s3"

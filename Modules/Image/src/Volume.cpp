@@ -15,6 +15,13 @@ Matrix3 ImageGeometry::indexFromPhysical() const {
   return spacing.cwiseInverse().asDiagonal() * direction.inverse();
 }
 
+bool ImageGeometry::covers(const Vector3& point) const {
+  const Vector3 index = toIndex(point);
+  for (int a = 0; a < 3; ++a)
+    if (!(index[a] >= -0.5 && index[a] <= size[a] - 0.5)) return false;
+  return true;
+}
+
 bool ImageGeometry::sameGridAs(const ImageGeometry& other) const {
   return size == other.size && (spacing - other.spacing).norm() <= 1e-6 * spacing.norm() &&
          (origin - other.origin).norm() <= 1e-6 * (1 + origin.norm()) &&

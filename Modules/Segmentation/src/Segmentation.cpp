@@ -31,13 +31,6 @@ class ImageForceField final : public ForceField {
   double strength_;
 };
 
-bool insideImage(const ImageGeometry& geometry, const Vector3& point) {
-  const Vector3 index = geometry.toIndex(point);
-  for (int a = 0; a < 3; ++a)
-    if (!(index[a] >= -0.5 && index[a] <= geometry.size[a] - 0.5)) return false;
-  return true;
-}
-
 Matrix3X limitPoints(const ControlMesh& mesh, int segments) {
   const LimitSurface surface(mesh);
   return tessellate(surface, mesh.points(), segments).points;
@@ -98,13 +91,13 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
   if (!initial.isClosed()) throw Error("the initial model must be a closed control mesh");
   const ImageGeometry& grid = image.geometry;
   for (const auto& landmark : landmarks)
-    if (!insideImage(grid, landmark.position))
+    if (!grid.covers(landmark.position))
       throw Error("landmark '" + landmark.label + "' at (" + std::to_string(landmark.position.x()) + ", " +
                   std::to_string(landmark.position.y()) + ", " + std::to_string(landmark.position.z()) +
                   ") mm LPS lies outside the image");
   const Matrix3X start = limitPoints(initial, 2);
   for (Eigen::Index p = 0; p < start.rows(); ++p)
-    if (!insideImage(grid, start.row(p).transpose())) throw Error("the initial model reaches outside the image");
+    if (!grid.covers(start.row(p).transpose())) throw Error("the initial model reaches outside the image");
 
   SegmentResult result;
   auto clock = Clock::now();

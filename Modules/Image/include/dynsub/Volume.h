@@ -29,6 +29,9 @@ struct ImageGeometry {
   // Continuous index <-> physical point (mm).
   Vector3 toPhysical(const Vector3& index) const;
   Vector3 toIndex(const Vector3& point) const;
+  // Whether a physical point lies in one of the grid's voxels (continuous
+  // index within -0.5 .. size - 0.5 on every axis).
+  bool covers(const Vector3& point) const;
   // The linear part of toIndex, index = indexFromPhysical() * (point - origin),
   // for loops over many points (it holds a 3 x 3 inverse).
   Matrix3 indexFromPhysical() const;
