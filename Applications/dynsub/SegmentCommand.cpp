@@ -93,15 +93,6 @@ void runSegment(SegmentCommandOptions o) {
   // Every input is read and checked before anything is written.
   const Volume image = readVolume(o.image);
   const std::vector<Landmark> landmarks = o.landmarks.empty() ? std::vector<Landmark>{} : readLandmarks(o.landmarks);
-  for (std::size_t i = 0; i < landmarks.size(); ++i)
-    if (!image.geometry.covers(landmarks[i].position)) {
-      const Vector3& p = landmarks[i].position;
-      std::ostringstream message;
-      message << "landmark " << i + 1 << " of " << landmarks.size()
-              << (landmarks[i].label.empty() ? "" : " ('" + landmarks[i].label + "')") << " at (" << p.x() << ", "
-              << p.y() << ", " << p.z() << ") mm LPS lies outside " << o.image;
-      throw Error(o.landmarks, message.str());
-    }
   Mask reference;
   if (!o.reference.empty()) {
     const Volume labels = readVolume(o.reference);
@@ -137,6 +128,8 @@ void runSegment(SegmentCommandOptions o) {
     } catch (const LandmarksOffEdges& error) {
       // Name the file the points came from, and the options that help.
       throw Error(o.landmarks, std::string(error.what()) + " (--edge-landmark-reach, --edge-reference image)");
+    } catch (const LandmarkError& error) {
+      throw Error(o.landmarks, error.what());
     }
   }();
   line.finish();

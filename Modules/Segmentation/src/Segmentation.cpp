@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <sstream>
 
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/Error.h"
@@ -90,11 +91,15 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
   checkSegmentOptions(options);
   if (!initial.isClosed()) throw Error("the initial model must be a closed control mesh");
   const ImageGeometry& grid = image.geometry;
-  for (const auto& landmark : landmarks)
-    if (!grid.covers(landmark.position))
-      throw Error("landmark '" + landmark.label + "' at (" + std::to_string(landmark.position.x()) + ", " +
-                  std::to_string(landmark.position.y()) + ", " + std::to_string(landmark.position.z()) +
-                  ") mm LPS lies outside the image");
+  for (std::size_t i = 0; i < landmarks.size(); ++i)
+    if (!grid.covers(landmarks[i].position)) {
+      const Vector3& p = landmarks[i].position;
+      std::ostringstream message;
+      message << "landmark " << i + 1 << " of " << landmarks.size()
+              << (landmarks[i].label.empty() ? "" : " ('" + landmarks[i].label + "')") << " at (" << p.x() << ", "
+              << p.y() << ", " << p.z() << ") mm LPS lies outside the image";
+      throw LandmarkError(message.str());
+    }
   const Matrix3X start = limitPoints(initial, 2);
   for (Eigen::Index p = 0; p < start.rows(); ++p)
     if (!grid.covers(start.row(p).transpose())) throw Error("the initial model reaches outside the image");

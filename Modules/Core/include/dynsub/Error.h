@@ -14,4 +14,11 @@ class Error : public std::runtime_error {
   Error(const std::string& source, const std::string& message);
 };
 
+// An Error about landmarks given as points (outside the image, on no edge):
+// a caller that read them from a file names it.
+class LandmarkError : public Error {
+ public:
+  using Error::Error;
+};
+
 }  // namespace dynsub

@@ -75,9 +75,9 @@ struct EdgeScale {
 };
 
 // Landmarks given to set the edge thresholds lie where the image has no edge (step 3).
-class LandmarksOffEdges : public Error {
+class LandmarksOffEdges : public LandmarkError {
  public:
-  using Error::Error;
+  using LandmarkError::LandmarkError;
 };
 
 // Throws dynsub::Error for non-finite or impossible options.

@@ -60,8 +60,9 @@ ControlMesh initialFromLandmarks(const std::vector<Landmark>& landmarks);
 // The cube's limit surface as a sphere of `radius` mm around `centre`.
 ControlMesh initialSphere(const Vector3& centre, double radius);
 
-// Throws dynsub::Error when the initial model or a landmark lies outside the
-// image, or for impossible options. extraForces (not owned) act besides the
+// Throws dynsub::Error when the initial model lies outside the image or for
+// impossible options, LandmarkError when a landmark lies outside the image or
+// the landmarks are on no edge (EdgePotential.h). extraForces (not owned) act besides the
 // image, landmark and inflation forces, e.g. an interactive pull
 // (ForceModel.h); the progress callback may throw to stop the evolution.
 SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmarks, const ControlMesh& initial,
