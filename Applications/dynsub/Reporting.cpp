@@ -24,9 +24,11 @@ void SimulationArguments::addOptions(CLI::App& command, const SimulationOptions&
   command.add_option("--max-level", values.maxLevel, "Global refinements allowed (0-6)")
       ->default_val(defaults.maxLevel)
       ->check(CLI::Range(0, 6));
-  command.add_option("--scheme", scheme, "Time integration: first-order (massless, TVCG eq. 32) or second-order (eq. 31)")
+  command.add_option("--scheme", scheme,
+                     "How the equilibrium is reached: static (Newton steps on K p = f_p), or time integration, "
+                     "first-order (massless, TVCG eq. 32) or second-order (eq. 31)")
       ->default_val(scheme)
-      ->check(CLI::IsMember({"first-order", "second-order"}));
+      ->check(CLI::IsMember({"static", "first-order", "second-order"}));
   command.add_option("--solver", solver,
                      "Linear solver per step: cholesky (factored once per level), cg, or pcg (incomplete Cholesky)")
       ->default_val(solver)
@@ -100,6 +102,7 @@ nlohmann::ordered_json levelJson(const LevelSummary& l, double maxErrorPercent, 
     j["rms_error_percent"] = rmsErrorPercent;
   }
   j["stabilizer_updates"] = l.stabilizerUpdates;
+  j["equilibrium_residual"] = l.residual;
   j["seconds"] = l.seconds;
   return j;
 }

@@ -5,10 +5,16 @@
 
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/Error.h"
+#include "dynsub/StaticSolver.h"
 
 namespace dynsub {
 
 SparseMatrix ForceModel::stabilizingStiffness(const Matrix3X&) { return SparseMatrix(); }
+
+void ForceModel::addTangentStiffness(const Matrix3X& controlPoints, TangentStiffness& into) {
+  const SparseMatrix s = stabilizingStiffness(controlPoints);
+  if (s.size() > 0) into.addScalar(s);
+}
 
 SpringForceModel::SpringForceModel(Matrix3X targets, Eigen::VectorXd stiffness, Attach attach)
     : targets_(std::move(targets)), stiffness_(std::move(stiffness)), attach_(attach) {
@@ -54,7 +60,7 @@ Matrix3X SpringForceModel::generalizedForce(const Matrix3X& controlPoints, doubl
   std::vector<ElementPoint> at;
   at.reserve(springs_.size());
   for (const Spring& s : springs_) at.push_back(s.attachment);
-  const SparseMatrix J = surface_->operators(at).J;
+  const SparseMatrix J = surface_->limitOperator(at);
   const Matrix3X stretch = targets_ - J * controlPoints;  // d - s per spring
   lengths_ = stretch.rowwise().norm();
   potential += 0.5 * stiffness_.dot(lengths_.cwiseAbs2());
@@ -62,6 +68,21 @@ Matrix3X SpringForceModel::generalizedForce(const Matrix3X& controlPoints, doubl
 }
 
 SparseMatrix SpringForceModel::stabilizingStiffness(const Matrix3X&) { return springStiffness(*surface_, springs_); }
+
+void SpringForceModel::addTangentStiffness(const Matrix3X& controlPoints, TangentStiffness& into) {
+  // Springs held at their attachments: k J^T J is the exact derivative.
+  if (attach_ == Attach::NearestAtLevelStart) return ForceModel::addTangentStiffness(controlPoints, into);
+  for (const Spring& spring : springs_) {
+    const LimitSample sample = surface_->evaluate(spring.attachment, controlPoints);
+    Eigen::Matrix3d block = spring.stiffness * Eigen::Matrix3d::Identity();
+    // NB: where the normal is undefined (a degenerate point) the spring stays isotropic.
+    if (sample.normal.squaredNorm() > 0.0) {
+      block = spring.stiffness * ((1.0 - kTangentialShare) * sample.normal * sample.normal.transpose() +
+                                  kTangentialShare * Eigen::Matrix3d::Identity());
+    }
+    into.addPoint(spring.attachment, block);
+  }
+}
 
 InflationForceModel::InflationForceModel(double pressure) : pressure_(pressure) {
   if (!std::isfinite(pressure)) throw Error("inflation pressure is not finite");
@@ -140,7 +161,7 @@ Matrix3X PullForceModel::generalizedForce(const Matrix3X& controlPoints, double&
   const Matrix3X force = springForces(*surface_, controlPoints, {Spring{attachment_, target_, stiffness_}}, &energy);
   potential += energy;
   // Where the spring holds the surface now: the place to re-attach after a refinement.
-  anchor_ = (surface_->operators({attachment_}).J * controlPoints).row(0).transpose();
+  anchor_ = (surface_->limitOperator({attachment_}) * controlPoints).row(0).transpose();
   return force;
 }
 

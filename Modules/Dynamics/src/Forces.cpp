@@ -37,7 +37,7 @@ Matrix3X springForces(const LimitSurface& surface, const Matrix3X& controlPoints
   std::vector<ElementPoint> at;
   at.reserve(springs.size());
   for (const Spring& s : springs) at.push_back(s.attachment);
-  const SparseMatrix J = surface.operators(at).J;
+  const SparseMatrix J = surface.limitOperator(at);
   Matrix3X pull = J * controlPoints;  // s at the attachments
   double total = 0.0;
   for (size_t i = 0; i < springs.size(); ++i) {
@@ -56,7 +56,7 @@ SparseMatrix springStiffness(const LimitSurface& surface, const std::vector<Spri
     at.push_back(springs[i].attachment);
     k(i) = springs[i].stiffness;
   }
-  const SparseMatrix J = surface.operators(at).J;
+  const SparseMatrix J = surface.limitOperator(at);
   return SparseMatrix(J.transpose() * k.asDiagonal() * J);
 }
 

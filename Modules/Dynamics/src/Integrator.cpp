@@ -11,7 +11,11 @@
 namespace dynsub {
 
 const char* toString(IntegrationScheme scheme) {
-  return scheme == IntegrationScheme::SecondOrder ? "second-order" : "first-order";
+  switch (scheme) {
+    case IntegrationScheme::SecondOrder: return "second-order";
+    case IntegrationScheme::FirstOrder: return "first-order";
+    default: return "static";
+  }
 }
 
 const char* toString(LinearSolver solver) {
@@ -25,7 +29,8 @@ const char* toString(LinearSolver solver) {
 IntegrationScheme parseIntegrationScheme(const std::string& text) {
   if (text == "second-order") return IntegrationScheme::SecondOrder;
   if (text == "first-order") return IntegrationScheme::FirstOrder;
-  throw Error("unknown integration scheme '" + text + "' (expected second-order or first-order)");
+  if (text == "static") return IntegrationScheme::Static;
+  throw Error("unknown integration scheme '" + text + "' (expected second-order, first-order or static)");
 }
 
 LinearSolver parseLinearSolver(const std::string& text) {
@@ -74,6 +79,7 @@ Integrator::Integrator(const PhysicalMatrices& matrices, const SymmetricMatrix& 
   s.options = options;
   const double dt = options.timeStep;
   if (!(std::isfinite(dt) && dt > 0.0)) throw Error("time step must be positive, got " + std::to_string(dt));
+  if (options.scheme == IntegrationScheme::Static) throw Error("internal: the static scheme is not a time integration");
   if (!(options.solverTolerance > 0.0) || options.solverMaxIterations < 1) {
     throw Error("iterative solver tolerance must be > 0 and iterations >= 1");
   }

@@ -3,11 +3,13 @@
 #include <chrono>
 #include <cmath>
 #include <deque>
+#include <limits>
 #include <string>
 
 #include "dynsub/CatmullClark.h"
 #include "dynsub/Error.h"
 #include "dynsub/LimitSurface.h"
+#include "dynsub/StaticSolver.h"
 
 namespace dynsub {
 
@@ -20,11 +22,254 @@ double modelSize(const Matrix3X& points) {
 // sum over x, y, z of a^T A a.
 double quadraticForm(const SymmetricMatrix& a, const Matrix3X& x) { return (x.array() * (a * x).array()).sum(); }
 
-struct LevelState {
-  ControlMesh mesh;
+double relativeChange(double energy, double last) {
+  return std::abs(energy - last) / std::max({std::abs(energy), std::abs(last), 1e-300});
+}
+
+// Everything a level is built on: the surface of its control mesh and the
+// matrices and quadrature over it (rebuilt only when the mesh is refined).
+struct LevelModel {
   int level = 0;
-  double elementSize = 1.0;
+  LimitSurface surface;
+  PhysicalMatrices matrices;
+  SurfaceQuadrature quadrature;
+  Matrix3X start;
+  double size = 0;  // bounding-box diagonal of the control points, mm
 };
+
+LevelModel buildLevel(const ControlMesh& mesh, int level, int& initialIsolation, const SimulationOptions& options) {
+  LevelModel model{level, LimitSurface(mesh), {}, {}, mesh.points(), 0.0};
+  if (level == 0) initialIsolation = model.surface.isolationLevels();
+  // Element sides are measured in elements of the initial model: a base mesh
+  // that is `b` global refinements past the initial one has side 2^-b.
+  const double elementSize = std::ldexp(1.0, initialIsolation - (level + model.surface.isolationLevels()));
+  AssemblyOptions assembly = options.assembly;
+  assembly.elementSize = elementSize;
+  Material material = options.material;
+  const double elasticity = std::pow(options.elasticityPerLevel, level);
+  for (double* m : {&material.tensionU, &material.tensionV, &material.rigidityUU, &material.rigidityUV,
+                    &material.rigidityVV}) {
+    *m *= elasticity;
+  }
+  model.matrices = assemblePhysicalMatrices(model.surface, material, assembly);
+  model.quadrature = makeSurfaceQuadrature(model.surface, options.quadraturePoints, elementSize);
+  model.size = modelSize(model.start);
+  if (!(model.size > 0.0)) throw Error("the control mesh has no extent");
+  return model;
+}
+
+// f_p at `points`; adds the forces' potential energy to `potential`.
+Matrix3X totalForce(const std::vector<ForceModel*>& forces, const Matrix3X& points, double& potential) {
+  Matrix3X force = Matrix3X::Zero(points.rows(), 3);
+  for (ForceModel* f : forces) force += f->generalizedForce(points, potential);
+  return force;
+}
+
+// The equilibrium rule of Simulation.h over a sliding window of steps.
+class EquilibriumWindow {
+ public:
+  EquilibriumWindow(const EquilibriumOptions& options, int window) : options_(options), window_(window) {}
+  void clear() { recent_.clear(); }
+  // Records a step (relative energy change, largest move / model size); true
+  // when the last `window` steps were all still.
+  bool settled(double change, double motion) {
+    recent_.emplace_back(change, motion);
+    if (static_cast<int>(recent_.size()) > window_) recent_.pop_front();
+    if (static_cast<int>(recent_.size()) < window_) return false;
+    for (const auto& [c, m] : recent_) {
+      if (c > options_.energyTolerance || m > options_.motionTolerance) return false;
+    }
+    return true;
+  }
+
+ private:
+  const EquilibriumOptions& options_;
+  int window_;
+  std::deque<std::pair<double, double>> recent_;
+};
+
+enum class LevelEnd { Equilibrium, StepLimit, Diverged };
+
+// The papers' time stepping (Integrator.h) from model.start; `points` ends at
+// the last state reached.
+LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& forces, const std::vector<int>& fixed,
+                      const SimulationOptions& options, double timeStep, const ProgressCallback& progress,
+                      Matrix3X& points, LevelSummary& summary) {
+  IntegratorOptions integratorOptions = options.integrator;
+  integratorOptions.timeStep = timeStep;
+  // The stabilizing stiffness of the forces at `at` (Integrator.h).
+  auto makeIntegrator = [&](const Matrix3X& at) {
+    SymmetricMatrix stabilizing(at.rows(), at.rows());
+    for (ForceModel* f : forces) {
+      const SparseMatrix s = f->stabilizingStiffness(at);
+      if (s.size() > 0) stabilizing += SymmetricMatrix(s);
+    }
+    return Integrator(model.matrices, stabilizing, fixed, integratorOptions);
+  };
+  Integrator integrator = makeIntegrator(model.start);
+  EquilibriumWindow window(options.equilibrium, options.equilibrium.window);
+  Matrix3X previous = model.start;
+  points = model.start;
+  double lastEnergy = std::numeric_limits<double>::quiet_NaN();
+  double firstEnergy = 0.0;
+  int rises = 0;
+  for (int step = 1; step <= options.equilibrium.maxSteps; ++step) {
+    double potential = 0.0;
+    const Matrix3X force = totalForce(forces, points, potential);
+    const Matrix3X velocity = (points - previous) / timeStep;
+    const double energy = 0.5 * quadraticForm(model.matrices.mass, velocity) +
+                          0.5 * quadraticForm(model.matrices.stiffness, points) + potential;
+    if (step == 1) firstEnergy = std::abs(energy);
+    if (!std::isfinite(energy) || std::abs(energy) > 1e3 * std::max(firstEnergy, 1e-300)) return LevelEnd::Diverged;
+    if (step > 1) {
+      const double change = relativeChange(energy, lastEnergy);
+      const bool still = window.settled(change, (points - previous).rowwise().norm().maxCoeff() / model.size);
+      // The motion is dissipative and re-attaching springs only lowers their
+      // energy, so an energy that keeps rising means the forces' stiffness
+      // has drifted from the one the integrator was built with. Changes
+      // within the equilibrium tolerance are not rises: near an equilibrium
+      // they are noise (and forces without a potential, like image forces,
+      // make the counted energy wander by that much).
+      rises = change > options.equilibrium.energyTolerance && energy > lastEnergy ? rises + 1 : 0;
+      if (rises >= 3) {
+        integrator = makeIntegrator(points);
+        ++summary.stabilizerUpdates;
+        rises = 0;
+        window.clear();
+      } else if (still) {
+        summary.energy = energy;
+        return LevelEnd::Equilibrium;
+      }
+    }
+    lastEnergy = energy;
+    summary.energy = energy;
+
+    Matrix3X next = integrator.step(previous, points, force);
+    summary.solverIterations += integrator.lastIterations();
+    const double motion = (next - points).rowwise().norm().maxCoeff();
+    if (!next.allFinite() || motion > model.size) return LevelEnd::Diverged;
+    previous = std::move(points);
+    points = std::move(next);
+    summary.steps = step;
+    if (progress) progress(Progress{model.level, step, energy, motion, &model.surface, &points});
+  }
+  return LevelEnd::StepLimit;
+}
+
+// Newton steps on K p = f_p (StaticSolver.h). When every force has a
+// potential, the total energy 1/2 p^T K p + potential is what the
+// equilibrium minimizes, and a step that does not lower it is halved (up to
+// 20 times; a direction that lowers nothing even then means the state is at
+// the minimum to rounding). Otherwise only a step moving a point farther than
+// the model's size is halved.
+LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>& forces, const std::vector<int>& fixed,
+                        const SimulationOptions& options, const ProgressCallback& progress, Matrix3X& points,
+                        LevelSummary& summary) {
+  bool lineSearch = true;
+  for (const ForceModel* f : forces) lineSearch = lineSearch && f->hasPotential();
+  StaticSolver solver(model.surface, model.matrices.stiffness, fixed);
+  // NB: a static step that moves nothing is conclusive by itself (there is no
+  // velocity to carry the state on), so two still steps in a row suffice.
+  EquilibriumWindow window(options.equilibrium, std::min(options.equilibrium.window, 2));
+  points = model.start;
+  double potential = 0.0;
+  Matrix3X force = totalForce(forces, points, potential);
+  double energy = 0.5 * quadraticForm(model.matrices.stiffness, points) + potential;
+  summary.energy = energy;
+  if (!std::isfinite(energy)) return LevelEnd::Diverged;
+  for (int step = 1; step <= options.equilibrium.maxSteps; ++step) {
+    const Matrix3X residual = force - model.matrices.stiffness * points;
+    const Matrix3X direction = solver.direction(forces, points, residual);
+    if (!direction.allFinite()) return LevelEnd::Diverged;
+    double length = 1.0;
+    bool accepted = false, evaluated = false;
+    Matrix3X trial, trialForce;
+    double trialEnergy = energy;
+    for (int halving = 0; halving <= 20 && !accepted; ++halving, length *= 0.5) {
+      if (direction.rowwise().norm().maxCoeff() * length > model.size) continue;
+      trial = points + length * direction;
+      double trialPotential = 0.0;
+      trialForce = totalForce(forces, trial, trialPotential);
+      trialEnergy = 0.5 * quadraticForm(model.matrices.stiffness, trial) + trialPotential;
+      if (!std::isfinite(trialEnergy)) continue;
+      evaluated = true;
+      // Rounding of the energy's sum must not count as a rise.
+      accepted = !lineSearch || trialEnergy <= energy + 1e-12 * std::abs(energy);
+    }
+    if (!accepted) {
+      if (lineSearch && evaluated) {
+        // NB: the springs were re-attached at the last trial; restore them.
+        double restored = 0.0;
+        force = totalForce(forces, points, restored);
+        return LevelEnd::Equilibrium;
+      }
+      return LevelEnd::Diverged;
+    }
+    const double motion = (trial - points).rowwise().norm().maxCoeff();
+    const double change = relativeChange(trialEnergy, energy);
+    points = std::move(trial);
+    force = std::move(trialForce);
+    energy = trialEnergy;
+    summary.energy = energy;
+    summary.steps = step;
+    if (progress) progress(Progress{model.level, step, energy, motion, &model.surface, &points});
+    if (window.settled(change, motion / model.size)) {
+      summary.stabilizerUpdates = solver.regularizations();
+      return LevelEnd::Equilibrium;
+    }
+  }
+  summary.stabilizerUpdates = solver.regularizations();
+  return LevelEnd::StepLimit;
+}
+
+// |f_p - K p| / max(|f_p|, |K p|) at `points` (Frobenius norms): 0 exactly at
+// the papers' equilibrium.
+double equilibriumResidual(const LevelModel& model, const std::vector<ForceModel*>& forces, const Matrix3X& points,
+                           const std::vector<int>& fixed) {
+  double potential = 0.0;
+  Matrix3X force = totalForce(forces, points, potential);
+  Matrix3X elastic = model.matrices.stiffness * points;
+  for (int v : fixed) {  // fixed vertices are held by their supports
+    force.row(v).setZero();
+    elastic.row(v).setZero();
+  }
+  const double scale = std::max({force.norm(), elastic.norm(), 1e-300});
+  return (force - elastic).norm() / scale;
+}
+
+// One level from model.start to its equilibrium (or step limit); a divergence
+// restarts it with half the time step.
+Matrix3X runLevel(const LevelModel& model, const std::vector<ForceModel*>& forces, const std::vector<int>& fixed,
+                  const SimulationOptions& options, double& timeStep, const ProgressCallback& progress,
+                  LevelSummary& summary) {
+  Matrix3X points;
+  for (int halvings = 0;; ++halvings) {
+    if (halvings > options.maxTimeStepHalvings) {
+      throw Error("the simulation diverged at level " + std::to_string(model.level) + " even with time step " +
+                  std::to_string(timeStep * 2.0) + " s (try a smaller --time-step or softer forces)");
+    }
+    for (ForceModel* f : forces) f->beginLevel(model.surface, model.quadrature, model.start);
+    summary.steps = 0;
+    summary.solverIterations = 0;
+    summary.stabilizerUpdates = 0;
+    LevelEnd end;
+    if (options.integrator.scheme == IntegrationScheme::Static) {
+      end = runStaticSteps(model, forces, fixed, options, progress, points, summary);
+      if (end == LevelEnd::Diverged) {
+        throw Error("the static scheme found no finite step at level " + std::to_string(model.level) +
+                    " (try --scheme first-order or softer forces)");
+      }
+    } else {
+      end = runTimeSteps(model, forces, fixed, options, timeStep, progress, points, summary);
+    }
+    if (end != LevelEnd::Diverged) {
+      summary.converged = end == LevelEnd::Equilibrium;
+      summary.timeStep = timeStep;
+      return points;
+    }
+    timeStep *= 0.5;
+  }
+}
 
 }  // namespace
 
@@ -61,138 +306,27 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
     }
   }
   SimulationResult result;
-  LevelState state{initial, 0, 1.0};
-  // Element sides are measured in elements of the initial model: a base mesh
-  // that is `b` global refinements past the initial one has side 2^-b.
+  ControlMesh mesh = initial;
   int initialIsolation = 0;  // set from the first level's surface
   double timeStep = options.integrator.timeStep;
-
-  for (;;) {
+  for (int level = 0;; ++level) {
     const auto started = std::chrono::steady_clock::now();
-    const LimitSurface surface(state.mesh);
-    if (state.level == 0) initialIsolation = surface.isolationLevels();
-    state.elementSize = std::ldexp(1.0, initialIsolation - (state.level + surface.isolationLevels()));
-    AssemblyOptions assembly = options.assembly;
-    assembly.elementSize = state.elementSize;
-    Material material = options.material;
-    const double elasticity = std::pow(options.elasticityPerLevel, state.level);
-    for (double* m : {&material.tensionU, &material.tensionV, &material.rigidityUU, &material.rigidityUV,
-                      &material.rigidityVV}) {
-      *m *= elasticity;
-    }
-    const PhysicalMatrices matrices = assemblePhysicalMatrices(surface, material, assembly);
-    const SurfaceQuadrature quadrature =
-        makeSurfaceQuadrature(surface, options.quadraturePoints, state.elementSize);
-    const Matrix3X start = state.mesh.points();
-    const double size = modelSize(start);
-    if (!(size > 0.0)) throw Error("the control mesh has no extent");
-
+    const LevelModel model = buildLevel(mesh, level, initialIsolation, options);
     LevelSummary summary;
-    summary.level = state.level;
-    summary.controlVertices = state.mesh.vertexCount();
-    Matrix3X current;
-    for (int halvings = 0;; ++halvings) {
-      if (halvings > options.maxTimeStepHalvings) {
-        throw Error("the simulation diverged at level " + std::to_string(state.level) + " even with time step " +
-                    std::to_string(timeStep * 2.0) + " s (try a smaller --time-step or softer forces)");
-      }
-      for (ForceModel* f : forces) f->beginLevel(surface, quadrature, start);
-      IntegratorOptions integratorOptions = options.integrator;
-      integratorOptions.timeStep = timeStep;
-      // The stabilizing stiffness of the forces at `points` (Integrator.h).
-      auto makeIntegrator = [&](const Matrix3X& points) {
-        SymmetricMatrix stabilizing(points.rows(), points.rows());
-        for (ForceModel* f : forces) {
-          const SparseMatrix s = f->stabilizingStiffness(points);
-          if (s.size() > 0) stabilizing += SymmetricMatrix(s);
-        }
-        return Integrator(matrices, stabilizing, fixed, integratorOptions);
-      };
-      Integrator integrator = makeIntegrator(start);
-
-      Matrix3X previous = start;
-      current = start;
-      std::deque<std::pair<double, double>> recent;  // (relative energy change, relative motion)
-      double lastEnergy = std::numeric_limits<double>::quiet_NaN();
-      double firstEnergy = 0.0;
-      int rises = 0;
-      bool diverged = false;
-      summary.steps = 0;
-      summary.converged = false;
-      summary.solverIterations = 0;
-      summary.stabilizerUpdates = 0;
-      for (int step = 1; step <= options.equilibrium.maxSteps; ++step) {
-        // Forces and the energy of the current state.
-        double potential = 0.0;
-        Matrix3X force = Matrix3X::Zero(current.rows(), 3);
-        for (ForceModel* f : forces) force += f->generalizedForce(current, potential);
-        const Matrix3X velocity = (current - previous) / timeStep;
-        const double energy = 0.5 * quadraticForm(matrices.mass, velocity) +
-                              0.5 * quadraticForm(matrices.stiffness, current) + potential;
-        if (step == 1) firstEnergy = std::abs(energy);
-        if (!std::isfinite(energy) || std::abs(energy) > 1e3 * std::max(firstEnergy, 1e-300)) {
-          diverged = true;
-          break;
-        }
-        if (step > 1) {
-          const double change =
-              std::abs(energy - lastEnergy) / std::max({std::abs(energy), std::abs(lastEnergy), 1e-300});
-          recent.emplace_back(change, (current - previous).rowwise().norm().maxCoeff() / size);
-          if (static_cast<int>(recent.size()) > options.equilibrium.window) recent.pop_front();
-          // The motion is dissipative and re-attaching springs only lowers
-          // their energy, so an energy that keeps rising means the forces'
-          // stiffness has drifted from the one the integrator was built with.
-          // Changes within the equilibrium tolerance are not rises: near an
-          // equilibrium they are noise (and forces without a potential, like
-          // image forces, make the counted energy wander by that much).
-          rises = change > options.equilibrium.energyTolerance && energy > lastEnergy ? rises + 1 : 0;
-          if (rises >= 3) {
-            integrator = makeIntegrator(current);
-            ++summary.stabilizerUpdates;
-            rises = 0;
-            recent.clear();
-          }
-        }
-        lastEnergy = energy;
-        summary.energy = energy;
-        if (static_cast<int>(recent.size()) == options.equilibrium.window) {
-          bool still = true;
-          for (const auto& [change, move] : recent) {
-            still = still && change <= options.equilibrium.energyTolerance && move <= options.equilibrium.motionTolerance;
-          }
-          if (still) {
-            summary.converged = true;
-            break;
-          }
-        }
-
-        Matrix3X next = integrator.step(previous, current, force);
-        summary.solverIterations += integrator.lastIterations();
-        const double motion = (next - current).rowwise().norm().maxCoeff();
-        if (!next.allFinite() || motion > size) {
-          diverged = true;
-          break;
-        }
-        previous = std::move(current);
-        current = std::move(next);
-        summary.steps = step;
-        if (progress) progress(Progress{state.level, step, energy, motion, &surface, &current});
-      }
-      if (!diverged) break;
-      timeStep *= 0.5;
-    }
-    summary.timeStep = timeStep;
-    state.mesh.setPoints(current);
+    summary.level = level;
+    summary.controlVertices = mesh.vertexCount();
+    const Matrix3X points = runLevel(model, forces, fixed, options, timeStep, progress, summary);
+    summary.residual = equilibriumResidual(model, forces, points, fixed);
+    mesh.setPoints(points);
     result.steps += summary.steps;
     summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     result.levels.push_back(summary);
 
-    const bool good = accept ? accept(surface, current) : true;
-    if (good || state.level >= options.maxLevel) break;
-    state.mesh = subdivide(state.mesh).mesh;
-    ++state.level;
+    const bool good = accept ? accept(model.surface, points) : true;
+    if (good || level >= options.maxLevel) break;
+    mesh = subdivide(mesh).mesh;
   }
-  result.mesh = std::move(state.mesh);
+  result.mesh = std::move(mesh);
   return result;
 }
 

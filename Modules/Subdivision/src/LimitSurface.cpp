@@ -53,9 +53,11 @@ bool needsIsolation(const Topology& topology) {
 
 // Rewrites derivative rows taken in parameters (a, b) into parameters (u, v),
 // given T = d(a, b)/d(u, v): gradient T^T g, Hessian T^T H T.
-void applyChainRule(SampleWeights& w, const Eigen::Matrix2d& t) {
-  const Eigen::RowVectorXd da = w.row(1), db = w.row(2);
-  const Eigen::RowVectorXd daa = w.row(3), dab = w.row(4), dbb = w.row(5);
+template <class Rows>
+void applyChainRule(Rows& w, const Eigen::Matrix2d& t) {
+  using Row = Eigen::Matrix<double, 1, Rows::ColsAtCompileTime>;
+  const Row da = w.row(1), db = w.row(2);
+  const Row daa = w.row(3), dab = w.row(4), dbb = w.row(5);
   w.row(1) = t(0, 0) * da + t(1, 0) * db;
   w.row(2) = t(0, 1) * da + t(1, 1) * db;
   w.row(3) = t(0, 0) * t(0, 0) * daa + 2.0 * t(0, 0) * t(1, 0) * dab + t(1, 0) * t(1, 0) * dbb;
@@ -199,8 +201,7 @@ struct LimitSurface::Impl {
                                  std::sin((masks.fanPosition + 1) * theta) * across;
   }
 
-  // Weights of s and its derivatives at an element point, over element.columns.
-  SampleWeights weights(const ElementPoint& point) const {
+  void checkPoint(const ElementPoint& point) const {
     if (point.element < 0 || point.element >= static_cast<int>(elements.size())) {
       throw Error("element " + std::to_string(point.element) + " does not exist (the surface has " +
                   std::to_string(elements.size()) + " elements)");
@@ -209,21 +210,26 @@ struct LimitSurface::Impl {
       throw Error("parameters (" + std::to_string(point.u) + ", " + std::to_string(point.v) +
                   ") of element " + std::to_string(point.element) + " are outside [0,1]^2");
     }
-    const Element& element = elements[point.element];
-    // NB: lazyProduct: these products are too small for Eigen's blocked GEMM,
-    // whose packing and allocation dominated closest-point searches.
-    if (element.type == ElementType::Normal) return detail::bsplineWeights(point.u, point.v).lazyProduct(element.grid);
+  }
 
+  // Where a point of a special element lies: the regular subpatch (grid rows
+  // of displacements over the element's columns), its own parameters and
+  // d(patch parameters)/d(element u, v); no patch at the extraordinary corner.
+  struct SubpatchPoint {
+    const GridMatrix* patch = nullptr;  // null: the point is the extraordinary vertex
+    LevelPatches deeper;                // storage for levels past the tabulated ones
+    double u = 0, v = 0;
+    Eigen::Matrix2d jacobian;
+  };
+  SubpatchPoint locateSubpatch(const Element& element, const ElementPoint& point) const {
     const Special& special = specials[element.special];
+    SubpatchPoint result;
     // Parameters with the extraordinary vertex at the origin.
     const auto [a, b] = detail::cornerFrame(element.corner, point.u, point.v);
     const Eigen::Matrix2d toCorner = detail::cornerFrameJacobian(element.corner);
-    SampleWeights w;
     if (a == 0.0 && b == 0.0) {
-      w.setZero(6, special.columns.size());
-      w.topRows(3) = special.vertexMasks;
-      applyChainRule(w, toCorner);
-      return w;
+      result.jacobian = toCorner;
+      return result;
     }
     // The level n >= 1 at which the point lies in a regular subpatch: the
     // smallest n with max(a, b) >= 2^-n.
@@ -233,23 +239,71 @@ struct LimitSurface::Impl {
     const double x = std::ldexp(a, level - 1);  // exact scaling into [0,1]^2
     const double y = std::ldexp(b, level - 1);
     const int child = quadrant(x, y);
-    auto [childU, childV] = detail::cornerFrame(child, x, y);
-    childU = std::min(1.0, 2.0 * childU);
-    childV = std::min(1.0, 2.0 * childV);
-    const GridMatrix* patch = nullptr;
-    LevelPatches deeper;
+    const auto [childU, childV] = detail::cornerFrame(child, x, y);
+    result.u = std::min(1.0, 2.0 * childU);
+    result.v = std::min(1.0, 2.0 * childV);
     if (level <= kTabulatedLevels) {
-      patch = &special.levels[level - 1][child - 1];
+      result.patch = &special.levels[level - 1][child - 1];
     } else {
       LocalMesh local = special.deepest;
-      for (int n = kTabulatedLevels + 1; n <= level; ++n) deeper = subdivideDisplacements(local);
-      patch = &deeper[child - 1];
+      for (int n = kTabulatedLevels + 1; n <= level; ++n) result.deeper = subdivideDisplacements(local);
+      result.patch = &result.deeper[child - 1];
     }
-    w = detail::bsplineWeights(childU, childV).lazyProduct(*patch);
-    w.row(0) += special.vertexMasks.row(0);  // the patch holds displacements from the limit point
-    const Eigen::Matrix2d jacobian = std::ldexp(1.0, level) * detail::cornerFrameJacobian(child) * toCorner;
-    applyChainRule(w, jacobian);
+    result.jacobian = std::ldexp(1.0, level) * detail::cornerFrameJacobian(child) * toCorner;
+    return result;
+  }
+
+  // Weights of s and its derivatives at an element point, over element.columns.
+  SampleWeights weights(const ElementPoint& point) const {
+    checkPoint(point);
+    const Element& element = elements[point.element];
+    // NB: lazyProduct: these products are too small for Eigen's blocked GEMM,
+    // whose packing and allocation dominated closest-point searches.
+    if (element.type == ElementType::Normal) return detail::bsplineWeights(point.u, point.v).lazyProduct(element.grid);
+    const Special& special = specials[element.special];
+    const SubpatchPoint at = locateSubpatch(element, point);
+    SampleWeights w;
+    if (!at.patch) {
+      w.setZero(6, special.columns.size());
+      w.topRows(3) = special.vertexMasks;
+    } else {
+      w = detail::bsplineWeights(at.u, at.v).lazyProduct(*at.patch);
+      w.row(0) += special.vertexMasks.row(0);  // the patch holds displacements from the limit point
+    }
+    applyChainRule(w, at.jacobian);
     return w;
+  }
+
+  // s and its derivatives (rows) at an element point for given control
+  // points: weights() applied, without allocating (the closest-point
+  // searches' inner loop).
+  Eigen::Matrix<double, 6, 3> values(const ElementPoint& point, const Matrix3X& controlPoints) const {
+    checkPoint(point);
+    const Element& element = elements[point.element];
+    // The 16 grid points (or displacements) of the piece the point lies on.
+    auto gridPoints = [&](const GridMatrix& grid) {
+      Eigen::Matrix<double, 16, 3> g = Eigen::Matrix<double, 16, 3>::Zero();
+      for (size_t c = 0; c < element.columns.size(); ++c) {
+        g.noalias() += grid.col(static_cast<Eigen::Index>(c)) * controlPoints.row(element.columns[c]);
+      }
+      return g;
+    };
+    if (element.type == ElementType::Normal) return detail::bsplineWeights(point.u, point.v) * gridPoints(element.grid);
+    const Special& special = specials[element.special];
+    const SubpatchPoint at = locateSubpatch(element, point);
+    Eigen::Matrix<double, 6, 3> result = Eigen::Matrix<double, 6, 3>::Zero();
+    Eigen::Matrix<double, 3, 3> masks = Eigen::Matrix<double, 3, 3>::Zero();
+    for (size_t c = 0; c < special.columns.size(); ++c) {
+      masks.noalias() += special.vertexMasks.col(static_cast<Eigen::Index>(c)) * controlPoints.row(special.columns[c]);
+    }
+    if (!at.patch) {
+      result.topRows(3) = masks;
+    } else {
+      result = detail::bsplineWeights(at.u, at.v) * gridPoints(*at.patch);
+      result.row(0) += masks.row(0);
+    }
+    applyChainRule(result, at.jacobian);
+    return result;
   }
 
   // The element point of a surface point and d(element u, v)/d(surface u, v).
@@ -378,9 +432,7 @@ SurfacePoint LimitSurface::toSurfacePoint(const ElementPoint& point) const {
 
 namespace {
 
-LimitSample sampleFrom(const SampleWeights& w, const std::vector<int>& columns, const Matrix3X& controlPoints) {
-  Eigen::Matrix<double, 6, 3> values = Eigen::Matrix<double, 6, 3>::Zero();
-  for (size_t c = 0; c < columns.size(); ++c) values.noalias() += w.col(c) * controlPoints.row(columns[c]);
+LimitSample sampleOf(const Eigen::Matrix<double, 6, 3>& values) {
   LimitSample sample;
   sample.position = values.row(0).transpose();
   sample.du = values.row(1).transpose();
@@ -405,7 +457,7 @@ void checkPoints(const Matrix3X& controlPoints, int expected) {
 
 LimitSample LimitSurface::evaluate(const ElementPoint& point, const Matrix3X& controlPoints) const {
   checkPoints(controlPoints, impl_->controlVertexCount);
-  return sampleFrom(impl_->weights(point), impl_->columnsOf(point.element), controlPoints);
+  return sampleOf(impl_->values(point, controlPoints));
 }
 
 LimitSample LimitSurface::evaluate(const SurfacePoint& point, const Matrix3X& controlPoints) const {
@@ -414,30 +466,51 @@ LimitSample LimitSurface::evaluate(const SurfacePoint& point, const Matrix3X& co
   const ElementPoint elementPoint = impl_->locate(point, jacobian);
   SampleWeights w = impl_->weights(elementPoint);
   applyChainRule(w, jacobian);
-  return sampleFrom(w, impl_->columnsOf(elementPoint.element), controlPoints);
+  const std::vector<int>& columns = impl_->columnsOf(elementPoint.element);
+  Eigen::Matrix<double, 6, 3> values = Eigen::Matrix<double, 6, 3>::Zero();
+  for (size_t c = 0; c < columns.size(); ++c) values.noalias() += w.col(c) * controlPoints.row(columns[c]);
+  return sampleOf(values);
 }
 
 namespace {
 
-LimitOperators assemble(int rows, int columns,
-                        const std::vector<std::pair<const std::vector<int>*, SampleWeights>>& samples) {
-  std::array<std::vector<Triplet>, 6> triplets;
-  for (size_t r = 0; r < samples.size(); ++r) {
-    const std::vector<int>& cols = *samples[r].first;
-    const SampleWeights& w = samples[r].second;
-    for (int q = 0; q < 6; ++q) {
+// The rows of `count` operators (s, s_u, ... in that order) as row-major
+// sparse matrices built in place: each row's columns are its element's,
+// already sorted, so no triplets are sorted or summed. Exact zeros are left out.
+std::array<SparseMatrix, 6> assemble(int columns, int count,
+                                     const std::vector<std::pair<const std::vector<int>*, SampleWeights>>& samples) {
+  std::array<SparseMatrix, 6> result;
+  const int rows = static_cast<int>(samples.size());
+  for (int q = 0; q < count; ++q) {
+    SparseMatrix& m = result[q];
+    m.resize(rows, columns);
+    size_t nonZeros = 0;
+    for (const auto& sample : samples) nonZeros += sample.first->size();
+    m.resizeNonZeros(static_cast<Eigen::Index>(nonZeros));
+    int* outer = m.outerIndexPtr();
+    int* inner = m.innerIndexPtr();
+    double* values = m.valuePtr();
+    int k = 0;
+    outer[0] = 0;
+    for (int r = 0; r < rows; ++r) {
+      const std::vector<int>& cols = *samples[r].first;
+      const SampleWeights& w = samples[r].second;
       for (size_t c = 0; c < cols.size(); ++c) {
-        if (w(q, c) != 0.0) triplets[q].emplace_back(static_cast<int>(r), cols[c], w(q, c));
+        if (w(q, c) == 0.0) continue;
+        inner[k] = cols[c];
+        values[k] = w(q, c);
+        ++k;
       }
+      outer[r + 1] = k;
     }
-  }
-  LimitOperators result;
-  SparseMatrix* targets[6] = {&result.J, &result.Ju, &result.Jv, &result.Juu, &result.Juv, &result.Jvv};
-  for (int q = 0; q < 6; ++q) {
-    targets[q]->resize(rows, columns);
-    targets[q]->setFromTriplets(triplets[q].begin(), triplets[q].end());
+    m.resizeNonZeros(k);
   }
   return result;
+}
+
+LimitOperators toOperators(std::array<SparseMatrix, 6>&& m) {
+  return LimitOperators{std::move(m[0]), std::move(m[1]), std::move(m[2]),
+                        std::move(m[3]), std::move(m[4]), std::move(m[5])};
 }
 
 }  // namespace
@@ -446,7 +519,14 @@ LimitOperators LimitSurface::operators(const std::vector<ElementPoint>& points) 
   std::vector<std::pair<const std::vector<int>*, SampleWeights>> samples;
   samples.reserve(points.size());
   for (const ElementPoint& point : points) samples.emplace_back(&impl_->columnsOf(point.element), impl_->weights(point));
-  return assemble(static_cast<int>(points.size()), impl_->controlVertexCount, samples);
+  return toOperators(assemble(impl_->controlVertexCount, 6, samples));
+}
+
+SparseMatrix LimitSurface::limitOperator(const std::vector<ElementPoint>& points) const {
+  std::vector<std::pair<const std::vector<int>*, SampleWeights>> samples;
+  samples.reserve(points.size());
+  for (const ElementPoint& point : points) samples.emplace_back(&impl_->columnsOf(point.element), impl_->weights(point));
+  return std::move(assemble(impl_->controlVertexCount, 1, samples)[0]);
 }
 
 LimitOperators LimitSurface::operators(const std::vector<SurfacePoint>& points) const {
@@ -459,7 +539,16 @@ LimitOperators LimitSurface::operators(const std::vector<SurfacePoint>& points) 
     applyChainRule(w, jacobian);
     samples.emplace_back(&impl_->columnsOf(elementPoint.element), std::move(w));
   }
-  return assemble(static_cast<int>(points.size()), impl_->controlVertexCount, samples);
+  return toOperators(assemble(impl_->controlVertexCount, 6, samples));
+}
+
+const std::vector<int>& LimitSurface::elementColumns(int element) const {
+  if (element < 0 || element >= elementCount()) throw Error("element " + std::to_string(element) + " does not exist");
+  return impl_->columnsOf(element);
+}
+
+Eigen::Matrix<double, 6, Eigen::Dynamic> LimitSurface::stencil(const ElementPoint& point) const {
+  return impl_->weights(point);
 }
 
 Eigen::Matrix<double, 6, 16> bicubicBsplineWeights(double a, double b) { return detail::bsplineWeights(a, b); }

@@ -10,6 +10,7 @@
 namespace dynsub {
 
 class ClosestPointLocator;
+class TangentStiffness;
 
 class ForceModel {
  public:
@@ -24,6 +25,13 @@ class ForceModel {
   // A stiffness S >= 0 of the force near the current state, used only to
   // stabilize time integration (Integrator.h); empty (0 x 0) if none.
   virtual SparseMatrix stabilizingStiffness(const Matrix3X& controlPoints);
+  // Adds an approximation of -d f_p / d p at the state of the last
+  // generalizedForce call, for the static scheme's Newton steps
+  // (StaticSolver.h). By default the stabilizing stiffness on x, y and z alike.
+  virtual void addTangentStiffness(const Matrix3X& controlPoints, TangentStiffness& into);
+  // True when generalizedForce adds the force's whole potential energy, so
+  // that the total energy is what the static scheme's steps must lower.
+  virtual bool hasPotential() const { return false; }
 };
 
 // Springs from fixed points in space to the surface (TVCG eq. 27).
@@ -42,6 +50,16 @@ class SpringForceModel final : public ForceModel {
                   const Matrix3X& controlPoints) override;
   Matrix3X generalizedForce(const Matrix3X& controlPoints, double& potential) override;
   SparseMatrix stabilizingStiffness(const Matrix3X& controlPoints) override;
+  // NearestEachStep: k (n n^T + kTangentialShare (I - n n^T)) at each
+  // attachment, n the limit normal there (the tangent-plane stiffness of
+  // StaticSolver.h); NearestAtLevelStart: k J^T J, the exact derivative.
+  void addTangentStiffness(const Matrix3X& controlPoints, TangentStiffness& into) override;
+  bool hasPotential() const override { return true; }
+
+  // The share of a spring's stiffness kept tangentially in the static
+  // scheme: enough to keep each step's slide along the surface bounded where
+  // the surface's elasticity is weak, small enough not to hold it back.
+  static constexpr double kTangentialShare = 0.05;
 
   // Spring lengths (distances target - attachment, mm) at the last evaluation.
   const Eigen::VectorXd& lengths() const { return lengths_; }
@@ -110,6 +128,7 @@ class PullForceModel final : public ForceModel {
   // The spring's stiffness while a pull is on (a stiff explicit spring would
   // make the surface oscillate about the target instead of settling).
   SparseMatrix stabilizingStiffness(const Matrix3X& controlPoints) override;
+  bool hasPotential() const override { return true; }
 
  private:
   // With the mutex held: attach to the surface point nearest anchor_ unless attached.

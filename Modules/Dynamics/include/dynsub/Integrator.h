@@ -27,12 +27,14 @@
 
 namespace dynsub {
 
-enum class IntegrationScheme { SecondOrder, FirstOrder };
+// Static is not a time integration: it solves for the equilibrium directly
+// (StaticSolver.h); Simulation.h routes it there.
+enum class IntegrationScheme { SecondOrder, FirstOrder, Static };
 enum class LinearSolver { Cholesky, ConjugateGradient, PreconditionedConjugateGradient };
 
 const char* toString(IntegrationScheme scheme);
 const char* toString(LinearSolver solver);
-// Parses "second-order"/"first-order" and "cholesky"/"cg"/"pcg"; throws dynsub::Error.
+// Parses "second-order"/"first-order"/"static" and "cholesky"/"cg"/"pcg"; throws dynsub::Error.
 IntegrationScheme parseIntegrationScheme(const std::string& text);
 LinearSolver parseLinearSolver(const std::string& text);
 

@@ -1,7 +1,10 @@
 #pragma once
 // Multilevel dynamics (TVCG 1998 §2.5.1, §3.3-3.4; ICCV 1998 §3): the control
 // points evolve under M p'' + D p' + K p = f_p, integrated implicitly
-// (Integrator.h), until equilibrium; then, unless the caller accepts the fit,
+// (Integrator.h), until equilibrium, or, with IntegrationScheme::Static, go
+// to the equilibrium K p = f_p by Newton steps (StaticSolver.h: the same
+// equilibria in tens of solves, for forces with a potential the energy
+// falls at every step); then, unless the caller accepts the fit,
 // the control mesh is replaced by its global Catmull-Clark refinement
 // (p' = A p: the limit surface is unchanged), the matrices are rebuilt and the
 // evolution goes on, up to `maxLevel` refinements.
@@ -13,7 +16,10 @@
 // level start). A level that reaches `maxSteps` first ends unconverged (and is
 // reported so).
 //
-// Stabilizer updates: the forces' stiffness that stabilizes the integration
+// A static step is still when it meets the same tolerances; two still steps
+// in a row are an equilibrium.
+//
+// Stabilizer updates (time stepping): the forces' stiffness that stabilizes the integration
 // (Integrator.h) is frozen when a level starts; when the energy rises by more
 // than energyTolerance for 3 steps in a row (springs re-attached elsewhere
 // have made it stale) it is frozen anew at the current state and the
@@ -65,7 +71,13 @@ struct LevelSummary {
   double energy = 0;    // N mm, at the end of the level
   double seconds = 0;   // wall time of the level, assembly included
   int solverIterations = 0;
-  int stabilizerUpdates = 0;  // times the forces' stiffness was re-frozen (see simulate)
+  // Time stepping: times the forces' stiffness was re-frozen (see above);
+  // static: diagonal shifts needed to factor the Newton system.
+  int stabilizerUpdates = 0;
+  // |f_p - K p| / max(|f_p|, |K p|) at the end of the level (Frobenius
+  // norms over the free control vertices): how far the papers' equilibrium
+  // equation K p = f_p is from holding; 0 exactly at equilibrium.
+  double residual = 0;
 };
 
 struct SimulationResult {

@@ -131,6 +131,16 @@ class LimitSurface {
   LimitSample evaluate(const SurfacePoint& point, const Matrix3X& controlPoints) const;
   LimitOperators operators(const std::vector<ElementPoint>& points) const;
   LimitOperators operators(const std::vector<SurfacePoint>& points) const;
+  // J alone (positions), for callers that need no derivatives.
+  SparseMatrix limitOperator(const std::vector<ElementPoint>& points) const;
+
+  // The control vertices an element depends on (sorted), and the weights of s
+  // and its derivatives at one of its points over them: rows s, s_u, s_v,
+  // s_uu, s_uv, s_vv (6 by elementColumns(point.element).size()). One row of
+  // operators() without building a sparse matrix, for loops that visit points
+  // one at a time (closest points, per-point stiffness).
+  const std::vector<int>& elementColumns(int element) const;
+  Eigen::Matrix<double, 6, Eigen::Dynamic> stencil(const ElementPoint& point) const;
 
   // A normal element is one piece of size 1. A special element is the three
   // regular pieces of each local-subdivision level 1..levels (size 2^-level);

@@ -1,0 +1,256 @@
+#include "dynsub/StaticSolver.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+
+#include <Eigen/SparseCholesky>
+
+#include "dynsub/Error.h"
+#include "dynsub/ForceModel.h"
+
+namespace dynsub {
+
+struct TangentStiffness::Impl {
+  const LimitSurface* surface = nullptr;
+  int vertices = 0;
+  // The scalar pattern (N by N, column-major, rows sorted): every pair of
+  // control vertices sharing an element.
+  std::vector<int> scalarOuter, scalarInner;
+  // Per element, for columns c of the element: position of row c[i] within
+  // scalar column c[j], at [j * m + i].
+  std::vector<std::vector<int>> position;
+  SymmetricMatrix matrix;  // 3N by 3N on the expanded pattern
+  // Per element, the pending sums of B_ab w w^T (lower triangles) for the six
+  // (a, b) with a <= b, and the elements touched since the last matrix().
+  // NB: kept allocated from step to step; allocating them anew each step
+  // cost more than filling them.
+  std::vector<std::array<Eigen::MatrixXd, 6>> pending;
+  std::vector<char> isTouched;
+  std::vector<int> touched;
+
+  void clearPending() {
+    for (int e : touched) {
+      for (Eigen::MatrixXd& x : pending[e]) x.setZero();
+      isTouched[e] = 0;
+    }
+    touched.clear();
+  }
+
+  // Index into matrix.valuePtr() of (3 i + a, 3 j + b), k the position of i in scalar column j.
+  int valueIndex(int j, int k, int a, int b) const {
+    return matrix.outerIndexPtr()[3 * j + b] + 3 * (k - scalarOuter[j]) + a;
+  }
+  int find(int i, int j) const {
+    const auto begin = scalarInner.begin() + scalarOuter[j], end = scalarInner.begin() + scalarOuter[j + 1];
+    const auto it = std::lower_bound(begin, end, i);
+    if (it == end || *it != i) {
+      throw Error("internal: control vertices " + std::to_string(i) + " and " + std::to_string(j) +
+                  " share no element");
+    }
+    return static_cast<int>(it - scalarInner.begin());
+  }
+  void addScalarEntry(int i, int j, double v) {
+    const int k = find(i, j);
+    double* values = matrix.valuePtr();
+    for (int a = 0; a < 3; ++a) values[valueIndex(j, k, a, a)] += v;
+  }
+  void flush() {
+    double* values = matrix.valuePtr();
+    static constexpr int pair[3][3] = {{0, 1, 2}, {1, 3, 4}, {2, 4, 5}};  // (a, b) -> slot of a <= b
+    for (int e : touched) {
+      const std::vector<int>& columns = surface->elementColumns(e);
+      const int m = static_cast<int>(columns.size());
+      std::array<Eigen::MatrixXd, 6>& w = pending[e];
+      for (int j = 0; j < m; ++j) {
+        for (int i = 0; i < m; ++i) {
+          const int k = position[e][j * m + i];
+          const int r = std::max(i, j), c = std::min(i, j);  // the stored lower triangle
+          for (int b = 0; b < 3; ++b) {
+            for (int a = 0; a < 3; ++a) values[valueIndex(columns[j], k, a, b)] += w[pair[a][b]](r, c);
+          }
+        }
+      }
+    }
+    clearPending();
+  }
+};
+
+TangentStiffness::TangentStiffness(const LimitSurface& surface) : impl_(std::make_unique<Impl>()) {
+  Impl& s = *impl_;
+  s.surface = &surface;
+  s.vertices = surface.controlVertexCount();
+  const int n = s.vertices;
+  std::vector<std::vector<int>> rows(n);
+  for (int e = 0; e < surface.elementCount(); ++e) {
+    const std::vector<int>& columns = surface.elementColumns(e);
+    for (int j : columns) rows[j].insert(rows[j].end(), columns.begin(), columns.end());
+  }
+  s.scalarOuter.assign(n + 1, 0);
+  for (int j = 0; j < n; ++j) {
+    std::sort(rows[j].begin(), rows[j].end());
+    rows[j].erase(std::unique(rows[j].begin(), rows[j].end()), rows[j].end());
+    s.scalarOuter[j + 1] = s.scalarOuter[j] + static_cast<int>(rows[j].size());
+    s.scalarInner.insert(s.scalarInner.end(), rows[j].begin(), rows[j].end());
+  }
+  s.position.resize(surface.elementCount());
+  for (int e = 0; e < surface.elementCount(); ++e) {
+    const std::vector<int>& columns = surface.elementColumns(e);
+    const int m = static_cast<int>(columns.size());
+    s.position[e].resize(static_cast<size_t>(m) * m);
+    for (int j = 0; j < m; ++j) {
+      for (int i = 0; i < m; ++i) s.position[e][j * m + i] = s.find(columns[i], columns[j]);
+    }
+  }
+  // Expand: scalar entry (i, j) becomes the 3 x 3 block of rows 3i..3i+2, columns 3j..3j+2.
+  const int nonZeros = 9 * static_cast<int>(s.scalarInner.size());
+  s.matrix.resize(3 * n, 3 * n);
+  s.matrix.resizeNonZeros(nonZeros);
+  int* outer = s.matrix.outerIndexPtr();
+  int* inner = s.matrix.innerIndexPtr();
+  outer[0] = 0;
+  for (int j = 0; j < n; ++j) {
+    const int count = 3 * (s.scalarOuter[j + 1] - s.scalarOuter[j]);
+    for (int b = 0; b < 3; ++b) {
+      const int start = outer[3 * j + b];
+      outer[3 * j + b + 1] = start + count;
+      for (int k = s.scalarOuter[j]; k < s.scalarOuter[j + 1]; ++k) {
+        for (int a = 0; a < 3; ++a) inner[start + 3 * (k - s.scalarOuter[j]) + a] = 3 * s.scalarInner[k] + a;
+      }
+    }
+  }
+  std::fill(s.matrix.valuePtr(), s.matrix.valuePtr() + nonZeros, 0.0);
+  s.pending.resize(surface.elementCount());
+  s.isTouched.assign(surface.elementCount(), 0);
+}
+
+TangentStiffness::~TangentStiffness() = default;
+
+const LimitSurface& TangentStiffness::surface() const { return *impl_->surface; }
+
+void TangentStiffness::reset(const SymmetricMatrix& scalar) {
+  Impl& s = *impl_;
+  if (scalar.rows() != s.vertices || scalar.cols() != s.vertices) throw Error("internal: stiffness has the wrong size");
+  s.clearPending();
+  std::fill(s.matrix.valuePtr(), s.matrix.valuePtr() + s.matrix.nonZeros(), 0.0);
+  for (int j = 0; j < scalar.outerSize(); ++j) {
+    for (SymmetricMatrix::InnerIterator it(scalar, j); it; ++it) s.addScalarEntry(static_cast<int>(it.row()), j, it.value());
+  }
+}
+
+void TangentStiffness::addScalar(const SparseMatrix& scalar) {
+  Impl& s = *impl_;
+  if (scalar.rows() != s.vertices || scalar.cols() != s.vertices) throw Error("internal: stiffness has the wrong size");
+  for (int i = 0; i < scalar.outerSize(); ++i) {
+    for (SparseMatrix::InnerIterator it(scalar, i); it; ++it) s.addScalarEntry(i, static_cast<int>(it.col()), it.value());
+  }
+}
+
+void TangentStiffness::addPoint(const ElementPoint& q, const Eigen::Matrix3d& block) {
+  Impl& s = *impl_;
+  const Eigen::RowVectorXd w = s.surface->stencil(q).row(0);
+  std::array<Eigen::MatrixXd, 6>& sums = s.pending[q.element];
+  if (!s.isTouched[q.element]) {
+    if (sums[0].rows() != w.size()) {
+      for (Eigen::MatrixXd& x : sums) x.setZero(w.size(), w.size());
+    }
+    s.isTouched[q.element] = 1;
+    s.touched.push_back(q.element);
+  }
+  static constexpr int a[6] = {0, 0, 0, 1, 1, 2}, b[6] = {0, 1, 2, 1, 2, 2};
+  for (int slot = 0; slot < 6; ++slot) {
+    const double weight = block(a[slot], b[slot]);
+    if (weight != 0.0) sums[slot].selfadjointView<Eigen::Lower>().rankUpdate(w.transpose(), weight);
+  }
+}
+
+SymmetricMatrix& TangentStiffness::matrix() {
+  impl_->flush();
+  return impl_->matrix;
+}
+
+struct StaticSolver::Impl {
+  SymmetricMatrix stiffness;
+  TangentStiffness tangent;
+  std::vector<bool> fixed;
+  Eigen::SimplicialLDLT<SymmetricMatrix, Eigen::Lower> factor;
+  bool analysed = false;
+  int regularizations = 0;
+
+  Impl(const LimitSurface& surface, const SymmetricMatrix& k) : stiffness(k), tangent(surface) {}
+};
+
+StaticSolver::StaticSolver(const LimitSurface& surface, const SymmetricMatrix& stiffness,
+                           const std::vector<int>& fixed)
+    : impl_(std::make_unique<Impl>(surface, stiffness)) {
+  Impl& s = *impl_;
+  const int n = surface.controlVertexCount();
+  if (stiffness.rows() != n || stiffness.cols() != n) throw Error("internal: stiffness has the wrong size");
+  s.fixed.assign(n, false);
+  for (int v : fixed) {
+    if (v < 0 || v >= n) throw Error("fixed control vertex " + std::to_string(v) + " does not exist");
+    s.fixed[v] = true;
+  }
+  if (std::find(s.fixed.begin(), s.fixed.end(), false) == s.fixed.end()) {
+    throw Error("every control vertex is fixed: nothing can move");
+  }
+}
+
+StaticSolver::~StaticSolver() = default;
+
+int StaticSolver::regularizations() const { return impl_->regularizations; }
+
+Matrix3X StaticSolver::direction(const std::vector<ForceModel*>& forces, const Matrix3X& controlPoints,
+                                 const Matrix3X& residual) {
+  Impl& s = *impl_;
+  s.tangent.reset(s.stiffness);
+  for (ForceModel* f : forces) f->addTangentStiffness(controlPoints, s.tangent);
+  SymmetricMatrix& h = s.tangent.matrix();
+  const int dofs = static_cast<int>(h.rows());
+  // Fixed vertices: their rows and columns become the identity, their right-hand side 0.
+  const bool anyFixed = std::find(s.fixed.begin(), s.fixed.end(), true) != s.fixed.end();
+  if (anyFixed) {
+    for (int j = 0; j < dofs; ++j) {
+      for (SymmetricMatrix::InnerIterator it(h, j); it; ++it) {
+        if (s.fixed[it.row() / 3] || s.fixed[j / 3]) it.valueRef() = it.row() == j ? 1.0 : 0.0;
+      }
+    }
+  }
+  Eigen::VectorXd rhs(dofs);
+  for (int v = 0; v < static_cast<int>(s.fixed.size()); ++v) {
+    for (int a = 0; a < 3; ++a) rhs(3 * v + a) = s.fixed[v] ? 0.0 : residual(v, a);
+  }
+  if (!s.analysed) {
+    s.factor.analyzePattern(h);
+    s.analysed = true;
+  }
+  const Eigen::VectorXd diagonal = h.diagonal();
+  const double meanDiagonal = diagonal.cwiseAbs().mean();
+  double shift = 0.0;
+  for (int attempt = 0;; ++attempt) {
+    s.factor.factorize(h);
+    const bool positive = s.factor.info() == Eigen::Success &&
+                          (s.factor.vectorD().array() > 1e-12 * s.factor.vectorD().cwiseAbs().maxCoeff()).all();
+    if (positive) break;
+    // NB: K alone leaves translations free; forces that pin too little (a
+    // single spring, a field with no slope) leave H singular. A small shift
+    // turns the step into a slightly damped one instead of failing.
+    if (attempt == 3 || !(meanDiagonal > 0.0)) {
+      throw Error("the equilibrium system is not positive definite even after a diagonal shift of " +
+                  std::to_string(shift) + " (is the surface anchored by its forces?)");
+    }
+    const double next = (shift == 0.0 ? 1e-8 : 1e3 * shift / meanDiagonal) * meanDiagonal;
+    for (int d = 0; d < dofs; ++d) h.coeffRef(d, d) += next - shift;
+    shift = next;
+    ++s.regularizations;
+  }
+  const Eigen::VectorXd solution = s.factor.solve(rhs);
+  Matrix3X d(s.fixed.size(), 3);
+  for (int v = 0; v < static_cast<int>(s.fixed.size()); ++v) {
+    for (int a = 0; a < 3; ++a) d(v, a) = solution(3 * v + a);
+  }
+  return d;
+}
+
+}  // namespace dynsub
