@@ -27,7 +27,7 @@ ProgressCallback ConvergenceRecorder::callback(ProgressCallback next) {
   return [this, next](const Progress& p) {
     ConvergenceSample sample{p.level, p.step, p.energy, std::nan("")};
     if (fitError_ && p.surface && p.controlPoints && (p.step == 1 || p.step % stride_ == 0))
-      sample.fitError = fitError_(*p.surface, *p.controlPoints);
+      sample.fitError = fitError_(p);
     history_.add(sample);
     if (next) next(p);
   };

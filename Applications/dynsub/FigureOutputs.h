@@ -24,7 +24,7 @@ class OutputSet;
 // on the current surface.
 class ConvergenceRecorder {
  public:
-  using FitError = std::function<double(const LimitSurface& surface, const Matrix3X& controlPoints)>;
+  using FitError = std::function<double(const Progress& progress)>;
   ConvergenceRecorder(std::string fitErrorName, FitError fitError, int stride);
   // Records, then calls `next` (may be empty).
   ProgressCallback callback(ProgressCallback next);

@@ -11,6 +11,7 @@
 #include "Commands.h"
 #include "FigureOutputs.h"
 #include "Reporting.h"
+#include "dynsub/ClosestPoint.h"
 #include "dynsub/Error.h"
 #include "dynsub/ImageIO.h"
 #include "dynsub/MeshIO.h"
@@ -107,21 +108,18 @@ void runSegment(SegmentCommandOptions o) {
 
   const auto start = std::chrono::steady_clock::now();
   ProgressLine line;
-  // The rms landmark distance every 25 steps. Each sample rebuilds a
-  // closest-point locator on the surface (about 20 ms at 386 control
-  // vertices, several steps' worth): every 5 steps it took 60 % of the
-  // caudate's evolution time.
+  // The rms landmark distance every 5 steps, the landmarks' nearest points
+  // tracked from sample to sample (a new locator only when the level changes).
   const Matrix3X landmarkPoints = landmarkPositions(landmarks);
+  TrackedDistances tracked(landmarkPoints);
   ConvergenceRecorder recorder(
       "rms landmark distance (mm)",
       landmarks.empty() ? ConvergenceRecorder::FitError()
-                        : [&](const LimitSurface& surface, const Matrix3X& controlPoints) {
-                            double squares = 0;
-                            for (double d : distancesToSurface(surface, controlPoints, landmarkPoints))
-                              squares += d * d;
-                            return std::sqrt(squares / landmarkPoints.rows());
+                        : [&](const Progress& p) {
+                            const Eigen::VectorXd d = tracked.measure(*p.surface, p.level, *p.controlPoints);
+                            return std::sqrt(d.squaredNorm() / static_cast<double>(d.size()));
                           },
-      25);
+      5);
   const SegmentResult result = [&] {
     try {
       return segment(image, landmarks, initial, o.segment, recorder.callback(line.callback()));

@@ -59,13 +59,38 @@ struct ClosestPointLocator::Impl {
   int candidates = 6;
   std::vector<ElementPoint> samples;
   SparseMatrix sampleOperator;
+  SparseMatrix patchOperator;  // LimitSurface::patchOperator
+  std::vector<char> normal;    // per element
   SampleCloud cloud;
   std::unique_ptr<Tree> tree;
   Matrix3X controlPoints;
+  Matrix3X grids;  // patchOperator * controlPoints
+
+  // The limit surface at p: on a normal element from its grid of this state
+  // (a 6 x 16 by 16 x 3 product), elsewhere through the surface.
+  LimitSample evaluate(const ElementPoint& p) const {
+    if (!normal[p.element]) return surface->evaluate(p, controlPoints);
+    const Eigen::Matrix<double, 6, 3> v =
+        bicubicBsplineWeights(p.u, p.v) * grids.middleRows<16>(16 * static_cast<Eigen::Index>(p.element));
+    LimitSample sample;
+    sample.position = v.row(0).transpose();
+    sample.du = v.row(1).transpose();
+    sample.dv = v.row(2).transpose();
+    sample.duu = v.row(3).transpose();
+    sample.duv = v.row(4).transpose();
+    sample.dvv = v.row(5).transpose();
+    const Vector3 n = sample.du.cross(sample.dv);
+    sample.normal = n.norm() > 0.0 ? Vector3(n.normalized()) : Vector3::Zero();
+    return sample;
+  }
 
   // Newton's method for min |s(u, v) - q|^2 on one element, from (u, v), kept in [0,1]^2.
   ClosestPoint refine(ElementPoint p, const Vector3& q) const {
-    LimitSample s = surface->evaluate(p, controlPoints);
+    if (p.element < 0 || p.element >= static_cast<int>(normal.size()) ||
+        !(p.u >= 0.0 && p.u <= 1.0 && p.v >= 0.0 && p.v <= 1.0)) {
+      throw Error("internal: closest-point search started outside the surface");
+    }
+    LimitSample s = evaluate(p);
     double best = (s.position - q).squaredNorm();
     for (int iteration = 0; iteration < 30; ++iteration) {
       const Vector3 r = s.position - q;
@@ -89,7 +114,7 @@ struct ClosestPointLocator::Impl {
       bool improved = false;
       for (int halving = 0; halving < 20; ++halving) {
         ElementPoint trial{p.element, std::clamp(p.u + step(0), 0.0, 1.0), std::clamp(p.v + step(1), 0.0, 1.0)};
-        const LimitSample t = surface->evaluate(trial, controlPoints);
+        const LimitSample t = evaluate(trial);
         const double d = (t.position - q).squaredNorm();
         if (d <= best) {
           improved = (best - d) > 0.0 || std::abs(trial.u - p.u) + std::abs(trial.v - p.v) > 0.0;
@@ -124,7 +149,12 @@ ClosestPointLocator::ClosestPointLocator(const LimitSurface& surface, int sample
     }
   }
   impl_->sampleOperator = surface.limitOperator(impl_->samples);
+  impl_->patchOperator = surface.patchOperator();
+  impl_->normal.resize(surface.elementCount());
+  for (int e = 0; e < surface.elementCount(); ++e) impl_->normal[e] = surface.elementType(e) == ElementType::Normal;
 }
+
+const SparseMatrix& ClosestPointLocator::patchOperator() const { return impl_->patchOperator; }
 
 ClosestPointLocator::~ClosestPointLocator() = default;
 ClosestPointLocator::ClosestPointLocator(ClosestPointLocator&&) noexcept = default;
@@ -138,6 +168,7 @@ void ClosestPointLocator::update(const Matrix3X& controlPoints) {
   if (!controlPoints.allFinite()) throw Error("closest-point search got non-finite control points");
   impl_->controlPoints = controlPoints;
   impl_->cloud.points = impl_->sampleOperator * controlPoints;
+  impl_->grids = impl_->patchOperator * controlPoints;
   impl_->tree = std::make_unique<Tree>(3, impl_->cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
 }
 
@@ -188,6 +219,28 @@ std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries,
   std::vector<ClosestPoint> result(queries.rows());
   parallelFor(queries.rows(), [&](Eigen::Index i) { result[i] = find(queries.row(i).transpose(), hints[i]); });
   return result;
+}
+
+TrackedDistances::TrackedDistances(Matrix3X points) : points_(std::move(points)) {}
+TrackedDistances::~TrackedDistances() = default;
+
+Eigen::VectorXd TrackedDistances::measure(const LimitSurface& surface, int level, const Matrix3X& controlPoints) {
+  if (&surface != surface_ || level != level_ || !locator_) {
+    locator_ = std::make_unique<ClosestPointLocator>(surface);
+    surface_ = &surface;
+    level_ = level;
+    hints_.clear();
+  }
+  locator_->update(controlPoints);
+  const std::vector<ClosestPoint> nearest =
+      hints_.empty() ? locator_->findAll(points_) : locator_->findAll(points_, hints_);
+  hints_.resize(nearest.size());
+  Eigen::VectorXd distances(static_cast<Eigen::Index>(nearest.size()));
+  for (size_t i = 0; i < nearest.size(); ++i) {
+    hints_[i] = nearest[i].point;
+    distances(static_cast<Eigen::Index>(i)) = nearest[i].distance;
+  }
+  return distances;
 }
 
 }  // namespace dynsub

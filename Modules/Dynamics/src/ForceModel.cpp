@@ -38,33 +38,65 @@ void SpringForceModel::beginLevel(const LimitSurface& surface, const SurfaceQuad
   surface_ = &surface;
   locator_ = std::make_unique<ClosestPointLocator>(surface);
   springs_.clear();  // attachments of the previous level mean nothing on the new surface
+  tracked_.clear();
   attach(controlPoints);
+  acceptState();
+}
+
+void SpringForceModel::acceptState() {
+  tracked_.resize(springs_.size());
+  for (size_t i = 0; i < springs_.size(); ++i) tracked_[i] = springs_[i].attachment;
 }
 
 void SpringForceModel::attach(const Matrix3X& controlPoints) {
   locator_->update(controlPoints);
-  // Track last step's attachments where there are some (same level).
-  std::vector<ElementPoint> hints;
-  for (const Spring& s : springs_) hints.push_back(s.attachment);
-  const std::vector<ClosestPoint> nearest =
-      hints.size() == static_cast<size_t>(targets_.rows()) ? locator_->findAll(targets_, hints)
-                                                           : locator_->findAll(targets_);
+  // Track the last accepted state's attachments where there are some (same level).
+  const std::vector<ClosestPoint> nearest = tracked_.size() == static_cast<size_t>(targets_.rows())
+                                                ? locator_->findAll(targets_, tracked_)
+                                                : locator_->findAll(targets_);
   springs_.resize(nearest.size());
+  positions_.resize(targets_.rows(), 3);
   for (size_t i = 0; i < nearest.size(); ++i) {
     springs_[i] = Spring{nearest[i].point, targets_.row(i).transpose(), stiffness_(i)};
+    positions_.row(static_cast<Eigen::Index>(i)) = nearest[i].position.transpose();
   }
 }
 
 Matrix3X SpringForceModel::generalizedForce(const Matrix3X& controlPoints, double& potential) {
-  if (attach_ == Attach::NearestEachStep) attach(controlPoints);
-  std::vector<ElementPoint> at;
-  at.reserve(springs_.size());
-  for (const Spring& s : springs_) at.push_back(s.attachment);
-  const SparseMatrix J = surface_->limitOperator(at);
-  const Matrix3X stretch = targets_ - J * controlPoints;  // d - s per spring
+  if (attach_ == Attach::NearestAtLevelStart) {
+    std::vector<ElementPoint> at;
+    at.reserve(springs_.size());
+    for (const Spring& s : springs_) at.push_back(s.attachment);
+    const SparseMatrix J = surface_->limitOperator(at);
+    const Matrix3X stretch = targets_ - J * controlPoints;  // d - s per spring
+    lengths_ = stretch.rowwise().norm();
+    potential += 0.5 * stiffness_.dot(lengths_.cwiseAbs2());
+    return J.transpose() * (stiffness_.asDiagonal() * stretch);
+  }
+  attach(controlPoints);
+  const Matrix3X stretch = targets_ - positions_;  // the locator's positions at these control points
   lengths_ = stretch.rowwise().norm();
   potential += 0.5 * stiffness_.dot(lengths_.cwiseAbs2());
-  return J.transpose() * (stiffness_.asDiagonal() * stretch);
+  // J^T k (d - s), without building J: pulls on a normal element's 16 grid
+  // points go back through the patch operator in one product; the few on
+  // special elements through their stencils.
+  const SparseMatrix& patches = locator_->patchOperator();
+  Matrix3X onGrids = Matrix3X::Zero(patches.rows(), 3);
+  Matrix3X force = Matrix3X::Zero(controlPoints.rows(), 3);
+  for (size_t i = 0; i < springs_.size(); ++i) {
+    const ElementPoint& q = springs_[i].attachment;
+    const Eigen::RowVector3d pull = stiffness_(static_cast<Eigen::Index>(i)) * stretch.row(static_cast<Eigen::Index>(i));
+    if (surface_->elementType(q.element) == ElementType::Normal) {
+      onGrids.middleRows<16>(16 * static_cast<Eigen::Index>(q.element)).noalias() +=
+          bicubicBsplineWeights(q.u, q.v).row(0).transpose() * pull;
+    } else {
+      const Eigen::RowVectorXd w = surface_->stencil(q).row(0);
+      const std::vector<int>& columns = surface_->elementColumns(q.element);
+      for (size_t c = 0; c < columns.size(); ++c) force.row(columns[c]) += w(static_cast<Eigen::Index>(c)) * pull;
+    }
+  }
+  force.noalias() += patches.transpose() * onGrids;
+  return force;
 }
 
 SparseMatrix SpringForceModel::stabilizingStiffness(const Matrix3X&) { return springStiffness(*surface_, springs_); }

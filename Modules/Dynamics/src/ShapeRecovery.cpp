@@ -95,6 +95,10 @@ ControlMesh initialModel(const Matrix3X& points, InitialShape shape) {
 
 SimulationOptions FitOptions::defaultSimulation() {
   SimulationOptions o;
+  // Springs to the nearest points have a potential, so Newton steps with the
+  // tangent-plane stiffness reach the equilibrium with the energy falling at
+  // every step (StaticSolver.h).
+  o.integrator.scheme = IntegrationScheme::Static;
   o.maxLevel = 3;
   // The data springs do not stiffen with refinement; weakening the surface's
   // elasticity 4-fold per level lets the finer levels follow the data closer.

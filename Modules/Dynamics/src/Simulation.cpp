@@ -65,6 +65,10 @@ Matrix3X totalForce(const std::vector<ForceModel*>& forces, const Matrix3X& poin
   return force;
 }
 
+void acceptState(const std::vector<ForceModel*>& forces) {
+  for (ForceModel* f : forces) f->acceptState();
+}
+
 // The equilibrium rule of Simulation.h over a sliding window of steps.
 class EquilibriumWindow {
  public:
@@ -116,6 +120,7 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
   for (int step = 1; step <= options.equilibrium.maxSteps; ++step) {
     double potential = 0.0;
     const Matrix3X force = totalForce(forces, points, potential);
+    acceptState(forces);
     const Matrix3X velocity = (points - previous) / timeStep;
     const double energy = 0.5 * quadraticForm(model.matrices.mass, velocity) +
                           0.5 * quadraticForm(model.matrices.stiffness, points) + potential;
@@ -174,39 +179,49 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
   points = model.start;
   double potential = 0.0;
   Matrix3X force = totalForce(forces, points, potential);
+  acceptState(forces);
   double energy = 0.5 * quadraticForm(model.matrices.stiffness, points) + potential;
   summary.energy = energy;
   if (!std::isfinite(energy)) return LevelEnd::Diverged;
   for (int step = 1; step <= options.equilibrium.maxSteps; ++step) {
     const Matrix3X residual = force - model.matrices.stiffness * points;
-    const Matrix3X direction = solver.direction(forces, points, residual);
-    if (!direction.allFinite()) return LevelEnd::Diverged;
-    double length = 1.0;
-    bool accepted = false, evaluated = false;
     Matrix3X trial, trialForce;
     double trialEnergy = energy;
-    for (int halving = 0; halving <= 20 && !accepted; ++halving, length *= 0.5) {
-      if (direction.rowwise().norm().maxCoeff() * length > model.size) continue;
-      trial = points + length * direction;
-      double trialPotential = 0.0;
-      trialForce = totalForce(forces, trial, trialPotential);
-      trialEnergy = 0.5 * quadraticForm(model.matrices.stiffness, trial) + trialPotential;
-      if (!std::isfinite(trialEnergy)) continue;
-      evaluated = true;
-      // Rounding of the energy's sum must not count as a rise.
-      accepted = !lineSearch || trialEnergy <= energy + 1e-12 * std::abs(energy);
+    bool accepted = false, evaluated = false;
+    // The Newton direction first; where it lowers nothing, the isotropic one.
+    for (const bool isotropic : {false, true}) {
+      if (isotropic && !lineSearch) break;
+      const Matrix3X direction = solver.direction(forces, points, residual, isotropic);
+      if (!direction.allFinite()) return LevelEnd::Diverged;
+      double length = 1.0;
+      for (int halving = 0; halving <= 20 && !accepted; ++halving, length *= 0.5) {
+        if (direction.rowwise().norm().maxCoeff() * length > model.size) continue;
+        trial = points + length * direction;
+        double trialPotential = 0.0;
+        trialForce = totalForce(forces, trial, trialPotential);
+        trialEnergy = 0.5 * quadraticForm(model.matrices.stiffness, trial) + trialPotential;
+        if (!std::isfinite(trialEnergy)) continue;
+        evaluated = true;
+        // Rounding of the energy's sum must not count as a rise.
+        accepted = !lineSearch || trialEnergy <= energy + 1e-12 * std::abs(energy);
+      }
+      if (accepted) break;
     }
     if (!accepted) {
       if (lineSearch && evaluated) {
-        // NB: the springs were re-attached at the last trial; restore them.
+        // Neither direction lowers the energy: a minimum to rounding. The
+        // forces were last evaluated at a trial; evaluate them here again.
         double restored = 0.0;
         force = totalForce(forces, points, restored);
+        acceptState(forces);
+        summary.stabilizerUpdates = solver.regularizations();
         return LevelEnd::Equilibrium;
       }
       return LevelEnd::Diverged;
     }
     const double motion = (trial - points).rowwise().norm().maxCoeff();
     const double change = relativeChange(trialEnergy, energy);
+    acceptState(forces);
     points = std::move(trial);
     force = std::move(trialForce);
     energy = trialEnergy;

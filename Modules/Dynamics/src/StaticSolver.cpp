@@ -170,13 +170,59 @@ SymmetricMatrix& TangentStiffness::matrix() {
   return impl_->matrix;
 }
 
+namespace {
+
+// Unknown 3 v + a as row v, column a.
+Matrix3X toPoints(const Eigen::VectorXd& x, size_t vertices) {
+  Matrix3X points(vertices, 3);
+  for (size_t v = 0; v < vertices; ++v) {
+    for (int a = 0; a < 3; ++a) points(static_cast<Eigen::Index>(v), a) = x(static_cast<Eigen::Index>(3 * v + a));
+  }
+  return points;
+}
+
+}  // namespace
+
 struct StaticSolver::Impl {
   SymmetricMatrix stiffness;
   TangentStiffness tangent;
   std::vector<bool> fixed;
   Eigen::SimplicialLDLT<SymmetricMatrix, Eigen::Lower> factor;
   bool analysed = false;
+  bool factored = false;  // `factor` holds some earlier step's matrix
   int regularizations = 0;
+
+  // Conjugate gradients on h x = rhs preconditioned by the earlier step's
+  // factor; true when they reach kReuseTolerance within kReuseIterations.
+  bool solveWithEarlierFactor(const SymmetricMatrix& h, const Eigen::VectorXd& rhs, Eigen::VectorXd& x) const {
+    x = factor.solve(rhs);
+    Eigen::VectorXd r = rhs - h.selfadjointView<Eigen::Lower>() * x;
+    const double target = kReuseTolerance * rhs.norm();
+    if (r.norm() <= target) return true;
+    Eigen::VectorXd z = factor.solve(r), p = z;
+    double rz = r.dot(z);
+    for (int i = 0; i < kReuseIterations; ++i) {
+      const Eigen::VectorXd hp = h.selfadjointView<Eigen::Lower>() * p;
+      const double curvature = p.dot(hp);
+      if (!(curvature > 0.0)) return false;
+      const double alpha = rz / curvature;
+      x += alpha * p;
+      r -= alpha * hp;
+      if (r.norm() <= target) return x.allFinite();
+      z = factor.solve(r);
+      const double next = r.dot(z);
+      p = z + (next / rz) * p;
+      rz = next;
+    }
+    return false;
+  }
+  // NB: a Newton direction need not be exact (the line search and the
+  // residual f_p - K p decide where the steps end), and from step to step H
+  // changes little, so an earlier factor preconditions it well: a few
+  // triangular solves instead of a new factorization, which at thousands of
+  // control vertices costs ten times a whole force evaluation.
+  static constexpr double kReuseTolerance = 1e-6;
+  static constexpr int kReuseIterations = 20;
 
   Impl(const LimitSurface& surface, const SymmetricMatrix& k) : stiffness(k), tangent(surface) {}
 };
@@ -202,10 +248,16 @@ StaticSolver::~StaticSolver() = default;
 int StaticSolver::regularizations() const { return impl_->regularizations; }
 
 Matrix3X StaticSolver::direction(const std::vector<ForceModel*>& forces, const Matrix3X& controlPoints,
-                                 const Matrix3X& residual) {
+                                 const Matrix3X& residual, bool isotropic) {
   Impl& s = *impl_;
   s.tangent.reset(s.stiffness);
-  for (ForceModel* f : forces) f->addTangentStiffness(controlPoints, s.tangent);
+  for (ForceModel* f : forces) {
+    if (isotropic) {
+      f->ForceModel::addTangentStiffness(controlPoints, s.tangent);
+    } else {
+      f->addTangentStiffness(controlPoints, s.tangent);
+    }
+  }
   SymmetricMatrix& h = s.tangent.matrix();
   const int dofs = static_cast<int>(h.rows());
   // Fixed vertices: their rows and columns become the identity, their right-hand side 0.
@@ -221,6 +273,8 @@ Matrix3X StaticSolver::direction(const std::vector<ForceModel*>& forces, const M
   for (int v = 0; v < static_cast<int>(s.fixed.size()); ++v) {
     for (int a = 0; a < 3; ++a) rhs(3 * v + a) = s.fixed[v] ? 0.0 : residual(v, a);
   }
+  Eigen::VectorXd solution;
+  if (s.factored && !isotropic && s.solveWithEarlierFactor(h, rhs, solution)) return toPoints(solution, s.fixed.size());
   if (!s.analysed) {
     s.factor.analyzePattern(h);
     s.analysed = true;
@@ -245,12 +299,10 @@ Matrix3X StaticSolver::direction(const std::vector<ForceModel*>& forces, const M
     shift = next;
     ++s.regularizations;
   }
-  const Eigen::VectorXd solution = s.factor.solve(rhs);
-  Matrix3X d(s.fixed.size(), 3);
-  for (int v = 0; v < static_cast<int>(s.fixed.size()); ++v) {
-    for (int a = 0; a < 3; ++a) d(v, a) = solution(3 * v + a);
-  }
-  return d;
+  // The isotropic fallback's factor would precondition the next Newton step badly.
+  s.factored = !isotropic;
+  solution = s.factor.solve(rhs);
+  return toPoints(solution, s.fixed.size());
 }
 
 }  // namespace dynsub

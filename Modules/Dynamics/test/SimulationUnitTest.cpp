@@ -9,6 +9,7 @@
 #include <random>
 
 #include <Eigen/SparseCholesky>
+#include <unsupported/Eigen/KroneckerProduct>
 
 #include "dynsub/CatmullClark.h"
 #include "dynsub/ClosestPoint.h"
@@ -19,6 +20,7 @@
 #include "dynsub/LimitSurface.h"
 #include "dynsub/ShapeRecovery.h"
 #include "dynsub/Simulation.h"
+#include "dynsub/StaticSolver.h"
 #include "dynsub/StandardMeshes.h"
 #include "dynsub/Tessellation.h"
 
@@ -106,6 +108,79 @@ INSTANTIATE_TEST_SUITE_P(
              (std::get<1>(info.param) == LinearSolver::Cholesky ? "Cholesky"
               : std::get<1>(info.param) == LinearSolver::ConjugateGradient ? "CG" : "PCG");
     });
+// The static scheme has its own solver (StaticSolver.h); springs held at
+// their attachments make its Newton step exact.
+INSTANTIATE_TEST_SUITE_P(StaticScheme, PureSpringTest,
+                         ::testing::Values(std::make_tuple(IntegrationScheme::Static, LinearSolver::Cholesky)));
+
+// The 3N x 3N Newton matrix against its definition, built densely:
+// K (x) I_3 + sum_q (J_q^T J_q) (x) B_q, unknown 3 v + a.
+TEST(TangentStiffness, MatchesItsDenseDefinition) {
+  const ControlMesh mesh = makeCube98();
+  const LimitSurface surface(mesh);
+  const PhysicalMatrices m = assemblePhysicalMatrices(surface, Material{});
+  TangentStiffness h(surface);
+  h.reset(m.stiffness);
+  const int n = surface.controlVertexCount();
+  Eigen::MatrixXd expected = Eigen::kroneckerProduct(Eigen::MatrixXd(m.stiffness), Eigen::Matrix3d::Identity());
+  std::mt19937_64 random(3);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int i = 0; i < 40; ++i) {
+    const ElementPoint q{static_cast<int>(unit(random) * surface.elementCount()) % surface.elementCount(), unit(random),
+                         unit(random)};
+    Eigen::Matrix3d b = Eigen::Matrix3d::Random();
+    b = (b * b.transpose()).eval();
+    h.addPoint(q, b);
+    const Eigen::VectorXd j = Eigen::RowVectorXd(surface.limitOperator({q}).row(0)).transpose();
+    expected += Eigen::kroneckerProduct(Eigen::MatrixXd(j * j.transpose()), b);
+  }
+  const SparseMatrix scalar = springStiffness(surface, {Spring{ElementPoint{5, 0.3, 0.6}, Vector3::Zero(), 2.0}});
+  h.addScalar(scalar);
+  expected += Eigen::kroneckerProduct(Eigen::MatrixXd(scalar), Eigen::Matrix3d::Identity());
+  const Eigen::MatrixXd actual(h.matrix());
+  ASSERT_EQ(actual.rows(), 3 * n);
+  // Sums of the same products in another order: rounding of ~1e-15 of the entries.
+  EXPECT_LT((actual - expected).cwiseAbs().maxCoeff(), 1e-12 * expected.cwiseAbs().maxCoeff());
+}
+
+// With springs to the nearest points the static scheme's total energy (the
+// function whose minimum is the papers' equilibrium) falls at every step, and
+// the equation K p = f_p holds at the end to the equilibrium rule's accuracy.
+TEST(StaticScheme, EnergyFallsAtEveryStepToTheEquilibrium) {
+  const Matrix3X points = ellipsoidPoints(1500, Vector3(30, 20, 10), 11);
+  FitOptions options;
+  ASSERT_EQ(options.simulation.integrator.scheme, IntegrationScheme::Static);
+  std::vector<std::pair<int, double>> energies;
+  const FitResult result = fitPointCloud(points, initialModel(points, InitialShape::Sphere), options,
+                                         [&](const Progress& p) { energies.emplace_back(p.level, p.energy); });
+  ASSERT_GT(energies.size(), 2u);
+  for (size_t i = 1; i < energies.size(); ++i) {
+    if (energies[i].first != energies[i - 1].first) continue;  // a new level starts from a refined mesh
+    // The line search's own allowance for the energy sum's rounding.
+    EXPECT_LE(energies[i].second, energies[i - 1].second + 1e-12 * std::abs(energies[i - 1].second)) << i;
+  }
+  for (const LevelSummary& level : result.levels) {
+    EXPECT_TRUE(level.converged);
+    // Steps stop when they move points by < 1e-4 of the size; the force
+    // imbalance left is of that order relative to the forces (measured 1e-3).
+    EXPECT_LT(level.residual, 2e-2);
+  }
+  EXPECT_LE(result.error.maxPercent, 1.0);
+}
+
+// A fixed control vertex stays exactly where it was under the static scheme.
+TEST(StaticScheme, FixedVerticesStay) {
+  const ControlMesh cube = makeCube98();
+  const LimitSurface surface(cube);
+  Matrix3X targets = tessellate(surface, cube.points(), 1).points * 1.2;
+  SpringForceModel springs(targets, Eigen::VectorXd::Constant(targets.rows(), 1.0), SpringForceModel::Attach::NearestEachStep);
+  SimulationOptions options;
+  options.integrator.scheme = IntegrationScheme::Static;
+  const SimulationResult result = simulate(cube, {&springs}, {0, 17}, options);
+  EXPECT_EQ(result.mesh.points().row(0), cube.points().row(0));
+  EXPECT_EQ(result.mesh.points().row(17), cube.points().row(17));
+  EXPECT_GT((result.mesh.points() - cube.points()).cwiseAbs().maxCoeff(), 0.05);
+}
 
 TEST(Integrator, SolversTakeTheSameStep) {
   const ControlMesh cube = makeCube98();

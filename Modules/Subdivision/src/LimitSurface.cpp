@@ -32,8 +32,8 @@ void zeroRowSums(Eigen::MatrixXd& displacements) {
 }
 
 // One level deeper around the extraordinary vertex, keeping row sums at 0.
-LevelPatches subdivideDisplacements(LocalMesh& mesh) {
-  LevelPatches patches = detail::subdivideAroundCorner(mesh);
+LevelPatches subdivideDisplacements(LocalMesh& mesh, detail::CornerStep& step) {
+  LevelPatches patches = detail::subdivideAroundCorner(mesh, step);
   zeroRowSums(mesh.weights);
   return patches;
 }
@@ -86,6 +86,7 @@ struct LimitSurface::Impl {
     std::vector<int> columns;
     std::vector<LevelPatches> levels;  // levels[n - 1]: subpatches at level n
     LocalMesh deepest;                 // the neighbourhood after the last level
+    detail::CornerStep step;           // the last level's step (the one deeper levels repeat)
     Eigen::Matrix<double, 3, Eigen::Dynamic> vertexMasks;  // limit position, tangent u, tangent v
     // levels and deepest hold displacements from the limit position (row 0 of vertexMasks).
   };
@@ -168,7 +169,7 @@ struct LimitSurface::Impl {
     local.weights.rowwise() -= special.vertexMasks.row(0);
     zeroRowSums(local.weights);
     for (int level = 1; level <= kTabulatedLevels; ++level) {
-      special.levels.push_back(subdivideDisplacements(local));
+      special.levels.push_back(subdivideDisplacements(local, special.step));
     }
     special.deepest = std::move(local);
     if (masks.boundary) setBoundaryTangents(special, masks, along);
@@ -189,7 +190,8 @@ struct LimitSurface::Impl {
   // so J_u and J_v stay linear operators.
   void setBoundaryTangents(Special& special, const detail::VertexMasks& masks, const Eigen::RowVectorXd& along) {
     LocalMesh deep = special.deepest;
-    for (int level = kTabulatedLevels; level < kCrossTangentLevel; ++level) subdivideDisplacements(deep);
+    detail::CornerStep step = special.step;
+    for (int level = kTabulatedLevels; level < kCrossTangentLevel; ++level) subdivideDisplacements(deep, step);
     const Polygon& face = deep.topology.face(deep.face);
     const int x = face[0];
     const int interior = !deep.topology.isBoundaryEdge(deep.topology.findEdge(x, face[1])) ? face[1] : face[3];
@@ -246,7 +248,8 @@ struct LimitSurface::Impl {
       result.patch = &special.levels[level - 1][child - 1];
     } else {
       LocalMesh local = special.deepest;
-      for (int n = kTabulatedLevels + 1; n <= level; ++n) result.deeper = subdivideDisplacements(local);
+      detail::CornerStep step = special.step;
+      for (int n = kTabulatedLevels + 1; n <= level; ++n) result.deeper = subdivideDisplacements(local, step);
       result.patch = &result.deeper[child - 1];
     }
     result.jacobian = std::ldexp(1.0, level) * detail::cornerFrameJacobian(child) * toCorner;
@@ -542,6 +545,37 @@ LimitOperators LimitSurface::operators(const std::vector<SurfacePoint>& points) 
   return toOperators(assemble(impl_->controlVertexCount, 6, samples));
 }
 
+SparseMatrix LimitSurface::patchOperator() const {
+  const Impl& s = *impl_;
+  SparseMatrix result(16 * elementCount(), s.controlVertexCount);
+  size_t nonZeros = 0;
+  for (const Impl::Element& e : s.elements) {
+    if (e.type == ElementType::Normal) nonZeros += 16 * e.columns.size();
+  }
+  result.resizeNonZeros(static_cast<Eigen::Index>(nonZeros));
+  int* outer = result.outerIndexPtr();
+  int* inner = result.innerIndexPtr();
+  double* values = result.valuePtr();
+  int k = 0;
+  outer[0] = 0;
+  for (size_t e = 0; e < s.elements.size(); ++e) {
+    const Impl::Element& element = s.elements[e];
+    for (int slot = 0; slot < 16; ++slot) {
+      if (element.type == ElementType::Normal) {
+        for (size_t c = 0; c < element.columns.size(); ++c) {
+          if (element.grid(slot, static_cast<Eigen::Index>(c)) == 0.0) continue;
+          inner[k] = element.columns[c];
+          values[k] = element.grid(slot, static_cast<Eigen::Index>(c));
+          ++k;
+        }
+      }
+      outer[16 * e + slot + 1] = k;
+    }
+  }
+  result.resizeNonZeros(k);
+  return result;
+}
+
 const std::vector<int>& LimitSurface::elementColumns(int element) const {
   if (element < 0 || element >= elementCount()) throw Error("element " + std::to_string(element) + " does not exist");
   return impl_->columnsOf(element);
@@ -567,9 +601,10 @@ ElementPieces LimitSurface::elementPieces(int element, int levels) const {
   const Impl::Special& special = s.specials[e.special];
   const Eigen::Matrix2d toCorner = detail::cornerFrameJacobian(e.corner);
   LocalMesh local = special.deepest;
+  detail::CornerStep step = special.step;
   LevelPatches deeper;
   for (int level = 1; level <= levels; ++level) {
-    if (level > kTabulatedLevels) deeper = subdivideDisplacements(local);
+    if (level > kTabulatedLevels) deeper = subdivideDisplacements(local, step);
     const LevelPatches& patches = level <= kTabulatedLevels ? special.levels[level - 1] : deeper;
     for (int child = 1; child <= 3; ++child) {
       BsplinePiece piece;

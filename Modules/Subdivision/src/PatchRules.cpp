@@ -241,17 +241,19 @@ Neighbourhood extractNeighbourhood(const Topology& topology, int x, int f) {
   return result;
 }
 
-LevelPatches subdivideAroundCorner(LocalMesh& mesh) {
-  const Refinement refinement = refine(mesh.topology);
-  const Eigen::MatrixXd refined = refinement.subdivisionMatrix * mesh.weights;
-  const int firstChild = refinement.childFaceOffset[mesh.face];
-  LevelPatches patches;
+CornerStep cornerStep(const Topology& topology, int face) {
+  const Refinement refinement = refine(topology);
+  const Eigen::MatrixXd refined = Eigen::MatrixXd(refinement.subdivisionMatrix);  // refined <- local
+  const int firstChild = refinement.childFaceOffset[face];
+  CornerStep step;
+  step.from = topology;
+  step.face = face;
   std::array<SmallStencil, 16> grid;
   for (int k = 1; k <= 3; ++k) {
     if (!gatherRegularPatch(refinement.topology, firstChild + k, grid)) {
       throw Error("internal: subpatch " + std::to_string(k) + " next to an extraordinary vertex is not regular");
     }
-    Eigen::Matrix<double, 16, Eigen::Dynamic>& patch = patches[k - 1];
+    Eigen::MatrixXd& patch = step.patches[k - 1];
     patch.setZero(16, refined.cols());
     for (int s = 0; s < 16; ++s) {
       for (const auto& [v, w] : grid[s]) patch.row(s) += w * refined.row(v);
@@ -259,11 +261,23 @@ LevelPatches subdivideAroundCorner(LocalMesh& mesh) {
   }
   // The vertex point of the extraordinary vertex keeps its index, and child 0
   // has it as corner 0.
-  const int x = mesh.topology.face(mesh.face)[0];
+  const int x = topology.face(face)[0];
   Neighbourhood next = extractNeighbourhood(refinement.topology, x, firstChild);
-  mesh.weights = refined(next.parentVertex, Eigen::all);
-  mesh.topology = std::move(next.topology);
-  mesh.face = next.face;
+  step.next = refined(next.parentVertex, Eigen::all);
+  step.to = std::move(next.topology);
+  step.toFace = next.face;
+  return step;
+}
+
+LevelPatches subdivideAroundCorner(LocalMesh& mesh, CornerStep& step) {
+  const bool applies = step.face == mesh.face && step.from.vertexCount() == mesh.topology.vertexCount() &&
+                       step.from.faces() == mesh.topology.faces();
+  if (!applies) step = cornerStep(mesh.topology, mesh.face);
+  LevelPatches patches;
+  for (int k = 0; k < 3; ++k) patches[k].noalias() = step.patches[k] * mesh.weights;
+  mesh.weights = step.next * mesh.weights;
+  mesh.topology = step.to;
+  mesh.face = step.toFace;
   return patches;
 }
 

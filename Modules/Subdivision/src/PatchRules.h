@@ -59,9 +59,27 @@ struct LocalMesh {
 };
 // Three regular subpatches of `face` after one local subdivision, children
 // 1, 2, 3 (each in its own corner frame), as 16 grid rows over the columns of
-// `weights`. Advances `mesh` to the next level (the child at corner 0).
+// `weights`.
 using LevelPatches = std::array<Eigen::Matrix<double, 16, Eigen::Dynamic>, 3>;
-LevelPatches subdivideAroundCorner(LocalMesh& mesh);
+
+// One level of that subdivision as fixed linear maps over the local
+// vertices, valid for one local topology (`from`, `face`): the patches are
+// patches[k] * weights, the next level's weights next * weights. After a
+// level or two around an isolated extraordinary vertex the local topology
+// repeats itself, so a step built once serves every deeper level.
+struct CornerStep {
+  Topology from;
+  int face = -1;
+  std::array<Eigen::MatrixXd, 3> patches;  // 16 by #local vertices
+  Eigen::MatrixXd next;                    // #next local vertices by #local vertices
+  Topology to;
+  int toFace = -1;
+};
+CornerStep cornerStep(const Topology& topology, int face);
+// The level's patches of `mesh`; advances it to the next level (the child at
+// corner 0). Goes through `step`, rebuilt first unless it applies to mesh's
+// topology.
+LevelPatches subdivideAroundCorner(LocalMesh& mesh, CornerStep& step);
 
 // (u, v) in the frame whose origin is corner k of a quad and whose u axis runs
 // to corner k+1: k = 0: (u, v); 1: (v, 1-u); 2: (1-u, 1-v); 3: (1-v, u).

@@ -41,11 +41,36 @@ class ClosestPointLocator {
   // One result per row of `queries`, in order (in parallel; deterministic).
   std::vector<ClosestPoint> findAll(const Matrix3X& queries) const;
   std::vector<ClosestPoint> findAll(const Matrix3X& queries, const std::vector<ElementPoint>& hints) const;
+  // The surface's patchOperator(), which update() applies to find points on
+  // normal elements without going through the surface's general path.
+  const SparseMatrix& patchOperator() const;
 
   struct Impl;
 
  private:
   std::unique_ptr<Impl> impl_;
+};
+
+// Distances (mm) from fixed points to a surface that moves and now and then
+// is refined, for following a fit as it evolves: the locator is built once
+// per level and each call starts from the last call's nearest points
+// (ClosestPointLocator::find with hints), so a call costs about one Newton
+// search per point instead of a new tessellation and a full search.
+class TrackedDistances {
+ public:
+  explicit TrackedDistances(Matrix3X points);
+  ~TrackedDistances();
+  // `level` tells surfaces apart: a level other than the last call's (or a
+  // surface of another size) builds a new locator. The surface must live
+  // until the next call.
+  Eigen::VectorXd measure(const LimitSurface& surface, int level, const Matrix3X& controlPoints);
+
+ private:
+  Matrix3X points_;
+  const LimitSurface* surface_ = nullptr;
+  int level_ = -1;
+  std::unique_ptr<ClosestPointLocator> locator_;
+  std::vector<ElementPoint> hints_;
 };
 
 }  // namespace dynsub

@@ -22,6 +22,12 @@ class ForceModel {
   // f_p at the control points (#control x 3); adds the force's potential
   // energy (N mm) to `potential` where it has one.
   virtual Matrix3X generalizedForce(const Matrix3X& controlPoints, double& potential) = 0;
+  // The state of the last generalizedForce call is the one the simulation
+  // goes on from. The static scheme also evaluates trial states it may
+  // reject; forces that track the surface (springs re-attaching to the
+  // nearest points) track it from accepted states only, so that a rejected
+  // trial leaves no trace.
+  virtual void acceptState() {}
   // A stiffness S >= 0 of the force near the current state, used only to
   // stabilize time integration (Integrator.h); empty (0 x 0) if none.
   virtual SparseMatrix stabilizingStiffness(const Matrix3X& controlPoints);
@@ -49,6 +55,7 @@ class SpringForceModel final : public ForceModel {
   void beginLevel(const LimitSurface& surface, const SurfaceQuadrature& quadrature,
                   const Matrix3X& controlPoints) override;
   Matrix3X generalizedForce(const Matrix3X& controlPoints, double& potential) override;
+  void acceptState() override;
   SparseMatrix stabilizingStiffness(const Matrix3X& controlPoints) override;
   // NearestEachStep: k (n n^T + kTangentialShare (I - n n^T)) at each
   // attachment, n the limit normal there (the tangent-plane stiffness of
@@ -58,8 +65,12 @@ class SpringForceModel final : public ForceModel {
 
   // The share of a spring's stiffness kept tangentially in the static
   // scheme: enough to keep each step's slide along the surface bounded where
-  // the surface's elasticity is weak, small enough not to hold it back.
-  static constexpr double kTangentialShare = 0.05;
+  // the surface's elasticity is weak (with none, Newton steps slide the
+  // control mesh along itself by up to the model's size and the energy rises),
+  // small enough not to hold the slide back. Chosen on synthetic clouds only
+  // (sphere, ellipsoid, a noisy peanut, the bundled torus: 0, 0.003, 0.01,
+  // 0.03, 0.05 tried; Documentation/Performance.md), never on CGAL's scans.
+  static constexpr double kTangentialShare = 0.01;
 
   // Spring lengths (distances target - attachment, mm) at the last evaluation.
   const Eigen::VectorXd& lengths() const { return lengths_; }
@@ -72,7 +83,9 @@ class SpringForceModel final : public ForceModel {
   Attach attach_;
   const LimitSurface* surface_ = nullptr;
   std::unique_ptr<ClosestPointLocator> locator_;
-  std::vector<Spring> springs_;
+  std::vector<Spring> springs_;       // at the last evaluation
+  std::vector<ElementPoint> tracked_;  // attachments at the last accepted state
+  Matrix3X positions_;                 // the surface at the attachments (NearestEachStep)
   Eigen::VectorXd lengths_;
 };
 

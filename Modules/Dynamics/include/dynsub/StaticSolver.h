@@ -68,12 +68,15 @@ class StaticSolver {
   ~StaticSolver();
 
   // The Newton direction d (#control x 3) at `controlPoints` for the residual
-  // f_p - K p (#control x 3), with H from the forces' tangent stiffness there.
+  // f_p - K p (#control x 3), with H from the forces' tangent stiffness there,
+  // or, with `isotropic`, from their stabilizing stiffness on x, y and z alike
+  // (for springs the classic step to the nearest points, which never raises
+  // their energy: the fallback where a Newton step lowers nothing).
   // A matrix that will not factor as positive definite is regularized (a
   // diagonal shift growing 1000-fold, up to 1e-2 of the mean diagonal); if it
   // still fails, throws dynsub::Error.
   Matrix3X direction(const std::vector<ForceModel*>& forces, const Matrix3X& controlPoints,
-                     const Matrix3X& residual);
+                     const Matrix3X& residual, bool isotropic = false);
   // Diagonal shifts applied over all factorizations (0 when none was needed).
   int regularizations() const;
 

@@ -133,6 +133,15 @@ class LimitSurface {
   LimitOperators operators(const std::vector<SurfacePoint>& points) const;
   // J alone (positions), for callers that need no derivatives.
   SparseMatrix limitOperator(const std::vector<ElementPoint>& points) const;
+  // The 16 B-spline control points of every normal element's patch as one
+  // operator (16 #elements by #control vertices; row 16 e + slot, slots as
+  // in bicubicBsplineWeights; the rows of special elements are empty): with
+  // G = patchOperator() * p, any point of a normal element e is
+  // bicubicBsplineWeights(u, v) * G.middleRows(16 e, 16), and forces on its
+  // grid points go back to the control vertices by patchOperator()^T. Built
+  // once per control-mesh topology by callers that evaluate many points of
+  // one state (closest-point searches, springs).
+  SparseMatrix patchOperator() const;
 
   // The control vertices an element depends on (sorted), and the weights of s
   // and its derivatives at one of its points over them: rows s, s_u, s_v,
