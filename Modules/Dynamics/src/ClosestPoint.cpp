@@ -70,18 +70,8 @@ struct ClosestPointLocator::Impl {
   // (a 6 x 16 by 16 x 3 product), elsewhere through the surface.
   LimitSample evaluate(const ElementPoint& p) const {
     if (!normal[p.element]) return surface->evaluate(p, controlPoints);
-    const Eigen::Matrix<double, 6, 3> v =
-        bicubicBsplineWeights(p.u, p.v) * grids.middleRows<16>(16 * static_cast<Eigen::Index>(p.element));
-    LimitSample sample;
-    sample.position = v.row(0).transpose();
-    sample.du = v.row(1).transpose();
-    sample.dv = v.row(2).transpose();
-    sample.duu = v.row(3).transpose();
-    sample.duv = v.row(4).transpose();
-    sample.dvv = v.row(5).transpose();
-    const Vector3 n = sample.du.cross(sample.dv);
-    sample.normal = n.norm() > 0.0 ? Vector3(n.normalized()) : Vector3::Zero();
-    return sample;
+    return limitSampleOf(bicubicBsplineWeights(p.u, p.v) *
+                         grids.middleRows<16>(16 * static_cast<Eigen::Index>(p.element)));
   }
 
   // Newton's method for min |s(u, v) - q|^2 on one element, from (u, v), kept in [0,1]^2.

@@ -435,19 +435,6 @@ SurfacePoint LimitSurface::toSurfacePoint(const ElementPoint& point) const {
 
 namespace {
 
-LimitSample sampleOf(const Eigen::Matrix<double, 6, 3>& values) {
-  LimitSample sample;
-  sample.position = values.row(0).transpose();
-  sample.du = values.row(1).transpose();
-  sample.dv = values.row(2).transpose();
-  sample.duu = values.row(3).transpose();
-  sample.duv = values.row(4).transpose();
-  sample.dvv = values.row(5).transpose();
-  const Vector3 normal = sample.du.cross(sample.dv);
-  const double length = normal.norm();
-  sample.normal = length > 0.0 ? Vector3(normal / length) : Vector3::Zero();
-  return sample;
-}
 
 void checkPoints(const Matrix3X& controlPoints, int expected) {
   if (controlPoints.rows() != expected) {
@@ -460,7 +447,7 @@ void checkPoints(const Matrix3X& controlPoints, int expected) {
 
 LimitSample LimitSurface::evaluate(const ElementPoint& point, const Matrix3X& controlPoints) const {
   checkPoints(controlPoints, impl_->controlVertexCount);
-  return sampleOf(impl_->values(point, controlPoints));
+  return limitSampleOf(impl_->values(point, controlPoints));
 }
 
 LimitSample LimitSurface::evaluate(const SurfacePoint& point, const Matrix3X& controlPoints) const {
@@ -472,7 +459,7 @@ LimitSample LimitSurface::evaluate(const SurfacePoint& point, const Matrix3X& co
   const std::vector<int>& columns = impl_->columnsOf(elementPoint.element);
   Eigen::Matrix<double, 6, 3> values = Eigen::Matrix<double, 6, 3>::Zero();
   for (size_t c = 0; c < columns.size(); ++c) values.noalias() += w.col(c) * controlPoints.row(columns[c]);
-  return sampleOf(values);
+  return limitSampleOf(values);
 }
 
 namespace {
@@ -583,6 +570,20 @@ const std::vector<int>& LimitSurface::elementColumns(int element) const {
 
 Eigen::Matrix<double, 6, Eigen::Dynamic> LimitSurface::stencil(const ElementPoint& point) const {
   return impl_->weights(point);
+}
+
+LimitSample limitSampleOf(const Eigen::Matrix<double, 6, 3>& values) {
+  LimitSample sample;
+  sample.position = values.row(0).transpose();
+  sample.du = values.row(1).transpose();
+  sample.dv = values.row(2).transpose();
+  sample.duu = values.row(3).transpose();
+  sample.duv = values.row(4).transpose();
+  sample.dvv = values.row(5).transpose();
+  const Vector3 normal = sample.du.cross(sample.dv);
+  const double length = normal.norm();
+  sample.normal = length > 0.0 ? Vector3(normal / length) : Vector3::Zero();
+  return sample;
 }
 
 Eigen::Matrix<double, 6, 16> bicubicBsplineWeights(double a, double b) { return detail::bsplineWeights(a, b); }

@@ -67,6 +67,8 @@ struct SurfacePoint {
 struct LimitSample {
   Vector3 position, du, dv, duu, duv, dvv, normal;
 };
+// The sample whose rows s, s_u, s_v, s_uu, s_uv, s_vv are given (6 x 3), with its normal.
+LimitSample limitSampleOf(const Eigen::Matrix<double, 6, 3>& rows);
 
 // An element as bicubic B-spline patches (TVCG §3.1, eq. 26): the patch with
 // corner grid `grid` (16 rows in the slot order of a regular patch, over the
