@@ -175,7 +175,10 @@ TEST_F(ViewerTest, TheSurfaceFitsLiveAndCanBePausedResetAndPulled) {
   ASSERT_TRUE(viewer.fitting());
   ASSERT_TRUE(viewer.waitForFit(120.0)) << viewer.status();
   EXPECT_NE(viewer.status().find("fit done"), std::string::npos) << viewer.status();
-  EXPECT_GE(viewer.surfaceUpdates(), 3) << "the surface was not redrawn while it moved";
+  // The first step is published at once (the redraw clock starts expired)
+  // and the settled surface at the end: two redraws at least. More are not
+  // guaranteed, since this fit settles within a few redraw intervals (40 ms).
+  EXPECT_GE(viewer.surfaceUpdates(), 2) << "the surface was not redrawn while it moved";
   vtkPolyData* surface = liveSurface(viewer);
   ASSERT_NE(surface, nullptr);
   const auto [fitted, fittedWorst] = radialError(surface, phantom);
