@@ -117,7 +117,7 @@ struct ClosestPointLocator::Impl {
       }
       if (!improved) break;
     }
-    return ClosestPoint{p, s.position, std::sqrt(best)};
+    return ClosestPoint{p, s.position, std::sqrt(best), s.normal};
   }
 };
 

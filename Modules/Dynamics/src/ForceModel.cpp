@@ -56,9 +56,11 @@ void SpringForceModel::attach(const Matrix3X& controlPoints) {
                                                 : locator_->findAll(targets_);
   springs_.resize(nearest.size());
   positions_.resize(targets_.rows(), 3);
+  normals_.resize(targets_.rows(), 3);
   for (size_t i = 0; i < nearest.size(); ++i) {
     springs_[i] = Spring{nearest[i].point, targets_.row(i).transpose(), stiffness_(i)};
     positions_.row(static_cast<Eigen::Index>(i)) = nearest[i].position.transpose();
+    normals_.row(static_cast<Eigen::Index>(i)) = nearest[i].normal.transpose();
   }
 }
 
@@ -104,12 +106,14 @@ SparseMatrix SpringForceModel::stabilizingStiffness(const Matrix3X&) { return sp
 void SpringForceModel::addTangentStiffness(const Matrix3X& controlPoints, TangentStiffness& into) {
   // Springs held at their attachments: k J^T J is the exact derivative.
   if (attach_ == Attach::NearestAtLevelStart) return ForceModel::addTangentStiffness(controlPoints, into);
-  for (const Spring& spring : springs_) {
-    const LimitSample sample = surface_->evaluate(spring.attachment, controlPoints);
+  // The normals are the last evaluation's, the state the Newton step starts from.
+  for (size_t i = 0; i < springs_.size(); ++i) {
+    const Spring& spring = springs_[i];
+    const Vector3 normal = normals_.row(static_cast<Eigen::Index>(i)).transpose();
     Eigen::Matrix3d block = spring.stiffness * Eigen::Matrix3d::Identity();
     // NB: where the normal is undefined (a degenerate point) the spring stays isotropic.
-    if (sample.normal.squaredNorm() > 0.0) {
-      block = spring.stiffness * ((1.0 - kTangentialShare) * sample.normal * sample.normal.transpose() +
+    if (normal.squaredNorm() > 0.0) {
+      block = spring.stiffness * ((1.0 - kTangentialShare) * normal * normal.transpose() +
                                   kTangentialShare * Eigen::Matrix3d::Identity());
     }
     into.addPoint(spring.attachment, block);

@@ -20,6 +20,7 @@ struct ClosestPoint {
   ElementPoint point;
   Vector3 position;  // mm
   double distance = 0;
+  Vector3 normal = Vector3::Zero();  // unit limit normal at the point (zero where undefined)
 };
 
 class ClosestPointLocator {

@@ -86,6 +86,7 @@ class SpringForceModel final : public ForceModel {
   std::vector<Spring> springs_;       // at the last evaluation
   std::vector<ElementPoint> tracked_;  // attachments at the last accepted state
   Matrix3X positions_;                 // the surface at the attachments (NearestEachStep)
+  Matrix3X normals_;                   // and its unit normals there
   Eigen::VectorXd lengths_;
 };
 
