@@ -69,7 +69,9 @@ void runFit(FitCommandOptions o) {
   TrackedDistances tracked(data);
   ConvergenceRecorder recorder(
       "max error (% of diameter)",
-      [&](const Progress& p) { return 100.0 * tracked.measure(*p.surface, p.level, *p.controlPoints).maxCoeff() / diameter; },
+      [&](const Progress& p) {
+        return 100.0 * tracked.measure(*p.surface, p.level, *p.controlPoints).maxCoeff() / diameter;
+      },
       5);
   const FitResult result = fitPointCloud(data, initial, o.fit, recorder.callback(line.callback()));
   line.finish();

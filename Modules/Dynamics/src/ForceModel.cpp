@@ -87,7 +87,8 @@ Matrix3X SpringForceModel::generalizedForce(const Matrix3X& controlPoints, doubl
   Matrix3X force = Matrix3X::Zero(controlPoints.rows(), 3);
   for (size_t i = 0; i < springs_.size(); ++i) {
     const ElementPoint& q = springs_[i].attachment;
-    const Eigen::RowVector3d pull = stiffness_(static_cast<Eigen::Index>(i)) * stretch.row(static_cast<Eigen::Index>(i));
+    const Eigen::Index row = static_cast<Eigen::Index>(i);
+    const Eigen::RowVector3d pull = stiffness_(row) * stretch.row(row);
     if (surface_->elementType(q.element) == ElementType::Normal) {
       onGrids.middleRows<16>(16 * static_cast<Eigen::Index>(q.element)).noalias() +=
           bicubicBsplineWeights(q.u, q.v).row(0).transpose() * pull;

@@ -173,6 +173,10 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
   bool lineSearch = true;
   for (const ForceModel* f : forces) lineSearch = lineSearch && f->hasPotential();
   StaticSolver solver(model.surface, model.matrices.stiffness, fixed);
+  auto finish = [&](LevelEnd end) {
+    summary.stabilizerUpdates = solver.regularizations();
+    return end;
+  };
   // NB: a static step that moves nothing is conclusive by itself (there is no
   // velocity to carry the state on), so two still steps in a row suffice.
   EquilibriumWindow window(options.equilibrium, std::min(options.equilibrium.window, 2));
@@ -208,16 +212,10 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
       if (accepted) break;
     }
     if (!accepted) {
-      if (lineSearch && evaluated) {
-        // Neither direction lowers the energy: a minimum to rounding. The
-        // forces were last evaluated at a trial; evaluate them here again.
-        double restored = 0.0;
-        force = totalForce(forces, points, restored);
-        acceptState(forces);
-        summary.stabilizerUpdates = solver.regularizations();
-        return LevelEnd::Equilibrium;
-      }
-      return LevelEnd::Diverged;
+      // Neither direction lowers the energy: a minimum to rounding. (The
+      // forces were last evaluated at a rejected trial, but they track from
+      // `points`, the last accepted state, so nothing needs restoring.)
+      return finish(lineSearch && evaluated ? LevelEnd::Equilibrium : LevelEnd::Diverged);
     }
     const double motion = (trial - points).rowwise().norm().maxCoeff();
     const double change = relativeChange(trialEnergy, energy);
@@ -228,13 +226,9 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
     summary.energy = energy;
     summary.steps = step;
     if (progress) progress(Progress{model.level, step, energy, motion, &model.surface, &points});
-    if (window.settled(change, motion / model.size)) {
-      summary.stabilizerUpdates = solver.regularizations();
-      return LevelEnd::Equilibrium;
-    }
+    if (window.settled(change, motion / model.size)) return finish(LevelEnd::Equilibrium);
   }
-  summary.stabilizerUpdates = solver.regularizations();
-  return LevelEnd::StepLimit;
+  return finish(LevelEnd::StepLimit);
 }
 
 // |f_p - K p| / max(|f_p|, |K p|) at `points` (Frobenius norms): 0 exactly at

@@ -127,15 +127,15 @@ TangentStiffness::TangentStiffness(const LimitSurface& surface) : impl_(std::mak
 
 TangentStiffness::~TangentStiffness() = default;
 
-const LimitSurface& TangentStiffness::surface() const { return *impl_->surface; }
-
 void TangentStiffness::reset(const SymmetricMatrix& scalar) {
   Impl& s = *impl_;
   if (scalar.rows() != s.vertices || scalar.cols() != s.vertices) throw Error("internal: stiffness has the wrong size");
   s.clearPending();
   std::fill(s.matrix.valuePtr(), s.matrix.valuePtr() + s.matrix.nonZeros(), 0.0);
   for (int j = 0; j < scalar.outerSize(); ++j) {
-    for (SymmetricMatrix::InnerIterator it(scalar, j); it; ++it) s.addScalarEntry(static_cast<int>(it.row()), j, it.value());
+    for (SymmetricMatrix::InnerIterator it(scalar, j); it; ++it) {
+      s.addScalarEntry(static_cast<int>(it.row()), j, it.value());
+    }
   }
 }
 
@@ -143,7 +143,9 @@ void TangentStiffness::addScalar(const SparseMatrix& scalar) {
   Impl& s = *impl_;
   if (scalar.rows() != s.vertices || scalar.cols() != s.vertices) throw Error("internal: stiffness has the wrong size");
   for (int i = 0; i < scalar.outerSize(); ++i) {
-    for (SparseMatrix::InnerIterator it(scalar, i); it; ++it) s.addScalarEntry(i, static_cast<int>(it.col()), it.value());
+    for (SparseMatrix::InnerIterator it(scalar, i); it; ++it) {
+      s.addScalarEntry(i, static_cast<int>(it.col()), it.value());
+    }
   }
 }
 

@@ -173,7 +173,8 @@ TEST(StaticScheme, FixedVerticesStay) {
   const ControlMesh cube = makeCube98();
   const LimitSurface surface(cube);
   Matrix3X targets = tessellate(surface, cube.points(), 1).points * 1.2;
-  SpringForceModel springs(targets, Eigen::VectorXd::Constant(targets.rows(), 1.0), SpringForceModel::Attach::NearestEachStep);
+  SpringForceModel springs(targets, Eigen::VectorXd::Constant(targets.rows(), 1.0),
+                           SpringForceModel::Attach::NearestEachStep);
   SimulationOptions options;
   options.integrator.scheme = IntegrationScheme::Static;
   const SimulationResult result = simulate(cube, {&springs}, {0, 17}, options);

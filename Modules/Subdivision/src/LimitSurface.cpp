@@ -40,6 +40,8 @@ LevelPatches subdivideDisplacements(LocalMesh& mesh, detail::CornerStep& step) {
 
 using GridMatrix = Eigen::Matrix<double, 16, Eigen::Dynamic>;
 using SampleWeights = Eigen::Matrix<double, 6, Eigen::Dynamic>;  // s, su, sv, suu, suv, svv
+// Points as the columns they depend on and their weights: the rows of limit operators.
+using PointSamples = std::vector<std::pair<const std::vector<int>*, SampleWeights>>;
 
 bool needsIsolation(const Topology& topology) {
   for (int f = 0; f < topology.faceCount(); ++f) {
@@ -341,6 +343,14 @@ struct LimitSurface::Impl {
   }
 
   const std::vector<int>& columnsOf(int element) const { return elements[element].columns; }
+
+  // Each point's columns and weights, the rows operators() are assembled from.
+  PointSamples samplesAt(const std::vector<ElementPoint>& points) const {
+    PointSamples samples;
+    samples.reserve(points.size());
+    for (const ElementPoint& point : points) samples.emplace_back(&columnsOf(point.element), weights(point));
+    return samples;
+  }
 };
 
 LimitSurface::LimitSurface(const ControlMesh& mesh) : impl_(std::make_unique<Impl>()) {
@@ -467,15 +477,14 @@ namespace {
 // The rows of `count` operators (s, s_u, ... in that order) as row-major
 // sparse matrices built in place: each row's columns are its element's,
 // already sorted, so no triplets are sorted or summed. Exact zeros are left out.
-std::array<SparseMatrix, 6> assemble(int columns, int count,
-                                     const std::vector<std::pair<const std::vector<int>*, SampleWeights>>& samples) {
+std::array<SparseMatrix, 6> assemble(int columns, int count, const PointSamples& samples) {
   std::array<SparseMatrix, 6> result;
   const int rows = static_cast<int>(samples.size());
+  size_t nonZeros = 0;
+  for (const auto& sample : samples) nonZeros += sample.first->size();
   for (int q = 0; q < count; ++q) {
     SparseMatrix& m = result[q];
     m.resize(rows, columns);
-    size_t nonZeros = 0;
-    for (const auto& sample : samples) nonZeros += sample.first->size();
     m.resizeNonZeros(static_cast<Eigen::Index>(nonZeros));
     int* outer = m.outerIndexPtr();
     int* inner = m.innerIndexPtr();
@@ -506,21 +515,15 @@ LimitOperators toOperators(std::array<SparseMatrix, 6>&& m) {
 }  // namespace
 
 LimitOperators LimitSurface::operators(const std::vector<ElementPoint>& points) const {
-  std::vector<std::pair<const std::vector<int>*, SampleWeights>> samples;
-  samples.reserve(points.size());
-  for (const ElementPoint& point : points) samples.emplace_back(&impl_->columnsOf(point.element), impl_->weights(point));
-  return toOperators(assemble(impl_->controlVertexCount, 6, samples));
+  return toOperators(assemble(impl_->controlVertexCount, 6, impl_->samplesAt(points)));
 }
 
 SparseMatrix LimitSurface::limitOperator(const std::vector<ElementPoint>& points) const {
-  std::vector<std::pair<const std::vector<int>*, SampleWeights>> samples;
-  samples.reserve(points.size());
-  for (const ElementPoint& point : points) samples.emplace_back(&impl_->columnsOf(point.element), impl_->weights(point));
-  return std::move(assemble(impl_->controlVertexCount, 1, samples)[0]);
+  return std::move(assemble(impl_->controlVertexCount, 1, impl_->samplesAt(points))[0]);
 }
 
 LimitOperators LimitSurface::operators(const std::vector<SurfacePoint>& points) const {
-  std::vector<std::pair<const std::vector<int>*, SampleWeights>> samples;
+  PointSamples samples;
   samples.reserve(points.size());
   for (const SurfacePoint& point : points) {
     Eigen::Matrix2d jacobian;

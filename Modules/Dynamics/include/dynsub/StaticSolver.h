@@ -42,7 +42,6 @@ class TangentStiffness {
   explicit TangentStiffness(const LimitSurface& surface);
   ~TangentStiffness();
 
-  const LimitSurface& surface() const;
   // Starts anew with `scalar` (N by N) on x, y and z alike.
   void reset(const SymmetricMatrix& scalar);
   // Adds S (x) I_3 for a symmetric N by N S joining only control vertices
