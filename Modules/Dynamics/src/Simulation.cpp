@@ -37,9 +37,10 @@ struct LevelModel {
   double size = 0;  // bounding-box diagonal of the control points, mm
 };
 
+// initialIsolation < 0: `mesh` is the initial model, and sets it.
 LevelModel buildLevel(const ControlMesh& mesh, int level, int& initialIsolation, const SimulationOptions& options) {
   LevelModel model{level, LimitSurface(mesh), {}, {}, mesh.points(), 0.0};
-  if (level == 0) initialIsolation = model.surface.isolationLevels();
+  if (initialIsolation < 0) initialIsolation = model.surface.isolationLevels();
   // Element sides are measured in elements of the initial model: a base mesh
   // that is `b` global refinements past the initial one has side 2^-b.
   const double elementSize = std::ldexp(1.0, initialIsolation - (level + model.surface.isolationLevels()));
@@ -289,6 +290,10 @@ void checkSimulationOptions(const SimulationOptions& o) {
     throw Error("equilibrium tolerances must be > 0, the window and the step limit >= 1");
   }
   if (o.maxLevel < 0 || o.maxLevel > 6) throw Error("the maximum level must be in 0..6, got " + std::to_string(o.maxLevel));
+  if (o.origin.level < 0 || o.origin.level > o.maxLevel || o.origin.isolation < -1) {
+    throw Error("the initial mesh's level must be in 0..maximum level (" + std::to_string(o.maxLevel) + "), got " +
+                std::to_string(o.origin.level) + " (isolation " + std::to_string(o.origin.isolation) + ")");
+  }
   if (o.maxTimeStepHalvings < 0) throw Error("time-step halvings must be >= 0");
   if (!(o.elasticityPerLevel > 0.0 && o.elasticityPerLevel <= 1.0)) {
     throw Error("the elasticity factor per level must be in (0, 1], got " + std::to_string(o.elasticityPerLevel));
@@ -316,9 +321,9 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
   }
   SimulationResult result;
   ControlMesh mesh = initial;
-  int initialIsolation = 0;  // set from the first level's surface
+  int initialIsolation = options.origin.isolation;  // -1 until the first level's surface sets it
   double timeStep = options.integrator.timeStep;
-  for (int level = 0;; ++level) {
+  for (int level = options.origin.level;; ++level) {
     const auto started = std::chrono::steady_clock::now();
     const LevelModel model = buildLevel(mesh, level, initialIsolation, options);
     LevelSummary summary;
@@ -332,7 +337,10 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
     result.levels.push_back(summary);
 
     const bool good = accept ? accept(model.surface, points) : true;
-    if (good || level >= options.maxLevel) break;
+    if (good || level >= options.maxLevel) {
+      result.origin = {level, initialIsolation};
+      break;
+    }
     mesh = subdivide(mesh).mesh;
   }
   result.mesh = std::move(mesh);

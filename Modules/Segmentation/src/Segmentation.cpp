@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <sstream>
+#include <tuple>
 
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/Error.h"
@@ -85,9 +86,8 @@ std::vector<double> distancesToSurface(const LimitSurface& surface, const Matrix
   return distances;
 }
 
-SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmarks, const ControlMesh& initial,
-                      const SegmentOptions& options, const ProgressCallback& progress,
-                      const std::vector<ForceModel*>& extraForces) {
+SegmentationRegion::SegmentationRegion(const Volume& image, const std::vector<Landmark>& landmarks,
+                                       const ControlMesh& initial, const SegmentOptions& options) {
   checkSegmentOptions(options);
   if (!initial.isClosed()) throw Error("the initial model must be a closed control mesh");
   const ImageGeometry& grid = image.geometry;
@@ -104,24 +104,33 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
   for (Eigen::Index p = 0; p < start.rows(); ++p)
     if (!grid.covers(start.row(p).transpose())) throw Error("the initial model reaches outside the image");
 
-  SegmentResult result;
   auto clock = Clock::now();
   const Matrix3X landmarkPoints = landmarkPositions(landmarks);
   Matrix3X extent(start.rows() + landmarkPoints.rows(), 3);
   extent << start, landmarkPoints;
-  const auto [first, size] = boundingRegion(grid, extent, options.margin);
-  result.regionFirst = first;
-  result.regionSize = size;
-  const Volume region = cropVolume(image, first, size);
-  result.seconds.crop = secondsSince(clock);
-
+  std::tie(first_, size_) = boundingRegion(grid, extent, options.margin);
+  const Volume region = cropVolume(image, first_, size_);
+  geometry_ = region.geometry;
+  cropSeconds_ = secondsSince(clock);
   clock = Clock::now();
-  const DirectionField directions(region, options.edges, landmarkPoints);
-  result.edgeScale = directions.scale();
-  result.seconds.potential = secondsSince(clock);
+  directions_ = std::make_unique<const DirectionField>(region, options.edges, landmarkPoints);
+  potentialSeconds_ = secondsSince(clock);
+}
 
-  clock = Clock::now();
-  const ImageForceField field(directions, options.imageForce);
+bool SegmentationRegion::covers(const Matrix3X& points) const {
+  for (Eigen::Index p = 0; p < points.rows(); ++p)
+    if (!geometry_.covers(points.row(p).transpose())) return false;
+  return true;
+}
+
+SegmentResult evolveInRegion(const SegmentationRegion& region, const std::vector<Landmark>& landmarks,
+                             const ControlMesh& initial, const LevelOrigin& origin, const SegmentOptions& options,
+                             const ProgressCallback& progress, const std::vector<ForceModel*>& extraForces) {
+  checkSegmentOptions(options);
+  if (!initial.isClosed()) throw Error("the initial model must be a closed control mesh");
+  const auto clock = Clock::now();
+  const Matrix3X landmarkPoints = landmarkPositions(landmarks);
+  const ImageForceField field(region.directions(), options.imageForce);
   FieldForceModel imageForces(field);
   Eigen::VectorXd stiffness = Eigen::VectorXd::Constant(landmarkPoints.rows(), options.landmarkStiffness);
   SpringForceModel springs(landmarkPoints, stiffness, SpringForceModel::Attach::NearestEachStep);
@@ -137,24 +146,42 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
       if (distance > options.landmarkTolerance) return false;
     return true;
   };
-  SimulationResult simulation = simulate(initial, forces, {}, options.simulation, landmarksFit, progress);
-  result.mesh = simulation.mesh;
-  result.levels = simulation.levels;
-  result.steps = simulation.steps;
-  result.seconds.evolution = secondsSince(clock);
+  SimulationOptions simulation = options.simulation;
+  simulation.origin = origin;
+  SimulationResult evolved = simulate(initial, forces, {}, simulation, landmarksFit, progress);
 
-  clock = Clock::now();
+  SegmentResult result;
+  result.mesh = std::move(evolved.mesh);
+  result.levels = std::move(evolved.levels);
+  result.steps = evolved.steps;
+  result.origin = evolved.origin;
+  result.regionFirst = region.first();
+  result.regionSize = region.size();
+  result.edgeScale = region.directions().scale();
+  result.seconds.crop = region.cropSeconds();
+  result.seconds.potential = region.potentialSeconds();
+  result.seconds.evolution = secondsSince(clock);
+  if (landmarkPoints.rows() > 0)
+    result.landmarkDistances = distancesToSurface(LimitSurface(result.mesh), result.mesh.points(), landmarkPoints);
+  return result;
+}
+
+SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmarks, const ControlMesh& initial,
+                      const SegmentOptions& options, const ProgressCallback& progress,
+                      const std::vector<ForceModel*>& extraForces) {
+  const SegmentationRegion region(image, landmarks, initial, options);
+  SegmentResult result = evolveInRegion(region, landmarks, initial, {}, options, progress, extraForces);
+
+  const auto clock = Clock::now();
   const LimitSurface surface(result.mesh);
   const TriangleSurface triangles = tessellate(surface, result.mesh.points(), 8);
   if (!triangles.points.allFinite()) throw Error("the evolution produced a non-finite surface");
   // Voxelize on the part of the grid the final surface covers (it may have left the region).
+  const ImageGeometry& grid = image.geometry;
   const auto [outFirst, outSize] = boundingRegion(grid, triangles.points, 2.0);
   const Mask part = voxelizeSurface(triangles.points, triangles.triangles, grid.region(outFirst, outSize));
   result.labelmap = pasteMask(part, grid, outFirst);
   result.seconds.voxelize = secondsSince(clock);
-
-  if (landmarkPoints.rows() > 0)
-    result.landmarkDistances = distancesToSurface(surface, result.mesh.points(), landmarkPoints);
   return result;
 }
 

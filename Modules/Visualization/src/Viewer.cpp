@@ -5,7 +5,9 @@
 #include <cmath>
 #include <condition_variable>
 #include <iomanip>
+#include <memory>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -46,8 +48,8 @@ const char* const kHelp =
     "              left click  place a landmark (on one: select it); drag to move it\n"
     "              right click on a landmark, Delete, BackSpace  delete it\n"
     "3D view:      left drag  rotate;  wheel  zoom\n"
-    "              Ctrl + left drag on the surface while fitting  pull it\n"
-    "Keys:         space  start / pause / resume fitting;  r  stop and reset\n"
+    "              Ctrl + left drag on the surface  pull it (after a fit: refit with the pull)\n"
+    "Keys:         space  start (after a fit: refit) / pause / resume;  r  stop and forget the fit\n"
     "              s  save landmarks;  l  load landmarks;  h  this help;  q  quit";
 
 struct FitCancelled {};
@@ -87,6 +89,16 @@ struct Viewer::Impl {
   TriangleSurface published;
   std::string fitText;
   int updates = 0;
+  // What the next fit starts from: the last finished fit (its mesh and
+  // levels) and the region whose edge directions it used; a refit reuses the
+  // region while the landmarks and the surface stay inside it. Written by the
+  // worker, read only while no worker runs; r (reset) forgets them.
+  struct Fitted {
+    ControlMesh mesh;
+    LevelOrigin origin;
+  };
+  std::optional<Fitted> fitted;
+  std::shared_ptr<const SegmentationRegion> region;
 
   explicit Impl(ViewerInput in);
   ~Impl() { stopFit(); }
@@ -123,9 +135,9 @@ struct Viewer::Impl {
 
   void landmarksChanged() {
     showLandmarks();
-    if (running) {
-      startFit();  // the fit restarts with the new set
-      message = "landmarks changed: fitting again";
+    if (running || fitted) {
+      startFit();  // the fit restarts with the new set, from the last fit if there is one
+      message = fitted ? "landmarks changed: refitting" : "landmarks changed: fitting again";
     }
   }
 
@@ -188,7 +200,7 @@ struct Viewer::Impl {
       fitText = "fitting: starting";
     }
     running = true;
-    worker = std::thread([this, marks = landmarks] { fit(marks); });
+    worker = std::thread([this, marks = landmarks, start = fitted] { fit(marks, start); });
   }
 
   void stopFit() {
@@ -210,10 +222,14 @@ struct Viewer::Impl {
     fitText = text;
   }
 
-  // The worker thread: the segmentation pipeline with a live observer.
-  void fit(const std::vector<Landmark>& marks) {
+  // The worker thread: the segmentation pipeline with a live observer, from
+  // the cube inside the landmarks or, for a refit, from the last fit.
+  void fit(const std::vector<Landmark>& marks, const std::optional<Fitted>& start) {
     try {
-      const ControlMesh initial = initialFromLandmarks(marks);
+      const auto started = std::chrono::steady_clock::now();
+      const ControlMesh initial = start ? start->mesh : initialFromLandmarks(marks);
+      if (!start || !region || !region->covers(landmarkPositions(marks)) || !region->covers(initial.points()))
+        region = std::make_shared<const SegmentationRegion>(input.image, marks, initial, input.segment);
       auto last = std::chrono::steady_clock::now() - kRedrawInterval;
       auto observe = [&](const Progress& p) {
         {
@@ -225,17 +241,20 @@ struct Viewer::Impl {
         if (now - last < kRedrawInterval || !p.surface || !p.controlPoints) return;
         last = now;
         std::ostringstream text;
-        text << "fitting: level " << p.level << ", step " << p.step << std::scientific << std::setprecision(3)
-             << ", energy " << p.energy << " N mm";
+        text << (start ? "refitting" : "fitting") << ": level " << p.level << ", step " << p.step << std::scientific
+             << std::setprecision(3) << ", energy " << p.energy << " N mm";
         publish(tessellate(*p.surface, *p.controlPoints, 4), text.str());
       };
-      const SegmentResult result = segment(input.image, marks, initial, input.segment, observe, {&pull});
+      const SegmentResult result = evolveInRegion(*region, marks, initial, start ? start->origin : LevelOrigin{},
+                                                  input.segment, observe, {&pull});
+      fitted = Fitted{result.mesh, result.origin};
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
       double worst = 0;
       for (double d : result.landmarkDistances) worst = std::max(worst, d);
       std::ostringstream text;
-      text << "fit done: " << result.mesh.vertexCount() << " control vertices, " << result.levels.back().level
-           << " refinement(s), " << result.steps << " steps;\nfarthest landmark " << std::fixed
-           << std::setprecision(2) << worst << " mm";
+      text << (start ? "refit" : "fit") << " done: " << result.mesh.vertexCount() << " control vertices, "
+           << result.levels.back().level << " refinement(s), " << result.steps << " steps in " << std::fixed
+           << std::setprecision(2) << seconds << " s;\nfarthest landmark " << worst << " mm";
       publish(tessellate(LimitSurface(result.mesh), result.mesh.points(), 8), text.str());
     } catch (const FitCancelled&) {
       std::lock_guard<std::mutex> lock(mutex);
@@ -288,6 +307,8 @@ struct Viewer::Impl {
 
   void reset() {
     stopFit();
+    fitted.reset();
+    region.reset();
     {
       std::lock_guard<std::mutex> lock(mutex);
       fitText.clear();
@@ -330,12 +351,14 @@ class ViewerStyle : public vtkInteractorStyleTrackballCamera {
       return;
     }
     if (view == 3 && Interactor->GetControlKey()) {
-      if (!viewer->running) {
+      if (!viewer->running && !viewer->fitted) {
         viewer->message = "start fitting (space) to pull the surface";
         viewer->render();
         return;
       }
       if (viewer->picker->Pick(x, y, 0, viewer->surface3d.renderer()) && viewer->liveSurface->GetNumberOfPoints() > 0) {
+        // After a fit, the pull refits from it (the pull acts from the first step).
+        if (!viewer->running) viewer->startFit();
         double p[3];
         viewer->picker->GetPickPosition(p);
         const Vector3 grabbed(p[0], p[1], p[2]);

@@ -185,25 +185,26 @@ TEST_F(ViewerTest, TheSurfaceFitsLiveAndCanBePausedResetAndPulled) {
   // Half the coarsest voxel (1.5 mm): the phantom tests' bar.
   EXPECT_LT(fitted, 0.75) << "mean distance from the ball's surface, mm";
   std::cout << "live fit: " << viewer.surfaceUpdates() << " redraws, mean radial error " << fitted << " mm\n";
+  const int updatesBeforeReset = viewer.surfaceUpdates();
 
-  // Pause holds the surface still; space resumes; r stops and clears.
-  viewer.startOrPauseFitting();  // starts again
-  std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  viewer.startOrPauseFitting();  // pauses
-  viewer.waitForFit(0.3);
-  const int paused = viewer.surfaceUpdates();
-  viewer.waitForFit(0.5);
-  EXPECT_EQ(viewer.surfaceUpdates(), paused) << "the surface moved while paused";
-  EXPECT_TRUE(viewer.fitting());
+  // r stops and forgets the fit.
   viewer.resetFitting();
   EXPECT_FALSE(viewer.fitting());
   EXPECT_EQ(liveSurface(viewer), nullptr) << "reset left a surface";
 
-  // Pull: Ctrl + drag from the front of the ball to beside it, while fitting.
-  viewer.startOrPauseFitting();
-  while (viewer.surfaceUpdates() == paused && viewer.fitting()) viewer.waitForFit(0.05);
-  viewer.startOrPauseFitting();  // pause, so the pick sees a still surface
-  viewer.waitForFit(0.2);
+  // Pause holds the fit still: paused before its first step, it draws nothing
+  // (the worker waits at each step while paused); space resumes it.
+  viewer.startOrPauseFitting();  // starts afresh
+  viewer.startOrPauseFitting();  // pauses
+  viewer.waitForFit(0.5);
+  EXPECT_TRUE(viewer.fitting());
+  EXPECT_EQ(viewer.surfaceUpdates(), updatesBeforeReset) << "the surface moved while paused";
+  viewer.startOrPauseFitting();  // resumes
+  ASSERT_TRUE(viewer.waitForFit(120.0)) << viewer.status();
+  EXPECT_NE(viewer.status().find("fit done"), std::string::npos) << viewer.status();
+
+  // Pull after the fit: Ctrl + drag from the front of the ball to beside it
+  // refits from the fitted surface with the pull on.
   vtkRenderer* renderer3d = viewer.surfaceRenderer();
   renderer3d->ResetCamera();
   viewer.window()->Render();
@@ -225,8 +226,9 @@ TEST_F(ViewerTest, TheSurfaceFitsLiveAndCanBePausedResetAndPulled) {
   play(viewer, {mouse("LeftButtonPressEvent", display(front), ctrl),
                 mouse("MouseMoveEvent", display(0.5 * (front + beside)), ctrl),
                 mouse("MouseMoveEvent", display(beside), ctrl)});
-  viewer.startOrPauseFitting();  // resume with the pull on
+  EXPECT_TRUE(viewer.fitting()) << "the pull did not start a refit";
   ASSERT_TRUE(viewer.waitForFit(120.0)) << viewer.status();
+  EXPECT_NE(viewer.status().find("refit done"), std::string::npos) << viewer.status();
   play(viewer, {mouse("LeftButtonReleaseEvent", display(beside), ctrl)});
   surface = liveSurface(viewer);
   ASSERT_NE(surface, nullptr);
@@ -256,6 +258,37 @@ TEST_F(ViewerTest, TheCaudateFitsLiveOnTheRealMri) {
   const std::string temporary = std::string(DYNSUB_BINARY_DIR) + "/Testing/Temporary";
   std::filesystem::create_directories(temporary);
   writePng(viewer.window(), temporary + "/ViewerCaudate.png");
+
+  // One more click, on the caudate's lateral edge in a coronal slice between
+  // the landmark slices (y = 21 and 12 mm): AAL's outermost caudate voxel
+  // there, plus half a voxel. The fit refits from where it is.
+  play(viewer, {key("h", 'h', Eigen::Vector2d(origin[0] + 0.5 * size[0], origin[1] + 0.5 * size[1]))});  // help off
+  const Volume aal = readVolume("/usr/share/mricron/templates/aal.nii.gz");
+  const double sliceY = 16.0;
+  Vector3 edge(-1e9, 0, 0);
+  const ImageGeometry& g = aal.geometry;
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i) {
+        if (std::lround(aal.at(i, j, k)) != 71) continue;
+        const Vector3 p = g.toPhysical(Vector3(i, j, k));
+        if (std::abs(p.y() - sliceY) < 0.5 && p.x() > edge.x()) edge = p;
+      }
+  ASSERT_GT(edge.x(), -1e9) << "no caudate voxel on the slice";
+  edge.x() += 0.5 * g.spacing.x();  // LPS x grows to the left: lateral for the left caudate
+  SliceView& coronal = viewer.sliceView(SliceOrientation::Coronal);
+  SlicePlane plane = coronal.plane();
+  plane.origin = edge;
+  coronal.showPlane(plane);
+  viewer.window()->Render();
+  const std::size_t before = viewer.landmarks().size();
+  play(viewer, {mouse("LeftButtonPressEvent", coronal.displayPosition(edge)),
+                mouse("LeftButtonReleaseEvent", coronal.displayPosition(edge))});
+  ASSERT_EQ(viewer.landmarks().size(), before + 1) << "the click placed no landmark";
+  EXPECT_TRUE(viewer.fitting()) << "adding a landmark after the fit did not refit";
+  ASSERT_TRUE(viewer.waitForFit(300.0)) << viewer.status();
+  EXPECT_NE(viewer.status().find("refit done: 386 control vertices"), std::string::npos) << viewer.status();
+  std::cout << "after one more landmark: " << viewer.status() << '\n';
 }
 
 }  // namespace

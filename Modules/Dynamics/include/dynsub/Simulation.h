@@ -48,12 +48,26 @@ struct EquilibriumOptions {
   int maxSteps = 1000;            // per level
 };
 
+// A control mesh's place in a multilevel fit: `level` global refinements of
+// the initial model, whose patches needed `isolation` levels to isolate its
+// extraordinary vertices (LimitSurface::isolationLevels; -1: the mesh is the
+// initial model itself).
+struct LevelOrigin {
+  int level = 0;
+  int isolation = -1;
+};
+
 struct SimulationOptions {
   Material material;
   AssemblyOptions assembly;  // elementSize is set per level by the simulation
   IntegratorOptions integrator;
   EquilibriumOptions equilibrium;
-  int maxLevel = 0;  // global refinements allowed
+  int maxLevel = 0;  // global refinements allowed (counted from the initial model)
+  // Where the initial mesh stands: a refit that starts from an earlier
+  // result's mesh continues that result's levels (SimulationResult::origin),
+  // so its elasticity, element sizes and refinement budget are the ones the
+  // earlier fit had reached. The default is a fresh start.
+  LevelOrigin origin;
   // Tension and rigidity at level g are multiplied by elasticityPerLevel^g.
   // 1 keeps the physics of the initial model (the energy of a surface does not
   // depend on the level); < 1 lets each refinement trade smoothing for detail.
@@ -84,6 +98,7 @@ struct SimulationResult {
   ControlMesh mesh;  // the final control mesh (points at the final state)
   std::vector<LevelSummary> levels;
   int steps = 0;  // over all levels
+  LevelOrigin origin;  // of `mesh`: what a refit from it passes as SimulationOptions::origin
 };
 
 struct Progress {

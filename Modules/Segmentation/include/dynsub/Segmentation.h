@@ -15,6 +15,8 @@
 // initial model and the landmarks, grown by `margin` mm (enough for the
 // surface to reach edges beyond them); the edge potential is built there only.
 // The result is voxelized on the input image's full grid.
+#include <array>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -51,6 +53,36 @@ struct SegmentResult {
   EdgeScale edgeScale;  // the edge thresholds used
   std::vector<double> landmarkDistances;  // mm, final distance of each landmark to the surface
   std::array<int, 3> regionFirst{}, regionSize{};  // the region of interest (voxel box)
+  LevelOrigin origin;  // of `mesh`: a refit from it continues its levels (Simulation.h)
+};
+
+// The image side of a segmentation: the region of interest cropped from the
+// image and its edge directions (EdgePotential.h), with the time each took.
+// segment() builds one per call; an interactive refit keeps it and reuses it
+// while the model and the landmarks stay inside.
+class SegmentationRegion {
+ public:
+  // The bounding box of the initial model's limit surface and the landmarks,
+  // grown by options.margin mm; the landmarks set the edge thresholds. Throws
+  // as segment() does when a landmark or the model lies outside the image.
+  SegmentationRegion(const Volume& image, const std::vector<Landmark>& landmarks, const ControlMesh& initial,
+                     const SegmentOptions& options);
+
+  // Whether every point lies inside the region's grid (a refit beyond it
+  // needs a new region: the edge directions are zero outside).
+  bool covers(const Matrix3X& points) const;
+
+  const DirectionField& directions() const { return *directions_; }
+  const std::array<int, 3>& first() const { return first_; }  // voxel box in the image
+  const std::array<int, 3>& size() const { return size_; }
+  double cropSeconds() const { return cropSeconds_; }
+  double potentialSeconds() const { return potentialSeconds_; }
+
+ private:
+  std::array<int, 3> first_{}, size_{};
+  ImageGeometry geometry_;
+  double cropSeconds_ = 0, potentialSeconds_ = 0;
+  std::unique_ptr<const DirectionField> directions_;
 };
 
 // The papers' cube placed inside the landmarks' PCA ellipsoid (half its
@@ -68,6 +100,14 @@ ControlMesh initialSphere(const Vector3& centre, double radius);
 SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmarks, const ControlMesh& initial,
                       const SegmentOptions& options, const ProgressCallback& progress = nullptr,
                       const std::vector<ForceModel*>& extraForces = {});
+
+// The evolution alone, in a region built for these options (no labelmap; the
+// result's landmarkDistances and levels are filled): what an interactive
+// refit runs. `initial` may be an earlier result's mesh, with its `origin`.
+SegmentResult evolveInRegion(const SegmentationRegion& region, const std::vector<Landmark>& landmarks,
+                             const ControlMesh& initial, const LevelOrigin& origin, const SegmentOptions& options,
+                             const ProgressCallback& progress = nullptr,
+                             const std::vector<ForceModel*>& extraForces = {});
 
 void checkSegmentOptions(const SegmentOptions& options);
 

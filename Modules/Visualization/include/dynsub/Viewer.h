@@ -9,14 +9,20 @@
 //                 drag: move the selected landmark within the slice
 //                 right click on a landmark, or Delete/BackSpace: delete it
 //   3D view       left drag: rotate; wheel: zoom; Ctrl + left drag on the
-//                 surface while fitting: pull it (an interactive spring)
-//   keys          space: start, pause or resume fitting; r: stop and reset
+//                 surface: pull it (an interactive spring), while fitting
+//                 or, after a fit, by refitting with the pull on
+//   keys          space: start (after a fit: refit), pause or resume
+//                 fitting; r: stop and forget the fit
 //                 s: save the landmarks (.mrk.json, LPS); l: load them again
 //                 h: show or hide the help; q: quit
-// Fitting runs on a worker thread: it starts from the landmarks' initial
-// model (at least 4 landmarks), and the surface is redrawn in every view as it
-// moves (about 25 times a second). Editing the landmarks while fitting
-// restarts the fit with the new set.
+// Fitting runs on a worker thread: the first fit starts from the landmarks'
+// initial model (at least 4 landmarks), and the surface is redrawn in every
+// view as it moves (about 25 times a second). Editing the landmarks while
+// fitting, or after a fit, refits: from the last finished fit if there is one
+// (its control mesh and level), reusing its region and edge directions (with
+// the edge thresholds the region was built with) while the landmarks and the
+// surface stay inside; otherwise from the initial model. The status line
+// gives each fit's steps and time.
 #include <memory>
 #include <string>
 #include <vector>
@@ -67,7 +73,7 @@ class Viewer {
   void loadLandmarks();
   void startOrPauseFitting();
   void resetFitting();
-  bool fitting() const;  // a fit is running or paused
+  bool fitting() const;  // a fit or refit is running or paused
   // Processes live updates (and renders) until the fit ends or `seconds`
   // pass; true if it ended. For tests and scripts without an event loop.
   bool waitForFit(double seconds);
