@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <thread>
 
@@ -61,10 +62,48 @@ struct ClosestPointLocator::Impl {
   SparseMatrix sampleOperator;
   SparseMatrix patchOperator;  // LimitSurface::patchOperator
   std::vector<char> normal;    // per element
+  // The k-d tree is built over the samples at the control points of its last
+  // build (treeControlPoints) and rebuilt only when a full search needs the
+  // samples where they are now. Between builds no sample has moved farther
+  // than `drift` mm, so a sample now within r of a point was within r + drift
+  // of it in the tree: tracked searches check those few samples where they
+  // are now instead of rebuilding the tree at every step.
   SampleCloud cloud;
   std::unique_ptr<Tree> tree;
+  Matrix3X treeControlPoints;
+  double drift = std::numeric_limits<double>::infinity();
+  double sampleWeightBound = 0;  // max over samples of the sum of |weights|
   Matrix3X controlPoints;
   Matrix3X grids;  // patchOperator * controlPoints
+
+  void updateTree() {
+    if (drift == 0.0) return;
+    cloud.points = sampleOperator * controlPoints;
+    tree = std::make_unique<Tree>(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    treeControlPoints = controlPoints;
+    drift = 0.0;
+  }
+
+  // Whether a tracked closest point at `distance` from q is at least as near
+  // as every sample of the surface as it is now.
+  bool noSampleNearer(const Vector3& q, double distance) const {
+    if (drift == 0.0) {
+      uint32_t index = 0;
+      double squared = 0.0;
+      tree->knnSearch(q.data(), 1, &index, &squared);
+      return distance <= std::sqrt(squared);
+    }
+    const double radius = distance + drift * (1.0 + 1e-9) + 1e-12;  // a margin for rounding
+    std::vector<std::pair<uint32_t, double>> within;
+    tree->radiusSearch(q.data(), radius * radius, within, nanoflann::SearchParams(32, 0.0, false));
+    for (const auto& [index, oldSquared] : within) {
+      Vector3 now = Vector3::Zero();  // the sample now, summed as sampleOperator * controlPoints does
+      for (SparseMatrix::InnerIterator it(sampleOperator, index); it; ++it)
+        now += it.value() * controlPoints.row(it.col()).transpose();
+      if (std::sqrt((now - q).squaredNorm()) < distance) return false;
+    }
+    return true;
+  }
 
   // The limit surface at p: on a normal element from its grid of this state
   // (a 6 x 16 by 16 x 3 product), elsewhere through the surface.
@@ -139,6 +178,10 @@ ClosestPointLocator::ClosestPointLocator(const LimitSurface& surface, int sample
     }
   }
   impl_->sampleOperator = surface.limitOperator(impl_->samples);
+  Eigen::VectorXd absoluteRowSums = Eigen::VectorXd::Zero(impl_->sampleOperator.rows());
+  for (Eigen::Index c = 0; c < impl_->sampleOperator.outerSize(); ++c)
+    for (SparseMatrix::InnerIterator it(impl_->sampleOperator, c); it; ++it) absoluteRowSums(it.row()) += std::abs(it.value());
+  impl_->sampleWeightBound = absoluteRowSums.size() ? absoluteRowSums.maxCoeff() : 0.0;
   impl_->patchOperator = surface.patchOperator();
   impl_->normal.resize(surface.elementCount());
   for (int e = 0; e < surface.elementCount(); ++e) impl_->normal[e] = surface.elementType(e) == ElementType::Normal;
@@ -156,15 +199,29 @@ void ClosestPointLocator::update(const Matrix3X& controlPoints) {
                 std::to_string(impl_->surface->controlVertexCount()));
   }
   if (!controlPoints.allFinite()) throw Error("closest-point search got non-finite control points");
-  impl_->controlPoints = controlPoints;
-  impl_->cloud.points = impl_->sampleOperator * controlPoints;
-  impl_->grids = impl_->patchOperator * controlPoints;
-  impl_->tree = std::make_unique<Tree>(3, impl_->cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  Impl& s = *impl_;
+  s.controlPoints = controlPoints;
+  s.grids = s.patchOperator * controlPoints;
+  if (s.tree) {
+    // |sample move| <= sum |weights| * largest control-point move.
+    const double moved = (controlPoints - s.treeControlPoints).rowwise().norm().maxCoeff();
+    s.drift = s.sampleWeightBound * moved;
+  }
 }
 
 ClosestPoint ClosestPointLocator::find(const Vector3& query) const {
+  if (impl_->controlPoints.size() == 0) throw Error("internal: closest-point search used before update()");
+  impl_->updateTree();
+  return search(query);
+}
+
+ClosestPoint ClosestPointLocator::find(const Vector3& query, const ElementPoint& hint) const {
+  return findAll(query.transpose(), {hint}).front();
+}
+
+// The full search (the tree is current).
+ClosestPoint ClosestPointLocator::search(const Vector3& query) const {
   const Impl& s = *impl_;
-  if (!s.tree) throw Error("internal: closest-point search used before update()");
   if (!query.allFinite()) throw Error("closest-point query is not finite");
   const size_t k = std::min<size_t>(s.candidates, s.samples.size());
   std::vector<uint32_t> index(k);
@@ -183,31 +240,46 @@ ClosestPoint ClosestPointLocator::find(const Vector3& query) const {
   return best;
 }
 
-ClosestPoint ClosestPointLocator::find(const Vector3& query, const ElementPoint& hint) const {
-  const Impl& s = *impl_;
-  if (!s.tree) throw Error("internal: closest-point search used before update()");
-  if (!query.allFinite()) throw Error("closest-point query is not finite");
-  if (hint.element < 0 || hint.element >= s.surface->elementCount()) return find(query);
-  const ClosestPoint tracked = s.refine(hint, query);
-  uint32_t index = 0;
-  double squared = 0.0;
-  s.tree->knnSearch(query.data(), 1, &index, &squared);
-  if (tracked.distance <= std::sqrt(squared)) return tracked;
-  const ClosestPoint searched = find(query);
-  return searched.distance < tracked.distance ? searched : tracked;
-}
-
 std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries) const {
+  if (impl_->controlPoints.size() == 0) throw Error("internal: closest-point search used before update()");
+  impl_->updateTree();
   std::vector<ClosestPoint> result(queries.rows());
-  parallelFor(queries.rows(), [&](Eigen::Index i) { result[i] = find(queries.row(i).transpose()); });
+  parallelFor(queries.rows(), [&](Eigen::Index i) { result[i] = search(queries.row(i).transpose()); });
   return result;
 }
 
 std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries,
                                                        const std::vector<ElementPoint>& hints) const {
+  Impl& s = *impl_;
+  if (s.controlPoints.size() == 0) throw Error("internal: closest-point search used before update()");
   if (hints.size() != static_cast<size_t>(queries.rows())) throw Error("internal: one hint per query expected");
+  if (!queries.allFinite()) throw Error("closest-point query is not finite");
+  if (!s.tree) s.updateTree();
+  // A tracked point is kept when it is at least as near as the nearest
+  // sample (see Impl::noSampleNearer); the rest get the full search on a
+  // current tree.
   std::vector<ClosestPoint> result(queries.rows());
-  parallelFor(queries.rows(), [&](Eigen::Index i) { result[i] = find(queries.row(i).transpose(), hints[i]); });
+  std::vector<char> decided(queries.rows(), 0);
+  parallelFor(queries.rows(), [&](Eigen::Index i) {
+    const ElementPoint& hint = hints[i];
+    if (hint.element < 0 || hint.element >= s.surface->elementCount()) return;
+    const Vector3 q = queries.row(i).transpose();
+    result[i] = s.refine(hint, q);
+    decided[i] = s.noSampleNearer(q, result[i].distance);
+  });
+  if (std::find(decided.begin(), decided.end(), 0) == decided.end()) return result;
+  s.updateTree();
+  parallelFor(queries.rows(), [&](Eigen::Index i) {
+    if (decided[i]) return;
+    const Vector3 q = queries.row(i).transpose();
+    const ElementPoint& hint = hints[i];
+    if (hint.element < 0 || hint.element >= s.surface->elementCount()) {
+      result[i] = search(q);
+      return;
+    }
+    const ClosestPoint searched = search(q);
+    if (searched.distance < result[i].distance) result[i] = searched;
+  });
   return result;
 }
 

@@ -31,15 +31,20 @@ class ClosestPointLocator {
   ClosestPointLocator(ClosestPointLocator&&) noexcept;
   ClosestPointLocator& operator=(ClosestPointLocator&&) noexcept;
 
-  // Rebuilds the tree for new control points (#control vertices x 3).
+  // New control points (#control vertices x 3). The sample tree is rebuilt
+  // lazily, by the first search that needs the samples where they are now.
   void update(const Matrix3X& controlPoints);
   ClosestPoint find(const Vector3& query) const;
   // With a hint (e.g. last step's closest point): Newton's method from the hint
   // first, kept if it is at least as near as the nearest tessellation sample
   // (so within the tessellation's accuracy of the true closest point); the full
   // search otherwise. For tracking a moving surface; use find() for errors.
+  // While the surface moves little, most of these decisions are made against
+  // the tree of an earlier state (see ClosestPoint.cpp) and cost no rebuild;
+  // the results are the same as with a tree rebuilt at every update.
   ClosestPoint find(const Vector3& query, const ElementPoint& hint) const;
   // One result per row of `queries`, in order (in parallel; deterministic).
+  // Searches may rebuild the tree: calls on one locator must not overlap.
   std::vector<ClosestPoint> findAll(const Matrix3X& queries) const;
   std::vector<ClosestPoint> findAll(const Matrix3X& queries, const std::vector<ElementPoint>& hints) const;
   // The surface's patchOperator(), which update() applies to find points on
@@ -49,6 +54,7 @@ class ClosestPointLocator {
   struct Impl;
 
  private:
+  ClosestPoint search(const Vector3& query) const;  // the full search on a current tree
   std::unique_ptr<Impl> impl_;
 };
 
