@@ -1,15 +1,24 @@
-// DynSub's segmentation beside ITK's geodesic active contour and deformable
-// simplex mesh, in one run, on the same cropped region of the same MRI from the
-// same landmarks:
-//   build/bin/SegmentationComparison [IMAGE LABELS LANDMARKS LABEL]
+// DynSub's segmentation beside ITK's threshold level set, geodesic active
+// contour and deformable simplex mesh, in one run, on the same cropped region
+// of the same MRI from the same landmarks:
+//   build/bin/SegmentationComparison [--dynsub-only] [IMAGE LABELS LANDMARKS LABEL]
+// (--dynsub-only: DynSub's segmentation and refit alone, e.g. for profiling)
 // (defaults: the demo's left caudate of Colin27 against AAL label 71).
 // DynSub uses the landmarks as springs; the level set cannot, so it starts
 // from DynSub's own initial model (voxelized) and reads its speed image's
 // edge level at the landmarks. The simplex mesh starts from the same initial
-// model's limit surface (as triangles) and cannot use the landmarks either. Prints Dice, distances and seconds for each,
-// DynSub's stage seconds, and the process's peak memory after each method.
+// model's limit surface (as triangles) and cannot use the landmarks either.
+// The threshold level set (ITK-SNAP's region snake) starts from the same
+// voxelized model, with its intensity window from the voxels inside it.
+// Prints Dice, distances and seconds for each, DynSub's stage seconds, and the
+// process's peak memory after each method. Then DynSub's refit after one more
+// landmark (what the viewer's worker runs when a click is added after a fit):
+// on the reference's lateral edge in the coronal plane y = 16 mm, between the
+// demo's landmark slices.
 #include <sys/resource.h>
 
+#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -17,6 +26,8 @@
 #include "BridgeGeometry.h"
 #include "ItkDeformableSimplexMesh.h"
 #include "ItkGeodesicActiveContour.h"
+#include "ItkThresholdLevelSet.h"
+#include "dynsub/Error.h"
 #include "dynsub/ImageIO.h"
 #include "dynsub/LimitSurface.h"
 #include "dynsub/Metrics.h"
@@ -39,7 +50,41 @@ void printRow(const char* method, const OverlapMetrics& m, double seconds, const
               m.dice, m.jaccard, m.volumeDifferencePercent, m.meanSurfaceDistance, m.hd95, seconds, extra.c_str());
 }
 
+// The reference's outermost voxel (largest LPS x) in the coronal plane y, plus
+// half a voxel: a click on the structure's lateral edge.
+Vector3 lateralEdge(const Mask& reference, double y) {
+  const ImageGeometry& g = reference.geometry;
+  Vector3 edge(-1e300, 0, 0);
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i) {
+        if (!reference.voxels[g.offset(i, j, k)]) continue;
+        const Vector3 p = g.toPhysical(Vector3(i, j, k));
+        if (std::abs(p.y() - y) < 0.5 && p.x() > edge.x()) edge = p;
+      }
+  if (edge.x() < -1e299) throw Error("the reference has no voxel in the coronal plane y = " + std::to_string(y));
+  edge.x() += 0.5 * g.spacing.x();
+  return edge;
+}
+
+void refitAfterOneLandmark(const Volume& image, const Mask& reference, std::vector<Landmark> landmarks,
+                           const ControlMesh& initial, const SegmentResult& fitted) {
+  const SegmentOptions options;
+  const SegmentationRegion region(image, landmarks, initial, options);  // the viewer keeps the first fit's
+  landmarks.push_back({"added", lateralEdge(reference, 16.0)});
+  const auto started = std::chrono::steady_clock::now();
+  const SegmentResult refit = evolveInRegion(region, landmarks, fitted.mesh, fitted.origin, options);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  double worst = 0;
+  for (double d : refit.landmarkDistances) worst = std::max(worst, d);
+  std::printf("refit after one more landmark: %.3f s, %d steps at %d control vertices (level build and steps %.3f s), "
+              "farthest landmark %.2f mm\n",
+              seconds, refit.steps, refit.levels.back().controlVertices, refit.levels.back().seconds, worst);
+}
+
 int run(int argc, char** argv) {
+  const bool dynsubOnly = argc > 1 && std::string(argv[1]) == "--dynsub-only";
+  if (dynsubOnly) --argc, ++argv;
   const std::string templates = "/usr/share/mricron/templates/";
   const std::string imagePath = argc > 1 ? argv[1] : templates + "ch2.nii.gz";
   const std::string labelsPath = argc > 2 ? argv[2] : templates + "aal.nii.gz";
@@ -77,8 +122,37 @@ int run(int argc, char** argv) {
                std::to_string(static_cast<int>(dynsubPeak)) + " MB");
   std::printf("  stages: crop %.4f s, edge potential %.3f s, evolution %.3f s, voxelize %.3f s\n",
               dynsub.seconds.crop, dynsub.seconds.potential, dynsub.seconds.evolution, dynsub.seconds.voxelize);
+  if (dynsubOnly) {
+    refitAfterOneLandmark(image, reference, landmarks, initial, dynsub);
+    return 0;
+  }
   printRow("initial model (both methods)", compareMasks(pasteMask(initialMask, image.geometry, dynsub.regionFirst),
                                                         reference), 0.0, "");
+  struct ThresholdRun {
+    double window, curvature;
+  };
+  for (const ThresholdRun& t : std::vector<ThresholdRun>{{0.0, 1.0}, {1.0, 1.0}, {2.0, 1.0}, {0.0, 3.0}, {1.0, 3.0}, {1.5, 3.0}}) {
+    const double window = t.window;
+    itkbaseline::ThresholdLevelSetOptions options;
+    options.window = window;
+    options.curvature = t.curvature;
+    const itkbaseline::ThresholdLevelSetResult run =
+        itkbaseline::thresholdLevelSet(toBridge(region), cropped.voxels, initialMask.voxels, edgeVoxels, options);
+    Mask mask{region, run.mask};
+    char name[64], extra[128];
+    if (window > 0) {
+      std::snprintf(name, sizeof name, "ITK threshold LS, %.1f sd, curv. %.0f", window, t.curvature);
+    } else {
+      std::snprintf(name, sizeof name, "ITK threshold LS, marked, curv. %.0f", t.curvature);
+    }
+    std::snprintf(extra, sizeof extra, "%d iterations, window %.1f..%.1f, peak %d MB", run.elapsedIterations,
+                  run.lower, run.upper, static_cast<int>(peakMegabytes()));
+    if (mask.count() == 0) {
+      std::printf("%-34s empty result (the front vanished)\n", name);
+      continue;
+    }
+    printRow(name, compareMasks(pasteMask(mask, image.geometry, dynsub.regionFirst), reference), run.seconds, extra);
+  }
   for (double propagation : {0.5, 1.0, 2.0}) {
     itkbaseline::GacOptions options;
     options.propagation = propagation;
@@ -128,6 +202,7 @@ int run(int argc, char** argv) {
       std::printf("%-34s no closed surface to measure: %s\n", name, e.what());
     }
   }
+  refitAfterOneLandmark(image, reference, landmarks, initial, dynsub);
   return 0;
 }
 

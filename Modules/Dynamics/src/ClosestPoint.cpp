@@ -58,16 +58,16 @@ void parallelFor(Eigen::Index count, const Body& body) {
 struct ClosestPointLocator::Impl {
   const LimitSurface* surface = nullptr;
   int candidates = 6;
+  // Samples: samplesPerSide^2 per element, element by element. On a normal
+  // element a sample is gridWeights.row(local) times the element's grid (the
+  // same parameters on every element); elsewhere a row of specialOperator.
   std::vector<ElementPoint> samples;
-  SparseMatrix sampleOperator;
+  int perElement = 0;  // samples per element
+  Eigen::Matrix<double, Eigen::Dynamic, 16> gridWeights;
+  SparseMatrix specialOperator;
+  std::vector<int> specialRow;  // per sample: its row of specialOperator, -1 on normal elements
   SparseMatrix patchOperator;  // LimitSurface::patchOperator
   std::vector<char> normal;    // per element
-  // The k-d tree is built over the samples at the control points of its last
-  // build (treeControlPoints) and rebuilt only when a full search needs the
-  // samples where they are now. Between builds no sample has moved farther
-  // than `drift` mm, so a sample now within r of a point was within r + drift
-  // of it in the tree: tracked searches check those few samples where they
-  // are now instead of rebuilding the tree at every step.
   SampleCloud cloud;
   std::unique_ptr<Tree> tree;
   Matrix3X treeControlPoints;
@@ -76,9 +76,31 @@ struct ClosestPointLocator::Impl {
   Matrix3X controlPoints;
   Matrix3X grids;  // patchOperator * controlPoints
 
+  // Where sample i lies at the current control points.
+  Vector3 sample(Eigen::Index i) const {
+    const int row = specialRow[i];
+    if (row >= 0) {
+      Vector3 p = Vector3::Zero();
+      for (SparseMatrix::InnerIterator it(specialOperator, row); it; ++it)
+        p += it.value() * controlPoints.row(it.col()).transpose();
+      return p;
+    }
+    const Eigen::Index element = i / perElement;
+    return (gridWeights.row(i % perElement) * grids.middleRows<16>(16 * element)).transpose();
+  }
+
   void updateTree() {
     if (drift == 0.0) return;
-    cloud.points = sampleOperator * controlPoints;
+    cloud.points.resize(static_cast<Eigen::Index>(samples.size()), 3);
+    const Matrix3X special = specialOperator * controlPoints;
+    for (Eigen::Index e = 0; e < static_cast<Eigen::Index>(normal.size()); ++e) {
+      auto block = cloud.points.middleRows(e * perElement, perElement);
+      if (normal[e]) {
+        block.noalias() = gridWeights * grids.middleRows<16>(16 * e);
+      } else {
+        block = special.middleRows(specialRow[e * perElement], perElement);
+      }
+    }
     tree = std::make_unique<Tree>(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
     treeControlPoints = controlPoints;
     drift = 0.0;
@@ -97,10 +119,7 @@ struct ClosestPointLocator::Impl {
     std::vector<std::pair<uint32_t, double>> within;
     tree->radiusSearch(q.data(), radius * radius, within, nanoflann::SearchParams(32, 0.0, false));
     for (const auto& [index, oldSquared] : within) {
-      Vector3 now = Vector3::Zero();  // the sample now, summed as sampleOperator * controlPoints does
-      for (SparseMatrix::InnerIterator it(sampleOperator, index); it; ++it)
-        now += it.value() * controlPoints.row(it.col()).transpose();
-      if (std::sqrt((now - q).squaredNorm()) < distance) return false;
+      if (std::sqrt((sample(index) - q).squaredNorm()) < distance) return false;
     }
     return true;
   }
@@ -177,14 +196,34 @@ ClosestPointLocator::ClosestPointLocator(const LimitSurface& surface, int sample
       }
     }
   }
-  impl_->sampleOperator = surface.limitOperator(impl_->samples);
-  Eigen::VectorXd absoluteRowSums = Eigen::VectorXd::Zero(impl_->sampleOperator.rows());
-  for (Eigen::Index c = 0; c < impl_->sampleOperator.outerSize(); ++c)
-    for (SparseMatrix::InnerIterator it(impl_->sampleOperator, c); it; ++it) absoluteRowSums(it.row()) += std::abs(it.value());
-  impl_->sampleWeightBound = absoluteRowSums.size() ? absoluteRowSums.maxCoeff() : 0.0;
+  impl_->perElement = samplesPerElement * samplesPerElement;
+  impl_->gridWeights.resize(impl_->perElement, 16);
+  for (int i = 0; i < impl_->perElement; ++i)
+    impl_->gridWeights.row(i) = bicubicBsplineWeights(impl_->samples[i].u, impl_->samples[i].v).row(0);
   impl_->patchOperator = surface.patchOperator();
   impl_->normal.resize(surface.elementCount());
-  for (int e = 0; e < surface.elementCount(); ++e) impl_->normal[e] = surface.elementType(e) == ElementType::Normal;
+  std::vector<ElementPoint> special;
+  impl_->specialRow.assign(impl_->samples.size(), -1);
+  for (int e = 0; e < surface.elementCount(); ++e) {
+    impl_->normal[e] = surface.elementType(e) == ElementType::Normal;
+    if (impl_->normal[e]) continue;
+    for (int i = 0; i < impl_->perElement; ++i) {
+      impl_->specialRow[e * impl_->perElement + i] = static_cast<int>(special.size());
+      special.push_back(impl_->samples[e * impl_->perElement + i]);
+    }
+  }
+  impl_->specialOperator = surface.limitOperator(special);
+  // A sample moves at most (sum of its |weights|) x the largest control-point
+  // move. On normal elements the bicubic weights are >= 0 and sum to 1, so
+  // the grid rows' sums bound them.
+  double bound = 0.0;
+  for (const SparseMatrix* m : {&impl_->specialOperator, &impl_->patchOperator})
+    for (Eigen::Index r = 0; r < m->outerSize(); ++r) {
+      double sum = 0.0;
+      for (SparseMatrix::InnerIterator it(*m, r); it; ++it) sum += std::abs(it.value());
+      bound = std::max(bound, sum);
+    }
+  impl_->sampleWeightBound = bound;
 }
 
 const SparseMatrix& ClosestPointLocator::patchOperator() const { return impl_->patchOperator; }

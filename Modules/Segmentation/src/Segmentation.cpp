@@ -140,9 +140,12 @@ SegmentResult evolveInRegion(const SegmentationRegion& region, const std::vector
   if (options.inflation != 0) forces.push_back(&inflation);
   forces.insert(forces.end(), extraForces.begin(), extraForces.end());
   // Refine while a landmark is farther than the tolerance (see the header).
+  // The last level's distances are the result's.
+  std::vector<double> distances;
   auto landmarksFit = [&](const LimitSurface& surface, const Matrix3X& controlPoints) {
     if (landmarkPoints.rows() == 0) return false;
-    for (double distance : distancesToSurface(surface, controlPoints, landmarkPoints))
+    distances = distancesToSurface(surface, controlPoints, landmarkPoints);
+    for (double distance : distances)
       if (distance > options.landmarkTolerance) return false;
     return true;
   };
@@ -161,8 +164,7 @@ SegmentResult evolveInRegion(const SegmentationRegion& region, const std::vector
   result.seconds.crop = region.cropSeconds();
   result.seconds.potential = region.potentialSeconds();
   result.seconds.evolution = secondsSince(clock);
-  if (landmarkPoints.rows() > 0)
-    result.landmarkDistances = distancesToSurface(LimitSurface(result.mesh), result.mesh.points(), landmarkPoints);
+  result.landmarkDistances = std::move(distances);  // simulate() asks landmarksFit at every level's end
   return result;
 }
 

@@ -114,6 +114,7 @@ struct Progress {
 };
 
 // Decides at an equilibrium whether the fit is good enough (true: stop).
+// Asked at the end of every level, the last one included.
 using AcceptFit = std::function<bool(const LimitSurface& surface, const Matrix3X& controlPoints)>;
 using ProgressCallback = std::function<void(const Progress&)>;
 
