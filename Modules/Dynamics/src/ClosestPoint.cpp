@@ -106,22 +106,27 @@ struct ClosestPointLocator::Impl {
     drift = 0.0;
   }
 
-  // Whether a tracked closest point at `distance` from q is at least as near
-  // as every sample of the surface as it is now.
-  bool noSampleNearer(const Vector3& q, double distance) const {
+  // Whether a sample of the surface as it is now lies nearer to q than a
+  // tracked closest point at `distance`. Unknown when too many samples of the
+  // tree are candidates (a point far off the surface): a current tree is then
+  // cheaper than checking them one by one.
+  enum class Nearer { No, Yes, Unknown };
+  Nearer sampleNearer(const Vector3& q, double distance) const {
     if (drift == 0.0) {
       uint32_t index = 0;
       double squared = 0.0;
       tree->knnSearch(q.data(), 1, &index, &squared);
-      return distance <= std::sqrt(squared);
+      return distance <= std::sqrt(squared) ? Nearer::No : Nearer::Yes;
     }
+    constexpr std::size_t kMostChecked = 64;
     const double radius = distance + drift * (1.0 + 1e-9) + 1e-12;  // a margin for rounding
     std::vector<std::pair<uint32_t, double>> within;
     tree->radiusSearch(q.data(), radius * radius, within, nanoflann::SearchParams(32, 0.0, false));
+    if (within.size() > kMostChecked) return Nearer::Unknown;
     for (const auto& [index, oldSquared] : within) {
-      if (std::sqrt((sample(index) - q).squaredNorm()) < distance) return false;
+      if (std::sqrt((sample(index) - q).squaredNorm()) < distance) return Nearer::Yes;
     }
-    return true;
+    return Nearer::No;
   }
 
   // The limit surface at p: on a normal element from its grid of this state
@@ -294,28 +299,30 @@ std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries,
   if (hints.size() != static_cast<size_t>(queries.rows())) throw Error("internal: one hint per query expected");
   if (!queries.allFinite()) throw Error("closest-point query is not finite");
   if (!s.tree) s.updateTree();
-  // A tracked point is kept when it is at least as near as the nearest
-  // sample (see Impl::noSampleNearer); the rest get the full search on a
-  // current tree.
+  // A tracked point is kept when no sample is nearer (Impl::sampleNearer);
+  // the rest are decided, or searched, on a current tree.
+  using Nearer = Impl::Nearer;
   std::vector<ClosestPoint> result(queries.rows());
-  std::vector<char> decided(queries.rows(), 0);
+  std::vector<Nearer> nearer(queries.rows(), Nearer::Yes);
   parallelFor(queries.rows(), [&](Eigen::Index i) {
     const ElementPoint& hint = hints[i];
-    if (hint.element < 0 || hint.element >= s.surface->elementCount()) return;
+    if (hint.element < 0 || hint.element >= s.surface->elementCount()) return;  // searched below
     const Vector3 q = queries.row(i).transpose();
     result[i] = s.refine(hint, q);
-    decided[i] = s.noSampleNearer(q, result[i].distance);
+    nearer[i] = s.sampleNearer(q, result[i].distance);
   });
-  if (std::find(decided.begin(), decided.end(), 0) == decided.end()) return result;
+  if (std::find_if(nearer.begin(), nearer.end(), [](Nearer n) { return n != Nearer::No; }) == nearer.end())
+    return result;
   s.updateTree();
   parallelFor(queries.rows(), [&](Eigen::Index i) {
-    if (decided[i]) return;
+    if (nearer[i] == Nearer::No) return;
     const Vector3 q = queries.row(i).transpose();
     const ElementPoint& hint = hints[i];
     if (hint.element < 0 || hint.element >= s.surface->elementCount()) {
       result[i] = search(q);
       return;
     }
+    if (nearer[i] == Nearer::Unknown && s.sampleNearer(q, result[i].distance) == Nearer::No) return;
     const ClosestPoint searched = search(q);
     if (searched.distance < result[i].distance) result[i] = searched;
   });
