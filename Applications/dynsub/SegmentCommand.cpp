@@ -158,6 +158,10 @@ void runSegment(SegmentCommandOptions o) {
                              {"evolution", result.seconds.evolution},
                              {"voxelize", result.seconds.voxelize}};
   report["region_of_interest"] = {{"first_voxel", result.regionFirst}, {"size_voxels", result.regionSize}};
+  report["initial_volume_mm3"] = result.initialVolume;
+  report["surface_volume_mm3"] = result.volume;
+  report["surface_outside_region"] = result.outsideRegion;
+  report["warnings"] = result.warnings;
   nlohmann::ordered_json residuals = nlohmann::ordered_json::array();
   for (std::size_t i = 0; i < landmarks.size(); ++i)
     residuals.push_back({{"label", landmarks[i].label},
@@ -194,6 +198,7 @@ void runSegment(SegmentCommandOptions o) {
   std::cout << std::fixed << std::setprecision(1) << "segmented " << result.labelmap.count() * image.geometry.spacing.prod()
             << " mm^3 with " << result.mesh.vertexCount() << " control vertices (" << result.levels.back().level
             << " refinement(s), " << result.steps << " steps) in " << seconds << " s\n";
+  for (const std::string& warning : result.warnings) std::cerr << "warning: " << warning << '\n';
   if (!o.reference.empty())
     std::cout << std::setprecision(3) << "Dice " << metrics.dice << ", mean surface distance "
               << metrics.meanSurfaceDistance << " mm, HD95 " << metrics.hd95 << " mm against " << o.reference

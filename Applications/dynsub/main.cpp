@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   dynsub::app::addFitCommand(app);
   dynsub::app::addDeformCommand(app);
   dynsub::app::addSegmentCommand(app);
+  dynsub::app::addEvaluateCommand(app);
   dynsub::app::addRenderCommand(app);
   dynsub::app::addViewCommand(app);
   dynsub::app::addSolidCommand(app);

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 #include <tuple>
 
@@ -36,6 +37,15 @@ class ImageForceField final : public ForceField {
 Matrix3X limitPoints(const ControlMesh& mesh, int segments) {
   const LimitSurface surface(mesh);
   return tessellate(surface, mesh.points(), segments).points;
+}
+
+// The volume a closed, consistently oriented triangle surface encloses (mm^3):
+// the divergence theorem, a signed tetrahedron per triangle.
+double enclosedVolume(const TriangleSurface& s) {
+  double six = 0;
+  for (const auto& t : s.triangles)
+    six += s.points.row(t[0]).dot(s.points.row(t[1]).cross(s.points.row(t[2])));
+  return std::abs(six) / 6.0;
 }
 
 }  // namespace
@@ -119,9 +129,11 @@ SegmentationRegion::SegmentationRegion(const Volume& image, const std::vector<La
 
 bool SegmentationRegion::covers(const Matrix3X& points) const {
   for (Eigen::Index p = 0; p < points.rows(); ++p)
-    if (!geometry_.covers(points.row(p).transpose())) return false;
+    if (!covers(Vector3(points.row(p).transpose()))) return false;
   return true;
 }
+
+bool SegmentationRegion::covers(const Vector3& point) const { return geometry_.covers(point); }
 
 SegmentResult evolveInRegion(const SegmentationRegion& region, const std::vector<Landmark>& landmarks,
                              const ControlMesh& initial, const LevelOrigin& origin, const SegmentOptions& options,
@@ -184,6 +196,28 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
   const Mask part = voxelizeSurface(triangles.points, triangles.triangles, grid.region(outFirst, outSize));
   result.labelmap = pasteMask(part, grid, outFirst);
   result.seconds.voxelize = secondsSince(clock);
+
+  result.initialVolume = enclosedVolume(tessellate(LimitSurface(initial), initial.points(), 8));
+  result.volume = enclosedVolume(triangles);
+  Eigen::Index outside = 0;
+  for (Eigen::Index p = 0; p < triangles.points.rows(); ++p)
+    outside += !region.covers(Vector3(triangles.points.row(p).transpose()));
+  result.outsideRegion = static_cast<double>(outside) / std::max<Eigen::Index>(triangles.points.rows(), 1);
+  std::ostringstream warning;
+  warning << std::fixed << std::setprecision(0);
+  if (result.volume < kCollapsedBelow * result.initialVolume) {
+    warning << "the surface shrank to " << 100 * result.volume / result.initialVolume
+            << " % of the initial model's volume: it has probably collapsed (give more landmarks, or start "
+               "closer to the structure's boundary)";
+    result.warnings.push_back(warning.str());
+    warning.str("");
+  }
+  if (result.outsideRegion > kLeakedAbove) {
+    warning << 100 * result.outsideRegion
+            << " % of the surface left the region of interest, where no image force holds it: it has "
+               "probably leaked (add landmarks where it escaped, or raise --margin)";
+    result.warnings.push_back(warning.str());
+  }
   return result;
 }
 

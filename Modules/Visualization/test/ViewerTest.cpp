@@ -249,7 +249,10 @@ TEST_F(ViewerTest, TheCaudateFitsLiveOnTheRealMri) {
   viewer.startOrPauseFitting();
   ASSERT_TRUE(viewer.waitForFit(300.0)) << viewer.status();
   EXPECT_NE(viewer.status().find("fit done: 386 control vertices"), std::string::npos) << viewer.status();
-  EXPECT_GE(viewer.surfaceUpdates(), 10) << "too few redraws to watch the fit";
+  // Redraws come at most every 40 ms while the worker publishes; this fit
+  // takes about a second (0.9 s here), so 3 is a floor any machine meets that
+  // takes over 0.12 s, yet fails if the surface is drawn only at the end.
+  EXPECT_GE(viewer.surfaceUpdates(), 3) << "too few redraws to watch the fit";
   std::cout << "caudate: " << viewer.surfaceUpdates() << " redraws; " << viewer.status() << '\n';
   SliceView& axial = viewer.sliceView(SliceOrientation::Axial);
   int* size = axial.renderer()->GetSize();

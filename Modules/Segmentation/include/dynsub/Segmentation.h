@@ -54,7 +54,19 @@ struct SegmentResult {
   std::vector<double> landmarkDistances;  // mm, final distance of each landmark to the surface
   std::array<int, 3> regionFirst{}, regionSize{};  // the region of interest (voxel box)
   LevelOrigin origin;  // of `mesh`: a refit from it continues its levels (Simulation.h)
+  // What tells a result not to trust (segment() fills these): the volumes
+  // enclosed by the initial model and by the result (mm^3), the share of the
+  // result's surface outside the region of interest, where no image force
+  // acts, and a warning for each of: a collapse (the result encloses less
+  // than kCollapsedBelow of the initial model's volume), a leak (more than
+  // kLeakedAbove of its surface left the region).
+  double initialVolume = 0, volume = 0;
+  double outsideRegion = 0;  // fraction of the tessellation's points
+  std::vector<std::string> warnings;
 };
+
+constexpr double kCollapsedBelow = 0.5;
+constexpr double kLeakedAbove = 0.05;
 
 // The image side of a segmentation: the region of interest cropped from the
 // image and its edge directions (EdgePotential.h), with the time each took.
@@ -71,6 +83,7 @@ class SegmentationRegion {
   // Whether every point lies inside the region's grid (a refit beyond it
   // needs a new region: the edge directions are zero outside).
   bool covers(const Matrix3X& points) const;
+  bool covers(const Vector3& point) const;
 
   const DirectionField& directions() const { return *directions_; }
   const std::array<int, 3>& first() const { return first_; }  // voxel box in the image

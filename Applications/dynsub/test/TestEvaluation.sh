@@ -1,0 +1,82 @@
+#!/usr/bin/env bash
+# dynsub evaluate on the reduced plan (Data/Evaluation/ci_plan.json: 7
+# structures of the test split x 3 protocols x 1 seed on Colin27 at 1 mm),
+# and its refusals of bad plans.
+#
+# What is asserted: every run completes and is scored; the seed-only runs
+# (one click, no landmarks) are flagged as collapses, since the surface
+# still shrinks to nothing from a single click, and segment itself warns of
+# every collapse (without the reference); and the landmark protocols'
+# mean Dice stays at or above what this code measures today, as a guard
+# against regressions (0.61 for six slices, 0.52 for three; the floors leave
+# 0.05). These are NOT the targets of the evaluation's issue (mean Dice >=
+# 0.85 from <= 40 points on <= 6 slices): those are not met yet, see
+# Documentation/Segmentation.md.
+# Needs DYNSUB (the executable) and DATA.
+set -u
+templates=/usr/share/mricron/templates
+if [ ! -f "$templates/ch2.nii.gz" ] || [ ! -f "$templates/aal.nii.gz" ]; then
+  echo "FAILED: $templates/ch2.nii.gz or aal.nii.gz is missing (install mricron-data; ./run does)"
+  exit 1
+fi
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+source "$(dirname "${BASH_SOURCE[0]}")/Checks.sh"
+
+"$DYNSUB" evaluate "$DATA/Evaluation/ci_plan.json" --out "$work/eval" --jobs 2 >"$work/eval.log" 2>&1
+check "evaluate succeeds" test $? -eq 0
+cat "$work/eval.log"
+for f in runs.csv summary.csv summary.json dice_test.svg; do
+  check "evaluate writes $f" test -s "$work/eval/$f"
+done
+check "21 runs, all scored, seed-only runs flagged as collapses, Dice floors hold" python3 - "$work/eval/runs.csv" <<'PY'
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+ok = len(rows) == 21
+for r in rows:
+    if r["error"]:
+        print("run failed:", r); ok = False
+    if r["protocol"] == "seed" and r["collapsed"] != "1":
+        print("a seed-only run was not flagged as a collapse:", r); ok = False
+    if r["collapsed"] == "1" and "collapsed" not in r["warnings"]:
+        print("segment did not warn of its own collapse:", r); ok = False
+    if r["protocol"] != "seed" and int(r["landmarks"]) != {"six_slices": 36, "sparse": 15}[r["protocol"]]:
+        print("wrong number of clicks:", r); ok = False
+    if r["protocol"] != "seed" and not (0 < float(r["dice"]) <= 1):
+        print("Dice out of range:", r); ok = False
+for protocol, floor in (("six_slices", 0.56), ("sparse", 0.47)):
+    dice = [float(r["dice"]) for r in rows if r["protocol"] == protocol]
+    mean = sum(dice) / len(dice)
+    print(f"{protocol}: mean Dice {mean:.3f} over {len(dice)} runs (floor {floor})")
+    ok = ok and mean >= floor
+formats = {r["format"] for r in rows if r["protocol"] != "seed"}
+ok = ok and formats <= {"mrk.json", "fcsv", "csv"} and len(formats) >= 1
+sys.exit(0 if ok else 1)
+PY
+check "the SVG plot is well-formed XML" python3 -c "import sys, xml.dom.minidom; xml.dom.minidom.parse(sys.argv[1])" \
+  "$work/eval/dice_test.svg"
+
+# Bad plans: a clear error naming the file, a non-zero exit, no output.
+bad() {  # bad NAME PLAN-TEXT EXPECTED-MESSAGE
+  local name=$1 text=$2 expected=$3
+  printf '%s' "$text" >"$work/$name.json"
+  "$DYNSUB" evaluate "$work/$name.json" --out "$work/out_$name" >"$work/$name.log" 2>&1
+  local status=$?
+  check "$name: non-zero exit" test $status -ne 0
+  check "$name: the error names the plan and the problem" grep -q "$name.json.*$expected" "$work/$name.log"
+  check "$name: no output" test ! -e "$work/out_$name/runs.csv"
+}
+bad not_json '{"reference": ' "not valid JSON"
+bad no_splits '{"reference": "x.nii.gz", "images": [], "structures": [], "protocols": [], "splits": []}' \
+  "needs images, structures, protocols and splits"
+bad unknown_structure "$(python3 -c "
+import json, sys; p = json.load(open('$DATA/Evaluation/ci_plan.json')); p['splits'][0]['structures'] = ['nucleus_x']
+print(json.dumps(p))")" "unknown structure 'nucleus_x'"
+bad bad_protocol "$(python3 -c "
+import json; p = json.load(open('$DATA/Evaluation/ci_plan.json')); p['protocols'][0]['coverage'] = [0.9, 0.2]
+print(json.dumps(p))")" "coverage"
+"$DYNSUB" evaluate "$work/missing.json" --out "$work/out_missing" >"$work/missing.log" 2>&1
+check "missing plan: non-zero exit and the file named" grep -q "missing.json" "$work/missing.log"
+
+echo "$failures failure(s)"
+test "$failures" -eq 0

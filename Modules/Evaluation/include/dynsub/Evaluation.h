@@ -1,0 +1,86 @@
+#pragma once
+// How well segmentation holds up over structures x click protocols x seeds
+// (`dynsub evaluate`): each run makes an expert-like landmark set from a
+// reference labelmap (ClickProtocol.h), writes it in the protocol's file
+// format and reads it back as a user's file would be, segments the image
+// with the default options, and scores the result against the reference.
+//
+// Scoring is in physical space: the final surface is voxelized on the
+// reference's own grid, so images of any resolution (Colin27 at 1 mm and at
+// 0.5 mm against the 1 mm AAL atlas) are scored alike. Besides Dice and the
+// surface distances, a run reports its leak (volume outside the reference)
+// and miss (reference volume not covered), and is flagged as a collapse when
+// it keeps less than a fifth of the reference's volume.
+//
+// Plans are JSON (Data/Evaluation/README.md gives the format). A plan's
+// splits name which structures and seeds each split runs: the tuning split is
+// what parameters may be chosen on, the test split what is reported.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "dynsub/ClickProtocol.h"
+
+namespace dynsub {
+
+struct EvaluationImage {
+  std::string name;
+  std::string path;
+};
+
+struct EvaluationStructure {
+  std::string name;
+  std::vector<int> labels;  // its label values in the reference
+  int axis = 1;             // the slice orientation experts use for it
+};
+
+struct EvaluationProtocol {
+  ClickProtocol clicks;   // its axis is the structure's unless `ownAxis`
+  bool ownAxis = false;
+  std::string format = "mrk.json";  // mrk.json, fcsv or csv; "rotate": by seed
+};
+
+struct EvaluationSplit {
+  std::string name;
+  std::vector<std::string> structures;  // empty: all
+  std::vector<unsigned> seeds;
+};
+
+struct EvaluationPlan {
+  std::string reference;  // labelmap path
+  std::vector<EvaluationImage> images;
+  std::vector<EvaluationStructure> structures;
+  std::vector<EvaluationProtocol> protocols;
+  std::vector<EvaluationSplit> splits;
+};
+
+// Throws dynsub::Error naming the file and the problem.
+EvaluationPlan readEvaluationPlan(const std::string& path);
+
+struct EvaluationRun {
+  std::string split, image, structure, protocol, format;
+  unsigned seed = 0;
+  int landmarks = 0;
+  std::string error;  // empty when the run succeeded
+  double dice = 0, jaccard = 0, meanSurfaceDistance = 0, hd95 = 0;
+  double volume = 0, referenceVolume = 0;  // mm^3
+  double leak = 0, miss = 0;                // mm^3 outside the reference, reference not covered
+  bool collapsed = false;
+  std::string warnings;  // segment()'s own (collapse, leak), joined by "; "
+  double seconds = 0;  // segmentation alone (the image is read once per plan)
+  int steps = 0, controlVertices = 0;
+};
+
+struct EvaluationOptions {
+  std::vector<std::string> splits;  // empty: every split
+  int jobs = 2;                     // runs at once
+  std::string landmarkDirectory;    // where each run's landmark file is written
+};
+
+// The runs of the plan's splits, in a fixed order (split, image, structure,
+// protocol, seed) whatever `jobs` is. `done` (may be null) is called after
+// each run, from the worker that ran it, serialized.
+std::vector<EvaluationRun> runEvaluation(const EvaluationPlan& plan, const EvaluationOptions& options,
+                                         const std::function<void(const EvaluationRun&, int finished, int total)>& done);
+
+}  // namespace dynsub

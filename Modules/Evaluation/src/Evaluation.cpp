@@ -1,0 +1,241 @@
+#include "dynsub/Evaluation.h"
+
+#include <atomic>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "dynsub/Error.h"
+#include "dynsub/ImageIO.h"
+#include "dynsub/LimitSurface.h"
+#include "dynsub/Metrics.h"
+#include "dynsub/Segmentation.h"
+#include "dynsub/Tessellation.h"
+#include "dynsub/Voxelize.h"
+
+namespace dynsub {
+
+namespace {
+
+int axisOf(const std::string& orientation, const std::string& where) {
+  if (orientation == "sagittal") return 0;
+  if (orientation == "coronal") return 1;
+  if (orientation == "axial") return 2;
+  throw Error(where + ": orientation must be sagittal, coronal or axial, got '" + orientation + "'");
+}
+
+// The plan's paths are relative to the plan's own directory.
+std::string resolve(const std::string& path, const std::filesystem::path& base) {
+  const std::filesystem::path p(path);
+  return p.is_absolute() ? path : (base / p).lexically_normal().string();
+}
+
+// A seed-only run starts from a sphere of this radius (mm) at the click,
+// about the size of a bubble dropped in ITK-SNAP.
+constexpr double kSeedRadius = 3.0;
+// A result keeping less than this fraction of the reference's volume has collapsed.
+constexpr double kCollapsedBelow = 0.2;
+
+EvaluationRun runOne(const Volume& image, const Mask& reference, const EvaluationProtocol& protocol, int axis,
+                     EvaluationRun run, const std::string& landmarkDirectory) {
+  const auto started = std::chrono::steady_clock::now();
+  ClickProtocol clicks = protocol.clicks;
+  if (!protocol.ownAxis) clicks.axis = axis;
+  // The clicks go through a file in the protocol's format, as a user's would.
+  std::vector<Landmark> landmarks = expertClicks(reference, clicks, run.seed);
+  if (!landmarks.empty()) {
+    const std::string path = (std::filesystem::path(landmarkDirectory) /
+                              (run.split + "_" + run.image + "_" + run.structure + "_" + run.protocol + "_" +
+                               std::to_string(run.seed) + "." + run.format)).string();
+    writeLandmarks(landmarks, path);
+    landmarks = readLandmarks(path);
+  }
+  run.landmarks = static_cast<int>(landmarks.size());
+  const ControlMesh initial =
+      clicks.seedOnly ? initialSphere(seedClick(reference), kSeedRadius) : initialFromLandmarks(landmarks);
+  const SegmentResult result = segment(image, landmarks, initial, SegmentOptions());
+  run.steps = result.steps;
+  for (const std::string& w : result.warnings) run.warnings += (run.warnings.empty() ? "" : "; ") + w;
+  run.controlVertices = result.mesh.vertexCount();
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+
+  // Scored on the reference's grid (see the header).
+  const LimitSurface surface(result.mesh);
+  const TriangleSurface triangles = tessellate(surface, result.mesh.points(), 8);
+  const ImageGeometry& grid = reference.geometry;
+  const auto [first, size] = boundingRegion(grid, triangles.points, 2.0);
+  const Mask part = voxelizeSurface(triangles.points, triangles.triangles, grid.region(first, size));
+  const Mask mask = pasteMask(part, grid, first);
+  const double voxel = grid.spacing.prod();
+  long long overlap = 0;
+  for (size_t i = 0; i < mask.voxels.size(); ++i) overlap += mask.voxels[i] && reference.voxels[i];
+  run.volume = mask.count() * voxel;
+  run.referenceVolume = reference.count() * voxel;
+  run.leak = run.volume - overlap * voxel;
+  run.miss = run.referenceVolume - overlap * voxel;
+  run.collapsed = run.volume < kCollapsedBelow * run.referenceVolume;
+  if (mask.count() > 0) {
+    const OverlapMetrics m = compareMasks(mask, reference);
+    run.dice = m.dice;
+    run.jaccard = m.jaccard;
+    run.meanSurfaceDistance = m.meanSurfaceDistance;
+    run.hd95 = m.hd95;
+  }
+  return run;
+}
+
+}  // namespace
+
+EvaluationPlan readEvaluationPlan(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error(path, "cannot open the evaluation plan");
+  nlohmann::json j;
+  try {
+    in >> j;
+  } catch (const std::exception& e) {
+    throw Error(path, std::string("not valid JSON: ") + e.what());
+  }
+  const std::filesystem::path base = std::filesystem::absolute(path).parent_path();
+  EvaluationPlan plan;
+  try {
+    plan.reference = resolve(j.at("reference").get<std::string>(), base);
+    for (const auto& i : j.at("images")) plan.images.push_back({i.at("name"), resolve(i.at("path"), base)});
+    for (const auto& s : j.at("structures")) {
+      const std::string name = s.at("name");
+      plan.structures.push_back({name, s.at("labels").get<std::vector<int>>(),
+                                 axisOf(s.at("orientation"), "structure '" + name + "'")});
+    }
+    for (const auto& p : j.at("protocols")) {
+      EvaluationProtocol protocol;
+      ClickProtocol& c = protocol.clicks;
+      c.name = p.at("name");
+      c.seedOnly = p.value("seed_only", false);
+      c.slices = p.value("slices", c.slices);
+      c.pointsPerSlice = p.value("points_per_slice", c.pointsPerSlice);
+      if (p.contains("coverage")) {
+        const auto coverage = p.at("coverage").get<std::vector<double>>();
+        if (coverage.size() != 2) throw Error(path, "protocol '" + c.name + "': coverage is [low, high]");
+        c.coverageLow = coverage[0];
+        c.coverageHigh = coverage[1];
+      }
+      c.scatter = p.value("scatter_mm", c.scatter);
+      c.mistakes = p.value("mistakes", c.mistakes);
+      c.mistakeDistance = p.value("mistake_distance_mm", c.mistakeDistance);
+      if (p.contains("orientation")) {
+        protocol.ownAxis = true;
+        c.axis = axisOf(p.at("orientation"), "protocol '" + c.name + "'");
+      }
+      protocol.format = p.value("format", protocol.format);
+      if (protocol.format != "mrk.json" && protocol.format != "fcsv" && protocol.format != "csv" &&
+          protocol.format != "rotate")
+        throw Error(path, "protocol '" + c.name + "': format must be mrk.json, fcsv, csv or rotate");
+      checkClickProtocol(c);
+      plan.protocols.push_back(protocol);
+    }
+    for (const auto& s : j.at("splits")) {
+      EvaluationSplit split{s.at("name"), s.value("structures", std::vector<std::string>{}),
+                            s.at("seeds").get<std::vector<unsigned>>()};
+      for (const std::string& name : split.structures) {
+        bool known = false;
+        for (const auto& structure : plan.structures) known = known || structure.name == name;
+        if (!known) throw Error(path, "split '" + split.name + "' names unknown structure '" + name + "'");
+      }
+      plan.splits.push_back(split);
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(path, std::string("not an evaluation plan: ") + e.what());
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    throw Error(message.rfind(path, 0) == 0 ? message : path + ": " + message);
+  }
+  if (plan.images.empty() || plan.structures.empty() || plan.protocols.empty() || plan.splits.empty())
+    throw Error(path, "an evaluation plan needs images, structures, protocols and splits");
+  return plan;
+}
+
+std::vector<EvaluationRun> runEvaluation(const EvaluationPlan& plan, const EvaluationOptions& options,
+                                         const std::function<void(const EvaluationRun&, int, int)>& done) {
+  if (options.jobs < 1 || options.jobs > 64) throw Error("jobs must be in 1..64");
+  std::vector<const EvaluationSplit*> splits;
+  for (const EvaluationSplit& s : plan.splits)
+    if (options.splits.empty() ||
+        std::find(options.splits.begin(), options.splits.end(), s.name) != options.splits.end())
+      splits.push_back(&s);
+  for (const std::string& name : options.splits) {
+    bool known = false;
+    for (const EvaluationSplit& s : plan.splits) known = known || s.name == name;
+    if (!known) throw Error("the plan has no split '" + name + "'");
+  }
+
+  // Every input is read once, before any run.
+  const Volume labels = readVolume(plan.reference);
+  std::map<std::string, Mask> references;
+  for (const EvaluationStructure& s : plan.structures) {
+    references[s.name] = selectLabels(labels, s.labels);
+    if (references[s.name].count() == 0)
+      throw Error(plan.reference, "structure '" + s.name + "' has no voxel with its labels");
+  }
+  std::vector<Volume> images;
+  for (const EvaluationImage& i : plan.images) images.push_back(readVolume(i.path));
+  std::filesystem::create_directories(options.landmarkDirectory);
+
+  struct Job {
+    const Volume* image;
+    const EvaluationStructure* structure;
+    const EvaluationProtocol* protocol;
+    EvaluationRun run;
+  };
+  std::vector<Job> jobs;
+  for (const EvaluationSplit* split : splits)
+    for (size_t i = 0; i < plan.images.size(); ++i)
+      for (const EvaluationStructure& structure : plan.structures) {
+        if (!split->structures.empty() && std::find(split->structures.begin(), split->structures.end(),
+                                                    structure.name) == split->structures.end())
+          continue;
+        for (const EvaluationProtocol& protocol : plan.protocols)
+          for (unsigned seed : split->seeds) {
+            EvaluationRun run;
+            run.split = split->name;
+            run.image = plan.images[i].name;
+            run.structure = structure.name;
+            run.protocol = protocol.clicks.name;
+            run.seed = seed;
+            static const char* const kFormats[] = {"mrk.json", "fcsv", "csv"};
+            run.format = protocol.format == "rotate" ? kFormats[seed % 3] : protocol.format;
+            jobs.push_back({&images[i], &structure, &protocol, run});
+          }
+      }
+
+  std::vector<EvaluationRun> runs(jobs.size());
+  std::atomic<size_t> next{0};
+  std::mutex report;
+  int finished = 0;
+  auto work = [&] {
+    for (size_t k = next++; k < jobs.size(); k = next++) {
+      const Job& job = jobs[k];
+      EvaluationRun run = job.run;
+      try {
+        run = runOne(*job.image, references.at(job.structure->name), *job.protocol, job.structure->axis, run,
+                     options.landmarkDirectory);
+      } catch (const std::exception& e) {
+        run.error = e.what();
+      }
+      runs[k] = run;
+      std::lock_guard<std::mutex> lock(report);
+      ++finished;
+      if (done) done(run, finished, static_cast<int>(jobs.size()));
+    }
+  };
+  std::vector<std::thread> workers;
+  for (int t = 1; t < options.jobs; ++t) workers.emplace_back(work);
+  work();
+  for (std::thread& w : workers) w.join();
+  return runs;
+}
+
+}  // namespace dynsub
