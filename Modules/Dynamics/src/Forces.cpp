@@ -79,10 +79,16 @@ Eigen::VectorXd areaElements(const SurfaceQuadrature& q, const Matrix3X& control
 
 Matrix3X inflationForces(const SurfaceQuadrature& q, const Matrix3X& controlPoints, double pressure) {
   if (!std::isfinite(pressure)) throw Error("inflation pressure is not finite");
+  return pressureForces(q, controlPoints, Eigen::VectorXd::Constant(q.J.rows(), pressure));
+}
+
+Matrix3X pressureForces(const SurfaceQuadrature& q, const Matrix3X& controlPoints, const Eigen::VectorXd& pressures) {
+  if (pressures.size() != q.J.rows()) throw Error("internal: one pressure per quadrature point expected");
+  if (!pressures.allFinite()) throw Error("a pressure is not finite");
   const Matrix3X su = q.Ju * controlPoints, sv = q.Jv * controlPoints;
   Matrix3X area(su.rows(), 3);
   for (Eigen::Index i = 0; i < su.rows(); ++i) {
-    area.row(i) = pressure * su.row(i).cross(sv.row(i));
+    area.row(i) = pressures(i) * su.row(i).cross(sv.row(i));
   }
   return integrate(q, area);
 }

@@ -58,14 +58,15 @@ void checkPointCloud(const Matrix3X& points, const std::string& source) {
   }
 }
 
-ControlMesh initialModel(const Matrix3X& points, InitialShape shape) {
+ControlMesh initialModel(const Matrix3X& points, InitialShape shape, double fraction) {
+  if (!(fraction > 0 && fraction <= 1)) throw Error("the initial model's fraction of the data's extent must be in (0, 1]");
   const Principal p = principalAxes(points);
   if (shape == InitialShape::Sphere) {
     ControlMesh cube = makeCube98();
     // The cube's limit surface spans [-h, h]^3 around the origin.
     const double h = limitPositions(cube).cwiseAbs().maxCoeff();
     Vector3 scale;
-    for (int i = 0; i < 3; ++i) scale(i) = 0.5 * std::sqrt(3.0 * p.variances(i)) / h;
+    for (int i = 0; i < 3; ++i) scale(i) = fraction * std::sqrt(3.0 * p.variances(i)) / h;
     const Matrix3X placed = ((cube.points() * scale.asDiagonal()) * p.axes.transpose()).rowwise() + p.mean.transpose();
     cube.setPoints(placed);
     return cube;

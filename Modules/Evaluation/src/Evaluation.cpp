@@ -41,8 +41,9 @@ constexpr double kSeedRadius = 3.0;
 // A result keeping less than this fraction of the reference's volume has collapsed.
 constexpr double kCollapsedBelow = 0.2;
 
-EvaluationRun runOne(const Volume& image, const Mask& reference, const EvaluationProtocol& protocol, int axis,
-                     EvaluationRun run, const std::string& landmarkDirectory) {
+EvaluationRun runOne(const EvaluationPlan& plan, const Volume& image, const Mask& reference,
+                     const EvaluationProtocol& protocol, int axis, EvaluationRun run,
+                     const std::string& landmarkDirectory) {
   const auto started = std::chrono::steady_clock::now();
   ClickProtocol clicks = protocol.clicks;
   if (!protocol.ownAxis) clicks.axis = axis;
@@ -57,8 +58,9 @@ EvaluationRun runOne(const Volume& image, const Mask& reference, const Evaluatio
   }
   run.landmarks = static_cast<int>(landmarks.size());
   const ControlMesh initial =
-      clicks.seedOnly ? initialSphere(seedClick(reference), kSeedRadius) : initialFromLandmarks(landmarks);
-  const SegmentResult result = segment(image, landmarks, initial, SegmentOptions());
+      clicks.seedOnly ? initialSphere(seedClick(reference), kSeedRadius)
+                      : initialFromLandmarks(landmarks, plan.initialFraction);
+  const SegmentResult result = segment(image, landmarks, initial, plan.segment);
   run.steps = result.steps;
   for (const std::string& w : result.warnings) run.warnings += (run.warnings.empty() ? "" : "; ") + w;
   run.controlVertices = result.mesh.vertexCount();
@@ -136,6 +138,40 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
         throw Error(path, "protocol '" + c.name + "': format must be mrk.json, fcsv, csv or rotate");
       checkClickProtocol(c);
       plan.protocols.push_back(protocol);
+    }
+    if (j.contains("segment")) {
+      // Settings to compare on the tuning split; an unknown name is an error, not a silent default.
+      SegmentOptions& o = plan.segment;
+      const std::map<std::string, double*> settings = {
+          {"image_force", &o.imageForce},
+          {"landmark_stiffness", &o.landmarkStiffness},
+          {"landmark_tolerance_mm", &o.landmarkTolerance},
+          {"inflation", &o.inflation},
+          {"region_pressure", &o.regionPressure},
+          {"region_window", &o.regionWindow},
+          {"margin_mm", &o.margin},
+          {"sigma_mm", &o.edges.sigma},
+          {"capture_range_mm", &o.edges.captureRange},
+          {"elasticity_per_level", &o.simulation.elasticityPerLevel},
+          {"tension", &o.simulation.material.tensionU},
+          {"rigidity", &o.simulation.material.rigidityUU},
+          {"initial_fraction", &plan.initialFraction}};
+      for (const auto& [name, value] : j.at("segment").items()) {
+        if (name == "max_level") {
+          o.simulation.maxLevel = value.get<int>();
+          continue;
+        }
+        const auto setting = settings.find(name);
+        if (setting == settings.end()) throw Error(path, "unknown segment setting '" + name + "'");
+        *setting->second = value.get<double>();
+      }
+      // One tension and one rigidity for every direction (rigidity_uv is twice rigidity_uu, as by default).
+      o.simulation.material.tensionV = o.simulation.material.tensionU;
+      o.simulation.material.rigidityVV = o.simulation.material.rigidityUU;
+      o.simulation.material.rigidityUV = 2 * o.simulation.material.rigidityUU;
+      checkSegmentOptions(o);
+      if (!(plan.initialFraction > 0 && plan.initialFraction <= 1))
+        throw Error(path, "initial_fraction must be in (0, 1]");
     }
     for (const auto& s : j.at("splits")) {
       EvaluationSplit split{s.at("name"), s.value("structures", std::vector<std::string>{}),
@@ -220,7 +256,7 @@ std::vector<EvaluationRun> runEvaluation(const EvaluationPlan& plan, const Evalu
       const Job& job = jobs[k];
       EvaluationRun run = job.run;
       try {
-        run = runOne(*job.image, references.at(job.structure->name), *job.protocol, job.structure->axis, run,
+        run = runOne(plan, *job.image, references.at(job.structure->name), *job.protocol, job.structure->axis, run,
                      options.landmarkDirectory);
       } catch (const std::exception& e) {
         run.error = e.what();

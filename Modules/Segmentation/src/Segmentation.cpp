@@ -1,13 +1,16 @@
 #include "dynsub/Segmentation.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
+#include <memory>
 #include <sstream>
 #include <tuple>
 
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/Error.h"
+#include "dynsub/Forces.h"
 #include "dynsub/ShapeRecovery.h"
 #include "dynsub/StandardMeshes.h"
 #include "dynsub/Tessellation.h"
@@ -33,6 +36,51 @@ class ImageForceField final : public ForceField {
   const DirectionField& directions_;
   double strength_;
 };
+
+// The gated region pressure (SegmentOptions::regionPressure).
+class RegionPressureForceModel final : public ForceModel {
+ public:
+  RegionPressureForceModel(const Volume& image, double median, double spread, double strength, double window)
+      : image_(image), toIndex_(image.geometry.indexFromPhysical()), median_(median),
+        width_(window * std::max(spread, 1e-6)), strength_(strength) {}
+  void beginLevel(const LimitSurface&, const SurfaceQuadrature& quadrature, const Matrix3X&) override {
+    quadrature_ = &quadrature;
+  }
+  Matrix3X generalizedForce(const Matrix3X& controlPoints, double&) override {
+    const Matrix3X positions = quadrature_->J * controlPoints;
+    Eigen::VectorXd pressures(positions.rows());
+    for (Eigen::Index i = 0; i < positions.rows(); ++i) {
+      const Vector3 index = toIndex_ * (positions.row(i).transpose() - image_.geometry.origin);
+      const double gate = 1.0 - std::abs(image_.interpolate(index) - median_) / width_;
+      pressures(i) = strength_ * std::clamp(gate, -1.0, 1.0);
+    }
+    return pressureForces(*quadrature_, controlPoints, pressures);
+  }
+
+ private:
+  const Volume& image_;
+  Matrix3 toIndex_;
+  double median_, width_, strength_;
+  const SurfaceQuadrature* quadrature_ = nullptr;
+};
+
+// Median and robust spread (1.4826 x the median absolute deviation) of the
+// region's intensities inside a closed model.
+std::pair<double, double> insideIntensities(const Volume& region, const ControlMesh& model) {
+  const TriangleSurface s = tessellate(LimitSurface(model), model.points(), 4);
+  const Mask inside = voxelizeSurface(s.points, s.triangles, region.geometry);
+  std::vector<double> values;
+  for (size_t i = 0; i < inside.voxels.size(); ++i)
+    if (inside.voxels[i]) values.push_back(region.voxels[i]);
+  if (values.empty()) throw Error("the initial model encloses no voxel of the region: no appearance to learn");
+  auto median = [](std::vector<double> v) {
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+  };
+  const double m = median(values);
+  for (double& v : values) v = std::abs(v - m);
+  return {m, 1.4826 * median(values)};
+}
 
 Matrix3X limitPoints(const ControlMesh& mesh, int segments) {
   const LimitSurface surface(mesh);
@@ -68,13 +116,16 @@ void checkSegmentOptions(const SegmentOptions& options) {
   finiteNonNegative(options.margin, "margin");
   finiteNonNegative(options.landmarkTolerance, "landmark tolerance");
   if (!std::isfinite(options.inflation)) throw Error("inflation must be finite");
+  if (!std::isfinite(options.regionPressure)) throw Error("the region pressure must be finite");
+  if (!(options.regionWindow > 0) || !std::isfinite(options.regionWindow))
+    throw Error("the region window must be a finite number > 0");
   checkSimulationOptions(options.simulation);
 }
 
-ControlMesh initialFromLandmarks(const std::vector<Landmark>& landmarks) {
+ControlMesh initialFromLandmarks(const std::vector<Landmark>& landmarks, double fraction) {
   const Matrix3X points = landmarkPositions(landmarks);
   checkPointCloud(points, "the landmarks");
-  return initialModel(points, InitialShape::Sphere);
+  return initialModel(points, InitialShape::Sphere, fraction);
 }
 
 ControlMesh initialSphere(const Vector3& centre, double radius) {
@@ -119,7 +170,8 @@ SegmentationRegion::SegmentationRegion(const Volume& image, const std::vector<La
   Matrix3X extent(start.rows() + landmarkPoints.rows(), 3);
   extent << start, landmarkPoints;
   std::tie(first_, size_) = boundingRegion(grid, extent, options.margin);
-  const Volume region = cropVolume(image, first_, size_);
+  image_ = cropVolume(image, first_, size_);
+  const Volume& region = image_;
   geometry_ = region.geometry;
   cropSeconds_ = secondsSince(clock);
   clock = Clock::now();
@@ -147,7 +199,14 @@ SegmentResult evolveInRegion(const SegmentationRegion& region, const std::vector
   Eigen::VectorXd stiffness = Eigen::VectorXd::Constant(landmarkPoints.rows(), options.landmarkStiffness);
   SpringForceModel springs(landmarkPoints, stiffness, SpringForceModel::Attach::NearestEachStep);
   InflationForceModel inflation(options.inflation);
+  std::unique_ptr<RegionPressureForceModel> regionPressure;
+  if (options.regionPressure != 0) {
+    const auto [median, spread] = insideIntensities(region.image(), initial);
+    regionPressure = std::make_unique<RegionPressureForceModel>(region.image(), median, spread,
+                                                                options.regionPressure, options.regionWindow);
+  }
   std::vector<ForceModel*> forces = {&imageForces};
+  if (regionPressure) forces.push_back(regionPressure.get());
   if (landmarkPoints.rows() > 0 && options.landmarkStiffness > 0) forces.push_back(&springs);
   if (options.inflation != 0) forces.push_back(&inflation);
   forces.insert(forces.end(), extraForces.begin(), extraForces.end());

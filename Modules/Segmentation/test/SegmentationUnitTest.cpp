@@ -163,6 +163,32 @@ TEST(TorusPhantom, SegmentsToDice95AndHalfAVoxel) {
   expectAccurate(result, phantom, 0.95);
 }
 
+// One click and no landmarks: image edges and tension alone shrink a small
+// sphere to nothing, and segment() says so; the gated region pressure grows
+// it through the ball's tissue until the intensity changes at its boundary.
+TEST(Segment, ASeedCollapsesAndIsReportedUnlessTheRegionPressureGrowsIt) {
+  const Ellipsoid shape{Vector3(0, 0, 0), Vector3(10, 10, 10)};
+  const ImageGeometry grid = gridAround(shape.centre, Vector3(40, 40, 40), Vector3(1, 1, 1), Matrix3::Identity());
+  const Phantom phantom = makePhantom(grid, [&](const Vector3& x) { return shape.inside(x); }, 5.0, 3);
+  const ControlMesh seed = initialSphere(Vector3(1, -1, 0.5), 3.0);
+  SegmentOptions options;
+  options.margin = 12.0;  // the region must hold the ball around a 3 mm seed
+  const SegmentResult collapsed = segment(phantom.image, {}, seed, options);
+  ASSERT_EQ(collapsed.warnings.size(), 1u);
+  EXPECT_NE(collapsed.warnings[0].find("collapsed"), std::string::npos) << collapsed.warnings[0];
+  EXPECT_LT(collapsed.volume, kCollapsedBelow * collapsed.initialVolume);
+
+  options.regionPressure = 0.2;
+  const SegmentResult grown = segment(phantom.image, {}, seed, options);
+  EXPECT_TRUE(grown.warnings.empty()) << grown.warnings.front();
+  const OverlapMetrics m = compareMasks(grown.labelmap, phantom.truth);
+  std::printf("seed: collapsed to %.1f mm^3; with the region pressure Dice %.3f, volume %.0f of %.0f mm^3\n",
+              collapsed.volume, m.dice, grown.volume, 4.0 / 3.0 * M_PI * 1000.0);
+  // Within about a voxel of the ball everywhere (a one-voxel shell of a
+  // 10 mm ball is about 0.15 of Dice).
+  EXPECT_GT(m.dice, 0.9);
+}
+
 TEST(Segment, RefusesLandmarksAndModelsOutsideTheImage) {
   const Ellipsoid shape{Vector3(0, 0, 0), Vector3(8, 8, 8)};
   const ImageGeometry grid = gridAround(shape.centre, Vector3(30, 30, 30), Vector3(1, 1, 1), Matrix3::Identity());

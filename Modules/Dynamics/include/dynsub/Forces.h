@@ -52,6 +52,9 @@ Matrix3X springForces(const LimitSurface& surface, const Matrix3X& controlPoints
 SparseMatrix springStiffness(const LimitSurface& surface, const std::vector<Spring>& springs);
 
 Matrix3X inflationForces(const SurfaceQuadrature& quadrature, const Matrix3X& controlPoints, double pressure);
+// A pressure that varies over the surface: one value (N/mm^2) per quadrature point.
+Matrix3X pressureForces(const SurfaceQuadrature& quadrature, const Matrix3X& controlPoints,
+                        const Eigen::VectorXd& pressures);
 Matrix3X fieldForces(const SurfaceQuadrature& quadrature, const Matrix3X& controlPoints, const ForceField& field);
 // slope * sum_q w_q |s_u x s_v|_q J_q^T J_q (#control by #control): the
 // stiffness of a field whose force changes by `slope` N/mm^3 in every

@@ -30,11 +30,12 @@ void checkPointCloud(const Matrix3X& points, const std::string& source);
 enum class InitialShape { Sphere, Torus };
 
 // The papers' initial model placed inside the data's PCA ellipsoid. Sphere:
-// the 98-vertex cube, its limit surface scaled to half the ellipsoid's
-// semi-axes (sqrt(3 lambda_i): exact for points spread over an ellipsoid's
-// surface). Torus: the 32-vertex torus around the axis of least variance, with
-// the data's mean ring radius and half its mean tube radius.
-ControlMesh initialModel(const Matrix3X& points, InitialShape shape);
+// the 98-vertex cube, its limit surface scaled to `fraction` (by default
+// half) of the ellipsoid's semi-axes (sqrt(3 lambda_i): exact for points
+// spread over an ellipsoid's surface). Torus: the 32-vertex torus around the
+// axis of least variance, with the data's mean ring radius and half its mean
+// tube radius.
+ControlMesh initialModel(const Matrix3X& points, InitialShape shape, double fraction = 0.5);
 
 struct FitOptions {
   double tolerancePercent = 1.0;  // max_error_percent that stops refinement

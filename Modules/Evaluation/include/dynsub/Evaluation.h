@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "dynsub/ClickProtocol.h"
+#include "dynsub/Segmentation.h"
 
 namespace dynsub {
 
@@ -47,6 +48,10 @@ struct EvaluationSplit {
 };
 
 struct EvaluationPlan {
+  // What every run segments with: the defaults unless the plan's "segment"
+  // object sets some (for comparing settings on the tuning split).
+  SegmentOptions segment;
+  double initialFraction = 0.5;  // initialFromLandmarks
   std::string reference;  // labelmap path
   std::vector<EvaluationImage> images;
   std::vector<EvaluationStructure> structures;

@@ -34,6 +34,13 @@ struct SegmentOptions {
   double landmarkStiffness = 10.0;  // N/mm per landmark
   double landmarkTolerance = 0.5;   // mm, largest landmark distance accepted without refining
   double inflation = 0.0;          // N/mm^2 along the normal (> 0 grows)
+  // A pressure gated by appearance (N/mm^2, 0: off): k g(I) along the
+  // normal, with g = 1 - |I - m| / (regionWindow s) clamped to [-1, 1], m and
+  // s the median and robust spread (1.4826 MAD) of the intensities inside
+  // the initial model. It grows the surface through tissue like the inside
+  // and pushes it back where the intensity is unlike it.
+  double regionPressure = 0.0;
+  double regionWindow = 2.0;
   double margin = 8.0;             // mm around the model and the landmarks
   SimulationOptions simulation = defaultSimulation();
 
@@ -86,6 +93,7 @@ class SegmentationRegion {
   bool covers(const Vector3& point) const;
 
   const DirectionField& directions() const { return *directions_; }
+  const Volume& image() const { return image_; }  // the image cropped to the region
   const std::array<int, 3>& first() const { return first_; }  // voxel box in the image
   const std::array<int, 3>& size() const { return size_; }
   double cropSeconds() const { return cropSeconds_; }
@@ -94,13 +102,15 @@ class SegmentationRegion {
  private:
   std::array<int, 3> first_{}, size_{};
   ImageGeometry geometry_;
+  Volume image_;
   double cropSeconds_ = 0, potentialSeconds_ = 0;
   std::unique_ptr<const DirectionField> directions_;
 };
 
-// The papers' cube placed inside the landmarks' PCA ellipsoid (half its
-// semi-axes). Throws dynsub::Error for fewer than 4 landmarks or flat ones.
-ControlMesh initialFromLandmarks(const std::vector<Landmark>& landmarks);
+// The papers' cube placed inside the landmarks' PCA ellipsoid (`fraction`
+// of its semi-axes, by default half). Throws dynsub::Error for fewer than 4
+// landmarks or flat ones.
+ControlMesh initialFromLandmarks(const std::vector<Landmark>& landmarks, double fraction = 0.5);
 
 // The cube's limit surface as a sphere of `radius` mm around `centre`.
 ControlMesh initialSphere(const Vector3& centre, double radius);
