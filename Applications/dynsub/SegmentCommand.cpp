@@ -161,13 +161,17 @@ void runSegment(SegmentCommandOptions o) {
   report["initial_volume_mm3"] = result.initialVolume;
   report["surface_volume_mm3"] = result.volume;
   report["surface_outside_region"] = result.outsideRegion;
+  if (std::isfinite(result.surfaceOnEdges)) report["surface_on_edges"] = result.surfaceOnEdges;
   report["warnings"] = result.warnings;
   nlohmann::ordered_json residuals = nlohmann::ordered_json::array();
-  for (std::size_t i = 0; i < landmarks.size(); ++i)
+  for (std::size_t i = 0; i < landmarks.size(); ++i) {
     residuals.push_back({{"label", landmarks[i].label},
                          {"position_lps_mm", {landmarks[i].position.x(), landmarks[i].position.y(),
                                               landmarks[i].position.z()}},
                          {"distance_mm", result.landmarkDistances[i]}});
+    if (i < result.landmarkEdgeDistances.size() && std::isfinite(result.landmarkEdgeDistances[i]))
+      residuals.back()["edge_distance_mm"] = result.landmarkEdgeDistances[i];
+  }
   report["landmark_residuals"] = residuals;
   nlohmann::ordered_json levels = nlohmann::ordered_json::array();
   for (const auto& level : result.levels) levels.push_back(levelJson(level, -1, -1));  // no fit error in segmentation

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <vector>
 
@@ -186,7 +187,9 @@ DirectionField::DirectionField(const Volume& image, const EdgeOptions& options, 
   scale_ = edgeScale(magnitude, options, landmarks);
   edges_ = edgeMap(magnitude, gradient, scale_);
   // P = -distance to the nearest edge (see the header).
-  Volume potential{image.geometry, itkbridge::distanceMap(toBridge(image.geometry), edges_.voxels)};
+  edgeDistance_ = Volume{image.geometry, itkbridge::distanceMap(toBridge(image.geometry), edges_.voxels)};
+  hasEdges_ = edges_.count() > 0;
+  Volume potential = edgeDistance_;
   std::vector<std::uint8_t> keep(potential.voxels.size());
   for (std::size_t v = 0; v < keep.size(); ++v) {
     keep[v] = potential.voxels[v] <= options.captureRange ? 1 : 0;
@@ -196,6 +199,14 @@ DirectionField::DirectionField(const Volume& image, const EdgeOptions& options, 
 }
 
 double DirectionField::slopeBound() const { return 2.0 / geometry_.spacing.minCoeff(); }
+
+double DirectionField::edgeDistance(const Vector3& point) const {
+  if (!hasEdges_) return std::numeric_limits<double>::infinity();
+  const Vector3 index = geometry_.toIndex(point);
+  for (int a = 0; a < 3; ++a)
+    if (!(index[a] >= 0 && index[a] <= geometry_.size[a] - 1)) return std::numeric_limits<double>::infinity();
+  return edgeDistance_.interpolate(index);
+}
 
 Matrix3X DirectionField::sample(const Matrix3X& points) const {
   Matrix3X result = Matrix3X::Zero(points.rows(), 3);

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -306,6 +308,24 @@ long long edgesNear(const DirectionField& field, const Vector3& centre, double r
         if (edges.voxels[g.offset(i, j, k)] && std::abs((g.toPhysical(Vector3(i, j, k)) - centre).norm() - radius) < 1.1)
           ++count;
   return count;
+}
+
+TEST(EdgePotential, EdgeDistanceIsTheDistanceToTheBallsSurface) {
+  const ImageGeometry g = grid({40, 36, 30}, Vector3(0.8, 0.9, 1.1), Vector3(5, -7, 3), skewDirection());
+  const Vector3 centre = g.toPhysical(Vector3(19.5, 17.5, 14.5));
+  const double radius = 8.0;
+  const DirectionField field(ballPhantom(g, centre, radius), EdgeOptions{});
+  // Edge voxels lie within 1.1 mm of the sphere (the test above), so the
+  // distance to them is |r - 8| to within that plus the interpolation's
+  // error of about half a voxel.
+  for (double r : {0.0, 3.0, 6.0, 8.0, 11.0})
+    for (const Vector3& u : {Vector3(1, 0, 0), Vector3(0, -1, 1).normalized(), Vector3(1, 1, 1).normalized()})
+      EXPECT_NEAR(field.edgeDistance(centre + r * u), std::abs(r - radius), 1.7) << "r " << r;
+  EXPECT_EQ(field.edgeDistance(centre + Vector3(100, 0, 0)), std::numeric_limits<double>::infinity());
+  EdgeOptions plain;
+  plain.method = EdgeMethod::GradientMagnitude;
+  EXPECT_EQ(DirectionField(ballPhantom(g, centre, radius), plain).edgeDistance(centre),
+            std::numeric_limits<double>::infinity());
 }
 
 TEST(EdgePotential, LandmarksSetTheEdgeThresholds) {

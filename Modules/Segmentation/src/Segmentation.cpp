@@ -271,6 +271,27 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
     result.warnings.push_back(warning.str());
     warning.str("");
   }
+  if (options.edges.method == EdgeMethod::MongaDeriche) {
+    const DirectionField& field = region.directions();
+    const double voxel = region.image().geometry.spacing.maxCoeff();
+    Eigen::Index held = 0;
+    for (Eigen::Index p = 0; p < triangles.points.rows(); ++p)
+      held += field.edgeDistance(Vector3(triangles.points.row(p).transpose())) <= voxel;
+    result.surfaceOnEdges = static_cast<double>(held) / std::max<Eigen::Index>(triangles.points.rows(), 1);
+    for (std::size_t i = 0; i < landmarks.size(); ++i) {
+      const double d = field.edgeDistance(landmarks[i].position);
+      result.landmarkEdgeDistances.push_back(d);
+      if (d > options.edges.captureRange) {
+        warning << std::setprecision(1) << "landmark " << i + 1
+                << (landmarks[i].label.empty() ? "" : " ('" + landmarks[i].label + "')") << " is more than "
+                << options.edges.captureRange
+                << " mm from every edge the image shows: a click off the boundary? It pulls the surface there"
+                << std::setprecision(0);
+        result.warnings.push_back(warning.str());
+        warning.str("");
+      }
+    }
+  }
   if (result.outsideRegion > kLeakedAbove) {
     warning << 100 * result.outsideRegion
             << " % of the surface left the region of interest, where no image force holds it: it has "

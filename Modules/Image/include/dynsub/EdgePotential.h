@@ -99,6 +99,10 @@ class DirectionField {
   double slopeBound() const;
 
   const Mask& edges() const { return edges_; }  // MongaDeriche only (else empty)
+  // Distance (mm) from a point to the nearest edge voxel, trilinear between
+  // voxel centres (MongaDeriche only; infinity outside the image, without an
+  // edge map, or when it holds no edge).
+  double edgeDistance(const Vector3& point) const;
   const EdgeScale& scale() const { return scale_; }  // MongaDeriche only
 
  private:
@@ -106,6 +110,8 @@ class DirectionField {
   EdgeScale scale_;
   Volume components_[3];
   Mask edges_;
+  Volume edgeDistance_;  // MongaDeriche only: step 4's distance d
+  bool hasEdges_ = false;
 };
 
 }  // namespace dynsub
