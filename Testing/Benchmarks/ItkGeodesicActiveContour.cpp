@@ -1,15 +1,14 @@
 #include "ItkGeodesicActiveContour.h"
 #include "ItkImages.h"
+#include "ItkLevelSetSteps.h"
 
 #include <chrono>
 #include <stdexcept>
 
-#include <itkBinaryThresholdImageFilter.h>
 #include <itkCurvatureAnisotropicDiffusionImageFilter.h>
 #include <itkGeodesicActiveContourLevelSetImageFilter.h>
 #include <itkGradientMagnitudeRecursiveGaussianImageFilter.h>
 #include <itkSigmoidImageFilter.h>
-#include <itkSignedMaurerDistanceMapImageFilter.h>
 
 namespace itkbaseline {
 
@@ -54,15 +53,9 @@ GacResult geodesicActiveContour(const Geometry& grid, const std::vector<float>& 
   sigmoid->SetOutputMinimum(0.0);
   sigmoid->SetOutputMaximum(1.0);
 
-  // Negative inside, in mm.
-  auto distance = itk::SignedMaurerDistanceMapImageFilter<ByteImage, FloatImage>::New();
-  distance->SetInput(initial);
-  distance->SetInsideIsPositive(false);
-  distance->SetSquaredDistance(false);
-  distance->SetUseImageSpacing(true);
 
   auto gac = itk::GeodesicActiveContourLevelSetImageFilter<FloatImage, FloatImage>::New();
-  gac->SetInput(distance->GetOutput());
+  gac->SetInput(initialLevelSet(initial));
   gac->SetFeatureImage(sigmoid->GetOutput());
   gac->SetPropagationScaling(options.propagation);
   gac->SetCurvatureScaling(options.curvature);
@@ -70,16 +63,9 @@ GacResult geodesicActiveContour(const Geometry& grid, const std::vector<float>& 
   gac->SetMaximumRMSError(options.maximumRmsError);
   gac->SetNumberOfIterations(options.iterations);
 
-  auto threshold = itk::BinaryThresholdImageFilter<FloatImage, ByteImage>::New();
-  threshold->SetInput(gac->GetOutput());
-  threshold->SetLowerThreshold(-1e30);
-  threshold->SetUpperThreshold(0.0);
-  threshold->SetInsideValue(1);
-  threshold->SetOutsideValue(0);
-  threshold->Update();
+  gac->Update();
   result.elapsedIterations = static_cast<int>(gac->GetElapsedIterations());
-  const ByteImage* out = threshold->GetOutput();
-  result.mask.assign(out->GetBufferPointer(), out->GetBufferPointer() + initialMask.size());
+  result.mask = insideOf(gac->GetOutput());
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
 }

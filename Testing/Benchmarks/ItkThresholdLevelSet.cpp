@@ -1,12 +1,11 @@
 #include "ItkThresholdLevelSet.h"
 #include "ItkImages.h"
+#include "ItkLevelSetSteps.h"
 
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
 
-#include <itkBinaryThresholdImageFilter.h>
-#include <itkSignedMaurerDistanceMapImageFilter.h>
 #include <itkThresholdSegmentationLevelSetImageFilter.h>
 
 namespace itkbaseline {
@@ -45,15 +44,9 @@ ThresholdLevelSetResult thresholdLevelSet(const Geometry& grid, const std::vecto
 
   const auto image = makeImage<FloatImage>(grid, voxels);
   const auto initial = makeImage<ByteImage>(grid, initialMask);
-  // Negative inside, in mm.
-  auto distance = itk::SignedMaurerDistanceMapImageFilter<ByteImage, FloatImage>::New();
-  distance->SetInput(initial);
-  distance->SetInsideIsPositive(false);
-  distance->SetSquaredDistance(false);
-  distance->SetUseImageSpacing(true);
 
   auto levelSet = itk::ThresholdSegmentationLevelSetImageFilter<FloatImage, FloatImage>::New();
-  levelSet->SetInput(distance->GetOutput());
+  levelSet->SetInput(initialLevelSet(initial));
   levelSet->SetFeatureImage(image);
   levelSet->SetLowerThreshold(result.lower);
   levelSet->SetUpperThreshold(result.upper);
@@ -62,16 +55,9 @@ ThresholdLevelSetResult thresholdLevelSet(const Geometry& grid, const std::vecto
   levelSet->SetMaximumRMSError(options.maximumRmsError);
   levelSet->SetNumberOfIterations(options.iterations);
 
-  auto threshold = itk::BinaryThresholdImageFilter<FloatImage, ByteImage>::New();
-  threshold->SetInput(levelSet->GetOutput());
-  threshold->SetLowerThreshold(-1e30);
-  threshold->SetUpperThreshold(0.0);
-  threshold->SetInsideValue(1);
-  threshold->SetOutsideValue(0);
-  threshold->Update();
+  levelSet->Update();
   result.elapsedIterations = static_cast<int>(levelSet->GetElapsedIterations());
-  const ByteImage* out = threshold->GetOutput();
-  result.mask.assign(out->GetBufferPointer(), out->GetBufferPointer() + initialMask.size());
+  result.mask = insideOf(levelSet->GetOutput());
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
 }
