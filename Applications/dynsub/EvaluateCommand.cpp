@@ -87,7 +87,8 @@ void writeRunsCsv(const std::vector<EvaluationRun>& runs, const std::string& pat
          "volume_mm3,reference_volume_mm3,leak_mm3,miss_mm3,collapsed,seconds,steps,control_vertices,warnings,error\n";
   out << std::setprecision(6);
   for (const EvaluationRun& r : runs)
-    out << r.split << ',' << r.image << ',' << r.structure << ',' << r.protocol << ',' << r.seed << ',' << r.format
+    out << csvField(r.split) << ',' << csvField(r.image) << ',' << csvField(r.structure) << ','
+        << csvField(r.protocol) << ',' << r.seed << ',' << r.format
         << ',' << r.landmarks << ',' << r.dice << ',' << r.jaccard << ',' << r.meanSurfaceDistance << ',' << r.hd95
         << ',' << r.volume << ',' << r.referenceVolume << ',' << r.leak << ',' << r.miss << ','
         << (r.collapsed ? 1 : 0) << ',' << r.seconds << ',' << r.steps << ',' << r.controlVertices << ','
@@ -101,7 +102,8 @@ void writeSummaryCsv(const std::vector<Group>& groups, const std::string& path) 
          "failures,mean_seconds\n";
   out << std::setprecision(4);
   for (const Group& g : groups)
-    out << g.split << ',' << g.image << ',' << g.structure << ',' << g.protocol << ',' << g.runs << ','
+    out << csvField(g.split) << ',' << csvField(g.image) << ',' << csvField(g.structure) << ','
+        << csvField(g.protocol) << ',' << g.runs << ','
         << g.meanDice << ',' << g.worstDice << ',' << g.meanLeakPercent << ',' << g.meanMissPercent << ','
         << g.collapses << ',' << g.failures << ',' << g.meanSeconds << '\n';
   if (!out) throw Error(path, "could not be written");
@@ -123,6 +125,22 @@ nlohmann::ordered_json summaryJson(const std::vector<Group>& groups, const std::
   return j;
 }
 
+std::string xmlText(const std::string& text) {
+  std::string escaped;
+  for (char c : text) {
+    if (c == '<') {
+      escaped += "&lt;";
+    } else if (c == '>') {
+      escaped += "&gt;";
+    } else if (c == '&') {
+      escaped += "&amp;";
+    } else {
+      escaped += c;
+    }
+  }
+  return escaped;
+}
+
 // A strip plot of one split's Dice: a column per structure and protocol
 // (grouped by image), a dot per run, a bar at the mean, the 0.80 and 0.85
 // lines; collapses and failures in red. Plain SVG, for any browser.
@@ -140,7 +158,7 @@ void writeDicePlot(const std::vector<EvaluationRun>& runs, const std::vector<Gro
   out << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
       << "\" font-family=\"sans-serif\" font-size=\"11\">\n"
       << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
-      << "<text x=\"" << left << "\" y=\"18\" font-size=\"13\">Dice per run, split '" << split << "'</text>\n";
+      << "<text x=\"" << left << "\" y=\"18\" font-size=\"13\">Dice per run, split '" << xmlText(split) << "'</text>\n";
   for (double tick = 0; tick <= 1.0001; tick += 0.1)
     out << "<line x1=\"" << left << "\" x2=\"" << width - 10 << "\" y1=\"" << y(tick) << "\" y2=\"" << y(tick)
         << "\" stroke=\"#eee\"/><text x=\"" << left - 6 << "\" y=\"" << y(tick) + 4 << "\" text-anchor=\"end\">"
@@ -156,14 +174,14 @@ void writeDicePlot(const std::vector<EvaluationRun>& runs, const std::vector<Gro
         continue;
       const bool bad = !r.error.empty() || r.collapsed;
       out << "<circle cx=\"" << x << "\" cy=\"" << y(r.error.empty() ? r.dice : 0.0) << "\" r=\"2.5\" fill=\""
-          << (bad ? "#d62728" : "#1f77b4") << "\" fill-opacity=\"0.7\"><title>" << r.structure << ' ' << r.protocol
+          << (bad ? "#d62728" : "#1f77b4") << "\" fill-opacity=\"0.7\"><title>" << xmlText(r.structure) << ' ' << xmlText(r.protocol)
           << " seed " << r.seed << ": " << std::setprecision(3) << r.dice << "</title></circle>\n"
           << std::setprecision(1);
     }
     out << "<line x1=\"" << x - 7 << "\" x2=\"" << x + 7 << "\" y1=\"" << y(g.meanDice) << "\" y2=\""
         << y(g.meanDice) << "\" stroke=\"black\" stroke-width=\"2\"/>\n";
     out << "<text transform=\"translate(" << x + 4 << "," << top + plotHeight + 8 << ") rotate(60)\">"
-        << g.image << " " << g.structure << " " << g.protocol << "</text>\n";
+        << xmlText(g.image + " " + g.structure + " " + g.protocol) << "</text>\n";
   }
   out << "</svg>\n";
   if (!out) throw Error(path, "could not be written");

@@ -75,6 +75,9 @@ print(json.dumps(p))")" "unknown structure 'nucleus_x'"
 bad bad_protocol "$(python3 -c "
 import json; p = json.load(open('$DATA/Evaluation/ci_plan.json')); p['protocols'][0]['coverage'] = [0.9, 0.2]
 print(json.dumps(p))")" "coverage"
+bad duplicate_structure "$(python3 -c "
+import json; p = json.load(open('$DATA/Evaluation/ci_plan.json')); p['structures'].append(p['structures'][0])
+print(json.dumps(p))")" "two structures are named 'caudate_left'"
 "$DYNSUB" evaluate "$work/missing.json" --out "$work/out_missing" >"$work/missing.log" 2>&1
 check "missing plan: non-zero exit and the file named" grep -q "missing.json" "$work/missing.log"
 

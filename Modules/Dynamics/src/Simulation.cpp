@@ -290,7 +290,8 @@ void checkSimulationOptions(const SimulationOptions& o) {
     throw Error("equilibrium tolerances must be > 0, the window and the step limit >= 1");
   }
   if (o.maxLevel < 0 || o.maxLevel > 6) throw Error("the maximum level must be in 0..6, got " + std::to_string(o.maxLevel));
-  if (o.origin.level < 0 || o.origin.level > o.maxLevel || o.origin.isolation < -1) {
+  if (o.origin.level < 0 || o.origin.level > o.maxLevel || o.origin.isolation < -1 ||
+      (o.origin.level > 0 && o.origin.isolation < 0)) {
     throw Error("the initial mesh's level must be in 0..maximum level (" + std::to_string(o.maxLevel) + "), got " +
                 std::to_string(o.origin.level) + " (isolation " + std::to_string(o.origin.isolation) + ")");
   }

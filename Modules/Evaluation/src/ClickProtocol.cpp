@@ -1,10 +1,13 @@
 #include "dynsub/ClickProtocol.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <random>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "dynsub/Error.h"
 
@@ -104,7 +107,9 @@ std::vector<Landmark> expertClicks(const Mask& reference, const ClickProtocol& p
   }
 
   const auto [a, b] = inPlaneAxes(axis);
-  std::normal_distribution<double> error(0.0, protocol.scatter);
+  // No draw at all without scatter (a normal distribution needs a spread > 0).
+  std::normal_distribution<double> error(0.0, std::max(protocol.scatter, 1e-300));
+  auto handError = [&] { return protocol.scatter > 0 ? error(random) : 0.0; };
   std::vector<Landmark> clicks;
   std::vector<Vector3> outwards;  // per click, LPS unit vectors
   for (int index : indices) {
@@ -121,8 +126,8 @@ std::vector<Landmark> expertClicks(const Mask& reference, const ClickProtocol& p
     for (int n = 0; n < protocol.pointsPerSlice; ++n) {
       Vector3 at = boundary[pick].index;
       // A hand's error, in the slice's plane (index units scaled to mm).
-      at[a] += error(random) / g.spacing[a];
-      at[b] += error(random) / g.spacing[b];
+      at[a] += handError() / g.spacing[a];
+      at[b] += handError() / g.spacing[b];
       clicks.push_back({"", g.toPhysical(at)});
       outwards.push_back((g.direction * boundary[pick].outward).normalized());
       for (size_t i = 0; i < physical.size(); ++i)

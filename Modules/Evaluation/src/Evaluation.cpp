@@ -1,11 +1,14 @@
 #include "dynsub/Evaluation.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <mutex>
+#include <set>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -39,12 +42,11 @@ std::string resolve(const std::string& path, const std::filesystem::path& base) 
 // about the size of a bubble dropped in ITK-SNAP.
 constexpr double kSeedRadius = 3.0;
 // A result keeping less than this fraction of the reference's volume has collapsed.
-constexpr double kCollapsedBelow = 0.2;
+constexpr double kCollapsedBelowReference = 0.2;
 
 EvaluationRun runOne(const EvaluationPlan& plan, const Volume& image, const Mask& reference,
                      const EvaluationProtocol& protocol, int axis, EvaluationRun run,
                      const std::string& landmarkDirectory) {
-  const auto started = std::chrono::steady_clock::now();
   ClickProtocol clicks = protocol.clicks;
   if (!protocol.ownAxis) clicks.axis = axis;
   // The clicks go through a file in the protocol's format, as a user's would.
@@ -60,6 +62,7 @@ EvaluationRun runOne(const EvaluationPlan& plan, const Volume& image, const Mask
   const ControlMesh initial =
       clicks.seedOnly ? initialSphere(seedClick(reference), kSeedRadius)
                       : initialFromLandmarks(landmarks, plan.initialFraction);
+  const auto started = std::chrono::steady_clock::now();
   const SegmentResult result = segment(image, landmarks, initial, plan.segment);
   run.steps = result.steps;
   for (const std::string& w : result.warnings) run.warnings += (run.warnings.empty() ? "" : "; ") + w;
@@ -80,7 +83,8 @@ EvaluationRun runOne(const EvaluationPlan& plan, const Volume& image, const Mask
   run.referenceVolume = reference.count() * voxel;
   run.leak = run.volume - overlap * voxel;
   run.miss = run.referenceVolume - overlap * voxel;
-  run.collapsed = run.volume < kCollapsedBelow * run.referenceVolume;
+  run.collapsed = run.volume < kCollapsedBelowReference * run.referenceVolume;
+  run.meanSurfaceDistance = run.hd95 = std::numeric_limits<double>::quiet_NaN();  // no surface to measure
   if (mask.count() > 0) {
     const OverlapMetrics m = compareMasks(mask, reference);
     run.dice = m.dice;
@@ -191,6 +195,24 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
   }
   if (plan.images.empty() || plan.structures.empty() || plan.protocols.empty() || plan.splits.empty())
     throw Error(path, "an evaluation plan needs images, structures, protocols and splits");
+  // Names make the runs' file names and the summary's groups: each once.
+  auto unique = [&](const std::vector<std::string>& names, const char* what) {
+    std::set<std::string> seen;
+    for (const std::string& n : names)
+      if (!seen.insert(n).second) throw Error(path, std::string("two ") + what + " are named '" + n + "'");
+  };
+  std::vector<std::string> names;
+  for (const auto& i : plan.images) names.push_back(i.name);
+  unique(names, "images");
+  names.clear();
+  for (const auto& s : plan.structures) names.push_back(s.name);
+  unique(names, "structures");
+  names.clear();
+  for (const auto& p : plan.protocols) names.push_back(p.clicks.name);
+  unique(names, "protocols");
+  names.clear();
+  for (const auto& s : plan.splits) names.push_back(s.name);
+  unique(names, "splits");
   return plan;
 }
 

@@ -51,7 +51,10 @@ class RegionPressureForceModel final : public ForceModel {
     Eigen::VectorXd pressures(positions.rows());
     for (Eigen::Index i = 0; i < positions.rows(); ++i) {
       const Vector3 index = toIndex_ * (positions.row(i).transpose() - image_.geometry.origin);
-      const double gate = 1.0 - std::abs(image_.interpolate(index) - median_) / width_;
+      bool inside = true;
+      for (int a = 0; a < 3; ++a) inside = inside && index[a] >= 0 && index[a] <= image_.geometry.size[a] - 1;
+      // Outside the region the image is unknown (interpolate would repeat its border): no push.
+      const double gate = inside ? 1.0 - std::abs(image_.interpolate(index) - median_) / width_ : 0.0;
       pressures(i) = strength_ * std::clamp(gate, -1.0, 1.0);
     }
     return pressureForces(*quadrature_, controlPoints, pressures);
@@ -194,6 +197,8 @@ SegmentResult evolveInRegion(const SegmentationRegion& region, const std::vector
   if (!initial.isClosed()) throw Error("the initial model must be a closed control mesh");
   const auto clock = Clock::now();
   const Matrix3X landmarkPoints = landmarkPositions(landmarks);
+  if (!region.covers(landmarkPoints) || !region.covers(initial.points()))
+    throw Error("the landmarks or the initial model reach outside the region of interest: build a new region");
   const ImageForceField field(region.directions(), options.imageForce);
   FieldForceModel imageForces(field);
   Eigen::VectorXd stiffness = Eigen::VectorXd::Constant(landmarkPoints.rows(), options.landmarkStiffness);

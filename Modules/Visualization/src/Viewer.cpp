@@ -136,8 +136,9 @@ struct Viewer::Impl {
   void landmarksChanged() {
     showLandmarks();
     if (running || fitted) {
+      const bool refit = fitted.has_value();  // read before a new worker may write it
       startFit();  // the fit restarts with the new set, from the last fit if there is one
-      message = fitted ? "landmarks changed: refitting" : "landmarks changed: fitting again";
+      if (running) message = refit ? "landmarks changed: refitting" : "landmarks changed: fitting again";
     }
   }
 

@@ -23,6 +23,8 @@ struct ClosestPoint {
   Vector3 normal = Vector3::Zero();  // unit limit normal at the point (zero where undefined)
 };
 
+// Not for concurrent use: searches are const but may rebuild the sample tree
+// (each call parallelizes over its queries itself).
 class ClosestPointLocator {
  public:
   // The surface must outlive the locator. samplesPerElement in 2..64.

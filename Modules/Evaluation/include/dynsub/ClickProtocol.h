@@ -21,7 +21,8 @@
 // among ties) and no landmarks.
 //
 // Everything is drawn from `seed`: the same protocol and seed give the same
-// clicks on any machine.
+// clicks wherever the same C++ standard library runs (its distributions and
+// shuffle are not specified bit for bit across libraries).
 #include <string>
 #include <vector>
 

@@ -3,7 +3,8 @@
 // (`dynsub evaluate`): each run makes an expert-like landmark set from a
 // reference labelmap (ClickProtocol.h), writes it in the protocol's file
 // format and reads it back as a user's file would be, segments the image
-// with the default options, and scores the result against the reference.
+// (with `dynsub segment`'s defaults unless the plan sets some), and scores
+// the result against the reference.
 //
 // Scoring is in physical space: the final surface is voxelized on the
 // reference's own grid, so images of any resolution (Colin27 at 1 mm and at
@@ -67,12 +68,12 @@ struct EvaluationRun {
   unsigned seed = 0;
   int landmarks = 0;
   std::string error;  // empty when the run succeeded
-  double dice = 0, jaccard = 0, meanSurfaceDistance = 0, hd95 = 0;
+  double dice = 0, jaccard = 0, meanSurfaceDistance = 0, hd95 = 0;  // distances NaN for an empty result
   double volume = 0, referenceVolume = 0;  // mm^3
   double leak = 0, miss = 0;                // mm^3 outside the reference, reference not covered
   bool collapsed = false;
   std::string warnings;  // segment()'s own (collapse, leak), joined by "; "
-  double seconds = 0;  // segmentation alone (the image is read once per plan)
+  double seconds = 0;  // segment() alone (the image is read once per plan, the clicks made before)
   int steps = 0, controlVertices = 0;
 };
 
