@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "dynsub/Simulation.h"
+#include "dynsub/SurfaceWriter.h"
 
 namespace CLI {
 class App;
@@ -72,9 +73,12 @@ void writeJson(const nlohmann::ordered_json& json, const std::string& path);
 // The outputs of a simulation, all or none: DIR/surface.vtp (the limit
 // surface, 8 x 8 squares per element), DIR/control_mesh.obj, DIR/report.json.
 // Throws dynsub::Error if the control points are not finite.
-// `extra` may add further files to the same set (e.g. a labelmap).
+// `extra` may add further files to the same set (e.g. a labelmap);
+// `surfaceScalars` are point data of surface.vtp (one value per point of that
+// tessellation, as tessellate(LimitSurface(mesh), mesh.points(), 8) orders them).
 void writeModelOutputs(const std::filesystem::path& dir, const ControlMesh& mesh,
                        const nlohmann::ordered_json& report,
-                       const std::function<void(OutputSet&)>& extra = nullptr);
+                       const std::function<void(OutputSet&)>& extra = nullptr,
+                       const std::vector<PointScalars>& surfaceScalars = {});
 
 }  // namespace dynsub::app

@@ -197,7 +197,8 @@ void runSegment(SegmentCommandOptions o) {
   writeModelOutputs(dir, result.mesh, report, [&](OutputSet& outputs) {
     writeMask(result.labelmap, outputs.add("labelmap.nii.gz"));
     addFigureOutputs(outputs, o.figures, result.mesh, recorder.history(), &image, landmarkPoints, Matrix3X());
-  });
+  }, result.surfaceEdgeDistances.size() ? std::vector<PointScalars>{{"edge_distance_mm", result.surfaceEdgeDistances}}
+                                        : std::vector<PointScalars>{});
 
   std::cout << std::fixed << std::setprecision(1) << "segmented " << result.labelmap.count() * image.geometry.spacing.prod()
             << " mm^3 with " << result.mesh.vertexCount() << " control vertices (" << result.levels.back().level

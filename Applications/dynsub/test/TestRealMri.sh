@@ -67,6 +67,17 @@ ok = mri[0] == labels[0] and mri[1] == labels[1] and close(mri[3], labels[3])
 ok = ok and (labels[2] == 0 or close(labels[4], mri[3]))
 sys.exit(0 if ok else 1)
 PY
+# How far to trust it, in the report and on the surface: every landmark's
+# edge distance, the share held by edges, and the per-point edge distance as
+# surface.vtp point data (its name appears in the XML header).
+check "caudate_left: report and surface say where edges hold it" python3 - "$work/caudate_left" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1] + "/report.json"))
+ok = 0 < r["surface_on_edges"] <= 1 and all("edge_distance_mm" in l for l in r["landmark_residuals"])
+ok = ok and isinstance(r["warnings"], list) and r["surface_volume_mm3"] > r["initial_volume_mm3"]
+head = open(sys.argv[1] + "/surface.vtp", "rb").read(4096)
+sys.exit(0 if ok and b'Name="edge_distance_mm"' in head else 1)
+PY
 segment_structure cerebellum "$DATA/Landmarks/cerebellum.mrk.json" $(seq 91 116)
 # segment_from_atlas_points NAME VIEW SLICES POINTS LABEL...: landmarks made
 # from the AAL labels' boundary (as Data/Landmarks/README.md says), then segment.

@@ -280,8 +280,12 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
     const DirectionField& field = region.directions();
     const double voxel = region.image().geometry.spacing.maxCoeff();
     Eigen::Index held = 0;
-    for (Eigen::Index p = 0; p < triangles.points.rows(); ++p)
-      held += field.edgeDistance(Vector3(triangles.points.row(p).transpose())) <= voxel;
+    result.surfaceEdgeDistances.resize(triangles.points.rows());
+    for (Eigen::Index p = 0; p < triangles.points.rows(); ++p) {
+      const double d = field.edgeDistance(Vector3(triangles.points.row(p).transpose()));
+      held += d <= voxel;
+      result.surfaceEdgeDistances(p) = std::isfinite(d) ? d : -1.0;
+    }
     result.surfaceOnEdges = static_cast<double>(held) / std::max<Eigen::Index>(triangles.points.rows(), 1);
     for (std::size_t i = 0; i < landmarks.size(); ++i) {
       const double d = field.edgeDistance(landmarks[i].position);

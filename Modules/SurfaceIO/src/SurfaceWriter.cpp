@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <filesystem>
 
+#include <vtkDoubleArray.h>
 #include <vtkNew.h>
 #include <vtkOBJWriter.h>
 #include <vtkPLYWriter.h>
+#include <vtkPointData.h>
 #include <vtkPolyData.h>
 #include <vtkSTLWriter.h>
 #include <vtkXMLPolyDataWriter.h>
@@ -19,15 +21,26 @@ namespace dynsub {
 
 std::vector<std::string> triangleSurfaceExtensions() { return {".vtp", ".obj", ".ply", ".stl"}; }
 
-void writeTriangleSurface(const TriangleSurface& surface, const std::string& path) {
+void writeTriangleSurface(const TriangleSurface& surface, const std::string& path,
+                          const std::vector<PointScalars>& scalars) {
   const std::string extension = lowerCaseExtension(path);
   const std::vector<std::string> known = triangleSurfaceExtensions();
   if (std::find(known.begin(), known.end(), extension) == known.end()) {
     throw Error(path, "unknown surface format '" + extension + "' (expected .vtp, .obj, .ply or .stl)");
   }
   if (!surface.points.allFinite()) throw Error(path, "the surface has non-finite coordinates; nothing written");
+  for (const PointScalars& s : scalars)
+    if (s.values.size() != surface.points.rows() || !s.values.allFinite())
+      throw Error(path, "point data '" + s.name + "' needs one finite value per point; nothing written");
   AtomicOutput output(path);
   vtkSmartPointer<vtkPolyData> polyData = toPolyData(surface);
+  for (const PointScalars& s : scalars) {
+    vtkNew<vtkDoubleArray> array;
+    array->SetName(s.name.c_str());
+    array->SetNumberOfValues(s.values.size());
+    for (Eigen::Index i = 0; i < s.values.size(); ++i) array->SetValue(i, s.values(i));
+    polyData->GetPointData()->AddArray(array);
+  }
   int written = 0;
   if (extension == ".vtp") {
     vtkNew<vtkXMLPolyDataWriter> writer;

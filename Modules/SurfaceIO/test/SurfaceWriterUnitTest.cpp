@@ -1,9 +1,11 @@
 // Unit tests (no rendering): written surfaces read back through VTK's readers
 // with the same points, triangles and element tags.
+#include <cmath>
 #include <filesystem>
 
 #include <gtest/gtest.h>
 #include <vtkCellData.h>
+#include <vtkPointData.h>
 #include <vtkDataArray.h>
 #include <vtkNew.h>
 #include <vtkOBJReader.h>
@@ -51,6 +53,28 @@ TEST(SurfaceWriter, VtpKeepsGeometryAndElementTags) {
   for (vtkIdType c = 0; c < type->GetNumberOfTuples(); ++c) special += type->GetTuple1(c) == 1.0;
   // 8 valence-3 vertices x 3 special elements x 2 x 2 squares x 2 triangles.
   EXPECT_EQ(special, 8 * 3 * 2 * 2 * 2);
+}
+
+TEST(SurfaceWriter, VtpCarriesPointScalarsAndRefusesBadOnes) {
+  const dynsub::TriangleSurface surface = cubeSurface();
+  const Eigen::VectorXd values = surface.points.col(2).array() * 2.0 + 1.0;
+  const std::string path = scratch("scalars.vtp");
+  dynsub::writeTriangleSurface(surface, path, {{"edge_distance_mm", values}});
+  vtkNew<vtkXMLPolyDataReader> reader;
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  vtkDataArray* array = reader->GetOutput()->GetPointData()->GetArray("edge_distance_mm");
+  ASSERT_NE(array, nullptr);
+  ASSERT_EQ(array->GetNumberOfTuples(), values.size());
+  for (vtkIdType i = 0; i < array->GetNumberOfTuples(); i += 7) EXPECT_EQ(array->GetTuple1(i), values(i));
+  // Wrong size or NaN: an error and no file.
+  const std::string bad = scratch("bad_scalars.vtp");
+  fs::remove(bad);
+  EXPECT_THROW(dynsub::writeTriangleSurface(surface, bad, {{"short", values.head(3)}}), dynsub::Error);
+  Eigen::VectorXd nan = values;
+  nan(5) = std::nan("");
+  EXPECT_THROW(dynsub::writeTriangleSurface(surface, bad, {{"nan", nan}}), dynsub::Error);
+  EXPECT_FALSE(fs::exists(bad));
 }
 
 TEST(SurfaceWriter, ObjPlyStlReadBack) {

@@ -80,6 +80,10 @@ struct SegmentResult {
   // (Documentation/Segmentation.md).
   double surfaceOnEdges = std::numeric_limits<double>::quiet_NaN();
   std::vector<double> landmarkEdgeDistances;
+  // Per point of the result's 8 x 8-per-element tessellation (tessellate()'s
+  // order): the distance to the nearest edge (mm), -1 outside the region
+  // where it is unknown. Empty for the plain gradient potential.
+  Eigen::VectorXd surfaceEdgeDistances;
   std::vector<std::string> warnings;
 };
 

@@ -13,9 +13,17 @@
 
 namespace dynsub {
 
+// A named value per point of the surface (e.g. a distance in mm), written as
+// point data where the format has it (.vtp); the other formats leave it out.
+struct PointScalars {
+  std::string name;
+  Eigen::VectorXd values;  // one per row of TriangleSurface::points, finite
+};
+
 // Throws dynsub::Error naming the file for an unknown extension, a missing or
-// read-only directory, or a failed write.
-void writeTriangleSurface(const TriangleSurface& surface, const std::string& path);
+// read-only directory, a failed write, or scalars of the wrong size or not finite.
+void writeTriangleSurface(const TriangleSurface& surface, const std::string& path,
+                          const std::vector<PointScalars>& scalars = {});
 
 // The extensions writeTriangleSurface accepts, with the dot (".vtp", ...).
 std::vector<std::string> triangleSurfaceExtensions();
