@@ -203,9 +203,7 @@ double DirectionField::slopeBound() const { return 2.0 / geometry_.spacing.minCo
 double DirectionField::edgeDistance(const Vector3& point) const {
   if (!hasEdges_) return std::numeric_limits<double>::infinity();
   const Vector3 index = geometry_.toIndex(point);
-  for (int a = 0; a < 3; ++a)
-    if (!(index[a] >= 0 && index[a] <= geometry_.size[a] - 1)) return std::numeric_limits<double>::infinity();
-  return edgeDistance_.interpolate(index);
+  return geometry_.spans(index) ? edgeDistance_.interpolate(index) : std::numeric_limits<double>::infinity();
 }
 
 Matrix3X DirectionField::sample(const Matrix3X& points) const {
@@ -213,9 +211,7 @@ Matrix3X DirectionField::sample(const Matrix3X& points) const {
   const Matrix3 toIndex = geometry_.indexFromPhysical();
   for (Eigen::Index p = 0; p < points.rows(); ++p) {
     const Vector3 index = toIndex * (points.row(p).transpose() - geometry_.origin);
-    bool inside = true;
-    for (int a = 0; a < 3; ++a) inside = inside && index[a] >= 0 && index[a] <= geometry_.size[a] - 1;
-    if (!inside) continue;
+    if (!geometry_.spans(index)) continue;
     for (int a = 0; a < 3; ++a) result(p, a) = components_[a].interpolate(index);
   }
   return result;

@@ -15,6 +15,12 @@ Matrix3 ImageGeometry::indexFromPhysical() const {
   return spacing.cwiseInverse().asDiagonal() * direction.inverse();
 }
 
+bool ImageGeometry::spans(const Vector3& index) const {
+  for (int a = 0; a < 3; ++a)
+    if (!(index[a] >= 0 && index[a] <= size[a] - 1)) return false;
+  return true;
+}
+
 bool ImageGeometry::covers(const Vector3& point) const {
   const Vector3 index = toIndex(point);
   for (int a = 0; a < 3; ++a)

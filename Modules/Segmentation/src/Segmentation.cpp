@@ -51,10 +51,9 @@ class RegionPressureForceModel final : public ForceModel {
     Eigen::VectorXd pressures(positions.rows());
     for (Eigen::Index i = 0; i < positions.rows(); ++i) {
       const Vector3 index = toIndex_ * (positions.row(i).transpose() - image_.geometry.origin);
-      bool inside = true;
-      for (int a = 0; a < 3; ++a) inside = inside && index[a] >= 0 && index[a] <= image_.geometry.size[a] - 1;
       // Outside the region the image is unknown (interpolate would repeat its border): no push.
-      const double gate = inside ? 1.0 - std::abs(image_.interpolate(index) - median_) / width_ : 0.0;
+      const double gate =
+          image_.geometry.spans(index) ? 1.0 - std::abs(image_.interpolate(index) - median_) / width_ : 0.0;
       pressures(i) = strength_ * std::clamp(gate, -1.0, 1.0);
     }
     return pressureForces(*quadrature_, controlPoints, pressures);

@@ -32,6 +32,10 @@ struct ImageGeometry {
   // Whether a physical point lies in one of the grid's voxels (continuous
   // index within -0.5 .. size - 0.5 on every axis).
   bool covers(const Vector3& point) const;
+  // Whether a continuous index lies between the first and the last voxel
+  // centres on every axis (0 .. size - 1): where trilinear interpolation
+  // needs no clamping, i.e. where the image is known rather than repeated.
+  bool spans(const Vector3& index) const;
   // The linear part of toIndex, index = indexFromPhysical() * (point - origin),
   // for loops over many points (it holds a 3 x 3 inverse).
   Matrix3 indexFromPhysical() const;
