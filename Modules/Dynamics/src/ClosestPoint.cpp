@@ -1,7 +1,6 @@
 #include "dynsub/ClosestPoint.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -133,6 +132,12 @@ struct ClosestPointLocator::Impl {
     return Nearer::No;
   }
 
+  // Whether p names a point of the surface: an element, with (u, v) in [0,1]^2.
+  bool onSurface(const ElementPoint& p) const {
+    return p.element >= 0 && p.element < static_cast<int>(normal.size()) && p.u >= 0.0 && p.u <= 1.0 &&
+           p.v >= 0.0 && p.v <= 1.0;
+  }
+
   // The limit surface at p: on a normal element from its grid of this state
   // (a 6 x 16 by 16 x 3 product), elsewhere through the surface.
   LimitSample evaluate(const ElementPoint& p) const {
@@ -146,10 +151,7 @@ struct ClosestPointLocator::Impl {
 
   // Newton's method for min |s(u, v) - q|^2 on one element, from (u, v), kept in [0,1]^2.
   ClosestPoint refine(ElementPoint p, const Vector3& q) const {
-    if (p.element < 0 || p.element >= static_cast<int>(normal.size()) ||
-        !(p.u >= 0.0 && p.u <= 1.0 && p.v >= 0.0 && p.v <= 1.0)) {
-      throw Error("internal: closest-point search started outside the surface");
-    }
+    if (!onSurface(p)) throw Error("internal: closest-point search started outside the surface");
     LimitSample s = evaluate(p);
     double best = (s.position - q).squaredNorm();
     for (int iteration = 0; iteration < 30; ++iteration) {
@@ -310,15 +312,11 @@ std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries,
   // A tracked point is kept when no sample is nearer (Impl::sampleNearer);
   // the rest are decided, or searched, on a current tree.
   using Nearer = Impl::Nearer;
-  // A hint off the surface (another level's, or out of range) means a full search.
-  auto validHint = [&](const ElementPoint& h) {
-    return h.element >= 0 && h.element < s.surface->elementCount() && h.u >= 0 && h.u <= 1 && h.v >= 0 && h.v <= 1;
-  };
   std::vector<ClosestPoint> result(queries.rows());
   std::vector<Nearer> nearer(queries.rows(), Nearer::Yes);
   parallelFor(queries.rows(), [&](Eigen::Index i) {
     const ElementPoint& hint = hints[i];
-    if (!validHint(hint)) return;  // searched below
+    if (!s.onSurface(hint)) return;  // a hint off the surface (another level's) means a full search, below
     const Vector3 q = queries.row(i).transpose();
     result[i] = s.refine(hint, q);
     nearer[i] = s.sampleNearer(q, result[i].distance);
@@ -329,7 +327,7 @@ std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries,
   parallelFor(queries.rows(), [&](Eigen::Index i) {
     if (nearer[i] == Nearer::No) return;
     const Vector3 q = queries.row(i).transpose();
-    if (!validHint(hints[i])) {
+    if (!s.onSurface(hints[i])) {
       result[i] = search(q);
       return;
     }

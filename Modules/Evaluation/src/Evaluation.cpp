@@ -196,23 +196,17 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
   if (plan.images.empty() || plan.structures.empty() || plan.protocols.empty() || plan.splits.empty())
     throw Error(path, "an evaluation plan needs images, structures, protocols and splits");
   // Names make the runs' file names and the summary's groups: each once.
-  auto unique = [&](const std::vector<std::string>& names, const char* what) {
+  auto unique = [&](const auto& entries, const auto& nameOf, const char* what) {
     std::set<std::string> seen;
-    for (const std::string& n : names)
-      if (!seen.insert(n).second) throw Error(path, std::string("two ") + what + " are named '" + n + "'");
+    for (const auto& entry : entries)
+      if (!seen.insert(nameOf(entry)).second)
+        throw Error(path, std::string("two ") + what + " are named '" + nameOf(entry) + "'");
   };
-  std::vector<std::string> names;
-  for (const auto& i : plan.images) names.push_back(i.name);
-  unique(names, "images");
-  names.clear();
-  for (const auto& s : plan.structures) names.push_back(s.name);
-  unique(names, "structures");
-  names.clear();
-  for (const auto& p : plan.protocols) names.push_back(p.clicks.name);
-  unique(names, "protocols");
-  names.clear();
-  for (const auto& s : plan.splits) names.push_back(s.name);
-  unique(names, "splits");
+  const auto name = [](const auto& entry) { return entry.name; };
+  unique(plan.images, name, "images");
+  unique(plan.structures, name, "structures");
+  unique(plan.protocols, [](const EvaluationProtocol& p) { return p.clicks.name; }, "protocols");
+  unique(plan.splits, name, "splits");
   return plan;
 }
 

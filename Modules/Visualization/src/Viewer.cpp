@@ -98,7 +98,7 @@ struct Viewer::Impl {
     LevelOrigin origin;
   };
   std::optional<Fitted> fitted;
-  std::shared_ptr<const SegmentationRegion> region;
+  std::unique_ptr<const SegmentationRegion> region;
 
   explicit Impl(ViewerInput in);
   ~Impl() { stopFit(); }
@@ -230,7 +230,7 @@ struct Viewer::Impl {
       const auto started = std::chrono::steady_clock::now();
       const ControlMesh initial = start ? start->mesh : initialFromLandmarks(marks);
       if (!start || !region || !region->covers(landmarkPositions(marks)) || !region->covers(initial.points()))
-        region = std::make_shared<const SegmentationRegion>(input.image, marks, initial, input.segment);
+        region = std::make_unique<const SegmentationRegion>(input.image, marks, initial, input.segment);
       auto last = std::chrono::steady_clock::now() - kRedrawInterval;
       auto observe = [&](const Progress& p) {
         {
