@@ -445,7 +445,6 @@ SurfacePoint LimitSurface::toSurfacePoint(const ElementPoint& point) const {
 
 namespace {
 
-
 void checkPoints(const Matrix3X& controlPoints, int expected) {
   if (controlPoints.rows() != expected) {
     throw Error("got " + std::to_string(controlPoints.rows()) + " control points for a surface of " +
