@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <memory>
 #include <sstream>
 
 #include <CLI/CLI.hpp>
@@ -16,6 +17,7 @@
 #include "dynsub/ImageIO.h"
 #include "dynsub/MeshIO.h"
 #include "dynsub/Metrics.h"
+#include "dynsub/SeedGrowth.h"
 #include "dynsub/Segmentation.h"
 
 namespace dynsub::app {
@@ -35,29 +37,57 @@ struct SegmentCommandOptions {
   const CLI::Option* edgeLowOption = nullptr;
   const CLI::Option* edgeHighOption = nullptr;
   SegmentOptions segment;
+  SeedOptions seed;
   SimulationArguments simulation;
   FigureOptions figures;
 };
 
-ControlMesh chooseInitialModel(const SegmentCommandOptions& o, const std::vector<Landmark>& landmarks) {
+// Where the evolution starts, and which points its springs pull to.
+struct Start {
+  ControlMesh initial;
+  std::vector<Landmark> springs;  // the user's landmarks, or the seed region's boundary without them
+  std::unique_ptr<SeedRegion> seed;  // for --init seed:
+};
+
+// "x,y,z[,r]" after a prefix: `count` finite numbers.
+std::vector<double> numbersAfter(const std::string& value, std::size_t prefix, int count, const char* expected) {
+  std::stringstream in(value.substr(prefix));
+  std::vector<double> v(count);
+  char comma = ',';
+  for (int i = 0; i < count; ++i)
+    if (!(in >> v[i]) || !std::isfinite(v[i]) || (i + 1 < count && (!(in >> comma) || comma != ',')))
+      throw Error("--init " + value + ": expected " + expected + " (LPS mm)");
+  if (in >> comma) throw Error("--init " + value + ": expected " + expected + " (LPS mm)");
+  return v;
+}
+
+Start chooseStart(SegmentCommandOptions& o, const Volume& image, const std::vector<Landmark>& landmarks) {
+  Start start;
+  start.springs = landmarks;
   if (o.init == "auto") {
     if (landmarks.size() < 4)
       throw Error("--init auto builds the initial model from the landmarks: give at least 4 with --landmarks, "
-                  "or use --init sphere:x,y,z,r or --init MESH");
-    return initialFromLandmarks(landmarks);
+                  "or use --init seed:x,y,z, --init sphere:x,y,z,r or --init MESH");
+    start.initial = initialFromLandmarks(landmarks);
+  } else if (o.init.rfind("sphere:", 0) == 0) {
+    const std::vector<double> v = numbersAfter(o.init, 7, 4, "sphere:x,y,z,r");
+    start.initial = initialSphere(Vector3(v[0], v[1], v[2]), v[3]);
+  } else if (o.init.rfind("seed:", 0) == 0) {
+    // The region the click's tissue fills (SeedGrowth.h) gives the initial
+    // model; without landmarks its boundary points are the springs, softer
+    // than an expert's clicks.
+    const std::vector<double> v = numbersAfter(o.init, 5, 3, "seed:x,y,z");
+    start.seed = std::make_unique<SeedRegion>(growFromSeed(image, Vector3(v[0], v[1], v[2]), o.seed));
+    start.initial = initialFromLandmarks(start.seed->boundary);
+    if (landmarks.empty()) {
+      start.springs = start.seed->boundary;
+      o.segment.landmarkStiffness = o.seed.stiffness;
+    }
+  } else {
+    start.initial = readControlMesh(o.init);
+    if (!start.initial.isClosed()) throw Error(o.init, "the initial model must be a closed control mesh");
   }
-  if (o.init.rfind("sphere:", 0) == 0) {
-    std::stringstream in(o.init.substr(7));
-    double v[4];
-    char comma = ',';
-    for (int i = 0; i < 4; ++i)
-      if (!(in >> v[i]) || (i < 3 && !(in >> comma)) || comma != ',')
-        throw Error("--init " + o.init + ": expected sphere:x,y,z,r (LPS mm)");
-    return initialSphere(Vector3(v[0], v[1], v[2]), v[3]);
-  }
-  ControlMesh mesh = readControlMesh(o.init);
-  if (!mesh.isClosed()) throw Error(o.init, "the initial model must be a closed control mesh");
-  return mesh;
+  return start;
 }
 
 nlohmann::ordered_json metricsJson(const OverlapMetrics& m) {
@@ -83,8 +113,9 @@ void runSegment(SegmentCommandOptions o) {
   // image (landmarks off every edge are an error, not a silent switch).
   EdgeOptions& edges = o.segment.edges;
   edges.reference = o.edgeReference == "image" ? EdgeReference::Image : EdgeReference::Landmarks;
+  const bool pointsOnBoundary = !o.landmarks.empty() || o.init.rfind("seed:", 0) == 0;  // see chooseStart
   Hysteresis& thresholds =
-      edges.reference == EdgeReference::Landmarks && !o.landmarks.empty() ? edges.ofLandmarks : edges.ofImage;
+      edges.reference == EdgeReference::Landmarks && pointsOnBoundary ? edges.ofLandmarks : edges.ofImage;
   if (o.edgeLowOption->count()) thresholds.low = o.edgeLow;
   if (o.edgeHighOption->count()) thresholds.high = o.edgeHigh;
   checkSegmentOptions(o.segment);
@@ -102,19 +133,21 @@ void runSegment(SegmentCommandOptions o) {
     reference = selectLabels(labels, o.referenceLabels);
     if (reference.count() == 0) throw Error(o.reference, "no voxel has the reference label(s)");
   }
-  const ControlMesh initial = chooseInitialModel(o, landmarks);
+  const Start start = chooseStart(o, image, landmarks);
+  const ControlMesh& initial = start.initial;
+  const std::vector<Landmark>& springs = start.springs;
   const std::filesystem::path dir(o.out);
   prepareOutputDirectory(dir);
 
-  const auto start = std::chrono::steady_clock::now();
+  const auto started = std::chrono::steady_clock::now();
   ProgressLine line;
   // The rms landmark distance every 5 steps, the landmarks' nearest points
   // tracked from sample to sample (a new locator only when the level changes).
-  const Matrix3X landmarkPoints = landmarkPositions(landmarks);
+  const Matrix3X landmarkPoints = landmarkPositions(springs);
   TrackedDistances tracked(landmarkPoints);
   ConvergenceRecorder recorder(
       "rms landmark distance (mm)",
-      landmarks.empty() ? ConvergenceRecorder::FitError()
+      springs.empty() ? ConvergenceRecorder::FitError()
                         : [&](const Progress& p) {
                             const Eigen::VectorXd d = tracked.measure(*p.surface, p.level, *p.controlPoints);
                             return std::sqrt(d.squaredNorm() / static_cast<double>(d.size()));
@@ -122,7 +155,7 @@ void runSegment(SegmentCommandOptions o) {
       5);
   const SegmentResult result = [&] {
     try {
-      return segment(image, landmarks, initial, o.segment, recorder.callback(line.callback()));
+      return segment(image, springs, initial, o.segment, recorder.callback(line.callback()));
     } catch (const LandmarksOffEdges& error) {
       // Name the file the points came from, and the options that help.
       throw Error(o.landmarks, std::string(error.what()) + " (--edge-landmark-reach, --edge-reference image)");
@@ -131,13 +164,25 @@ void runSegment(SegmentCommandOptions o) {
     }
   }();
   line.finish();
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
 
   nlohmann::ordered_json report;
   report["image"] = o.image;
   report["landmarks"] = o.landmarks;
   report["landmark_count"] = landmarks.size();
   report["init"] = o.init;
+  if (const SeedRegion* seed = start.seed.get()) {
+    report["seed"] = {{"position_lps_mm", {seed->click.x(), seed->click.y(), seed->click.z()}},
+                      {"median", seed->median},
+                      {"spread", seed->spread},
+                      {"intensity_window", {seed->low, seed->high}},
+                      {"window_spreads", seed->window},
+                      {"opening_mm", seed->opening},
+                      {"region_volume_mm3", seed->mask.count() * seed->mask.geometry.spacing.prod()},
+                      {"boundary_points", seed->boundary.size()},
+                      {"springs", landmarks.empty() ? "boundary points" : "landmarks"},
+                      {"leaked", seed->touchesReach}};
+  }
   OverlapMetrics metrics;
   if (!o.reference.empty()) {
     metrics = compareMasks(result.labelmap, reference);
@@ -162,12 +207,17 @@ void runSegment(SegmentCommandOptions o) {
   report["surface_volume_mm3"] = result.volume;
   report["surface_outside_region"] = result.outsideRegion;
   if (std::isfinite(result.surfaceOnEdges)) report["surface_on_edges"] = result.surfaceOnEdges;
-  report["warnings"] = result.warnings;
+  std::vector<std::string> warnings = result.warnings;
+  if (start.seed) {
+    const std::vector<std::string> seed = seedWarnings(*start.seed);
+    warnings.insert(warnings.begin(), seed.begin(), seed.end());
+  }
+  report["warnings"] = warnings;
   nlohmann::ordered_json residuals = nlohmann::ordered_json::array();
-  for (std::size_t i = 0; i < landmarks.size(); ++i) {
-    residuals.push_back({{"label", landmarks[i].label},
-                         {"position_lps_mm", {landmarks[i].position.x(), landmarks[i].position.y(),
-                                              landmarks[i].position.z()}},
+  for (std::size_t i = 0; i < springs.size(); ++i) {
+    residuals.push_back({{"label", springs[i].label},
+                         {"position_lps_mm", {springs[i].position.x(), springs[i].position.y(),
+                                              springs[i].position.z()}},
                          {"distance_mm", result.landmarkDistances[i]}});
     if (i < result.landmarkEdgeDistances.size() && std::isfinite(result.landmarkEdgeDistances[i]))
       residuals.back()["edge_distance_mm"] = result.landmarkEdgeDistances[i];
@@ -203,7 +253,7 @@ void runSegment(SegmentCommandOptions o) {
   std::cout << std::fixed << std::setprecision(1) << "segmented " << result.labelmap.count() * image.geometry.spacing.prod()
             << " mm^3 with " << result.mesh.vertexCount() << " control vertices (" << result.levels.back().level
             << " refinement(s), " << result.steps << " steps) in " << seconds << " s\n";
-  for (const std::string& warning : result.warnings) std::cerr << "warning: " << warning << '\n';
+  for (const std::string& warning : warnings) std::cerr << "warning: " << warning << '\n';
   if (!o.reference.empty())
     std::cout << std::setprecision(3) << "Dice " << metrics.dice << ", mean surface distance "
               << metrics.meanSurfaceDistance << " mm, HD95 " << metrics.hd95 << " mm against " << o.reference
@@ -230,6 +280,8 @@ void addSegmentCommand(CLI::App& app) {
   command->add_option("--landmarks", o->landmarks, "Boundary points: .mrk.json, .fcsv or .csv (x,y,z in LPS mm)");
   command->add_option("--init", o->init,
                       "Initial model: auto (the 98-vertex cube inside the landmarks' PCA ellipsoid), "
+                      "seed:x,y,z (one click inside the structure, LPS mm: grown through the tissue like the "
+                      "click's, its boundary the springs when no --landmarks are given), "
                       "sphere:x,y,z,r (LPS mm), or a closed control mesh file in LPS mm")
       ->default_val("auto");
   command->add_option("--reference", o->reference, "Reference labelmap on the image's grid, for Dice and distances");
@@ -271,6 +323,18 @@ void addSegmentCommand(CLI::App& app) {
       ->default_val(o->segment.inflation);
   command->add_option("--margin", o->segment.margin, "Region of interest around the model and landmarks, mm")
       ->default_val(o->segment.margin);
+  command->add_option("--seed-window", o->seed.window,
+                      "With --init seed: the intensity window grown through, in robust spreads (1.4826 MAD) of "
+                      "the intensities near the click either side of their median")
+      ->default_val(o->seed.window)
+      ->check(CLI::PositiveNumber);
+  command->add_option("--seed-opening", o->seed.opening,
+                      "With --init seed: the radius (mm) of the opening that cuts thin bridges to like tissue")
+      ->default_val(o->seed.opening)
+      ->check(CLI::NonNegativeNumber);
+  command->add_option("--seed-reach", o->seed.reach, "With --init seed: how far (mm) the region may grow from the click")
+      ->default_val(o->seed.reach)
+      ->check(CLI::PositiveNumber);
   o->simulation.addOptions(*command, SegmentOptions::defaultSimulation());
   o->figures.addOptions(*command);
   command->callback([o] { runSegment(*o); });

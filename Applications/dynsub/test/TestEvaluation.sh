@@ -3,14 +3,14 @@
 # structures of the test split x 3 protocols x 1 seed on Colin27 at 1 mm),
 # and its refusals of bad plans.
 #
-# What is asserted: every run completes and is scored; the seed-only runs
-# (one click, no landmarks) are flagged as collapses, since the surface
-# still shrinks to nothing from a single click, and segment itself warns of
-# every collapse (without the reference); and the landmark protocols'
-# mean Dice stays at or above what this code measures today, as a guard
-# against regressions (0.61 for six slices, 0.52 for three; the floors leave
-# 0.05). These are NOT the targets of the evaluation's issue (mean Dice >=
-# 0.85 from <= 40 points on <= 6 slices): those are not met yet, see
+# What is asserted: every run completes and is scored; a run that collapses
+# (less than a fifth of the reference's volume) was warned of by segment or
+# by the seed's growth, without the reference; and each protocol's mean Dice
+# stays at or above what this code measures today, as a guard against
+# regressions (0.61 for six slices, 0.52 for three, 0.41 from one seed
+# click; the floors leave 0.05-0.06). These are NOT the targets of the
+# evaluation's issue (mean Dice >= 0.85 from <= 40 points on <= 6 slices,
+# >= 0.75-0.80 from one click): those are not met yet, see
 # Documentation/Segmentation.md.
 # Needs DYNSUB (the executable) and DATA.
 set -u
@@ -29,22 +29,20 @@ cat "$work/eval.log"
 for f in runs.csv summary.csv summary.json dice_test.svg; do
   check "evaluate writes $f" test -s "$work/eval/$f"
 done
-check "21 runs, all scored, seed-only runs flagged as collapses, Dice floors hold" python3 - "$work/eval/runs.csv" <<'PY'
+check "21 runs, all scored, every collapse warned of, Dice floors hold" python3 - "$work/eval/runs.csv" <<'PY'
 import csv, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
 ok = len(rows) == 21
 for r in rows:
     if r["error"]:
         print("run failed:", r); ok = False
-    if r["protocol"] == "seed" and r["collapsed"] != "1":
-        print("a seed-only run was not flagged as a collapse:", r); ok = False
-    if r["collapsed"] == "1" and "collapsed" not in r["warnings"]:
-        print("segment did not warn of its own collapse:", r); ok = False
+    if r["collapsed"] == "1" and "collapse" not in r["warnings"]:
+        print("a collapse was not warned of:", r); ok = False
     if r["protocol"] != "seed" and int(r["landmarks"]) != {"six_slices": 36, "sparse": 15}[r["protocol"]]:
         print("wrong number of clicks:", r); ok = False
     if r["protocol"] != "seed" and not (0 < float(r["dice"]) <= 1):
         print("Dice out of range:", r); ok = False
-for protocol, floor in (("six_slices", 0.56), ("sparse", 0.47)):
+for protocol, floor in (("six_slices", 0.56), ("sparse", 0.47), ("seed", 0.35)):
     dice = [float(r["dice"]) for r in rows if r["protocol"] == protocol]
     mean = sum(dice) / len(dice)
     print(f"{protocol}: mean Dice {mean:.3f} over {len(dice)} runs (floor {floor})")

@@ -98,5 +98,25 @@ bar=0.80 segment_from_atlas_points cerebellum_12_points sagittal 4 3 $(seq 91 11
 segment_from_atlas_points cerebellum_left_hemisphere sagittal 5 6 $(seq 91 2 107)
 segment_from_atlas_points cerebellum_right_hemisphere sagittal 5 6 $(seq 92 2 108)
 
+# One click inside the left caudate (the demo landmarks' centroid) and no
+# landmarks: the surface starts from the region grown from the click. It
+# measures 0.643; the floor (0.58) guards against a return to the collapse
+# every single click used to end in (Dice 0.000). Not the issue's bar (0.75).
+"$DYNSUB" segment "$templates/ch2.nii.gz" --init seed:15.4,-1.5,16.0 --reference "$templates/aal.nii.gz" \
+  --reference-label 71 --no-figures --out "$work/caudate_seed" >"$work/caudate_seed.log" 2>&1
+check "caudate from one seed click: segment succeeds" test $? -eq 0
+cat "$work/caudate_seed.log"
+check "caudate from one seed click: Dice >= 0.58, the seed's region reported" python3 - "$work/caudate_seed" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1] + "/report.json"))
+print("Dice", r["dice"], "seed", r["seed"])
+ok = r["dice"] >= 0.58 and r["seed"]["springs"] == "boundary points" and not r["seed"]["leaked"]
+sys.exit(0 if ok and r["seed"]["region_volume_mm3"] > 1000 and r["landmark_count"] == 0 else 1)
+PY
+for bad in seed:15.4,-1.5 seed:15.4,-1.5,16,2 seed:a,b,c seed:1500,0,0; do
+  "$DYNSUB" segment "$templates/ch2.nii.gz" --init "$bad" --no-figures --out "$work/bad_seed" >"$work/bad.log" 2>&1
+  check "--init $bad: a clear error, no output" bash -c "test $? -ne 0 && grep -q 'seed' '$work/bad.log' && test ! -e '$work/bad_seed'"
+done
+
 echo "$failures failure(s)"
 test "$failures" -eq 0

@@ -17,6 +17,7 @@
 #include "dynsub/ImageIO.h"
 #include "dynsub/LimitSurface.h"
 #include "dynsub/Metrics.h"
+#include "dynsub/SeedGrowth.h"
 #include "dynsub/Segmentation.h"
 #include "dynsub/Tessellation.h"
 #include "dynsub/Voxelize.h"
@@ -38,9 +39,6 @@ std::string resolve(const std::string& path, const std::filesystem::path& base) 
   return p.is_absolute() ? path : (base / p).lexically_normal().string();
 }
 
-// A seed-only run starts from a sphere of this radius (mm) at the click,
-// about the size of a bubble dropped in ITK-SNAP.
-constexpr double kSeedRadius = 3.0;
 // A result keeping less than this fraction of the reference's volume has collapsed.
 constexpr double kCollapsedBelowReference = 0.2;
 
@@ -59,11 +57,16 @@ EvaluationRun runOne(const EvaluationPlan& plan, const Volume& image, const Mask
     landmarks = readLandmarks(path);
   }
   run.landmarks = static_cast<int>(landmarks.size());
-  const ControlMesh initial =
-      clicks.seedOnly ? initialSphere(seedClick(reference), kSeedRadius)
-                      : initialFromLandmarks(landmarks, plan.initialFraction);
   const auto started = std::chrono::steady_clock::now();
-  const SegmentResult result = segment(image, landmarks, initial, plan.segment);
+  SegmentOptions options = plan.segment;
+  if (clicks.seedOnly) {  // as segment --init seed: does without landmarks
+    const SeedRegion grown = growFromSeed(image, seedClick(reference), plan.seed);
+    landmarks = grown.boundary;
+    options.landmarkStiffness = plan.seed.stiffness;
+    for (const std::string& w : seedWarnings(grown)) run.warnings += (run.warnings.empty() ? "" : "; ") + w;
+  }
+  const ControlMesh initial = initialFromLandmarks(landmarks, plan.initialFraction);
+  const SegmentResult result = segment(image, landmarks, initial, options);
   run.steps = result.steps;
   for (const std::string& w : result.warnings) run.warnings += (run.warnings.empty() ? "" : "; ") + w;
   run.controlVertices = result.mesh.vertexCount();
@@ -176,6 +179,25 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
       checkSegmentOptions(o);
       if (!(plan.initialFraction > 0 && plan.initialFraction <= 1))
         throw Error(path, "initial_fraction must be in (0, 1]");
+    }
+    if (j.contains("seed")) {
+      // The seed-only runs' region growth, likewise.
+      SeedOptions& o = plan.seed;
+      const std::map<std::string, double*> settings = {{"stats_radius_mm", &o.statsRadius},
+                                                       {"window", &o.window},
+                                                       {"reach_mm", &o.reach},
+                                                       {"opening_mm", &o.opening},
+                                                       {"stiffness", &o.stiffness}};
+      for (const auto& [name, value] : j.at("seed").items()) {
+        if (name == "boundary_points") {
+          o.boundaryPoints = value.get<int>();
+          continue;
+        }
+        const auto setting = settings.find(name);
+        if (setting == settings.end()) throw Error(path, "unknown seed setting '" + name + "'");
+        *setting->second = value.get<double>();
+      }
+      checkSeedOptions(o);
     }
     for (const auto& s : j.at("splits")) {
       EvaluationSplit split{s.at("name"), s.value("structures", std::vector<std::string>{}),

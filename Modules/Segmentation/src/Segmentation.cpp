@@ -286,18 +286,25 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
       result.surfaceEdgeDistances(p) = std::isfinite(d) ? d : -1.0;
     }
     result.surfaceOnEdges = static_cast<double>(held) / std::max<Eigen::Index>(triangles.points.rows(), 1);
+    // One warning naming every landmark beyond the capture range.
+    std::string far;
+    int farCount = 0;
     for (std::size_t i = 0; i < landmarks.size(); ++i) {
       const double d = field.edgeDistance(landmarks[i].position);
       result.landmarkEdgeDistances.push_back(d);
       if (d > options.edges.captureRange) {
-        warning << std::setprecision(1) << "landmark " << i + 1
-                << (landmarks[i].label.empty() ? "" : " ('" + landmarks[i].label + "')") << " is more than "
-                << options.edges.captureRange
-                << " mm from every edge the image shows: a click off the boundary? It pulls the surface there"
-                << std::setprecision(0);
-        result.warnings.push_back(warning.str());
-        warning.str("");
+        far += (far.empty() ? "" : ", ") + std::to_string(i + 1) +
+               (landmarks[i].label.empty() ? "" : " ('" + landmarks[i].label + "')");
+        ++farCount;
       }
+    }
+    if (farCount > 0) {
+      warning << std::setprecision(1) << (farCount == 1 ? "landmark " : "landmarks ") << far
+              << (farCount == 1 ? " is" : " are") << " more than " << options.edges.captureRange
+              << " mm from every edge the image shows: a click off the boundary? It pulls the surface there"
+              << std::setprecision(0);
+      result.warnings.push_back(warning.str());
+      warning.str("");
     }
   }
   if (result.outsideRegion > kLeakedAbove) {

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "dynsub/ClickProtocol.h"
+#include "dynsub/SeedGrowth.h"
 #include "dynsub/Segmentation.h"
 
 namespace dynsub {
@@ -53,6 +54,7 @@ struct EvaluationPlan {
   // object sets some (for comparing settings on the tuning split).
   SegmentOptions segment;
   double initialFraction = 0.5;  // initialFromLandmarks
+  SeedOptions seed;  // seed-only runs: the region grown from the click (SeedGrowth.h)
   std::string reference;  // labelmap path
   std::vector<EvaluationImage> images;
   std::vector<EvaluationStructure> structures;

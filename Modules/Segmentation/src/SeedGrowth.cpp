@@ -1,0 +1,312 @@
+#include "dynsub/SeedGrowth.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+
+#include "dynsub/Error.h"
+
+namespace dynsub {
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+constexpr double kGuardWindow = 2.5;  // the leak guard's narrower window
+
+// The lower envelope of the parabolas (h (p - q))^2 + f[q] over one line of
+// the grid (Felzenszwalb and Huttenlocher's exact 1D squared distance), in
+// place; `v` and `z` are scratch of n and n + 1 entries.
+void squaredDistance1D(double* f, long long stride, int n, double h2, std::vector<int>& v, std::vector<double>& z,
+                       std::vector<double>& line) {
+  for (int q = 0; q < n; ++q) line[q] = f[q * stride];
+  int k = -1;
+  for (int q = 0; q < n; ++q) {
+    if (line[q] == kInfinity) continue;  // such parabolas never reach the envelope
+    double s = -kInfinity;
+    while (k >= 0) {
+      const int r = v[k];
+      s = ((line[q] + h2 * q * q) - (line[r] + h2 * r * r)) / (2 * h2 * (q - r));
+      if (s > z[k]) break;
+      --k;
+    }
+    ++k;
+    v[k] = q;
+    z[k] = k == 0 ? -kInfinity : s;
+    z[k + 1] = kInfinity;
+  }
+  if (k < 0) return;  // no feature on this line: the distances stay infinite
+  k = 0;
+  for (int p = 0; p < n; ++p) {
+    while (z[k + 1] < p) ++k;
+    const double d = p - v[k];
+    f[p * stride] = h2 * d * d + line[v[k]];
+  }
+}
+
+// Squared Euclidean distance (mm^2) from each voxel to the nearest voxel with
+// feature[i] != 0, exact for any spacing (separable, one pass per axis).
+std::vector<double> squaredDistanceTo(const std::vector<std::uint8_t>& feature, const ImageGeometry& g) {
+  std::vector<double> d(feature.size());
+  for (std::size_t i = 0; i < feature.size(); ++i) d[i] = feature[i] ? 0.0 : kInfinity;
+  const int longest = *std::max_element(g.size.begin(), g.size.end());
+  std::vector<int> v(longest);
+  std::vector<double> z(longest + 1), line(longest);
+  const long long strides[3] = {1, g.size[0], static_cast<long long>(g.size[0]) * g.size[1]};
+  for (int axis = 0; axis < 3; ++axis) {
+    const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+    const double h2 = g.spacing(axis) * g.spacing(axis);
+    for (int jb = 0; jb < g.size[b]; ++jb)
+      for (int ja = 0; ja < g.size[a]; ++ja)
+        squaredDistance1D(d.data() + ja * strides[a] + jb * strides[b], strides[axis], g.size[axis], h2, v, z, line);
+  }
+  return d;
+}
+
+// The voxels of `allowed` 6-connected to any of `starts` (which must be allowed).
+std::vector<std::uint8_t> connectedTo(const std::vector<std::uint8_t>& allowed, const ImageGeometry& g,
+                                      std::vector<long long> starts) {
+  std::vector<std::uint8_t> reached(allowed.size(), 0);
+  for (long long start : starts) reached[start] = 1;
+  std::vector<long long> stack = std::move(starts);
+  const long long sx = 1, sy = g.size[0], sz = static_cast<long long>(g.size[0]) * g.size[1];
+  while (!stack.empty()) {
+    const long long o = stack.back();
+    stack.pop_back();
+    const int i = static_cast<int>(o % sy), j = static_cast<int>((o / sy) % g.size[1]),
+              k = static_cast<int>(o / sz);
+    const std::pair<bool, long long> neighbours[6] = {{i > 0, o - sx},           {i + 1 < g.size[0], o + sx},
+                                                      {j > 0, o - sy},           {j + 1 < g.size[1], o + sy},
+                                                      {k > 0, o - sz},           {k + 1 < g.size[2], o + sz}};
+    for (const auto& [inside, n] : neighbours)
+      if (inside && allowed[n] && !reached[n]) {
+        reached[n] = 1;
+        stack.push_back(n);
+      }
+  }
+  return reached;
+}
+
+double median(std::vector<double> values) {
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+}  // namespace
+
+void checkSeedOptions(const SeedOptions& o) {
+  auto positive = [](double value, const char* name) {
+    if (!(value > 0) || !std::isfinite(value))
+      throw Error(std::string("the seed's ") + name + " must be a finite number > 0");
+  };
+  positive(o.statsRadius, "statistics radius");
+  positive(o.window, "intensity window");
+  positive(o.reach, "reach");
+  if (!(o.opening >= 0) || !std::isfinite(o.opening)) throw Error("the seed's opening must be a finite number >= 0");
+  if (o.boundaryPoints < 4) throw Error("the seed's region needs at least 4 boundary points");
+}
+
+namespace {
+
+// One growth with the options' window and opening (the header's steps 1-4).
+SeedRegion growOnce(const Volume& image, const Vector3& click, const SeedOptions& options) {
+  const ImageGeometry& full = image.geometry;
+  const Vector3 index = full.toIndex(click);
+  std::array<int, 3> first{}, size{}, seedVoxel{};
+  for (int a = 0; a < 3; ++a) {
+    seedVoxel[a] = std::clamp(static_cast<int>(std::lround(index(a))), 0, full.size[a] - 1);
+    const int reach = static_cast<int>(std::ceil(options.reach / full.spacing(a)));
+    first[a] = std::max(0, seedVoxel[a] - reach);
+    size[a] = std::min(full.size[a], seedVoxel[a] + reach + 1) - first[a];
+  }
+  SeedRegion result;
+  result.click = click;
+  result.first = first;
+  const Volume box = cropVolume(image, first, size);
+  const ImageGeometry& g = box.geometry;
+  const long long n = g.voxelCount();
+  const int si = seedVoxel[0] - first[0], sj = seedVoxel[1] - first[1], sk = seedVoxel[2] - first[2];
+  const long long seed = g.offset(si, sj, sk);
+
+  // 1. Appearance at the click.
+  std::vector<double> ball;
+  int r[3];
+  for (int a = 0; a < 3; ++a) r[a] = static_cast<int>(std::ceil(options.statsRadius / g.spacing(a)));
+  for (int k = sk - r[2]; k <= sk + r[2]; ++k)
+    for (int j = sj - r[1]; j <= sj + r[1]; ++j)
+      for (int i = si - r[0]; i <= si + r[0]; ++i) {
+        if (!g.contains(i, j, k)) continue;
+        const Vector3 d = (Vector3(i - si, j - sj, k - sk).array() * g.spacing.array()).matrix();
+        if (d.norm() <= options.statsRadius) ball.push_back(box.at(i, j, k));
+      }
+  result.median = median(ball);
+  for (double& value : ball) value = std::abs(value - result.median);
+  std::vector<float> sorted(box.voxels);
+  const auto percentile = [&](double p) {
+    auto at = sorted.begin() + static_cast<long long>(p * (sorted.size() - 1));
+    std::nth_element(sorted.begin(), at, sorted.end());
+    return static_cast<double>(*at);
+  };
+  const double range = percentile(0.99) - percentile(0.01);
+  result.spread = std::max(1.4826 * median(ball), 0.01 * range);
+  if (!std::isfinite(result.median) || !std::isfinite(result.spread))
+    throw Error("the image's intensities near the seed are not finite");
+  result.low = result.median - options.window * result.spread;
+  result.high = result.median + options.window * result.spread;
+
+  // 2. Growth through the window.
+  std::vector<std::uint8_t> like(n);
+  for (long long o = 0; o < n; ++o) like[o] = box.voxels[o] >= result.low && box.voxels[o] <= result.high;
+  if (!like[seed]) like[seed] = 1;  // the click itself is inside, whatever its own value
+  const std::vector<std::uint8_t> grown = connectedTo(like, g, {seed});
+  result.grownVoxels = std::count(grown.begin(), grown.end(), 1);
+
+  // 3. Opening.
+  std::vector<std::uint8_t> region = grown;
+  if (options.opening > 0) {
+    std::vector<std::uint8_t> outside(n);
+    for (long long o = 0; o < n; ++o) outside[o] = !grown[o];
+    const std::vector<double> depth = squaredDistanceTo(outside, g);
+    const double r2 = options.opening * options.opening;
+    std::vector<std::uint8_t> core(n);
+    for (long long o = 0; o < n; ++o) core[o] = grown[o] && depth[o] > r2;
+    // The core voxel nearest the click, within the opening's reach of it.
+    long long start = -1;
+    double nearest = kInfinity;
+    if (core[seed]) {
+      start = seed;
+    } else {
+      const int reach = static_cast<int>(std::ceil(2 * options.opening / g.spacing.minCoeff())) + 1;
+      for (int k = std::max(0, sk - reach); k <= std::min(g.size[2] - 1, sk + reach); ++k)
+        for (int j = std::max(0, sj - reach); j <= std::min(g.size[1] - 1, sj + reach); ++j)
+          for (int i = std::max(0, si - reach); i <= std::min(g.size[0] - 1, si + reach); ++i) {
+            const long long o = g.offset(i, j, k);
+            const double d = (Vector3(i - si, j - sj, k - sk).array() * g.spacing.array()).matrix().norm();
+            if (core[o] && d < nearest && d <= 2 * options.opening + g.spacing.maxCoeff()) {
+              nearest = d;
+              start = o;
+            }
+          }
+    }
+    if (start < 0)
+      throw Error("the tissue at the seed is thinner than the seed's opening (" + std::to_string(options.opening) +
+                  " mm): click deeper inside the structure, or lower the opening");
+    const std::vector<double> away = squaredDistanceTo(connectedTo(core, g, {start}), g);
+    for (long long o = 0; o < n; ++o) region[o] = grown[o] && away[o] <= r2;
+  }
+
+  // 4. Holes: what the box's border cannot reach through the outside.
+  {
+    std::vector<std::uint8_t> outside(n);
+    std::vector<long long> border;
+    for (int k = 0; k < g.size[2]; ++k)
+      for (int j = 0; j < g.size[1]; ++j)
+        for (int i = 0; i < g.size[0]; ++i) {
+          const long long o = g.offset(i, j, k);
+          outside[o] = !region[o];
+          if (outside[o] && (i == 0 || j == 0 || k == 0 || i + 1 == g.size[0] || j + 1 == g.size[1] ||
+                             k + 1 == g.size[2]))
+            border.push_back(o);
+        }
+    const std::vector<std::uint8_t> reached = connectedTo(outside, g, std::move(border));
+    for (long long o = 0; o < n; ++o) region[o] = !reached[o];
+  }
+
+  // The boundary, and whether the region touches its box.
+  std::vector<Vector3> faces;
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i) {
+        if (!region[g.offset(i, j, k)]) continue;
+        const int step[6][3] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
+        for (const auto& s : step) {
+          const int a = i + s[0], b = j + s[1], c = k + s[2];
+          if (!g.contains(a, b, c)) {  // the box's side: the voxel itself (its face may be the image's edge)
+            result.touchesReach = true;
+            faces.push_back(g.toPhysical(Vector3(i, j, k)));
+            continue;
+          }
+          if (!region[g.offset(a, b, c)])
+            faces.push_back(g.toPhysical(Vector3(i + 0.5 * s[0], j + 0.5 * s[1], k + 0.5 * s[2])));
+        }
+      }
+  result.mask.geometry = g;
+  result.mask.voxels = std::move(region);
+  result.window = options.window;
+  result.opening = options.opening;
+  if (faces.size() < 4) throw Error("the region grown from the seed is too small to start a surface from");
+
+  // Farthest-point sampling from the boundary point nearest the click.
+  std::vector<double> gap(faces.size(), kInfinity);
+  std::size_t next = 0;
+  for (std::size_t f = 1; f < faces.size(); ++f)
+    if ((faces[f] - click).squaredNorm() < (faces[next] - click).squaredNorm()) next = f;
+  const std::size_t keep = std::min<std::size_t>(faces.size(), options.boundaryPoints);
+  for (std::size_t taken = 0; taken < keep; ++taken) {
+    result.boundary.push_back({"seed boundary " + std::to_string(taken + 1), faces[next]});
+    gap[next] = 0;
+    std::size_t farthest = 0;
+    for (std::size_t f = 0; f < faces.size(); ++f) {
+      gap[f] = std::min(gap[f], (faces[f] - faces[next]).squaredNorm());
+      if (gap[f] > gap[farthest]) farthest = f;
+    }
+    next = farthest;
+  }
+  return result;
+}
+
+}  // namespace
+
+SeedRegion growFromSeed(const Volume& image, const Vector3& click, const SeedOptions& options) {
+  checkSeedOptions(options);
+  if (!click.allFinite() || !image.geometry.covers(click)) {
+    std::ostringstream message;
+    message << "the seed (" << click.x() << ", " << click.y() << ", " << click.z()
+            << ") mm LPS lies outside the image";
+    throw Error(message.str());
+  }
+  // The leak guard (see the header): a narrower window, then wider openings,
+  // until the region stays inside its reach; the last region grown otherwise.
+  std::vector<double> windows = {options.window};
+  if (options.window > kGuardWindow) windows.push_back(kGuardWindow);
+  SeedRegion result;
+  std::string failure;
+  for (const double window : windows)
+    for (const double extra : {0.0, 1.0, 2.0}) {
+      SeedOptions attempt = options;
+      attempt.window = window;
+      attempt.opening = options.opening + extra;
+      try {
+        result = growOnce(image, click, attempt);
+      } catch (const Error& e) {
+        failure = e.what();  // opened away at the click: try the next
+        continue;
+      }
+      if (!result.touchesReach) return result;
+    }
+  if (result.boundary.empty()) throw Error(failure);
+  return result;
+}
+
+std::vector<std::string> seedWarnings(const SeedRegion& region) {
+  std::vector<std::string> warnings;
+  std::ostringstream message;
+  message << std::fixed << std::setprecision(1);
+  if (region.touchesReach) {
+    message << "the region grown from the seed (intensities " << region.low << " to " << region.high
+            << ") reached the edge of its reach even with the narrowest window and the widest opening: it has "
+               "leaked into like tissue around the structure (give landmarks, or click deeper inside)";
+    warnings.push_back(message.str());
+    message.str("");
+  }
+  const double volume = region.mask.count() * region.mask.geometry.spacing.prod();
+  if (volume < kSmallSeedRegion) {
+    message << "the region grown from the seed holds only " << volume << " mm^3 (intensities " << region.low
+            << " to " << region.high << ", opening " << region.opening
+            << " mm): the surface starts small and may collapse (give landmarks, or click deeper inside)";
+    warnings.push_back(message.str());
+  }
+  return warnings;
+}
+
+}  // namespace dynsub
