@@ -36,7 +36,7 @@ ProgressCallback ConvergenceRecorder::callback(ProgressCallback next) {
 void FigureOptions::addOptions(CLI::App& command) {
   command.add_flag("!--no-figures", figures,
                    "Do not render slices.png, surface3d.png and convergence.png (rendering needs an X display; "
-                   "use xvfb-run without a screen)");
+                   "without DISPLAY a private Xvfb is started for the run)");
 }
 
 void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const ControlMesh& mesh,
@@ -45,7 +45,7 @@ void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const Co
   writeConvergenceCsv(history, outputs.add("convergence.csv"));
   if (!options.figures) return;
   std::string why;
-  if (!displayAvailable(&why)) {
+  if (!figureDisplay(&why)) {
     std::cerr << "warning: no figures written: " << why << '\n';
     return;
   }

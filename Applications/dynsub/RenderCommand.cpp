@@ -29,7 +29,7 @@ struct RenderCommandOptions {
 
 void runRender(const RenderCommandOptions& o) {
   std::string why;
-  if (!displayAvailable(&why)) throw Error("rendering needs an X display: " + why);
+  if (!figureDisplay(&why)) throw Error("rendering needs an X display: " + why);
   // Every input is read and checked before anything is written.
   const vtkSmartPointer<vtkPolyData> surface = readSurfacePolyData(o.surface);
   FigureScene scene;
@@ -68,7 +68,7 @@ void addRenderCommand(CLI::App& app) {
       "render",
       "Make the figures of segment and fit from saved results: DIR/slices.png (slices through the surface with "
       "its contour and the landmarks), DIR/surface3d.png and, with --convergence, DIR/convergence.png.\n"
-      "Needs an X display (xvfb-run provides one on a machine without a screen).");
+      "Needs an X display; without DISPLAY a private Xvfb is started for the run.");
   command->add_option("--surface", o->surface, "Limit surface: surface.vtp (or .obj, .ply, .stl), mm")->required();
   command->add_option("--image", o->image, "The image the surface was segmented in (slices show it)");
   command->add_option("--landmarks", o->landmarks, "Landmarks: .mrk.json, .fcsv or .csv");

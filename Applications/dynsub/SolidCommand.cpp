@@ -65,7 +65,7 @@ std::string writeSculpture(const std::filesystem::path& dir, const Sculpture& sc
   writeLattice(solid, outputs.add("sculpted.vtu"));
   std::string figure;
   std::string why;
-  if (o.figure && displayAvailable(&why)) {
+  if (o.figure && figureDisplay(&why)) {
     writePng(sculptureFigure(sculpture), outputs.add("sculpted.png"));
     figure = ", sculpted.png";
   } else if (o.figure) {
@@ -188,7 +188,7 @@ void addSolidCommand(CLI::App& app) {
   sculpt->add_option("--rope-stiffness", so->settings.ropeStiffness, "The rope, N/mm")
       ->default_val(so->settings.ropeStiffness);
   sculpt->add_flag("!--no-figures", so->figure,
-                   "Do not render sculpted.png (rendering needs an X display; use xvfb-run without a screen)");
+                   "Do not render sculpted.png (rendering needs an X display; without DISPLAY a private Xvfb is started)");
   sculpt->callback([so, sculpt] {
     if (!so->script.empty() && sculpt->count("--out") == 0)
       throw Error("--out DIR is required with --script (where the sculpted solid is written)");

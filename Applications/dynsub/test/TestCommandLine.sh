@@ -119,11 +119,23 @@ sys.exit(0 if head[:8] == b'\x89PNG\r\n\x1a\n' and struct.unpack('>II', head[16:
 "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --init torus --no-figures --out "$work/nofig" >/dev/null 2>&1
 check "--no-figures writes no figure" test ! -e "$work/nofig/slices.png"
 check "--no-figures still writes convergence.csv" test -s "$work/nofig/convergence.csv"
+# Without DISPLAY the command starts its own Xvfb for the figures and stops
+# it; without Xvfb either (PATH emptied) it says so and writes the rest.
+private_servers() { pgrep -c -f -- "Xvfb -displayfd" || true; }
+servers_before=$(private_servers)
 env -u DISPLAY "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --init torus --out "$work/nodisplay" >/dev/null \
   2>"$work/stderr"
 check "fit without a display succeeds" test -s "$work/nodisplay/surface.vtp"
-check "fit without a display warns" grep -q "no figures written: DISPLAY is not set" "$work/stderr"
-check "fit without a display writes no figure" test ! -e "$work/nodisplay/slices.png"
+for name in slices.png surface3d.png convergence.png; do
+  check "fit without a display draws $name on a private Xvfb" \
+    bash -c "test -s '$work/nodisplay/$name' && head -c 4 '$work/nodisplay/$name' | grep -q PNG"
+done
+check "fit without a display leaves no Xvfb running" test "$(private_servers)" -eq "$servers_before"
+env -u DISPLAY PATH=/nonexistent "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --init torus --out "$work/noxvfb" \
+  >/dev/null 2>"$work/stderr"
+check "fit without a display or Xvfb succeeds" test -s "$work/noxvfb/surface.vtp"
+check "fit without a display or Xvfb warns" grep -q "no figures written: DISPLAY is not set and no virtual X server" "$work/stderr"
+check "fit without a display or Xvfb writes no figure" test ! -e "$work/noxvfb/slices.png"
 "$DYNSUB" render --surface "$work/caudate/surface.vtp" --image "$mri/ch2.nii.gz" \
   --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --convergence "$work/caudate/convergence.csv" \
   --out "$work/rendered" >/dev/null
@@ -137,8 +149,10 @@ expect_error "render: not a surface" 1 "text.vtp" "$work/r2" \
   bash -c "echo hello >'$work/text.vtp'; '$DYNSUB' render --surface '$work/text.vtp' --out '$work/r2'"
 expect_error "render: corrupt convergence history" 1 "expected the header" "$work/r3" \
   "$DYNSUB" render --surface "$work/caudate/surface.vtp" --convergence "$work/points.txt" --out "$work/r3"
-expect_error "render: no display" 1 "X display" "$work/r4" \
-  env -u DISPLAY "$DYNSUB" render --surface "$work/caudate/surface.vtp" --out "$work/r4"
+expect_error "render: no display and no Xvfb" 1 "install the xvfb package" "$work/r4" \
+  env -u DISPLAY PATH=/nonexistent "$DYNSUB" render --surface "$work/caudate/surface.vtp" --out "$work/r4"
+env -u DISPLAY "$DYNSUB" render --surface "$work/caudate/surface.vtp" --out "$work/r5" >/dev/null 2>&1
+check "render without a display draws on a private Xvfb" test -s "$work/r5/surface3d.png"
 expect_error "view: no display" 1 "needs an X display" "$work/v1" \
   env -u DISPLAY "$DYNSUB" view "$mri/ch2.nii.gz" --landmarks "$work/v1"
 expect_error "view: missing image" 1 "no such file" "$work/v2" \
@@ -250,10 +264,13 @@ expect_error "solid sculpt: a diverging simulation" 1 "diverged" "$work/s35" \
   --time-step 0.5 --out "$work/s35"
 expect_error "solid sculpt: the window without a display" 1 "needs an X display" "$work/sculpted" \
   env -u DISPLAY "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice"
+env -u DISPLAY PATH=/nonexistent "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" \
+  --script "$DATA/Solids/arm.sculpt" --out "$work/arm3" >/dev/null 2>"$work/stderr"
+check "solid sculpt --script without a display or Xvfb writes the rest" test -s "$work/arm3/sculpted.vtu" -a ! -e "$work/arm3/sculpted.png"
+check "solid sculpt --script without a display or Xvfb warns" grep -q "no figure written: DISPLAY is not set" "$work/stderr"
 env -u DISPLAY "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" --script "$DATA/Solids/arm.sculpt" \
-  --out "$work/arm3" >/dev/null 2>"$work/stderr"
-check "solid sculpt --script without a display writes the rest" test -s "$work/arm3/sculpted.vtu" -a ! -e "$work/arm3/sculpted.png"
-check "solid sculpt --script without a display warns" grep -q "no figure written: DISPLAY is not set" "$work/stderr"
+  --out "$work/arm4" >/dev/null 2>&1
+check "solid sculpt --script without a display draws on a private Xvfb" test -s "$work/arm4/sculpted.png"
 
 if [ "$failures" -gt 0 ]; then echo "$failures check(s) failed"; exit 1; fi
 echo "all command-line checks passed"

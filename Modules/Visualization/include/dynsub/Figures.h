@@ -11,9 +11,9 @@
 // Windows are fixed-size, without multisampling, and render off screen, so
 // the same input gives the same pixels (rendering regression tests rely on it).
 //
-// Debian's VTK renders through X11 only: an X display is needed (xvfb-run
-// provides one on a machine without a screen). displayAvailable says whether
-// one can be opened; without it VTK would abort the process.
+// Debian's VTK renders through X11 only: an X display is needed, or VTK
+// aborts the process. displayAvailable says whether one can be opened;
+// figureDisplay provides one on a machine without a screen.
 #include <string>
 
 #include <vtkSmartPointer.h>
@@ -50,5 +50,11 @@ void writePng(vtkRenderWindow* window, const std::string& path);
 
 // True when an X display can be opened; otherwise `why` says what is missing.
 bool displayAvailable(std::string* why = nullptr);
+
+// For writing figures: the X display, or, when DISPLAY is not set (a cluster
+// node, a batch job), a private virtual X server (Xvfb, 1280x1024x24, no TCP)
+// started for this process on a free display number and stopped when the
+// process ends. False, with `why`, when neither works (no xvfb package).
+bool figureDisplay(std::string* why = nullptr);
 
 }  // namespace dynsub
