@@ -14,55 +14,6 @@ namespace {
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr double kGuardWindow = 2.5;  // the leak guard's narrower window
 
-// The lower envelope of the parabolas (h (p - q))^2 + f[q] over one line of
-// the grid (Felzenszwalb and Huttenlocher's exact 1D squared distance), in
-// place; `v` and `z` are scratch of n and n + 1 entries.
-void squaredDistance1D(double* f, long long stride, int n, double h2, std::vector<int>& v, std::vector<double>& z,
-                       std::vector<double>& line) {
-  for (int q = 0; q < n; ++q) line[q] = f[q * stride];
-  int k = -1;
-  for (int q = 0; q < n; ++q) {
-    if (line[q] == kInfinity) continue;  // such parabolas never reach the envelope
-    double s = -kInfinity;
-    while (k >= 0) {
-      const int r = v[k];
-      s = ((line[q] + h2 * q * q) - (line[r] + h2 * r * r)) / (2 * h2 * (q - r));
-      if (s > z[k]) break;
-      --k;
-    }
-    ++k;
-    v[k] = q;
-    z[k] = k == 0 ? -kInfinity : s;
-    z[k + 1] = kInfinity;
-  }
-  if (k < 0) return;  // no feature on this line: the distances stay infinite
-  k = 0;
-  for (int p = 0; p < n; ++p) {
-    while (z[k + 1] < p) ++k;
-    const double d = p - v[k];
-    f[p * stride] = h2 * d * d + line[v[k]];
-  }
-}
-
-// Squared Euclidean distance (mm^2) from each voxel to the nearest voxel with
-// feature[i] != 0, exact for any spacing (separable, one pass per axis).
-std::vector<double> squaredDistanceTo(const std::vector<std::uint8_t>& feature, const ImageGeometry& g) {
-  std::vector<double> d(feature.size());
-  for (std::size_t i = 0; i < feature.size(); ++i) d[i] = feature[i] ? 0.0 : kInfinity;
-  const int longest = *std::max_element(g.size.begin(), g.size.end());
-  std::vector<int> v(longest);
-  std::vector<double> z(longest + 1), line(longest);
-  const long long strides[3] = {1, g.size[0], static_cast<long long>(g.size[0]) * g.size[1]};
-  for (int axis = 0; axis < 3; ++axis) {
-    const int a = (axis + 1) % 3, b = (axis + 2) % 3;
-    const double h2 = g.spacing(axis) * g.spacing(axis);
-    for (int jb = 0; jb < g.size[b]; ++jb)
-      for (int ja = 0; ja < g.size[a]; ++ja)
-        squaredDistance1D(d.data() + ja * strides[a] + jb * strides[b], strides[axis], g.size[axis], h2, v, z, line);
-  }
-  return d;
-}
-
 // The voxels of `allowed` 6-connected to any of `starts` (which must be allowed).
 std::vector<std::uint8_t> connectedTo(const std::vector<std::uint8_t>& allowed, const ImageGeometry& g,
                                       std::vector<long long> starts) {
@@ -164,12 +115,11 @@ SeedRegion growOnce(const Volume& image, const Vector3& click, const SeedOptions
   // 3. Opening.
   std::vector<std::uint8_t> region = grown;
   if (options.opening > 0) {
-    std::vector<std::uint8_t> outside(n);
-    for (long long o = 0; o < n; ++o) outside[o] = !grown[o];
-    const std::vector<double> depth = squaredDistanceTo(outside, g);
-    const double r2 = options.opening * options.opening;
+    Mask outside{g, std::vector<std::uint8_t>(n)};
+    for (long long o = 0; o < n; ++o) outside.voxels[o] = !grown[o];
+    const std::vector<float> depth = distanceTo(outside);
     std::vector<std::uint8_t> core(n);
-    for (long long o = 0; o < n; ++o) core[o] = grown[o] && depth[o] > r2;
+    for (long long o = 0; o < n; ++o) core[o] = grown[o] && depth[o] > options.opening;
     // The core voxel nearest the click, within the opening's reach of it.
     long long start = -1;
     double nearest = kInfinity;
@@ -191,8 +141,8 @@ SeedRegion growOnce(const Volume& image, const Vector3& click, const SeedOptions
     if (start < 0)
       throw Error("the tissue at the seed is thinner than the seed's opening (" + std::to_string(options.opening) +
                   " mm): click deeper inside the structure, or lower the opening");
-    const std::vector<double> away = squaredDistanceTo(connectedTo(core, g, {start}), g);
-    for (long long o = 0; o < n; ++o) region[o] = grown[o] && away[o] <= r2;
+    const std::vector<float> away = distanceTo(Mask{g, connectedTo(core, g, {start})});
+    for (long long o = 0; o < n; ++o) region[o] = grown[o] && away[o] <= options.opening;
   }
 
   // 4. Holes: what the box's border cannot reach through the outside.

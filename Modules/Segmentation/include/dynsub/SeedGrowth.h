@@ -11,7 +11,7 @@
 //     lies within m +- window s, no farther than `reach` mm from the click
 //     along any axis.
 //  3. Opening by a ball of `opening` mm: the grown voxels deeper than that
-//     (by exact Euclidean distance) that stay connected to the click, grown
+//     (by exact Euclidean distance, distanceTo in Volume.h) that stay connected to the click, grown
 //     back by the same distance inside the grown region. This cuts the thin
 //     bridges through which like tissue joins the structure to its
 //     neighbours.
