@@ -8,6 +8,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "RobustStatistics.h"
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/Error.h"
 #include "dynsub/Forces.h"
@@ -66,22 +67,15 @@ class RegionPressureForceModel final : public ForceModel {
   const SurfaceQuadrature* quadrature_ = nullptr;
 };
 
-// Median and robust spread (1.4826 x the median absolute deviation) of the
-// region's intensities inside a closed model.
-std::pair<double, double> insideIntensities(const Volume& region, const ControlMesh& model) {
+// The appearance of the region's intensities inside a closed model.
+RobustStatistics insideIntensities(const Volume& region, const ControlMesh& model) {
   const TriangleSurface s = tessellate(LimitSurface(model), model.points(), 4);
   const Mask inside = voxelizeSurface(s.points, s.triangles, region.geometry);
   std::vector<double> values;
   for (size_t i = 0; i < inside.voxels.size(); ++i)
     if (inside.voxels[i]) values.push_back(region.voxels[i]);
   if (values.empty()) throw Error("the initial model encloses no voxel of the region: no appearance to learn");
-  auto median = [](std::vector<double> v) {
-    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-    return v[v.size() / 2];
-  };
-  const double m = median(values);
-  for (double& v : values) v = std::abs(v - m);
-  return {m, 1.4826 * median(values)};
+  return robustStatistics(std::move(values));
 }
 
 Matrix3X limitPoints(const ControlMesh& mesh, int segments) {
@@ -205,8 +199,8 @@ SegmentResult evolveInRegion(const SegmentationRegion& region, const std::vector
   InflationForceModel inflation(options.inflation);
   std::unique_ptr<RegionPressureForceModel> regionPressure;
   if (options.regionPressure != 0) {
-    const auto [median, spread] = insideIntensities(region.image(), initial);
-    regionPressure = std::make_unique<RegionPressureForceModel>(region.image(), median, spread,
+    const RobustStatistics inside = insideIntensities(region.image(), initial);
+    regionPressure = std::make_unique<RegionPressureForceModel>(region.image(), inside.median, inside.spread,
                                                                 options.regionPressure, options.regionWindow);
   }
   std::vector<ForceModel*> forces = {&imageForces};

@@ -1,0 +1,29 @@
+#pragma once
+// Private to the Segmentation module: the median and the robust spread of a
+// sample (1.4826 x the median absolute deviation, which is the standard
+// deviation for normal data and ignores outliers up to half the sample), the
+// appearance both the region pressure and the seed's growth learn.
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace dynsub {
+
+struct RobustStatistics {
+  double median = 0, spread = 0;
+};
+
+// `values` must not be empty.
+inline RobustStatistics robustStatistics(std::vector<double> values) {
+  auto median = [](std::vector<double>& v) {
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+  };
+  RobustStatistics s;
+  s.median = median(values);
+  for (double& v : values) v = std::abs(v - s.median);
+  s.spread = 1.4826 * median(values);
+  return s;
+}
+
+}  // namespace dynsub
