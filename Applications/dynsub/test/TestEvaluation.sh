@@ -14,14 +14,10 @@
 # Documentation/Segmentation.md.
 # Needs DYNSUB (the executable) and DATA.
 set -u
-templates=/usr/share/mricron/templates
-if [ ! -f "$templates/ch2.nii.gz" ] || [ ! -f "$templates/aal.nii.gz" ]; then
-  echo "FAILED: $templates/ch2.nii.gz or aal.nii.gz is missing (install mricron-data; ./run does)"
-  exit 1
-fi
+source "$(dirname "${BASH_SOURCE[0]}")/Checks.sh"
+require_colin27
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-source "$(dirname "${BASH_SOURCE[0]}")/Checks.sh"
 
 "$DYNSUB" evaluate "$DATA/Evaluation/ci_plan.json" --out "$work/eval" --jobs 2 >"$work/eval.log" 2>&1
 check "evaluate succeeds" test $? -eq 0

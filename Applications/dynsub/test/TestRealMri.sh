@@ -16,14 +16,10 @@
 # Held out, at the bar: each cerebellar hemisphere from 30 points.
 # Needs DYNSUB (the executable), DATA and TOOLS.
 set -u
-templates=/usr/share/mricron/templates
-if [ ! -f "$templates/ch2.nii.gz" ] || [ ! -f "$templates/aal.nii.gz" ]; then
-  echo "FAILED: $templates/ch2.nii.gz or aal.nii.gz is missing (install mricron-data; ./run does)"
-  exit 1
-fi
+source "$(dirname "${BASH_SOURCE[0]}")/Checks.sh"
+require_colin27
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-source "$(dirname "${BASH_SOURCE[0]}")/Checks.sh"
 
 # segment_structure NAME LANDMARKS LABEL... (Dice bar: $bar)
 bar=0.85
