@@ -173,12 +173,12 @@ void writeJson(const nlohmann::ordered_json& json, const std::string& path) {
 
 void writeModelOutputs(const std::filesystem::path& dir, const ControlMesh& mesh,
                        const nlohmann::ordered_json& report, const std::function<void(OutputSet&)>& extra,
-                       const std::vector<PointScalars>& surfaceScalars) {
+                       const std::vector<PointScalars>& surfaceScalars, const std::string& space) {
   const Matrix3X control = mesh.points();
   if (!control.allFinite()) throw Error("internal: the control points are not finite; nothing was written");
   const TriangleSurface triangles = tessellate(LimitSurface(mesh), control, 8);
   OutputSet outputs(dir);
-  writeTriangleSurface(triangles, outputs.add("surface.vtp"), surfaceScalars);
+  writeTriangleSurface(triangles, outputs.add("surface.vtp"), surfaceScalars, space);
   writeObj(mesh, outputs.add("control_mesh.obj"));
   writeJson(report, outputs.add("report.json"));
   if (extra) extra(outputs);

@@ -75,10 +75,12 @@ void writeJson(const nlohmann::ordered_json& json, const std::string& path);
 // Throws dynsub::Error if the control points are not finite.
 // `extra` may add further files to the same set (e.g. a labelmap);
 // `surfaceScalars` are point data of surface.vtp (one value per point of that
-// tessellation, as tessellate(LimitSurface(mesh), mesh.points(), 8) orders them).
+// tessellation, as tessellate(LimitSurface(mesh), mesh.points(), 8) orders them);
+// `space` ("LPS" for surfaces in an image's physical space) is recorded in
+// surface.vtp for 3D Slicer (SurfaceWriter.h).
 void writeModelOutputs(const std::filesystem::path& dir, const ControlMesh& mesh,
                        const nlohmann::ordered_json& report,
                        const std::function<void(OutputSet&)>& extra = nullptr,
-                       const std::vector<PointScalars>& surfaceScalars = {});
+                       const std::vector<PointScalars>& surfaceScalars = {}, const std::string& space = "");
 
 }  // namespace dynsub::app

@@ -12,10 +12,9 @@
 #include "Commands.h"
 #include "FigureOutputs.h"
 #include "Reporting.h"
-#include "dynsub/ClosestPoint.h"
+#include "SegmentRun.h"
 #include "dynsub/Error.h"
 #include "dynsub/ImageIO.h"
-#include "dynsub/MeshIO.h"
 #include "dynsub/Metrics.h"
 #include "dynsub/SeedGrowth.h"
 #include "dynsub/Segmentation.h"
@@ -41,69 +40,6 @@ struct SegmentCommandOptions {
   SimulationArguments simulation;
   FigureOptions figures;
 };
-
-// Where the evolution starts, and which points its springs pull to.
-struct Start {
-  ControlMesh initial;
-  std::vector<Landmark> springs;  // the user's landmarks, or the seed region's boundary without them
-  std::unique_ptr<SeedRegion> seed;  // for --init seed:
-};
-
-// "x,y,z[,r]" after a prefix: `count` finite numbers.
-std::vector<double> numbersAfter(const std::string& value, std::size_t prefix, int count, const char* expected) {
-  std::stringstream in(value.substr(prefix));
-  std::vector<double> v(count);
-  char comma = ',';
-  for (int i = 0; i < count; ++i)
-    if (!(in >> v[i]) || !std::isfinite(v[i]) || (i + 1 < count && (!(in >> comma) || comma != ',')))
-      throw Error("--init " + value + ": expected " + expected + " (LPS mm)");
-  if (in >> comma) throw Error("--init " + value + ": expected " + expected + " (LPS mm)");
-  return v;
-}
-
-Start chooseStart(SegmentCommandOptions& o, const Volume& image, const std::vector<Landmark>& landmarks) {
-  Start start;
-  start.springs = landmarks;
-  if (o.init == "auto") {
-    if (landmarks.size() < 4)
-      throw Error("--init auto builds the initial model from the landmarks: give at least 4 with --landmarks, "
-                  "or use --init seed:x,y,z, --init sphere:x,y,z,r or --init MESH");
-    start.initial = initialFromLandmarks(landmarks);
-  } else if (o.init.rfind("sphere:", 0) == 0) {
-    const std::vector<double> v = numbersAfter(o.init, 7, 4, "sphere:x,y,z,r");
-    start.initial = initialSphere(Vector3(v[0], v[1], v[2]), v[3]);
-  } else if (o.init.rfind("seed:", 0) == 0) {
-    // The region the click's tissue fills (SeedGrowth.h) gives the initial
-    // model; without landmarks its boundary points are the springs, softer
-    // than an expert's clicks.
-    const std::vector<double> v = numbersAfter(o.init, 5, 3, "seed:x,y,z");
-    start.seed = std::make_unique<SeedRegion>(growFromSeed(image, Vector3(v[0], v[1], v[2]), o.seed));
-    start.initial = initialFromLandmarks(start.seed->boundary);
-    if (landmarks.empty()) {
-      start.springs = start.seed->boundary;
-      o.segment.landmarkStiffness = o.seed.stiffness;
-    }
-  } else {
-    start.initial = readControlMesh(o.init);
-    if (!start.initial.isClosed()) throw Error(o.init, "the initial model must be a closed control mesh");
-  }
-  return start;
-}
-
-nlohmann::ordered_json metricsJson(const OverlapMetrics& m) {
-  return {{"dice", m.dice},
-          {"jaccard", m.jaccard},
-          {"volume_difference_percent", m.volumeDifferencePercent},
-          {"mean_surface_distance_mm", m.meanSurfaceDistance},
-          {"hd95_mm", m.hd95},
-          {"hausdorff_mm", m.hausdorff},
-          {"volume_mm3", m.volumeA},
-          {"reference_volume_mm3", m.volumeB}};
-}
-
-const char* referenceName(EdgeReference reference) {
-  return reference == EdgeReference::Landmarks ? "landmarks" : "image";
-}
 
 void runSegment(SegmentCommandOptions o) {
   if (o.potential == "gradient") o.segment.edges.method = EdgeMethod::GradientMagnitude;
@@ -133,122 +69,44 @@ void runSegment(SegmentCommandOptions o) {
     reference = selectLabels(labels, o.referenceLabels);
     if (reference.count() == 0) throw Error(o.reference, "no voxel has the reference label(s)");
   }
-  const Start start = chooseStart(o, image, landmarks);
-  const ControlMesh& initial = start.initial;
-  const std::vector<Landmark>& springs = start.springs;
+  SegmentInputs inputs;
+  inputs.image = o.image;
+  inputs.landmarkSource = o.landmarks;
+  inputs.landmarks = landmarks;
+  inputs.init = parseInitialModel(o.init, "--init");
+  if (inputs.init.kind == InitialModel::Kind::FromLandmarks && landmarks.size() < 4)
+    throw Error("--init auto builds the initial model from the landmarks: give at least 4 with --landmarks, "
+                "or use --init seed:x,y,z, --init sphere:x,y,z,r or --init MESH");
+  inputs.segment = o.segment;
+  inputs.seed = o.seed;
+  inputs.potential = o.potential;
+  if (!o.reference.empty()) {
+    inputs.reference = &reference;
+    inputs.referencePath = o.reference;
+    inputs.referenceLabels = o.referenceLabels;
+  }
   const std::filesystem::path dir(o.out);
   prepareOutputDirectory(dir);
 
-  const auto started = std::chrono::steady_clock::now();
   ProgressLine line;
-  // The rms landmark distance every 5 steps, the landmarks' nearest points
-  // tracked from sample to sample (a new locator only when the level changes).
-  const Matrix3X landmarkPoints = landmarkPositions(springs);
-  TrackedDistances tracked(landmarkPoints);
-  ConvergenceRecorder recorder(
-      "rms landmark distance (mm)",
-      springs.empty() ? ConvergenceRecorder::FitError()
-                        : [&](const Progress& p) {
-                            const Eigen::VectorXd d = tracked.measure(*p.surface, p.level, *p.controlPoints);
-                            return std::sqrt(d.squaredNorm() / static_cast<double>(d.size()));
-                          },
-      5);
-  const SegmentResult result = [&] {
-    try {
-      return segment(image, springs, initial, o.segment, recorder.callback(line.callback()));
-    } catch (const LandmarksOffEdges& error) {
-      // Name the file the points came from, and the options that help.
-      throw Error(o.landmarks, std::string(error.what()) + " (--edge-landmark-reach, --edge-reference image)");
-    } catch (const LandmarkError& error) {
-      throw Error(o.landmarks, error.what());
-    }
-  }();
+  const SegmentRun run = runSegmentation(image, inputs, line.callback());
   line.finish();
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  const SegmentResult& result = run.result;
+  const OverlapMetrics& metrics = run.metrics;
+  const double seconds = run.seconds;
+  const std::vector<std::string>& warnings = run.warnings;
 
-  nlohmann::ordered_json report;
-  report["image"] = o.image;
-  report["landmarks"] = o.landmarks;
-  report["landmark_count"] = landmarks.size();
-  report["init"] = o.init;
-  if (const SeedRegion* seed = start.seed.get()) {
-    report["seed"] = {{"position_lps_mm", {seed->click.x(), seed->click.y(), seed->click.z()}},
-                      {"median", seed->median},
-                      {"spread", seed->spread},
-                      {"intensity_window", {seed->low, seed->high}},
-                      {"window_spreads", seed->window},
-                      {"opening_mm", seed->opening},
-                      {"region_volume_mm3", seed->mask.count() * seed->mask.geometry.spacing.prod()},
-                      {"boundary_points", seed->boundary.size()},
-                      {"springs", landmarks.empty() ? "boundary points" : "landmarks"},
-                      {"leaked", seed->touchesReach}};
-  }
-  OverlapMetrics metrics;
-  if (!o.reference.empty()) {
-    metrics = compareMasks(result.labelmap, reference);
-    report["reference"] = o.reference;
-    report["reference_labels"] = o.referenceLabels;
-    const nlohmann::ordered_json measured = metricsJson(metrics);
-    for (const auto& [key, value] : measured.items()) report[key] = value;
-  } else {
-    report["volume_mm3"] = result.labelmap.count() * image.geometry.spacing.prod();
-  }
-  report["control_vertices"] = result.mesh.vertexCount();
-  report["levels"] = result.levels.back().level;
-  report["iterations"] = result.steps;
-  report["final_energy"] = result.levels.back().energy;
-  report["seconds"] = seconds;
-  report["stage_seconds"] = {{"crop", result.seconds.crop},
-                             {"edge_potential", result.seconds.potential},
-                             {"evolution", result.seconds.evolution},
-                             {"voxelize", result.seconds.voxelize}};
-  report["region_of_interest"] = {{"first_voxel", result.regionFirst}, {"size_voxels", result.regionSize}};
-  report["initial_volume_mm3"] = result.initialVolume;
-  report["surface_volume_mm3"] = result.volume;
-  report["surface_outside_region"] = result.outsideRegion;
-  if (std::isfinite(result.surfaceOnEdges)) report["surface_on_edges"] = result.surfaceOnEdges;
-  std::vector<std::string> warnings = result.warnings;
-  if (start.seed) {
-    const std::vector<std::string> seed = seedWarnings(*start.seed);
-    warnings.insert(warnings.begin(), seed.begin(), seed.end());
-  }
-  report["warnings"] = warnings;
-  nlohmann::ordered_json residuals = nlohmann::ordered_json::array();
-  for (std::size_t i = 0; i < springs.size(); ++i) {
-    residuals.push_back({{"label", springs[i].label},
-                         {"position_lps_mm", {springs[i].position.x(), springs[i].position.y(),
-                                              springs[i].position.z()}},
-                         {"distance_mm", result.landmarkDistances[i]}});
-    if (i < result.landmarkEdgeDistances.size() && std::isfinite(result.landmarkEdgeDistances[i]))
-      residuals.back()["edge_distance_mm"] = result.landmarkEdgeDistances[i];
-  }
-  report["landmark_residuals"] = residuals;
-  nlohmann::ordered_json levels = nlohmann::ordered_json::array();
-  for (const auto& level : result.levels) levels.push_back(levelJson(level, -1, -1));  // no fit error in segmentation
-  report["per_level"] = levels;
-  nlohmann::ordered_json parameters = simulationJson(o.segment.simulation);
-  parameters["potential"] = o.potential;
-  parameters["sigma_mm"] = o.segment.edges.sigma;
-  if (o.segment.edges.method == EdgeMethod::MongaDeriche) {
-    const EdgeScale& scale = result.edgeScale;
-    parameters["edge_reference"] = referenceName(scale.reference);
-    parameters["edge_reference_magnitude"] = scale.magnitude;
-    parameters["edge_low"] = scale.fractions.low;
-    parameters["edge_high"] = scale.fractions.high;
-  }
-  parameters["capture_range_mm"] = o.segment.edges.captureRange;
-  parameters["image_force"] = o.segment.imageForce;
-  parameters["landmark_stiffness"] = o.segment.landmarkStiffness;
-  parameters["landmark_tolerance_mm"] = o.segment.landmarkTolerance;
-  parameters["inflation"] = o.segment.inflation;
-  parameters["margin_mm"] = o.segment.margin;
-  report["parameters"] = parameters;
-
-  writeModelOutputs(dir, result.mesh, report, [&](OutputSet& outputs) {
-    writeMask(result.labelmap, outputs.add("labelmap.nii.gz"));
-    addFigureOutputs(outputs, o.figures, result.mesh, recorder.history(), &image, landmarkPoints, Matrix3X());
-  }, result.surfaceEdgeDistances.size() ? std::vector<PointScalars>{{"edge_distance_mm", result.surfaceEdgeDistances}}
-                                        : std::vector<PointScalars>{});
+  writeModelOutputs(
+      dir, result.mesh, run.report,
+      [&](OutputSet& outputs) {
+        writeMask(result.labelmap, outputs.add("labelmap.nii.gz"));
+        addFigureOutputs(outputs, o.figures, result.mesh, run.history, &image, landmarkPositions(run.springs),
+                         Matrix3X());
+      },
+      result.surfaceEdgeDistances.size()
+          ? std::vector<PointScalars>{{"edge_distance_mm", result.surfaceEdgeDistances}}
+          : std::vector<PointScalars>{},
+      "LPS");
 
   std::cout << std::fixed << std::setprecision(1) << "segmented " << result.labelmap.count() * image.geometry.spacing.prod()
             << " mm^3 with " << result.mesh.vertexCount() << " control vertices (" << result.levels.back().level

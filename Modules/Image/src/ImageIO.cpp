@@ -25,15 +25,22 @@ Volume readVolume(const std::string& path) {
   return volume;
 }
 
-void writeMask(const Mask& mask, const std::string& path) {
+void writeMask(const Mask& mask, const std::string& path, std::uint8_t label) {
   // The file is written under a temporary name and renamed when complete; a
   // header that names a separate data file would name the temporary one.
   const std::string extension = lowerCaseExtension(path);
   if (extension == ".mhd" || extension == ".nhdr" || extension == ".hdr")
     throw Error(path, "a header with a separate data file is not written; use .nii.gz, .nii, .nrrd or .mha");
+  if (label == 0) throw Error(path, "the structure's label value must be 1-255 (0 is the background)");
   requireWritableDirectoryFor(path);
   AtomicOutput output(path);
-  itkbridge::writeLabels(toBridge(mask.geometry), mask.voxels, output.temporaryPath());
+  if (label == 1) {
+    itkbridge::writeLabels(toBridge(mask.geometry), mask.voxels, output.temporaryPath());
+  } else {
+    std::vector<std::uint8_t> labels(mask.voxels.size());
+    for (std::size_t i = 0; i < labels.size(); ++i) labels[i] = mask.voxels[i] ? label : 0;
+    itkbridge::writeLabels(toBridge(mask.geometry), labels, output.temporaryPath());
+  }
   output.commit();
 }
 

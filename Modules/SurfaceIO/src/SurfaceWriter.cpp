@@ -4,12 +4,14 @@
 #include <filesystem>
 
 #include <vtkDoubleArray.h>
+#include <vtkFieldData.h>
 #include <vtkNew.h>
 #include <vtkOBJWriter.h>
 #include <vtkPLYWriter.h>
 #include <vtkPointData.h>
 #include <vtkPolyData.h>
 #include <vtkSTLWriter.h>
+#include <vtkStringArray.h>
 #include <vtkXMLPolyDataWriter.h>
 
 #include "dynsub/AtomicOutput.h"
@@ -22,7 +24,7 @@ namespace dynsub {
 std::vector<std::string> triangleSurfaceExtensions() { return {".vtp", ".obj", ".ply", ".stl"}; }
 
 void writeTriangleSurface(const TriangleSurface& surface, const std::string& path,
-                          const std::vector<PointScalars>& scalars) {
+                          const std::vector<PointScalars>& scalars, const std::string& space) {
   const std::string extension = lowerCaseExtension(path);
   const std::vector<std::string> known = triangleSurfaceExtensions();
   if (std::find(known.begin(), known.end(), extension) == known.end()) {
@@ -32,6 +34,8 @@ void writeTriangleSurface(const TriangleSurface& surface, const std::string& pat
   for (const PointScalars& s : scalars)
     if (s.values.size() != surface.points.rows() || !s.values.allFinite())
       throw Error(path, "point data '" + s.name + "' needs one finite value per point; nothing written");
+  if (!space.empty() && space != "LPS" && space != "RAS")
+    throw Error(path, "unknown coordinate space '" + space + "' (expected LPS or RAS)");
   AtomicOutput output(path);
   vtkSmartPointer<vtkPolyData> polyData = toPolyData(surface);
   for (const PointScalars& s : scalars) {
@@ -40,6 +44,12 @@ void writeTriangleSurface(const TriangleSurface& surface, const std::string& pat
     array->SetNumberOfValues(s.values.size());
     for (Eigen::Index i = 0; i < s.values.size(); ++i) array->SetValue(i, s.values(i));
     polyData->GetPointData()->AddArray(array);
+  }
+  if (!space.empty()) {
+    vtkNew<vtkStringArray> array;
+    array->SetName("SPACE");
+    array->InsertNextValue(space);
+    polyData->GetFieldData()->AddArray(array);
   }
   int written = 0;
   if (extension == ".vtp") {

@@ -7,6 +7,8 @@
 #include <vtkCellData.h>
 #include <vtkPointData.h>
 #include <vtkDataArray.h>
+#include <vtkFieldData.h>
+#include <vtkStringArray.h>
 #include <vtkNew.h>
 #include <vtkOBJReader.h>
 #include <vtkPLYReader.h>
@@ -74,6 +76,31 @@ TEST(SurfaceWriter, VtpCarriesPointScalarsAndRefusesBadOnes) {
   Eigen::VectorXd nan = values;
   nan(5) = std::nan("");
   EXPECT_THROW(dynsub::writeTriangleSurface(surface, bad, {{"nan", nan}}), dynsub::Error);
+  EXPECT_FALSE(fs::exists(bad));
+}
+
+// 3D Slicer reads a model's coordinate system from the field-data string
+// array SPACE; a surface in an image's physical space is marked LPS.
+TEST(SurfaceWriter, VtpRecordsItsCoordinateSpaceForSlicer) {
+  const dynsub::TriangleSurface surface = cubeSurface();
+  const std::string path = scratch("lps.vtp");
+  dynsub::writeTriangleSurface(surface, path, {}, "LPS");
+  vtkNew<vtkXMLPolyDataReader> reader;
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  auto* space = vtkStringArray::SafeDownCast(reader->GetOutput()->GetFieldData()->GetAbstractArray("SPACE"));
+  ASSERT_NE(space, nullptr);
+  ASSERT_EQ(space->GetNumberOfValues(), 1);
+  EXPECT_EQ(space->GetValue(0), "LPS");
+  // Without a space nothing is claimed; an unknown one is refused, with no file.
+  const std::string plain = scratch("plain.vtp");
+  dynsub::writeTriangleSurface(surface, plain);
+  reader->SetFileName(plain.c_str());
+  reader->Update();
+  EXPECT_EQ(reader->GetOutput()->GetFieldData()->GetAbstractArray("SPACE"), nullptr);
+  const std::string bad = scratch("xyz_space.vtp");
+  fs::remove(bad);
+  EXPECT_THROW(dynsub::writeTriangleSurface(surface, bad, {}, "XYZ"), dynsub::Error);
   EXPECT_FALSE(fs::exists(bad));
 }
 

@@ -7,6 +7,7 @@
 // .mhd) and DICOM series (a directory holding one series, via GDCM). Any pixel
 // type is read as float; an image that is not 3D (a single slice counts as 2D)
 // or has no voxels is refused.
+#include <cstdint>
 #include <string>
 
 #include "dynsub/Volume.h"
@@ -17,10 +18,11 @@ namespace dynsub {
 // truncated, of an unknown format, not 3D or empty.
 Volume readVolume(const std::string& path);
 
-// Writes a mask as an unsigned 8-bit labelmap (1 = structure) on its grid, in
+// Writes a mask as an unsigned 8-bit labelmap (`label` = structure, 0 =
+// background; 3D Slicer colours a segment by its label value) on its grid, in
 // any single-file format ITK writes by extension (.nii.gz for ITK-SNAP and 3D
 // Slicer; .mhd, .nhdr and .hdr, with their separate data file, are refused).
 // The file appears complete or not at all.
-void writeMask(const Mask& mask, const std::string& path);
+void writeMask(const Mask& mask, const std::string& path, std::uint8_t label = 1);
 
 }  // namespace dynsub

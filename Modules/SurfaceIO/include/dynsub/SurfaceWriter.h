@@ -20,10 +20,13 @@ struct PointScalars {
   Eigen::VectorXd values;  // one per row of TriangleSurface::points, finite
 };
 
-// Throws dynsub::Error naming the file for an unknown extension, a missing or
-// read-only directory, a failed write, or scalars of the wrong size or not finite.
+// `space`, when not empty, names the coordinate system of a .vtp as the
+// field-data string array "SPACE" that 3D Slicer reads ("LPS" or "RAS";
+// Slicer assumes LPS without it). Throws dynsub::Error naming the file for an
+// unknown extension or space, a missing or read-only directory, a failed
+// write, or scalars of the wrong size or not finite.
 void writeTriangleSurface(const TriangleSurface& surface, const std::string& path,
-                          const std::vector<PointScalars>& scalars = {});
+                          const std::vector<PointScalars>& scalars = {}, const std::string& space = "");
 
 // The extensions writeTriangleSurface accepts, with the dot (".vtp", ...).
 std::vector<std::string> triangleSurfaceExtensions();

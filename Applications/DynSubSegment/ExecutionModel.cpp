@@ -1,0 +1,105 @@
+#include "ExecutionModel.h"
+
+#include <iomanip>
+#include <sstream>
+
+#include <CLI/CLI.hpp>
+
+namespace dynsub::slicer {
+
+namespace {
+
+std::string escaped(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    if (c == '&') out += "&amp;";
+    else if (c == '<') out += "&lt;";
+    else if (c == '>') out += "&gt;";
+    else if (c == '"') out += "&quot;";
+    else out += c;
+  }
+  return out;
+}
+
+std::string number(double value) {
+  std::ostringstream out;
+  out << std::setprecision(12) << value;
+  return out.str();
+}
+
+// The default a plain value shows in Slicer's panel: the target's value now.
+std::string defaultOf(const Parameter& p) {
+  if (!p.channel.empty() || p.index >= 0) return "";
+  if (const auto* d = std::get_if<double*>(&p.target)) return number(**d);
+  if (const auto* i = std::get_if<int*>(&p.target)) return std::to_string(**i);
+  if (const auto* s = std::get_if<std::string*>(&p.target)) return **s;
+  return "";
+}
+
+void tag(std::ostringstream& out, const char* indent, const std::string& name, const std::string& text) {
+  out << indent << '<' << name << '>' << escaped(text) << "</" << name << ">\n";
+}
+
+}  // namespace
+
+std::string descriptor(const Module& module) {
+  std::ostringstream out;
+  out << "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<executable>\n";
+  tag(out, "  ", "category", module.category);
+  tag(out, "  ", "title", module.title);
+  tag(out, "  ", "description", module.description);
+  tag(out, "  ", "version", module.version);
+  tag(out, "  ", "license", module.license);
+  tag(out, "  ", "contributor", module.contributor);
+  tag(out, "  ", "acknowledgements", module.acknowledgements);
+  for (const ParameterGroup& group : module.groups) {
+    out << "  <parameters" << (group.advanced ? " advanced=\"true\"" : "") << ">\n";
+    tag(out, "    ", "label", group.label);
+    tag(out, "    ", "description", group.description);
+    for (const Parameter& p : group.parameters) {
+      out << "    <" << p.element << (p.attributes.empty() ? "" : " " + p.attributes) << ">\n";
+      tag(out, "      ", "name", p.name);
+      tag(out, "      ", "label", p.label);
+      tag(out, "      ", "description", p.description);
+      if (p.index >= 0) tag(out, "      ", "index", std::to_string(p.index));
+      else tag(out, "      ", "longflag", "--" + p.flag);
+      if (!p.channel.empty()) tag(out, "      ", "channel", p.channel);
+      const std::string value = defaultOf(p);
+      if (!value.empty()) tag(out, "      ", "default", value);
+      for (const std::string& choice : p.choices) tag(out, "      ", "element", choice);
+      if (!p.minimum.empty() || !p.maximum.empty() || !p.step.empty()) {
+        out << "      <constraints>\n";
+        if (!p.minimum.empty()) tag(out, "        ", "minimum", p.minimum);
+        if (!p.maximum.empty()) tag(out, "        ", "maximum", p.maximum);
+        if (!p.step.empty()) tag(out, "        ", "step", p.step);
+        out << "      </constraints>\n";
+      }
+      out << "    </" << p.element << ">\n";
+    }
+    out << "  </parameters>\n";
+  }
+  out << "</executable>\n";
+  return out.str();
+}
+
+void addOptions(CLI::App& app, const Module& module) {
+  for (const ParameterGroup& group : module.groups) {
+    for (const Parameter& p : group.parameters) {
+      const std::string name = p.index >= 0 ? p.name : "--" + p.flag;
+      CLI::Option* option = std::visit([&](auto* target) { return app.add_option(name, *target, p.description); },
+                                       p.target);
+      if (std::holds_alternative<std::vector<std::string>*>(p.target)) {
+        // One value per occurrence, so that "--seed a --seed b IMAGE" leaves IMAGE positional.
+        option->expected(1)->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+      }
+      if (p.index >= 0) option->required();
+      if (!p.choices.empty()) option->check(CLI::IsMember(p.choices));
+      if (!p.minimum.empty() && !p.maximum.empty())
+        option->check(CLI::Range(std::stod(p.minimum), std::stod(p.maximum)));
+      const std::string value = defaultOf(p);
+      if (!value.empty()) option->default_str(value);
+    }
+  }
+}
+
+}  // namespace dynsub::slicer

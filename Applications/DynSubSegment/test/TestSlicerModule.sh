@@ -1,0 +1,90 @@
+#!/usr/bin/env bash
+# DynSubSegment, the 3D Slicer CLI module, run the ways Slicer and nipype run it:
+#  - `--xml` prints only the descriptor, which keeps Slicer's parser rules and
+#    from which nipype's Slicer interface generator builds a working class;
+#  - the Colin27 left caudate, the volume given as NRRD and each of the demo's
+#    36 landmarks as one `--seed x,y,z` (LPS), as Slicer passes a markups
+#    list: Dice >= 0.80 against AAL (the issue's bar; it measures 0.850), the
+#    labelmap NRRD on the volume's grid, the model a .vtp marked SPACE=LPS,
+#    and <filter-progress> rising to 1;
+#  - one point only: read as a click inside the caudate;
+#  - bad input: exit 1 with a message naming the problem and no output;
+#    a usage error: exit 2.
+# Needs MODULE (the executable), DATA and TOOLS; Debian's python3 with
+# python3-nipype and python3-nibabel.
+set -u
+source "$(dirname "${BASH_SOURCE[0]}")/../../dynsub/test/Checks.sh"
+require_colin27
+here=$(dirname "${BASH_SOURCE[0]}")
+python=/usr/bin/python3
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+"$MODULE" --xml >"$work/xml.out" 2>"$work/xml.err"
+check "--xml exits 0" test $? -eq 0
+check "--xml prints nothing on stderr" test ! -s "$work/xml.err"
+check "--xml starts with <?xml" test "$(head -c 5 "$work/xml.out")" = "<?xml"
+check "descriptor: Slicer's rules, the program's flags, nipype's generator" \
+  "$python" "$here/slicer_module_check.py" descriptor "$MODULE"
+
+"$python" "$TOOLS/nifti_to_nrrd.py" "$templates/ch2.nii.gz" "$work/ch2.nrrd"
+check "Colin27 written as NRRD" test -s "$work/ch2.nrrd"
+mapfile -t seeds < <("$python" -c '
+import json, sys
+for p in json.load(open(sys.argv[1]))["markups"][0]["controlPoints"]:
+    print("--seed"); print("%r,%r,%r" % tuple(p["position"]))' "$DATA/Landmarks/caudate_left.mrk.json")
+check "36 landmarks as --seed arguments" test "${#seeds[@]}" -eq 72
+
+"$MODULE" "${seeds[@]}" --labelmap "$work/caudate.nrrd" --model "$work/caudate.vtp" --report "$work/report.json" \
+  --labelValue 7 "$work/ch2.nrrd" >"$work/run.out" 2>"$work/run.err"
+check "caudate: exit 0" test $? -eq 0
+cat "$work/run.out" | grep -v filter-progress; cat "$work/run.err"
+check "caudate: Dice >= 0.80, labelmap on the volume's grid with value 7" \
+  "$python" "$here/slicer_module_check.py" dice "$work/caudate.nrrd" 7 "$templates/aal.nii.gz" 71 0.80
+check "caudate: the model is marked SPACE=LPS for Slicer" grep -q 'Name="SPACE"' "$work/caudate.vtp"
+check "caudate: report written" grep -q '"landmark_count": 36' "$work/report.json"
+check "caudate: progress rises to 1.00" awk -F'[<>]' '/<filter-progress>/ { if ($3 < last) bad = 1; last = $3; n++ }
+  END { exit !(n >= 5 && !bad && last == 1.00) }' "$work/run.out"
+check "caudate: stdout is tags and the summary only" test -z "$(grep -v -e '^<filter-' -e '^segmented ' "$work/run.out")"
+
+"$MODULE" --seed 15.4,-1.5,16.0 --labelmap "$work/inside.nrrd" --report "$work/inside.json" "$work/ch2.nrrd" \
+  >"$work/inside.out" 2>&1
+check "one point: exit 0" test $? -eq 0
+check "one point: read as a click inside" grep -q '"springs": "boundary points"' "$work/inside.json"
+check "one point: a caudate-sized region (Dice >= 0.5)" \
+  "$python" "$here/slicer_module_check.py" dice "$work/inside.nrrd" 1 "$templates/aal.nii.gz" 71 0.5
+
+# expect_failure NAME CODE PATTERN ARGS...: exit CODE, PATTERN on stderr, no output file.
+expect_failure() {
+  local name=$1 code=$2 pattern=$3; shift 3
+  rm -f "$work/bad.nrrd"
+  "$MODULE" "$@" >"$work/bad.out" 2>"$work/bad.err"
+  local status=$?
+  check "$name: exit $code (got $status)" test "$status" -eq "$code"
+  check "$name: says '$pattern'" grep -q -- "$pattern" "$work/bad.err"
+  check "$name: no labelmap" test ! -e "$work/bad.nrrd"
+  check "$name: no temporary file" test -z "$(ls -A "$work" | grep '^\.tmp')"
+}
+expect_failure "missing volume" 1 "no-such.nrrd" "${seeds[@]}" --labelmap "$work/bad.nrrd" "$work/no-such.nrrd"
+expect_failure "three points" 1 "3 boundary points are too few" --seed 1,2,3 --seed 4,5,6 --seed 7,8,9 \
+  --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
+expect_failure "no points" 1 "no points" --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
+expect_failure "malformed point" 1 "expected x,y,z" --seed 1,2 --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
+expect_failure "NaN point" 1 "expected x,y,z" --seed nan,2,3 --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
+expect_failure "point outside the volume" 1 "outside the image" --seed 500,0,0 "${seeds[@]:2}" \
+  --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
+expect_failure "no output asked for" 1 "nothing to write" "${seeds[@]}" "$work/ch2.nrrd"
+expect_failure "unknown labelmap format" 1 "unknown labelmap format" "${seeds[@]}" --labelmap "$work/bad.png" \
+  "$work/ch2.nrrd"
+expect_failure "model in a missing directory" 1 "no-dir" "${seeds[@]}" --labelmap "$work/bad.nrrd" \
+  --model "$work/no-dir/m.vtp" "$work/ch2.nrrd"
+expect_failure "sigma out of range" 2 "sigma" "${seeds[@]}" --sigma 50 --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
+expect_failure "unknown option" 2 "frobnicate" --frobnicate "$work/ch2.nrrd"
+
+mkdir "$work/nipype"
+check "nipype's generated interface runs the module" \
+  "$python" "$here/slicer_module_check.py" nipype-run "$MODULE" "$work/ch2.nrrd" \
+  "$DATA/Landmarks/caudate_left.mrk.json" "$work/nipype"
+
+echo "$failures failure(s)"
+exit $((failures > 0))
