@@ -51,7 +51,7 @@ slicer::Module describe(Arguments& a) {
       "a small control mesh, moves toward the image's edges and toward points placed on the structure's boundary, "
       "and is refined until it meets them. Give at least 4 boundary points, or one point inside the structure "
       "(its tissue is grown from there and the surface starts on that region's boundary).";
-  m.version = "0.1.0";
+  m.version = DYNSUB_VERSION;
   m.license = "See the DynSub source tree";
   m.contributor = "DynSub developers";
   m.acknowledgements = "Built on ITK, VTK, Eigen and OpenMesh.";

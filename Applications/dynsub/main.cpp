@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
       "dynamics toward image edges and expert landmarks, and refines itself until it fits.\n"
       "Coordinates are in mm. Run 'dynsub COMMAND --help' for each command.",
       "dynsub"};
+  app.set_version_flag("--version", std::string("dynsub ") + DYNSUB_VERSION);
   app.require_subcommand(1);
   dynsub::app::addLimitCommand(app);
   dynsub::app::addMeshCommand(app);

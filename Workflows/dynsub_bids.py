@@ -1,0 +1,307 @@
+"""The BIDS side of the DynSub cohort workflow (Snakefile): which jobs a
+dataset holds, what each job writes and under which BIDS derivative names,
+and the group table.
+
+Naming (BIDS 1.9 derivatives, "imaging data types: segmentations"): one job
+is one structure of one T1w image, written beside the image's own path:
+
+    sub-<label>[/ses-<label>]/anat/sub-<label>[_ses-<label>]_space-orig_desc-<structure>_dseg.nii.gz
+    ..._dseg.tsv     the lookup table (index 1 = the structure)
+    ..._dseg.json    sidecar: Sources, SpatialReference, the run's figures
+    ..._surface.vtp  the fitted limit surface (LPS mm)
+    ..._report.json  dynsub segment's report
+    ..._convergence.csv
+    sub-<label>[/ses-<label>]/figures/sub-<label>[_ses-<label>]_desc-<structure>_{slices,surface3d,convergence}.png
+
+`space-orig` is the T1w's own grid; `desc-` carries the structure, so BIDS
+labels (letters and digits only) are required of structure names.
+"""
+import csv
+import glob
+import json
+import os
+import re
+import shlex
+import shutil
+import subprocess
+import tempfile
+
+LABEL = r"[A-Za-z0-9]+"
+T1W = re.compile(rf"^sub-(?P<sub>{LABEL})(?:_ses-(?P<ses>{LABEL}))?_T1w\.nii(?:\.gz)?$")
+LANDMARKS = re.compile(rf"^sub-(?P<sub>{LABEL})(?:_ses-(?P<ses>{LABEL}))?_desc-(?P<structure>{LABEL})"
+                       r"_landmarks\.(?:mrk\.json|fcsv|csv)$")
+FIGURES = ("slices", "surface3d", "convergence")
+
+
+class CohortError(Exception):
+    """A dataset the workflow cannot run on; the message names the file."""
+
+
+class Job:
+    """One structure of one T1w image."""
+
+    def __init__(self, subject, session, structure, t1w):
+        self.subject, self.session, self.structure, self.t1w = subject, session, structure, t1w
+        self.landmarks = None          # a landmark file, or
+        self.seed = None               # (x, y, z) LPS mm of one click inside
+        self.reference = None          # an expert labelmap on the T1w's grid
+        self.reference_labels = []     # the structure's values in it
+
+    @property
+    def dir(self):  # sub-01 or sub-01/ses-1
+        return f"sub-{self.subject}" + (f"/ses-{self.session}" if self.session else "")
+
+    @property
+    def stem(self):  # sub-01 or sub-01_ses-1
+        return f"sub-{self.subject}" + (f"_ses-{self.session}" if self.session else "")
+
+    @property
+    def key(self):
+        return (self.stem, self.structure)
+
+    def inputs(self):
+        files = {"t1w": self.t1w}
+        if self.landmarks:
+            files["landmarks"] = self.landmarks
+        if self.reference:
+            files["reference"] = self.reference
+        return files
+
+
+def output_paths(out, dir, stem, structure):
+    """The declared outputs of one job (figures are written when they can be rendered)."""
+    base = f"{out}/{dir}/anat/{stem}_space-orig_desc-{structure}"
+    return {"dseg": base + "_dseg.nii.gz", "lut": base + "_dseg.tsv", "sidecar": base + "_dseg.json",
+            "surface": base + "_surface.vtp", "report": base + "_report.json",
+            "convergence": base + "_convergence.csv"}
+
+
+def log_path(out, dir, stem, structure):
+    return f"{out}/logs/{dir}/{stem}_desc-{structure}.log"
+
+
+def default_seeds(bids):
+    path = f"{bids}/derivatives/seeds.tsv"
+    return path if os.path.exists(path) else None
+
+
+def figure_paths(out, dir, stem, structure):
+    return {name: f"{out}/{dir}/figures/{stem}_desc-{structure}_{name}.png" for name in FIGURES}
+
+
+def _relative(path, root):
+    return os.path.relpath(os.path.abspath(path), os.path.abspath(root))
+
+
+def find_jobs(bids, landmarks_dir, seeds_table, reference_dir):
+    """Every (image, structure) with landmarks or a seed, keyed by (stem, structure)."""
+    if not os.path.isdir(bids):
+        raise CohortError(f"{bids}: no such BIDS directory")
+    images = {}
+    for path in sorted(glob.glob(f"{bids}/sub-*/anat/*_T1w.nii*") + glob.glob(f"{bids}/sub-*/ses-*/anat/*_T1w.nii*")):
+        match = T1W.match(os.path.basename(path))
+        if not match:
+            raise CohortError(f"{path}: not handled (expected sub-<label>[_ses-<label>]_T1w.nii[.gz], "
+                              "letters and digits in labels)")
+        subject, session = match["sub"], match["ses"]
+        expected = f"{bids}/sub-{subject}" + (f"/ses-{session}" if session else "") + "/anat"
+        if os.path.dirname(path) != expected:
+            raise CohortError(f"{path}: its name does not match its folder")
+        if (subject, session) in images:
+            raise CohortError(f"{path}: a second T1w for sub-{subject}" + (f" ses-{session}" if session else "") +
+                              f" (also {images[(subject, session)]})")
+        images[(subject, session)] = path
+
+    jobs = {}
+
+    def job_for(subject, session, structure, source):
+        if (subject, session) not in images:
+            raise CohortError(f"{source}: no T1w image for sub-{subject}" + (f" ses-{session}" if session else ""))
+        job = Job(subject, session, structure, images[(subject, session)])
+        return jobs.setdefault(job.key, job)
+
+    if landmarks_dir and os.path.isdir(landmarks_dir):
+        for path in sorted(glob.glob(f"{landmarks_dir}/sub-*/anat/*_landmarks.*") +
+                           glob.glob(f"{landmarks_dir}/sub-*/ses-*/anat/*_landmarks.*")):
+            match = LANDMARKS.match(os.path.basename(path))
+            if not match:
+                raise CohortError(f"{path}: not handled (expected sub-<label>[_ses-<label>]_desc-<structure>"
+                                  "_landmarks.mrk.json|.fcsv|.csv, letters and digits in labels)")
+            job = job_for(match["sub"], match["ses"], match["structure"], path)
+            if job.landmarks:
+                raise CohortError(f"{path}: a second landmark file for {job.stem} {job.structure} "
+                                  f"(also {job.landmarks})")
+            job.landmarks = path
+
+    if seeds_table:
+        with open(seeds_table, newline="") as f:
+            rows = list(csv.DictReader(f, delimiter="\t"))
+        for line, row in enumerate(rows, start=2):
+            where = f"{seeds_table}:{line}"
+            try:
+                subject = row["participant_id"].removeprefix("sub-")
+                session = (row.get("session_id") or "n/a").removeprefix("ses-")
+                session = None if session == "n/a" else session
+                structure = row["structure"]
+                seed = tuple(float(row[c]) for c in ("x", "y", "z"))
+            except (KeyError, TypeError, ValueError):
+                raise CohortError(f"{where}: expected columns participant_id, [session_id,] structure, x, y, z "
+                                  "(LPS mm)") from None
+            if not re.fullmatch(LABEL, structure) or not all(abs(v) < float("inf") for v in seed):
+                raise CohortError(f"{where}: structure must be letters and digits, x y z finite numbers")
+            job_for(subject, session, structure, where).seed = seed
+
+    if reference_dir and os.path.isdir(reference_dir):
+        table = f"{reference_dir}/dseg.tsv"
+        names = {}
+        if os.path.exists(table):
+            with open(table, newline="") as f:
+                for row in csv.DictReader(f, delimiter="\t"):
+                    names.setdefault(row["name"], []).append(int(row["index"]))
+        for job in jobs.values():
+            path = f"{reference_dir}/{job.dir}/anat/{job.stem}_dseg.nii.gz"
+            if os.path.exists(path) and job.structure in names:
+                job.reference, job.reference_labels = path, names[job.structure]
+    return jobs
+
+
+def _last_error(log):
+    """The line of the log that says what went wrong."""
+    try:
+        lines = [l.strip() for l in open(log, errors="replace") if l.strip()]
+    except OSError:
+        return "no log"
+    errors = [l for l in lines if "error" in l.lower()]
+    return (errors or lines or ["empty log"])[-1]
+
+
+def run_segmentation(job, outputs, figures, log, dynsub, extra_args, bids, out):
+    """Runs `dynsub segment` for one job and gives its results their BIDS names.
+
+    dynsub writes all its outputs or none into a private directory beside the
+    final files; they are renamed into place only when it succeeded, so a
+    failed job leaves nothing (Snakemake also removes a failed job's outputs).
+    """
+    anat = os.path.dirname(outputs["dseg"])
+    os.makedirs(anat, exist_ok=True)
+    work = tempfile.mkdtemp(prefix=".work-", dir=anat)
+    try:
+        result = os.path.join(work, "result")
+        command = [dynsub, "segment", job.t1w, "--out", result]
+        if job.landmarks:
+            command += ["--landmarks", job.landmarks]
+        if job.seed:
+            command += ["--init", "seed:%r,%r,%r" % job.seed]
+        if job.reference:
+            command += ["--reference", job.reference, "--reference-label", ",".join(map(str, job.reference_labels))]
+        command += shlex.split(extra_args)
+        with open(log, "w") as f:
+            f.write("$ " + shlex.join(command) + "\n")
+            f.flush()
+            status = subprocess.run(command, stdout=f, stderr=subprocess.STDOUT).returncode
+        if status != 0:
+            raise RuntimeError(f"{job.stem} {job.structure}: dynsub segment failed (exit {status}): "
+                               f"{_last_error(log)} (log: {log})")
+        with open(outputs["lut"], "w") as f:
+            f.write("index\tname\n1\t%s\n" % job.structure)
+        sources = [f"bids:raw:{_relative(job.t1w, bids)}"]
+        if job.landmarks:
+            sources.append(f"bids:raw:{_relative(job.landmarks, bids)}")
+        sidecar = {
+            "Description": f"{job.structure} segmented by a dynamic Catmull-Clark subdivision surface "
+                           "(dynsub segment)" + (" from a seed click" if job.seed and not job.landmarks else ""),
+            "Sources": sources,
+            "SpatialReference": f"bids:raw:{_relative(job.t1w, bids)}",
+            "Surface": os.path.basename(outputs["surface"]),
+            "Report": os.path.basename(outputs["report"]),
+        }
+        if job.seed:
+            sidecar["SeedLPS"] = list(job.seed)
+        with open(outputs["sidecar"], "w") as f:
+            json.dump(sidecar, f, indent=2)
+            f.write("\n")
+        os.replace(f"{result}/surface.vtp", outputs["surface"])
+        os.replace(f"{result}/report.json", outputs["report"])
+        os.replace(f"{result}/convergence.csv", outputs["convergence"])
+        os.replace(f"{result}/labelmap.nii.gz", outputs["dseg"])
+        for name, path in figures.items():  # rendered when an X server could be had
+            if os.path.exists(f"{result}/{name}.png"):
+                os.makedirs(os.path.dirname(path), exist_ok=True)
+                os.replace(f"{result}/{name}.png", path)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+
+GROUP_COLUMNS = {
+    "participant_id": "The subject (sub-<label>).",
+    "session_id": "The session (ses-<label>), or n/a.",
+    "structure": "The structure (the desc- entity of the files).",
+    "status": "ok, failed (see message and the job's log) or not run.",
+    "volume_mm3": "Volume of the labelmap, mm^3.",
+    "dice": "Dice against the reference labelmap, where there is one.",
+    "mean_surface_distance_mm": "Mean symmetric surface distance to the reference, mm.",
+    "hd95_mm": "95th percentile of the surface distances to the reference, mm.",
+    "control_vertices": "Control vertices of the final surface.",
+    "iterations": "Time steps of the evolution.",
+    "seconds": "Wall-clock seconds of the segmentation.",
+    "warnings": "dynsub's warnings (a collapse, a leak, landmarks off edges), separated by '; '.",
+    "message": "Why a job failed.",
+    "dseg": "The labelmap, relative to the dataset root.",
+}
+
+
+def group_rows(jobs, out):
+    rows = []
+    for key in sorted(jobs):
+        job = jobs[key]
+        paths = output_paths(out, job.dir, job.stem, job.structure)
+        row = {c: "n/a" for c in GROUP_COLUMNS}
+        row.update(participant_id=f"sub-{job.subject}", session_id=f"ses-{job.session}" if job.session else "n/a",
+                   structure=job.structure)
+        log = log_path(out, job.dir, job.stem, job.structure)
+        if all(os.path.exists(p) for p in paths.values()):
+            report = json.load(open(paths["report"]))
+            row.update(status="ok", dseg=_relative(paths["dseg"], out),
+                       warnings="; ".join(report.get("warnings", [])) or "n/a")
+            for column in ("volume_mm3", "dice", "mean_surface_distance_mm", "hd95_mm", "control_vertices",
+                           "iterations", "seconds"):
+                if column in report:
+                    value = report[column]
+                    row[column] = f"{value:.4f}" if isinstance(value, float) else str(value)
+        elif os.path.exists(log):
+            row.update(status="failed", message=_last_error(log))
+        else:
+            row.update(status="not run")
+        rows.append(row)
+    return rows
+
+
+def write_group_table(jobs, out, table):
+    """segmentations.tsv (and its JSON column descriptions): one row per job."""
+    rows = group_rows(jobs, out)
+    os.makedirs(os.path.dirname(table) or ".", exist_ok=True)
+    temporary = table + ".tmp"
+    with open(temporary, "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=list(GROUP_COLUMNS), delimiter="\t", lineterminator="\n")
+        writer.writeheader()
+        for row in rows:
+            writer.writerow({k: str(v).replace("\t", " ").replace("\n", " ") for k, v in row.items()})
+    os.replace(temporary, table)
+    with open(table.removesuffix(".tsv") + ".json", "w") as f:
+        json.dump({c: {"Description": d} for c, d in GROUP_COLUMNS.items()}, f, indent=2)
+        f.write("\n")
+    return rows
+
+
+def write_dataset_description(path, version, bids):
+    description = {
+        "Name": "DynSub segmentations",
+        "BIDSVersion": "1.9.0",
+        "DatasetType": "derivative",
+        "GeneratedBy": [{"Name": "DynSub", "Version": version,
+                         "Description": "dynamic Catmull-Clark subdivision surfaces (dynsub segment)"}],
+        "DatasetLinks": {"raw": "file://" + os.path.abspath(bids)},
+    }
+    with open(path, "w") as f:
+        json.dump(description, f, indent=2)
+        f.write("\n")

@@ -1,0 +1,191 @@
+"""The cohort's QC report: one self-contained HTML page (figures embedded,
+no network, no external script) with a sortable group table that flags
+outliers, and per segmentation its slices with the contour, the 3D view,
+the convergence plot and its numbers.
+
+Flags (the reasons a row is marked for a look):
+  failed       the job did not complete;
+  warnings     dynsub warned (a collapse, a leak, landmarks far from edges, a seed region that leaked);
+  volume       the volume is more than 3 robust standard deviations (1.4826 MAD) from the
+               median of the same structure, judged only with at least 4 of that structure;
+  residual     the rms distance of the landmarks to the surface exceeds 1 mm (twice the
+               default landmark tolerance: the surface did not come to the clicks).
+"""
+import base64
+import html
+import json
+import math
+import os
+import statistics
+
+import dynsub_bids as bids
+
+RESIDUAL_LIMIT_MM = 1.0
+ROBUST_Z_LIMIT = 3.0
+MIN_FOR_VOLUME_FLAG = 4
+
+
+def _number(value):
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        return None
+
+
+def _image(path, alt):
+    if not os.path.exists(path):
+        return f'<p class="missing">{html.escape(alt)}: not rendered</p>'
+    data = base64.b64encode(open(path, "rb").read()).decode("ascii")
+    return f'<img src="data:image/png;base64,{data}" alt="{html.escape(alt)}">'
+
+
+def _rms_residual(report):
+    distances = [r["distance_mm"] for r in report.get("landmark_residuals", []) if "distance_mm" in r]
+    return math.sqrt(sum(d * d for d in distances) / len(distances)) if distances else None
+
+
+def flagged_rows(jobs, out):
+    rows = bids.group_rows(jobs, out)
+    for row, key in zip(rows, sorted(jobs)):
+        job = jobs[key]
+        row["job"] = job
+        row["flags"] = []
+        row["rms_residual_mm"] = None
+        if row["status"] != "ok":
+            row["flags"].append("failed")
+            continue
+        report = json.load(open(bids.output_paths(out, job.dir, job.stem, job.structure)["report"]))
+        row["report"] = report
+        row["rms_residual_mm"] = _rms_residual(report)
+        if report.get("warnings"):
+            row["flags"].append("warnings")
+        if row["rms_residual_mm"] is not None and row["rms_residual_mm"] > RESIDUAL_LIMIT_MM:
+            row["flags"].append("residual")
+    by_structure = {}
+    for row in rows:
+        if row["status"] == "ok":
+            by_structure.setdefault(row["structure"], []).append(row)
+    for group in by_structure.values():
+        volumes = [_number(r["volume_mm3"]) for r in group]
+        if len(volumes) < MIN_FOR_VOLUME_FLAG:
+            continue
+        median = statistics.median(volumes)
+        spread = 1.4826 * statistics.median(abs(v - median) for v in volumes)
+        for row, volume in zip(group, volumes):
+            row["volume_z"] = (volume - median) / spread if spread > 0 else 0.0
+            if abs(row["volume_z"]) > ROBUST_Z_LIMIT:
+                row["flags"].append("volume")
+    return rows
+
+
+STYLE = """
+body { font-family: sans-serif; margin: 1.5em; color: #222; }
+table { border-collapse: collapse; font-size: 0.9em; }
+th, td { border: 1px solid #bbb; padding: 0.25em 0.5em; text-align: right; }
+th { background: #eee; cursor: pointer; user-select: none; }
+th[aria-sort="ascending"]::after { content: " \\25B2"; }
+th[aria-sort="descending"]::after { content: " \\25BC"; }
+td.text { text-align: left; }
+tr.flagged td { background: #fde2e2; }
+.flag { display: inline-block; background: #c0392b; color: white; border-radius: 3px; padding: 0 0.3em;
+        margin-right: 0.2em; font-size: 0.85em; }
+section { border-top: 2px solid #ccc; margin-top: 2em; padding-top: 0.5em; }
+section img { max-width: 32%; margin-right: 1%; vertical-align: top; border: 1px solid #ddd; }
+.missing { color: #888; font-style: italic; display: inline-block; width: 30%; }
+dl { display: grid; grid-template-columns: max-content auto; gap: 0.1em 1em; }
+dt { font-weight: bold; }
+"""
+
+# Sorting by a column's text, or numerically when every cell is a number or n/a.
+SCRIPT = """
+document.querySelectorAll("table.sortable th").forEach(function (header, column) {
+  header.addEventListener("click", function () {
+    var table = header.closest("table"), body = table.tBodies[0];
+    var rows = Array.prototype.slice.call(body.rows);
+    var ascending = header.getAttribute("aria-sort") !== "ascending";
+    table.querySelectorAll("th").forEach(function (h) { h.removeAttribute("aria-sort"); });
+    header.setAttribute("aria-sort", ascending ? "ascending" : "descending");
+    var key = function (row) { return row.cells[column].getAttribute("data-value") || row.cells[column].textContent; };
+    var numeric = rows.every(function (r) { var k = key(r); return k === "n/a" || !isNaN(parseFloat(k)); });
+    rows.sort(function (a, b) {
+      var x = key(a), y = key(b), order;
+      if (numeric) {
+        x = x === "n/a" ? -Infinity : parseFloat(x); y = y === "n/a" ? -Infinity : parseFloat(y);
+        order = x - y;
+      } else { order = x.localeCompare(y); }
+      return ascending ? order : -order;
+    });
+    rows.forEach(function (r) { body.appendChild(r); });
+  });
+});
+"""
+
+COLUMNS = [("participant_id", "subject", True), ("session_id", "session", True), ("structure", "structure", True),
+           ("status", "status", True), ("volume_mm3", "volume (mm³)", False),
+           ("volume_z", "volume robust z", False), ("dice", "Dice", False), ("hd95_mm", "HD95 (mm)", False),
+           ("rms_residual_mm", "landmark rms (mm)", False), ("control_vertices", "control vertices", False),
+           ("seconds", "seconds", False), ("flags", "flags", True)]
+
+
+def _cell(row, key, text):
+    value = row.get(key)
+    if key == "flags":
+        shown = "".join(f'<span class="flag">{html.escape(f)}</span>' for f in value) or "—"
+        return f'<td class="text" data-value="{len(value)}">{shown}</td>'
+    if isinstance(value, float):
+        value = f"{value:.2f}"
+    value = "n/a" if value in (None, "") else str(value)
+    if key == "structure" and row["status"] == "ok":
+        anchor = f'{row["job"].stem}-{row["structure"]}'
+        return f'<td class="text" data-value="{html.escape(value)}"><a href="#{anchor}">{html.escape(value)}</a></td>'
+    return f'<td class="{"text" if text else "num"}">{html.escape(value)}</td>'
+
+
+def write_report(jobs, out, path):
+    rows = flagged_rows(jobs, out)
+    flagged = sum(1 for r in rows if r["flags"])
+    parts = ["<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
+             "<title>DynSub QC report</title>", f"<style>{STYLE}</style></head><body>",
+             "<h1>DynSub QC report</h1>",
+             f"<p>{len(rows)} segmentations, {sum(r['status'] == 'ok' for r in rows)} complete, "
+             f"{flagged} flagged. Click a column header to sort; click a structure for its figures.</p>",
+             '<table class="sortable" id="group"><thead><tr>']
+    parts += [f"<th>{html.escape(title)}</th>" for _, title, _ in COLUMNS]
+    parts.append("</tr></thead><tbody>")
+    for row in rows:
+        parts.append(f'<tr class="{"flagged" if row["flags"] else ""}">')
+        parts += [_cell(row, key, text) for key, _, text in COLUMNS]
+        parts.append("</tr>")
+    parts.append("</tbody></table>")
+    parts.append("<p>Flags: <b>failed</b> the job did not complete; <b>warnings</b> dynsub warned; "
+                 f"<b>volume</b> more than {ROBUST_Z_LIMIT:g} robust SD from the structure's median "
+                 f"(with at least {MIN_FOR_VOLUME_FLAG} of it); <b>residual</b> landmarks more than "
+                 f"{RESIDUAL_LIMIT_MM:g} mm rms from the surface.</p>")
+    for row in rows:
+        job = row["job"]
+        title = f'{row["participant_id"]} {row["session_id"] if row["session_id"] != "n/a" else ""} {job.structure}'
+        parts.append(f'<section id="{job.stem}-{job.structure}"><h2>{html.escape(title)}</h2>')
+        if row["status"] != "ok":
+            parts.append(f'<p><span class="flag">{html.escape(row["status"])}</span> '
+                         f'{html.escape(row["message"])}</p></section>')
+            continue
+        figures = bids.figure_paths(out, job.dir, job.stem, job.structure)
+        parts += [_image(figures["slices"], "slices with the contour"), _image(figures["surface3d"], "3D view"),
+                  _image(figures["convergence"], "convergence")]
+        report = row["report"]
+        facts = [("flags", ", ".join(row["flags"]) or "none"), ("volume (mm³)", row["volume_mm3"]),
+                 ("Dice", row["dice"]), ("mean surface distance (mm)", row["mean_surface_distance_mm"]),
+                 ("control vertices", row["control_vertices"]), ("steps", row["iterations"]),
+                 ("seconds", row["seconds"]), ("landmarks", report.get("landmark_count")),
+                 ("start", report.get("init")), ("surface on edges", report.get("surface_on_edges", "n/a"))]
+        shown = [(k, f"{v:.3g}" if isinstance(v, float) else v) for k, v in facts]
+        parts.append("<dl>" + "".join(f"<dt>{html.escape(k)}</dt><dd>{html.escape(str(v))}</dd>" for k, v in shown))
+        for warning in report.get("warnings", []):
+            parts.append(f"<dt>warning</dt><dd>{html.escape(warning)}</dd>")
+        parts.append("</dl></section>")
+    parts.append(f"<script>{SCRIPT}</script></body></html>")
+    temporary = path + ".tmp"
+    with open(temporary, "w", encoding="utf-8") as f:
+        f.write("\n".join(parts) + "\n")
+    os.replace(temporary, path)
+    return rows

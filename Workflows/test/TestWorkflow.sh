@@ -1,0 +1,110 @@
+#!/usr/bin/env bash
+# The Snakemake cohort workflow (Workflows/Snakefile) on a small BIDS cohort
+# made from Colin27 (make_cohort.py): the 1 mm MRI, a rigidly moved copy with
+# its landmarks (.fcsv, RAS) and reference moved along, the 0.5 mm MRI in a
+# session (.csv landmarks), a seed click from a seeds table.
+#  - `snakemake --cores 2` writes derivatives that keep the BIDS naming rules
+#    (check_derivatives.py), the group table and the QC page; the moved copy
+#    scores what the original does (Dice within 0.01);
+#  - a second run does nothing;
+#  - a broken subject (a truncated T1w) fails alone under --keep-going: no
+#    output of its own, the others untouched, the table and the page list it;
+#  - the Slurm profile's dry run passes, and a run through it with a stand-in
+#    sbatch (the job script run in the background) completes;
+#  - the QC page renders in headless Chromium without console messages;
+#  - bad configurations fail with a clear message.
+# Needs DYNSUB, DATA, WORKFLOWS; snakemake, python3-nibabel,
+# python3-bids-validator and chromium.
+set -u
+source "$DATA/../Applications/dynsub/test/Checks.sh"
+require_colin27
+here=$(dirname "${BASH_SOURCE[0]}")
+python=/usr/bin/python3
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cd "$work"
+snake() { snakemake -s "$WORKFLOWS/Snakefile" --config bids="$work/bids" dynsub="$DYNSUB" "$@"; }
+
+"$python" "$here/make_cohort.py" "$templates" "$DATA" "$work/bids"
+check "cohort made" test -s "$work/bids/sub-02/anat/sub-02_T1w.nii.gz"
+
+snake out="$work/out" --cores 2 >"$work/run1.log" 2>&1
+check "first run: exit 0" test $? -eq 0 || tail -40 "$work/run1.log"
+check "first run: BIDS derivative names, sidecars, grids (and the raw cohort valid BIDS)" \
+  "$python" "$here/check_derivatives.py" "$work/bids" "$work/out" 4
+cat "$work/out/segmentations.tsv"
+check "group table: 4 segmentations, the moved copy as good as the original" "$python" - "$work/out" <<'PY'
+import csv, sys
+rows = {(r["participant_id"], r["session_id"], r["structure"]): r
+        for r in csv.DictReader(open(sys.argv[1] + "/segmentations.tsv"), delimiter="\t")}
+original, moved = rows[("sub-01", "n/a", "caudateL")], rows[("sub-02", "n/a", "caudateL")]
+fine = rows[("sub-03", "ses-2", "caudateL")]
+seed = rows[("sub-01", "n/a", "thalamusL")]
+assert len(rows) == 4 and all(r["status"] == "ok" for r in rows.values()), rows
+assert float(original["dice"]) >= 0.84, original          # the demo's 0.850
+assert abs(float(moved["dice"]) - float(original["dice"])) <= 0.01, (moved, original)  # rigid motion changes nothing
+assert fine["dice"] == "n/a" and abs(float(fine["volume_mm3"]) / float(original["volume_mm3"]) - 1) < 0.15, fine
+assert float(seed["dice"]) >= 0.4, seed                   # one click: measured 0.517
+PY
+check "QC page written" test -s "$work/out/report.html"
+
+touch "$work/marker"
+snake out="$work/out" --cores 2 >"$work/run2.log" 2>&1
+check "second run: exit 0" test $? -eq 0
+check "second run: nothing to be done" grep -q "Nothing to be done" "$work/run2.log"
+check "second run: no file rewritten" test -z "$(find "$work/out" -newer "$work/marker" -type f)"
+
+"$python" "$here/make_cohort.py" "$templates" "$DATA" "$work/bids" --broken
+touch "$work/marker"
+snake out="$work/out" --cores 2 --keep-going >"$work/run3.log" 2>&1
+check "broken subject: the run exits non-zero" test $? -ne 0
+check "broken subject: only its job ran" test "$(grep -c '^rule segment:' "$work/run3.log")" -eq 1
+check "broken subject: its failure names its T1w" grep -q "sub-04_T1w.nii.gz" "$work/run3.log"
+check "broken subject: no output of its own" test -z "$(find "$work/out/sub-04" -type f 2>/dev/null)"
+check "broken subject: no work directory left" test -z "$(find "$work/out" -name '.work-*')"
+check "broken subject: the others untouched" \
+  test -z "$(find "$work/out/sub-0"[123] -newer "$work/marker" -type f)"
+check "broken subject: listed as failed in the group table" \
+  grep -q -P "^sub-04\tn/a\tcaudateL\tfailed\t.*sub-04_T1w" "$work/out/segmentations.tsv"
+check "broken subject: flagged on the QC page" grep -q '<span class="flag">failed</span>' "$work/out/report.html"
+
+snake out="$work/cluster" --profile "$WORKFLOWS/profiles/slurm" -n >"$work/dry.log" 2>&1
+check "Slurm profile: dry run exits 0" test $? -eq 0
+check "Slurm profile: dry run plans 5 segmentations" grep -q -P "^segment\s+5\s" "$work/dry.log"
+check "Slurm profile: dry run writes nothing" test ! -e "$work/cluster/segmentations.tsv"
+rm "$work/bids/sub-04" "$work/bids/derivatives/landmarks/sub-04" -r
+mkdir "$work/fakebin"
+cat >"$work/fakebin/sbatch" <<'SH'
+#!/usr/bin/env bash
+# Stands in for Slurm's sbatch: runs the job script (the last argument) in the background, prints a job id.
+id=$((RANDOM + 1))
+nohup bash "${@: -1}" >"sbatch-$id.log" 2>&1 &
+echo "$id"
+SH
+chmod +x "$work/fakebin/sbatch"
+PATH="$work/fakebin:$PATH" snake out="$work/cluster" --profile "$WORKFLOWS/profiles/slurm" >"$work/cluster.log" 2>&1
+check "Slurm profile: a run through sbatch completes" test $? -eq 0 || { tail -40 "$work/cluster.log"; cat sbatch-*.log; }
+check "Slurm profile: 4 jobs submitted" test "$(grep -c "Submitted job .* with external jobid" "$work/cluster.log")" -eq 4
+check "Slurm profile: same derivatives" "$python" "$here/check_derivatives.py" "$work/bids" "$work/cluster" 4
+
+chromium --headless=new --no-sandbox --disable-gpu --hide-scrollbars --window-size=1400,2200 --enable-logging=stderr \
+  --v=0 --screenshot="$work/report.png" "file://$work/out/report.html" >"$work/chromium.log" 2>&1
+check "QC page: Chromium renders a screenshot" test -s "$work/report.png"
+check "QC page: no console message (script errors included)" test -z "$(grep CONSOLE "$work/chromium.log")"
+grep CONSOLE "$work/chromium.log"
+chromium --headless=new --no-sandbox --disable-gpu --dump-dom "file://$work/out/report.html" >"$work/dom.html" \
+  2>/dev/null
+check "QC page: the DOM holds the 5 rows" test "$(grep -o '<tr class=' "$work/dom.html" | wc -l)" -eq 5
+if [ -n "${KEEP_SCREENSHOT:-}" ]; then cp "$work/report.png" "$KEEP_SCREENSHOT"; fi
+
+snakemake -s "$WORKFLOWS/Snakefile" --cores 1 --config out="$work/x" >"$work/bad.log" 2>&1
+check "no bids: exit non-zero" test $? -ne 0
+check "no bids: says what is required" grep -q "config bids=DIR is required" "$work/bad.log"
+mkdir -p "$work/bids/sub-05/anat" && cp "$work/bids/sub-01/anat/sub-01_T1w.nii.gz" \
+  "$work/bids/sub-05/anat/sub-05_acq-fast_T1w.nii.gz"
+snake out="$work/out" --cores 1 >"$work/bad.log" 2>&1
+check "unhandled T1w name: exit non-zero" test $? -ne 0
+check "unhandled T1w name: the file is named" grep -q "sub-05_acq-fast_T1w.nii.gz: not handled" "$work/bad.log"
+
+echo "$failures failure(s)"
+exit $((failures > 0))

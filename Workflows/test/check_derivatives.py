@@ -1,0 +1,124 @@
+#!/usr/bin/env python3
+"""Checks a DynSub derivative dataset against the BIDS naming rules it claims.
+
+    check_derivatives.py RAW DERIVATIVES EXPECTED_JOBS
+
+RAW is the input dataset: every file the workflow read (T1w images) must be
+valid BIDS by the BIDS validator (Debian python3-bids-validator). In
+DERIVATIVES, every file must be one of: dataset_description.json (with
+DatasetType derivative and GeneratedBy), the group table and its sidecar,
+job logs, or per-subject files named
+sub-<label>[_ses-<label>]_space-orig_desc-<label>_<suffix> in sub-<label>/[ses-<label>/]anat
+(figures: ..._desc-<label>_<figure>.png in .../figures), with entities in
+BIDS order, labels of letters and digits, folders matching the entities,
+every dseg.nii.gz with its .tsv lookup table and .json sidecar, on the grid
+of its T1w, holding only the values the table names. EXPECTED_JOBS is the
+number of segmentations that must be there.
+"""
+import csv
+import json
+import os
+import re
+import sys
+
+import nibabel
+import numpy
+from bids_validator import BIDSValidator
+
+L = r"[A-Za-z0-9]+"
+ANAT = re.compile(rf"^sub-(?P<sub>{L})(?:_ses-(?P<ses>{L}))?_space-orig_desc-(?P<desc>{L})_"
+                  r"(?P<suffix>dseg\.nii\.gz|dseg\.tsv|dseg\.json|surface\.vtp|report\.json|convergence\.csv)$")
+FIGURE = re.compile(rf"^sub-(?P<sub>{L})(?:_ses-(?P<ses>{L}))?_desc-(?P<desc>{L})_"
+                    r"(?P<suffix>slices|surface3d|convergence)\.png$")
+LOG = re.compile(rf"^sub-(?P<sub>{L})(?:_ses-(?P<ses>{L}))?_desc-(?P<desc>{L})\.log$")
+problems = []
+
+
+def fail(message):
+    problems.append(message)
+
+
+def main():
+    raw, out, expected = sys.argv[1], sys.argv[2], int(sys.argv[3])
+    validator = BIDSValidator()
+    for folder, _, files in os.walk(raw):
+        if "/derivatives" in folder.removeprefix(raw):
+            continue
+        for name in files:
+            path = "/" + os.path.relpath(os.path.join(folder, name), raw)
+            if name.endswith("_T1w.nii.gz") and not validator.is_bids(path):
+                fail(f"raw: {path} is not valid BIDS")
+
+    description = json.load(open(f"{out}/dataset_description.json"))
+    if description.get("DatasetType") != "derivative":
+        fail("dataset_description.json: DatasetType is not derivative")
+    generated = description.get("GeneratedBy") or [{}]
+    if not (generated[0].get("Name") and generated[0].get("Version")):
+        fail("dataset_description.json: GeneratedBy needs Name and Version")
+    if not description.get("BIDSVersion"):
+        fail("dataset_description.json: no BIDSVersion")
+
+    segmentations = 0
+    for folder, dirs, files in os.walk(out):
+        dirs[:] = [d for d in dirs if not d.startswith(".")]  # .snakemake is Snakemake's own
+        relative = os.path.relpath(folder, out)
+        for name in files:
+            path = os.path.join(relative, name)
+            if relative == "." and name in ("dataset_description.json", "segmentations.tsv", "segmentations.json",
+                                            "report.html"):
+                continue
+            parts = relative.split(os.sep)
+            if parts[0] == "logs":
+                match, parts = LOG.match(name), parts[1:]
+                kind = None
+            elif parts[-1] == "anat":
+                match, kind = ANAT.match(name), "anat"
+                parts = parts[:-1]
+            elif parts[-1] == "figures":
+                match, kind = FIGURE.match(name), "figures"
+                parts = parts[:-1]
+            else:
+                match = None
+            if not match:
+                fail(f"{path}: not a BIDS derivative name this workflow writes")
+                continue
+            folders = [f"sub-{match['sub']}"] + ([f"ses-{match['ses']}"] if match["ses"] else [])
+            if parts != folders:
+                fail(f"{path}: its folder does not match its entities {folders}")
+            if kind == "anat" and match["suffix"] == "dseg.nii.gz":
+                segmentations += 1
+                check_dseg(raw, os.path.join(folder, name), match)
+    if segmentations != expected:
+        fail(f"{segmentations} segmentations, expected {expected}")
+    for problem in problems:
+        print("FAIL:", problem)
+    print(f"{segmentations} segmentations checked, {len(problems)} problem(s)")
+    sys.exit(1 if problems else 0)
+
+
+def check_dseg(raw, path, match):
+    stem = path.removesuffix(".nii.gz")
+    for companion in (stem + ".tsv", stem + ".json"):
+        if not os.path.exists(companion):
+            fail(f"{path}: no {os.path.basename(companion)} beside it")
+            return
+    table = list(csv.DictReader(open(stem + ".tsv"), delimiter="\t"))
+    if [list(r.keys()) for r in table][:1] != [["index", "name"]] or len(table) != 1 or \
+            table[0]["name"] != match["desc"]:
+        fail(f"{stem}.tsv: expected columns index, name and one row naming {match['desc']}")
+    sidecar = json.load(open(stem + ".json"))
+    for key in ("Sources", "SpatialReference"):
+        if key not in sidecar:
+            fail(f"{stem}.json: no {key}")
+    source = sidecar.get("SpatialReference", "").removeprefix("bids:raw:")
+    t1w = nibabel.load(os.path.join(raw, source))
+    labels = nibabel.load(path)
+    if labels.shape != t1w.shape or not numpy.allclose(labels.affine, t1w.affine, atol=1e-4):
+        fail(f"{path}: not on the grid of {source}")
+    values = set(numpy.unique(numpy.asanyarray(labels.dataobj)).tolist())
+    if values != {0, int(table[0]["index"])}:
+        fail(f"{path}: values {values}")
+
+
+if __name__ == "__main__":
+    main()
