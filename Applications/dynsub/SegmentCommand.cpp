@@ -181,6 +181,10 @@ void addSegmentCommand(CLI::App& app) {
       ->default_val(o->segment.inflation);
   command->add_option("--margin", o->segment.margin, "Region of interest around the model and landmarks, mm")
       ->default_val(o->segment.margin);
+  command->add_option("--slice-ends", o->segment.sliceEnds.enabled,
+                      "For landmarks on slices: follow the tissue between the clicked slices beyond them and add "
+                      "soft springs where it ends, so that the structure's unclicked ends are reached (true/false)")
+      ->default_val(o->segment.sliceEnds.enabled);
   command->add_option("--seed-window", o->seed.window,
                       "With --init seed: the intensity window grown through, in robust spreads (1.4826 MAD) of "
                       "the intensities near the click either side of their median")

@@ -162,6 +162,21 @@ SegmentRun runSegmentation(const Volume& image, SegmentInputs in, const Progress
                              {"edge_potential", result.seconds.potential},
                              {"evolution", result.seconds.evolution},
                              {"voxelize", result.seconds.voxelize}};
+  if (in.segment.sliceEnds.enabled) {
+    const SliceEnds& ends = result.sliceEnds;
+    nlohmann::ordered_json marched = nlohmann::ordered_json::array();
+    for (const SliceEnd& end : ends.ends)
+      marched.push_back({{"from_lps_mm", {end.start.x(), end.start.y(), end.start.z()}},
+                         {"to_lps_mm", {end.end.x(), end.end.y(), end.end.z()}},
+                         {"length_mm", end.length},
+                         {"stopped_by_reach", end.stoppedByReach}});
+    report["slice_ends"] = {{"axis", ends.axis},
+                            {"slices", ends.slices},
+                            {"median", ends.median},
+                            {"spread", ends.spread},
+                            {"ends", marched},
+                            {"springs", ends.springs.size()}};
+  }
   report["region_of_interest"] = {{"first_voxel", result.regionFirst}, {"size_voxels", result.regionSize}};
   report["initial_volume_mm3"] = result.initialVolume;
   report["surface_volume_mm3"] = result.volume;

@@ -162,10 +162,27 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
           {"elasticity_per_level", &o.simulation.elasticityPerLevel},
           {"tension", &o.simulation.material.tensionU},
           {"rigidity", &o.simulation.material.rigidityUU},
-          {"initial_fraction", &plan.initialFraction}};
+          {"initial_fraction", &plan.initialFraction},
+          {"slice_ends_window", &o.sliceEnds.window},
+          {"slice_ends_disk", &o.sliceEnds.disk},
+          {"slice_ends_reach", &o.sliceEnds.reach},
+          {"slice_ends_gap_mm", &o.sliceEnds.gap},
+          {"slice_ends_stiffness", &o.sliceEnds.stiffness}};
       for (const auto& [name, value] : j.at("segment").items()) {
         if (name == "max_level") {
           o.simulation.maxLevel = value.get<int>();
+          continue;
+        }
+        if (name == "slice_ends") {
+          o.sliceEnds.enabled = value.get<bool>();
+          continue;
+        }
+        if (name == "slice_ends_taper") {
+          o.sliceEnds.taper = value.get<bool>();
+          continue;
+        }
+        if (name == "slice_ends_spring_at_reach") {
+          o.sliceEnds.springAtReach = value.get<bool>();
           continue;
         }
         const auto setting = settings.find(name);

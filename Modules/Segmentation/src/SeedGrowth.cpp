@@ -6,6 +6,7 @@
 #include <limits>
 #include <sstream>
 
+#include "RegionGrowing.h"
 #include "RobustStatistics.h"
 #include "dynsub/Error.h"
 
@@ -14,31 +15,6 @@ namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr double kGuardWindow = 2.5;  // the leak guard's narrower window
-
-// The voxels of `allowed` 6-connected to any of `starts` (which must be allowed).
-std::vector<std::uint8_t> connectedTo(const std::vector<std::uint8_t>& allowed, const ImageGeometry& g,
-                                      std::vector<long long> starts) {
-  std::vector<std::uint8_t> reached(allowed.size(), 0);
-  for (long long start : starts) reached[start] = 1;
-  std::vector<long long> stack = std::move(starts);
-  const long long sx = 1, sy = g.size[0], sz = static_cast<long long>(g.size[0]) * g.size[1];
-  while (!stack.empty()) {
-    const long long o = stack.back();
-    stack.pop_back();
-    const int i = static_cast<int>(o % sy), j = static_cast<int>((o / sy) % g.size[1]),
-              k = static_cast<int>(o / sz);
-    const std::pair<bool, long long> neighbours[6] = {{i > 0, o - sx},           {i + 1 < g.size[0], o + sx},
-                                                      {j > 0, o - sy},           {j + 1 < g.size[1], o + sy},
-                                                      {k > 0, o - sz},           {k + 1 < g.size[2], o + sz}};
-    for (const auto& [inside, n] : neighbours)
-      if (inside && allowed[n] && !reached[n]) {
-        reached[n] = 1;
-        stack.push_back(n);
-      }
-  }
-  return reached;
-}
-
 
 }  // namespace
 
@@ -125,17 +101,12 @@ std::vector<std::uint8_t> growThrough(const SeedBox& box, double low, double hig
 void shapeRegion(const SeedBox& box, const std::vector<std::uint8_t>& grown, double opening, int boundaryPoints,
                  SeedRegion& region) {
   const ImageGeometry& g = box.image.geometry;
-  const long long n = g.voxelCount();
   const long long seed = box.seedOffset;
   const auto [si, sj, sk] = box.seed;
   // 3. Opening.
   std::vector<std::uint8_t> kept = grown;
   if (opening > 0) {
-    Mask outside{g, std::vector<std::uint8_t>(n)};
-    for (long long o = 0; o < n; ++o) outside.voxels[o] = !grown[o];
-    const std::vector<float> depth = distanceTo(outside);
-    std::vector<std::uint8_t> core(n);
-    for (long long o = 0; o < n; ++o) core[o] = grown[o] && depth[o] > opening;
+    const std::vector<std::uint8_t> core = coreOf(grown, g, opening);
     // The core voxel nearest the click, within the opening's reach of it.
     long long start = -1;
     double nearest = kInfinity;
@@ -157,66 +128,20 @@ void shapeRegion(const SeedBox& box, const std::vector<std::uint8_t>& grown, dou
     if (start < 0)
       throw Error("the tissue at the seed is thinner than the seed's opening (" + std::to_string(opening) +
                   " mm): click deeper inside the structure, or lower the opening");
-    const std::vector<float> away = distanceTo(Mask{g, connectedTo(core, g, {start})});
-    for (long long o = 0; o < n; ++o) kept[o] = grown[o] && away[o] <= opening;
+    kept = openFrom(grown, core, g, opening, {start});
   }
 
-  // 4. Holes: what the box's border cannot reach through the outside.
-  {
-    std::vector<std::uint8_t> outside(n);
-    std::vector<long long> border;
-    for (int k = 0; k < g.size[2]; ++k)
-      for (int j = 0; j < g.size[1]; ++j)
-        for (int i = 0; i < g.size[0]; ++i) {
-          const long long o = g.offset(i, j, k);
-          outside[o] = !kept[o];
-          if (outside[o] && (i == 0 || j == 0 || k == 0 || i + 1 == g.size[0] || j + 1 == g.size[1] ||
-                             k + 1 == g.size[2]))
-            border.push_back(o);
-        }
-    const std::vector<std::uint8_t> reached = connectedTo(outside, g, std::move(border));
-    for (long long o = 0; o < n; ++o) kept[o] = !reached[o];
-  }
+  // 4. Holes.
+  kept = fillHoles(kept, g);
 
   // The boundary, and whether the region touches its box.
-  std::vector<Vector3> faces;
-  region.touchesReach = false;
-  for (int k = 0; k < g.size[2]; ++k)
-    for (int j = 0; j < g.size[1]; ++j)
-      for (int i = 0; i < g.size[0]; ++i) {
-        if (!kept[g.offset(i, j, k)]) continue;
-        const int step[6][3] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
-        for (const auto& s : step) {
-          const int a = i + s[0], b = j + s[1], c = k + s[2];
-          if (!g.contains(a, b, c)) {  // the box's side: the voxel itself (its face may be the image's edge)
-            region.touchesReach = true;
-            faces.push_back(g.toPhysical(Vector3(i, j, k)));
-            continue;
-          }
-          if (!kept[g.offset(a, b, c)])
-            faces.push_back(g.toPhysical(Vector3(i + 0.5 * s[0], j + 0.5 * s[1], k + 0.5 * s[2])));
-        }
-      }
+  const std::vector<Vector3> faces = boundaryFaces(kept, g, &region.touchesReach);
   if (faces.size() < 4) throw Error("the region grown from the seed is too small to start a surface from");
   region.mask = Mask{g, std::move(kept)};
-
-  // Farthest-point sampling from the boundary point nearest the click.
-  std::vector<double> gap(faces.size(), kInfinity);
-  std::size_t next = 0;
-  for (std::size_t f = 1; f < faces.size(); ++f)
-    if ((faces[f] - region.click).squaredNorm() < (faces[next] - region.click).squaredNorm()) next = f;
-  const std::size_t keep = std::min<std::size_t>(faces.size(), boundaryPoints);
   region.boundary.clear();
-  for (std::size_t taken = 0; taken < keep; ++taken) {
-    region.boundary.push_back({"seed boundary " + std::to_string(taken + 1), faces[next]});
-    gap[next] = 0;
-    std::size_t farthest = 0;
-    for (std::size_t f = 0; f < faces.size(); ++f) {
-      gap[f] = std::min(gap[f], (faces[f] - faces[next]).squaredNorm());
-      if (gap[f] > gap[farthest]) farthest = f;
-    }
-    next = farthest;
-  }
+  const std::vector<Vector3> spread = farthestPointSample(faces, region.click, boundaryPoints);
+  for (std::size_t p = 0; p < spread.size(); ++p)
+    region.boundary.push_back({"seed boundary " + std::to_string(p + 1), spread[p]});
 }
 
 }  // namespace

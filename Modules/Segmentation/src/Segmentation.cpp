@@ -109,6 +109,7 @@ void checkSegmentOptions(const SegmentOptions& options) {
   };
   finiteNonNegative(options.imageForce, "image force");
   finiteNonNegative(options.landmarkStiffness, "landmark stiffness");
+  checkSliceEndOptions(options.sliceEnds);
   finiteNonNegative(options.margin, "margin");
   finiteNonNegative(options.landmarkTolerance, "landmark tolerance");
   if (!std::isfinite(options.inflation)) throw Error("inflation must be finite");
@@ -144,7 +145,8 @@ std::vector<double> distancesToSurface(const LimitSurface& surface, const Matrix
 }
 
 SegmentationRegion::SegmentationRegion(const Volume& image, const std::vector<Landmark>& landmarks,
-                                       const ControlMesh& initial, const SegmentOptions& options) {
+                                       const ControlMesh& initial, const SegmentOptions& options,
+                                       const std::vector<Landmark>& alsoCover) {
   checkSegmentOptions(options);
   if (!initial.isClosed()) throw Error("the initial model must be a closed control mesh");
   const ImageGeometry& grid = image.geometry;
@@ -163,8 +165,9 @@ SegmentationRegion::SegmentationRegion(const Volume& image, const std::vector<La
 
   auto clock = Clock::now();
   const Matrix3X landmarkPoints = landmarkPositions(landmarks);
-  Matrix3X extent(start.rows() + landmarkPoints.rows(), 3);
-  extent << start, landmarkPoints;
+  const Matrix3X coverPoints = landmarkPositions(alsoCover);
+  Matrix3X extent(start.rows() + landmarkPoints.rows() + coverPoints.rows(), 3);
+  extent << start, landmarkPoints, coverPoints;
   std::tie(first_, size_) = boundingRegion(grid, extent, options.margin);
   image_ = cropVolume(image, first_, size_);
   const Volume& region = image_;
@@ -240,8 +243,17 @@ SegmentResult evolveInRegion(const SegmentationRegion& region, const std::vector
 SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmarks, const ControlMesh& initial,
                       const SegmentOptions& options, const ProgressCallback& progress,
                       const std::vector<ForceModel*>& extraForces) {
-  const SegmentationRegion region(image, landmarks, initial, options);
-  SegmentResult result = evolveInRegion(region, landmarks, initial, {}, options, progress, extraForces);
+  // Soft springs at the structure's ends beyond the clicked slices (SliceEnds.h).
+  SliceEnds ends;
+  if (options.sliceEnds.enabled) ends = findSliceEnds(image, landmarks, initial, options.sliceEnds);
+  const SegmentationRegion region(image, landmarks, initial, options, ends.springs);
+  const Matrix3X endPoints = landmarkPositions(ends.springs);
+  SpringForceModel endSprings(endPoints, Eigen::VectorXd::Constant(endPoints.rows(), options.sliceEnds.stiffness),
+                              SpringForceModel::Attach::NearestEachStep);
+  std::vector<ForceModel*> forces = extraForces;
+  if (endPoints.rows() > 0) forces.push_back(&endSprings);
+  SegmentResult result = evolveInRegion(region, landmarks, initial, {}, options, progress, forces);
+  result.sliceEnds = std::move(ends);
 
   const auto clock = Clock::now();
   const LimitSurface surface(result.mesh);

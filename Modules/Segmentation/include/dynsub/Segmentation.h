@@ -25,6 +25,7 @@
 #include "dynsub/EdgePotential.h"
 #include "dynsub/Landmarks.h"
 #include "dynsub/Simulation.h"
+#include "dynsub/SliceEnds.h"
 #include "dynsub/Volume.h"
 
 namespace dynsub {
@@ -43,6 +44,9 @@ struct SegmentOptions {
   double regionPressure = 0.0;
   double regionWindow = 2.0;
   double margin = 8.0;             // mm around the model and the landmarks
+  // Soft springs where the tissue between the clicked slices ends beyond
+  // them (SliceEnds.h), for landmarks placed on slices.
+  SliceEndOptions sliceEnds;
   SimulationOptions simulation = defaultSimulation();
 
   static SimulationOptions defaultSimulation();
@@ -84,6 +88,7 @@ struct SegmentResult {
   // order): the distance to the nearest edge (mm), -1 outside the region
   // where it is unknown. Empty for the plain gradient potential.
   Eigen::VectorXd surfaceEdgeDistances;
+  SliceEnds sliceEnds;  // what options.sliceEnds found (no springs when off)
   std::vector<std::string> warnings;
 };
 
@@ -97,10 +102,11 @@ constexpr double kLeakedAbove = 0.05;
 class SegmentationRegion {
  public:
   // The bounding box of the initial model's limit surface and the landmarks,
-  // grown by options.margin mm; the landmarks set the edge thresholds. Throws
+  // grown by options.margin mm; the landmarks set the edge thresholds. The
+  // box also holds `alsoCover` (e.g. soft springs), which set nothing. Throws
   // as segment() does when a landmark or the model lies outside the image.
   SegmentationRegion(const Volume& image, const std::vector<Landmark>& landmarks, const ControlMesh& initial,
-                     const SegmentOptions& options);
+                     const SegmentOptions& options, const std::vector<Landmark>& alsoCover = {});
 
   // Whether every point lies inside the region's grid (a refit beyond it
   // needs a new region: the edge directions are zero outside).

@@ -1,0 +1,74 @@
+#pragma once
+// Landmarks placed on slices leave a structure's ends unclicked: experts
+// seldom click its first and last few slices. With no force there, the
+// surface's tension pulls it back to the outermost clicked slice, whatever
+// it started from. This looks for where the structure ends beyond them and
+// puts a soft spring there, at each end:
+//  1. The slices: the image axis along which the landmarks take the fewest
+//     distinct positions (at least 2, at most a third of the landmarks);
+//     landmarks that are not on slices of the image get no springs.
+//  2. Appearance: the median m and robust spread s (1.4826 MAD) of the
+//     intensities inside the initial model.
+//  3. At each end, from the centroid of the outermost slice's landmarks
+//     (at least 3 of them), a march outward along the slice axis in steps
+//     of half a voxel: at each step the median intensity of a disk across
+//     the axis (radius `disk` times the landmarks' rms distance from their
+//     centroid, at least one voxel). The march stops where that median has
+//     left m +- window s for two steps running, at most `reach` times the
+//     clicked span beyond the slice (experts leave some 10-20 % of a
+//     structure unclicked at each end).
+//  4. Where the march went more than `gap` mm and stopped at a change of
+//     intensity (not at its reach, where it found no end: the structure may
+//     go on in like tissue, as a cerebellar hemisphere does across the
+//     midline), a spring of `stiffness` pulls the surface to its last step
+//     inside; with `taper`, the end slice's clicks are also copied halfway
+//     there, drawn in toward their centroid by sqrt(3/4) as an ellipsoid's
+//     cross-section narrows, as springs.
+// A march through the structure's own tissue is what a one-dimensional
+// region growth from the clicked end sees; it cannot leak sideways into
+// like tissue the way a grown volume does.
+#include <string>
+#include <vector>
+
+#include "dynsub/ControlMesh.h"
+#include "dynsub/Landmarks.h"
+#include "dynsub/Volume.h"
+
+namespace dynsub {
+
+// The defaults were chosen on the evaluation plan's tuning split
+// (Documentation/Segmentation.md).
+struct SliceEndOptions {
+  bool enabled = true;
+  double window = 2.5;      // robust spreads either side of the median
+  double disk = 0.3;        // the disk's radius, a fraction of the end slice's rms radius
+  double reach = 0.5;       // the march's longest, a fraction of the clicked span
+  double gap = 2.0;         // mm: no spring for a shorter march
+  double stiffness = 10.0;  // N/mm per spring
+  bool taper = true;        // also springs halfway, the end slice's clicks drawn in (an ellipsoid's taper)
+  bool springAtReach = false;  // a spring also where the march ended at its reach, not at an intensity change
+};
+
+struct SliceEnd {
+  Vector3 start = Vector3::Zero();  // the outermost slice's centroid (LPS mm)
+  Vector3 end = Vector3::Zero();    // the march's last step inside
+  double length = 0;                // mm
+  bool stoppedByReach = false;      // the intensity never left the window
+};
+
+struct SliceEnds {
+  int axis = -1;  // the image axis of the slices; -1 when the landmarks are not on slices
+  int slices = 0;
+  double median = 0, spread = 0;
+  std::vector<SliceEnd> ends;     // the ends marched from (0, 1 or 2)
+  std::vector<Landmark> springs;  // for each end that went more than `gap`: its tip (and taper)
+};
+
+void checkSliceEndOptions(const SliceEndOptions& options);
+
+// Throws dynsub::Error on impossible options. Returns no springs (axis -1)
+// for fewer than 4 landmarks or landmarks not on slices.
+SliceEnds findSliceEnds(const Volume& image, const std::vector<Landmark>& landmarks, const ControlMesh& initial,
+                        const SliceEndOptions& options);
+
+}  // namespace dynsub

@@ -1,0 +1,114 @@
+#include "RegionGrowing.h"
+
+#include <algorithm>
+#include <limits>
+#include <utility>
+
+namespace dynsub {
+
+std::vector<std::uint8_t> connectedTo(const std::vector<std::uint8_t>& allowed, const ImageGeometry& g,
+                                      std::vector<long long> starts) {
+  std::vector<std::uint8_t> reached(allowed.size(), 0);
+  for (long long start : starts) reached[start] = 1;
+  std::vector<long long> stack = std::move(starts);
+  const long long sx = 1, sy = g.size[0], sz = static_cast<long long>(g.size[0]) * g.size[1];
+  while (!stack.empty()) {
+    const long long o = stack.back();
+    stack.pop_back();
+    const int i = static_cast<int>(o % sy), j = static_cast<int>((o / sy) % g.size[1]),
+              k = static_cast<int>(o / sz);
+    const std::pair<bool, long long> neighbours[6] = {{i > 0, o - sx},           {i + 1 < g.size[0], o + sx},
+                                                      {j > 0, o - sy},           {j + 1 < g.size[1], o + sy},
+                                                      {k > 0, o - sz},           {k + 1 < g.size[2], o + sz}};
+    for (const auto& [inside, n] : neighbours)
+      if (inside && allowed[n] && !reached[n]) {
+        reached[n] = 1;
+        stack.push_back(n);
+      }
+  }
+  return reached;
+}
+
+std::vector<std::uint8_t> coreOf(const std::vector<std::uint8_t>& grown, const ImageGeometry& g, double radius) {
+  const long long n = g.voxelCount();
+  Mask outside{g, std::vector<std::uint8_t>(n)};
+  for (long long o = 0; o < n; ++o) outside.voxels[o] = !grown[o];
+  const std::vector<float> depth = distanceTo(outside);
+  std::vector<std::uint8_t> core(n);
+  for (long long o = 0; o < n; ++o) core[o] = grown[o] && depth[o] > radius;
+  return core;
+}
+
+std::vector<std::uint8_t> openFrom(const std::vector<std::uint8_t>& grown, const std::vector<std::uint8_t>& core,
+                                   const ImageGeometry& g, double radius, std::vector<long long> coreStarts) {
+  const std::vector<float> away = distanceTo(Mask{g, connectedTo(core, g, std::move(coreStarts))});
+  std::vector<std::uint8_t> kept(grown.size());
+  for (std::size_t o = 0; o < grown.size(); ++o) kept[o] = grown[o] && away[o] <= radius;
+  return kept;
+}
+
+std::vector<std::uint8_t> fillHoles(const std::vector<std::uint8_t>& region, const ImageGeometry& g) {
+  const long long n = g.voxelCount();
+  std::vector<std::uint8_t> outside(n);
+  std::vector<long long> border;
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i) {
+        const long long o = g.offset(i, j, k);
+        outside[o] = !region[o];
+        if (outside[o] && (i == 0 || j == 0 || k == 0 || i + 1 == g.size[0] || j + 1 == g.size[1] ||
+                           k + 1 == g.size[2]))
+          border.push_back(o);
+      }
+  const std::vector<std::uint8_t> reached = connectedTo(outside, g, std::move(border));
+  std::vector<std::uint8_t> filled(n);
+  for (long long o = 0; o < n; ++o) filled[o] = !reached[o];
+  return filled;
+}
+
+std::vector<Vector3> boundaryFaces(const std::vector<std::uint8_t>& region, const ImageGeometry& g,
+                                   bool* touchesSide) {
+  std::vector<Vector3> faces;
+  *touchesSide = false;
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i) {
+        if (!region[g.offset(i, j, k)]) continue;
+        const int step[6][3] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
+        for (const auto& s : step) {
+          const int a = i + s[0], b = j + s[1], c = k + s[2];
+          if (!g.contains(a, b, c)) {  // the grid's side: the voxel itself (its face may be the image's edge)
+            *touchesSide = true;
+            faces.push_back(g.toPhysical(Vector3(i, j, k)));
+            continue;
+          }
+          if (!region[g.offset(a, b, c)])
+            faces.push_back(g.toPhysical(Vector3(i + 0.5 * s[0], j + 0.5 * s[1], k + 0.5 * s[2])));
+        }
+      }
+  return faces;
+}
+
+std::vector<Vector3> farthestPointSample(const std::vector<Vector3>& points, const Vector3& start,
+                                         std::size_t count) {
+  std::vector<Vector3> taken;
+  if (points.empty()) return taken;
+  std::vector<double> gap(points.size(), std::numeric_limits<double>::infinity());
+  std::size_t next = 0;
+  for (std::size_t f = 1; f < points.size(); ++f)
+    if ((points[f] - start).squaredNorm() < (points[next] - start).squaredNorm()) next = f;
+  const std::size_t keep = std::min(points.size(), count);
+  while (taken.size() < keep) {
+    taken.push_back(points[next]);
+    gap[next] = 0;
+    std::size_t farthest = 0;
+    for (std::size_t f = 0; f < points.size(); ++f) {
+      gap[f] = std::min(gap[f], (points[f] - points[next]).squaredNorm());
+      if (gap[f] > gap[farthest]) farthest = f;
+    }
+    next = farthest;
+  }
+  return taken;
+}
+
+}  // namespace dynsub

@@ -1,0 +1,161 @@
+#include "dynsub/SliceEnds.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "RobustStatistics.h"
+#include "dynsub/Error.h"
+#include "dynsub/LimitSurface.h"
+#include "dynsub/Tessellation.h"
+#include "dynsub/Voxelize.h"
+
+namespace dynsub {
+namespace {
+
+constexpr double kOnSlice = 0.25;  // voxels: landmarks this close along the axis share a slice
+
+// Step 1: the axis whose landmark positions (continuous voxel index) fall on
+// the fewest distinct slices, or -1.
+int sliceAxis(const std::vector<Vector3>& index, int* slices) {
+  int best = -1, fewest = static_cast<int>(index.size()) / 3 + 1;
+  for (int a = 0; a < 3; ++a) {
+    std::vector<double> along;
+    for (const Vector3& p : index) along.push_back(p(a));
+    std::sort(along.begin(), along.end());
+    int distinct = 1;
+    for (std::size_t i = 1; i < along.size(); ++i) distinct += along[i] - along[i - 1] > kOnSlice;
+    if (distinct >= 2 && distinct < fewest) {
+      fewest = distinct;
+      best = a;
+    }
+  }
+  *slices = best >= 0 ? fewest : 0;
+  return best;
+}
+
+// Step 2: the median and spread inside the initial model, on the image
+// cropped to the model's box.
+RobustStatistics insideModel(const Volume& image, const ControlMesh& initial) {
+  const TriangleSurface model = tessellate(LimitSurface(initial), initial.points(), 4);
+  const ImageGeometry& g = image.geometry;
+  std::array<int, 3> first{}, size{};
+  Vector3 low = Vector3::Constant(1e300), high = Vector3::Constant(-1e300);
+  for (Eigen::Index p = 0; p < model.points.rows(); ++p) {
+    const Vector3 index = g.toIndex(model.points.row(p).transpose());
+    low = low.cwiseMin(index);
+    high = high.cwiseMax(index);
+  }
+  for (int a = 0; a < 3; ++a) {
+    first[a] = std::clamp(static_cast<int>(std::floor(low(a))) - 1, 0, g.size[a] - 1);
+    size[a] = std::clamp(static_cast<int>(std::ceil(high(a))) + 2, first[a] + 1, g.size[a]) - first[a];
+  }
+  const Volume box = cropVolume(image, first, size);
+  const Mask inside = voxelizeSurface(model.points, model.triangles, box.geometry);
+  std::vector<double> values;
+  for (std::size_t o = 0; o < inside.voxels.size(); ++o)
+    if (inside.voxels[o]) values.push_back(box.voxels[o]);
+  if (values.empty()) return {std::nan(""), std::nan("")};
+  return robustStatistics(std::move(values));
+}
+
+// The median intensity of a disk across the axis (trilinear, so that the
+// march does not depend on how the disk's points fall between voxels), or
+// NaN when the disk leaves the image.
+double diskMedian(const Volume& image, const Vector3& centre, const Vector3& u, const Vector3& v, double radius,
+                  double step) {
+  const ImageGeometry& g = image.geometry;
+  std::vector<double> values;
+  const int n = static_cast<int>(std::ceil(radius / step));
+  for (int a = -n; a <= n; ++a)
+    for (int b = -n; b <= n; ++b) {
+      if (a * a + b * b > n * n) continue;
+      const Vector3 index = g.toIndex(centre + a * step * u + b * step * v);
+      if (!g.spans(index)) return std::nan("");
+      values.push_back(image.interpolate(index));
+    }
+  return robustStatistics(std::move(values)).median;
+}
+
+}  // namespace
+
+void checkSliceEndOptions(const SliceEndOptions& o) {
+  for (const auto& [value, name] : {std::pair{o.window, "window"}, {o.disk, "disk"}, {o.reach, "reach"},
+                                    {o.stiffness, "stiffness"}})
+    if (!(value > 0) || !std::isfinite(value))
+      throw Error(std::string("the slice ends' ") + name + " must be a finite number > 0");
+  if (!(o.gap >= 0) || !std::isfinite(o.gap)) throw Error("the slice ends' gap must be a finite number >= 0");
+}
+
+SliceEnds findSliceEnds(const Volume& image, const std::vector<Landmark>& landmarks, const ControlMesh& initial,
+                        const SliceEndOptions& options) {
+  checkSliceEndOptions(options);
+  SliceEnds result;
+  if (landmarks.size() < 4) return result;
+  const ImageGeometry& g = image.geometry;
+  std::vector<Vector3> index;
+  for (const Landmark& l : landmarks) index.push_back(g.toIndex(l.position));
+  const int axis = sliceAxis(index, &result.slices);
+  if (axis < 0) return result;
+  result.axis = axis;
+  const RobustStatistics inside = insideModel(image, initial);
+  result.median = inside.median;
+  result.spread = inside.spread;
+  if (!(inside.spread > 0) || !std::isfinite(inside.median)) return result;
+  const double low = inside.median - options.window * inside.spread;
+  const double high = inside.median + options.window * inside.spread;
+
+  double first = index[0](axis), last = index[0](axis);
+  for (const Vector3& p : index) {
+    first = std::min(first, p(axis));
+    last = std::max(last, p(axis));
+  }
+  const Vector3 along = g.direction.col(axis).normalized();
+  const Vector3 u = g.direction.col((axis + 1) % 3).normalized(), v = g.direction.col((axis + 2) % 3).normalized();
+  const double spacing = g.spacing(axis), span = (last - first) * spacing;
+  const double step = 0.5 * g.spacing.minCoeff();
+  for (const auto& [slice, outward] : {std::pair{first, -1.0}, {last, 1.0}}) {
+    // Step 3: the end slice's landmarks, their centroid and rms radius.
+    std::vector<Vector3> onSlice;
+    for (std::size_t i = 0; i < landmarks.size(); ++i)
+      if (std::abs(index[i](axis) - slice) <= kOnSlice) onSlice.push_back(landmarks[i].position);
+    if (onSlice.size() < 3) continue;
+    Vector3 centre = Vector3::Zero();
+    for (const Vector3& p : onSlice) centre += p;
+    centre /= static_cast<double>(onSlice.size());
+    double squared = 0;
+    for (const Vector3& p : onSlice) squared += (p - centre).squaredNorm();
+    const double radius = std::max(g.spacing.maxCoeff(), options.disk * std::sqrt(squared / onSlice.size()));
+    SliceEnd end;
+    end.start = end.end = centre;
+    const double longest = options.reach * span;
+    int outside = 0;
+    double reached = 0;
+    for (double t = step; t <= longest; t += step) {
+      const double m = diskMedian(image, centre + outward * t * along, u, v, radius, step);
+      if (!std::isfinite(m)) break;
+      if (m < low || m > high) {
+        if (++outside == 2) break;
+      } else {
+        outside = 0;
+        reached = t;
+      }
+    }
+    end.stoppedByReach = outside < 2 && reached + 2 * step > longest;
+    end.length = reached;
+    end.end = centre + outward * reached * along;
+    result.ends.push_back(end);
+    // Step 4.
+    if (reached > options.gap && (!end.stoppedByReach || options.springAtReach)) {
+      const std::string name = outward < 0 ? "slice end (first)" : "slice end (last)";
+      result.springs.push_back({name, end.end});
+      // Halfway, the end slice's clicks drawn in as an ellipsoid's cross-section narrows.
+      if (options.taper)
+        for (const Vector3& p : onSlice)
+          result.springs.push_back({name + " taper", centre + std::sqrt(0.75) * (p - centre) +
+                                                         outward * 0.5 * reached * along});
+    }
+  }
+  return result;
+}
+
+}  // namespace dynsub
