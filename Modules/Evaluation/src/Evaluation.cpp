@@ -168,21 +168,16 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
           {"slice_ends_reach", &o.sliceEnds.reach},
           {"slice_ends_gap_mm", &o.sliceEnds.gap},
           {"slice_ends_stiffness", &o.sliceEnds.stiffness}};
+      const std::map<std::string, bool*> switches = {{"slice_ends", &o.sliceEnds.enabled},
+                                                     {"slice_ends_taper", &o.sliceEnds.taper},
+                                                     {"slice_ends_spring_at_reach", &o.sliceEnds.springAtReach}};
       for (const auto& [name, value] : j.at("segment").items()) {
         if (name == "max_level") {
           o.simulation.maxLevel = value.get<int>();
           continue;
         }
-        if (name == "slice_ends") {
-          o.sliceEnds.enabled = value.get<bool>();
-          continue;
-        }
-        if (name == "slice_ends_taper") {
-          o.sliceEnds.taper = value.get<bool>();
-          continue;
-        }
-        if (name == "slice_ends_spring_at_reach") {
-          o.sliceEnds.springAtReach = value.get<bool>();
+        if (const auto setting = switches.find(name); setting != switches.end()) {
+          *setting->second = value.get<bool>();
           continue;
         }
         const auto setting = settings.find(name);
