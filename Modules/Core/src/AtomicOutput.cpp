@@ -1,8 +1,14 @@
 #include "dynsub/AtomicOutput.h"
 
-#include <filesystem>
-#include <system_error>
+#include <signal.h>
 #include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cctype>
+#include <filesystem>
+#include <string>
+#include <system_error>
 
 #include "dynsub/Error.h"
 
@@ -10,18 +16,54 @@ namespace fs = std::filesystem;
 
 namespace dynsub {
 
+namespace {
+
+std::string temporaryPrefix(long pid) { return ".tmp-" + std::to_string(pid) + "-"; }
+
+// Removes the temporary files a killed run left for `name` in `directory`:
+// ".tmp-<pid>-<name>" whose process no longer exists. A live process's are
+// kept (a concurrent run's, or an unrelated process that took over the pid).
+void removeStaleTemporaries(const fs::path& directory, const std::string& name) {
+  std::error_code error;
+  for (fs::directory_iterator entry(directory.empty() ? "." : directory, error), end; !error && entry != end;
+       entry.increment(error)) {
+    const std::string file = entry->path().filename().string();
+    if (file.size() <= name.size() + 6 || file.compare(0, 5, ".tmp-") != 0 ||
+        file.compare(file.size() - name.size() - 1, name.size() + 1, "-" + name) != 0)
+      continue;
+    const std::string digits = file.substr(5, file.size() - name.size() - 6);
+    if (digits.empty() || digits.size() > 9 ||
+        !std::all_of(digits.begin(), digits.end(), [](unsigned char c) { return std::isdigit(c); }))
+      continue;
+    const long pid = std::stol(digits);
+    if (pid == ::getpid() || ::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
+    std::error_code ignored;
+    fs::remove(entry->path(), ignored);
+  }
+}
+
+}  // namespace
+
 AtomicOutput::AtomicOutput(std::string target) : target_(std::move(target)) {
   requireWritableDirectoryFor(target_);
   const fs::path path(target_);
+  const std::string name = path.filename().string();
+  const std::string prefix = temporaryPrefix(::getpid());
+  if (name.compare(0, prefix.size(), prefix) == 0) {
+    // The target is already this process's temporary file (a writer handed the
+    // path of an enclosing output set): it is written in place, and the
+    // enclosing output makes it appear.
+    temporary_ = target_;
+    return;
+  }
+  removeStaleTemporaries(path.parent_path(), name);
   // The process id keeps two concurrent runs from sharing a temporary file; the
   // name ends with the target's file name, so writers still see its extension.
-  temporary_ = (path.parent_path() /
-                (".tmp-" + std::to_string(::getpid()) + "-" + path.filename().string()))
-                   .string();
+  temporary_ = (path.parent_path() / (prefix + name)).string();
 }
 
 AtomicOutput::~AtomicOutput() {
-  if (!committed_) {
+  if (!committed_ && temporary_ != target_) {
     std::error_code ignored;
     fs::remove(temporary_, ignored);
   }
@@ -32,7 +74,7 @@ void AtomicOutput::commit() {
   if (!fs::exists(temporary_, error)) {
     throw Error(target_, "the writer produced no output");
   }
-  fs::rename(temporary_, target_, error);
+  if (temporary_ != target_) fs::rename(temporary_, target_, error);
   if (error) {
     throw Error(target_, "cannot move the finished output into place: " + error.message());
   }

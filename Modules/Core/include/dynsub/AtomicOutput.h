@@ -3,6 +3,12 @@
 // content goes to a temporary file beside the target, which is renamed onto the
 // target by commit(). If commit() is never called (an exception, a failed
 // check), the destructor removes the temporary file and the target is untouched.
+//
+// The temporary file is ".tmp-<pid>-<name>". Those of runs that were killed
+// (their process is gone) are removed when the next output of that name is
+// opened. A target that is already this process's temporary file (a writer
+// given the path of an enclosing output) is written in place: the enclosing
+// output removes it or makes it appear.
 #include <string>
 
 namespace dynsub {
