@@ -261,6 +261,7 @@ def group_rows(jobs, out):
         log = log_path(out, job.dir, job.stem, job.structure)
         if all(os.path.exists(p) for p in paths.values()):
             report = json.load(open(paths["report"]))
+            row["report"] = report  # not a column: for the QC page (qc_report.py)
             row.update(status="ok", dseg=_relative(paths["dseg"], out),
                        warnings="; ".join(report.get("warnings", [])) or "n/a")
             for column in ("volume_mm3", "dice", "mean_surface_distance_mm", "hd95_mm", "control_vertices",
@@ -285,7 +286,7 @@ def write_group_table(jobs, out, table):
         writer = csv.DictWriter(f, fieldnames=list(GROUP_COLUMNS), delimiter="\t", lineterminator="\n")
         writer.writeheader()
         for row in rows:
-            writer.writerow({k: str(v).replace("\t", " ").replace("\n", " ") for k, v in row.items()})
+            writer.writerow({k: str(row[k]).replace("\t", " ").replace("\n", " ") for k in GROUP_COLUMNS})
     os.replace(temporary, table)
     with open(table.removesuffix(".tsv") + ".json", "w") as f:
         json.dump({c: {"Description": d} for c, d in GROUP_COLUMNS.items()}, f, indent=2)

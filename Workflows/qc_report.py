@@ -13,7 +13,6 @@ Flags (the reasons a row is marked for a look):
 """
 import base64
 import html
-import json
 import math
 import os
 import statistics
@@ -54,8 +53,7 @@ def flagged_rows(jobs, out):
         if row["status"] != "ok":
             row["flags"].append("failed")
             continue
-        report = json.load(open(bids.output_paths(out, job.dir, job.stem, job.structure)["report"]))
-        row["report"] = report
+        report = row["report"]
         row["rms_residual_mm"] = _rms_residual(report)
         if report.get("warnings"):
             row["flags"].append("warnings")

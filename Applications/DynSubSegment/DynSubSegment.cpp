@@ -24,9 +24,7 @@
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
 #include "dynsub/ImageIO.h"
-#include "dynsub/LimitSurface.h"
 #include "dynsub/SurfaceWriter.h"
-#include "dynsub/Tessellation.h"
 
 namespace {
 
@@ -236,9 +234,7 @@ void run(Arguments a) {
     writeMask(run.result.labelmap, outputs.back()->temporaryPath(), static_cast<std::uint8_t>(a.labelValue));
   }
   if (!a.model.empty()) {
-    const Matrix3X control = run.result.mesh.points();
-    if (!control.allFinite()) throw Error("internal: the control points are not finite; nothing was written");
-    const TriangleSurface triangles = tessellate(LimitSurface(run.result.mesh), control, 8);
+    const TriangleSurface triangles = app::outputSurface(run.result.mesh);
     std::vector<PointScalars> scalars;
     if (run.result.surfaceEdgeDistances.size()) scalars.push_back({"edge_distance_mm", run.result.surfaceEdgeDistances});
     outputs.push_back(std::make_unique<AtomicOutput>(a.model));

@@ -171,12 +171,16 @@ void writeJson(const nlohmann::ordered_json& json, const std::string& path) {
   if (!out) throw Error(path, "could not be written");
 }
 
+TriangleSurface outputSurface(const ControlMesh& mesh) {
+  const Matrix3X control = mesh.points();
+  if (!control.allFinite()) throw Error("internal: the control points are not finite; nothing was written");
+  return tessellate(LimitSurface(mesh), control, 8);
+}
+
 void writeModelOutputs(const std::filesystem::path& dir, const ControlMesh& mesh,
                        const nlohmann::ordered_json& report, const std::function<void(OutputSet&)>& extra,
                        const std::vector<PointScalars>& surfaceScalars, const std::string& space) {
-  const Matrix3X control = mesh.points();
-  if (!control.allFinite()) throw Error("internal: the control points are not finite; nothing was written");
-  const TriangleSurface triangles = tessellate(LimitSurface(mesh), control, 8);
+  const TriangleSurface triangles = outputSurface(mesh);
   OutputSet outputs(dir);
   writeTriangleSurface(triangles, outputs.add("surface.vtp"), surfaceScalars, space);
   writeObj(mesh, outputs.add("control_mesh.obj"));

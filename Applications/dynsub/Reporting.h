@@ -70,6 +70,10 @@ class OutputSet {
 
 void writeJson(const nlohmann::ordered_json& json, const std::string& path);
 
+// The limit surface as the programs write it: 8 x 8 squares per element.
+// Throws dynsub::Error if the control points are not finite.
+TriangleSurface outputSurface(const ControlMesh& mesh);
+
 // The outputs of a simulation, all or none: DIR/surface.vtp (the limit
 // surface, 8 x 8 squares per element), DIR/control_mesh.obj, DIR/report.json.
 // Throws dynsub::Error if the control points are not finite.

@@ -5,7 +5,11 @@
 // appearance both the region pressure and the seed's growth learn.
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <vector>
+
+#include "dynsub/ControlMesh.h"
+#include "dynsub/Volume.h"
 
 namespace dynsub {
 
@@ -25,5 +29,11 @@ inline RobustStatistics robustStatistics(std::vector<double> values) {
   s.spread = 1.4826 * median(values);
   return s;
 }
+
+// The appearance inside a closed model: the median and spread of the
+// image's intensities at the voxel centres the model's limit surface encloses
+// (voxelized on the part of the grid it covers); none when it encloses no
+// voxel centre.
+std::optional<RobustStatistics> insideIntensities(const Volume& image, const ControlMesh& model);
 
 }  // namespace dynsub

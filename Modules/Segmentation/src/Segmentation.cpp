@@ -67,17 +67,6 @@ class RegionPressureForceModel final : public ForceModel {
   const SurfaceQuadrature* quadrature_ = nullptr;
 };
 
-// The appearance of the region's intensities inside a closed model.
-RobustStatistics insideIntensities(const Volume& region, const ControlMesh& model) {
-  const TriangleSurface s = tessellate(LimitSurface(model), model.points(), 4);
-  const Mask inside = voxelizeSurface(s.points, s.triangles, region.geometry);
-  std::vector<double> values;
-  for (size_t i = 0; i < inside.voxels.size(); ++i)
-    if (inside.voxels[i]) values.push_back(region.voxels[i]);
-  if (values.empty()) throw Error("the initial model encloses no voxel of the region: no appearance to learn");
-  return robustStatistics(std::move(values));
-}
-
 Matrix3X limitPoints(const ControlMesh& mesh, int segments) {
   const LimitSurface surface(mesh);
   return tessellate(surface, mesh.points(), segments).points;
@@ -202,8 +191,9 @@ SegmentResult evolveInRegion(const SegmentationRegion& region, const std::vector
   InflationForceModel inflation(options.inflation);
   std::unique_ptr<RegionPressureForceModel> regionPressure;
   if (options.regionPressure != 0) {
-    const RobustStatistics inside = insideIntensities(region.image(), initial);
-    regionPressure = std::make_unique<RegionPressureForceModel>(region.image(), inside.median, inside.spread,
+    const std::optional<RobustStatistics> inside = insideIntensities(region.image(), initial);
+    if (!inside) throw Error("the initial model encloses no voxel of the region: no appearance to learn");
+    regionPressure = std::make_unique<RegionPressureForceModel>(region.image(), inside->median, inside->spread,
                                                                 options.regionPressure, options.regionWindow);
   }
   std::vector<ForceModel*> forces = {&imageForces};

@@ -5,9 +5,6 @@
 
 #include "RobustStatistics.h"
 #include "dynsub/Error.h"
-#include "dynsub/LimitSurface.h"
-#include "dynsub/Tessellation.h"
-#include "dynsub/Voxelize.h"
 
 namespace dynsub {
 namespace {
@@ -31,31 +28,6 @@ int sliceAxis(const std::vector<Vector3>& index, int* slices) {
   }
   *slices = best >= 0 ? fewest : 0;
   return best;
-}
-
-// Step 2: the median and spread inside the initial model, on the image
-// cropped to the model's box.
-RobustStatistics insideModel(const Volume& image, const ControlMesh& initial) {
-  const TriangleSurface model = tessellate(LimitSurface(initial), initial.points(), 4);
-  const ImageGeometry& g = image.geometry;
-  std::array<int, 3> first{}, size{};
-  Vector3 low = Vector3::Constant(1e300), high = Vector3::Constant(-1e300);
-  for (Eigen::Index p = 0; p < model.points.rows(); ++p) {
-    const Vector3 index = g.toIndex(model.points.row(p).transpose());
-    low = low.cwiseMin(index);
-    high = high.cwiseMax(index);
-  }
-  for (int a = 0; a < 3; ++a) {
-    first[a] = std::clamp(static_cast<int>(std::floor(low(a))) - 1, 0, g.size[a] - 1);
-    size[a] = std::clamp(static_cast<int>(std::ceil(high(a))) + 2, first[a] + 1, g.size[a]) - first[a];
-  }
-  const Volume box = cropVolume(image, first, size);
-  const Mask inside = voxelizeSurface(model.points, model.triangles, box.geometry);
-  std::vector<double> values;
-  for (std::size_t o = 0; o < inside.voxels.size(); ++o)
-    if (inside.voxels[o]) values.push_back(box.voxels[o]);
-  if (values.empty()) return {std::nan(""), std::nan("")};
-  return robustStatistics(std::move(values));
 }
 
 // The median intensity of a disk across the axis (trilinear, so that the
@@ -97,12 +69,14 @@ SliceEnds findSliceEnds(const Volume& image, const std::vector<Landmark>& landma
   const int axis = sliceAxis(index, &result.slices);
   if (axis < 0) return result;
   result.axis = axis;
-  const RobustStatistics inside = insideModel(image, initial);
-  result.median = inside.median;
-  result.spread = inside.spread;
-  if (!(inside.spread > 0) || !std::isfinite(inside.median)) return result;
-  const double low = inside.median - options.window * inside.spread;
-  const double high = inside.median + options.window * inside.spread;
+  // Step 2.
+  const std::optional<RobustStatistics> inside = insideIntensities(image, initial);
+  if (!inside) return result;
+  result.median = inside->median;
+  result.spread = inside->spread;
+  if (!(inside->spread > 0) || !std::isfinite(inside->median)) return result;
+  const double low = inside->median - options.window * inside->spread;
+  const double high = inside->median + options.window * inside->spread;
 
   double first = index[0](axis), last = index[0](axis);
   for (const Vector3& p : index) {
