@@ -1,10 +1,8 @@
 // dynsub deform: modeling by forces (TVCG §4.1, Fig. 6): springs from points in
 // space to the nearest points of the limit surface pull it to a new equilibrium.
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
-#include <sstream>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -12,8 +10,8 @@
 #include "Commands.h"
 #include "Reporting.h"
 #include "dynsub/Error.h"
-#include "dynsub/TextFields.h"
 #include "dynsub/ForceModel.h"
+#include "dynsub/SpringFile.h"
 #include "dynsub/MeshIO.h"
 #include "dynsub/Topology.h"
 #include "dynsub/CatmullClark.h"
@@ -31,56 +29,9 @@ struct DeformOptions {
   SimulationArguments simulation;
 };
 
-struct SpringFile {
-  Matrix3X targets;
-  Eigen::VectorXd stiffness;
-};
-
-// Lines "x y z" or "x y z k" (spaces, tabs or commas), '#' comments.
-SpringFile readSprings(const std::string& path, double defaultStiffness) {
-  std::ifstream in(path);
-  if (!std::filesystem::exists(path)) throw Error(path, "no such file");
-  if (!in) throw Error(path, "cannot be opened");
-  std::vector<Eigen::Vector4d> rows;
-  std::string line;
-  int number = 0;
-  while (std::getline(in, line)) {
-    ++number;
-    const size_t comment = line.find('#');
-    if (comment != std::string::npos) line.erase(comment);
-    for (char& c : line) {
-      if (c == ',' || c == ';' || c == '\t' || c == '\r') c = ' ';
-    }
-    std::istringstream fields(line);
-    std::vector<double> values;
-    std::string field;
-    while (fields >> field) {
-      double value = 0;
-      if (!parseNumber(field, value))
-        throw Error(path, "line " + std::to_string(number) + ": '" + field + "' is not a number");
-      values.push_back(value);
-    }
-    if (values.empty()) continue;
-    if (values.size() != 3 && values.size() != 4) {
-      throw Error(path, "line " + std::to_string(number) + ": expected x y z or x y z stiffness");
-    }
-    const Eigen::Vector4d row(values[0], values[1], values[2], values.size() == 4 ? values[3] : defaultStiffness);
-    if (!row.allFinite()) throw Error(path, "line " + std::to_string(number) + ": a value is not finite");
-    if (!(row(3) > 0.0)) throw Error(path, "line " + std::to_string(number) + ": stiffness must be > 0");
-    rows.push_back(row);
-  }
-  if (rows.empty()) throw Error(path, "has no springs");
-  SpringFile result{Matrix3X(rows.size(), 3), Eigen::VectorXd(rows.size())};
-  for (size_t i = 0; i < rows.size(); ++i) {
-    result.targets.row(i) = rows[i].head<3>().transpose();
-    result.stiffness(i) = rows[i](3);
-  }
-  return result;
-}
-
 void runDeform(DeformOptions o) {
   const ControlMesh mesh = readControlMesh(o.mesh);
-  const SpringFile springs = readSprings(o.springs, o.stiffness);
+  const SpringFile springs = readSpringFile(o.springs, o.stiffness);
   const std::filesystem::path dir(o.out);
   prepareOutputDirectory(dir);
   SimulationOptions options = o.simulation.apply(o.simulation.values);

@@ -65,24 +65,31 @@ std::vector<Landmark> readMarkupsJson(const std::string& path, std::ifstream& in
   if (!document.contains("markups") || !document["markups"].is_array())
     throw Error(path, "no \"markups\" list (not a 3D Slicer markups file)");
   std::vector<Landmark> landmarks;
-  for (const auto& markup : document["markups"]) {
-    const std::string system = markup.value("coordinateSystem", "LPS");
-    if (system != "LPS" && system != "RAS") throw Error(path, "unknown coordinateSystem \"" + system + "\"");
-    if (markup.contains("coordinateUnits") && markup["coordinateUnits"] != "mm")
-      throw Error(path, "coordinateUnits must be mm");
-    if (!markup.contains("controlPoints")) continue;
-    int index = 0;
-    for (const auto& point : markup["controlPoints"]) {
-      ++index;
-      if (point.value("positionStatus", "defined") != "defined") continue;
-      const auto& position = point.contains("position") ? point["position"] : nlohmann::json();
-      if (!position.is_array() || position.size() != 3 || !position[0].is_number() || !position[1].is_number() ||
-          !position[2].is_number())
-        throw Error(path, "control point " + std::to_string(index) + " has no [x, y, z] position");
-      Vector3 p(position[0].get<double>(), position[1].get<double>(), position[2].get<double>());
-      if (!p.allFinite()) throw Error(path, "control point " + std::to_string(index) + " is not finite");
-      landmarks.push_back({point.value("label", "F-" + std::to_string(index)), system == "RAS" ? flipXY(p) : p});
+  // A field of another JSON type than the format's (a number for a label, a
+  // markup that is not an object) makes nlohmann::json throw: the file is
+  // malformed, and the message names the file.
+  try {
+    for (const auto& markup : document["markups"]) {
+      const std::string system = markup.value("coordinateSystem", "LPS");
+      if (system != "LPS" && system != "RAS") throw Error(path, "unknown coordinateSystem \"" + system + "\"");
+      if (markup.contains("coordinateUnits") && markup["coordinateUnits"] != "mm")
+        throw Error(path, "coordinateUnits must be mm");
+      if (!markup.contains("controlPoints")) continue;
+      int index = 0;
+      for (const auto& point : markup["controlPoints"]) {
+        ++index;
+        if (point.value("positionStatus", "defined") != "defined") continue;
+        const auto& position = point.contains("position") ? point["position"] : nlohmann::json();
+        if (!position.is_array() || position.size() != 3 || !position[0].is_number() || !position[1].is_number() ||
+            !position[2].is_number())
+          throw Error(path, "control point " + std::to_string(index) + " has no [x, y, z] position");
+        Vector3 p(position[0].get<double>(), position[1].get<double>(), position[2].get<double>());
+        if (!p.allFinite()) throw Error(path, "control point " + std::to_string(index) + " is not finite");
+        landmarks.push_back({point.value("label", "F-" + std::to_string(index)), system == "RAS" ? flipXY(p) : p});
+      }
     }
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(path, std::string("a malformed 3D Slicer markups file: ") + e.what());
   }
   return landmarks;
 }

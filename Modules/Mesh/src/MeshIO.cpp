@@ -1,10 +1,12 @@
 #include "dynsub/MeshIO.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "dynsub/AtomicOutput.h"
@@ -80,7 +82,7 @@ PolygonData readObj(const std::string& path) {
         const long index = parseInteger(corner.substr(0, corner.find('/')), path, line);
         // OBJ indices start at 1; negative ones count back from the last vertex read.
         const long resolved = index > 0 ? index - 1 : static_cast<long>(points.size()) + index;
-        if (index == 0 || resolved < 0) {
+        if (index == 0 || resolved < 0 || resolved > std::numeric_limits<int>::max()) {
           throw Error(path, "line " + std::to_string(line) + ": vertex index " +
                                 std::to_string(index) + " is out of range");
         }
@@ -119,6 +121,11 @@ PolygonData readOff(const std::string& path) {
   const long vertexCount = parseInteger(tokens[0], path, line);
   const long faceCount = parseInteger(tokens[1], path, line);
   if (vertexCount < 0 || faceCount < 0) throw Error(path, "line " + std::to_string(line) + ": negative counts");
+  // Every vertex and face takes at least two bytes: counts beyond the file's
+  // size are a corrupt header, refused before anything is allocated.
+  if (static_cast<std::uintmax_t>(vertexCount) + static_cast<std::uintmax_t>(faceCount) >
+      std::filesystem::file_size(path))
+    throw Error(path, "line " + std::to_string(line) + ": the counts announce more vertices and faces than the file holds");
   PolygonData data;
   data.points.resize(vertexCount, 3);
   for (long v = 0; v < vertexCount; ++v) {
@@ -133,7 +140,12 @@ PolygonData readOff(const std::string& path) {
       throw Error(path, "line " + std::to_string(line) + ": the face lists fewer vertices than it declares");
     }
     Polygon face;
-    for (long k = 0; k < n; ++k) face.push_back(static_cast<int>(parseInteger(tokens[k + 1], path, line)));
+    for (long k = 0; k < n; ++k) {
+      const long index = parseInteger(tokens[k + 1], path, line);
+      if (index < 0 || index > std::numeric_limits<int>::max())
+        throw Error(path, "line " + std::to_string(line) + ": vertex index " + tokens[k + 1] + " is out of range");
+      face.push_back(static_cast<int>(index));
+    }
     data.faces.push_back(std::move(face));
   }
   return data;
@@ -199,7 +211,23 @@ class PlyValueReader {
     return as(double{});
   }
 
+  // A list length or a vertex index: a whole number in [0, limit]. A float
+  // beyond the range of int is refused before it is converted.
+  long readIndex(const std::string& type, long limit, const char* what) {
+    const double value = read(type);
+    if (!(value >= 0 && value <= static_cast<double>(limit)) || value != std::floor(value))
+      throw Error(path_, std::string("PLY ") + what + " " + formatNumber(value) + " is not a whole number from 0 to " +
+                             std::to_string(limit));
+    return static_cast<long>(value);
+  }
+
  private:
+  static std::string formatNumber(double value) {
+    std::ostringstream text;
+    text << value;
+    return text.str();
+  }
+
   std::istream& in_;
   std::string path_;
   bool ascii_;
@@ -227,6 +255,11 @@ PolygonData readPly(const std::string& path) {
       PlyElement element;
       record >> element.name >> element.count;
       if (!record || element.count < 0) throw Error(path, "malformed PLY element line '" + text + "'");
+      // Every element takes at least one byte: a count beyond the file's
+      // size is a corrupt header, refused before anything is allocated.
+      if (static_cast<std::uintmax_t>(element.count) > std::filesystem::file_size(path))
+        throw Error(path, "the PLY header announces " + std::to_string(element.count) + " " + element.name +
+                              " elements, more than the file's size in bytes");
       elements.push_back(element);
     } else if (keyword == "property") {
       if (elements.empty()) throw Error(path, "PLY property before any element");
@@ -267,7 +300,7 @@ PolygonData readPly(const std::string& path) {
         for (size_t p = 0; p < element.properties.size(); ++p) {
           const PlyProperty& property = element.properties[p];
           if (!property.countType.empty()) {
-            const long n = static_cast<long>(reader.read(property.countType));
+            const long n = reader.readIndex(property.countType, std::numeric_limits<int>::max(), "list length");
             for (long k = 0; k < n; ++k) reader.read(property.type);
             continue;
           }
@@ -286,10 +319,12 @@ PolygonData readPly(const std::string& path) {
             reader.read(property.type);
             continue;
           }
-          const long n = static_cast<long>(reader.read(property.countType));
-          if (n < 0) throw Error(path, "negative list length in PLY element '" + element.name + "'");
+          const long n = reader.readIndex(property.countType, std::numeric_limits<int>::max(), "list length");
           Polygon face;
-          for (long k = 0; k < n; ++k) face.push_back(static_cast<int>(reader.read(property.type)));
+          for (long k = 0; k < n; ++k) {
+            if (indices) face.push_back(static_cast<int>(reader.readIndex(property.type, std::numeric_limits<int>::max(), "vertex index")));
+            else reader.read(property.type);
+          }
           if (indices) data.faces.push_back(std::move(face));
         }
       }

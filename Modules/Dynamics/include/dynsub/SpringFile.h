@@ -1,0 +1,22 @@
+#pragma once
+// Spring files for modeling by forces (dynsub deform): one spring per line,
+// "x y z" or "x y z stiffness" (mm, N/mm), separated by spaces, tabs, commas
+// or semicolons; '#' starts a comment.
+#include <string>
+
+#include "dynsub/Types.h"
+
+namespace dynsub {
+
+struct SpringFile {
+  Matrix3X targets;           // one row per spring: the point in space it pulls towards
+  Eigen::VectorXd stiffness;  // N/mm, > 0
+};
+
+// Springs without a stiffness of their own get `defaultStiffness`. Throws
+// dynsub::Error naming the file and line for a missing file, a field that is
+// not a number, a wrong number of fields, a value that is not finite, a
+// stiffness that is not positive, or a file without springs.
+SpringFile readSpringFile(const std::string& path, double defaultStiffness);
+
+}  // namespace dynsub

@@ -1,0 +1,54 @@
+#include "dynsub/SpringFile.h"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include "dynsub/Error.h"
+#include "dynsub/TextFields.h"
+
+namespace dynsub {
+
+SpringFile readSpringFile(const std::string& path, double defaultStiffness) {
+  std::ifstream in(path);
+  if (!std::filesystem::exists(path)) throw Error(path, "no such file");
+  if (!in) throw Error(path, "cannot be opened");
+  std::vector<Eigen::Vector4d> rows;
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    const size_t comment = line.find('#');
+    if (comment != std::string::npos) line.erase(comment);
+    for (char& c : line) {
+      if (c == ',' || c == ';' || c == '\t' || c == '\r') c = ' ';
+    }
+    std::istringstream fields(line);
+    std::vector<double> values;
+    std::string field;
+    while (fields >> field) {
+      double value = 0;
+      if (!parseNumber(field, value))
+        throw Error(path, "line " + std::to_string(number) + ": '" + field + "' is not a number");
+      values.push_back(value);
+    }
+    if (values.empty()) continue;
+    if (values.size() != 3 && values.size() != 4) {
+      throw Error(path, "line " + std::to_string(number) + ": expected x y z or x y z stiffness");
+    }
+    const Eigen::Vector4d row(values[0], values[1], values[2], values.size() == 4 ? values[3] : defaultStiffness);
+    if (!row.allFinite()) throw Error(path, "line " + std::to_string(number) + ": a value is not finite");
+    if (!(row(3) > 0.0)) throw Error(path, "line " + std::to_string(number) + ": stiffness must be > 0");
+    rows.push_back(row);
+  }
+  if (rows.empty()) throw Error(path, "has no springs");
+  SpringFile result{Matrix3X(rows.size(), 3), Eigen::VectorXd(rows.size())};
+  for (size_t i = 0; i < rows.size(); ++i) {
+    result.targets.row(i) = rows[i].head<3>().transpose();
+    result.stiffness(i) = rows[i](3);
+  }
+  return result;
+}
+
+}  // namespace dynsub

@@ -1,0 +1,15 @@
+// The gzip check made before ITK reads a .nii.gz (FileChecks.h: inflatedSize).
+#include "FileChecks.h"
+#include "FuzzInput.h"
+#include "dynsub/Error.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  using namespace dynsub::fuzz;
+  const InputFile input(data, size, ".nii.gz");
+  try {
+    dynsub::filechecks::inflatedSize(input.path());
+  } catch (const dynsub::Error& e) {
+    refused(e);
+  }
+  return 0;
+}
