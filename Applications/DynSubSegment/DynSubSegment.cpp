@@ -21,6 +21,7 @@
 #include "Reporting.h"
 #include "SegmentRun.h"
 #include "dynsub/AtomicOutput.h"
+#include "dynsub/TemporaryFileGuard.h"
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
 #include "dynsub/ImageIO.h"
@@ -257,6 +258,8 @@ void run(Arguments a) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Before any thread exists: a run Slicer cancels (SIGKILL) leaves no temporary file.
+  dynsub::startTemporaryFileGuard();
   Arguments arguments;
   const slicer::Module module = describe(arguments);
   // Slicer reads the descriptor from stdout, which must start with "<?xml".
@@ -277,7 +280,7 @@ int main(int argc, char** argv) {
     const int code = app.exit(error);
     return code == 0 ? 0 : 2;
   } catch (const dynsub::Error& error) {
-    std::cerr << "DynSubSegment: error: " << error.what() << '\n';
+    std::cerr << "DynSubSegment: error: " << dynsub::withoutTemporaryPrefix(error.what()) << '\n';
     return 1;
   } catch (const std::exception& error) {
     std::cerr << "DynSubSegment: unexpected error: " << error.what() << '\n';

@@ -17,6 +17,7 @@
 
 #include "Commands.h"
 #include "Reporting.h"
+#include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
 #include "dynsub/Evaluation.h"
 
@@ -93,7 +94,8 @@ void writeRunsCsv(const std::vector<EvaluationRun>& runs, const std::string& pat
         << ',' << r.volume << ',' << r.referenceVolume << ',' << r.leak << ',' << r.miss << ','
         << (r.collapsed ? 1 : 0) << ',' << r.seconds << ',' << r.steps << ',' << r.controlVertices << ','
         << csvField(r.warnings) << ',' << csvField(r.error) << '\n';
-  if (!out) throw Error(path, "could not be written");
+  out.close();
+  if (!out) throw writeFailure(path);
 }
 
 void writeSummaryCsv(const std::vector<Group>& groups, const std::string& path) {
@@ -106,7 +108,8 @@ void writeSummaryCsv(const std::vector<Group>& groups, const std::string& path) 
         << csvField(g.protocol) << ',' << g.runs << ','
         << g.meanDice << ',' << g.worstDice << ',' << g.meanLeakPercent << ',' << g.meanMissPercent << ','
         << g.collapses << ',' << g.failures << ',' << g.meanSeconds << '\n';
-  if (!out) throw Error(path, "could not be written");
+  out.close();
+  if (!out) throw writeFailure(path);
 }
 
 nlohmann::ordered_json summaryJson(const std::vector<Group>& groups, const std::vector<EvaluationRun>& runs,
@@ -184,7 +187,8 @@ void writeDicePlot(const std::vector<EvaluationRun>& runs, const std::vector<Gro
         << xmlText(g.image + " " + g.structure + " " + g.protocol) << "</text>\n";
   }
   out << "</svg>\n";
-  if (!out) throw Error(path, "could not be written");
+  out.close();
+  if (!out) throw writeFailure(path);
 }
 
 void runEvaluate(const EvaluateCommandOptions& o) {

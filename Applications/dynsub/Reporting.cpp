@@ -1,8 +1,12 @@
 #include "Reporting.h"
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iostream>
 
@@ -10,6 +14,7 @@
 
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
+#include "dynsub/TemporaryFileGuard.h"
 #include "dynsub/LimitSurface.h"
 #include "dynsub/MeshIO.h"
 #include "dynsub/SurfaceWriter.h"
@@ -144,6 +149,17 @@ OutputSet::OutputSet(std::filesystem::path dir) : dir_(std::move(dir)) {
   if (!std::filesystem::exists(dir_, error)) {
     if (!std::filesystem::create_directory(dir_, error)) throw Error(dir_.string(), "cannot be created: " + error.message());
     created_ = true;
+    temporaryfiles::createdDirectory(std::filesystem::absolute(dir_).string());
+  }
+  // Two runs writing to one directory at once take turns: each holds a lock
+  // on the directory from its first file to its commit, so their files never
+  // interleave (the last run's set is the one that stays whole).
+  lock_ = ::open(dir_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (lock_ < 0) throw Error(dir_.string(), "cannot be opened: " + std::string(std::strerror(errno)));
+  if (::flock(lock_, LOCK_EX | LOCK_NB) != 0) {
+    std::cerr << "dynsub: waiting for another run writing to " << dir_.string() << '\n';
+    while (::flock(lock_, LOCK_EX) != 0 && errno == EINTR) {
+    }
   }
 }
 
@@ -153,6 +169,8 @@ OutputSet::~OutputSet() {
     std::error_code error;
     std::filesystem::remove(dir_, error);
   }
+  if (created_) temporaryfiles::finishedDirectory(std::filesystem::absolute(dir_).string());
+  if (lock_ >= 0) ::close(lock_);  // releases the lock
 }
 
 std::string OutputSet::add(const std::string& name) {
@@ -168,7 +186,8 @@ void OutputSet::commit() {
 void writeJson(const nlohmann::ordered_json& json, const std::string& path) {
   std::ofstream out(path);
   out << json.dump(2) << '\n';
-  if (!out) throw Error(path, "could not be written");
+  out.close();
+  if (!out) throw writeFailure(path);
 }
 
 TriangleSurface outputSurface(const ControlMesh& mesh) {

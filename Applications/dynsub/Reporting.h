@@ -52,11 +52,15 @@ void prepareOutputDirectory(const std::filesystem::path& dir);
 
 // Files in one directory that appear together: each is written to a temporary
 // file, and commit() renames them all; before that nothing is visible (a
-// directory this created is removed again if commit() is never reached).
+// directory this created is removed again if commit() is never reached). A
+// set holds an exclusive lock (flock) on its directory for its lifetime, so
+// the sets of two runs writing there at once never interleave.
 class OutputSet {
  public:
   explicit OutputSet(std::filesystem::path dir);
   ~OutputSet();
+  OutputSet(const OutputSet&) = delete;
+  OutputSet& operator=(const OutputSet&) = delete;
   // The temporary path to write `name` to.
   std::string add(const std::string& name);
   void commit();
@@ -65,6 +69,7 @@ class OutputSet {
   std::filesystem::path dir_;
   bool created_ = false;
   bool committed_ = false;
+  int lock_ = -1;  // the directory, opened to hold its lock
   std::vector<std::unique_ptr<AtomicOutput>> outputs_;
 };
 

@@ -6,9 +6,13 @@
 #include <CLI/CLI.hpp>
 
 #include "Commands.h"
+#include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
+#include "dynsub/TemporaryFileGuard.h"
 
 int main(int argc, char** argv) {
+  // Before any thread exists: a run killed at any moment leaves no temporary file.
+  dynsub::startTemporaryFileGuard();
   CLI::App app{
       "DynSub: dynamic Catmull-Clark subdivision surfaces for segmenting 3D medical images and "
       "recovering shapes.\n"
@@ -33,7 +37,7 @@ int main(int argc, char** argv) {
     const int code = app.exit(error);
     return code == 0 ? 0 : 2;
   } catch (const dynsub::Error& error) {
-    std::cerr << "dynsub: error: " << error.what() << '\n';
+    std::cerr << "dynsub: error: " << dynsub::withoutTemporaryPrefix(error.what()) << '\n';
     return 1;
   } catch (const std::exception& error) {
     std::cerr << "dynsub: unexpected error: " << error.what() << '\n';

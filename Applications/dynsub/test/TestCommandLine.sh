@@ -180,10 +180,10 @@ expect_error "NaN edge threshold" 1 "edge thresholds" "$work/s9" \
 head -c 1700000 "$mri/ch2.nii.gz" >"$work/cut.nii.gz"
 expect_error "truncated .nii.gz" 1 "cut.nii.gz: truncated or corrupt compressed data" "$work/s12" \
   "$DYNSUB" segment "$work/cut.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --no-figures --out "$work/s12"
-# Six points in the air in front of the face (intensity 0 all around): they
-# cannot set edge thresholds, and saying so beats thresholds of 0.
+# Six points in the air in front of the face (intensity 0 all around): there
+# is no edge to set thresholds from, and saying so beats thresholds of 0.
 printf 'x,y,z\n75,-75,89\n70,-80,94\n65,-75,99\n75,-85,84\n70,-73,91\n65,-83,87\n' >"$work/air.csv"
-expect_error "landmarks off every edge" 1 "air.csv: the 6 landmarks are not on an image edge" "$work/s11" \
+expect_error "landmarks off every edge" 1 "air.csv: the image has no edges: its intensity is constant" "$work/s11" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/air.csv" --no-figures --out "$work/s11"
 expect_error "unknown edge reference" 2 "edge-reference" "$work/s10" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:-10,10,10,5 --edge-reference scanner --out "$work/s10"

@@ -1,16 +1,19 @@
 #include "dynsub/AtomicOutput.h"
 
 #include <signal.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <cctype>
+#include <cstring>
 #include <filesystem>
 #include <string>
 #include <system_error>
 
 #include "dynsub/Error.h"
+#include "dynsub/TemporaryFileGuard.h"
 
 namespace fs = std::filesystem;
 
@@ -60,12 +63,14 @@ AtomicOutput::AtomicOutput(std::string target) : target_(std::move(target)) {
   // The process id keeps two concurrent runs from sharing a temporary file; the
   // name ends with the target's file name, so writers still see its extension.
   temporary_ = (path.parent_path() / (prefix + name)).string();
+  temporaryfiles::created(fs::absolute(temporary_).string());
 }
 
 AtomicOutput::~AtomicOutput() {
   if (!committed_ && temporary_ != target_) {
     std::error_code ignored;
     fs::remove(temporary_, ignored);
+    temporaryfiles::finished(fs::absolute(temporary_, ignored).string());
   }
 }
 
@@ -79,6 +84,31 @@ void AtomicOutput::commit() {
     throw Error(target_, "cannot move the finished output into place: " + error.message());
   }
   committed_ = true;
+  if (temporary_ != target_) temporaryfiles::finished(fs::absolute(temporary_).string());
+}
+
+std::string withoutTemporaryPrefix(const std::string& text) {
+  const std::string prefix = temporaryPrefix(::getpid());
+  std::string result = text;
+  for (std::size_t at = result.find(prefix); at != std::string::npos; at = result.find(prefix, at))
+    result.erase(at, prefix.size());
+  return result;
+}
+
+Error writeFailure(const std::string& path, const std::string& detail) {
+  const int saved = errno;
+  std::string reason;
+  // A full file system is named as such whatever the writer reported.
+  fs::path directory = fs::path(path).parent_path();
+  if (directory.empty()) directory = ".";
+  struct statvfs space {};
+  if (::statvfs(directory.c_str(), &space) == 0 && space.f_bavail == 0)
+    reason = std::strerror(ENOSPC);
+  else if (!detail.empty())
+    reason = detail;
+  else
+    reason = saved ? std::strerror(saved) : "the stream failed";
+  return Error(withoutTemporaryPrefix(path), "could not be written: " + reason);
 }
 
 void requireWritableDirectoryFor(const std::string& path) {

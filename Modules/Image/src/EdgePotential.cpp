@@ -65,6 +65,10 @@ EdgeScale edgeScale(const Volume& magnitude, const EdgeOptions& options, const M
   // 99th percentile; a hundredth of it is flat tissue or off the image, and
   // thresholds set there would keep every ripple of noise as an edge (or,
   // in a region with no gradient at all, every voxel).
+  if (!(strongEdges > 0))
+    throw LandmarksOffEdges("the image has no edges: its intensity is constant in the segmentation's region, so the " +
+                            std::to_string(landmarks.rows()) + " landmarks cannot set the edge thresholds (and "
+                            "there is nothing in it to segment)");
   if (!(median > 0 && median >= 0.01 * strongEdges)) {
     std::ostringstream message;
     message << "the " << landmarks.rows() << " landmarks are not on an image edge: the median of their strongest "

@@ -1,6 +1,9 @@
 #include "dynsub/ImageIO.h"
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <sstream>
 
 #include "BridgeGeometry.h"
 #include "dynsub/AtomicOutput.h"
@@ -20,8 +23,32 @@ Volume readVolume(const std::string& path) {
     if (volume.geometry.size[a] < 2)
       throw Error(path, "not a 3D image (" + std::to_string(volume.geometry.size[a]) + " voxel(s) along axis " +
                             std::to_string(a) + ")");
-  if (!(std::abs(volume.geometry.direction.determinant()) > 1e-6)) throw Error(path, "singular direction matrix");
-  if (!(volume.geometry.spacing.minCoeff() > 0)) throw Error(path, "spacing must be positive");
+  const ImageGeometry& g = volume.geometry;
+  if (!g.direction.allFinite() || !(std::abs(g.direction.determinant()) > 1e-6))
+    throw Error(path, "singular direction matrix");
+  if (!g.origin.allFinite()) throw Error(path, "the origin is not finite");
+  if (!(g.spacing.minCoeff() > 0)) throw Error(path, "spacing must be positive");
+  // Options, tolerances and reports are in mm, chosen for voxels of tenths of
+  // a mm to a few mm: a spacing far outside that is a broken header (or a
+  // file in other units) that would give meaningless results.
+  if (!(g.spacing.minCoeff() >= kSmallestSpacing && g.spacing.maxCoeff() <= kLargestSpacing)) {
+    std::ostringstream message;
+    message << "voxel spacing " << g.spacing.x() << " x " << g.spacing.y() << " x " << g.spacing.z()
+            << " mm is outside the " << kSmallestSpacing << " to " << kLargestSpacing << " mm DynSub works with";
+    throw Error(path, message.str());
+  }
+  // NaN or infinite intensities would spread through the smoothing into every
+  // force near them.
+  const auto bad = std::find_if(volume.voxels.begin(), volume.voxels.end(), [](float v) { return !std::isfinite(v); });
+  if (bad != volume.voxels.end()) {
+    const long long first = bad - volume.voxels.begin(), count = std::count_if(bad, volume.voxels.end(), [](float v) {
+      return !std::isfinite(v);
+    });
+    const long long i = first % g.size[0], j = first / g.size[0] % g.size[1], k = first / g.size[0] / g.size[1];
+    throw Error(path, std::to_string(count) + " voxel(s) are NaN or infinite, the first at index (" +
+                          std::to_string(i) + ", " + std::to_string(j) + ", " + std::to_string(k) +
+                          "); intensities must be finite");
+  }
   return volume;
 }
 

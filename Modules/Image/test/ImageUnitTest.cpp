@@ -3,6 +3,7 @@
 #include <limits>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
@@ -151,6 +152,136 @@ TEST(ImageIO, BadFilesAreRefusedWithTheirName) {
   }
   std::ofstream(scratch("text.nii").string()) << "not an image\n";
   EXPECT_THROW(readVolume(scratch("text.nii").string()), Error);
+}
+
+// ---- Hostile numbers in image files: a clear error or a correct volume ----
+
+// A NIfTI-1 file of float voxels, written byte by byte (the header fields
+// DynSub and ITK read): `dims` may be larger than the voxels written, to make
+// a header that lies.
+void writeNifti(const fs::path& path, std::array<long, 3> dims, Vector3 spacing, const std::vector<float>& voxels,
+                double srowScale = 1.0) {
+  std::string header(352, '\0');
+  auto put = [&header](std::size_t at, auto value) { std::memcpy(&header[at], &value, sizeof value); };
+  put(0, std::int32_t{348});
+  put(40, std::int16_t{3});
+  for (int a = 0; a < 3; ++a) put(42 + 2 * a, static_cast<std::int16_t>(std::min<long>(dims[a], 32767)));
+  put(70, std::int16_t{16});  // float32
+  put(72, std::int16_t{32});
+  put(76, 1.0f);
+  for (int a = 0; a < 3; ++a) put(80 + 4 * a, static_cast<float>(spacing[a]));
+  put(108, 352.0f);
+  put(112, 1.0f);  // scl_slope
+  header[123] = 10;  // mm, seconds
+  put(254, std::int16_t{1});  // sform_code: scanner
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) put(280 + 16 * r + 4 * c, static_cast<float>(r == c ? srowScale * spacing[r] : 0.0));
+  std::memcpy(&header[344], "n+1\0", 4);
+  std::ofstream out(path, std::ios::binary);
+  out << header;
+  out.write(reinterpret_cast<const char*>(voxels.data()), static_cast<std::streamsize>(voxels.size() * sizeof(float)));
+}
+
+std::vector<float> ramp(std::size_t n, float scale) {
+  std::vector<float> voxels(n);
+  for (std::size_t v = 0; v < n; ++v) voxels[v] = scale * static_cast<float>(v % 17);
+  return voxels;
+}
+
+// The error readVolume gives for `path`, or "" when it reads it.
+std::string readError(const fs::path& path) {
+  try {
+    readVolume(path.string());
+    return "";
+  } catch (const Error& e) {
+    return e.what();
+  }
+}
+
+TEST(HostileImages, NanAndInfiniteVoxelsAreRefusedWithTheFirstIndex) {
+  for (const float bad : {std::numeric_limits<float>::quiet_NaN(), -std::numeric_limits<float>::infinity()}) {
+    std::vector<float> voxels = ramp(6 * 5 * 4, 1.0f);
+    voxels[2 + 6 * (3 + 5 * 1)] = bad;
+    voxels[100] = bad;
+    writeNifti(scratch("bad_voxels.nii"), {6, 5, 4}, Vector3(1, 1, 1), voxels);
+    const std::string error = readError(scratch("bad_voxels.nii"));
+    EXPECT_NE(error.find("bad_voxels.nii: 2 voxel(s) are NaN or infinite, the first at index (2, 3, 1)"),
+              std::string::npos)
+        << error;
+  }
+}
+
+// ITK keeps NaN in MetaImage and NRRD files; readVolume refuses them there too.
+TEST(HostileImages, NanVoxelsInMetaImageAndNrrdFilesAreRefused) {
+  std::vector<float> voxels = ramp(4 * 3 * 2, 1.0f);
+  voxels[7] = std::numeric_limits<float>::quiet_NaN();
+  const std::string data(reinterpret_cast<const char*>(voxels.data()), voxels.size() * sizeof(float));
+  std::ofstream(scratch("nan.mha"), std::ios::binary)
+      << "ObjectType = Image\nNDims = 3\nDimSize = 4 3 2\nElementType = MET_FLOAT\nElementDataFile = LOCAL\n" << data;
+  std::ofstream(scratch("nan.nrrd"), std::ios::binary)
+      << "NRRD0004\ntype: float\ndimension: 3\nsizes: 4 3 2\nencoding: raw\nendian: little\n\n" << data;
+  for (const std::string name : {"nan.mha", "nan.nrrd"}) {
+    const std::string error = readError(scratch(name));
+    EXPECT_NE(error.find(name + ": 1 voxel(s) are NaN or infinite, the first at index (3, 1, 0)"), std::string::npos)
+        << error;
+  }
+}
+
+TEST(HostileImages, ConstantAndExtremeIntensitiesAreReadExactly) {
+  // The ramp goes up to 16 times the scale: 2.4e38 of float's 3.4e38.
+  for (const float scale : {0.0f, 1.5e37f, 1e-37f, -1.5e37f}) {
+    const std::vector<float> voxels = scale == 0.0f ? std::vector<float>(60, 42.0f) : ramp(60, scale);
+    writeNifti(scratch("extreme.nii"), {5, 4, 3}, Vector3(1, 1, 1), voxels);
+    const Volume volume = readVolume(scratch("extreme.nii").string());
+    ASSERT_EQ(volume.voxels.size(), voxels.size());
+    for (std::size_t v = 0; v < voxels.size(); ++v) ASSERT_EQ(volume.voxels[v], voxels[v]) << "scale " << scale;
+  }
+}
+
+TEST(HostileImages, SpacingOutsideWhatDynSubWorksWithIsRefused) {
+  for (const double spacing : {1e-6, 1e5}) {
+    writeNifti(scratch("spacing.nii"), {4, 4, 4}, Vector3(1, spacing, 1), ramp(64, 1.0f));
+    const std::string error = readError(scratch("spacing.nii"));
+    EXPECT_NE(error.find("spacing.nii: voxel spacing"), std::string::npos) << error;
+    EXPECT_NE(error.find("outside the 0.0001 to 10000 mm"), std::string::npos) << error;
+  }
+  // Near the limits (NIfTI stores spacing as float: 1e-4 itself reads as 9.99999975e-5).
+  writeNifti(scratch("spacing.nii"), {4, 4, 4}, Vector3(2e-4, 1, 5e3), ramp(64, 1.0f));
+  EXPECT_EQ(readError(scratch("spacing.nii")), "");
+}
+
+TEST(HostileImages, ADegenerateDirectionIsRefused) {
+  // NRRD space directions with two parallel axes.
+  std::ofstream(scratch("parallel.nrrd"), std::ios::binary)
+      << "NRRD0004\ntype: float\ndimension: 3\nspace: left-posterior-superior\nsizes: 2 2 2\n"
+         "space directions: (1,0,0) (0,1,0) (1,0,0)\nencoding: raw\nendian: little\nspace origin: (0,0,0)\n\n"
+      << std::string(32, '\0');
+  const std::string error = readError(scratch("parallel.nrrd"));
+  EXPECT_NE(error.find("parallel.nrrd"), std::string::npos) << error;
+  EXPECT_FALSE(error.empty());
+}
+
+TEST(HostileImages, HeadersAnnouncingHugeImagesAreRefusedBeforeAllocating) {
+  // 1000^3 float voxels (4 GB) announced by a file of a few bytes: truncated.
+  writeNifti(scratch("huge.nii"), {1000, 1000, 1000}, Vector3(1, 1, 1), ramp(8, 1.0f));
+  std::string error = readError(scratch("huge.nii"));
+  EXPECT_NE(error.find("huge.nii: truncated"), std::string::npos) << error;
+  // 32767^3 (1.3e5 GiB): more than any memory, in NIfTI, MetaImage and NRRD
+  // (the last through ITK's header reader).
+  writeNifti(scratch("huge.nii"), {32767, 32767, 32767}, Vector3(1, 1, 1), ramp(8, 1.0f));
+  error = readError(scratch("huge.nii"));
+  EXPECT_NE(error.find("huge.nii: the header announces 35181150961663 voxels"), std::string::npos) << error;
+  EXPECT_NE(error.find("GiB of memory"), std::string::npos) << error;
+  std::ofstream(scratch("huge.mha"), std::ios::binary)
+      << "ObjectType = Image\nNDims = 3\nDimSize = 100000 100000 100000\nElementType = MET_FLOAT\n"
+         "ElementDataFile = LOCAL\n" << std::string(64, '\0');
+  error = readError(scratch("huge.mha"));
+  EXPECT_NE(error.find("huge.mha: the header announces 1000000000000000 voxels"), std::string::npos) << error;
+  std::ofstream(scratch("huge.nrrd"), std::ios::binary)
+      << "NRRD0004\ntype: float\ndimension: 3\nsizes: 100000 100000 100000\nencoding: raw\nendian: little\n\n"
+      << std::string(64, '\0');
+  error = readError(scratch("huge.nrrd"));
+  EXPECT_NE(error.find("huge.nrrd: the header announces 1000000000000000 voxels"), std::string::npos) << error;
 }
 
 TEST(Voxelize, SphereOnAnAnisotropicRotatedGrid) {

@@ -230,7 +230,8 @@ void writeLandmarks(const std::vector<Landmark>& landmarks, const std::string& p
         out << p.x() << ',' << p.y() << ',' << p.z() << ',' << labelOf(landmarks, i) << '\n';
       }
     }
-    if (!out) throw Error(path, "write failed");
+    out.close();
+    if (!out) throw writeFailure(path);
   }
   output.commit();
 }

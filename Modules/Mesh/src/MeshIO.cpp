@@ -366,7 +366,8 @@ void writeObj(const ControlMesh& mesh, const std::string& path) {
       for (int v : face) out << ' ' << v + 1;
       out << '\n';
     }
-    if (!out.flush()) throw Error(path, "writing failed (disk full?)");
+    out.close();
+    if (!out) throw writeFailure(path);
   }
   output.commit();
 }

@@ -159,6 +159,10 @@ SegmentationRegion::SegmentationRegion(const Volume& image, const std::vector<La
   extent << start, landmarkPoints, coverPoints;
   std::tie(first_, size_) = boundingRegion(grid, extent, options.margin);
   image_ = cropVolume(image, first_, size_);
+  // readVolume refuses such images; a volume made in memory is checked here,
+  // on the region the forces come from.
+  if (!std::all_of(image_.voxels.begin(), image_.voxels.end(), [](float v) { return std::isfinite(v); }))
+    throw Error("the image has voxels that are NaN or infinite in the segmentation's region");
   const Volume& region = image_;
   geometry_ = region.geometry;
   cropSeconds_ = secondsSince(clock);

@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <random>
 
 #include "dynsub/Error.h"
@@ -202,6 +203,103 @@ TEST(Segment, RefusesLandmarksAndModelsOutsideTheImage) {
   SegmentOptions nan;
   nan.imageForce = std::nan("");
   EXPECT_THROW(segment(phantom.image, landmarks, initial, nan), Error);
+}
+
+// Hostile numbers: each ends in a clear error or a correct result, never in
+// NaN. The ball of RefusesLandmarksAndModelsOutsideTheImage, with noise.
+struct HostileCase {
+  Ellipsoid shape{Vector3(0, 0, 0), Vector3(9, 8, 7)};
+  Phantom phantom =
+      makePhantom(gridAround(shape.centre, Vector3(32, 32, 32), Vector3(1, 1, 1), Matrix3::Identity()),
+                  [this](const Vector3& x) { return shape.inside(x); }, 4.0, 5);
+  std::vector<Landmark> landmarks = shape.landmarks(4, 6);
+};
+
+void expectFinite(const SegmentResult& result) {
+  EXPECT_TRUE(result.mesh.points().allFinite());
+  EXPECT_TRUE(std::isfinite(result.volume));
+  for (double d : result.landmarkDistances) EXPECT_TRUE(std::isfinite(d));
+}
+
+// Intensities scaled to near the largest and the smallest normal float: every
+// step of the segmentation is relative to the image's own contrast, so the
+// result is the ordinary one (the smoothing runs in float: a product of two
+// such values would overflow or underflow).
+TEST(HostileNumbers, IntensitiesNearTheFloatLimitsSegmentAsOrdinaryOnes) {
+  const HostileCase c;
+  const ControlMesh initial = initialFromLandmarks(c.landmarks);
+  const SegmentResult ordinary = segment(c.phantom.image, c.landmarks, initial, SegmentOptions());
+  for (const double scale : {1e36, 1e-36}) {
+    Volume scaled = c.phantom.image;
+    for (float& v : scaled.voxels) v = static_cast<float>(v * scale);
+    const SegmentResult result = segment(scaled, c.landmarks, initial, SegmentOptions());
+    expectFinite(result);
+    const double dice = compareMasks(result.labelmap, ordinary.labelmap).dice;
+    std::printf("intensities x %g: Dice %.4f with the ordinary result\n", scale, dice);
+    // Rounding in float differs at these scales; a voxel or two may flip.
+    EXPECT_GT(dice, 0.99) << "scale " << scale;
+  }
+}
+
+// A constant image has no edges and no contrast: with the edge thresholds
+// set by the landmarks (the default) that is a clear error; with thresholds
+// from the image there are no edges, and the landmarks alone shape the
+// surface, which passes through them.
+TEST(HostileNumbers, AConstantImageIsSaidToBeOrLeavesTheLandmarksToShapeTheSurface) {
+  HostileCase c;
+  std::fill(c.phantom.image.voxels.begin(), c.phantom.image.voxels.end(), 50.0f);
+  const ControlMesh initial = initialFromLandmarks(c.landmarks);
+  try {
+    segment(c.phantom.image, c.landmarks, initial, SegmentOptions());
+    ADD_FAILURE() << "a constant image set edge thresholds from the landmarks";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("intensity is constant"), std::string::npos) << e.what();
+  }
+  SegmentOptions fromImage;
+  fromImage.edges.reference = EdgeReference::Image;
+  const SegmentResult result = segment(c.phantom.image, c.landmarks, initial, fromImage);
+  expectFinite(result);
+  for (double d : result.landmarkDistances) EXPECT_LT(d, 1.0);
+  const double dice = compareMasks(result.labelmap, c.phantom.truth).dice;
+  std::printf("constant image, thresholds from the image: Dice %.3f with the ellipsoid the landmarks lie on\n", dice);
+  EXPECT_GT(dice, 0.8);
+}
+
+// NaN or infinite voxels in a volume made in memory (readVolume refuses
+// them in files) are refused before they reach a force.
+TEST(HostileNumbers, NanAndInfiniteVoxelsAreRefused) {
+  for (const float bad : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+    HostileCase c;
+    c.phantom.image.voxels[c.phantom.image.geometry.offset(16, 16, 16)] = bad;
+    try {
+      segment(c.phantom.image, c.landmarks, initialFromLandmarks(c.landmarks), SegmentOptions());
+      ADD_FAILURE() << "an image with a voxel " << bad << " was segmented";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("NaN or infinite"), std::string::npos) << e.what();
+    }
+  }
+}
+
+// Landmarks at one point, on a line or on one plane span no volume: the
+// initial model cannot be placed, and the error says why.
+TEST(HostileNumbers, LandmarksThatSpanNoVolumeAreRefused) {
+  const HostileCase c;
+  std::vector<Landmark> point(6, Landmark{"p", Vector3(1, 2, 3)});
+  std::vector<Landmark> line, plane;
+  for (int i = 0; i < 6; ++i) {
+    line.push_back({"l", Vector3(i, 2 * i, 0.5)});
+    plane.push_back({"s", Vector3(8 * std::cos(i), 7 * std::sin(i), 0.0)});
+  }
+  const std::pair<const std::vector<Landmark>*, const char*> cases[] = {
+      {&point, "coincide"}, {&line, "line"}, {&plane, "plane"}};
+  for (const auto& [landmarks, why] : cases) {
+    try {
+      segment(c.phantom.image, *landmarks, initialFromLandmarks(*landmarks), SegmentOptions());
+      ADD_FAILURE() << "landmarks that " << why << " were segmented";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace

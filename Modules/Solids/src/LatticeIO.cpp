@@ -7,6 +7,7 @@
 #include <vtkCellData.h>
 #include <vtkIdList.h>
 #include <vtkIntArray.h>
+#include <vtkErrorCode.h>
 #include <vtkNew.h>
 #include <vtkPoints.h>
 #include <vtkUnstructuredGrid.h>
@@ -152,7 +153,10 @@ void writeVtu(const Lattice& l, const std::string& path, const std::string& name
   writer->SetFileName(path.c_str());
   writer->SetInputData(grid);
   writer->SetDataModeToAppended();
-  if (writer->Write() != 1) throw Error(name, "VTK could not write the file");
+  // VTK's XML writers can return success on a full disk; the error code tells.
+  if (writer->Write() != 1 || writer->GetErrorCode() != vtkErrorCode::NoError)
+    throw writeFailure(name, std::string("VTK's writer failed (") +
+                                 vtkErrorCode::GetStringFromErrorCode(writer->GetErrorCode()) + ")");
 }
 
 }  // namespace

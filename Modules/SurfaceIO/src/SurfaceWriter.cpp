@@ -5,6 +5,7 @@
 
 #include <vtkDoubleArray.h>
 #include <vtkFieldData.h>
+#include <vtkErrorCode.h>
 #include <vtkNew.h>
 #include <vtkOBJWriter.h>
 #include <vtkPLYWriter.h>
@@ -51,32 +52,32 @@ void writeTriangleSurface(const TriangleSurface& surface, const std::string& pat
     array->InsertNextValue(space);
     polyData->GetFieldData()->AddArray(array);
   }
-  int written = 0;
+  // VTK's writers can return success on a full disk (an XML writer cut
+  // short at 16 KiB returned 1, measured): their error code tells.
+  auto write = [&](auto& writer) {
+    writer->SetFileName(output.temporaryPath().c_str());
+    writer->SetInputData(polyData);
+    const int written = writer->Write();
+    const unsigned long code = writer->GetErrorCode();
+    if (written != 1 || code != vtkErrorCode::NoError)
+      throw writeFailure(path, std::string("VTK's writer failed (") + vtkErrorCode::GetStringFromErrorCode(code) + ")");
+  };
   if (extension == ".vtp") {
     vtkNew<vtkXMLPolyDataWriter> writer;
-    writer->SetFileName(output.temporaryPath().c_str());
-    writer->SetInputData(polyData);
     writer->SetDataModeToAppended();
-    written = writer->Write();
+    write(writer);
   } else if (extension == ".obj") {
     vtkNew<vtkOBJWriter> writer;
-    writer->SetFileName(output.temporaryPath().c_str());
-    writer->SetInputData(polyData);
-    written = writer->Write();
+    write(writer);
   } else if (extension == ".ply") {
     vtkNew<vtkPLYWriter> writer;
-    writer->SetFileName(output.temporaryPath().c_str());
-    writer->SetInputData(polyData);
     writer->SetFileTypeToBinary();
-    written = writer->Write();
+    write(writer);
   } else {
     vtkNew<vtkSTLWriter> writer;
-    writer->SetFileName(output.temporaryPath().c_str());
-    writer->SetInputData(polyData);
     writer->SetFileTypeToBinary();
-    written = writer->Write();
+    write(writer);
   }
-  if (written != 1) throw Error(path, "VTK could not write the file");
   output.commit();
 }
 

@@ -14,6 +14,7 @@
 #include <vtkChartXY.h>
 #include <vtkContextActor.h>
 #include <vtkContextScene.h>
+#include <vtkErrorCode.h>
 #include <vtkNew.h>
 #include <vtkPNGWriter.h>
 #include <vtkPolyData.h>
@@ -143,7 +144,9 @@ void writePng(vtkRenderWindow* window, const std::string& path) {
   writer->SetInputConnection(capture->GetOutputPort());
   writer->SetFileName(output.temporaryPath().c_str());
   writer->Write();
-  if (writer->GetErrorCode() != 0) throw Error(path, "VTK could not write the PNG image");
+  if (writer->GetErrorCode() != 0)
+    throw writeFailure(path, std::string("VTK's PNG writer failed (") +
+                                 vtkErrorCode::GetStringFromErrorCode(writer->GetErrorCode()) + ")");
   output.commit();
 }
 

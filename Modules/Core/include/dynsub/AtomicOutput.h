@@ -4,12 +4,15 @@
 // target by commit(). If commit() is never called (an exception, a failed
 // check), the destructor removes the temporary file and the target is untouched.
 //
-// The temporary file is ".tmp-<pid>-<name>". Those of runs that were killed
-// (their process is gone) are removed when the next output of that name is
-// opened. A target that is already this process's temporary file (a writer
+// The temporary file is ".tmp-<pid>-<name>". A program that started the
+// guard of TemporaryFileGuard.h has those of a killed run removed at once;
+// otherwise those of runs that were killed (their process is gone) are
+// removed when the next output of that name is opened. A target that is already this process's temporary file (a writer
 // given the path of an enclosing output) is written in place: the enclosing
 // output removes it or makes it appear.
 #include <string>
+
+#include "dynsub/Error.h"
 
 namespace dynsub {
 
@@ -36,5 +39,15 @@ class AtomicOutput {
 
 // Throws dynsub::Error naming `path` unless its directory exists and is writable.
 void requireWritableDirectoryFor(const std::string& path);
+
+// `text` with this process's temporary-file prefix taken out of the file
+// names in it, so that a message names the file the user asked for.
+std::string withoutTemporaryPrefix(const std::string& text);
+
+// The error for a file whose writing failed (call right after the failure):
+// names the target and the reason: "No space left on device" when its file
+// system is full, else `detail` (a library's own report) or the system's
+// (errno, e.g. "File too large").
+Error writeFailure(const std::string& path, const std::string& detail = "");
 
 }  // namespace dynsub

@@ -14,8 +14,14 @@
 
 namespace dynsub {
 
+// The voxel spacings (mm) readVolume accepts.
+constexpr double kSmallestSpacing = 1e-4, kLargestSpacing = 1e4;
+
 // Throws dynsub::Error naming the path when it is missing, unreadable,
-// truncated, of an unknown format, not 3D or empty.
+// truncated, of an unknown format, not 3D or empty, too large for memory, has
+// a singular direction, an origin or spacing that is not finite, a spacing
+// outside [kSmallestSpacing, kLargestSpacing] mm, or a voxel that is NaN or
+// infinite.
 Volume readVolume(const std::string& path);
 
 // Writes a mask as an unsigned 8-bit labelmap (`label` = structure, 0 =
