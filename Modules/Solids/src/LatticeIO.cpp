@@ -1,5 +1,6 @@
 #include "dynsub/LatticeIO.h"
 
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
@@ -49,6 +50,12 @@ class LatticeReader {
     long long n = -1;
     if (!(line >> word >> n) || word != keyword || n < 0 || n > 100000000)
       fail(std::string("expected \"") + keyword + " N\"");
+    // Each item is a line of at least two bytes: a count beyond that is a
+    // corrupt file, refused before anything is allocated for it.
+    std::error_code error;
+    const auto size = std::filesystem::file_size(path_, error);
+    if (!error && static_cast<unsigned long long>(n) > size / 2)
+      fail(std::string("\"") + keyword + " " + std::to_string(n) + "\" announces more items than the file holds");
     return static_cast<int>(n);
   }
 

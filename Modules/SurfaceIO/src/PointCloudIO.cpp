@@ -1,6 +1,10 @@
 #include "dynsub/PointCloudIO.h"
 
+#include <cerrno>
+#include <cstdlib>
 #include <filesystem>
+#include <iterator>
+#include <string>
 #include <fstream>
 #include <sstream>
 #include <vector>
@@ -62,7 +66,30 @@ Matrix3X readText(const std::string& path, bool csv) {
   return result;
 }
 
+// VTK's XML reader allocates what a piece's NumberOfPoints (and cells)
+// announce before reading any data. A value no file of this size can hold
+// (one byte per item, inflated at most 1032 times, zlib's limit) is a corrupt
+// header: refused here rather than handed to the allocator.
+void checkVtpCounts(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto appended = text.find("<AppendedData");
+  if (appended != std::string::npos) text.resize(appended);  // the raw data holds arbitrary bytes
+  const unsigned long long limit = 1032ULL * std::filesystem::file_size(path);
+  for (auto at = text.find("NumberOf"); at != std::string::npos; at = text.find("NumberOf", at + 8)) {
+    const auto quote = text.find('"', at);
+    if (quote == std::string::npos || quote > at + 40 || text.compare(quote - 1, 1, "=") != 0) continue;
+    const std::string name = text.substr(at, quote - 1 - at);
+    errno = 0;
+    const unsigned long long n = std::strtoull(text.c_str() + quote + 1, nullptr, 10);
+    if (errno == ERANGE || n > limit)
+      throw Error(path, "its header announces " + name + " " + text.substr(quote + 1, text.find('"', quote + 1) - quote - 1) +
+                            ", more than a file of this size can hold");
+  }
+}
+
 Matrix3X readVtp(const std::string& path) {
+  checkVtpCounts(path);
   vtkNew<vtkXMLPolyDataReader> reader;
   if (!reader->CanReadFile(path.c_str())) throw Error(path, "is not a VTK XML polydata file");
   reader->SetFileName(path.c_str());
