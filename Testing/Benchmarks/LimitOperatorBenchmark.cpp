@@ -37,7 +37,7 @@ void DynSubBuildOperators(benchmark::State& state) {
   const std::vector<dynsub::SurfacePoint> points = samples(mesh.faceCount());
   for (auto _ : state) {
     const dynsub::LimitSurface surface(mesh);
-    dynsub::LimitOperators ops = surface.operators(points);
+    dynsub::LimitOperators ops = surface.operators(points, 1);  // J, J_u, J_v, as OpenSubdiv builds
     benchmark::DoNotOptimize(ops.J.nonZeros());
   }
   state.SetItemsProcessed(state.iterations() * points.size());

@@ -1,7 +1,10 @@
 #include "dynsub/LimitSurface.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <map>
+#include <mutex>
 
 #include "PatchRules.h"
 #include "dynsub/CatmullClark.h"
@@ -16,8 +19,9 @@ using detail::SmallStencil;
 
 namespace {
 
-// Special elements tabulate this many levels of subpatches at construction
-// (points closer than 2^-24 to the extraordinary corner are computed on demand).
+// Special elements keep up to this many levels of subpatches, each tabulated
+// the first time a point needs it (points closer than 2^-24 to the
+// extraordinary corner are computed on demand without being kept).
 constexpr int kTabulatedLevels = 24;
 // The cross-boundary tangent at a boundary extraordinary vertex is read at this
 // level (see setBoundaryTangents).
@@ -31,17 +35,43 @@ void zeroRowSums(Eigen::MatrixXd& displacements) {
   displacements.colwise() -= mean;
 }
 
+// The steps of local subdivision met so far, by local topology and face:
+// equal neighbourhoods share one (see extractNeighbourhood), so a surface
+// builds a handful, not a few per special element. Thread-safe; a step, once
+// made, stays where it is.
+class StepCache {
+ public:
+  const detail::CornerStep& stepFor(const LocalMesh& mesh) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    // A topology the cache made (a step's result) is found by its address;
+    // any other (a level-0 neighbourhood) by its faces, once.
+    const auto known = byAddress_.find({mesh.topology.get(), mesh.face});
+    if (known != byAddress_.end()) return *known->second;
+    auto key = std::make_pair(mesh.topology->faces(), mesh.face);
+    auto it = byStructure_.find(key);
+    if (it == byStructure_.end()) {
+      auto step = std::make_unique<detail::CornerStep>(detail::cornerStep(mesh.topology, mesh.face));
+      byAddress_.emplace(std::make_pair(step->from.get(), step->face), step.get());
+      it = byStructure_.emplace(std::move(key), std::move(step)).first;
+    }
+    return *it->second;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::map<std::pair<std::vector<Polygon>, int>, std::unique_ptr<detail::CornerStep>> byStructure_;
+  std::map<std::pair<const Topology*, int>, const detail::CornerStep*> byAddress_;
+};
+
 // One level deeper around the extraordinary vertex, keeping row sums at 0.
-LevelPatches subdivideDisplacements(LocalMesh& mesh, detail::CornerStep& step) {
-  LevelPatches patches = detail::subdivideAroundCorner(mesh, step);
+LevelPatches subdivideDisplacements(LocalMesh& mesh, StepCache& steps) {
+  LevelPatches patches = detail::subdivideAroundCorner(mesh, steps.stepFor(mesh));
   zeroRowSums(mesh.weights);
   return patches;
 }
 
 using GridMatrix = Eigen::Matrix<double, 16, Eigen::Dynamic>;
 using SampleWeights = Eigen::Matrix<double, 6, Eigen::Dynamic>;  // s, su, sv, suu, suv, svv
-// Points as the columns they depend on and their weights: the rows of limit operators.
-using PointSamples = std::vector<std::pair<const std::vector<int>*, SampleWeights>>;
 
 bool needsIsolation(const Topology& topology) {
   for (int f = 0; f < topology.faceCount(); ++f) {
@@ -54,17 +84,31 @@ bool needsIsolation(const Topology& topology) {
 }
 
 // Rewrites derivative rows taken in parameters (a, b) into parameters (u, v),
-// given T = d(a, b)/d(u, v): gradient T^T g, Hessian T^T H T.
+// given T = d(a, b)/d(u, v): gradient T^T g, Hessian T^T H T. Column by
+// column, so that nothing is allocated (this runs once per evaluated point).
+// With rows = 3 only s, s_u, s_v are rewritten (the rest may hold anything).
 template <class Rows>
-void applyChainRule(Rows& w, const Eigen::Matrix2d& t) {
-  using Row = Eigen::Matrix<double, 1, Rows::ColsAtCompileTime>;
-  const Row da = w.row(1), db = w.row(2);
-  const Row daa = w.row(3), dab = w.row(4), dbb = w.row(5);
-  w.row(1) = t(0, 0) * da + t(1, 0) * db;
-  w.row(2) = t(0, 1) * da + t(1, 1) * db;
-  w.row(3) = t(0, 0) * t(0, 0) * daa + 2.0 * t(0, 0) * t(1, 0) * dab + t(1, 0) * t(1, 0) * dbb;
-  w.row(4) = t(0, 0) * t(0, 1) * daa + (t(0, 0) * t(1, 1) + t(1, 0) * t(0, 1)) * dab + t(1, 0) * t(1, 1) * dbb;
-  w.row(5) = t(0, 1) * t(0, 1) * daa + 2.0 * t(0, 1) * t(1, 1) * dab + t(1, 1) * t(1, 1) * dbb;
+void applyChainRule(Rows& w, const Eigen::Matrix2d& t, int rows = 6) {
+  if (t.isIdentity(0.0)) return;
+  if (rows <= 3) {
+    for (Eigen::Index c = 0; c < w.cols(); ++c) {
+      const double da = w(1, c), db = w(2, c);
+      w(1, c) = t(0, 0) * da + t(1, 0) * db;
+      w(2, c) = t(0, 1) * da + t(1, 1) * db;
+    }
+    return;
+  }
+  const double uu0 = t(0, 0) * t(0, 0), uu1 = 2.0 * t(0, 0) * t(1, 0), uu2 = t(1, 0) * t(1, 0);
+  const double uv0 = t(0, 0) * t(0, 1), uv1 = t(0, 0) * t(1, 1) + t(1, 0) * t(0, 1), uv2 = t(1, 0) * t(1, 1);
+  const double vv0 = t(0, 1) * t(0, 1), vv1 = 2.0 * t(0, 1) * t(1, 1), vv2 = t(1, 1) * t(1, 1);
+  for (Eigen::Index c = 0; c < w.cols(); ++c) {
+    const double da = w(1, c), db = w(2, c), daa = w(3, c), dab = w(4, c), dbb = w(5, c);
+    w(1, c) = t(0, 0) * da + t(1, 0) * db;
+    w(2, c) = t(0, 1) * da + t(1, 1) * db;
+    w(3, c) = uu0 * daa + uu1 * dab + uu2 * dbb;
+    w(4, c) = uv0 * daa + uv1 * dab + uv2 * dbb;
+    w(5, c) = vv0 * daa + vv1 * dab + vv2 * dbb;
+  }
 }
 
 // Quadrant of (u, v) in a quad: the child of CatmullClark.h's numbering.
@@ -83,13 +127,23 @@ struct LimitSurface::Impl {
     int special = -1;  // index into specials
     std::vector<int> columns;
     GridMatrix grid;  // normal: 16 B-spline control points over `columns`
+    // Normal, when each grid point is a control vertex itself (no ghost, no
+    // isolation): the column of each slot, so that a point's weights are the
+    // B-spline basis itself; else slotColumn[0] = -1.
+    std::array<int, 16> slotColumn{-1};
   };
+  // NB: levels are tabulated when a point first needs them, and points are
+  // evaluated from several threads at once (closest-point searches), so the
+  // table grows under `mutex`. levels[n - 1] is written once, before
+  // `tabulated` reaches n, and never moved (the vector is sized up front):
+  // a reader that sees tabulated >= n may use it without the lock.
   struct Special {
     std::vector<int> columns;
-    std::vector<LevelPatches> levels;  // levels[n - 1]: subpatches at level n
-    LocalMesh deepest;                 // the neighbourhood after the last level
-    detail::CornerStep step;           // the last level's step (the one deeper levels repeat)
     Eigen::Matrix<double, 3, Eigen::Dynamic> vertexMasks;  // limit position, tangent u, tangent v
+    std::vector<LevelPatches> levels;  // levels[n - 1]: subpatches at level n
+    std::atomic<int> tabulated{0};
+    std::mutex mutex;
+    LocalMesh deepest;  // the neighbourhood after `tabulated` levels
     // levels and deepest hold displacements from the limit position (row 0 of vertexMasks).
   };
 
@@ -103,7 +157,27 @@ struct LimitSurface::Impl {
   std::vector<int> parametricFaceOffset;          // per control face, plus the total
   std::vector<int> controlFaceSize;
   std::vector<Element> elements;
-  std::vector<Special> specials;
+  std::vector<std::unique_ptr<Special>> specials;
+  mutable StepCache steps;
+
+  // The subpatches of a special element at a level 1..kTabulatedLevels,
+  // tabulated on first use.
+  const LevelPatches& level(Special& special, int n) const {
+    if (special.tabulated.load(std::memory_order_acquire) < n) {
+      const std::lock_guard<std::mutex> lock(special.mutex);
+      for (int next = special.tabulated.load(std::memory_order_relaxed) + 1; next <= n; ++next) {
+        special.levels[next - 1] = subdivideDisplacements(special.deepest, steps);
+        special.tabulated.store(next, std::memory_order_release);
+      }
+    }
+    return special.levels[n - 1];
+  }
+  // The neighbourhood after kTabulatedLevels levels, from which deeper ones
+  // are computed; final once every level is tabulated.
+  const LocalMesh& deepestTabulated(Special& special) const {
+    level(special, kTabulatedLevels);
+    return special.deepest;
+  }
 
   // Control-vertex columns and dense weights of a set of base-mesh stencils.
   std::vector<int> columnsOf(const std::vector<int>& baseVertices) const {
@@ -136,23 +210,34 @@ struct LimitSurface::Impl {
     for (int s = 0; s < 16; ++s) {
       for (const auto& [v, w] : grid[s]) element.grid.row(s) += w * rowOver(element.columns, v);
     }
+    if (element.columns.size() != 16) return;
+    for (int s = 0; s < 16; ++s) {
+      Eigen::Index column = 0;
+      const double largest = element.grid.row(s).maxCoeff(&column);
+      if (largest != 1.0 || element.grid.row(s).cwiseAbs().sum() != 1.0) {
+        element.slotColumn[0] = -1;
+        return;
+      }
+      element.slotColumn[s] = static_cast<int>(column);
+    }
   }
 
   void buildSpecial(Element& element, int face) {
     const int x = base.face(face)[element.corner];
     detail::Neighbourhood neighbourhood = detail::extractNeighbourhood(base, x, face);
-    Special special;
+    auto owned = std::make_unique<Special>();
+    Special& special = *owned;
     special.columns = columnsOf(neighbourhood.parentVertex);
     LocalMesh local;
     local.weights.resize(neighbourhood.parentVertex.size(), special.columns.size());
     for (size_t i = 0; i < neighbourhood.parentVertex.size(); ++i) {
       local.weights.row(i) = rowOver(special.columns, neighbourhood.parentVertex[i]);
     }
-    local.topology = std::move(neighbourhood.topology);
+    local.topology = std::make_shared<const Topology>(std::move(neighbourhood.topology));
     local.face = neighbourhood.face;
 
-    const int localX = local.topology.face(local.face)[0];
-    const detail::VertexMasks masks = detail::vertexMasks(local.topology, localX, local.face);
+    const int localX = local.topology->face(local.face)[0];
+    const detail::VertexMasks masks = detail::vertexMasks(*local.topology, localX, local.face);
     special.vertexMasks.setZero(3, special.columns.size());
     const SmallStencil* rows[3] = {&masks.position, &masks.tangentU, &masks.tangentV};
     for (int r = 0; r < 3; ++r) {
@@ -170,14 +255,12 @@ struct LimitSurface::Impl {
     for (const auto& [v, w] : masks.along) along += w * local.weights.row(v);
     local.weights.rowwise() -= special.vertexMasks.row(0);
     zeroRowSums(local.weights);
-    for (int level = 1; level <= kTabulatedLevels; ++level) {
-      special.levels.push_back(subdivideDisplacements(local, special.step));
-    }
+    special.levels.resize(kTabulatedLevels);
     special.deepest = std::move(local);
     if (masks.boundary) setBoundaryTangents(special, masks, along);
     element.columns = special.columns;
     element.special = static_cast<int>(specials.size());
-    specials.push_back(std::move(special));
+    specials.push_back(std::move(owned));
   }
 
   // Tangents at a boundary extraordinary vertex. Along the boundary the
@@ -191,12 +274,12 @@ struct LimitSurface::Impl {
   // vertex of 5 faces), so it is read at level 48. Still a fixed linear mask,
   // so J_u and J_v stay linear operators.
   void setBoundaryTangents(Special& special, const detail::VertexMasks& masks, const Eigen::RowVectorXd& along) {
-    LocalMesh deep = special.deepest;
-    detail::CornerStep step = special.step;
-    for (int level = kTabulatedLevels; level < kCrossTangentLevel; ++level) subdivideDisplacements(deep, step);
-    const Polygon& face = deep.topology.face(deep.face);
+    LocalMesh deep = special.deepest;  // level 0
+    for (int level = 0; level < kCrossTangentLevel; ++level) subdivideDisplacements(deep, steps);
+    const Topology& topology = *deep.topology;
+    const Polygon& face = topology.face(deep.face);
     const int x = face[0];
-    const int interior = !deep.topology.isBoundaryEdge(deep.topology.findEdge(x, face[1])) ? face[1] : face[3];
+    const int interior = !topology.isBoundaryEdge(topology.findEdge(x, face[1])) ? face[1] : face[3];
     Eigen::RowVectorXd across = std::ldexp(1.0, kCrossTangentLevel) * deep.weights.row(interior);
     const double theta = M_PI / masks.faces;
     special.vertexMasks.row(1) = std::cos(masks.fanPosition * theta) * along +
@@ -226,7 +309,7 @@ struct LimitSurface::Impl {
     Eigen::Matrix2d jacobian;
   };
   SubpatchPoint locateSubpatch(const Element& element, const ElementPoint& point) const {
-    const Special& special = specials[element.special];
+    Special& special = *specials[element.special];
     SubpatchPoint result;
     // Parameters with the extraordinary vertex at the origin.
     const auto [a, b] = detail::cornerFrame(element.corner, point.u, point.v);
@@ -247,35 +330,63 @@ struct LimitSurface::Impl {
     result.u = std::min(1.0, 2.0 * childU);
     result.v = std::min(1.0, 2.0 * childV);
     if (level <= kTabulatedLevels) {
-      result.patch = &special.levels[level - 1][child - 1];
+      result.patch = &Impl::level(special, level)[child - 1];
     } else {
-      LocalMesh local = special.deepest;
-      detail::CornerStep step = special.step;
-      for (int n = kTabulatedLevels + 1; n <= level; ++n) result.deeper = subdivideDisplacements(local, step);
+      LocalMesh local = deepestTabulated(special);
+      for (int n = kTabulatedLevels + 1; n <= level; ++n) result.deeper = subdivideDisplacements(local, steps);
       result.patch = &result.deeper[child - 1];
     }
     result.jacobian = std::ldexp(1.0, level) * detail::cornerFrameJacobian(child) * toCorner;
     return result;
   }
 
-  // Weights of s and its derivatives at an element point, over element.columns.
-  SampleWeights weights(const ElementPoint& point) const {
+  // Weights of s and its derivatives at an element point, over
+  // element.columns, into w (resized only if its size differs, so that a
+  // loop over points reuses one buffer). With rows = 1 or 3 only the first
+  // rows (s; s, s_u, s_v) are computed, the others left as they were.
+  void weightsInto(const ElementPoint& point, SampleWeights& w, int rows = 6) const {
     checkPoint(point);
     const Element& element = elements[point.element];
     // NB: lazyProduct: these products are too small for Eigen's blocked GEMM,
     // whose packing and allocation dominated closest-point searches.
-    if (element.type == ElementType::Normal) return detail::bsplineWeights(point.u, point.v).lazyProduct(element.grid);
-    const Special& special = specials[element.special];
+    auto product = [&](const Eigen::Matrix<double, 6, 16>& b, const auto& grid) {
+      if (rows == 6) {
+        w.noalias() = b.lazyProduct(grid);
+      } else if (rows == 3) {
+        w.topRows<3>().noalias() = b.topRows<3>().lazyProduct(grid);
+      } else {
+        w.topRows<1>().noalias() = b.topRows<1>().lazyProduct(grid);
+      }
+    };
+    if (element.type == ElementType::Normal) {
+      w.resize(6, element.grid.cols());
+      // The common case (a normal element of a mesh that needed no
+      // isolation) as a fixed-size product, which Eigen vectorizes.
+      const Eigen::Matrix<double, 6, 16> basis = detail::bsplineWeights(point.u, point.v);
+      if (element.slotColumn[0] >= 0) {
+        for (int slot = 0; slot < 16; ++slot) w.col(element.slotColumn[slot]).head(rows) = basis.col(slot).head(rows);
+      } else if (element.grid.cols() == 16) {
+        product(basis, Eigen::Map<const Eigen::Matrix<double, 16, 16>>(element.grid.data()));
+      } else {
+        product(basis, element.grid);
+      }
+      return;
+    }
+    const Special& special = *specials[element.special];
     const SubpatchPoint at = locateSubpatch(element, point);
-    SampleWeights w;
+    w.resize(6, static_cast<Eigen::Index>(special.columns.size()));
     if (!at.patch) {
-      w.setZero(6, special.columns.size());
+      w.setZero();
       w.topRows(3) = special.vertexMasks;
     } else {
-      w = detail::bsplineWeights(at.u, at.v).lazyProduct(*at.patch);
+      product(detail::bsplineWeights(at.u, at.v), *at.patch);
       w.row(0) += special.vertexMasks.row(0);  // the patch holds displacements from the limit point
     }
-    applyChainRule(w, at.jacobian);
+    applyChainRule(w, at.jacobian, rows);
+  }
+  SampleWeights weights(const ElementPoint& point) const {
+    SampleWeights w;
+    weightsInto(point, w);
     return w;
   }
 
@@ -294,7 +405,7 @@ struct LimitSurface::Impl {
       return g;
     };
     if (element.type == ElementType::Normal) return detail::bsplineWeights(point.u, point.v) * gridPoints(element.grid);
-    const Special& special = specials[element.special];
+    const Special& special = *specials[element.special];
     const SubpatchPoint at = locateSubpatch(element, point);
     Eigen::Matrix<double, 6, 3> result = Eigen::Matrix<double, 6, 3>::Zero();
     Eigen::Matrix<double, 3, 3> masks = Eigen::Matrix<double, 3, 3>::Zero();
@@ -343,14 +454,6 @@ struct LimitSurface::Impl {
   }
 
   const std::vector<int>& columnsOf(int element) const { return elements[element].columns; }
-
-  // Each point's columns and weights, the rows operators() are assembled from.
-  PointSamples samplesAt(const std::vector<ElementPoint>& points) const {
-    PointSamples samples;
-    samples.reserve(points.size());
-    for (const ElementPoint& point : points) samples.emplace_back(&columnsOf(point.element), weights(point));
-    return samples;
-  }
 };
 
 LimitSurface::LimitSurface(const ControlMesh& mesh) : impl_(std::make_unique<Impl>()) {
@@ -473,65 +576,87 @@ LimitSample LimitSurface::evaluate(const SurfacePoint& point, const Matrix3X& co
 
 namespace {
 
-// The rows of `count` operators (s, s_u, ... in that order) as row-major
-// sparse matrices built in place: each row's columns are its element's,
-// already sorted, so no triplets are sorted or summed. Exact zeros are left out.
-std::array<SparseMatrix, 6> assemble(int columns, int count, const PointSamples& samples) {
+// The rows of the first `count` operators (s, s_u, s_v, s_uu, s_uv, s_vv) at
+// the points, as row-major sparse matrices built in place in one pass: each
+// row's columns are its element's, already sorted, so no triplets are sorted
+// or summed, and no point's weights are kept. Exact zeros are left out.
+// `jacobians`, if not empty, holds d(element u, v)/d(point's own u, v) per point.
+std::array<SparseMatrix, 6> assemble(const LimitSurface& surface, const LimitSurface::Impl& impl,
+                                     const std::vector<ElementPoint>& points,
+                                     const std::vector<Eigen::Matrix2d>& jacobians, int count) {
   std::array<SparseMatrix, 6> result;
-  const int rows = static_cast<int>(samples.size());
+  const int rows = static_cast<int>(points.size());
   size_t nonZeros = 0;
-  for (const auto& sample : samples) nonZeros += sample.first->size();
+  for (const ElementPoint& point : points) nonZeros += surface.elementColumns(point.element).size();
+  std::array<int, 6> cursor{};
   for (int q = 0; q < count; ++q) {
-    SparseMatrix& m = result[q];
-    m.resize(rows, columns);
-    m.resizeNonZeros(static_cast<Eigen::Index>(nonZeros));
-    int* outer = m.outerIndexPtr();
-    int* inner = m.innerIndexPtr();
-    double* values = m.valuePtr();
-    int k = 0;
-    outer[0] = 0;
-    for (int r = 0; r < rows; ++r) {
-      const std::vector<int>& cols = *samples[r].first;
-      const SampleWeights& w = samples[r].second;
+    result[q].resize(rows, surface.controlVertexCount());
+    result[q].resizeNonZeros(static_cast<Eigen::Index>(nonZeros));
+    result[q].outerIndexPtr()[0] = 0;
+  }
+  SampleWeights w;
+  for (int r = 0; r < rows; ++r) {
+    impl.weightsInto(points[r], w, count);
+    if (!jacobians.empty()) applyChainRule(w, jacobians[r], count);
+    const std::vector<int>& cols = surface.elementColumns(points[r].element);
+    for (int q = 0; q < count; ++q) {
+      SparseMatrix& m = result[q];
+      int* inner = m.innerIndexPtr();
+      double* values = m.valuePtr();
+      int& k = cursor[q];
       for (size_t c = 0; c < cols.size(); ++c) {
-        if (w(q, c) == 0.0) continue;
+        const double value = w(q, static_cast<Eigen::Index>(c));
+        if (value == 0.0) continue;
         inner[k] = cols[c];
-        values[k] = w(q, c);
+        values[k] = value;
         ++k;
       }
-      outer[r + 1] = k;
+      m.outerIndexPtr()[r + 1] = k;
     }
-    m.resizeNonZeros(k);
   }
+  for (int q = 0; q < count; ++q) result[q].resizeNonZeros(cursor[q]);
   return result;
 }
 
-LimitOperators toOperators(std::array<SparseMatrix, 6>&& m) {
-  return LimitOperators{std::move(m[0]), std::move(m[1]), std::move(m[2]),
-                        std::move(m[3]), std::move(m[4]), std::move(m[5])};
+// NB: swap, not move: Eigen 3.4's SparseMatrix has no move constructor, and
+// std::move would copy every operator.
+LimitOperators toOperators(std::array<SparseMatrix, 6>& m) {
+  LimitOperators result;
+  result.J.swap(m[0]);
+  result.Ju.swap(m[1]);
+  result.Jv.swap(m[2]);
+  result.Juu.swap(m[3]);
+  result.Juv.swap(m[4]);
+  result.Jvv.swap(m[5]);
+  return result;
+}
+
+int operatorCount(int order) {
+  if (order < 0 || order > 2) throw Error("limit operators have derivatives of order 0, 1 or 2, not " + std::to_string(order));
+  return order == 0 ? 1 : order == 1 ? 3 : 6;
 }
 
 }  // namespace
 
-LimitOperators LimitSurface::operators(const std::vector<ElementPoint>& points) const {
-  return toOperators(assemble(impl_->controlVertexCount, 6, impl_->samplesAt(points)));
+LimitOperators LimitSurface::operators(const std::vector<ElementPoint>& points, int order) const {
+  std::array<SparseMatrix, 6> m = assemble(*this, *impl_, points, {}, operatorCount(order));
+  return toOperators(m);
 }
 
 SparseMatrix LimitSurface::limitOperator(const std::vector<ElementPoint>& points) const {
-  return std::move(assemble(impl_->controlVertexCount, 1, impl_->samplesAt(points))[0]);
+  std::array<SparseMatrix, 6> m = assemble(*this, *impl_, points, {}, 1);
+  SparseMatrix result;
+  result.swap(m[0]);
+  return result;
 }
 
-LimitOperators LimitSurface::operators(const std::vector<SurfacePoint>& points) const {
-  PointSamples samples;
-  samples.reserve(points.size());
-  for (const SurfacePoint& point : points) {
-    Eigen::Matrix2d jacobian;
-    const ElementPoint elementPoint = impl_->locate(point, jacobian);
-    SampleWeights w = impl_->weights(elementPoint);
-    applyChainRule(w, jacobian);
-    samples.emplace_back(&impl_->columnsOf(elementPoint.element), std::move(w));
-  }
-  return toOperators(assemble(impl_->controlVertexCount, 6, samples));
+LimitOperators LimitSurface::operators(const std::vector<SurfacePoint>& points, int order) const {
+  const int count = operatorCount(order);
+  std::vector<ElementPoint> at(points.size());
+  std::vector<Eigen::Matrix2d> jacobians(points.size());
+  for (size_t i = 0; i < points.size(); ++i) at[i] = impl_->locate(points[i], jacobians[i]);
+  std::array<SparseMatrix, 6> m = assemble(*this, *impl_, at, jacobians, count);
+  return toOperators(m);
 }
 
 SparseMatrix LimitSurface::patchOperator() const {
@@ -601,14 +726,14 @@ ElementPieces LimitSurface::elementPieces(int element, int levels) const {
     result.pieces.push_back(BsplinePiece{e.grid, Eigen::RowVectorXd::Zero(e.columns.size()), 1.0, false});
     return result;
   }
-  const Impl::Special& special = s.specials[e.special];
+  Impl::Special& special = *s.specials[e.special];
   const Eigen::Matrix2d toCorner = detail::cornerFrameJacobian(e.corner);
-  LocalMesh local = special.deepest;
-  detail::CornerStep step = special.step;
+  LocalMesh local;
+  if (levels > kTabulatedLevels) local = s.deepestTabulated(special);
   LevelPatches deeper;
   for (int level = 1; level <= levels; ++level) {
-    if (level > kTabulatedLevels) deeper = subdivideDisplacements(local, step);
-    const LevelPatches& patches = level <= kTabulatedLevels ? special.levels[level - 1] : deeper;
+    if (level > kTabulatedLevels) deeper = subdivideDisplacements(local, s.steps);
+    const LevelPatches& patches = level <= kTabulatedLevels ? s.level(special, level) : deeper;
     for (int child = 1; child <= 3; ++child) {
       BsplinePiece piece;
       piece.grid = patches[child - 1];

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_map>
 
 #include "dynsub/CatmullClark.h"
 #include "dynsub/Error.h"
@@ -210,7 +211,7 @@ VertexMasks vertexMasks(const Topology& topology, int x, int f) {
 }
 
 Neighbourhood extractNeighbourhood(const Topology& topology, int x, int f) {
-  std::vector<int> faces;
+  std::vector<int> faces;  // sorted: the set of faces to take
   for (int g : topology.vertexFaces(x)) {
     for (int w : topology.face(g)) {
       for (int h : topology.vertexFaces(w)) faces.push_back(h);
@@ -218,22 +219,53 @@ Neighbourhood extractNeighbourhood(const Topology& topology, int x, int f) {
   }
   std::sort(faces.begin(), faces.end());
   faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  auto indexOf = [&](int g) {
+    const auto it = std::lower_bound(faces.begin(), faces.end(), g);
+    return it != faces.end() && *it == g ? static_cast<int>(it - faces.begin()) : -1;
+  };
+
+  // NB: the faces are ordered breadth-first across edges from f, each rotated
+  // to begin where it was entered, and vertices numbered as first met. The
+  // order then depends only on the mesh's structure around x, not on its
+  // global numbering, so equal neighbourhoods (around every extraordinary
+  // vertex of one valence in otherwise regular surroundings, and around all
+  // of them after a level of subdivision) have equal local topologies, and
+  // LimitSurface shares their subdivision steps.
+  std::vector<std::pair<int, int>> order;  // (face, first corner)
+  order.reserve(faces.size());
+  std::vector<char> taken(faces.size(), 0);
+  order.emplace_back(f, topology.corner(f, x));
+  taken[indexOf(f)] = 1;
+  for (size_t next = 0; next < order.size(); ++next) {
+    const auto [g, first] = order[next];
+    const int n = topology.faceSize(g);
+    for (int k = 0; k < n; ++k) {
+      const int corner = (first + k) % n;
+      const int h = topology.otherFace(topology.faceEdge(g, corner), g);
+      const int index = h < 0 ? -1 : indexOf(h);
+      if (index < 0 || taken[index]) continue;
+      taken[index] = 1;
+      // h runs along the shared edge the other way: it is entered at g's next corner.
+      order.emplace_back(h, topology.corner(h, topology.face(g)[(corner + 1) % n]));
+    }
+  }
+  // Faces not reached across edges (none in a manifold mesh) keep their order.
+  for (size_t i = 0; i < faces.size(); ++i) {
+    if (!taken[i]) order.emplace_back(faces[i], 0);
+  }
 
   Neighbourhood result;
-  std::vector<int> localIndex(topology.vertexCount(), -1);
+  result.face = 0;
+  std::unordered_map<int, int> localIndex;
   std::vector<Polygon> polygons;
-  for (int g : faces) {
+  polygons.reserve(order.size());
+  for (const auto& [g, first] : order) {
     Polygon polygon = topology.face(g);
-    if (g == f) {
-      std::rotate(polygon.begin(), polygon.begin() + topology.corner(f, x), polygon.end());
-      result.face = static_cast<int>(polygons.size());
-    }
+    std::rotate(polygon.begin(), polygon.begin() + first, polygon.end());
     for (int& v : polygon) {
-      if (localIndex[v] < 0) {
-        localIndex[v] = static_cast<int>(result.parentVertex.size());
-        result.parentVertex.push_back(v);
-      }
-      v = localIndex[v];
+      const auto [it, added] = localIndex.emplace(v, static_cast<int>(result.parentVertex.size()));
+      if (added) result.parentVertex.push_back(v);
+      v = it->second;
     }
     polygons.push_back(std::move(polygon));
   }
@@ -241,12 +273,13 @@ Neighbourhood extractNeighbourhood(const Topology& topology, int x, int f) {
   return result;
 }
 
-CornerStep cornerStep(const Topology& topology, int face) {
+CornerStep cornerStep(std::shared_ptr<const Topology> from, int face) {
+  const Topology& topology = *from;
   const Refinement refinement = refine(topology);
   const Eigen::MatrixXd refined = Eigen::MatrixXd(refinement.subdivisionMatrix);  // refined <- local
   const int firstChild = refinement.childFaceOffset[face];
   CornerStep step;
-  step.from = topology;
+  step.from = std::move(from);
   step.face = face;
   std::array<SmallStencil, 16> grid;
   for (int k = 1; k <= 3; ++k) {
@@ -264,15 +297,15 @@ CornerStep cornerStep(const Topology& topology, int face) {
   const int x = topology.face(face)[0];
   Neighbourhood next = extractNeighbourhood(refinement.topology, x, firstChild);
   step.next = refined(next.parentVertex, Eigen::all);
-  step.to = std::move(next.topology);
+  step.to = std::make_shared<const Topology>(std::move(next.topology));
   step.toFace = next.face;
   return step;
 }
 
-LevelPatches subdivideAroundCorner(LocalMesh& mesh, CornerStep& step) {
-  const bool applies = step.face == mesh.face && step.from.vertexCount() == mesh.topology.vertexCount() &&
-                       step.from.faces() == mesh.topology.faces();
-  if (!applies) step = cornerStep(mesh.topology, mesh.face);
+LevelPatches subdivideAroundCorner(LocalMesh& mesh, const CornerStep& step) {
+  if (step.face != mesh.face || (step.from != mesh.topology && step.from->faces() != mesh.topology->faces())) {
+    throw Error("internal: a local subdivision step applied to another neighbourhood");
+  }
   LevelPatches patches;
   for (int k = 0; k < 3; ++k) patches[k].noalias() = step.patches[k] * mesh.weights;
   mesh.weights = step.next * mesh.weights;

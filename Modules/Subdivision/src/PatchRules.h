@@ -3,6 +3,7 @@
 // regular quad, the uniform bicubic B-spline basis, the limit and tangent masks
 // at a vertex, and one step of local subdivision around an extraordinary vertex.
 #include <array>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -52,8 +53,10 @@ Neighbourhood extractNeighbourhood(const Topology& topology, int x, int f);
 
 // A neighbourhood whose vertices are blends (rows of `weights`) of a fixed set
 // of control vertices, with the extraordinary vertex at corner 0 of `face`.
+// The topology is shared: every level of every neighbourhood of one
+// structure has the same one.
 struct LocalMesh {
-  Topology topology;
+  std::shared_ptr<const Topology> topology;
   Eigen::MatrixXd weights;
   int face = -1;
 };
@@ -68,18 +71,18 @@ using LevelPatches = std::array<Eigen::Matrix<double, 16, Eigen::Dynamic>, 3>;
 // level or two around an isolated extraordinary vertex the local topology
 // repeats itself, so a step built once serves every deeper level.
 struct CornerStep {
-  Topology from;
+  std::shared_ptr<const Topology> from;
   int face = -1;
   std::array<Eigen::MatrixXd, 3> patches;  // 16 by #local vertices
   Eigen::MatrixXd next;                    // #next local vertices by #local vertices
-  Topology to;
+  std::shared_ptr<const Topology> to;
   int toFace = -1;
 };
-CornerStep cornerStep(const Topology& topology, int face);
+CornerStep cornerStep(std::shared_ptr<const Topology> topology, int face);
 // The level's patches of `mesh`; advances it to the next level (the child at
-// corner 0). Goes through `step`, rebuilt first unless it applies to mesh's
-// topology.
-LevelPatches subdivideAroundCorner(LocalMesh& mesh, CornerStep& step);
+// corner 0). `step` must be cornerStep(mesh.topology, mesh.face), or an
+// equal one.
+LevelPatches subdivideAroundCorner(LocalMesh& mesh, const CornerStep& step);
 
 // (u, v) in the frame whose origin is corner k of a quad and whose u axis runs
 // to corner k+1: k = 0: (u, v); 1: (v, 1-u); 2: (1-u, 1-v); 3: (1-v, u).

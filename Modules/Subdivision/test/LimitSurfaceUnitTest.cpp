@@ -1,10 +1,14 @@
 // Unit tests (no rendering): properties of the exact limit surface with exact
 // answers, checked over meshes covering every case (TestMeshes.h).
+#include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <random>
+#include <thread>
 
 #include <gtest/gtest.h>
 
+#include "PatchRules.h"
 #include "TestMeshes.h"
 #include "dynsub/CatmullClark.h"
 #include "dynsub/Error.h"
@@ -227,6 +231,80 @@ TEST(LimitSurface, BadParametersAreRejected) {
   EXPECT_THROW(surface.evaluate(ElementPoint{0, std::nan(""), 0.5}, cube.points()), dynsub::Error);
   EXPECT_THROW(surface.evaluate(SurfacePoint{-1, 0.5, 0.5}, cube.points()), dynsub::Error);
   EXPECT_THROW(surface.evaluate(ElementPoint{0, 0.5, 0.5}, cube.points().topRows(10)), dynsub::Error);
+}
+
+TEST(LimitSurface, EqualNeighbourhoodsShareOneLocalTopology) {
+  // The cube's rotations take any (corner, face at it) pair to any other, so
+  // the 24 neighbourhoods of cube98's special elements are one and the same;
+  // numbered by structure, not by the mesh's numbering, they must be equal
+  // however the mesh is numbered (here: vertices and faces shuffled). This is
+  // what lets LimitSurface build one subdivision step for all 24.
+  const dynsub::ControlMesh cube = dynsub::makeCube98();
+  std::mt19937 random(3);
+  std::vector<int> renumber(cube.vertexCount());
+  std::iota(renumber.begin(), renumber.end(), 0);
+  std::shuffle(renumber.begin(), renumber.end(), random);
+  dynsub::Matrix3X points(cube.vertexCount(), 3);
+  for (int v = 0; v < cube.vertexCount(); ++v) points.row(renumber[v]) = cube.points().row(v);
+  std::vector<dynsub::Polygon> faces = cube.faces();
+  for (dynsub::Polygon& face : faces) {
+    for (int& v : face) v = renumber[v];
+  }
+  std::shuffle(faces.begin(), faces.end(), random);
+  const dynsub::Topology topology(cube.vertexCount(), faces);
+
+  std::vector<dynsub::Topology> neighbourhoods;
+  for (int x = 0; x < topology.vertexCount(); ++x) {
+    if (topology.isRegularVertex(x)) continue;
+    for (int f : topology.vertexFaces(x)) neighbourhoods.push_back(dynsub::detail::extractNeighbourhood(topology, x, f).topology);
+  }
+  ASSERT_EQ(neighbourhoods.size(), 24u);
+  for (const dynsub::Topology& neighbourhood : neighbourhoods) {
+    EXPECT_EQ(neighbourhood.faces(), neighbourhoods.front().faces());
+  }
+}
+
+TEST(LimitSurface, ManyThreadsEvaluatingAtOnceAgreeWithOne) {
+  // Special elements tabulate their levels when a point first needs them,
+  // from whichever thread asks. Points at every depth (kParameters reach
+  // level 30) on every element, evaluated by 4 threads at once on a fresh
+  // surface, each in its own order, must equal one thread's results exactly.
+  for (const dynsub::ControlMesh& mesh : {dynsub::makeCube98(), dynsub::testing::makeFan(5, true), dynsub::testing::makeFan(5, false),
+                                          dynsub::testing::makeTetrahedron()}) {
+    std::vector<ElementPoint> points;
+    const LimitSurface one(mesh);
+    for (int e = 0; e < one.elementCount(); ++e) {
+      if (one.elementType(e) != dynsub::ElementType::Special) continue;
+      for (double u : kParameters)
+        for (double v : kParameters) points.push_back({e, u, v});
+    }
+    ASSERT_FALSE(points.empty());
+    std::vector<dynsub::LimitSample> expected;
+    for (const ElementPoint& point : points) expected.push_back(one.evaluate(point, mesh.points()));
+
+    const LimitSurface many(mesh);
+    constexpr int kThreads = 4;
+    std::vector<std::vector<dynsub::LimitSample>> results(kThreads, std::vector<dynsub::LimitSample>(points.size()));
+    std::vector<std::thread> threads;
+    for (int t = 0; t < kThreads; ++t) {
+      threads.emplace_back([&, t] {
+        // Thread t starts at its own quarter and walks backwards on odd t.
+        for (size_t k = 0; k < points.size(); ++k) {
+          const size_t start = t * points.size() / kThreads;
+          const size_t i = (t % 2 ? points.size() - 1 - (start + k) % points.size() : (start + k) % points.size());
+          results[t][i] = many.evaluate(points[i], mesh.points());
+        }
+      });
+    }
+    for (std::thread& thread : threads) thread.join();
+    for (int t = 0; t < kThreads; ++t) {
+      for (size_t i = 0; i < points.size(); ++i) {
+        ASSERT_EQ(results[t][i].position, expected[i].position) << "thread " << t << ", point " << i;
+        ASSERT_EQ(results[t][i].du, expected[i].du) << "thread " << t << ", point " << i;
+        ASSERT_EQ(results[t][i].dvv, expected[i].dvv) << "thread " << t << ", point " << i;
+      }
+    }
+  }
 }
 
 }  // namespace

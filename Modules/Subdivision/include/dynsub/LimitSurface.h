@@ -34,9 +34,10 @@
 // being the quad (corner k, midpoint of edge k, centre, midpoint of edge k-1).
 // Derivatives are taken with respect to the parameters of the point's kind.
 //
-// Cost: construction is O(#control vertices) plus a fixed table per special
-// element; evaluating a point is O(1). Nothing is invalidated by moving control
-// points: only the topology is baked in.
+// Cost: construction is O(#control vertices); a special element tabulates
+// each level of its subpatches the first time a point needs it (thread-safe),
+// so evaluating a point is O(1) after the first one at its level. Nothing is
+// invalidated by moving control points: only the topology is baked in.
 #include <array>
 #include <memory>
 #include <vector>
@@ -131,8 +132,10 @@ class LimitSurface {
 
   LimitSample evaluate(const ElementPoint& point, const Matrix3X& controlPoints) const;
   LimitSample evaluate(const SurfacePoint& point, const Matrix3X& controlPoints) const;
-  LimitOperators operators(const std::vector<ElementPoint>& points) const;
-  LimitOperators operators(const std::vector<SurfacePoint>& points) const;
+  // Derivatives up to `order` (0, 1 or 2); the operators of higher ones are
+  // left empty (0 x 0).
+  LimitOperators operators(const std::vector<ElementPoint>& points, int order = 2) const;
+  LimitOperators operators(const std::vector<SurfacePoint>& points, int order = 2) const;
   // J alone (positions), for callers that need no derivatives.
   SparseMatrix limitOperator(const std::vector<ElementPoint>& points) const;
   // The 16 B-spline control points of every normal element's patch as one
