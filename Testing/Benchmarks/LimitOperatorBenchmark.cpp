@@ -10,6 +10,7 @@
 #include <opensubdiv/far/stencilTableFactory.h>
 
 #include "OpenSubdivReference.h"
+#include "dynsub/ApplyOperator.h"
 #include "dynsub/CatmullClark.h"
 #include "dynsub/LimitSurface.h"
 #include "dynsub/StandardMeshes.h"
@@ -50,7 +51,8 @@ void DynSubApplyOperators(benchmark::State& state) {
   const dynsub::LimitOperators ops = surface.operators(samples(mesh.faceCount()));
   const dynsub::Matrix3X control = mesh.points();
   for (auto _ : state) {
-    dynsub::Matrix3X s = ops.J * control, su = ops.Ju * control, sv = ops.Jv * control;
+    dynsub::Matrix3X s = dynsub::applyOperator(ops.J, control), su = dynsub::applyOperator(ops.Ju, control),
+                     sv = dynsub::applyOperator(ops.Jv, control);
     benchmark::DoNotOptimize(s.data());
     benchmark::DoNotOptimize(su.data());
     benchmark::DoNotOptimize(sv.data());

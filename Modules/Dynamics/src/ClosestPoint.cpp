@@ -8,6 +8,7 @@
 
 #include <nanoflann.hpp>
 
+#include "dynsub/ApplyOperator.h"
 #include "dynsub/Error.h"
 
 namespace dynsub {
@@ -92,7 +93,7 @@ struct ClosestPointLocator::Impl {
   void updateTree() {
     if (drift == 0.0) return;
     cloud.points.resize(static_cast<Eigen::Index>(samples.size()), 3);
-    const Matrix3X special = specialOperator * controlPoints;
+    const Matrix3X special = applyOperator(specialOperator, controlPoints);
     for (Eigen::Index e = 0; e < static_cast<Eigen::Index>(normal.size()); ++e) {
       auto block = cloud.points.middleRows(e * perElement, perElement);
       if (normal[e]) {
@@ -281,7 +282,7 @@ void ClosestPointLocator::update(const Matrix3X& controlPoints) {
   if (!controlPoints.allFinite()) throw Error("closest-point search got non-finite control points");
   Impl& s = *impl_;
   s.controlPoints = controlPoints;
-  s.grids = s.patchOperator * controlPoints;
+  s.grids = applyOperator(s.patchOperator, controlPoints);
   if (s.tree) {
     // |sample move| <= sum |weights| * largest control-point move.
     const double moved = (controlPoints - s.treeControlPoints).rowwise().norm().maxCoeff();

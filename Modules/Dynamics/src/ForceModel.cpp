@@ -3,6 +3,7 @@
 #include <cmath>
 #include <string>
 
+#include "dynsub/ApplyOperator.h"
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/Error.h"
 #include "dynsub/StaticSolver.h"
@@ -70,7 +71,7 @@ Matrix3X SpringForceModel::generalizedForce(const Matrix3X& controlPoints, doubl
     at.reserve(springs_.size());
     for (const Spring& s : springs_) at.push_back(s.attachment);
     const SparseMatrix J = surface_->limitOperator(at);
-    const Matrix3X stretch = targets_ - J * controlPoints;  // d - s per spring
+    const Matrix3X stretch = targets_ - applyOperator(J, controlPoints);  // d - s per spring
     lengths_ = stretch.rowwise().norm();
     potential += 0.5 * stiffness_.dot(lengths_.cwiseAbs2());
     return J.transpose() * (stiffness_.asDiagonal() * stretch);

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <string>
 
+#include "dynsub/ApplyOperator.h"
 #include "dynsub/Error.h"
 #include "dynsub/GaussLegendre.h"
 
@@ -38,7 +39,7 @@ Matrix3X springForces(const LimitSurface& surface, const Matrix3X& controlPoints
   at.reserve(springs.size());
   for (const Spring& s : springs) at.push_back(s.attachment);
   const SparseMatrix J = surface.limitOperator(at);
-  Matrix3X pull = J * controlPoints;  // s at the attachments
+  Matrix3X pull = applyOperator(J, controlPoints);  // s at the attachments
   double total = 0.0;
   for (size_t i = 0; i < springs.size(); ++i) {
     const Vector3 stretch = springs[i].target - pull.row(i).transpose();
@@ -69,7 +70,7 @@ Matrix3X integrate(const SurfaceQuadrature& q, const Matrix3X& densityTimesArea)
 
 // |s_u x s_v| at every quadrature point: surface area per unit parametric area.
 Eigen::VectorXd areaElements(const SurfaceQuadrature& q, const Matrix3X& controlPoints) {
-  const Matrix3X su = q.Ju * controlPoints, sv = q.Jv * controlPoints;
+  const Matrix3X su = applyOperator(q.Ju, controlPoints), sv = applyOperator(q.Jv, controlPoints);
   Eigen::VectorXd area(su.rows());
   for (Eigen::Index i = 0; i < su.rows(); ++i) area(i) = su.row(i).cross(sv.row(i)).norm();
   return area;
@@ -85,7 +86,7 @@ Matrix3X inflationForces(const SurfaceQuadrature& q, const Matrix3X& controlPoin
 Matrix3X pressureForces(const SurfaceQuadrature& q, const Matrix3X& controlPoints, const Eigen::VectorXd& pressures) {
   if (pressures.size() != q.J.rows()) throw Error("internal: one pressure per quadrature point expected");
   if (!pressures.allFinite()) throw Error("a pressure is not finite");
-  const Matrix3X su = q.Ju * controlPoints, sv = q.Jv * controlPoints;
+  const Matrix3X su = applyOperator(q.Ju, controlPoints), sv = applyOperator(q.Jv, controlPoints);
   Matrix3X area(su.rows(), 3);
   for (Eigen::Index i = 0; i < su.rows(); ++i) {
     area.row(i) = pressures(i) * su.row(i).cross(sv.row(i));
@@ -94,7 +95,7 @@ Matrix3X pressureForces(const SurfaceQuadrature& q, const Matrix3X& controlPoint
 }
 
 Matrix3X fieldForces(const SurfaceQuadrature& q, const Matrix3X& controlPoints, const ForceField& field) {
-  const Matrix3X positions = q.J * controlPoints;
+  const Matrix3X positions = applyOperator(q.J, controlPoints);
   Matrix3X forces = field.forcesAt(positions);
   if (forces.rows() != positions.rows()) {
     throw Error("force field returned " + std::to_string(forces.rows()) + " forces for " +

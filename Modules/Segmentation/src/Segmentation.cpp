@@ -9,6 +9,7 @@
 #include <tuple>
 
 #include "RobustStatistics.h"
+#include "dynsub/ApplyOperator.h"
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/Error.h"
 #include "dynsub/Forces.h"
@@ -48,7 +49,7 @@ class RegionPressureForceModel final : public ForceModel {
     quadrature_ = &quadrature;
   }
   Matrix3X generalizedForce(const Matrix3X& controlPoints, double&) override {
-    const Matrix3X positions = quadrature_->J * controlPoints;
+    const Matrix3X positions = applyOperator(quadrature_->J, controlPoints);
     Eigen::VectorXd pressures(positions.rows());
     for (Eigen::Index i = 0; i < positions.rows(); ++i) {
       const Vector3 index = toIndex_ * (positions.row(i).transpose() - image_.geometry.origin);

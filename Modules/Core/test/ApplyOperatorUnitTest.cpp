@@ -1,0 +1,53 @@
+// applyOperator against Eigen's own sparse-times-dense product.
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "dynsub/ApplyOperator.h"
+
+namespace {
+
+using dynsub::Matrix3X;
+using dynsub::SparseMatrix;
+
+SparseMatrix randomOperator(int rows, int cols, std::mt19937& random) {
+  std::uniform_int_distribution<int> column(0, cols - 1);
+  std::uniform_real_distribution<double> weight(-1.0, 1.0);
+  std::vector<dynsub::Triplet> triplets;
+  for (int r = 0; r < rows; ++r) {
+    for (int k = 0; k < 1 + r % 17; ++k) triplets.emplace_back(r, column(random), weight(random));
+  }
+  SparseMatrix op(rows, cols);
+  op.setFromTriplets(triplets.begin(), triplets.end());
+  return op;
+}
+
+TEST(ApplyOperator, EqualsEigensProductToTheBit) {
+  // The same sums in the same order: equal, not merely close.
+  std::mt19937 random(5);
+  const SparseMatrix op = randomOperator(500, 120, random);
+  const Matrix3X points = Matrix3X::Random(120, 3);
+  const Matrix3X expected = op * points;
+  const Matrix3X result = dynsub::applyOperator(op, points);
+  ASSERT_EQ(result.rows(), 500);
+  EXPECT_TRUE((result.array() == expected.array()).all());
+}
+
+TEST(ApplyOperator, ReadsAnUncompressedOperator) {
+  // After insert() a matrix keeps room in each row: only its counted entries are read.
+  std::mt19937 random(6);
+  SparseMatrix op = randomOperator(50, 30, random);
+  op.reserve(Eigen::VectorXi::Constant(50, 4));
+  op.insert(7, 29) = 2.5;
+  ASSERT_FALSE(op.isCompressed());
+  const Matrix3X points = Matrix3X::Random(30, 3);
+  const Matrix3X expected = op * points;
+  EXPECT_TRUE((dynsub::applyOperator(op, points).array() == expected.array()).all());
+}
+
+TEST(ApplyOperator, AnEmptyOperatorGivesNoRows) {
+  const SparseMatrix op(0, 4);
+  EXPECT_EQ(dynsub::applyOperator(op, Matrix3X::Zero(4, 3)).rows(), 0);
+}
+
+}  // namespace
