@@ -158,15 +158,15 @@ TEST_P(OracleTest, TessellationMatchesOpenSubdivAtEveryOutputPoint) {
 INSTANTIATE_TEST_SUITE_P(AllMeshes, OracleTest, ::testing::ValuesIn(dynsub::testing::allTestMeshes()),
                          [](const auto& info) { return info.param.name; });
 
-// A hostile mesh: an interior vertex of valence 50, whose special elements
-// need their deepest tabulated levels; it agrees like valence 3-8 (3e-16).
-// Not here: a boundary vertex of 50 faces. Its positions and derivatives
-// agree, but the normal at the vertex itself does not: the cross-boundary
-// tangent read at level 48 (LimitSurface.cpp) has not converged when the
-// fan has many faces (spread of that normal over the fan: 2e-8 rad at 5
-// faces, 2e-2 at 12, 1.5 at 50; OpenSubdiv's: 1.5e-8). A known gap.
+// Hostile meshes: an interior vertex of valence 50, whose special elements
+// need their deepest tabulated levels (it agrees like valence 3-8, 3e-16),
+// and boundary vertices of 12 and 50 faces, whose cross-boundary tangent
+// comes from the eigenstructure of the local subdivision (LimitSurface.cpp;
+// read from level 48 instead, the normal there was off by 2e-2 and 1.5 rad).
 INSTANTIATE_TEST_SUITE_P(Valence50, OracleTest,
-                         ::testing::Values(dynsub::testing::NamedMesh{"fan50", dynsub::testing::makeFan(50, true)}),
+                         ::testing::Values(dynsub::testing::NamedMesh{"fan50", dynsub::testing::makeFan(50, true)},
+                                           dynsub::testing::NamedMesh{"openfan12", dynsub::testing::makeFan(12, false)},
+                                           dynsub::testing::NamedMesh{"openfan50", dynsub::testing::makeFan(50, false)}),
                          [](const auto& info) { return info.param.name; });
 
 }  // namespace

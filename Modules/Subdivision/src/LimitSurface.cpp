@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <atomic>
+#include <complex>
 #include <cmath>
 #include <map>
 #include <mutex>
+
+#include <Eigen/Eigenvalues>
 
 #include "PatchRules.h"
 #include "dynsub/CatmullClark.h"
@@ -23,8 +26,8 @@ namespace {
 // the first time a point needs it (points closer than 2^-24 to the
 // extraordinary corner are computed on demand without being kept).
 constexpr int kTabulatedLevels = 24;
-// The cross-boundary tangent at a boundary extraordinary vertex is read at this
-// level (see setBoundaryTangents).
+// The cross-boundary tangent at a boundary extraordinary vertex has the
+// magnitude it has at this level (see setBoundaryTangents).
 constexpr int kCrossTangentLevel = 48;
 
 // Displacements from the limit point have rows summing to exactly 0; removing
@@ -52,6 +55,9 @@ class StepCache {
     if (it == byStructure_.end()) {
       auto step = std::make_unique<detail::CornerStep>(detail::cornerStep(mesh.topology, mesh.face));
       byAddress_.emplace(std::make_pair(step->from.get(), step->face), step.get());
+      // A step whose result has its own topology (every level past the first
+      // one or two) leads to itself, found by address from then on.
+      if (step->toFace == step->face && step->to->faces() == step->from->faces()) step->to = step->from;
       it = byStructure_.emplace(std::move(key), std::move(step)).first;
     }
     return *it->second;
@@ -266,21 +272,73 @@ struct LimitSurface::Impl {
   // Tangents at a boundary extraordinary vertex. Along the boundary the
   // boundary curve's tangent is exact. Across it no closed-form mask fits the
   // standard boundary rules (the Biermann et al. mask, made for modified rules,
-  // is off by up to 2e-2 rad here), so the cross tangent is read from the
-  // subdivision itself: the displacement of an interior neighbour of the vertex
-  // at the deepest tabulated level, scaled by 2^level. Its part across the
-  // boundary converges to the subdominant eigen-direction like
-  // (lambda3/lambda2)^level (measured: 7e-5 rad at level 24 for a boundary
-  // vertex of 5 faces), so it is read at level 48. Still a fixed linear mask,
-  // so J_u and J_v stay linear operators.
+  // is off by up to 2e-2 rad here), so the cross tangent comes from the
+  // subdivision's own eigenstructure. Past the first level or two one step S
+  // maps the neighbourhood's displacements to the next level's, so at level
+  // L >= m they are S^(L-m) W_m = sum_j lambda_j^(L-m) r_j (l_j W_m) over the
+  // eigenvalues lambda_j, right eigenvectors r_j and left ones l_j of S. The
+  // displacement of an interior neighbour of the vertex, scaled by 2^L, turns
+  // across the boundary at the rate of the largest eigenvalue it holds; read
+  // at a finite level (48 before) the next eigenvalues still pull it off by
+  // (lambda_next / lambda_top)^L, which is 2e-2 rad at 12 faces and 1.5 rad at
+  // 50, where the eigenvalues crowd together. Here only the top eigenvalue's
+  // terms are kept: the limit direction, exact to the eigensolver's accuracy,
+  // with the magnitude of the level-48 reading, so that the masks are as
+  // before where that reading had converged. Still a fixed linear mask, so
+  // J_u and J_v stay linear operators.
   void setBoundaryTangents(Special& special, const detail::VertexMasks& masks, const Eigen::RowVectorXd& along) {
     LocalMesh deep = special.deepest;  // level 0
-    for (int level = 0; level < kCrossTangentLevel; ++level) subdivideDisplacements(deep, steps);
+    int level = 0;
+    for (;; ++level) {
+      const detail::CornerStep& step = steps.stepFor(deep);
+      if (step.to == step.from && step.toFace == step.face) break;
+      if (level == 8) throw Error("internal: the subdivision around a boundary vertex does not repeat");
+      subdivideDisplacements(deep, steps);
+    }
+    const Eigen::MatrixXd& repeated = steps.stepFor(deep).next;
     const Topology& topology = *deep.topology;
     const Polygon& face = topology.face(deep.face);
     const int x = face[0];
-    const int interior = !topology.isBoundaryEdge(topology.findEdge(x, face[1])) ? face[1] : face[3];
-    Eigen::RowVectorXd across = std::ldexp(1.0, kCrossTangentLevel) * deep.weights.row(interior);
+    // NB: the new 1-ring of x (x, and the corners of the faces at x) is made
+    // from the old 1-ring alone, so S is block triangular: the eigenvalues
+    // that matter, and their left eigenvectors (zero off the 1-ring), are
+    // those of S restricted to the 1-ring, a quarter of the work of the whole
+    // neighbourhood's at a fan of 50 faces, times the fan's 50 elements.
+    std::vector<int> ring;
+    for (int f : topology.vertexFaces(x)) ring.insert(ring.end(), topology.face(f).begin(), topology.face(f).end());
+    std::sort(ring.begin(), ring.end());
+    ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
+    const Eigen::MatrixXd ringStep = repeated(ring, ring);
+    if (std::abs(repeated(ring, Eigen::all).cwiseAbs().sum() - ringStep.cwiseAbs().sum()) > 1e-12 * ringStep.cwiseAbs().sum()) {
+      throw Error("internal: the 1-ring of a boundary vertex is not closed under subdivision");
+    }
+    const int interiorVertex = !topology.isBoundaryEdge(topology.findEdge(x, face[1])) ? face[1] : face[3];
+    const Eigen::Index interior = std::lower_bound(ring.begin(), ring.end(), interiorVertex) - ring.begin();
+    const Eigen::EigenSolver<Eigen::MatrixXd> solver(ringStep);
+    if (solver.info() != Eigen::Success) throw Error("internal: no eigenvectors for a boundary vertex's subdivision");
+    const Eigen::VectorXcd lambda = solver.eigenvalues();
+    const Eigen::MatrixXcd right = solver.eigenvectors();
+    const Eigen::MatrixXcd left = right.inverse();
+    const Eigen::MatrixXcd coefficients = left * deep.weights(ring, Eigen::all).cast<std::complex<double>>();  // l_j W_m
+    // The terms of the interior neighbour's displacement, and the largest
+    // eigenvalue among them (not 1: displacements from the limit point hold
+    // none of it, but for rounding).
+    std::vector<double> size(lambda.size(), 0.0);
+    double top = 0.0, largestTerm = 0.0;
+    for (Eigen::Index j = 0; j < lambda.size(); ++j) {
+      size[j] = std::abs(right(interior, j)) * coefficients.row(j).norm();
+      if (std::abs(lambda(j) - 1.0) > 1e-6) largestTerm = std::max(largestTerm, size[j]);
+    }
+    for (Eigen::Index j = 0; j < lambda.size(); ++j) {
+      if (std::abs(lambda(j) - 1.0) > 1e-6 && size[j] > 1e-9 * largestTerm) top = std::max(top, std::abs(lambda(j)));
+    }
+    Eigen::RowVectorXcd sum = Eigen::RowVectorXcd::Zero(deep.weights.cols());
+    for (Eigen::Index j = 0; j < lambda.size(); ++j) {
+      const bool isTop = std::abs(lambda(j) - 1.0) > 1e-6 && size[j] > 1e-9 * largestTerm &&
+                         std::abs(lambda(j)) >= top * (1.0 - 1e-9);
+      if (isTop) sum += std::pow(lambda(j), kCrossTangentLevel - level) * right(interior, j) * coefficients.row(j);
+    }
+    const Eigen::RowVectorXd across = std::ldexp(1.0, kCrossTangentLevel) * sum.real();
     const double theta = M_PI / masks.faces;
     special.vertexMasks.row(1) = std::cos(masks.fanPosition * theta) * along +
                                  std::sin(masks.fanPosition * theta) * across;

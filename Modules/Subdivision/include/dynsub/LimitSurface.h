@@ -15,11 +15,12 @@
 //    §2.3 / §3.1.2: local subdivision of its neighbourhood n times leaves the
 //    point in one of three regular subpatches of size 2^-n, with n finite for
 //    every (u, v) != the extraordinary corner. Nothing is truncated; the first
-//    24 levels are tabulated at construction, deeper ones computed on demand.
+//    24 levels are tabulated when first needed, deeper ones computed on demand.
 //    At the extraordinary vertex itself: the exact limit position mask, and
 //    tangents (interior: the masks of Halstead et al. 1993; boundary: the
-//    boundary curve's tangent, and across it a tangent read from the
-//    subdivision at level 48, exact to ~1e-7 rad). There the
+//    boundary curve's tangent, and across it the limit direction of the local
+//    subdivision's top eigenvector, exact to ~1e-7 rad at any number of
+//    faces). There the
 //    parameterization is singular (|s_u| -> 0 for valence 3, -> infinity for
 //    valence >= 5), so s_u and s_v are the tangent-mask vectors, scaled to equal
 //    the B-spline derivatives at a regular vertex; they span the exact tangent
