@@ -50,9 +50,12 @@ void DynSubApplyOperators(benchmark::State& state) {
   const dynsub::LimitSurface surface(mesh);
   const dynsub::LimitOperators ops = surface.operators(samples(mesh.faceCount()));
   const dynsub::Matrix3X control = mesh.points();
+  // Into arrays allocated once, as OpenSubdiv's side below writes into its own.
+  dynsub::Matrix3X s, su, sv;
   for (auto _ : state) {
-    dynsub::Matrix3X s = dynsub::applyOperator(ops.J, control), su = dynsub::applyOperator(ops.Ju, control),
-                     sv = dynsub::applyOperator(ops.Jv, control);
+    dynsub::applyOperator(ops.J, control, s);
+    dynsub::applyOperator(ops.Ju, control, su);
+    dynsub::applyOperator(ops.Jv, control, sv);
     benchmark::DoNotOptimize(s.data());
     benchmark::DoNotOptimize(su.data());
     benchmark::DoNotOptimize(sv.data());

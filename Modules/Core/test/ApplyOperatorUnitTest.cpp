@@ -31,6 +31,10 @@ TEST(ApplyOperator, EqualsEigensProductToTheBit) {
   const Matrix3X result = dynsub::applyOperator(op, points);
   ASSERT_EQ(result.rows(), 500);
   EXPECT_TRUE((result.array() == expected.array()).all());
+  // Into a reused array of another size.
+  Matrix3X reused = Matrix3X::Constant(7, 3, 1.0);
+  dynsub::applyOperator(op, points, reused);
+  EXPECT_TRUE((reused.array() == expected.array()).all());
 }
 
 TEST(ApplyOperator, ReadsAnUncompressedOperator) {
