@@ -38,11 +38,11 @@ TEST(ApplyOperator, EqualsEigensProductToTheBit) {
 }
 
 TEST(ApplyOperator, ReadsAnUncompressedOperator) {
-  // After insert() a matrix keeps room in each row: only its counted entries are read.
+  // After reserve() a matrix keeps room in each row: only its counted entries are read.
   std::mt19937 random(6);
   SparseMatrix op = randomOperator(50, 30, random);
   op.reserve(Eigen::VectorXi::Constant(50, 4));
-  op.insert(7, 29) = 2.5;
+  op.coeffRef(7, 29) = 2.5;  // found or inserted; the rows keep their spare room
   ASSERT_FALSE(op.isCompressed());
   const Matrix3X points = Matrix3X::Random(30, 3);
   const Matrix3X expected = op * points;
