@@ -99,7 +99,9 @@ TEST_P(LimitSurfaceProperties, OperatorRowsArePartitionsOfUnity) {
     const Eigen::VectorXd sizes = d->cwiseAbs() * ones;
     for (Eigen::Index r = 0; r < sums.size(); ++r) {
       const double t = std::max({std::min(points[r].u, 1 - points[r].u), std::min(points[r].v, 1 - points[r].v)});
-      if (t == 0.0 || t >= 1e-3) EXPECT_LE(std::abs(sums(r)), 1e-10 * (1.0 + sizes(r)));
+      if (t == 0.0 || t >= 1e-3) {
+        EXPECT_LE(std::abs(sums(r)), 1e-10 * (1.0 + sizes(r)));
+      }
     }
   }
   // The operators and direct evaluation agree.
