@@ -329,14 +329,15 @@ struct LimitSurface::Impl {
       size[j] = std::abs(right(interior, j)) * coefficients.row(j).norm();
       if (std::abs(lambda(j) - 1.0) > 1e-6) largestTerm = std::max(largestTerm, size[j]);
     }
+    auto held = [&](Eigen::Index j) { return std::abs(lambda(j) - 1.0) > 1e-6 && size[j] > 1e-9 * largestTerm; };
     for (Eigen::Index j = 0; j < lambda.size(); ++j) {
-      if (std::abs(lambda(j) - 1.0) > 1e-6 && size[j] > 1e-9 * largestTerm) top = std::max(top, std::abs(lambda(j)));
+      if (held(j)) top = std::max(top, std::abs(lambda(j)));
     }
     Eigen::RowVectorXcd sum = Eigen::RowVectorXcd::Zero(deep.weights.cols());
     for (Eigen::Index j = 0; j < lambda.size(); ++j) {
-      const bool isTop = std::abs(lambda(j) - 1.0) > 1e-6 && size[j] > 1e-9 * largestTerm &&
-                         std::abs(lambda(j)) >= top * (1.0 - 1e-9);
-      if (isTop) sum += std::pow(lambda(j), kCrossTangentLevel - level) * right(interior, j) * coefficients.row(j);
+      if (held(j) && std::abs(lambda(j)) >= top * (1.0 - 1e-9)) {
+        sum += std::pow(lambda(j), kCrossTangentLevel - level) * right(interior, j) * coefficients.row(j);
+      }
     }
     const Eigen::RowVectorXd across = std::ldexp(1.0, kCrossTangentLevel) * sum.real();
     const double theta = M_PI / masks.faces;
