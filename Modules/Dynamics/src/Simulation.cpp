@@ -1,11 +1,13 @@
 #include "dynsub/Simulation.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <deque>
 #include <limits>
 #include <string>
 
+#include "dynsub/ApplyOperator.h"
 #include "dynsub/CatmullClark.h"
 #include "dynsub/Error.h"
 #include "dynsub/LimitSurface.h"
@@ -162,6 +164,26 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
   return LevelEnd::StepLimit;
 }
 
+// How far a step from `from` to `to` moved the limit surface across itself:
+// the largest |n . (s(to) - s(from))| over the quadrature points, n the unit
+// normal at `from`. A static step also slides the parametrization along the
+// surface, which changes no shape (the tangent-plane stiffness leaves that
+// slide to the surface's weak elasticity, StaticSolver.h), so control-point
+// motion would keep a fitted shape "moving" for hundreds of steps.
+double shapeMotion(const SurfaceQuadrature& quadrature, const Matrix3X& from, const Matrix3X& to) {
+  const Matrix3X moved = applyOperator(quadrature.J, Matrix3X(to - from));
+  const Matrix3X su = applyOperator(quadrature.Ju, from), sv = applyOperator(quadrature.Jv, from);
+  double largest = 0.0;
+  for (Eigen::Index i = 0; i < moved.rows(); ++i) {
+    const Eigen::Vector3d n = su.row(i).transpose().cross(sv.row(i).transpose());
+    const double length = n.norm();
+    // A degenerate normal (a collapsed element) counts the whole move.
+    const double across = length > 0.0 ? std::abs(n.dot(moved.row(i).transpose())) / length : moved.row(i).norm();
+    largest = std::max(largest, across);
+  }
+  return largest;
+}
+
 // Newton steps on K p = f_p (StaticSolver.h). When every force has a
 // potential, the total energy 1/2 p^T K p + potential is what the
 // equilibrium minimizes, and a step that does not lower it is halved (up to
@@ -221,13 +243,16 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
     const double motion = (trial - points).rowwise().norm().maxCoeff();
     const double change = relativeChange(trialEnergy, energy);
     acceptState(forces);
+    const Matrix3X previous = std::move(points);
     points = std::move(trial);
     force = std::move(trialForce);
     energy = trialEnergy;
     summary.energy = energy;
     summary.steps = step;
     if (progress) progress(Progress{model.level, step, energy, motion, &model.surface, &points});
-    if (window.settled(change, motion / model.size)) return finish(LevelEnd::Equilibrium);
+    if (window.settled(change, shapeMotion(model.quadrature, previous, points) / model.size)) {
+      return finish(LevelEnd::Equilibrium);
+    }
   }
   return finish(LevelEnd::StepLimit);
 }

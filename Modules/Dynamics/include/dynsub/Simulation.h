@@ -16,8 +16,15 @@
 // level start). A level that reaches `maxSteps` first ends unconverged (and is
 // reported so).
 //
-// A static step is still when it meets the same tolerances; two still steps
-// in a row are an equilibrium.
+// A static step is still when it changes the energy by at most
+// `energyTolerance` and moves the limit surface *across itself* (along its
+// normals, at the quadrature points) by at most `motionTolerance` of the
+// size; two still steps in a row are an equilibrium. The motion along the
+// surface is left out: the static scheme leaves the parametrization's slide
+// to the surface's weak elasticity (StaticSolver.h), a creep that changes
+// neither the shape nor the fit and took 80 % of the steps (the kitten 269
+// steps, 47 without it). What it leaves is reported: LevelSummary::residual
+// includes the tangential imbalance.
 //
 // Stabilizer updates (time stepping): the forces' stiffness that stabilizes the integration
 // (Integrator.h) is frozen when a level starts; when the energy rises by more
