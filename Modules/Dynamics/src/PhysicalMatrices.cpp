@@ -1,6 +1,8 @@
 #include "dynsub/PhysicalMatrices.h"
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <string>
 
 #include "dynsub/Error.h"
@@ -63,15 +65,15 @@ void checkMaterial(const Material& m) {
   }
 }
 
-ElementIntegrals integrateElement(const LimitSurface& surface, int element, const AssemblyOptions& options) {
-  checkOptions(options);
+namespace {
+
+// The integrals over `pieces` (a normal element's one piece, or a special
+// element's levels), over the pieces' columns.
+ElementIntegrals integratePieces(const ElementPieces& pieces, bool special, const AssemblyOptions& options) {
   // NB: the unit integrals depend only on the quadrature order; cache the default.
   static const UnitIntegrals exact = unitIntegrals(4);
   const UnitIntegrals unit = options.quadraturePoints == 4 ? exact : unitIntegrals(options.quadraturePoints);
-
-  const bool special = surface.elementType(element) == ElementType::Special;
-  const ElementPieces pieces = surface.elementPieces(element, special ? options.levels : 1);
-  const int n = static_cast<int>(pieces.columns.size());
+  const int n = static_cast<int>(pieces.pieces.empty() ? 0 : pieces.pieces.front().grid.cols());
   ElementIntegrals result;
   result.columns = pieces.columns;
   for (Eigen::MatrixXd* m : {&result.mass, &result.tensionU, &result.tensionV, &result.plateUU, &result.plateUV,
@@ -100,6 +102,43 @@ ElementIntegrals integrateElement(const LimitSurface& surface, int element, cons
   return result;
 }
 
+// Integrals over a structure's neighbourhood vertices carried to an
+// element's columns: the pieces are the shared ones times `map`, so each
+// integral G^T U G becomes map^T (G^T U G) map.
+ElementIntegrals mapIntegrals(const ElementIntegrals& shared, const Eigen::MatrixXd& map,
+                              const std::vector<int>& columns) {
+  ElementIntegrals result;
+  result.columns = columns;
+  result.mass = map.transpose() * shared.mass * map;
+  result.tensionU = map.transpose() * shared.tensionU * map;
+  result.tensionV = map.transpose() * shared.tensionV * map;
+  result.plateUU = map.transpose() * shared.plateUU * map;
+  result.plateUV = map.transpose() * shared.plateUV * map;
+  result.plateVV = map.transpose() * shared.plateVV * map;
+  return result;
+}
+
+// One element's integrals; a special element's through its structure's,
+// integrated once per structure in `cache` (by SharedPieces::key).
+ElementIntegrals integrate(const LimitSurface& surface, int element, const AssemblyOptions& options,
+                           std::map<int, ElementIntegrals>& cache) {
+  if (surface.elementType(element) == ElementType::Normal) {
+    return integratePieces(surface.elementPieces(element, 1), false, options);
+  }
+  const SharedPieces shared = surface.sharedPieces(element, options.levels);
+  auto found = cache.find(shared.key);
+  if (found == cache.end()) found = cache.emplace(shared.key, integratePieces(*shared.pieces, true, options)).first;
+  return mapIntegrals(found->second, *shared.map, surface.elementColumns(element));
+}
+
+}  // namespace
+
+ElementIntegrals integrateElement(const LimitSurface& surface, int element, const AssemblyOptions& options) {
+  checkOptions(options);
+  std::map<int, ElementIntegrals> cache;
+  return integrate(surface, element, options, cache);
+}
+
 PhysicalMatrices assemblePhysicalMatrices(const LimitSurface& surface, const std::vector<Material>& materials,
                                           const AssemblyOptions& options) {
   checkOptions(options);
@@ -110,31 +149,55 @@ PhysicalMatrices assemblePhysicalMatrices(const LimitSurface& surface, const std
   }
   for (const Material& m : materials) checkMaterial(m);
 
-  std::vector<Eigen::Triplet<double>> mass, damping, stiffness;
+  // NB: summed in place on the pattern of every pair of control vertices
+  // sharing an element, in element order (the sums setFromTriplets made from
+  // m^2 triplets per matrix and element, millions on a fine mesh, whose
+  // building and sorting took most of the assembly).
+  const int vertices = surface.controlVertexCount();
+  std::vector<std::vector<int>> rows(vertices);
+  for (int e = 0; e < elements; ++e) {
+    const std::vector<int>& columns = surface.elementColumns(e);
+    if (!std::is_sorted(columns.begin(), columns.end())) throw Error("internal: element columns are not sorted");
+    for (int j : columns) rows[j].insert(rows[j].end(), columns.begin(), columns.end());
+  }
+  SymmetricMatrix pattern(vertices, vertices);
+  std::vector<int> perColumn(vertices);
+  for (int j = 0; j < vertices; ++j) {
+    std::sort(rows[j].begin(), rows[j].end());
+    rows[j].erase(std::unique(rows[j].begin(), rows[j].end()), rows[j].end());
+    perColumn[j] = static_cast<int>(rows[j].size());
+  }
+  pattern.reserve(perColumn);
+  for (int j = 0; j < vertices; ++j) {
+    for (int i : rows[j]) pattern.insert(i, j) = 0.0;
+  }
+  pattern.makeCompressed();
+  PhysicalMatrices result;
+  result.mass = pattern;
+  result.damping = pattern;
+  result.stiffness = pattern;
+  const int* outer = pattern.outerIndexPtr();
+  const int* inner = pattern.innerIndexPtr();
+  std::map<int, ElementIntegrals> shared;
   for (int e = 0; e < elements; ++e) {
     const Material& m = materials.size() == 1 ? materials[0] : materials[e];
-    const ElementIntegrals integrals = integrateElement(surface, e, options);
+    const ElementIntegrals integrals = integrate(surface, e, options, shared);
     const Eigen::MatrixXd k = m.tensionU * integrals.tensionU + m.tensionV * integrals.tensionV +
                               m.rigidityUU * integrals.plateUU + m.rigidityUV * integrals.plateUV +
                               m.rigidityVV * integrals.plateVV;
-    const int n = static_cast<int>(integrals.columns.size());
+    const std::vector<int>& columns = integrals.columns;
+    const int n = static_cast<int>(columns.size());
     for (int j = 0; j < n; ++j) {
+      // The element's rows are sorted, so one walk down the column finds them all.
+      int position = outer[columns[j]];
       for (int i = 0; i < n; ++i) {
-        const int row = integrals.columns[i], column = integrals.columns[j];
-        mass.emplace_back(row, column, m.mass * integrals.mass(i, j));
-        damping.emplace_back(row, column, m.damping * integrals.mass(i, j));
-        stiffness.emplace_back(row, column, k(i, j));
+        while (inner[position] != columns[i]) ++position;
+        result.mass.valuePtr()[position] += m.mass * integrals.mass(i, j);
+        result.damping.valuePtr()[position] += m.damping * integrals.mass(i, j);
+        result.stiffness.valuePtr()[position] += k(i, j);
       }
     }
   }
-  const int vertices = surface.controlVertexCount();
-  PhysicalMatrices result;
-  result.mass.resize(vertices, vertices);
-  result.damping.resize(vertices, vertices);
-  result.stiffness.resize(vertices, vertices);
-  result.mass.setFromTriplets(mass.begin(), mass.end());
-  result.damping.setFromTriplets(damping.begin(), damping.end());
-  result.stiffness.setFromTriplets(stiffness.begin(), stiffness.end());
   return result;
 }
 

@@ -36,6 +36,35 @@ TEST_P(PhysicalMatricesTest, MassSumsToDensityTimesParametricArea) {
   EXPECT_NEAR(m.damping.sum(), material.damping * surface.elementCount(), 1e-11 * surface.elementCount());
 }
 
+// The assembly sums each element's integrals in place on the shared pattern;
+// setFromTriplets over the same integrals, in the same element order, must
+// give the same matrices to the bit.
+TEST_P(PhysicalMatricesTest, AssemblyIsTheSumOfTheElementIntegrals) {
+  const LimitSurface surface(GetParam().mesh);
+  const Material material;
+  const PhysicalMatrices m = assemblePhysicalMatrices(surface, material);
+  std::vector<Eigen::Triplet<double>> mass, stiffness;
+  for (int e = 0; e < surface.elementCount(); ++e) {
+    const ElementIntegrals in = integrateElement(surface, e);
+    const Eigen::MatrixXd k = material.tensionU * in.tensionU + material.tensionV * in.tensionV +
+                              material.rigidityUU * in.plateUU + material.rigidityUV * in.plateUV +
+                              material.rigidityVV * in.plateVV;
+    for (size_t j = 0; j < in.columns.size(); ++j) {
+      for (size_t i = 0; i < in.columns.size(); ++i) {
+        mass.emplace_back(in.columns[i], in.columns[j], material.mass * in.mass(i, j));
+        stiffness.emplace_back(in.columns[i], in.columns[j], k(i, j));
+      }
+    }
+  }
+  const int n = surface.controlVertexCount();
+  SymmetricMatrix expectedMass(n, n), expectedStiffness(n, n);
+  expectedMass.setFromTriplets(mass.begin(), mass.end());
+  expectedStiffness.setFromTriplets(stiffness.begin(), stiffness.end());
+  EXPECT_EQ(dense(m.mass), dense(expectedMass));
+  EXPECT_EQ(dense(m.stiffness), dense(expectedStiffness));
+  EXPECT_EQ(m.stiffness.nonZeros(), expectedStiffness.nonZeros());
+}
+
 TEST_P(PhysicalMatricesTest, ConstantsAreInTheNullSpaceOfK) {
   const LimitSurface surface(GetParam().mesh);
   const PhysicalMatrices m = assemblePhysicalMatrices(surface, Material{});

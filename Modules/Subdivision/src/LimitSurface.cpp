@@ -1,6 +1,7 @@
 #include "dynsub/LimitSurface.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <complex>
 #include <cmath>
@@ -137,6 +138,10 @@ struct LimitSurface::Impl {
     // isolation): the column of each slot, so that a point's weights are the
     // B-spline basis itself; else slotColumn[0] = -1.
     std::array<int, 16> slotColumn{-1};
+    // Special: the structure of its neighbourhood (index into `structures`)
+    // and the blend of its columns each neighbourhood vertex is (rows).
+    int structure = -1;
+    Eigen::MatrixXd structureMap;
   };
   // NB: levels are tabulated when a point first needs them, and points are
   // evaluated from several threads at once (closest-point searches), so the
@@ -164,6 +169,15 @@ struct LimitSurface::Impl {
   std::vector<int> controlFaceSize;
   std::vector<Element> elements;
   std::vector<std::unique_ptr<Special>> specials;
+  // One special per neighbourhood structure, over the neighbourhood's own
+  // vertices (identity weights): what every special element of that
+  // structure is, up to its structureMap. Few: after isolation a structure
+  // is a valence (and whether at a boundary).
+  std::map<std::vector<int>, int> structureIndex;
+  std::vector<std::unique_ptr<Special>> structures;
+  // Their pieces, per (structure, corner, levels), made on first use.
+  mutable std::map<std::array<int, 3>, ElementPieces> structurePieces;
+  mutable std::mutex structurePiecesMutex;
   mutable StepCache steps;
 
   // The subpatches of a special element at a level 1..kTabulatedLevels,
@@ -228,20 +242,12 @@ struct LimitSurface::Impl {
     }
   }
 
-  void buildSpecial(Element& element, int face) {
-    const int x = base.face(face)[element.corner];
-    detail::Neighbourhood neighbourhood = detail::extractNeighbourhood(base, x, face);
+  // A special element's tables from its neighbourhood `local`, whose
+  // vertices are the blends (rows of local.weights) of `columns`.
+  std::unique_ptr<Special> makeSpecial(LocalMesh local, std::vector<int> columns) {
     auto owned = std::make_unique<Special>();
     Special& special = *owned;
-    special.columns = columnsOf(neighbourhood.parentVertex);
-    LocalMesh local;
-    local.weights.resize(neighbourhood.parentVertex.size(), special.columns.size());
-    for (size_t i = 0; i < neighbourhood.parentVertex.size(); ++i) {
-      local.weights.row(i) = rowOver(special.columns, neighbourhood.parentVertex[i]);
-    }
-    local.topology = std::make_shared<const Topology>(std::move(neighbourhood.topology));
-    local.face = neighbourhood.face;
-
+    special.columns = std::move(columns);
     const int localX = local.topology->face(local.face)[0];
     const detail::VertexMasks masks = detail::vertexMasks(*local.topology, localX, local.face);
     special.vertexMasks.setZero(3, special.columns.size());
@@ -264,9 +270,67 @@ struct LimitSurface::Impl {
     special.levels.resize(kTabulatedLevels);
     special.deepest = std::move(local);
     if (masks.boundary) setBoundaryTangents(special, masks, along);
-    element.columns = special.columns;
+    return owned;
+  }
+
+  void buildSpecial(Element& element, int face) {
+    const int x = base.face(face)[element.corner];
+    detail::Neighbourhood neighbourhood = detail::extractNeighbourhood(base, x, face);
+    const std::vector<int> columns = columnsOf(neighbourhood.parentVertex);
+    LocalMesh local;
+    local.weights.resize(neighbourhood.parentVertex.size(), columns.size());
+    for (size_t i = 0; i < neighbourhood.parentVertex.size(); ++i) {
+      local.weights.row(i) = rowOver(columns, neighbourhood.parentVertex[i]);
+    }
+    local.topology = std::make_shared<const Topology>(std::move(neighbourhood.topology));
+    local.face = neighbourhood.face;
+
+    // The structure: neighbourhoods are numbered by their structure
+    // (extractNeighbourhood), so equal ones have equal local topologies.
+    std::vector<int> key{local.face};
+    for (int f = 0; f < local.topology->faceCount(); ++f) {
+      key.push_back(-local.topology->faceSize(f));
+      key.insert(key.end(), local.topology->face(f).begin(), local.topology->face(f).end());
+    }
+    const auto [found, added] = structureIndex.try_emplace(std::move(key), static_cast<int>(structures.size()));
+    if (added) {
+      const Eigen::Index n = local.weights.rows();
+      std::vector<int> vertices(n);
+      for (Eigen::Index i = 0; i < n; ++i) vertices[i] = static_cast<int>(i);
+      structures.push_back(makeSpecial(LocalMesh{local.topology, Eigen::MatrixXd::Identity(n, n), local.face},
+                                       std::move(vertices)));
+    }
+    element.structure = found->second;
+    element.structureMap = local.weights;
+    element.columns = columns;
     element.special = static_cast<int>(specials.size());
-    specials.push_back(std::move(owned));
+    specials.push_back(makeSpecial(std::move(local), columns));
+  }
+
+  // The pieces of a special element's levels 1..levels (three subpatches
+  // each) from `special`'s tables, over its columns.
+  ElementPieces piecesOf(Special& special, int corner, int levels) const {
+    ElementPieces result;
+    result.columns = special.columns;
+    const Eigen::Matrix2d toCorner = detail::cornerFrameJacobian(corner);
+    LocalMesh local;
+    if (levels > kTabulatedLevels) local = deepestTabulated(special);
+    LevelPatches deeper;
+    for (int level = 1; level <= levels; ++level) {
+      if (level > kTabulatedLevels) deeper = subdivideDisplacements(local, steps);
+      const LevelPatches& patches = level <= kTabulatedLevels ? this->level(special, level) : deeper;
+      for (int child = 1; child <= 3; ++child) {
+        BsplinePiece piece;
+        piece.grid = patches[child - 1];
+        piece.offset = special.vertexMasks.row(0);
+        piece.size = std::ldexp(1.0, -level);
+        // d(piece a, b)/d(element u, v) is a signed permutation: a follows u unless it is swapped.
+        const Eigen::Matrix2d turn = detail::cornerFrameJacobian(child) * toCorner;
+        piece.swapped = turn(0, 0) == 0.0;
+        result.pieces.push_back(std::move(piece));
+      }
+    }
+    return result;
   }
 
   // Tangents at a boundary extraordinary vertex. Along the boundary the
@@ -779,32 +843,29 @@ ElementPieces LimitSurface::elementPieces(int element, int levels) const {
   if (element < 0 || element >= elementCount()) throw Error("element " + std::to_string(element) + " does not exist");
   if (levels < 1 || levels > 60) throw Error("special elements are split into 1..60 levels, not " + std::to_string(levels));
   const Impl::Element& e = s.elements[element];
-  ElementPieces result;
-  result.columns = e.columns;
   if (e.type == ElementType::Normal) {
+    ElementPieces result;
+    result.columns = e.columns;
     result.pieces.push_back(BsplinePiece{e.grid, Eigen::RowVectorXd::Zero(e.columns.size()), 1.0, false});
     return result;
   }
-  Impl::Special& special = *s.specials[e.special];
-  const Eigen::Matrix2d toCorner = detail::cornerFrameJacobian(e.corner);
-  LocalMesh local;
-  if (levels > kTabulatedLevels) local = s.deepestTabulated(special);
-  LevelPatches deeper;
-  for (int level = 1; level <= levels; ++level) {
-    if (level > kTabulatedLevels) deeper = subdivideDisplacements(local, s.steps);
-    const LevelPatches& patches = level <= kTabulatedLevels ? s.level(special, level) : deeper;
-    for (int child = 1; child <= 3; ++child) {
-      BsplinePiece piece;
-      piece.grid = patches[child - 1];
-      piece.offset = special.vertexMasks.row(0);
-      piece.size = std::ldexp(1.0, -level);
-      // d(piece a, b)/d(element u, v) is a signed permutation: a follows u unless it is swapped.
-      const Eigen::Matrix2d turn = detail::cornerFrameJacobian(child) * toCorner;
-      piece.swapped = turn(0, 0) == 0.0;
-      result.pieces.push_back(std::move(piece));
-    }
+  return s.piecesOf(*s.specials[e.special], e.corner, levels);
+}
+
+SharedPieces LimitSurface::sharedPieces(int element, int levels) const {
+  const Impl& s = *impl_;
+  if (element < 0 || element >= elementCount()) throw Error("element " + std::to_string(element) + " does not exist");
+  if (levels < 1 || levels > 60) throw Error("special elements are split into 1..60 levels, not " + std::to_string(levels));
+  const Impl::Element& e = s.elements[element];
+  if (e.type == ElementType::Normal) throw Error("internal: element " + std::to_string(element) + " is not special");
+  const std::array<int, 3> key{e.structure, e.corner, levels};
+  const std::lock_guard<std::mutex> lock(s.structurePiecesMutex);
+  auto found = s.structurePieces.find(key);
+  if (found == s.structurePieces.end()) {
+    found = s.structurePieces.emplace(key, s.piecesOf(*s.structures[e.structure], e.corner, levels)).first;
   }
-  return result;
+  // A std::map's elements never move: the pointer stays valid as others are added.
+  return SharedPieces{(e.structure * 4 + e.corner) * 61 + levels, &found->second, &e.structureMap};
 }
 
 SparseMatrix LimitSurface::controlVertexLimitOperator() const {

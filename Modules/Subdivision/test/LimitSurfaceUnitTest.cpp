@@ -310,3 +310,55 @@ TEST(LimitSurface, ManyThreadsEvaluatingAtOnceAgreeWithOne) {
 }
 
 }  // namespace
+
+// A special element's pieces are its structure's pieces times its map
+// (LimitSurface::sharedPieces), at tabulated levels and past them, on meshes
+// that need isolation (the pyramid's apex of valence 4 beside corners of
+// valence 3; the L shape's boundary corners; the prism's n-gons) and one that
+// does not (cube98). Few structures serve every element: the physical
+// matrices integrate each once (small meshes like the L shape have as many
+// structures as special elements).
+TEST(LimitSurface, SpecialElementsAreTheirStructuresPiecesMapped) {
+  const std::vector<std::pair<std::string, dynsub::ControlMesh>> meshes = {
+      {"cube98", dynsub::makeCube98()},
+      {"pyramid", dynsub::testing::makePyramid()},
+      {"lshape", dynsub::testing::makeLShape()},
+      {"prism5", dynsub::testing::makePrism(5)}};
+  for (const auto& [name, mesh] : meshes) {
+    const LimitSurface surface(mesh);
+    std::vector<int> keys;
+    int specials = 0;
+    for (int e = 0; e < surface.elementCount(); ++e) {
+      if (surface.elementType(e) != dynsub::ElementType::Special) continue;
+      ++specials;
+      for (const int levels : {6, 30}) {
+        const dynsub::ElementPieces own = surface.elementPieces(e, levels);
+        const dynsub::SharedPieces shared = surface.sharedPieces(e, levels);
+        ASSERT_EQ(shared.pieces->pieces.size(), own.pieces.size()) << name;
+        ASSERT_EQ(shared.map->cols(), static_cast<Eigen::Index>(own.columns.size())) << name;
+        for (size_t k = 0; k < own.pieces.size(); ++k) {
+          const dynsub::BsplinePiece& piece = shared.pieces->pieces[k];
+          const Eigen::MatrixXd grid = piece.grid * *shared.map;
+          const Eigen::RowVectorXd offset = piece.offset * *shared.map;
+          // The same sums in another order: rounding of the entries' size
+          // (they shrink like the subdominant eigenvalue^level), plus that of
+          // the level-0 weights (<= 1), whose row sums' rounding subdivision
+          // keeps at every level as a translation (measured 2e-18).
+          const double scale = own.pieces[k].grid.cwiseAbs().maxCoeff();
+          EXPECT_LT((grid - own.pieces[k].grid).cwiseAbs().maxCoeff(), 1e-12 * scale + 1e-16)
+              << name << " " << e << " " << k;
+          EXPECT_LT((offset - own.pieces[k].offset).cwiseAbs().maxCoeff(), 1e-14) << name << " " << e;
+          EXPECT_EQ(piece.swapped, own.pieces[k].swapped);
+          EXPECT_EQ(piece.size, own.pieces[k].size);
+        }
+        keys.push_back(shared.key);
+      }
+    }
+    std::sort(keys.begin(), keys.end());
+    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+    ASSERT_GT(specials, 0) << name;
+    // Per (structure, corner, levels): cube98's 24 special elements are one
+    // structure in 4 corners, so 8 keys for the two level counts.
+    if (name == "cube98") EXPECT_LE(keys.size(), 8u);
+  }
+}

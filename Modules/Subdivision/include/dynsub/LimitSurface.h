@@ -97,6 +97,18 @@ struct ElementPieces {
   std::vector<BsplinePiece> pieces;
 };
 
+// Special elements whose neighbourhoods have one structure (after isolation,
+// every special element of one valence in regular surroundings) have the same
+// pieces over their neighbourhood's vertices; only the blends of control
+// vertices those vertices are differ. Whatever is linear in the pieces (the
+// physical matrices' integrals) is then computed once per structure and
+// mapped.
+struct SharedPieces {
+  int key = -1;                           // equal keys, equal `pieces`
+  const ElementPieces* pieces = nullptr;  // over the neighbourhood's vertices (columns 0..n-1); owned by the surface
+  const Eigen::MatrixXd* map = nullptr;   // neighbourhood vertices by the element's columns
+};
+
 // Rows: points; columns: control vertices; s = J * p for each coordinate.
 // Rows of J sum to 1, rows of the derivative operators to 0.
 struct LimitOperators {
@@ -162,6 +174,10 @@ class LimitSurface {
   // the square of side 2^-levels at the extraordinary corner is left out
   // (levels in 1..60; levels > 24 are computed on demand).
   ElementPieces elementPieces(int element, int levels) const;
+  // A special element's pieces as those of its neighbourhood's structure
+  // (SharedPieces): elementPieces(element, levels) is, piece by piece, the
+  // shared grid and offset times `map`, to rounding.
+  SharedPieces sharedPieces(int element, int levels) const;
 
   // Row i gives the limit position of control vertex i (#control by #control).
   SparseMatrix controlVertexLimitOperator() const;
