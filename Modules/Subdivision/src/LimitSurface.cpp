@@ -428,10 +428,12 @@ struct LimitSurface::Impl {
   struct SubpatchPoint {
     const GridMatrix* patch = nullptr;  // null: the point is the extraordinary vertex
     LevelPatches deeper;                // storage for levels past the tabulated ones
+    int level = 0, child = 0;           // of the patch: level 1.., child 1..3
     double u = 0, v = 0;
     Eigen::Matrix2d jacobian;
   };
-  SubpatchPoint locateSubpatch(const Element& element, const ElementPoint& point) const {
+  // fetch = false: level, child, parameters and jacobian only (patch stays null).
+  SubpatchPoint locateSubpatch(const Element& element, const ElementPoint& point, bool fetch = true) const {
     Special& special = *specials[element.special];
     SubpatchPoint result;
     // Parameters with the extraordinary vertex at the origin.
@@ -452,6 +454,10 @@ struct LimitSurface::Impl {
     const auto [childU, childV] = detail::cornerFrame(child, x, y);
     result.u = std::min(1.0, 2.0 * childU);
     result.v = std::min(1.0, 2.0 * childV);
+    result.level = level;
+    result.child = child;
+    result.jacobian = std::ldexp(1.0, level) * detail::cornerFrameJacobian(child) * toCorner;
+    if (!fetch) return result;
     if (level <= kTabulatedLevels) {
       result.patch = &Impl::level(special, level)[child - 1];
     } else {
@@ -459,7 +465,6 @@ struct LimitSurface::Impl {
       for (int n = kTabulatedLevels + 1; n <= level; ++n) result.deeper = subdivideDisplacements(local, steps);
       result.patch = &result.deeper[child - 1];
     }
-    result.jacobian = std::ldexp(1.0, level) * detail::cornerFrameJacobian(child) * toCorner;
     return result;
   }
 
@@ -820,6 +825,72 @@ const std::vector<int>& LimitSurface::elementColumns(int element) const {
 
 Eigen::Matrix<double, 6, Eigen::Dynamic> LimitSurface::stencil(const ElementPoint& point) const {
   return impl_->weights(point);
+}
+
+struct SurfaceState::Impl {
+  const LimitSurface* surface = nullptr;
+  Matrix3X controlPoints;
+  // Per special element: its subpatches' grid points at this state, levels
+  // 1..ready, filled in order under `mutex`. grids is sized once, on the
+  // first fill, and never moved: a reader that sees ready >= n may use level
+  // n without the lock (as LimitSurface's own tables, Impl::Special).
+  struct Cache {
+    std::atomic<int> ready{0};
+    std::mutex mutex;
+    Eigen::Matrix<double, 3, 3> masks;                // limit position and tangents at the vertex
+    std::vector<Eigen::Matrix<double, 16, 3>> grids;  // [3 (level - 1) + child - 1]
+  };
+  std::unique_ptr<Cache[]> caches;
+  static constexpr int kCachedLevels = 12;
+};
+
+SurfaceState::SurfaceState(const LimitSurface& surface) : impl_(std::make_unique<Impl>()) {
+  impl_->surface = &surface;
+  impl_->caches = std::make_unique<Impl::Cache[]>(surface.impl_->specials.size());
+}
+
+SurfaceState::~SurfaceState() = default;
+
+void SurfaceState::reset(const Matrix3X& controlPoints) {
+  checkPoints(controlPoints, impl_->surface->controlVertexCount());
+  impl_->controlPoints = controlPoints;
+  for (size_t i = 0; i < impl_->surface->impl_->specials.size(); ++i) {
+    impl_->caches[i].ready.store(0, std::memory_order_relaxed);
+  }
+}
+
+LimitSample SurfaceState::evaluate(const ElementPoint& point) const {
+  const LimitSurface::Impl& s = *impl_->surface->impl_;
+  const Matrix3X& p = impl_->controlPoints;
+  if (p.rows() != s.controlVertexCount) throw Error("internal: surface state used before reset()");
+  s.checkPoint(point);
+  const LimitSurface::Impl::Element& element = s.elements[point.element];
+  if (element.type == ElementType::Normal) return limitSampleOf(s.values(point, p));
+  const LimitSurface::Impl::SubpatchPoint at = s.locateSubpatch(element, point, false);
+  if (at.level == 0 || at.level > Impl::kCachedLevels) return limitSampleOf(s.values(point, p));
+  LimitSurface::Impl::Special& special = *s.specials[element.special];
+  Impl::Cache& cache = impl_->caches[element.special];
+  if (cache.ready.load(std::memory_order_acquire) < at.level) {
+    const std::lock_guard<std::mutex> lock(cache.mutex);
+    if (cache.grids.empty()) cache.grids.resize(3 * Impl::kCachedLevels);
+    auto pointsOf = [&](const auto& weights, auto& out) {
+      out.setZero();
+      for (size_t c = 0; c < special.columns.size(); ++c) {
+        out.noalias() += weights.col(static_cast<Eigen::Index>(c)) * p.row(special.columns[c]);
+      }
+    };
+    for (int next = cache.ready.load(std::memory_order_relaxed) + 1; next <= at.level; ++next) {
+      if (next == 1) pointsOf(special.vertexMasks, cache.masks);
+      const LevelPatches& patches = s.level(special, next);
+      for (int child = 0; child < 3; ++child) pointsOf(patches[child], cache.grids[3 * (next - 1) + child]);
+      cache.ready.store(next, std::memory_order_release);
+    }
+  }
+  Eigen::Matrix<double, 6, 3> result =
+      detail::bsplineWeights(at.u, at.v) * cache.grids[3 * (at.level - 1) + at.child - 1];
+  result.row(0) += cache.masks.row(0);
+  applyChainRule(result, at.jacobian);
+  return limitSampleOf(result);
 }
 
 LimitSample limitSampleOf(const Eigen::Matrix<double, 6, 3>& values) {

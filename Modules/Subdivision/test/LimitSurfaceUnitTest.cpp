@@ -362,3 +362,51 @@ TEST(LimitSurface, SpecialElementsAreTheirStructuresPiecesMapped) {
     if (name == "cube98") EXPECT_LE(keys.size(), 8u);
   }
 }
+
+// SurfaceState keeps each special element's subpatch grid points for one
+// state; its evaluations must be LimitSurface::evaluate's to rounding, at
+// every depth (cached levels and past them) and after a reset to another
+// state, and from several threads at once.
+TEST(SurfaceState, EvaluatesAsTheSurfaceDoesAtEveryDepthAndState) {
+  const dynsub::ControlMesh mesh = dynsub::testing::makePyramid();
+  const LimitSurface surface(mesh);
+  dynsub::SurfaceState state(surface);
+  std::vector<ElementPoint> points;
+  for (int e = 0; e < surface.elementCount(); ++e) {
+    for (const double t : {0.0, 0.3, 0.7, 1.0}) points.push_back(ElementPoint{e, t, 1.0 - t});
+    for (int depth = 1; depth <= 20; depth += 3) {
+      const double d = std::ldexp(0.7, -depth);
+      for (const double u : {d, 1.0 - d}) {
+        for (const double v : {0.5 * d, 1.0 - 0.5 * d}) points.push_back(ElementPoint{e, u, v});
+      }
+    }
+  }
+  dynsub::Matrix3X controlPoints = mesh.points();
+  for (int round = 0; round < 2; ++round) {
+    state.reset(controlPoints);
+    std::vector<dynsub::LimitSample> fromThreads(points.size());
+    std::vector<std::thread> threads;
+    for (int t = 0; t < 3; ++t) {
+      threads.emplace_back([&, t] {
+        for (size_t i = t; i < points.size(); i += 3) fromThreads[i] = state.evaluate(points[i]);
+      });
+    }
+    for (std::thread& t : threads) t.join();
+    for (size_t i = 0; i < points.size(); ++i) {
+      const dynsub::LimitSample expected = surface.evaluate(points[i], controlPoints);
+      const dynsub::LimitSample& actual = fromThreads[i];
+      // The same products summed in another order; derivatives grow 2^level
+      // near the vertex, hence tolerances relative to each quantity's size.
+      auto near = [](const dynsub::Vector3& a, const dynsub::Vector3& b) {
+        return (a - b).norm() <= 1e-12 * std::max(1.0, b.norm());
+      };
+      EXPECT_TRUE(near(actual.position, expected.position)) << round << " " << i;
+      EXPECT_TRUE(near(actual.du, expected.du)) << round << " " << i;
+      EXPECT_TRUE(near(actual.dv, expected.dv)) << round << " " << i;
+      EXPECT_TRUE(near(actual.duu, expected.duu)) << round << " " << i;
+      EXPECT_TRUE(near(actual.dvv, expected.dvv)) << round << " " << i;
+    }
+    controlPoints = (controlPoints * 1.3).eval();
+    controlPoints.col(0).array() += 2.0;
+  }
+}

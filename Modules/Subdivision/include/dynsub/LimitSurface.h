@@ -185,6 +185,29 @@ class LimitSurface {
   struct Impl;
 
  private:
+  friend class SurfaceState;
+  std::unique_ptr<Impl> impl_;
+};
+
+// The limit surface at one state of its control points, for many evaluations
+// at that state (the Newton iterations of closest-point searches). On a
+// special element LimitSurface::evaluate multiplies the subpatch's 16 by m
+// grid by the m control points at every call; here each subpatch's 16 grid
+// points are computed the first time a point needs them and kept until the
+// next reset(), so a point costs one bicubic evaluation down to 12 levels
+// from an extraordinary vertex (deeper points, and normal elements, take
+// LimitSurface::evaluate). Equal to it to rounding. evaluate() may be called
+// from several threads at once, reset() not.
+class SurfaceState {
+ public:
+  explicit SurfaceState(const LimitSurface& surface);  // the surface must outlive this
+  ~SurfaceState();
+  void reset(const Matrix3X& controlPoints);
+  LimitSample evaluate(const ElementPoint& point) const;
+
+  struct Impl;
+
+ private:
   std::unique_ptr<Impl> impl_;
 };
 
