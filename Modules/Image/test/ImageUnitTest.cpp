@@ -353,6 +353,50 @@ TEST(Metrics, ShiftedCubesByHand) {
   EXPECT_THROW(compareMasks(box(g, {0, 0, 0}, {-1, -1, -1}), a), Error);
 }
 
+// The surface distances are computed on the box around both masks (Metrics.cpp);
+// against brute force over every pair of boundary voxels, for masks far from
+// the border, touching it, and far apart, on an anisotropic grid.
+TEST(Metrics, SurfaceDistancesAgreeWithBruteForce) {
+  const ImageGeometry g = grid({24, 20, 18}, Vector3(0.7, 1.0, 1.3), Vector3::Zero(), Matrix3::Identity());
+  auto boundary = [&](const Mask& m) {
+    std::vector<Vector3> points;
+    for (int k = 0; k < g.size[2]; ++k)
+      for (int j = 0; j < g.size[1]; ++j)
+        for (int i = 0; i < g.size[0]; ++i) {
+          if (!m.voxels[g.offset(i, j, k)]) continue;
+          bool edge = false;
+          for (const auto& [a, b, c] : {std::array<int, 3>{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}}) {
+            edge = edge || !g.contains(i + a, j + b, k + c) || !m.voxels[g.offset(i + a, j + b, k + c)];
+          }
+          if (edge) points.push_back(g.toPhysical(Vector3(i, j, k)));
+        }
+    return points;
+  };
+  const std::vector<std::pair<Mask, Mask>> cases = {
+      {box(g, {5, 5, 5}, {12, 11, 10}), box(g, {7, 4, 6}, {14, 12, 9})},
+      {box(g, {0, 0, 3}, {9, 8, 17}), box(g, {2, 1, 0}, {11, 19, 12})},
+      {box(g, {1, 2, 2}, {4, 5, 5}), box(g, {18, 14, 12}, {23, 19, 16})}};
+  for (const auto& [a, b] : cases) {
+    const std::vector<Vector3> ba = boundary(a), bb = boundary(b);
+    std::vector<double> distances;
+    for (const auto& [from, to] : {std::pair{&ba, &bb}, std::pair{&bb, &ba}}) {
+      for (const Vector3& p : *from) {
+        double nearest = 1e300;
+        for (const Vector3& q : *to) nearest = std::min(nearest, (p - q).norm());
+        distances.push_back(nearest);
+      }
+    }
+    double sum = 0.0;
+    for (double d : distances) sum += d;
+    std::sort(distances.begin(), distances.end());
+    const OverlapMetrics m = compareMasks(a, b);
+    // Maurer's transform is exact; the distances are stored as float.
+    EXPECT_NEAR(m.meanSurfaceDistance, sum / distances.size(), 1e-5);
+    EXPECT_NEAR(m.hausdorff, distances.back(), 1e-5);
+    EXPECT_NEAR(m.hd95, distances[static_cast<size_t>(std::ceil(0.95 * distances.size())) - 1], 1e-5);
+  }
+}
+
 // A bright ball of radius 8 mm on a dark background, anisotropic and rotated.
 Volume ballPhantom(const ImageGeometry& g, const Vector3& centre, double radius) {
   Volume v{g, std::vector<float>(g.voxelCount())};
