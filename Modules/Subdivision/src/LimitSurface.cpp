@@ -828,20 +828,25 @@ Eigen::Matrix<double, 6, Eigen::Dynamic> LimitSurface::stencil(const ElementPoin
 }
 
 struct SurfaceState::Impl {
+  static constexpr int kCachedLevels = 12;
   const LimitSurface* surface = nullptr;
   Matrix3X controlPoints;
-  // Per special element: its subpatches' grid points at this state, levels
-  // 1..ready, filled in order under `mutex`. grids is sized once, on the
-  // first fill, and never moved: a reader that sees ready >= n may use level
-  // n without the lock (as LimitSurface's own tables, Impl::Special).
+  // Per special element: the grid points of each subpatch a point has needed
+  // at this state (slot 3 (level - 1) + child - 1; slot kSlots: the vertex
+  // masks), each filled once under `mutex`. grids is sized once, on the
+  // first fill, and never moved: a reader that sees ready[slot] set may read
+  // that slot without the lock.
+  // NB: one subpatch at a time, not whole levels: where most elements are
+  // special and hold few points (the eight: 315 points on 184 special
+  // elements) filling all three children cost more than it saved.
+  static constexpr int kSlots = 3 * kCachedLevels;
   struct Cache {
-    std::atomic<int> ready{0};
+    std::array<std::atomic<bool>, kSlots + 1> ready{};
     std::mutex mutex;
     Eigen::Matrix<double, 3, 3> masks;                // limit position and tangents at the vertex
-    std::vector<Eigen::Matrix<double, 16, 3>> grids;  // [3 (level - 1) + child - 1]
+    std::vector<Eigen::Matrix<double, 16, 3>> grids;  // [slot]
   };
   std::unique_ptr<Cache[]> caches;
-  static constexpr int kCachedLevels = 12;
 };
 
 SurfaceState::SurfaceState(const LimitSurface& surface) : impl_(std::make_unique<Impl>()) {
@@ -855,7 +860,7 @@ void SurfaceState::reset(const Matrix3X& controlPoints) {
   checkPoints(controlPoints, impl_->surface->controlVertexCount());
   impl_->controlPoints = controlPoints;
   for (size_t i = 0; i < impl_->surface->impl_->specials.size(); ++i) {
-    impl_->caches[i].ready.store(0, std::memory_order_relaxed);
+    for (std::atomic<bool>& r : impl_->caches[i].ready) r.store(false, std::memory_order_relaxed);
   }
 }
 
@@ -870,24 +875,26 @@ LimitSample SurfaceState::evaluate(const ElementPoint& point) const {
   if (at.level == 0 || at.level > Impl::kCachedLevels) return limitSampleOf(s.values(point, p));
   LimitSurface::Impl::Special& special = *s.specials[element.special];
   Impl::Cache& cache = impl_->caches[element.special];
-  if (cache.ready.load(std::memory_order_acquire) < at.level) {
+  const int slot = 3 * (at.level - 1) + at.child - 1;
+  if (!cache.ready[slot].load(std::memory_order_acquire) || !cache.ready[Impl::kSlots].load(std::memory_order_acquire)) {
     const std::lock_guard<std::mutex> lock(cache.mutex);
-    if (cache.grids.empty()) cache.grids.resize(3 * Impl::kCachedLevels);
+    if (cache.grids.empty()) cache.grids.resize(Impl::kSlots);
     auto pointsOf = [&](const auto& weights, auto& out) {
       out.setZero();
       for (size_t c = 0; c < special.columns.size(); ++c) {
         out.noalias() += weights.col(static_cast<Eigen::Index>(c)) * p.row(special.columns[c]);
       }
     };
-    for (int next = cache.ready.load(std::memory_order_relaxed) + 1; next <= at.level; ++next) {
-      if (next == 1) pointsOf(special.vertexMasks, cache.masks);
-      const LevelPatches& patches = s.level(special, next);
-      for (int child = 0; child < 3; ++child) pointsOf(patches[child], cache.grids[3 * (next - 1) + child]);
-      cache.ready.store(next, std::memory_order_release);
+    if (!cache.ready[Impl::kSlots].load(std::memory_order_relaxed)) {
+      pointsOf(special.vertexMasks, cache.masks);
+      cache.ready[Impl::kSlots].store(true, std::memory_order_release);
+    }
+    if (!cache.ready[slot].load(std::memory_order_relaxed)) {
+      pointsOf(s.level(special, at.level)[at.child - 1], cache.grids[slot]);
+      cache.ready[slot].store(true, std::memory_order_release);
     }
   }
-  Eigen::Matrix<double, 6, 3> result =
-      detail::bsplineWeights(at.u, at.v) * cache.grids[3 * (at.level - 1) + at.child - 1];
+  Eigen::Matrix<double, 6, 3> result = detail::bsplineWeights(at.u, at.v) * cache.grids[slot];
   result.row(0) += cache.masks.row(0);
   applyChainRule(result, at.jacobian);
   return limitSampleOf(result);
