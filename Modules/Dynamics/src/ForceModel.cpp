@@ -160,11 +160,20 @@ void PullForceModel::grab(const Vector3& surfacePoint, const Vector3& target) {
   attached_ = false;
   anchor_ = surfacePoint;
   target_ = target;
+  ++moves_;
 }
 
 void PullForceModel::moveTo(const Vector3& target) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (target.allFinite()) target_ = target;
+  if (target.allFinite()) {
+    target_ = target;
+    ++moves_;
+  }
+}
+
+unsigned PullForceModel::moves() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return moves_;
 }
 
 void PullForceModel::release() {

@@ -76,6 +76,7 @@ struct Viewer::Impl {
   bool landmarksEdited = false;
   bool pulling = false;
   double pullDepth = 0;       // display depth of the grabbed point
+  Vector3 grabbedPoint = Vector3::Zero();  // where the pull took hold of the surface
   std::string message;        // the last action's outcome
 
   // The fit and what it hands to the interface thread.
@@ -190,6 +191,19 @@ struct Viewer::Impl {
 
   void startFit() {
     stopFit();
+    launchFit();
+  }
+
+  // A refit with the pull on from its first step: taking hold before the
+  // worker starts, or a refit that settles at once would never see the pull.
+  void startPulledFit(const Vector3& grabbed, const Vector3& target) {
+    stopFit();
+    pull.grab(grabbed, target);
+    pulling = true;
+    launchFit();
+  }
+
+  void launchFit() {
     if (landmarks.size() < 4) {
       message = "place at least 4 landmarks to fit (" + std::to_string(landmarks.size()) + " so far)";
       return;
@@ -246,17 +260,35 @@ struct Viewer::Impl {
              << std::setprecision(3) << ", energy " << p.energy << " N mm";
         publish(tessellate(*p.surface, *p.controlPoints, 4), text.str());
       };
-      const SegmentResult result = evolveInRegion(*region, marks, initial, start ? start->origin : LevelOrigin{},
-                                                  input.segment, observe, {&pull});
-      fitted = Fitted{result.mesh, result.origin};
-      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-      double worst = 0;
-      for (double d : result.landmarkDistances) worst = std::max(worst, d);
-      std::ostringstream text;
-      text << (start ? "refit" : "fit") << " done: " << result.mesh.vertexCount() << " control vertices, "
-           << result.levels.back().level << " refinement(s), " << result.steps << " steps in " << std::fixed
-           << std::setprecision(2) << seconds << " s;\nfarthest landmark " << worst << " mm";
-      publish(tessellate(LimitSurface(result.mesh), result.mesh.points(), 8), text.str());
+      unsigned moves = pull.moves();
+      SegmentResult result = evolveInRegion(*region, marks, initial, start ? start->origin : LevelOrigin{},
+                                            input.segment, observe, {&pull});
+      for (;;) {
+        fitted = Fitted{result.mesh, result.origin};
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+        double worst = 0;
+        for (double d : result.landmarkDistances) worst = std::max(worst, d);
+        std::ostringstream text;
+        text << (start ? "refit" : "fit") << " done: " << result.mesh.vertexCount() << " control vertices, "
+             << result.levels.back().level << " refinement(s), " << result.steps << " steps in " << std::fixed
+             << std::setprecision(2) << seconds << " s;\nfarthest landmark " << worst << " mm";
+        publish(tessellate(LimitSurface(result.mesh), result.mesh.points(), 8), text.str());
+        {
+          // The pull moved during the fit, perhaps after its last step (a fit
+          // may settle on a step that read the new target before moving to
+          // it, or the hand moved while this one was being published): go on
+          // from where it settled until a fit has seen the pull stand still.
+          // Decided under the lock the interface takes to move the pull, so
+          // no move falls between this test and the end of the fit.
+          std::lock_guard<std::mutex> lock(mutex);
+          if (!pull.active() || pull.moves() == moves) {
+            running = false;
+            return;
+          }
+          moves = pull.moves();
+        }
+        result = evolveInRegion(*region, marks, result.mesh, result.origin, input.segment, observe, {&pull});
+      }
     } catch (const FitCancelled&) {
       std::lock_guard<std::mutex> lock(mutex);
       fitText = "fitting stopped";
@@ -358,8 +390,6 @@ class ViewerStyle : public vtkInteractorStyleTrackballCamera {
         return;
       }
       if (viewer->picker->Pick(x, y, 0, viewer->surface3d.renderer()) && viewer->liveSurface->GetNumberOfPoints() > 0) {
-        // After a fit, the pull refits from it (the pull acts from the first step).
-        if (!viewer->running) viewer->startFit();
         double p[3];
         viewer->picker->GetPickPosition(p);
         const Vector3 grabbed(p[0], p[1], p[2]);
@@ -367,8 +397,21 @@ class ViewerStyle : public vtkInteractorStyleTrackballCamera {
         r->SetWorldPoint(p[0], p[1], p[2], 1.0);
         r->WorldToDisplay();
         viewer->pullDepth = r->GetDisplayPoint()[2];
-        viewer->pull.grab(grabbed, grabbed);
-        viewer->pulling = true;
+        viewer->grabbedPoint = grabbed;
+        // After a fit, the pull refits from it (the pull acts from the first step).
+        bool held = false;
+        {
+          std::lock_guard<std::mutex> lock(viewer->mutex);  // see the end of Impl::fit
+          if (viewer->running) {
+            viewer->pull.grab(grabbed, grabbed);
+            held = true;
+          }
+        }
+        if (held) {
+          viewer->pulling = true;
+        } else {
+          viewer->startPulledFit(grabbed, grabbed);
+        }
         viewer->message = "pulling";
         viewer->render();
       }
@@ -392,7 +435,21 @@ class ViewerStyle : public vtkInteractorStyleTrackballCamera {
       r->SetDisplayPoint(x, y, viewer->pullDepth);
       r->DisplayToWorld();
       const double* w = r->GetWorldPoint();
-      viewer->pull.moveTo(Vector3(w[0] / w[3], w[1] / w[3], w[2] / w[3]));
+      const Vector3 target(w[0] / w[3], w[1] / w[3], w[2] / w[3]);
+      bool moved = false;
+      {
+        std::lock_guard<std::mutex> lock(viewer->mutex);  // see the end of Impl::fit
+        if (viewer->running) {
+          viewer->pull.moveTo(target);
+          moved = true;
+        }
+      }
+      if (!moved) {
+        // The refit settled before the hand moved on (a refit takes tens of
+        // milliseconds): refit again from where it settled, with the pull at
+        // the hand.
+        viewer->startPulledFit(viewer->grabbedPoint, target);
+      }
       return;
     }
     vtkInteractorStyleTrackballCamera::OnMouseMove();

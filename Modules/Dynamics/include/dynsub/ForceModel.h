@@ -135,6 +135,9 @@ class PullForceModel final : public ForceModel {
   void moveTo(const Vector3& target);
   void release();
   bool active() const;
+  // grab and moveTo calls so far: a simulation during which this changed
+  // may have settled on a target that has moved since.
+  unsigned moves() const;
 
   void beginLevel(const LimitSurface& surface, const SurfaceQuadrature& quadrature,
                   const Matrix3X& controlPoints) override;
@@ -154,6 +157,7 @@ class PullForceModel final : public ForceModel {
   bool attached_ = false;
   Vector3 anchor_ = Vector3::Zero();  // where to attach (mm)
   Vector3 target_ = Vector3::Zero();
+  unsigned moves_ = 0;
   ElementPoint attachment_;
   const LimitSurface* surface_ = nullptr;
 };
