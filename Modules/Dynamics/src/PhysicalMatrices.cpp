@@ -139,23 +139,10 @@ ElementIntegrals integrateElement(const LimitSurface& surface, int element, cons
   return integrate(surface, element, options, cache);
 }
 
-PhysicalMatrices assemblePhysicalMatrices(const LimitSurface& surface, const std::vector<Material>& materials,
-                                          const AssemblyOptions& options) {
-  checkOptions(options);
-  const int elements = surface.elementCount();
-  if (materials.size() != 1 && static_cast<int>(materials.size()) != elements) {
-    throw Error("got " + std::to_string(materials.size()) + " materials for a surface of " +
-                std::to_string(elements) + " elements (give one, or one per element)");
-  }
-  for (const Material& m : materials) checkMaterial(m);
-
-  // NB: summed in place on the pattern of every pair of control vertices
-  // sharing an element, in element order (the sums setFromTriplets made from
-  // m^2 triplets per matrix and element, millions on a fine mesh, whose
-  // building and sorting took most of the assembly).
+SymmetricMatrix elementPattern(const LimitSurface& surface) {
   const int vertices = surface.controlVertexCount();
   std::vector<std::vector<int>> rows(vertices);
-  for (int e = 0; e < elements; ++e) {
+  for (int e = 0; e < surface.elementCount(); ++e) {
     const std::vector<int>& columns = surface.elementColumns(e);
     if (!std::is_sorted(columns.begin(), columns.end())) throw Error("internal: element columns are not sorted");
     for (int j : columns) rows[j].insert(rows[j].end(), columns.begin(), columns.end());
@@ -172,6 +159,24 @@ PhysicalMatrices assemblePhysicalMatrices(const LimitSurface& surface, const std
     for (int i : rows[j]) pattern.insert(i, j) = 0.0;
   }
   pattern.makeCompressed();
+  return pattern;
+}
+
+PhysicalMatrices assemblePhysicalMatrices(const LimitSurface& surface, const std::vector<Material>& materials,
+                                          const AssemblyOptions& options) {
+  checkOptions(options);
+  const int elements = surface.elementCount();
+  if (materials.size() != 1 && static_cast<int>(materials.size()) != elements) {
+    throw Error("got " + std::to_string(materials.size()) + " materials for a surface of " +
+                std::to_string(elements) + " elements (give one, or one per element)");
+  }
+  for (const Material& m : materials) checkMaterial(m);
+
+  // NB: summed in place on the pattern of every pair of control vertices
+  // sharing an element, in element order (the sums setFromTriplets made from
+  // m^2 triplets per matrix and element, millions on a fine mesh, whose
+  // building and sorting took most of the assembly).
+  const SymmetricMatrix pattern = elementPattern(surface);
   PhysicalMatrices result;
   result.mass = pattern;
   result.damping = pattern;

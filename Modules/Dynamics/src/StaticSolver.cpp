@@ -82,18 +82,9 @@ TangentStiffness::TangentStiffness(const LimitSurface& surface) : impl_(std::mak
   s.surface = &surface;
   s.vertices = surface.controlVertexCount();
   const int n = s.vertices;
-  std::vector<std::vector<int>> rows(n);
-  for (int e = 0; e < surface.elementCount(); ++e) {
-    const std::vector<int>& columns = surface.elementColumns(e);
-    for (int j : columns) rows[j].insert(rows[j].end(), columns.begin(), columns.end());
-  }
-  s.scalarOuter.assign(n + 1, 0);
-  for (int j = 0; j < n; ++j) {
-    std::sort(rows[j].begin(), rows[j].end());
-    rows[j].erase(std::unique(rows[j].begin(), rows[j].end()), rows[j].end());
-    s.scalarOuter[j + 1] = s.scalarOuter[j] + static_cast<int>(rows[j].size());
-    s.scalarInner.insert(s.scalarInner.end(), rows[j].begin(), rows[j].end());
-  }
+  const SymmetricMatrix pattern = elementPattern(surface);
+  s.scalarOuter.assign(pattern.outerIndexPtr(), pattern.outerIndexPtr() + n + 1);
+  s.scalarInner.assign(pattern.innerIndexPtr(), pattern.innerIndexPtr() + pattern.nonZeros());
   s.position.resize(surface.elementCount());
   for (int e = 0; e < surface.elementCount(); ++e) {
     const std::vector<int>& columns = surface.elementColumns(e);

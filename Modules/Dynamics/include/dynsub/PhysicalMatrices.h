@@ -79,6 +79,12 @@ struct PhysicalMatrices {
   SymmetricMatrix mass, damping, stiffness;
 };
 
+// The pattern of every matrix summed over elements (#control by #control,
+// column-major, compressed, rows sorted, values 0): an entry for every pair
+// of control vertices that share an element. Throws dynsub::Error if an
+// element's columns are not sorted (the in-place sums walk them in order).
+SymmetricMatrix elementPattern(const LimitSurface& surface);
+
 // One material per element (surface.elementCount()), or one for all.
 // Throws dynsub::Error for negative or non-finite parameters or bad options.
 PhysicalMatrices assemblePhysicalMatrices(const LimitSurface& surface, const std::vector<Material>& materials,
