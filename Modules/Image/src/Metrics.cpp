@@ -30,17 +30,6 @@ Mask boundaryOf(const Mask& mask) {
   return boundary;
 }
 
-// The masks' voxels within `first` + [0, size).
-Mask cropMask(const Mask& mask, const std::array<int, 3>& first, const std::array<int, 3>& size) {
-  Mask part{mask.geometry.region(first, size), {}};
-  part.voxels.resize(static_cast<std::size_t>(part.geometry.voxelCount()));
-  std::size_t v = 0;
-  for (int k = 0; k < size[2]; ++k)
-    for (int j = 0; j < size[1]; ++j)
-      for (int i = 0; i < size[0]; ++i) part.voxels[v++] = mask.voxels[mask.geometry.offset(first[0] + i, first[1] + j, first[2] + k)];
-  return part;
-}
-
 }  // namespace
 
 OverlapMetrics compareMasks(const Mask& a, const Mask& b) {

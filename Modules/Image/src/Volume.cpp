@@ -79,15 +79,30 @@ Mask selectLabels(const Volume& labels, const std::vector<int>& values) {
   return mask;
 }
 
-Volume cropVolume(const Volume& volume, const std::array<int, 3>& first, const std::array<int, 3>& size) {
-  Volume result;
-  result.geometry = volume.geometry.region(first, size);
+namespace {
+
+// The voxels of `image` (a Volume or a Mask) on an index box.
+template <class Image>
+Image cropImage(const Image& image, const std::array<int, 3>& first, const std::array<int, 3>& size) {
+  Image result;
+  result.geometry = image.geometry.region(first, size);
   result.voxels.resize(result.geometry.voxelCount());
   long long out = 0;
   for (int k = 0; k < size[2]; ++k)
     for (int j = 0; j < size[1]; ++j)
-      for (int i = 0; i < size[0]; ++i) result.voxels[out++] = volume.at(first[0] + i, first[1] + j, first[2] + k);
+      for (int i = 0; i < size[0]; ++i)
+        result.voxels[out++] = image.voxels[image.geometry.offset(first[0] + i, first[1] + j, first[2] + k)];
   return result;
+}
+
+}  // namespace
+
+Volume cropVolume(const Volume& volume, const std::array<int, 3>& first, const std::array<int, 3>& size) {
+  return cropImage(volume, first, size);
+}
+
+Mask cropMask(const Mask& mask, const std::array<int, 3>& first, const std::array<int, 3>& size) {
+  return cropImage(mask, first, size);
 }
 
 std::pair<std::array<int, 3>, std::array<int, 3>> boundingRegion(const ImageGeometry& geometry,

@@ -69,6 +69,7 @@ Mask selectLabels(const Volume& labels, const std::vector<int>& values);
 
 // The sub-image on an index box (clamped to the image).
 Volume cropVolume(const Volume& volume, const std::array<int, 3>& first, const std::array<int, 3>& size);
+Mask cropMask(const Mask& mask, const std::array<int, 3>& first, const std::array<int, 3>& size);
 
 // The smallest index box, grown by `margin` mm on every side and clamped to the
 // image, that contains the given physical points. Returns {first, size}.
