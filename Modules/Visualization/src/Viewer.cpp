@@ -194,11 +194,26 @@ struct Viewer::Impl {
     launchFit();
   }
 
-  // A refit with the pull on from its first step: taking hold before the
-  // worker starts, or a refit that settles at once would never see the pull.
-  void startPulledFit(const Vector3& grabbed, const Vector3& target) {
-    stopFit();
-    pull.grab(grabbed, target);
+  // The pull, held at grabbedPoint, drawn to `target`; `grab`: it takes hold
+  // anew. A running fit takes it, decided under the lock the end of fit()
+  // takes, so the fit cannot end between the test and the move. Otherwise a
+  // refit starts with the pull on from its first step (held before the worker
+  // starts, or a refit that settled at once would never see it).
+  void pullTo(const Vector3& target, bool grab) {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (running) {
+        if (grab) {
+          pull.grab(grabbedPoint, target);
+        } else {
+          pull.moveTo(target);
+        }
+        pulling = true;
+        return;
+      }
+    }
+    stopFit();  // lets go of the pull
+    pull.grab(grabbedPoint, target);
     pulling = true;
     launchFit();
   }
@@ -398,20 +413,8 @@ class ViewerStyle : public vtkInteractorStyleTrackballCamera {
         r->WorldToDisplay();
         viewer->pullDepth = r->GetDisplayPoint()[2];
         viewer->grabbedPoint = grabbed;
-        // After a fit, the pull refits from it (the pull acts from the first step).
-        bool held = false;
-        {
-          std::lock_guard<std::mutex> lock(viewer->mutex);  // see the end of Impl::fit
-          if (viewer->running) {
-            viewer->pull.grab(grabbed, grabbed);
-            held = true;
-          }
-        }
-        if (held) {
-          viewer->pulling = true;
-        } else {
-          viewer->startPulledFit(grabbed, grabbed);
-        }
+        // After a fit, the pull refits from it.
+        viewer->pullTo(grabbed, true);
         viewer->message = "pulling";
         viewer->render();
       }
@@ -435,21 +438,9 @@ class ViewerStyle : public vtkInteractorStyleTrackballCamera {
       r->SetDisplayPoint(x, y, viewer->pullDepth);
       r->DisplayToWorld();
       const double* w = r->GetWorldPoint();
-      const Vector3 target(w[0] / w[3], w[1] / w[3], w[2] / w[3]);
-      bool moved = false;
-      {
-        std::lock_guard<std::mutex> lock(viewer->mutex);  // see the end of Impl::fit
-        if (viewer->running) {
-          viewer->pull.moveTo(target);
-          moved = true;
-        }
-      }
-      if (!moved) {
-        // The refit settled before the hand moved on (a refit takes tens of
-        // milliseconds): refit again from where it settled, with the pull at
-        // the hand.
-        viewer->startPulledFit(viewer->grabbedPoint, target);
-      }
+      // A refit may have settled before the hand moved on (it takes tens of
+      // milliseconds): then another starts from where it settled.
+      viewer->pullTo(Vector3(w[0] / w[3], w[1] / w[3], w[2] / w[3]), false);
       return;
     }
     vtkInteractorStyleTrackballCamera::OnMouseMove();
