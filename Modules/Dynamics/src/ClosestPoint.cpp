@@ -94,13 +94,12 @@ struct ClosestPointLocator::Impl {
   void updateTree() {
     if (drift == 0.0) return;
     cloud.points.resize(static_cast<Eigen::Index>(samples.size()), 3);
-    const Matrix3X& special = specialSamples;
     for (Eigen::Index e = 0; e < static_cast<Eigen::Index>(normal.size()); ++e) {
       auto block = cloud.points.middleRows(e * perElement, perElement);
       if (normal[e]) {
         block.noalias() = gridWeights * grids.middleRows<16>(16 * e);
       } else {
-        block = special.middleRows(specialRow[e * perElement], perElement);
+        block = specialSamples.middleRows(specialRow[e * perElement], perElement);
       }
     }
     tree = std::make_unique<Tree>(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));

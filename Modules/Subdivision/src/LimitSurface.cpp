@@ -521,29 +521,34 @@ struct LimitSurface::Impl {
   // s and its derivatives (rows) at an element point for given control
   // points: weights() applied, without allocating (the closest-point
   // searches' inner loop).
+  // weights (rows over `columns`) applied to the control points, into out.
+  template <class Weights, class Out>
+  static void blend(const Weights& weights, const std::vector<int>& columns, const Matrix3X& controlPoints, Out& out) {
+    out.setZero();
+    for (size_t c = 0; c < columns.size(); ++c) {
+      out.noalias() += weights.col(static_cast<Eigen::Index>(c)) * controlPoints.row(columns[c]);
+    }
+  }
+
   Eigen::Matrix<double, 6, 3> values(const ElementPoint& point, const Matrix3X& controlPoints) const {
     checkPoint(point);
     const Element& element = elements[point.element];
     // The 16 grid points (or displacements) of the piece the point lies on.
-    auto gridPoints = [&](const GridMatrix& grid) {
-      Eigen::Matrix<double, 16, 3> g = Eigen::Matrix<double, 16, 3>::Zero();
-      for (size_t c = 0; c < element.columns.size(); ++c) {
-        g.noalias() += grid.col(static_cast<Eigen::Index>(c)) * controlPoints.row(element.columns[c]);
-      }
-      return g;
-    };
-    if (element.type == ElementType::Normal) return detail::bsplineWeights(point.u, point.v) * gridPoints(element.grid);
+    Eigen::Matrix<double, 16, 3> grid;
+    if (element.type == ElementType::Normal) {
+      blend(element.grid, element.columns, controlPoints, grid);
+      return detail::bsplineWeights(point.u, point.v) * grid;
+    }
     const Special& special = *specials[element.special];
     const SubpatchPoint at = locateSubpatch(element, point);
     Eigen::Matrix<double, 6, 3> result = Eigen::Matrix<double, 6, 3>::Zero();
-    Eigen::Matrix<double, 3, 3> masks = Eigen::Matrix<double, 3, 3>::Zero();
-    for (size_t c = 0; c < special.columns.size(); ++c) {
-      masks.noalias() += special.vertexMasks.col(static_cast<Eigen::Index>(c)) * controlPoints.row(special.columns[c]);
-    }
+    Eigen::Matrix<double, 3, 3> masks;
+    blend(special.vertexMasks, special.columns, controlPoints, masks);
     if (!at.patch) {
       result.topRows(3) = masks;
     } else {
-      result = detail::bsplineWeights(at.u, at.v) * gridPoints(*at.patch);
+      blend(*at.patch, element.columns, controlPoints, grid);
+      result = detail::bsplineWeights(at.u, at.v) * grid;
       result.row(0) += masks.row(0);
     }
     applyChainRule(result, at.jacobian);
@@ -879,18 +884,12 @@ LimitSample SurfaceState::evaluate(const ElementPoint& point) const {
   if (!cache.ready[slot].load(std::memory_order_acquire) || !cache.ready[Impl::kSlots].load(std::memory_order_acquire)) {
     const std::lock_guard<std::mutex> lock(cache.mutex);
     if (cache.grids.empty()) cache.grids.resize(Impl::kSlots);
-    auto pointsOf = [&](const auto& weights, auto& out) {
-      out.setZero();
-      for (size_t c = 0; c < special.columns.size(); ++c) {
-        out.noalias() += weights.col(static_cast<Eigen::Index>(c)) * p.row(special.columns[c]);
-      }
-    };
     if (!cache.ready[Impl::kSlots].load(std::memory_order_relaxed)) {
-      pointsOf(special.vertexMasks, cache.masks);
+      LimitSurface::Impl::blend(special.vertexMasks, special.columns, p, cache.masks);
       cache.ready[Impl::kSlots].store(true, std::memory_order_release);
     }
     if (!cache.ready[slot].load(std::memory_order_relaxed)) {
-      pointsOf(s.level(special, at.level)[at.child - 1], cache.grids[slot]);
+      LimitSurface::Impl::blend(s.level(special, at.level)[at.child - 1], special.columns, p, cache.grids[slot]);
       cache.ready[slot].store(true, std::memory_order_release);
     }
   }
