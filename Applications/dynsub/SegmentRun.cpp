@@ -176,6 +176,9 @@ SegmentRun runSegmentation(const Volume& image, SegmentInputs in, const Progress
                             {"spread", ends.spread},
                             {"ends", marched},
                             {"springs", ends.springs.size()}};
+    nlohmann::json points = nlohmann::json::array();
+    for (const Landmark& l : ends.springs) points.push_back({l.position(0), l.position(1), l.position(2)});
+    report["slice_ends"]["spring_points_lps_mm"] = points;
   }
   report["region_of_interest"] = {{"first_voxel", result.regionFirst}, {"size_voxels", result.regionSize}};
   report["initial_volume_mm3"] = result.initialVolume;

@@ -15,8 +15,10 @@
 //     the axis (radius `disk` times the landmarks' rms distance from their
 //     centroid, at least one voxel). The march stops where that median has
 //     left m +- window s for two steps running, at most `reach` times the
-//     clicked span beyond the slice (experts leave some 10-20 % of a
-//     structure unclicked at each end).
+//     clicked span beyond the slice. Experts leave some 10-20 % of a
+//     structure unclicked at each end, but the clicked span is shorter than
+//     the slices' coverage: three slices over 60 % of a caudate span 40 %
+//     of it, and its head reaches a clicked span beyond the last one.
 //  4. Where the march went more than `gap` mm and stopped at a change of
 //     intensity (not at its reach, where it found no end: the structure may
 //     go on in like tissue, as a cerebellar hemisphere does across the
@@ -42,7 +44,7 @@ struct SliceEndOptions {
   bool enabled = true;
   double window = 2.5;      // robust spreads either side of the median
   double disk = 0.3;        // the disk's radius, a fraction of the end slice's rms radius
-  double reach = 0.5;       // the march's longest, a fraction of the clicked span
+  double reach = 1.0;       // the march's longest, a fraction of the clicked span
   double gap = 2.0;         // mm: no spring for a shorter march
   double stiffness = 10.0;  // N/mm per spring
   bool taper = true;        // also springs halfway, the end slice's clicks drawn in (an ellipsoid's taper)
