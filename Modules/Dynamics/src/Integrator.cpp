@@ -4,8 +4,8 @@
 #include <string>
 
 #include <Eigen/IterativeLinearSolvers>
-#include <Eigen/SparseCholesky>
 
+#include "SparseCholesky.h"
 #include "dynsub/Error.h"
 
 namespace dynsub {
@@ -46,7 +46,7 @@ struct Integrator::Impl {
   std::vector<int> freeIndex;                // free position of each vertex, or -1
   std::vector<int> freeVertices;
   SymmetricMatrix lhsFree, lhsCoupling;      // free x free, free x fixed
-  Eigen::SimplicialLDLT<SymmetricMatrix> cholesky;
+  SparseCholesky cholesky;
   Eigen::ConjugateGradient<SymmetricMatrix, Eigen::Lower | Eigen::Upper, Eigen::IdentityPreconditioner> cg;
   Eigen::ConjugateGradient<SymmetricMatrix, Eigen::Lower | Eigen::Upper, Eigen::IncompleteCholesky<double>> pcg;
   int iterations = 0;
@@ -120,11 +120,10 @@ Integrator::Integrator(const PhysicalMatrices& matrices, const SymmetricMatrix& 
 
   switch (options.solver) {
     case LinearSolver::Cholesky:
-      s.cholesky.compute(s.lhsFree);
+      s.cholesky.analyzePattern(s.lhsFree);
       // NB: a singular matrix (K alone: translations cost nothing) factors with
-      // pivots at rounding level rather than failing; treat those as zero.
-      if (s.cholesky.info() != Eigen::Success ||
-          (s.cholesky.vectorD().array() <= 1e-12 * s.cholesky.vectorD().cwiseAbs().maxCoeff()).any()) {
+      // pivots at rounding level rather than failing; those count as zero.
+      if (!s.cholesky.factorize(s.lhsFree)) {
         throw Error("the left-hand matrix of the time step is not positive definite (is the surface anchored? "
                     "first-order integration needs damping > 0)");
       }

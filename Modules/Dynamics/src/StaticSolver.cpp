@@ -5,8 +5,7 @@
 #include <cmath>
 #include <string>
 
-#include <Eigen/SparseCholesky>
-
+#include "SparseCholesky.h"
 #include "dynsub/Error.h"
 #include "dynsub/ForceModel.h"
 
@@ -180,7 +179,7 @@ struct StaticSolver::Impl {
   SymmetricMatrix stiffness;
   TangentStiffness tangent;
   std::vector<bool> fixed;
-  Eigen::SimplicialLDLT<SymmetricMatrix, Eigen::Lower> factor;
+  SparseCholesky factor;
   bool analysed = false;
   bool factored = false;  // `factor` holds some earlier step's matrix
   int regularizations = 0;
@@ -276,10 +275,7 @@ Matrix3X StaticSolver::direction(const std::vector<ForceModel*>& forces, const M
   const double meanDiagonal = diagonal.cwiseAbs().mean();
   double shift = 0.0;
   for (int attempt = 0;; ++attempt) {
-    s.factor.factorize(h);
-    const bool positive = s.factor.info() == Eigen::Success &&
-                          (s.factor.vectorD().array() > 1e-12 * s.factor.vectorD().cwiseAbs().maxCoeff()).all();
-    if (positive) break;
+    if (s.factor.factorize(h)) break;
     // NB: K alone leaves translations free; forces that pin too little (a
     // single spring, a field with no slope) leave H singular. A small shift
     // turns the step into a slightly damped one instead of failing.
