@@ -174,6 +174,11 @@ void addSegmentCommand(CLI::App& app) {
       ->default_val(o->segment.imageForce);
   command->add_option("--landmark-stiffness", o->segment.landmarkStiffness, "Spring stiffness per landmark, N/mm")
       ->default_val(o->segment.landmarkStiffness);
+  command->add_option("--landmark-dead-zone", o->segment.landmarkDeadZone,
+                      "A landmark's spring pulls only where the surface is farther than this from the click, mm "
+                      "(a click's error; 0: a plain spring)")
+      ->default_val(o->segment.landmarkDeadZone)
+      ->check(CLI::NonNegativeNumber);
   command->add_option("--landmark-tolerance", o->segment.landmarkTolerance,
                       "Refine at equilibrium while a landmark is farther than this from the surface, mm")
       ->default_val(o->segment.landmarkTolerance);

@@ -217,6 +217,7 @@ SegmentRun runSegmentation(const Volume& image, SegmentInputs in, const Progress
   parameters["capture_range_mm"] = in.segment.edges.captureRange;
   parameters["image_force"] = in.segment.imageForce;
   parameters["landmark_stiffness"] = in.segment.landmarkStiffness;
+  parameters["landmark_dead_zone_mm"] = in.segment.landmarkDeadZone;
   parameters["landmark_tolerance_mm"] = in.segment.landmarkTolerance;
   parameters["inflation"] = in.segment.inflation;
   parameters["margin_mm"] = in.segment.margin;

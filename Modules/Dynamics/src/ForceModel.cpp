@@ -77,9 +77,15 @@ Matrix3X SpringForceModel::generalizedForce(const Matrix3X& controlPoints, doubl
     return J.transpose() * (stiffness_.asDiagonal() * stretch);
   }
   attach(controlPoints);
-  const Matrix3X stretch = targets_ - positions_;  // the locator's positions at these control points
+  Matrix3X stretch = targets_ - positions_;  // the locator's positions at these control points
   lengths_ = stretch.rowwise().norm();
-  potential += 0.5 * stiffness_.dot(lengths_.cwiseAbs2());
+  if (deadZone_ > 0) {
+    const Eigen::ArrayXd beyond = (lengths_.array() - deadZone_).max(0.0);
+    potential += 0.5 * (stiffness_.array() * beyond.square()).sum();
+    stretch.array().colwise() *= (lengths_.array() > deadZone_).select(beyond / lengths_.array(), 0.0);
+  } else {
+    potential += 0.5 * stiffness_.dot(lengths_.cwiseAbs2());
+  }
   // J^T k (d - s), without building J: pulls on a normal element's 16 grid
   // points go back through the patch operator in one product; the few on
   // special elements through their stencils.
@@ -101,6 +107,11 @@ Matrix3X SpringForceModel::generalizedForce(const Matrix3X& controlPoints, doubl
   }
   force.noalias() += patches.transpose() * onGrids;
   return force;
+}
+
+void SpringForceModel::setDeadZone(double zone) {
+  if (!(zone >= 0) || !std::isfinite(zone)) throw Error("a spring's dead zone must be a finite number >= 0 mm");
+  deadZone_ = zone;
 }
 
 SparseMatrix SpringForceModel::stabilizingStiffness(const Matrix3X&) { return springStiffness(*surface_, springs_); }

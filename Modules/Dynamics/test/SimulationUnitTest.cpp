@@ -188,6 +188,47 @@ TEST(StaticScheme, EnergyFallsAtEveryStepToTheEquilibrium) {
   EXPECT_NEAR(result.error.maxPercent, reference.error.maxPercent, 1e-2);
 }
 
+// A dead zone of z mm: a spring whose target lies within z of the surface
+// pulls not at all; one at distance L beyond pulls as a plain spring to a
+// target L - z away along the same line. Targets are put on the limit
+// normals a little off the surface (0.01-0.05 of the cube's size of about
+// 2, well inside its curvature radius), so each spring attaches where its
+// target was lifted from, in both models.
+TEST(SpringForceModel, ADeadZonePullsOnlyBeyondIt) {
+  const ControlMesh cube = makeCube98();
+  const LimitSurface surface(cube);
+  const Matrix3X onSurface = tessellate(surface, cube.points(), 1).points;
+  ClosestPointLocator locator(surface);
+  locator.update(cube.points());
+  Matrix3X normals(onSurface.rows(), 3);
+  const std::vector<ClosestPoint> nearest = locator.findAll(onSurface);
+  for (Eigen::Index i = 0; i < onSurface.rows(); ++i) normals.row(i) = nearest[i].normal.transpose();
+  const double zone = 0.02;
+  const SurfaceQuadrature quadrature = makeSurfaceQuadrature(surface);
+  const Eigen::VectorXd k = Eigen::VectorXd::Constant(onSurface.rows(), 3.0);
+  auto forceOf = [&](const Matrix3X& targets, double deadZone, double& potential) {
+    SpringForceModel springs(targets, k, SpringForceModel::Attach::NearestEachStep);
+    springs.setDeadZone(deadZone);
+    springs.beginLevel(surface, quadrature, cube.points());
+    potential = 0.0;
+    return springs.generalizedForce(cube.points(), potential);
+  };
+  double potential = 0.0;
+  const Matrix3X inside = forceOf(onSurface + 0.01 * normals, zone, potential);
+  EXPECT_EQ(inside.cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(potential, 0.0);
+  double beyondPotential = 0.0, plainPotential = 0.0;
+  const Matrix3X beyond = forceOf(onSurface + 0.05 * normals, zone, beyondPotential);
+  const Matrix3X plain = forceOf(onSurface + 0.03 * normals, 0.0, plainPotential);
+  // The attachments agree to the closest-point search's tolerance (1e-9 of the size).
+  EXPECT_LT((beyond - plain).cwiseAbs().maxCoeff(), 1e-7 * plain.cwiseAbs().maxCoeff());
+  EXPECT_NEAR(beyondPotential, plainPotential, 1e-7 * plainPotential);
+  EXPECT_GT(plain.cwiseAbs().maxCoeff(), 0.0);
+  SpringForceModel springs(onSurface, k, SpringForceModel::Attach::NearestEachStep);
+  EXPECT_THROW(springs.setDeadZone(-1.0), Error);
+  EXPECT_THROW(springs.setDeadZone(std::nan("")), Error);
+}
+
 // A fixed control vertex stays exactly where it was under the static scheme.
 TEST(StaticScheme, FixedVerticesStay) {
   const ControlMesh cube = makeCube98();

@@ -152,6 +152,7 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
       const std::map<std::string, double*> settings = {
           {"image_force", &o.imageForce},
           {"landmark_stiffness", &o.landmarkStiffness},
+          {"landmark_dead_zone_mm", &o.landmarkDeadZone},
           {"landmark_tolerance_mm", &o.landmarkTolerance},
           {"inflation", &o.inflation},
           {"region_pressure", &o.regionPressure},

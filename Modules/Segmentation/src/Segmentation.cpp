@@ -99,6 +99,7 @@ void checkSegmentOptions(const SegmentOptions& options) {
   };
   finiteNonNegative(options.imageForce, "image force");
   finiteNonNegative(options.landmarkStiffness, "landmark stiffness");
+  finiteNonNegative(options.landmarkDeadZone, "landmark dead zone");
   checkSliceEndOptions(options.sliceEnds);
   finiteNonNegative(options.margin, "margin");
   finiteNonNegative(options.landmarkTolerance, "landmark tolerance");
@@ -193,6 +194,7 @@ SegmentResult evolveInRegion(const SegmentationRegion& region, const std::vector
   FieldForceModel imageForces(field);
   Eigen::VectorXd stiffness = Eigen::VectorXd::Constant(landmarkPoints.rows(), options.landmarkStiffness);
   SpringForceModel springs(landmarkPoints, stiffness, SpringForceModel::Attach::NearestEachStep);
+  springs.setDeadZone(options.landmarkDeadZone);
   InflationForceModel inflation(options.inflation);
   std::unique_ptr<RegionPressureForceModel> regionPressure;
   if (options.regionPressure != 0) {

@@ -75,6 +75,11 @@ class SpringForceModel final : public ForceModel {
   // Spring lengths (distances target - attachment, mm) at the last evaluation.
   const Eigen::VectorXd& lengths() const { return lengths_; }
 
+  // NearestEachStep only: a spring pulls with k (length - zone) beyond `zone`
+  // mm and not at all within it, for targets known only to about that much
+  // (an expert's clicks). 0 (the default) is the plain spring.
+  void setDeadZone(double zone);
+
  private:
   void attach(const Matrix3X& controlPoints);
 
@@ -88,6 +93,7 @@ class SpringForceModel final : public ForceModel {
   Matrix3X positions_;                 // the surface at the attachments (NearestEachStep)
   Matrix3X normals_;                   // and its unit normals there
   Eigen::VectorXd lengths_;
+  double deadZone_ = 0;
 };
 
 // A pressure (N/mm^2) along the limit normal; positive inflates an outward-oriented surface.

@@ -34,6 +34,7 @@ struct SegmentOptions {
   EdgeOptions edges;
   double imageForce = 0.05;        // k, N/mm^2 of surface
   double landmarkStiffness = 10.0;  // N/mm per landmark
+  double landmarkDeadZone = 0.0;    // mm: a landmark's spring pulls only beyond this (a click's error)
   double landmarkTolerance = 0.5;   // mm, largest landmark distance accepted without refining
   double inflation = 0.0;          // N/mm^2 along the normal (> 0 grows)
   // A pressure gated by appearance (N/mm^2, 0: off): k g(I) along the
