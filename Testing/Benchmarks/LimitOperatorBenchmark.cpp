@@ -48,14 +48,12 @@ void DynSubBuildOperators(benchmark::State& state) {
 void DynSubApplyOperators(benchmark::State& state) {
   const dynsub::ControlMesh mesh = cubeAtLevel(static_cast<int>(state.range(0)));
   const dynsub::LimitSurface surface(mesh);
-  const dynsub::LimitOperators ops = surface.operators(samples(mesh.faceCount()));
+  const dynsub::LimitOperators ops = surface.operators(samples(mesh.faceCount()), 1);  // J, J_u, J_v
   const dynsub::Matrix3X control = mesh.points();
   // Into arrays allocated once, as OpenSubdiv's side below writes into its own.
   dynsub::Matrix3X s, su, sv;
   for (auto _ : state) {
-    dynsub::applyOperator(ops.J, control, s);
-    dynsub::applyOperator(ops.Ju, control, su);
-    dynsub::applyOperator(ops.Jv, control, sv);
+    dynsub::applyOperators(ops.J, ops.Ju, ops.Jv, control, s, su, sv);
     benchmark::DoNotOptimize(s.data());
     benchmark::DoNotOptimize(su.data());
     benchmark::DoNotOptimize(sv.data());

@@ -49,6 +49,27 @@ TEST(ApplyOperator, ReadsAnUncompressedOperator) {
   EXPECT_TRUE((dynsub::applyOperator(op, points).array() == expected.array()).all());
 }
 
+TEST(ApplyOperators, EqualThreeApplicationsToTheBitAndRefuseOtherPatterns) {
+  // Three operators on one pattern (the values differ, zeros included).
+  std::mt19937 random(7);
+  const SparseMatrix a = randomOperator(400, 90, random);
+  SparseMatrix b = a, c = a;
+  std::uniform_real_distribution<double> weight(-1.0, 1.0);
+  for (Eigen::Index k = 0; k < a.nonZeros(); ++k) {
+    b.valuePtr()[k] = k % 5 == 0 ? 0.0 : weight(random);
+    c.valuePtr()[k] = weight(random);
+  }
+  const Matrix3X points = Matrix3X::Random(90, 3);
+  Matrix3X ra, rb, rc;
+  dynsub::applyOperators(a, b, c, points, ra, rb, rc);
+  EXPECT_TRUE((ra.array() == dynsub::applyOperator(a, points).array()).all());
+  EXPECT_TRUE((rb.array() == dynsub::applyOperator(b, points).array()).all());
+  EXPECT_TRUE((rc.array() == dynsub::applyOperator(c, points).array()).all());
+  // Another pattern (rows of other lengths) is refused, not misread.
+  const SparseMatrix other = randomOperator(400, 90, random);
+  EXPECT_THROW(dynsub::applyOperators(a, other, c, points, ra, rb, rc), std::invalid_argument);
+}
+
 TEST(ApplyOperator, AnEmptyOperatorGivesNoRows) {
   const SparseMatrix op(0, 4);
   EXPECT_EQ(dynsub::applyOperator(op, Matrix3X::Zero(4, 3)).rows(), 0);

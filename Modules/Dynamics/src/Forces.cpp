@@ -69,8 +69,7 @@ Matrix3X integrate(const SurfaceQuadrature& q, const Matrix3X& densityTimesArea)
 }
 
 // |s_u x s_v| at every quadrature point: surface area per unit parametric area.
-Eigen::VectorXd areaElements(const SurfaceQuadrature& q, const Matrix3X& controlPoints) {
-  const Matrix3X su = applyOperator(q.Ju, controlPoints), sv = applyOperator(q.Jv, controlPoints);
+Eigen::VectorXd areaElements(const Matrix3X& su, const Matrix3X& sv) {
   Eigen::VectorXd area(su.rows());
   for (Eigen::Index i = 0; i < su.rows(); ++i) area(i) = su.row(i).cross(sv.row(i)).norm();
   return area;
@@ -95,18 +94,20 @@ Matrix3X pressureForces(const SurfaceQuadrature& q, const Matrix3X& controlPoint
 }
 
 Matrix3X fieldForces(const SurfaceQuadrature& q, const Matrix3X& controlPoints, const ForceField& field) {
-  const Matrix3X positions = applyOperator(q.J, controlPoints);
+  Matrix3X positions, su, sv;
+  applyOperators(q.J, q.Ju, q.Jv, controlPoints, positions, su, sv);  // one pass: they share a pattern
   Matrix3X forces = field.forcesAt(positions);
   if (forces.rows() != positions.rows()) {
     throw Error("force field returned " + std::to_string(forces.rows()) + " forces for " +
                 std::to_string(positions.rows()) + " points");
   }
   if (!forces.allFinite()) throw Error("force field returned a non-finite force");
-  return integrate(q, areaElements(q, controlPoints).asDiagonal() * forces);
+  return integrate(q, areaElements(su, sv).asDiagonal() * forces);
 }
 
 SparseMatrix fieldStiffness(const SurfaceQuadrature& q, const Matrix3X& controlPoints, double slope) {
-  const Eigen::VectorXd weights = slope * q.weights.cwiseProduct(areaElements(q, controlPoints));
+  const Eigen::VectorXd weights =
+      slope * q.weights.cwiseProduct(areaElements(applyOperator(q.Ju, controlPoints), applyOperator(q.Jv, controlPoints)));
   return SparseMatrix(q.J.transpose() * weights.asDiagonal() * q.J);
 }
 

@@ -712,7 +712,9 @@ namespace {
 // The rows of the first `count` operators (s, s_u, s_v, s_uu, s_uv, s_vv) at
 // the points, as row-major sparse matrices built in place in one pass: each
 // row's columns are its element's, already sorted, so no triplets are sorted
-// or summed, and no point's weights are kept. Exact zeros are left out.
+// or summed, and no point's weights are kept. A column whose weights are
+// zero in every operator is left out; the operators share one pattern
+// (applyOperators() reads it once for all).
 // `jacobians`, if not empty, holds d(element u, v)/d(point's own u, v) per point.
 std::array<SparseMatrix, 6> assemble(const LimitSurface& surface, const LimitSurface::Impl& impl,
                                      const std::vector<ElementPoint>& points,
@@ -732,20 +734,15 @@ std::array<SparseMatrix, 6> assemble(const LimitSurface& surface, const LimitSur
     impl.weightsInto(points[r], w, count);
     if (!jacobians.empty()) applyChainRule(w, jacobians[r], count);
     const std::vector<int>& cols = surface.elementColumns(points[r].element);
-    for (int q = 0; q < count; ++q) {
-      SparseMatrix& m = result[q];
-      int* inner = m.innerIndexPtr();
-      double* values = m.valuePtr();
-      int& k = cursor[q];
-      for (size_t c = 0; c < cols.size(); ++c) {
-        const double value = w(q, static_cast<Eigen::Index>(c));
-        if (value == 0.0) continue;
-        inner[k] = cols[c];
-        values[k] = value;
-        ++k;
+    for (size_t c = 0; c < cols.size(); ++c) {
+      const auto column = w.col(static_cast<Eigen::Index>(c)).head(count);
+      if ((column.array() == 0.0).all()) continue;
+      for (int q = 0; q < count; ++q) {
+        result[q].innerIndexPtr()[cursor[q]] = cols[c];
+        result[q].valuePtr()[cursor[q]++] = column(q);
       }
-      m.outerIndexPtr()[r + 1] = k;
     }
+    for (int q = 0; q < count; ++q) result[q].outerIndexPtr()[r + 1] = cursor[q];
   }
   for (int q = 0; q < count; ++q) result[q].resizeNonZeros(cursor[q]);
   return result;

@@ -1,5 +1,8 @@
 #pragma once
 // Applying a sparse operator over control vertices to points.
+#include <algorithm>
+#include <stdexcept>
+
 #include "dynsub/Types.h"
 
 namespace dynsub {
@@ -31,6 +34,52 @@ inline void applyOperator(const SparseMatrix& op, const Matrix3X& points, Matrix
     result(row, 0) = sx;
     result(row, 1) = sy;
     result(row, 2) = sz;
+  }
+}
+
+// a * points, b * points and c * points for three compressed operators of one
+// sparsity pattern (LimitOperators' J, J_u and J_v): the pattern and each
+// control point are read once for all three, where three applyOperator()
+// calls read them three times. The same sums in the same order as those.
+// Throws std::invalid_argument where the operators' row extents differ; that
+// their columns agree too is checked in debug builds only (reading the
+// pattern three times to check it would cost what sharing it saves).
+inline void applyOperators(const SparseMatrix& a, const SparseMatrix& b, const SparseMatrix& c,
+                           const Matrix3X& points, Matrix3X& ra, Matrix3X& rb, Matrix3X& rc) {
+  const Eigen::Index rows = a.rows();
+  for (const SparseMatrix* op : {&a, &b, &c}) {
+    if (!op->isCompressed() || op->rows() != rows || op->cols() != points.rows() ||
+        op->nonZeros() != a.nonZeros() ||
+        !std::equal(a.outerIndexPtr(), a.outerIndexPtr() + rows + 1, op->outerIndexPtr()))
+      throw std::invalid_argument("applyOperators: the operators do not share one compressed pattern");
+    eigen_assert(std::equal(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros(), op->innerIndexPtr()));
+  }
+  ra.resize(rows, 3);
+  rb.resize(rows, 3);
+  rc.resize(rows, 3);
+  const int* outer = a.outerIndexPtr();
+  const int* inner = a.innerIndexPtr();
+  const double *wa = a.valuePtr(), *wb = b.valuePtr(), *wc = c.valuePtr();
+  const double* x = points.data();
+  const double* y = x + points.rows();
+  const double* z = y + points.rows();
+  for (Eigen::Index row = 0; row < rows; ++row) {
+    double ax = 0.0, ay = 0.0, az = 0.0, bx = 0.0, by = 0.0, bz = 0.0, cx = 0.0, cy = 0.0, cz = 0.0;
+    for (int k = outer[row]; k < outer[row + 1]; ++k) {
+      const double px = x[inner[k]], py = y[inner[k]], pz = z[inner[k]];
+      ax += wa[k] * px;
+      ay += wa[k] * py;
+      az += wa[k] * pz;
+      bx += wb[k] * px;
+      by += wb[k] * py;
+      bz += wb[k] * pz;
+      cx += wc[k] * px;
+      cy += wc[k] * py;
+      cz += wc[k] * pz;
+    }
+    ra(row, 0) = ax, ra(row, 1) = ay, ra(row, 2) = az;
+    rb(row, 0) = bx, rb(row, 1) = by, rb(row, 2) = bz;
+    rc(row, 0) = cx, rc(row, 1) = cy, rc(row, 2) = cz;
   }
 }
 

@@ -110,7 +110,9 @@ struct SharedPieces {
 };
 
 // Rows: points; columns: control vertices; s = J * p for each coordinate.
-// Rows of J sum to 1, rows of the derivative operators to 0.
+// Rows of J sum to 1, rows of the derivative operators to 0. All the
+// operators built together share one sparsity pattern (a weight that is zero
+// in one and not in another is stored as an explicit zero).
 struct LimitOperators {
   SparseMatrix J, Ju, Jv, Juu, Juv, Jvv;
 };
