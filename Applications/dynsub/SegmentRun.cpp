@@ -164,21 +164,21 @@ SegmentRun runSegmentation(const Volume& image, SegmentInputs in, const Progress
                              {"voxelize", result.seconds.voxelize}};
   if (in.segment.sliceEnds.enabled) {
     const SliceEnds& ends = result.sliceEnds;
-    nlohmann::ordered_json marched = nlohmann::ordered_json::array();
+    nlohmann::ordered_json marched = nlohmann::ordered_json::array(), springs = nlohmann::ordered_json::array();
     for (const SliceEnd& end : ends.ends)
       marched.push_back({{"from_lps_mm", {end.start.x(), end.start.y(), end.start.z()}},
                          {"to_lps_mm", {end.end.x(), end.end.y(), end.end.z()}},
                          {"length_mm", end.length},
                          {"stopped_by_reach", end.stoppedByReach}});
+    for (const Landmark& spring : ends.springs)
+      springs.push_back({spring.position.x(), spring.position.y(), spring.position.z()});
     report["slice_ends"] = {{"axis", ends.axis},
                             {"slices", ends.slices},
                             {"median", ends.median},
                             {"spread", ends.spread},
                             {"ends", marched},
-                            {"springs", ends.springs.size()}};
-    nlohmann::json points = nlohmann::json::array();
-    for (const Landmark& l : ends.springs) points.push_back({l.position(0), l.position(1), l.position(2)});
-    report["slice_ends"]["spring_points_lps_mm"] = points;
+                            {"springs", ends.springs.size()},
+                            {"spring_points_lps_mm", springs}};
   }
   report["region_of_interest"] = {{"first_voxel", result.regionFirst}, {"size_voxels", result.regionSize}};
   report["initial_volume_mm3"] = result.initialVolume;

@@ -106,8 +106,8 @@ Matrix3X fieldForces(const SurfaceQuadrature& q, const Matrix3X& controlPoints, 
 }
 
 SparseMatrix fieldStiffness(const SurfaceQuadrature& q, const Matrix3X& controlPoints, double slope) {
-  const Eigen::VectorXd weights =
-      slope * q.weights.cwiseProduct(areaElements(applyOperator(q.Ju, controlPoints), applyOperator(q.Jv, controlPoints)));
+  const Matrix3X su = applyOperator(q.Ju, controlPoints), sv = applyOperator(q.Jv, controlPoints);
+  const Eigen::VectorXd weights = slope * q.weights.cwiseProduct(areaElements(su, sv));
   return SparseMatrix(q.J.transpose() * weights.asDiagonal() * q.J);
 }
 
