@@ -25,6 +25,7 @@
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
 #include "dynsub/ImageIO.h"
+#include "dynsub/ResidentHeap.h"
 #include "dynsub/SurfaceWriter.h"
 
 namespace {
@@ -258,6 +259,7 @@ void run(Arguments a) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  dynsub::useResidentHeap();
   // Before any thread exists: a run Slicer cancels (SIGKILL) leaves no temporary file.
   dynsub::startTemporaryFileGuard();
   Arguments arguments;

@@ -8,9 +8,11 @@
 #include "Commands.h"
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
+#include "dynsub/ResidentHeap.h"
 #include "dynsub/TemporaryFileGuard.h"
 
 int main(int argc, char** argv) {
+  dynsub::useResidentHeap();
   // Before any thread exists: a run killed at any moment leaves no temporary file.
   dynsub::startTemporaryFileGuard();
   CLI::App app{
