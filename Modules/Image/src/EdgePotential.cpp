@@ -14,7 +14,7 @@ namespace {
 
 // Gradient (LPS, per mm) of the image smoothed by a Gaussian of sigma mm.
 std::vector<Vector3> smoothedGradient(const Volume& image, double sigma) {
-  const std::vector<float> raw = itkbridge::recursiveGaussianGradient(toBridge(image.geometry), image.voxels, sigma);
+  const std::vector<float> raw = itkbridge::functions().recursiveGaussianGradient(toBridge(image.geometry), image.voxels, sigma);
   std::vector<Vector3> gradient(image.voxels.size());
   for (std::size_t v = 0; v < gradient.size(); ++v) gradient[v] = Vector3(raw[3 * v], raw[3 * v + 1], raw[3 * v + 2]);
   return gradient;
@@ -191,7 +191,7 @@ DirectionField::DirectionField(const Volume& image, const EdgeOptions& options, 
   scale_ = edgeScale(magnitude, options, landmarks);
   edges_ = edgeMap(magnitude, gradient, scale_);
   // P = -distance to the nearest edge (see the header).
-  edgeDistance_ = Volume{image.geometry, itkbridge::distanceMap(toBridge(image.geometry), edges_.voxels)};
+  edgeDistance_ = Volume{image.geometry, itkbridge::functions().distanceMap(toBridge(image.geometry), edges_.voxels)};
   hasEdges_ = edges_.count() > 0;
   Volume potential = edgeDistance_;
   std::vector<std::uint8_t> keep(potential.voxels.size());

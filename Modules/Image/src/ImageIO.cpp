@@ -17,7 +17,7 @@ Volume readVolume(const std::string& path) {
   if (!std::filesystem::exists(path, ignored)) throw Error(path, "no such file or directory");
   itkbridge::Geometry raw;
   Volume volume;
-  itkbridge::readImage(path, raw, volume.voxels);
+  itkbridge::functions().readImage(path, raw, volume.voxels);
   volume.geometry = fromBridge(raw);
   for (int a = 0; a < 3; ++a)
     if (volume.geometry.size[a] < 2)
@@ -62,11 +62,11 @@ void writeMask(const Mask& mask, const std::string& path, std::uint8_t label) {
   requireWritableDirectoryFor(path);
   AtomicOutput output(path);
   if (label == 1) {
-    itkbridge::writeLabels(toBridge(mask.geometry), mask.voxels, output.temporaryPath());
+    itkbridge::functions().writeLabels(toBridge(mask.geometry), mask.voxels, output.temporaryPath());
   } else {
     std::vector<std::uint8_t> labels(mask.voxels.size());
     for (std::size_t i = 0; i < labels.size(); ++i) labels[i] = mask.voxels[i] ? label : 0;
-    itkbridge::writeLabels(toBridge(mask.geometry), labels, output.temporaryPath());
+    itkbridge::functions().writeLabels(toBridge(mask.geometry), labels, output.temporaryPath());
   }
   output.commit();
 }

@@ -148,8 +148,6 @@ void requireEvenSlices(const std::string& directory, const FloatImage& image) {
                                " mm");
 }
 
-}  // namespace
-
 void readImage(const std::string& path, Geometry& geometry, std::vector<float>& voxels) {
   try {
     FloatImage::Pointer image;
@@ -229,4 +227,12 @@ std::vector<float> distanceMap(const Geometry& geometry, const std::vector<std::
   return distance;
 }
 
+}  // namespace
 }  // namespace dynsub::itkbridge
+
+// The library's one exported symbol (it is built with hidden visibility).
+extern "C" __attribute__((visibility("default"))) const dynsub::itkbridge::Functions* dynsubItkBridgeFunctions() {
+  using namespace dynsub::itkbridge;
+  static const Functions table{&readImage, &writeLabels, &recursiveGaussianGradient, &distanceMap};
+  return &table;
+}

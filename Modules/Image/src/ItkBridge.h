@@ -3,6 +3,13 @@
 // arrays, not Eigen, because ITK 5.2 bundles its own Eigen (3.3) whose headers
 // cannot share a translation unit with the Eigen 3.4 the rest of DynSub uses;
 // so ITK is included by ItkBridge.cpp alone.
+//
+// ItkBridge.cpp is a library of its own, libDynSubItkBridge.so in the build's
+// lib/ directory, opened at the first call of functions() (ItkBridgeLoader.cpp).
+// A program that never reads, writes or filters an image (`dynsub fit`,
+// `deform`, `limit`) then starts without ITK's and GDCM's libraries: loading
+// them, and GDCM's building and freeing of its DICOM dictionary, took about
+// 0.08 s of every run (Documentation/Performance.md).
 #include <array>
 #include <cstdint>
 #include <string>
@@ -17,19 +24,25 @@ struct Geometry {
   std::array<double, 9> direction{};  // row-major, columns are the index axes
 };
 
-// A file (any format ITK reads) or a directory holding one DICOM series, as
-// float. Throws dynsub::Error naming the path.
-void readImage(const std::string& path, Geometry& geometry, std::vector<float>& voxels);
+// What ITK does for DynSub, as function pointers: ItkBridge.cpp fills them in
+// the library, which exports them through one C symbol (kFunctionsSymbol).
+struct Functions {
+  // A file (any format ITK reads) or a directory holding one DICOM series, as
+  // float. Throws dynsub::Error naming the path.
+  void (*readImage)(const std::string& path, Geometry& geometry, std::vector<float>& voxels);
+  // An 8-bit labelmap, compressed when the format allows; throws dynsub::Error.
+  void (*writeLabels)(const Geometry& geometry, const std::vector<std::uint8_t>& voxels, const std::string& path);
+  // Gradient (physical LPS axes, per mm) of the image smoothed by a Gaussian of
+  // sigma mm, with Deriche's recursive filters; three components per voxel.
+  std::vector<float> (*recursiveGaussianGradient)(const Geometry& geometry, const std::vector<float>& voxels,
+                                                  double sigma);
+  // Euclidean distance (mm) from every voxel centre to the nearest non-zero voxel.
+  std::vector<float> (*distanceMap)(const Geometry& geometry, const std::vector<std::uint8_t>& mask);
+};
+inline constexpr const char* kFunctionsSymbol = "dynsubItkBridgeFunctions";
 
-// An 8-bit labelmap, compressed when the format allows; throws dynsub::Error.
-void writeLabels(const Geometry& geometry, const std::vector<std::uint8_t>& voxels, const std::string& path);
-
-// Gradient (physical LPS axes, per mm) of the image smoothed by a Gaussian of
-// sigma mm, with Deriche's recursive filters; three components per voxel.
-std::vector<float> recursiveGaussianGradient(const Geometry& geometry, const std::vector<float>& voxels,
-                                             double sigma);
-
-// Euclidean distance (mm) from every voxel centre to the nearest non-zero voxel.
-std::vector<float> distanceMap(const Geometry& geometry, const std::vector<std::uint8_t>& mask);
+// The library's functions, loaded at the first call (thread-safe). Throws
+// dynsub::Error when the library cannot be opened.
+const Functions& functions();
 
 }  // namespace dynsub::itkbridge

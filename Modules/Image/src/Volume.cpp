@@ -140,7 +140,7 @@ Mask pasteMask(const Mask& part, const ImageGeometry& full, const std::array<int
 }
 
 std::vector<float> distanceTo(const Mask& mask) {
-  return itkbridge::distanceMap(toBridge(mask.geometry), mask.voxels);
+  return itkbridge::functions().distanceMap(toBridge(mask.geometry), mask.voxels);
 }
 
 }  // namespace dynsub
