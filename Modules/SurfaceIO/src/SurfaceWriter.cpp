@@ -14,6 +14,7 @@
 #include <vtkSTLWriter.h>
 #include <vtkStringArray.h>
 #include <vtkXMLPolyDataWriter.h>
+#include <vtkZLibDataCompressor.h>
 
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
@@ -65,6 +66,9 @@ void writeTriangleSurface(const TriangleSurface& surface, const std::string& pat
   if (extension == ".vtp") {
     vtkNew<vtkXMLPolyDataWriter> writer;
     writer->SetDataModeToAppended();
+    vtkNew<vtkZLibDataCompressor> compressor;
+    compressor->SetCompressionLevel(1);
+    writer->SetCompressor(compressor);
     write(writer);
   } else if (extension == ".obj") {
     vtkNew<vtkOBJWriter> writer;
