@@ -186,10 +186,10 @@ double shapeMotion(const SurfaceQuadrature& quadrature, const Matrix3X& from, co
 
 // Newton steps on K p = f_p (StaticSolver.h). When every force has a
 // potential, the total energy 1/2 p^T K p + potential is what the
-// equilibrium minimizes, and a step that does not lower it is halved (up to
-// 20 times; a direction that lowers nothing even then means the state is at
-// the minimum to rounding). Otherwise only a step moving a point farther than
-// the model's size is halved.
+// equilibrium minimizes, and a step that does not lower it is shortened (up
+// to 20 times, by a factor of 2-10 each; a direction that lowers nothing even
+// then means the state is at the minimum to rounding). Otherwise only a step
+// moving a point farther than the model's size is halved.
 LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>& forces, const std::vector<int>& fixed,
                         const SimulationOptions& options, const ProgressCallback& progress, Matrix3X& points,
                         LevelSummary& summary) {
@@ -220,10 +220,14 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
       if (isotropic && !lineSearch) break;
       const Matrix3X direction = solver.direction(forces, points, residual, isotropic);
       if (!direction.allFinite()) return LevelEnd::Diverged;
+      // The energy's slope along the direction: its gradient is K p - f_p.
+      const double slope = -(residual.array() * direction.array()).sum();
       double length = 1.0;
-      for (int halving = 0; halving <= 20 && !accepted; ++halving, length *= 0.5) {
-        if (direction.rowwise().norm().maxCoeff() * length > model.size) continue;
-        trial = points + length * direction;
+      for (int shortening = 0; shortening <= 20 && !accepted; ++shortening) {
+        const double previousLength = length;
+        length *= 0.5;
+        if (direction.rowwise().norm().maxCoeff() * previousLength > model.size) continue;
+        trial = points + previousLength * direction;
         double trialPotential = 0.0;
         trialForce = totalForce(forces, trial, trialPotential);
         trialEnergy = 0.5 * quadraticForm(model.matrices.stiffness, trial) + trialPotential;
@@ -231,6 +235,17 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
         evaluated = true;
         // Rounding of the energy's sum must not count as a rise.
         accepted = !lineSearch || trialEnergy <= energy + 1e-12 * std::abs(energy);
+        // The next length is the lowest point of the parabola through the
+        // energy here, its slope here and the energy at the rejected length,
+        // kept within 0.1-0.5 of that length (safeguarded backtracking).
+        // NB: the kitten's trace showed steps accepted at 1/8-1/16 of the
+        // Newton step, each halving a whole closest-point search: 151 force
+        // evaluations in 51 steps, against 65 in 33 with this rule.
+        const double rise = trialEnergy - energy - slope * previousLength;
+        if (slope < 0.0 && rise > 0.0) {
+          length = std::clamp(-slope * previousLength * previousLength / (2.0 * rise), 0.1 * previousLength,
+                              0.5 * previousLength);
+        }
       }
       if (accepted) break;
     }
