@@ -62,15 +62,18 @@ void runFit(FitCommandOptions o) {
   o.fit.simulation = o.simulation.apply(o.fit.simulation);
 
   ProgressLine line;
-  // The papers' max error every 5 steps, from the data's nearest points
-  // tracked from sample to sample (the report's figures come from a full
-  // search at each level's end).
+  // The papers' max error every 5 steps: the data springs' lengths where the
+  // fit measured them at that state (the static scheme), else the data's
+  // nearest points tracked from sample to sample (the report's figures come
+  // from a full search at each level's end).
   const double diameter = 2.0 * smallestEnclosingSphere(data).radius;
   TrackedDistances tracked(data);
   ConvergenceRecorder recorder(
       "max error (% of diameter)",
       [&](const Progress& p) {
-        return 100.0 * tracked.measure(*p.surface, p.level, *p.controlPoints).maxCoeff() / diameter;
+        const Eigen::VectorXd distances =
+            p.dataDistances ? *p.dataDistances : tracked.measure(*p.surface, p.level, *p.controlPoints);
+        return 100.0 * distances.maxCoeff() / diameter;
       },
       5);
   const FitResult result = fitPointCloud(data, initial, o.fit, recorder.callback(line.callback()));

@@ -142,7 +142,17 @@ FitResult fitPointCloud(const Matrix3X& data, const ControlMesh& initial, const 
     result.levelErrors.push_back(e);
     return e.maxPercent <= options.tolerancePercent;
   };
-  SimulationResult simulation = simulate(initial, {&springs}, {}, options.simulation, accept, progress);
+  // The static scheme's progress comes after the accepted trial, the springs'
+  // last evaluation: their lengths are the data's distances at that state.
+  ProgressCallback progressWithDistances = progress;
+  if (progress && options.simulation.integrator.scheme == IntegrationScheme::Static) {
+    progressWithDistances = [&](const Progress& p) {
+      Progress withDistances = p;
+      withDistances.dataDistances = &springs.lengths();
+      progress(withDistances);
+    };
+  }
+  SimulationResult simulation = simulate(initial, {&springs}, {}, options.simulation, accept, progressWithDistances);
   result.mesh = std::move(simulation.mesh);
   result.levels = std::move(simulation.levels);
   result.steps = simulation.steps;

@@ -118,6 +118,11 @@ struct Progress {
   // the simulation (the exception propagates out of simulate).
   const LimitSurface* surface = nullptr;
   const Matrix3X* controlPoints = nullptr;
+  // Shape recovery in the static scheme (fitPointCloud): each data point's
+  // distance (mm) to the surface at this state, which the data springs
+  // measured for the step's last force evaluation. Null otherwise (the time
+  // steps evaluate forces before they move).
+  const Eigen::VectorXd* dataDistances = nullptr;
 };
 
 // Decides at an equilibrium whether the fit is good enough (true: stop).
