@@ -100,7 +100,7 @@ Matrix3X SpringForceModel::generalizedForce(const Matrix3X& controlPoints, doubl
       onGrids.middleRows<16>(16 * static_cast<Eigen::Index>(q.element)).noalias() +=
           bicubicBsplineWeights(q.u, q.v).row(0).transpose() * pull;
     } else {
-      const Eigen::RowVectorXd w = surface_->stencil(q).row(0);
+      const Eigen::RowVectorXd w = surface_->positionStencil(q);
       const std::vector<int>& columns = surface_->elementColumns(q.element);
       for (size_t c = 0; c < columns.size(); ++c) force.row(columns[c]) += w(static_cast<Eigen::Index>(c)) * pull;
     }

@@ -141,7 +141,7 @@ void TangentStiffness::addScalar(const SparseMatrix& scalar) {
 
 void TangentStiffness::addPoint(const ElementPoint& q, const Eigen::Matrix3d& block) {
   Impl& s = *impl_;
-  const Eigen::RowVectorXd w = s.surface->stencil(q).row(0);
+  const Eigen::RowVectorXd w = s.surface->positionStencil(q);
   std::array<Eigen::MatrixXd, 6>& sums = s.pending[q.element];
   if (!s.isTouched[q.element]) {
     if (sums[0].rows() != w.size()) {

@@ -96,7 +96,8 @@ bool needsIsolation(const Topology& topology) {
 // With rows = 3 only s, s_u, s_v are rewritten (the rest may hold anything).
 template <class Rows>
 void applyChainRule(Rows& w, const Eigen::Matrix2d& t, int rows = 6) {
-  if (t.isIdentity(0.0)) return;
+  // Row 0, the position, does not depend on the parametrization.
+  if (rows <= 1 || t.isIdentity(0.0)) return;
   if (rows <= 3) {
     for (Eigen::Index c = 0; c < w.cols(); ++c) {
       const double da = w(1, c), db = w(2, c);
@@ -483,7 +484,13 @@ struct LimitSurface::Impl {
       } else if (rows == 3) {
         w.topRows<3>().noalias() = b.topRows<3>().lazyProduct(grid);
       } else {
-        w.topRows<1>().noalias() = b.topRows<1>().lazyProduct(grid);
+        // Summed in the order the rows above are (k ascending), so that the
+        // position's weights equal row 0 of the whole product to the bit.
+        for (Eigen::Index j = 0; j < grid.cols(); ++j) {
+          double sum = b(0, 0) * grid(0, j);
+          for (Eigen::Index k = 1; k < 16; ++k) sum += b(0, k) * grid(k, j);
+          w(0, j) = sum;
+        }
       }
     };
     if (element.type == ElementType::Normal) {
@@ -827,6 +834,12 @@ const std::vector<int>& LimitSurface::elementColumns(int element) const {
 
 Eigen::Matrix<double, 6, Eigen::Dynamic> LimitSurface::stencil(const ElementPoint& point) const {
   return impl_->weights(point);
+}
+
+Eigen::RowVectorXd LimitSurface::positionStencil(const ElementPoint& point) const {
+  SampleWeights w;
+  impl_->weightsInto(point, w, 1);
+  return w.row(0);
 }
 
 struct SurfaceState::Impl {

@@ -112,6 +112,28 @@ TEST_P(LimitSurfaceProperties, OperatorRowsArePartitionsOfUnity) {
   }
 }
 
+// The position's weights alone (positionStencil, and J built alone by
+// limitOperator) are row 0 of the whole stencil to the bit, so that springs
+// and their stiffness see one surface whichever they use.
+TEST_P(LimitSurfaceProperties, PositionWeightsAreTheStencilsFirstRowToTheBit) {
+  const LimitSurface surface(GetParam().mesh);
+  std::vector<ElementPoint> points;
+  for (int e = 0; e < surface.elementCount(); ++e)
+    for (double u : kParameters)
+      for (double v : {0.0, 1e-6, 0.3, 1.0}) points.push_back({e, u, v});
+  const dynsub::SparseMatrix j = surface.limitOperator(points);
+  for (size_t k = 0; k < points.size(); ++k) {
+    const Eigen::RowVectorXd full = surface.stencil(points[k]).row(0);
+    const Eigen::RowVectorXd position = surface.positionStencil(points[k]);
+    ASSERT_EQ(position.size(), full.size());
+    EXPECT_TRUE((position.array() == full.array()).all()) << "element " << points[k].element;
+    const std::vector<int>& columns = surface.elementColumns(points[k].element);
+    for (size_t c = 0; c < columns.size(); ++c) {
+      EXPECT_EQ(j.coeff(static_cast<Eigen::Index>(k), columns[c]), full(static_cast<Eigen::Index>(c)));
+    }
+  }
+}
+
 TEST_P(LimitSurfaceProperties, RefinementPreservesTheLimitSurface) {
   const dynsub::ControlMesh& mesh = GetParam().mesh;
   const dynsub::SubdividedMesh refined = dynsub::subdivide(mesh);

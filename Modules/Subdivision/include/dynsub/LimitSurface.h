@@ -170,6 +170,9 @@ class LimitSurface {
   // one at a time (closest points, per-point stiffness).
   const std::vector<int>& elementColumns(int element) const;
   Eigen::Matrix<double, 6, Eigen::Dynamic> stencil(const ElementPoint& point) const;
+  // Row s of stencil() alone, at about a sixth of its cost (springs and their
+  // stiffness need the position's weights only).
+  Eigen::RowVectorXd positionStencil(const ElementPoint& point) const;
 
   // A normal element is one piece of size 1. A special element is the three
   // regular pieces of each local-subdivision level 1..levels (size 2^-level);
