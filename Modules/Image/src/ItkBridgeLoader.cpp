@@ -36,10 +36,13 @@ const Functions* load() {
     if (entry == nullptr) throw Error(candidate.string(), std::string("not DynSub's ITK bridge: ") + dlerror());
     return entry();
   }
-  throw Error(DYNSUB_ITK_BRIDGE_NAME, "cannot open the library that reads and filters images through ITK (looked in " +
-                                          candidates.front().parent_path().string() + " and " +
-                                          fs::path(DYNSUB_ITK_BRIDGE_BUILD_PATH).parent_path().string() + ")" +
-                                          failures);
+  std::string places;
+  for (const fs::path& candidate : candidates) {
+    const std::string place = candidate.parent_path().string();
+    if (places.find(place) == std::string::npos) places += (places.empty() ? "" : ", ") + place;
+  }
+  throw Error(DYNSUB_ITK_BRIDGE_NAME,
+              "cannot open the library that reads and filters images through ITK (looked in " + places + ")" + failures);
 }
 
 }  // namespace
