@@ -11,10 +11,10 @@ namespace dynsub {
 // Call once, first thing in main(), before any thread exists: keeps blocks up
 // to 32 MB in the heap, never trims it below 1 GB, grows it 64 MB at a time
 // and asks for transparent huge pages on what it has grown (the kernel's
-// "madvise" mode, Debian's default). That is the main heap; threads' arenas
-// keep glibc's 4 kB pages (ResidentHeap.cpp says why). Address space is
-// reserved, memory is only used where touched. Other allocators (a
-// sanitizer's) are left alone.
+// "madvise" mode, this machine's; "always" needs no asking, "never" refuses).
+// That is the main heap; threads' arenas keep glibc's 4 kB pages
+// (ResidentHeap.cpp says why). Address space is reserved, memory is only used
+// where touched. Other allocators (a sanitizer's) are left alone.
 void useResidentHeap();
 
 }  // namespace dynsub
