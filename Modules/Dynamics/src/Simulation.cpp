@@ -224,10 +224,10 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
       const double slope = -(residual.array() * direction.array()).sum();
       double length = 1.0;
       for (int shortening = 0; shortening <= 20 && !accepted; ++shortening) {
-        const double previousLength = length;
+        const double tried = length;  // this trial's length; `length` becomes the next one
         length *= 0.5;
-        if (direction.rowwise().norm().maxCoeff() * previousLength > model.size) continue;
-        trial = points + previousLength * direction;
+        if (direction.rowwise().norm().maxCoeff() * tried > model.size) continue;
+        trial = points + tried * direction;
         double trialPotential = 0.0;
         trialForce = totalForce(forces, trial, trialPotential);
         trialEnergy = 0.5 * quadraticForm(model.matrices.stiffness, trial) + trialPotential;
@@ -241,10 +241,9 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
         // NB: the kitten's trace showed steps accepted at 1/8-1/16 of the
         // Newton step, each halving a whole closest-point search: 151 force
         // evaluations in 51 steps, against 65 in 33 with this rule.
-        const double rise = trialEnergy - energy - slope * previousLength;
+        const double rise = trialEnergy - energy - slope * tried;
         if (slope < 0.0 && rise > 0.0) {
-          length = std::clamp(-slope * previousLength * previousLength / (2.0 * rise), 0.1 * previousLength,
-                              0.5 * previousLength);
+          length = std::clamp(-slope * tried * tried / (2.0 * rise), 0.1 * tried, 0.5 * tried);
         }
       }
       if (accepted) break;

@@ -41,8 +41,8 @@ const Functions* load() {
     const std::string place = candidate.parent_path().string();
     if (places.find(place) == std::string::npos) places += (places.empty() ? "" : ", ") + place;
   }
-  throw Error(DYNSUB_ITK_BRIDGE_NAME,
-              "cannot open the library that reads and filters images through ITK (looked in " + places + ")" + failures);
+  throw Error(DYNSUB_ITK_BRIDGE_NAME, "cannot open the library that reads and filters images through ITK (looked in " +
+                                          places + ")" + failures);
 }
 
 }  // namespace
