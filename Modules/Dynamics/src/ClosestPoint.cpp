@@ -4,10 +4,10 @@
 #include <cmath>
 #include <limits>
 #include <string>
-#include <thread>
 
 #include <nanoflann.hpp>
 
+#include "ParallelFor.h"
 #include "dynsub/ApplyOperator.h"
 #include "dynsub/Error.h"
 
@@ -27,32 +27,8 @@ struct SampleCloud {
 
 using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, SampleCloud>, SampleCloud, 3>;
 
-// body(i) for i in [0, count): on one contiguous chunk per hardware thread,
-// or on this thread alone when there are too few queries to pay for starting
-// threads (about 50 us, a few queries' worth). Each query is independent, so
-// the results do not depend on the thread count.
-// NB: plain threads started per call instead of OpenMP: libgomp's workers
-// spin-wait between parallel loops, which took a third of the CPU time of a
-// segmentation whose loops are mostly small.
-template <class Body>
-void parallelFor(Eigen::Index count, const Body& body) {
-  constexpr Eigen::Index kSerialBelow = 256;
-  const Eigen::Index threads =
-      std::min<Eigen::Index>(std::max(1u, std::thread::hardware_concurrency()), count / (kSerialBelow / 2));
-  if (count < kSerialBelow || threads < 2) {
-    for (Eigen::Index i = 0; i < count; ++i) body(i);
-    return;
-  }
-  std::vector<std::thread> workers;
-  const Eigen::Index chunk = (count + threads - 1) / threads;
-  for (Eigen::Index t = 1; t < threads; ++t) {
-    workers.emplace_back([&, t] {
-      for (Eigen::Index i = t * chunk; i < std::min(count, (t + 1) * chunk); ++i) body(i);
-    });
-  }
-  for (Eigen::Index i = 0; i < std::min(count, chunk); ++i) body(i);
-  for (std::thread& w : workers) w.join();
-}
+// Queries are worth threads from this many on.
+constexpr Eigen::Index kSerialBelow = 256;
 
 }  // namespace
 
@@ -336,7 +312,8 @@ std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries) 
   if (!queries.allFinite()) throw Error("closest-point query is not finite");  // before the workers start
   impl_->updateTree();
   std::vector<ClosestPoint> result(queries.rows());
-  parallelFor(queries.rows(), [&](Eigen::Index i) { result[i] = search(queries.row(i).transpose()); });
+  parallelFor(queries.rows(), queries.rows() >= kSerialBelow,
+              [&](Eigen::Index i) { result[i] = search(queries.row(i).transpose()); });
   return result;
 }
 
@@ -352,7 +329,7 @@ std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries,
   using Nearer = Impl::Nearer;
   std::vector<ClosestPoint> result(queries.rows());
   std::vector<Nearer> nearer(queries.rows(), Nearer::Yes);
-  parallelFor(queries.rows(), [&](Eigen::Index i) {
+  parallelFor(queries.rows(), queries.rows() >= kSerialBelow, [&](Eigen::Index i) {
     const ElementPoint& hint = hints[i];
     if (!s.onSurface(hint)) return;  // a hint off the surface (another level's) means a full search, below
     const Vector3 q = queries.row(i).transpose();
@@ -362,7 +339,7 @@ std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries,
   if (std::find_if(nearer.begin(), nearer.end(), [](Nearer n) { return n != Nearer::No; }) == nearer.end())
     return result;
   s.updateTree();
-  parallelFor(queries.rows(), [&](Eigen::Index i) {
+  parallelFor(queries.rows(), queries.rows() >= kSerialBelow, [&](Eigen::Index i) {
     if (nearer[i] == Nearer::No) return;
     const Vector3 q = queries.row(i).transpose();
     if (!s.onSurface(hints[i])) {

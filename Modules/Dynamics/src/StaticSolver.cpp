@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "ParallelFor.h"
 #include "SparseCholesky.h"
 #include "dynsub/Error.h"
 #include "dynsub/ForceModel.h"
@@ -21,21 +22,18 @@ struct TangentStiffness::Impl {
   // scalar column c[j], at [j * m + i].
   std::vector<std::vector<int>> position;
   SymmetricMatrix matrix;  // 3N by 3N on the expanded pattern
-  // Per element, the pending sums of B_ab w w^T (lower triangles) for the six
-  // (a, b) with a <= b, and the elements touched since the last matrix().
+  // matrix's values right after the last reset(): resetToLast() copies them
+  // instead of looking up every entry of K again (a binary search each).
+  std::vector<double> base;
+  // Points added since the last matrix(), in the order added.
+  std::vector<ElementPoint> points;
+  std::vector<Eigen::Matrix3d> blocks;
+  // Per element, the sums of B_ab w w^T (lower triangles) for the six (a, b)
+  // with a <= b, and the elements with points, in increasing order.
   // NB: kept allocated from step to step; allocating them anew each step
   // cost more than filling them.
-  std::vector<std::array<Eigen::MatrixXd, 6>> pending;
-  std::vector<char> isTouched;
+  std::vector<std::array<Eigen::MatrixXd, 6>> sums;
   std::vector<int> touched;
-
-  void clearPending() {
-    for (int e : touched) {
-      for (Eigen::MatrixXd& x : pending[e]) x.setZero();
-      isTouched[e] = 0;
-    }
-    touched.clear();
-  }
 
   // Index into matrix.valuePtr() of (3 i + a, 3 j + b), k the position of i in scalar column j.
   int valueIndex(int j, int k, int a, int b) const {
@@ -55,24 +53,77 @@ struct TangentStiffness::Impl {
     double* values = matrix.valuePtr();
     for (int a = 0; a < 3; ++a) values[valueIndex(j, k, a, a)] += v;
   }
+
+  // The points' sums per element: with W the element's position weights at
+  // its points (a row each) and D_ab their blocks' entries, W^T D_ab W.
+  // NB: one product per element and entry instead of a rank-one update per
+  // point and entry (the bear's level 0 has 140 points per element); the
+  // elements are independent, so they are shared between the cores, each
+  // element's sums made by one thread in one order whatever the thread count.
+  void sumPoints() {
+    touched.clear();
+    if (points.empty()) return;
+    const int elements = surface->elementCount();
+    std::vector<int> start(elements + 1, 0);  // the points of element e: order[start[e] .. start[e + 1])
+    for (const ElementPoint& q : points) ++start[q.element + 1];
+    for (int e = 0; e < elements; ++e) start[e + 1] += start[e];
+    std::vector<int> order(points.size()), next(start.begin(), start.end() - 1);
+    for (size_t i = 0; i < points.size(); ++i) order[next[points[i].element]++] = static_cast<int>(i);
+    for (int e = 0; e < elements; ++e) {
+      if (start[e + 1] > start[e]) touched.push_back(e);
+    }
+    static constexpr int a[6] = {0, 0, 0, 1, 1, 2}, b[6] = {0, 1, 2, 1, 2, 2};
+    const auto sumElement = [&](Eigen::Index t) {
+      const int e = touched[t];
+      const int count = start[e + 1] - start[e];
+      const int m = static_cast<int>(surface->elementColumns(e).size());
+      Eigen::MatrixXd weights(count, m), scaled(m, count);
+      for (int r = 0; r < count; ++r) weights.row(r) = surface->positionStencil(points[order[start[e] + r]]);
+      for (int slot = 0; slot < 6; ++slot) {
+        Eigen::MatrixXd& sum = sums[e][slot];
+        sum.setZero(m, m);
+        bool any = false;
+        for (int r = 0; r < count; ++r) {
+          const double weight = blocks[order[start[e] + r]](a[slot], b[slot]);
+          scaled.col(r) = weights.row(r).transpose() * weight;
+          any = any || weight != 0.0;
+        }
+        if (any) sum.triangularView<Eigen::Lower>() += scaled * weights;
+      }
+    };
+    parallelFor(static_cast<Eigen::Index>(touched.size()), points.size() >= 256, sumElement);
+    points.clear();
+    blocks.clear();
+  }
+
+  // Adds the elements' sums into the matrix, element after element in
+  // increasing order. The columns are split between the cores: each value is
+  // written by one thread, its sum in the same order whatever the thread count.
   void flush() {
     double* values = matrix.valuePtr();
     static constexpr int pair[3][3] = {{0, 1, 2}, {1, 3, 4}, {2, 4, 5}};  // (a, b) -> slot of a <= b
-    for (int e : touched) {
-      const std::vector<int>& columns = surface->elementColumns(e);
-      const int m = static_cast<int>(columns.size());
-      std::array<Eigen::MatrixXd, 6>& w = pending[e];
-      for (int j = 0; j < m; ++j) {
-        for (int i = 0; i < m; ++i) {
-          const int k = position[e][j * m + i];
-          const int r = std::max(i, j), c = std::min(i, j);  // the stored lower triangle
-          for (int b = 0; b < 3; ++b) {
-            for (int a = 0; a < 3; ++a) values[valueIndex(columns[j], k, a, b)] += w[pair[a][b]](r, c);
+    constexpr int parts = 2;
+    const auto flushColumns = [&](Eigen::Index part) {
+      const int first = static_cast<int>(part * vertices / parts);
+      const int last = static_cast<int>((part + 1) * vertices / parts);
+      for (int e : touched) {
+        const std::vector<int>& columns = surface->elementColumns(e);
+        const int m = static_cast<int>(columns.size());
+        const std::array<Eigen::MatrixXd, 6>& w = sums[e];
+        for (int j = 0; j < m; ++j) {
+          if (columns[j] < first || columns[j] >= last) continue;
+          for (int i = 0; i < m; ++i) {
+            const int k = position[e][j * m + i];
+            const int r = std::max(i, j), c = std::min(i, j);  // the stored lower triangle
+            for (int b = 0; b < 3; ++b) {
+              for (int a = 0; a < 3; ++a) values[valueIndex(columns[j], k, a, b)] += w[pair[a][b]](r, c);
+            }
           }
         }
       }
-    }
-    clearPending();
+    };
+    parallelFor(parts, touched.size() >= 64, flushColumns);
+    touched.clear();
   }
 };
 
@@ -111,8 +162,7 @@ TangentStiffness::TangentStiffness(const LimitSurface& surface) : impl_(std::mak
     }
   }
   std::fill(s.matrix.valuePtr(), s.matrix.valuePtr() + nonZeros, 0.0);
-  s.pending.resize(surface.elementCount());
-  s.isTouched.assign(surface.elementCount(), 0);
+  s.sums.resize(surface.elementCount());
 }
 
 TangentStiffness::~TangentStiffness() = default;
@@ -120,13 +170,23 @@ TangentStiffness::~TangentStiffness() = default;
 void TangentStiffness::reset(const SymmetricMatrix& scalar) {
   Impl& s = *impl_;
   if (scalar.rows() != s.vertices || scalar.cols() != s.vertices) throw Error("internal: stiffness has the wrong size");
-  s.clearPending();
+  s.points.clear();
+  s.blocks.clear();
   std::fill(s.matrix.valuePtr(), s.matrix.valuePtr() + s.matrix.nonZeros(), 0.0);
   for (int j = 0; j < scalar.outerSize(); ++j) {
     for (SymmetricMatrix::InnerIterator it(scalar, j); it; ++it) {
       s.addScalarEntry(static_cast<int>(it.row()), j, it.value());
     }
   }
+  s.base.assign(s.matrix.valuePtr(), s.matrix.valuePtr() + s.matrix.nonZeros());
+}
+
+void TangentStiffness::resetToLast() {
+  Impl& s = *impl_;
+  if (s.base.empty()) throw Error("internal: TangentStiffness::resetToLast before any reset");
+  s.points.clear();
+  s.blocks.clear();
+  std::copy(s.base.begin(), s.base.end(), s.matrix.valuePtr());
 }
 
 void TangentStiffness::addScalar(const SparseMatrix& scalar) {
@@ -141,23 +201,13 @@ void TangentStiffness::addScalar(const SparseMatrix& scalar) {
 
 void TangentStiffness::addPoint(const ElementPoint& q, const Eigen::Matrix3d& block) {
   Impl& s = *impl_;
-  const Eigen::RowVectorXd w = s.surface->positionStencil(q);
-  std::array<Eigen::MatrixXd, 6>& sums = s.pending[q.element];
-  if (!s.isTouched[q.element]) {
-    if (sums[0].rows() != w.size()) {
-      for (Eigen::MatrixXd& x : sums) x.setZero(w.size(), w.size());
-    }
-    s.isTouched[q.element] = 1;
-    s.touched.push_back(q.element);
-  }
-  static constexpr int a[6] = {0, 0, 0, 1, 1, 2}, b[6] = {0, 1, 2, 1, 2, 2};
-  for (int slot = 0; slot < 6; ++slot) {
-    const double weight = block(a[slot], b[slot]);
-    if (weight != 0.0) sums[slot].selfadjointView<Eigen::Lower>().rankUpdate(w.transpose(), weight);
-  }
+  if (q.element < 0 || q.element >= s.surface->elementCount()) throw Error("internal: point on no element");
+  s.points.push_back(q);
+  s.blocks.push_back(block);
 }
 
 SymmetricMatrix& TangentStiffness::matrix() {
+  impl_->sumPoints();
   impl_->flush();
   return impl_->matrix;
 }
@@ -216,7 +266,7 @@ struct StaticSolver::Impl {
   static constexpr double kReuseTolerance = 1e-6;
   static constexpr int kReuseIterations = 20;
 
-  Impl(const LimitSurface& surface, const SymmetricMatrix& k) : stiffness(k), tangent(surface) {}
+  Impl(const LimitSurface& surface, const SymmetricMatrix& k) : stiffness(k), tangent(surface) { tangent.reset(k); }
 };
 
 StaticSolver::StaticSolver(const LimitSurface& surface, const SymmetricMatrix& stiffness,
@@ -242,7 +292,7 @@ int StaticSolver::regularizations() const { return impl_->regularizations; }
 Matrix3X StaticSolver::direction(const std::vector<ForceModel*>& forces, const Matrix3X& controlPoints,
                                  const Matrix3X& residual, bool isotropic) {
   Impl& s = *impl_;
-  s.tangent.reset(s.stiffness);
+  s.tangent.resetToLast();
   for (ForceModel* f : forces) {
     if (isotropic) {
       f->ForceModel::addTangentStiffness(controlPoints, s.tangent);

@@ -44,6 +44,9 @@ class TangentStiffness {
 
   // Starts anew with `scalar` (N by N) on x, y and z alike.
   void reset(const SymmetricMatrix& scalar);
+  // Starts anew with the last reset()'s `scalar`, from a copy of the values
+  // it gave (the Newton steps of one level all start from K).
+  void resetToLast();
   // Adds S (x) I_3 for a symmetric N by N S joining only control vertices
   // that share an element (springs' and fields' J^T W J are such).
   void addScalar(const SparseMatrix& scalar);
