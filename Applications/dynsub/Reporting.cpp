@@ -89,6 +89,7 @@ nlohmann::ordered_json simulationJson(const SimulationOptions& o) {
   j["plate_levels"] = o.assembly.plateLevels;
   j["equilibrium"] = {{"energy_tolerance", o.equilibrium.energyTolerance},
                       {"motion_tolerance", o.equilibrium.motionTolerance},
+                      {"coarse_level_factor", o.equilibrium.coarseLevelFactor},
                       {"window", o.equilibrium.window},
                       {"max_steps", o.equilibrium.maxSteps}};
   return j;

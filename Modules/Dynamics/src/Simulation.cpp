@@ -95,7 +95,9 @@ class EquilibriumWindow {
   std::deque<std::pair<double, double>> recent_;
 };
 
-enum class LevelEnd { Equilibrium, StepLimit, Diverged };
+// Coarse: a level below the maximum settled to the looser rule and its fit
+// was not accepted (EquilibriumOptions::coarseLevelFactor).
+enum class LevelEnd { Equilibrium, Coarse, StepLimit, Diverged };
 
 // The papers' time stepping (Integrator.h) from model.start; `points` ends at
 // the last state reached.
@@ -190,9 +192,12 @@ double shapeMotion(const SurfaceQuadrature& quadrature, const Matrix3X& from, co
 // to 20 times, by a factor of 2-10 each; a direction that lowers nothing even
 // then means the state is at the minimum to rounding). Otherwise only a step
 // moving a point farther than the model's size is halved.
+// With `coarseAccept` (a level below the maximum), the level is asked at the
+// first state that meets the looser rule whether its fit is accepted; if not,
+// it ends there, and if so it goes on, unchanged, to the full rule.
 LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>& forces, const std::vector<int>& fixed,
-                        const SimulationOptions& options, const ProgressCallback& progress, Matrix3X& points,
-                        LevelSummary& summary) {
+                        const SimulationOptions& options, const AcceptFit& coarseAccept,
+                        const ProgressCallback& progress, Matrix3X& points, LevelSummary& summary) {
   bool lineSearch = true;
   for (const ForceModel* f : forces) lineSearch = lineSearch && f->hasPotential();
   StaticSolver solver(model.surface, model.matrices.stiffness, fixed);
@@ -203,6 +208,11 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
   // NB: a static step that moves nothing is conclusive by itself (there is no
   // velocity to carry the state on), so two still steps in a row suffice.
   EquilibriumWindow window(options.equilibrium, std::min(options.equilibrium.window, 2));
+  EquilibriumOptions loose = options.equilibrium;
+  loose.energyTolerance *= loose.coarseLevelFactor;
+  loose.motionTolerance *= loose.coarseLevelFactor;
+  EquilibriumWindow looseWindow(loose, std::min(options.equilibrium.window, 2));
+  bool asked = !coarseAccept;
   points = model.start;
   double potential = 0.0;
   Matrix3X force = totalForce(forces, points, potential);
@@ -264,8 +274,11 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
     summary.energy = energy;
     summary.steps = step;
     if (progress) progress(Progress{model.level, step, energy, motion, &model.surface, &points});
-    if (window.settled(change, shapeMotion(model.quadrature, previous, points) / model.size)) {
-      return finish(LevelEnd::Equilibrium);
+    const double shape = shapeMotion(model.quadrature, previous, points) / model.size;
+    if (window.settled(change, shape)) return finish(LevelEnd::Equilibrium);
+    if (!asked && looseWindow.settled(change, shape)) {
+      asked = true;
+      if (!coarseAccept(model.surface, points)) return finish(LevelEnd::Coarse);
     }
   }
   return finish(LevelEnd::StepLimit);
@@ -289,8 +302,8 @@ double equilibriumResidual(const LevelModel& model, const std::vector<ForceModel
 // One level from model.start to its equilibrium (or step limit); a divergence
 // restarts it with half the time step.
 Matrix3X runLevel(const LevelModel& model, const std::vector<ForceModel*>& forces, const std::vector<int>& fixed,
-                  const SimulationOptions& options, double& timeStep, const ProgressCallback& progress,
-                  LevelSummary& summary) {
+                  const SimulationOptions& options, const AcceptFit& coarseAccept, double& timeStep,
+                  const ProgressCallback& progress, LevelSummary& summary, LevelEnd& end) {
   Matrix3X points;
   for (int halvings = 0;; ++halvings) {
     if (halvings > options.maxTimeStepHalvings) {
@@ -301,9 +314,8 @@ Matrix3X runLevel(const LevelModel& model, const std::vector<ForceModel*>& force
     summary.steps = 0;
     summary.solverIterations = 0;
     summary.stabilizerUpdates = 0;
-    LevelEnd end;
     if (options.integrator.scheme == IntegrationScheme::Static) {
-      end = runStaticSteps(model, forces, fixed, options, progress, points, summary);
+      end = runStaticSteps(model, forces, fixed, options, coarseAccept, progress, points, summary);
       if (end == LevelEnd::Diverged) {
         throw Error("the static scheme found no finite step at level " + std::to_string(model.level) +
                     " (try --scheme first-order or softer forces)");
@@ -312,7 +324,7 @@ Matrix3X runLevel(const LevelModel& model, const std::vector<ForceModel*>& force
       end = runTimeSteps(model, forces, fixed, options, timeStep, progress, points, summary);
     }
     if (end != LevelEnd::Diverged) {
-      summary.converged = end == LevelEnd::Equilibrium;
+      summary.converged = end == LevelEnd::Equilibrium || end == LevelEnd::Coarse;
       summary.timeStep = timeStep;
       return points;
     }
@@ -327,6 +339,9 @@ void checkSimulationOptions(const SimulationOptions& o) {
   const EquilibriumOptions& e = o.equilibrium;
   if (!(e.energyTolerance > 0.0) || !(e.motionTolerance > 0.0) || e.window < 1 || e.maxSteps < 1) {
     throw Error("equilibrium tolerances must be > 0, the window and the step limit >= 1");
+  }
+  if (!(e.coarseLevelFactor >= 1.0 && std::isfinite(e.coarseLevelFactor))) {
+    throw Error("the coarse levels' tolerance factor must be finite and >= 1");
   }
   if (o.maxLevel < 0 || o.maxLevel > 6) throw Error("the maximum level must be in 0..6, got " + std::to_string(o.maxLevel));
   if (o.origin.level < 0 || o.origin.level > o.maxLevel || o.origin.isolation < -1 ||
@@ -369,14 +384,20 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
     LevelSummary summary;
     summary.level = level;
     summary.controlVertices = mesh.vertexCount();
-    const Matrix3X points = runLevel(model, forces, fixed, options, timeStep, progress, summary);
+    // The static scheme may end a level that will be refined at a looser rule.
+    const bool coarse = accept && options.integrator.scheme == IntegrationScheme::Static &&
+                        level < options.maxLevel && options.equilibrium.coarseLevelFactor > 1.0;
+    LevelEnd end = LevelEnd::Equilibrium;
+    const Matrix3X points =
+        runLevel(model, forces, fixed, options, coarse ? accept : AcceptFit(), timeStep, progress, summary, end);
     summary.residual = equilibriumResidual(model, forces, points, fixed);
     mesh.setPoints(points);
     result.steps += summary.steps;
     summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     result.levels.push_back(summary);
 
-    const bool good = accept ? accept(model.surface, points) : true;
+    // A coarse end was asked already, and refused.
+    const bool good = end == LevelEnd::Coarse ? false : accept ? accept(model.surface, points) : true;
     if (good || level >= options.maxLevel) {
       result.origin = {level, initialIsolation};
       break;

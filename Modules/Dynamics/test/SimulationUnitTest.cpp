@@ -201,6 +201,42 @@ TEST(StaticScheme, EnergyFallsAtEveryStepToTheEquilibrium) {
   EXPECT_NEAR(result.error.maxPercent, reference.error.maxPercent, 1e-2);
 }
 
+// Levels that are refined end at the looser rule of coarseLevelFactor; the
+// last level, and a level whose fit is accepted, end by the full rule. The
+// ellipsoid fits to 1 % at its first level, so a fit to 1 % must not change
+// at all; asked for 0.01 % (beyond reach), it is refined once, and the first
+// level then ends sooner.
+TEST(StaticScheme, OnlyRefinedLevelsEndAtTheLooserRule) {
+  const Matrix3X points = ellipsoidPoints(1500, Vector3(30, 20, 10), 11);
+  const ControlMesh initial = initialModel(points, InitialShape::Sphere);
+  FitOptions full;
+  full.simulation.equilibrium.coarseLevelFactor = 1.0;
+  FitOptions coarse = full;
+  coarse.simulation.equilibrium.coarseLevelFactor = 30.0;
+  EXPECT_EQ(FitOptions().simulation.equilibrium.coarseLevelFactor, 30.0);  // fit's default
+
+  const FitResult accepted = fitPointCloud(points, initial, full);
+  const FitResult acceptedCoarse = fitPointCloud(points, initial, coarse);
+  ASSERT_EQ(accepted.levels.size(), 1u);
+  ASSERT_EQ(acceptedCoarse.levels.size(), 1u);
+  EXPECT_EQ(acceptedCoarse.levelErrors.size(), 1u);  // asked twice, one level's error
+  EXPECT_EQ(acceptedCoarse.steps, accepted.steps);
+  EXPECT_EQ(acceptedCoarse.mesh.points(), accepted.mesh.points());  // the same steps, to the bit
+
+  full.tolerancePercent = coarse.tolerancePercent = 0.01;
+  full.simulation.maxLevel = coarse.simulation.maxLevel = 1;
+  const FitResult refined = fitPointCloud(points, initial, full);
+  const FitResult refinedCoarse = fitPointCloud(points, initial, coarse);
+  ASSERT_EQ(refined.levels.size(), 2u);
+  ASSERT_EQ(refinedCoarse.levels.size(), 2u);
+  EXPECT_EQ(refinedCoarse.levelErrors.size(), 2u);
+  EXPECT_LT(refinedCoarse.levels[0].steps, refined.levels[0].steps);
+  for (const LevelSummary& level : refinedCoarse.levels) EXPECT_TRUE(level.converged);
+  // The last level ends by the full rule from another start: the same fit to
+  // a tenth of its error (both about 0.1 % of the diameter).
+  EXPECT_NEAR(refinedCoarse.error.maxPercent, refined.error.maxPercent, 0.1 * refined.error.maxPercent);
+}
+
 // A dead zone of z mm: a spring whose target lies within z of the surface
 // pulls not at all; one at distance L beyond pulls as a plain spring to a
 // target L - z away along the same line. Targets are put on the limit

@@ -53,6 +53,12 @@ struct EquilibriumOptions {
   double motionTolerance = 1e-4;  // per step, fraction of the model size
   int window = 5;                 // steps
   int maxSteps = 1000;            // per level
+  // The static scheme, with a fit to accept (simulate's `accept`): a level
+  // below the maximum is asked whether its fit is accepted at its first state
+  // within tolerances this many times looser. If not, it ends there and is
+  // refined (its equilibrium was only where the next level starts); if so, it
+  // goes on unchanged to the full rule. 1: every level settles to the full rule.
+  double coarseLevelFactor = 1.0;
 };
 
 // A control mesh's place in a multilevel fit: `level` global refinements of
@@ -126,7 +132,10 @@ struct Progress {
 };
 
 // Decides at an equilibrium whether the fit is good enough (true: stop).
-// Asked at the end of every level, the last one included.
+// Asked at the end of every level, the last one included, and in the static
+// scheme also where a level below the maximum meets the looser rule of
+// EquilibriumOptions::coarseLevelFactor: after an acceptance there, the same
+// level is asked again at its end.
 using AcceptFit = std::function<bool(const LimitSurface& surface, const Matrix3X& controlPoints)>;
 using ProgressCallback = std::function<void(const Progress&)>;
 
