@@ -278,7 +278,7 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
     if (window.settled(change, shape)) return finish(LevelEnd::Equilibrium);
     if (!asked && looseWindow.settled(change, shape)) {
       asked = true;
-      if (!coarseAccept(model.surface, points)) return finish(LevelEnd::Coarse);
+      if (!coarseAccept(model.surface, points, false)) return finish(LevelEnd::Coarse);
     }
   }
   return finish(LevelEnd::StepLimit);
@@ -397,7 +397,7 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
     result.levels.push_back(summary);
 
     // A coarse end was asked already, and refused.
-    const bool good = end == LevelEnd::Coarse ? false : accept ? accept(model.surface, points) : true;
+    const bool good = end == LevelEnd::Coarse ? false : accept ? accept(model.surface, points, true) : true;
     if (good || level >= options.maxLevel) {
       result.origin = {level, initialIsolation};
       break;

@@ -211,7 +211,7 @@ SegmentResult evolveInRegion(const SegmentationRegion& region, const std::vector
   // Refine while a landmark is farther than the tolerance (see the header).
   // The last level's distances are the result's.
   std::vector<double> distances;
-  auto landmarksFit = [&](const LimitSurface& surface, const Matrix3X& controlPoints) {
+  auto landmarksFit = [&](const LimitSurface& surface, const Matrix3X& controlPoints, bool) {
     if (landmarkPoints.rows() == 0) return false;
     distances = distancesToSurface(surface, controlPoints, landmarkPoints);
     for (double distance : distances)

@@ -131,12 +131,13 @@ struct Progress {
   const Eigen::VectorXd* dataDistances = nullptr;
 };
 
-// Decides at an equilibrium whether the fit is good enough (true: stop).
-// Asked at the end of every level, the last one included, and in the static
-// scheme also where a level below the maximum meets the looser rule of
-// EquilibriumOptions::coarseLevelFactor: after an acceptance there, the same
-// level is asked again at its end.
-using AcceptFit = std::function<bool(const LimitSurface& surface, const Matrix3X& controlPoints)>;
+// Decides whether the fit is good enough (true: stop). Asked at the end of
+// every level, the last one included (`settled`), and in the static scheme
+// also where a level below the maximum first meets the looser rule of
+// EquilibriumOptions::coarseLevelFactor (not `settled`; the forces were last
+// evaluated at `controlPoints`). After an acceptance there, the same level
+// is asked again at its end.
+using AcceptFit = std::function<bool(const LimitSurface& surface, const Matrix3X& controlPoints, bool settled)>;
 using ProgressCallback = std::function<void(const Progress&)>;
 
 // forces are not owned. fixed: control vertices of the initial mesh that do not
