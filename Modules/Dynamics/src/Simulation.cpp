@@ -220,6 +220,8 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
   double energy = 0.5 * quadraticForm(model.matrices.stiffness, points) + potential;
   summary.energy = energy;
   if (!std::isfinite(energy)) return LevelEnd::Diverged;
+  // The length the last Newton direction was accepted at.
+  double lastLength = 1.0;
   for (int step = 1; step <= options.equilibrium.maxSteps; ++step) {
     const Matrix3X residual = force - model.matrices.stiffness * points;
     Matrix3X trial, trialForce;
@@ -232,7 +234,12 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
       if (!direction.allFinite()) return LevelEnd::Diverged;
       // The energy's slope along the direction: its gradient is K p - f_p.
       const double slope = -(residual.array() * direction.array()).sum();
-      double length = 1.0;
+      // NB: a Newton direction first tries 1.5 times the last one's accepted
+      // length (at most 1). Near the kitten's equilibrium the full step
+      // raised the energy step after step and 0.1-0.25 of it was accepted,
+      // two or three force evaluations a step. Chosen on the tuning clouds
+      // (force evaluations, all four): always 1: 102; 1.5: 88; 2: 90; 4: 102.
+      double length = isotropic ? 1.0 : std::min(1.0, 1.5 * lastLength);
       for (int shortening = 0; shortening <= 20 && !accepted; ++shortening) {
         const double tried = length;  // this trial's length; `length` becomes the next one
         length *= 0.5;
@@ -245,6 +252,7 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
         evaluated = true;
         // Rounding of the energy's sum must not count as a rise.
         accepted = !lineSearch || trialEnergy <= energy + 1e-12 * std::abs(energy);
+        if (accepted && !isotropic) lastLength = tried;
         // The next length is the lowest point of the parabola through the
         // energy here, its slope here and the energy at the rejected length,
         // kept within 0.1-0.5 of that length (safeguarded backtracking).
