@@ -101,6 +101,7 @@ nlohmann::ordered_json levelJson(const LevelSummary& l, double maxErrorPercent, 
   j["control_vertices"] = l.controlVertices;
   j["iterations"] = l.steps;
   j["equilibrium"] = l.converged;
+  j["equilibrium_rule"] = l.coarse ? "coarse" : "full";  // coarse: a refined level, ended at looser tolerances
   j["time_step_s"] = l.timeStep;
   j["energy"] = l.energy;
   if (maxErrorPercent >= 0) {

@@ -28,8 +28,8 @@ struct SampleCloud {
 
 using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, SampleCloud>, SampleCloud, 3>;
 
-// Queries are worth threads from this many on.
-constexpr Eigen::Index kSerialBelow = 256;
+// The threads a number of queries is worth: one per 128 (serial below 256).
+Eigen::Index threadsFor(Eigen::Index queries) { return queries / 128; }
 
 }  // namespace
 
@@ -313,7 +313,7 @@ std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries) 
   if (!queries.allFinite()) throw Error("closest-point query is not finite");  // before the workers start
   impl_->updateTree();
   std::vector<ClosestPoint> result(queries.rows());
-  parallelFor(queries.rows(), queries.rows() >= kSerialBelow,
+  parallelFor(queries.rows(), threadsFor(queries.rows()),
               [&](Eigen::Index i) { result[i] = search(queries.row(i).transpose()); });
   return result;
 }
@@ -334,7 +334,7 @@ std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries,
   // the rebuilt tree makes the result independent of which thread found it.
   std::vector<ClosestPoint> result(queries.rows());
   std::atomic<bool> stale{false};
-  parallelFor(queries.rows(), queries.rows() >= kSerialBelow, [&](Eigen::Index i) {
+  parallelFor(queries.rows(), threadsFor(queries.rows()), [&](Eigen::Index i) {
     const ElementPoint& hint = hints[i];
     if (!s.onSurface(hint)) {  // a hint off the surface (another level's) means a full search, below
       stale = true;
@@ -348,7 +348,7 @@ std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries,
   });
   if (!stale) return result;
   s.updateTree();
-  parallelFor(queries.rows(), queries.rows() >= kSerialBelow, [&](Eigen::Index i) {
+  parallelFor(queries.rows(), threadsFor(queries.rows()), [&](Eigen::Index i) {
     const Vector3 q = queries.row(i).transpose();
     if (!s.onSurface(hints[i])) {
       result[i] = search(q);

@@ -1,5 +1,5 @@
 #pragma once
-// Independent per-item work on both cores, private to the Dynamics module.
+// Independent per-item work on the machine's cores, private to the Dynamics module.
 #include <algorithm>
 #include <thread>
 #include <vector>
@@ -8,17 +8,20 @@
 
 namespace dynsub {
 
-// body(i) for i in [0, count): one contiguous chunk per hardware thread, or
-// this thread alone when `worthThreads` is false (starting a thread costs
-// about 50 us, a few closest-point queries' worth). Each item must be
-// independent of the others, so that results do not depend on the thread count.
+// body(i) for i in [0, count): one contiguous chunk per thread, on at most
+// `threadsWorthIt` threads (the caller's measure of its work: starting a
+// thread costs about 50 us, a few closest-point queries' worth), at most one
+// per hardware thread; on this thread alone when that is 1 or less. Each item
+// must be independent of the others, so that results do not depend on the
+// thread count.
 // NB: plain threads started per call instead of OpenMP: libgomp's workers
 // spin-wait between parallel loops, which took a third of the CPU time of a
 // segmentation whose loops are mostly small.
 template <class Body>
-void parallelFor(Eigen::Index count, bool worthThreads, const Body& body) {
-  const Eigen::Index threads = std::min<Eigen::Index>(std::max(1u, std::thread::hardware_concurrency()), count);
-  if (!worthThreads || threads < 2) {
+void parallelFor(Eigen::Index count, Eigen::Index threadsWorthIt, const Body& body) {
+  const Eigen::Index threads = std::min<Eigen::Index>(
+      {static_cast<Eigen::Index>(std::max(1u, std::thread::hardware_concurrency())), count, threadsWorthIt});
+  if (threads < 2) {
     for (Eigen::Index i = 0; i < count; ++i) body(i);
     return;
   }

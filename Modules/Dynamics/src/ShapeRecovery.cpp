@@ -145,8 +145,11 @@ FitResult fitPointCloud(const Matrix3X& data, const ControlMesh& initial, const 
 
   AcceptFit accept = [&](const LimitSurface& surface, const Matrix3X& points, bool settled) {
     // NB: mid-level (the static scheme's looser rule) the springs' lengths are
-    // the data's distances at `points`, measured by their last evaluation; a
-    // new search (2 % of the kitten's fit) would give the same answer.
+    // the data's distances at `points`, measured by their last evaluation
+    // (tracked, so never shorter than a new search's). When they accept, a
+    // new search (2 % of the kitten's fit) is saved, and the level goes on to
+    // its end, where the error is measured; when they do not, it is measured
+    // now, and decides.
     const Eigen::VectorXd& lengths = springs.lengths();
     if (!settled && lengths.size() == data.rows() &&
         100.0 * lengths.maxCoeff() / diameter <= options.tolerancePercent) {

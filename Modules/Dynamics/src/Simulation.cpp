@@ -77,8 +77,11 @@ class EquilibriumWindow {
  public:
   EquilibriumWindow(const EquilibriumOptions& options, int window) : options_(options), window_(window) {}
   void clear() { recent_.clear(); }
-  // Records a step (relative energy change, largest move / model size); true
-  // when the last `window` steps were all still.
+  // Whether a step (relative energy change, largest move / model size) is still.
+  bool still(double change, double motion) const {
+    return change <= options_.energyTolerance && motion <= options_.motionTolerance;
+  }
+  // Records a step; true when the last `window` steps were all still.
   bool settled(double change, double motion) {
     recent_.emplace_back(change, motion);
     if (static_cast<int>(recent_.size()) > window_) recent_.pop_front();
@@ -222,6 +225,9 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
   if (!std::isfinite(energy)) return LevelEnd::Diverged;
   // The length the last Newton direction was accepted at.
   double lastLength = 1.0;
+  // Whether the last step was still by the full rule. (Not the coarse one:
+  // the path of a level accepted at the looser rule must not depend on it.)
+  bool lastStill = false;
   for (int step = 1; step <= options.equilibrium.maxSteps; ++step) {
     const Matrix3X residual = force - model.matrices.stiffness * points;
     Matrix3X trial, trialForce;
@@ -237,9 +243,13 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
       // NB: a Newton direction first tries 1.5 times the last one's accepted
       // length (at most 1). Near the kitten's equilibrium the full step
       // raised the energy step after step and 0.1-0.25 of it was accepted,
-      // two or three force evaluations a step. Chosen on the tuning clouds
-      // (force evaluations, all four): always 1: 102; 1.5: 88; 2: 90; 4: 102.
-      double length = isotropic ? 1.0 : std::min(1.0, 1.5 * lastLength);
+      // two or three force evaluations a step. After a still step the next
+      // starts at 1 again: a step started short may look still only because
+      // it was short, and a level must not end on two such steps. Chosen on
+      // the tuning clouds (force evaluations, all four): always 1: 102; 1.5:
+      // 88, but levels could end on two short steps; 1.5 and 1 after a still
+      // step: 88; 2: 90; 4: 102.
+      double length = isotropic || !lineSearch || lastStill ? 1.0 : std::min(1.0, 1.5 * lastLength);
       for (int shortening = 0; shortening <= 20 && !accepted; ++shortening) {
         const double tried = length;  // this trial's length; `length` becomes the next one
         length *= 0.5;
@@ -284,6 +294,7 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
     if (progress) progress(Progress{model.level, step, energy, motion, &model.surface, &points});
     const double shape = shapeMotion(model.quadrature, previous, points) / model.size;
     if (window.settled(change, shape)) return finish(LevelEnd::Equilibrium);
+    lastStill = window.still(change, shape);
     if (!asked && looseWindow.settled(change, shape)) {
       asked = true;
       if (!coarseAccept(model.surface, points, false)) return finish(LevelEnd::Coarse);
@@ -333,6 +344,7 @@ Matrix3X runLevel(const LevelModel& model, const std::vector<ForceModel*>& force
     }
     if (end != LevelEnd::Diverged) {
       summary.converged = end == LevelEnd::Equilibrium || end == LevelEnd::Coarse;
+      summary.coarse = end == LevelEnd::Coarse;
       summary.timeStep = timeStep;
       return points;
     }

@@ -58,8 +58,10 @@ struct TangentStiffness::Impl {
   // its points (a row each) and D_ab their blocks' entries, W^T D_ab W.
   // NB: one product per element and entry instead of a rank-one update per
   // point and entry (the bear's level 0 has 140 points per element); the
-  // elements are independent, so they are shared between the cores, each
+  // elements are independent, so they are shared between threads, each
   // element's sums made by one thread in one order whatever the thread count.
+  // (Eigen's blocked product orders its sums by the CPU's cache sizes, so
+  // another machine may round differently; this one always the same way.)
   void sumPoints() {
     touched.clear();
     if (points.empty()) return;
@@ -91,14 +93,16 @@ struct TangentStiffness::Impl {
         if (any) sum.triangularView<Eigen::Lower>() += scaled * weights;
       }
     };
-    parallelFor(static_cast<Eigen::Index>(touched.size()), points.size() >= 256, sumElement);
+    // One thread per 128 points, as for closest-point queries.
+    parallelFor(static_cast<Eigen::Index>(touched.size()), static_cast<Eigen::Index>(points.size()) / 128, sumElement);
     points.clear();
     blocks.clear();
   }
 
   // Adds the elements' sums into the matrix, element after element in
-  // increasing order. The columns are split between the cores: each value is
-  // written by one thread, its sum in the same order whatever the thread count.
+  // increasing order. The columns are split in two halves, on two threads
+  // when there are enough elements: each value is written by one thread, its
+  // sum in the same order whatever the thread count.
   void flush() {
     double* values = matrix.valuePtr();
     static constexpr int pair[3][3] = {{0, 1, 2}, {1, 3, 4}, {2, 4, 5}};  // (a, b) -> slot of a <= b
@@ -122,7 +126,7 @@ struct TangentStiffness::Impl {
         }
       }
     };
-    parallelFor(parts, touched.size() >= 64, flushColumns);
+    parallelFor(parts, touched.size() >= 64 ? parts : 1, flushColumns);
     touched.clear();
   }
 };
@@ -201,7 +205,11 @@ void TangentStiffness::addScalar(const SparseMatrix& scalar) {
 
 void TangentStiffness::addPoint(const ElementPoint& q, const Eigen::Matrix3d& block) {
   Impl& s = *impl_;
-  if (q.element < 0 || q.element >= s.surface->elementCount()) throw Error("internal: point on no element");
+  // Checked here, on the caller's thread: the weights are taken later, on worker threads.
+  if (q.element < 0 || q.element >= s.surface->elementCount() || !(q.u >= 0.0 && q.u <= 1.0) ||
+      !(q.v >= 0.0 && q.v <= 1.0)) {
+    throw Error("internal: stiffness point outside the surface's elements");
+  }
   s.points.push_back(q);
   s.blocks.push_back(block);
 }

@@ -115,8 +115,11 @@ INSTANTIATE_TEST_SUITE_P(StaticScheme, PureSpringTest,
 
 // The 3N x 3N Newton matrix against its definition, built densely:
 // K (x) I_3 + sum_q (J_q^T J_q) (x) B_q, unknown 3 v + a. 400 points: from
-// 256 on, the points' sums are shared between threads, which must change
-// nothing, not even the last bit from one build to the next.
+// 256 on, the points' sums are shared between threads (on a machine with more
+// than one core), which must give the definition, and the same bits from one
+// build to the next. (That a serial build gives those bits too follows from
+// each element's sums being made by one thread; this test cannot choose the
+// thread count.)
 TEST(TangentStiffness, MatchesItsDenseDefinition) {
   const ControlMesh mesh = makeCube98();
   const LimitSurface surface(mesh);

@@ -55,7 +55,7 @@ struct FitResult {
   Sphere enclosingSphere;
   FitError error;
   std::vector<LevelSummary> levels;
-  std::vector<FitError> levelErrors;  // at each level's equilibrium
+  std::vector<FitError> levelErrors;  // one per level, where it ended
   int steps = 0;
   double seconds = 0;
 };

@@ -94,6 +94,9 @@ struct LevelSummary {
   int controlVertices = 0;
   int steps = 0;
   bool converged = false;
+  // The level ended at the looser rule of EquilibriumOptions::coarseLevelFactor
+  // (its fit was not accepted there, and it was refined).
+  bool coarse = false;
   double timeStep = 0;
   double energy = 0;    // N mm, at the end of the level
   double seconds = 0;   // wall time of the level, assembly included
