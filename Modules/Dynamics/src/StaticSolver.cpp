@@ -18,9 +18,11 @@ struct TangentStiffness::Impl {
   // The scalar pattern (N by N, column-major, rows sorted): every pair of
   // control vertices sharing an element.
   std::vector<int> scalarOuter, scalarInner;
-  // Per element, for columns c of the element: position of row c[i] within
-  // scalar column c[j], at [j * m + i].
-  std::vector<std::vector<int>> position;
+  // Per element, for columns c of the element: the index into matrix's values
+  // of (3 c[i], 3 c[j]), at [j * m + i]; (3 c[i] + a, 3 c[j] + b) is b
+  // strides and a entries further, a stride being columnStride[c[j]].
+  std::vector<std::vector<int>> entry;
+  std::vector<int> columnStride;
   SymmetricMatrix matrix;  // 3N by 3N on the expanded pattern
   // matrix's values right after the last reset(): resetToLast() copies them
   // instead of looking up every entry of K again (a binary search each).
@@ -28,8 +30,8 @@ struct TangentStiffness::Impl {
   // Points added since the last matrix(), in the order added.
   std::vector<ElementPoint> points;
   std::vector<Eigen::Matrix3d> blocks;
-  // Per element, the sums of B_ab w w^T (lower triangles) for the six (a, b)
-  // with a <= b, and the elements with points, in increasing order.
+  // Per element, the sums of B_ab w w^T (symmetric, both triangles) for the
+  // six (a, b) with a <= b, and the elements with points, in increasing order.
   // NB: kept allocated from step to step; allocating them anew each step
   // cost more than filling them.
   std::vector<std::array<Eigen::MatrixXd, 6>> sums;
@@ -90,7 +92,11 @@ struct TangentStiffness::Impl {
           scaled.col(r) = weights.row(r).transpose() * weight;
           any = any || weight != 0.0;
         }
-        if (any) sum.triangularView<Eigen::Lower>() += scaled * weights;
+        if (!any) continue;
+        sum.triangularView<Eigen::Lower>() += scaled * weights;
+        for (int c = 0; c < m; ++c) {
+          for (int r = c + 1; r < m; ++r) sum(c, r) = sum(r, c);
+        }
       }
     };
     // One thread per 128 points, as for closest-point queries.
@@ -105,7 +111,6 @@ struct TangentStiffness::Impl {
   // sum in the same order whatever the thread count.
   void flush() {
     double* values = matrix.valuePtr();
-    static constexpr int pair[3][3] = {{0, 1, 2}, {1, 3, 4}, {2, 4, 5}};  // (a, b) -> slot of a <= b
     constexpr int parts = 2;
     const auto flushColumns = [&](Eigen::Index part) {
       const int first = static_cast<int>(part * vertices / parts);
@@ -116,12 +121,17 @@ struct TangentStiffness::Impl {
         const std::array<Eigen::MatrixXd, 6>& w = sums[e];
         for (int j = 0; j < m; ++j) {
           if (columns[j] < first || columns[j] >= last) continue;
+          const int stride = columnStride[columns[j]];
+          // Slots: (0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2).
+          const double *s0 = w[0].col(j).data(), *s1 = w[1].col(j).data(), *s2 = w[2].col(j).data();
+          const double *s3 = w[3].col(j).data(), *s4 = w[4].col(j).data(), *s5 = w[5].col(j).data();
           for (int i = 0; i < m; ++i) {
-            const int k = position[e][j * m + i];
-            const int r = std::max(i, j), c = std::min(i, j);  // the stored lower triangle
-            for (int b = 0; b < 3; ++b) {
-              for (int a = 0; a < 3; ++a) values[valueIndex(columns[j], k, a, b)] += w[pair[a][b]](r, c);
-            }
+            double* x = values + entry[e][j * m + i];
+            x[0] += s0[i], x[1] += s1[i], x[2] += s2[i];
+            x += stride;
+            x[0] += s1[i], x[1] += s3[i], x[2] += s4[i];
+            x += stride;
+            x[0] += s2[i], x[1] += s4[i], x[2] += s5[i];
           }
         }
       }
@@ -139,13 +149,13 @@ TangentStiffness::TangentStiffness(const LimitSurface& surface) : impl_(std::mak
   const SymmetricMatrix pattern = elementPattern(surface);
   s.scalarOuter.assign(pattern.outerIndexPtr(), pattern.outerIndexPtr() + n + 1);
   s.scalarInner.assign(pattern.innerIndexPtr(), pattern.innerIndexPtr() + pattern.nonZeros());
-  s.position.resize(surface.elementCount());
+  std::vector<std::vector<int>> position(surface.elementCount());  // of row c[i] in scalar column c[j]
   for (int e = 0; e < surface.elementCount(); ++e) {
     const std::vector<int>& columns = surface.elementColumns(e);
     const int m = static_cast<int>(columns.size());
-    s.position[e].resize(static_cast<size_t>(m) * m);
+    position[e].resize(static_cast<size_t>(m) * m);
     for (int j = 0; j < m; ++j) {
-      for (int i = 0; i < m; ++i) s.position[e][j * m + i] = s.find(columns[i], columns[j]);
+      for (int i = 0; i < m; ++i) position[e][j * m + i] = s.find(columns[i], columns[j]);
     }
   }
   // Expand: scalar entry (i, j) becomes the 3 x 3 block of rows 3i..3i+2, columns 3j..3j+2.
@@ -166,6 +176,17 @@ TangentStiffness::TangentStiffness(const LimitSurface& surface) : impl_(std::mak
     }
   }
   std::fill(s.matrix.valuePtr(), s.matrix.valuePtr() + nonZeros, 0.0);
+  s.columnStride.resize(n);
+  for (int j = 0; j < n; ++j) s.columnStride[j] = 3 * (s.scalarOuter[j + 1] - s.scalarOuter[j]);
+  s.entry.resize(surface.elementCount());
+  for (int e = 0; e < surface.elementCount(); ++e) {
+    const std::vector<int>& columns = surface.elementColumns(e);
+    const int m = static_cast<int>(columns.size());
+    s.entry[e].resize(static_cast<size_t>(m) * m);
+    for (int j = 0; j < m; ++j) {
+      for (int i = 0; i < m; ++i) s.entry[e][j * m + i] = s.valueIndex(columns[j], position[e][j * m + i], 0, 0);
+    }
+  }
   s.sums.resize(surface.elementCount());
 }
 
