@@ -28,9 +28,6 @@ struct SampleCloud {
 
 using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, SampleCloud>, SampleCloud, 3>;
 
-// The threads a number of queries is worth: one per 128 (serial below 256).
-Eigen::Index threadsFor(Eigen::Index queries) { return queries / 128; }
-
 }  // namespace
 
 struct ClosestPointLocator::Impl {
@@ -313,7 +310,7 @@ std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries) 
   if (!queries.allFinite()) throw Error("closest-point query is not finite");  // before the workers start
   impl_->updateTree();
   std::vector<ClosestPoint> result(queries.rows());
-  parallelFor(queries.rows(), threadsFor(queries.rows()),
+  parallelFor(queries.rows(), threadsWorth(queries.rows()),
               [&](Eigen::Index i) { result[i] = search(queries.row(i).transpose()); });
   return result;
 }
@@ -334,7 +331,7 @@ std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries,
   // the rebuilt tree makes the result independent of which thread found it.
   std::vector<ClosestPoint> result(queries.rows());
   std::atomic<bool> stale{false};
-  parallelFor(queries.rows(), threadsFor(queries.rows()), [&](Eigen::Index i) {
+  parallelFor(queries.rows(), threadsWorth(queries.rows()), [&](Eigen::Index i) {
     const ElementPoint& hint = hints[i];
     if (!s.onSurface(hint)) {  // a hint off the surface (another level's) means a full search, below
       stale = true;
@@ -348,7 +345,7 @@ std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries,
   });
   if (!stale) return result;
   s.updateTree();
-  parallelFor(queries.rows(), threadsFor(queries.rows()), [&](Eigen::Index i) {
+  parallelFor(queries.rows(), threadsWorth(queries.rows()), [&](Eigen::Index i) {
     const Vector3 q = queries.row(i).transpose();
     if (!s.onSurface(hints[i])) {
       result[i] = search(q);

@@ -17,6 +17,10 @@ namespace dynsub {
 // NB: plain threads started per call instead of OpenMP: libgomp's workers
 // spin-wait between parallel loops, which took a third of the CPU time of a
 // segmentation whose loops are mostly small.
+// The threads `items` independent pieces of per-point work (a closest-point
+// query, a point's stiffness) are worth: one per 128, so none below 256.
+inline Eigen::Index threadsWorth(Eigen::Index items) { return items / 128; }
+
 template <class Body>
 void parallelFor(Eigen::Index count, Eigen::Index threadsWorthIt, const Body& body) {
   const Eigen::Index threads = std::min<Eigen::Index>(

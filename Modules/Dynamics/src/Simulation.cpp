@@ -86,10 +86,8 @@ class EquilibriumWindow {
     recent_.emplace_back(change, motion);
     if (static_cast<int>(recent_.size()) > window_) recent_.pop_front();
     if (static_cast<int>(recent_.size()) < window_) return false;
-    for (const auto& [c, m] : recent_) {
-      if (c > options_.energyTolerance || m > options_.motionTolerance) return false;
-    }
-    return true;
+    return std::all_of(recent_.begin(), recent_.end(),
+                       [&](const std::pair<double, double>& step) { return still(step.first, step.second); });
   }
 
  private:
@@ -250,10 +248,11 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
       // 88, but levels could end on two short steps; 1.5 and 1 after a still
       // step: 88; 2: 90; 4: 102.
       double length = isotropic || !lineSearch || lastStill ? 1.0 : std::min(1.0, 1.5 * lastLength);
+      const double largestMove = direction.rowwise().norm().maxCoeff();
       for (int shortening = 0; shortening <= 20 && !accepted; ++shortening) {
         const double tried = length;  // this trial's length; `length` becomes the next one
         length *= 0.5;
-        if (direction.rowwise().norm().maxCoeff() * tried > model.size) continue;
+        if (largestMove * tried > model.size) continue;
         trial = points + tried * direction;
         double trialPotential = 0.0;
         trialForce = totalForce(forces, trial, trialPotential);

@@ -99,8 +99,8 @@ struct TangentStiffness::Impl {
         }
       }
     };
-    // One thread per 128 points, as for closest-point queries.
-    parallelFor(static_cast<Eigen::Index>(touched.size()), static_cast<Eigen::Index>(points.size()) / 128, sumElement);
+    parallelFor(static_cast<Eigen::Index>(touched.size()), threadsWorth(static_cast<Eigen::Index>(points.size())),
+                sumElement);
     points.clear();
     blocks.clear();
   }
@@ -149,15 +149,6 @@ TangentStiffness::TangentStiffness(const LimitSurface& surface) : impl_(std::mak
   const SymmetricMatrix pattern = elementPattern(surface);
   s.scalarOuter.assign(pattern.outerIndexPtr(), pattern.outerIndexPtr() + n + 1);
   s.scalarInner.assign(pattern.innerIndexPtr(), pattern.innerIndexPtr() + pattern.nonZeros());
-  std::vector<std::vector<int>> position(surface.elementCount());  // of row c[i] in scalar column c[j]
-  for (int e = 0; e < surface.elementCount(); ++e) {
-    const std::vector<int>& columns = surface.elementColumns(e);
-    const int m = static_cast<int>(columns.size());
-    position[e].resize(static_cast<size_t>(m) * m);
-    for (int j = 0; j < m; ++j) {
-      for (int i = 0; i < m; ++i) position[e][j * m + i] = s.find(columns[i], columns[j]);
-    }
-  }
   // Expand: scalar entry (i, j) becomes the 3 x 3 block of rows 3i..3i+2, columns 3j..3j+2.
   const int nonZeros = 9 * static_cast<int>(s.scalarInner.size());
   s.matrix.resize(3 * n, 3 * n);
@@ -184,7 +175,9 @@ TangentStiffness::TangentStiffness(const LimitSurface& surface) : impl_(std::mak
     const int m = static_cast<int>(columns.size());
     s.entry[e].resize(static_cast<size_t>(m) * m);
     for (int j = 0; j < m; ++j) {
-      for (int i = 0; i < m; ++i) s.entry[e][j * m + i] = s.valueIndex(columns[j], position[e][j * m + i], 0, 0);
+      for (int i = 0; i < m; ++i) {
+        s.entry[e][j * m + i] = s.valueIndex(columns[j], s.find(columns[i], columns[j]), 0, 0);
+      }
     }
   }
   s.sums.resize(surface.elementCount());
