@@ -15,15 +15,19 @@ namespace dynsub {
 struct TangentStiffness::Impl {
   const LimitSurface* surface = nullptr;
   int vertices = 0;
-  // The scalar pattern (N by N, column-major, rows sorted): every pair of
-  // control vertices sharing an element.
+  // The scalar pattern's lower triangle (N by N, column-major, rows sorted,
+  // the diagonal first): every pair i >= j of control vertices sharing an
+  // element.
   std::vector<int> scalarOuter, scalarInner;
-  // Per element, for columns c of the element: the index into matrix's values
-  // of (3 c[i], 3 c[j]), at [j * m + i]; (3 c[i] + a, 3 c[j] + b) is b
-  // strides and a entries further, a stride being columnStride[c[j]].
+  // Per element, for columns c of the element (sorted, so c[i] >= c[j] for
+  // i >= j): the index into matrix's values of (3 c[i], 3 c[j]) for i >= j,
+  // at [j * m + i]. In a block below the diagonal (i > j), entry
+  // (3 c[i] + a, 3 c[j] + b) is a entries further and, for b = 1 and 2,
+  // firstStride[c[j]] and then secondStride[c[j]] more; diagonal blocks are
+  // laid out by diagonalOffsets.
   std::vector<std::vector<int>> entry;
-  std::vector<int> columnStride;
-  SymmetricMatrix matrix;  // 3N by 3N on the expanded pattern
+  std::vector<int> firstStride, secondStride;
+  SymmetricMatrix matrix;  // 3N by 3N, the lower triangle of the expanded pattern
   // matrix's values right after the last reset(): resetToLast() copies them
   // instead of looking up every entry of K again (a binary search each).
   std::vector<double> base;
@@ -37,9 +41,14 @@ struct TangentStiffness::Impl {
   std::vector<std::array<Eigen::MatrixXd, 6>> sums;
   std::vector<int> touched;
 
-  // Index into matrix.valuePtr() of (3 i + a, 3 j + b), k the position of i in scalar column j.
+  // Index into matrix.valuePtr() of (3 i + a, 3 j + b), k the position of
+  // i in scalar column j; i == j (k = scalarOuter[j]) needs a >= b.
+  // Column 3 j + b holds the diagonal block's rows 3 j + b .. 3 j + 2, then
+  // three rows for each i > j.
   int valueIndex(int j, int k, int a, int b) const {
-    return matrix.outerIndexPtr()[3 * j + b] + 3 * (k - scalarOuter[j]) + a;
+    const int start = matrix.outerIndexPtr()[3 * j + b];
+    if (k == scalarOuter[j]) return start + a - b;
+    return start + (3 - b) + 3 * (k - scalarOuter[j] - 1) + a;
   }
   int find(int i, int j) const {
     const auto begin = scalarInner.begin() + scalarOuter[j], end = scalarInner.begin() + scalarOuter[j + 1];
@@ -50,6 +59,7 @@ struct TangentStiffness::Impl {
     }
     return static_cast<int>(it - scalarInner.begin());
   }
+  // Adds v to (3 i + a, 3 j + a), a = 0, 1, 2, where i >= j (the lower triangle).
   void addScalarEntry(int i, int j, double v) {
     const int k = find(i, j);
     double* values = matrix.valuePtr();
@@ -105,10 +115,10 @@ struct TangentStiffness::Impl {
     blocks.clear();
   }
 
-  // Adds the elements' sums into the matrix, element after element in
-  // increasing order. The columns are split in two halves, on two threads
-  // when there are enough elements: each value is written by one thread, its
-  // sum in the same order whatever the thread count.
+  // Adds the elements' sums into the matrix's lower triangle, element after
+  // element in increasing order. The columns are split in two halves, on two
+  // threads when there are enough elements: each value is written by one
+  // thread, its sum in the same order whatever the thread count.
   void flush() {
     double* values = matrix.valuePtr();
     constexpr int parts = 2;
@@ -121,16 +131,24 @@ struct TangentStiffness::Impl {
         const std::array<Eigen::MatrixXd, 6>& w = sums[e];
         for (int j = 0; j < m; ++j) {
           if (columns[j] < first || columns[j] >= last) continue;
-          const int stride = columnStride[columns[j]];
+          const int stride1 = firstStride[columns[j]], stride2 = secondStride[columns[j]];
           // Slots: (0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2).
           const double *s0 = w[0].col(j).data(), *s1 = w[1].col(j).data(), *s2 = w[2].col(j).data();
           const double *s3 = w[3].col(j).data(), *s4 = w[4].col(j).data(), *s5 = w[5].col(j).data();
-          for (int i = 0; i < m; ++i) {
+          {  // The diagonal block: its lower triangle, column after column.
+            double* x = values + entry[e][j * m + j];
+            x[0] += s0[j], x[1] += s1[j], x[2] += s2[j];
+            x += stride1 + 1;
+            x[0] += s3[j], x[1] += s4[j];
+            x += stride2 + 1;
+            x[0] += s5[j];
+          }
+          for (int i = j + 1; i < m; ++i) {
             double* x = values + entry[e][j * m + i];
             x[0] += s0[i], x[1] += s1[i], x[2] += s2[i];
-            x += stride;
+            x += stride1;
             x[0] += s1[i], x[1] += s3[i], x[2] += s4[i];
-            x += stride;
+            x += stride2;
             x[0] += s2[i], x[1] += s4[i], x[2] += s5[i];
           }
         }
@@ -146,36 +164,49 @@ TangentStiffness::TangentStiffness(const LimitSurface& surface) : impl_(std::mak
   s.surface = &surface;
   s.vertices = surface.controlVertexCount();
   const int n = s.vertices;
-  const SymmetricMatrix pattern = elementPattern(surface);
+  // NB: only the lower triangle is stored: the factorization and the
+  // conjugate gradients read no other, and the points' sums are added into
+  // half as many values.
+  const SymmetricMatrix pattern = SymmetricMatrix(elementPattern(surface).triangularView<Eigen::Lower>());
   s.scalarOuter.assign(pattern.outerIndexPtr(), pattern.outerIndexPtr() + n + 1);
   s.scalarInner.assign(pattern.innerIndexPtr(), pattern.innerIndexPtr() + pattern.nonZeros());
-  // Expand: scalar entry (i, j) becomes the 3 x 3 block of rows 3i..3i+2, columns 3j..3j+2.
-  const int nonZeros = 9 * static_cast<int>(s.scalarInner.size());
+  for (int j = 0; j < n; ++j) {  // every vertex shares an element with itself: the diagonal leads each column
+    if (s.scalarOuter[j] == s.scalarOuter[j + 1] || s.scalarInner[s.scalarOuter[j]] != j) {
+      throw Error("internal: control vertex " + std::to_string(j) + " is in no element");
+    }
+  }
+  // Expand: scalar entry (i, j), i > j, becomes the 3 x 3 block of rows
+  // 3i..3i+2, columns 3j..3j+2; (j, j) the lower triangle of its block.
   s.matrix.resize(3 * n, 3 * n);
-  s.matrix.resizeNonZeros(nonZeros);
+  s.matrix.resizeNonZeros(9 * static_cast<int>(s.scalarInner.size()) - 3 * n);
   int* outer = s.matrix.outerIndexPtr();
   int* inner = s.matrix.innerIndexPtr();
   outer[0] = 0;
+  s.firstStride.resize(n);
+  s.secondStride.resize(n);
   for (int j = 0; j < n; ++j) {
-    const int count = 3 * (s.scalarOuter[j + 1] - s.scalarOuter[j]);
+    const int below = s.scalarOuter[j + 1] - s.scalarOuter[j] - 1;  // scalar rows i > j
     for (int b = 0; b < 3; ++b) {
-      const int start = outer[3 * j + b];
-      outer[3 * j + b + 1] = start + count;
-      for (int k = s.scalarOuter[j]; k < s.scalarOuter[j + 1]; ++k) {
-        for (int a = 0; a < 3; ++a) inner[start + 3 * (k - s.scalarOuter[j]) + a] = 3 * s.scalarInner[k] + a;
+      int next = outer[3 * j + b];
+      for (int a = b; a < 3; ++a) inner[next++] = 3 * j + a;
+      for (int k = s.scalarOuter[j] + 1; k < s.scalarOuter[j + 1]; ++k) {
+        for (int a = 0; a < 3; ++a) inner[next++] = 3 * s.scalarInner[k] + a;
       }
+      outer[3 * j + b + 1] = next;
     }
+    // From (3 i + a, 3 j) to (3 i + a, 3 j + 1): the rest of column 3 j, less
+    // the one diagonal row column 3 j + 1 lacks; likewise to 3 j + 2.
+    s.firstStride[j] = 3 * below + 2;
+    s.secondStride[j] = 3 * below + 1;
   }
-  std::fill(s.matrix.valuePtr(), s.matrix.valuePtr() + nonZeros, 0.0);
-  s.columnStride.resize(n);
-  for (int j = 0; j < n; ++j) s.columnStride[j] = 3 * (s.scalarOuter[j + 1] - s.scalarOuter[j]);
+  std::fill(s.matrix.valuePtr(), s.matrix.valuePtr() + s.matrix.nonZeros(), 0.0);
   s.entry.resize(surface.elementCount());
   for (int e = 0; e < surface.elementCount(); ++e) {
     const std::vector<int>& columns = surface.elementColumns(e);
     const int m = static_cast<int>(columns.size());
-    s.entry[e].resize(static_cast<size_t>(m) * m);
+    s.entry[e].assign(static_cast<size_t>(m) * m, -1);
     for (int j = 0; j < m; ++j) {
-      for (int i = 0; i < m; ++i) {
+      for (int i = j; i < m; ++i) {
         s.entry[e][j * m + i] = s.valueIndex(columns[j], s.find(columns[i], columns[j]), 0, 0);
       }
     }
@@ -193,7 +224,7 @@ void TangentStiffness::reset(const SymmetricMatrix& scalar) {
   std::fill(s.matrix.valuePtr(), s.matrix.valuePtr() + s.matrix.nonZeros(), 0.0);
   for (int j = 0; j < scalar.outerSize(); ++j) {
     for (SymmetricMatrix::InnerIterator it(scalar, j); it; ++it) {
-      s.addScalarEntry(static_cast<int>(it.row()), j, it.value());
+      if (it.row() >= j) s.addScalarEntry(static_cast<int>(it.row()), j, it.value());
     }
   }
   s.base.assign(s.matrix.valuePtr(), s.matrix.valuePtr() + s.matrix.nonZeros());
@@ -212,7 +243,7 @@ void TangentStiffness::addScalar(const SparseMatrix& scalar) {
   if (scalar.rows() != s.vertices || scalar.cols() != s.vertices) throw Error("internal: stiffness has the wrong size");
   for (int i = 0; i < scalar.outerSize(); ++i) {
     for (SparseMatrix::InnerIterator it(scalar, i); it; ++it) {
-      s.addScalarEntry(i, static_cast<int>(it.col()), it.value());
+      if (i >= it.col()) s.addScalarEntry(i, static_cast<int>(it.col()), it.value());
     }
   }
 }

@@ -53,8 +53,9 @@ class TangentStiffness {
   // Adds (J_q^T J_q) (x) B: a stiffness B (symmetric 3 x 3, N/mm) acting on
   // the limit position at q.
   void addPoint(const ElementPoint& q, const Eigen::Matrix3d& block);
-  // The matrix with every addition made (both triangles stored); the caller
-  // may change values in place until the next reset.
+  // The matrix with every addition made, its lower triangle alone stored
+  // (the solvers read no other); the caller may change values in place
+  // until the next reset.
   SymmetricMatrix& matrix();
 
   struct Impl;
