@@ -34,8 +34,9 @@ struct TangentStiffness::Impl {
   // Points added since the last matrix(), in the order added.
   std::vector<ElementPoint> points;
   std::vector<Eigen::Matrix3d> blocks;
-  // Per element, the sums of B_ab w w^T (symmetric, both triangles) for the
-  // six (a, b) with a <= b, and the elements with points, in increasing order.
+  // Per element, the sums of B_ab w w^T for the six (a, b) with a <= b (the
+  // lower triangle: flush() reads no other), and the elements with points,
+  // in increasing order.
   // NB: kept allocated from step to step; allocating them anew each step
   // cost more than filling them.
   std::vector<std::array<Eigen::MatrixXd, 6>> sums;
@@ -104,9 +105,6 @@ struct TangentStiffness::Impl {
         }
         if (!any) continue;
         sum.triangularView<Eigen::Lower>() += scaled * weights;
-        for (int c = 0; c < m; ++c) {
-          for (int r = c + 1; r < m; ++r) sum(c, r) = sum(r, c);
-        }
       }
     };
     parallelFor(static_cast<Eigen::Index>(touched.size()), threadsWorth(static_cast<Eigen::Index>(points.size())),
