@@ -76,7 +76,11 @@ struct ClosestPointLocator::Impl {
         block = specialSamples.middleRows(specialRow[e * perElement], perElement);
       }
     }
-    tree = std::make_unique<Tree>(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+    // NB: 64 samples a leaf, not nanoflann's usual 10-16: the tree is rebuilt
+    // at most evaluations of a fit (the kitten's 111 000 samples: 56 of 62),
+    // and its queries are few per rebuild; its build took 9.5 ms at 16, 7 ms
+    // at 64, and the searches no longer.
+    tree = std::make_unique<Tree>(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(64));
     treeControlPoints = controlPoints;
     drift = 0.0;
   }
