@@ -66,6 +66,11 @@ void writeTriangleSurface(const TriangleSurface& surface, const std::string& pat
   if (extension == ".vtp") {
     vtkNew<vtkXMLPolyDataWriter> writer;
     writer->SetDataModeToAppended();
+    // NB: raw bytes after the XML header, not base64 text (VTK's default):
+    // a third smaller, and the encoding was a fifth of the writing time of a
+    // fitted kitten's 15 MB surface. VTK's and ParaView's readers (and so
+    // Slicer's) read both.
+    writer->EncodeAppendedDataOff();
     vtkNew<vtkZLibDataCompressor> compressor;
     compressor->SetCompressionLevel(1);
     writer->SetCompressor(compressor);
