@@ -238,16 +238,16 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
       if (!direction.allFinite()) return LevelEnd::Diverged;
       // The energy's slope along the direction: its gradient is K p - f_p.
       const double slope = -(residual.array() * direction.array()).sum();
-      // NB: a Newton direction first tries 1.5 times the last one's accepted
-      // length (at most 1). Near the kitten's equilibrium the full step
-      // raised the energy step after step and 0.1-0.25 of it was accepted,
-      // two or three force evaluations a step. After a still step the next
-      // starts at 1 again: a step started short may look still only because
-      // it was short, and a level must not end on two such steps. Chosen on
-      // the tuning clouds (force evaluations, all four): always 1: 102; 1.5:
-      // 88, but levels could end on two short steps; 1.5 and 1 after a still
-      // step: 88; 2: 90; 4: 102.
-      double length = isotropic || !lineSearch || lastStill ? 1.0 : std::min(1.0, 1.5 * lastLength);
+      // NB: a Newton direction first tries the length the last one was
+      // accepted at. Near the kitten's equilibrium the full step raised the
+      // energy step after step and 0.1-0.5 of it was accepted, the best
+      // length shrinking slowly. After a still step the next starts at 1
+      // again: a step started short may look still only because it was
+      // short, and a level must not end on two such steps. Chosen on the
+      // tuning clouds (force evaluations, all four): always 1: 102; the last
+      // length times 1.0: 80, 1.2: 92, 1.5: 88 (two sessions' choice, with
+      // the conjugate gradients' tolerance 1e-6 then 1e-3), 2: 88-90, 4: 102.
+      double length = isotropic || !lineSearch || lastStill ? 1.0 : lastLength;
       const double largestMove = direction.rowwise().norm().maxCoeff();
       for (int shortening = 0; shortening <= 20 && !accepted; ++shortening) {
         const double tried = length;  // this trial's length; `length` becomes the next one
