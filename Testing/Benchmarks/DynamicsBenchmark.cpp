@@ -2,8 +2,11 @@
 // levels 0-3 (98, 386, 1538, 6146 control vertices): assembly of M, D, K; one
 // time step (force stiffness frozen, Integrator.h) with each linear solver,
 // including the factorization or preconditioner set-up, measured separately;
-// and time to equilibrium of a pure-spring problem (springs to a sphere around
-// the cube, attached once). Run: build/bin/DynamicsBenchmark
+// one Newton direction of the static scheme from a new solver (its matrix's
+// pattern, ordering and factorization: the springs to the nearest points with
+// their tangent-plane stiffness, StaticSolver.h); and time to equilibrium of a
+// pure-spring problem (springs to a sphere around the cube, attached once).
+// Run: build/bin/DynamicsBenchmark
 #include <benchmark/benchmark.h>
 
 #include "dynsub/CatmullClark.h"
@@ -12,6 +15,7 @@
 #include "dynsub/LimitSurface.h"
 #include "dynsub/PhysicalMatrices.h"
 #include "dynsub/Simulation.h"
+#include "dynsub/StaticSolver.h"
 #include "dynsub/StandardMeshes.h"
 #include "dynsub/Tessellation.h"
 
@@ -89,6 +93,29 @@ void BM_Step(benchmark::State& state) {
   state.counters["control_vertices"] = problem.mesh.vertexCount();
   state.counters["solver_iterations"] = integrator.lastIterations();
 }
+
+void BM_NewtonDirection(benchmark::State& state) {
+  const int level = static_cast<int>(state.range(0));
+  const ControlMesh mesh = cubeAtLevel(level);
+  const LimitSurface surface(mesh);
+  AssemblyOptions assembly;
+  assembly.elementSize = elementSize(level);
+  const PhysicalMatrices matrices = assemblePhysicalMatrices(surface, Material{}, assembly);
+  const Matrix3X points = mesh.points();
+  const Matrix3X targets = sphereTargets(surface, points);
+  SpringForceModel springs(targets, Eigen::VectorXd::Constant(targets.rows(), 100.0 * 96 / targets.rows()),
+                           SpringForceModel::Attach::NearestEachStep);
+  SurfaceQuadrature none;
+  springs.beginLevel(surface, none, points);
+  double potential = 0.0;
+  const Matrix3X residual = springs.generalizedForce(points, potential) - matrices.stiffness * points;
+  for (auto _ : state) {
+    StaticSolver solver(surface, matrices.stiffness, {});
+    benchmark::DoNotOptimize(solver.direction({&springs}, points, residual, false));
+  }
+  state.counters["control_vertices"] = mesh.vertexCount();
+}
+BENCHMARK(BM_NewtonDirection)->ArgName("level")->DenseRange(0, 3)->Unit(benchmark::kMillisecond);
 
 void BM_TimeToEquilibrium(benchmark::State& state) {
   const int level = static_cast<int>(state.range(0));
