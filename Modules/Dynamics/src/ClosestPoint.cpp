@@ -41,28 +41,28 @@ struct ClosestPointLocator::Impl {
   Eigen::Matrix<double, Eigen::Dynamic, 16> gridWeights;
   SparseMatrix specialOperator;
   std::vector<int> specialRow;  // per sample: its row of specialOperator, -1 on normal elements
-  SparseMatrix patchOperator;  // LimitSurface::patchOperator
-  std::vector<char> normal;    // per element
+  std::vector<char> normal;  // per element
   SampleCloud cloud;
   std::unique_ptr<Tree> tree;
   Matrix3X treeControlPoints;
   double drift = std::numeric_limits<double>::infinity();
   double sampleWeightBound = 0;  // max over samples of the sum of |weights|
   Matrix3X controlPoints;
-  Matrix3X grids;  // patchOperator * controlPoints
   // specialOperator * controlPoints.
   // NB: computed at every update: the checks for a nearer sample read the
   // special elements' samples many times over (tens of millions of sparse
   // rows on the kitten, 7 % of its fit).
   Matrix3X specialSamples;
-  std::unique_ptr<SurfaceState> state;  // the special elements' pieces at controlPoints
+  // The surface at controlPoints: the normal elements' grids (its
+  // patchOperator times them) and the special elements' pieces.
+  std::unique_ptr<SurfaceState> state;
 
   // Where sample i lies at the current control points.
   Vector3 sample(Eigen::Index i) const {
     const int row = specialRow[i];
     if (row >= 0) return specialSamples.row(row).transpose();
     const Eigen::Index element = i / perElement;
-    return (gridWeights.row(i % perElement) * grids.middleRows<16>(16 * element)).transpose();
+    return (gridWeights.row(i % perElement) * state->grids().middleRows<16>(16 * element)).transpose();
   }
 
   void updateTree() {
@@ -71,7 +71,7 @@ struct ClosestPointLocator::Impl {
     for (Eigen::Index e = 0; e < static_cast<Eigen::Index>(normal.size()); ++e) {
       auto block = cloud.points.middleRows(e * perElement, perElement);
       if (normal[e]) {
-        block.noalias() = gridWeights * grids.middleRows<16>(16 * e);
+        block.noalias() = gridWeights * state->grids().middleRows<16>(16 * e);
       } else {
         block = specialSamples.middleRows(specialRow[e * perElement], perElement);
       }
@@ -144,23 +144,11 @@ struct ClosestPointLocator::Impl {
            p.v >= 0.0 && p.v <= 1.0;
   }
 
-  // The limit surface at p: on a normal element from its grid of this state
-  // (a 6 x 16 by 16 x 3 product), on a special one from its subpatch's grid
-  // (SurfaceState).
-  LimitSample evaluate(const ElementPoint& p) const {
-    if (!normal[p.element]) return state->evaluate(p);
-    // NB: lazyProduct: Eigen sends the plain product to its blocked GEMM
-    // (a grid block of a dynamic matrix has a runtime stride), whose packing
-    // cost more than the 288 multiplications.
-    return limitSampleOf(bicubicBsplineWeights(p.u, p.v).lazyProduct(
-        grids.middleRows<16>(16 * static_cast<Eigen::Index>(p.element))));
-  }
-
   // Newton's method for min |s(u, v) - q|^2 on one element, from (u, v), kept in [0,1]^2.
   static constexpr double kShortStep = 1e-6;  // in element parameters
   ClosestPoint refine(ElementPoint p, const Vector3& q) const {
     if (!onSurface(p)) throw Error("internal: closest-point search started outside the surface");
-    LimitSample s = evaluate(p);
+    LimitSample s = state->evaluate(p);
     double best = (s.position - q).squaredNorm();
     for (int iteration = 0; iteration < 30; ++iteration) {
       const Vector3 r = s.position - q;
@@ -189,7 +177,7 @@ struct ClosestPointLocator::Impl {
       const int halvings = step.norm() < kShortStep ? 1 : 20;
       for (int halving = 0; halving < halvings; ++halving) {
         ElementPoint trial{p.element, std::clamp(p.u + step(0), 0.0, 1.0), std::clamp(p.v + step(1), 0.0, 1.0)};
-        const LimitSample t = evaluate(trial);
+        const LimitSample t = state->evaluate(trial);
         const double d = (t.position - q).squaredNorm();
         if (d <= best) {
           improved = (best - d) > 0.0 || std::abs(trial.u - p.u) + std::abs(trial.v - p.v) > 0.0;
@@ -228,7 +216,6 @@ ClosestPointLocator::ClosestPointLocator(const LimitSurface& surface, int sample
   impl_->gridWeights.resize(impl_->perElement, 16);
   for (int i = 0; i < impl_->perElement; ++i)
     impl_->gridWeights.row(i) = bicubicBsplineWeights(impl_->samples[i].u, impl_->samples[i].v).row(0);
-  impl_->patchOperator = surface.patchOperator();
   impl_->normal.resize(surface.elementCount());
   std::vector<ElementPoint> special;
   impl_->specialRow.assign(impl_->samples.size(), -1);
@@ -245,7 +232,8 @@ ClosestPointLocator::ClosestPointLocator(const LimitSurface& surface, int sample
   // move. On normal elements the bicubic weights are >= 0 and sum to 1, so
   // the grid rows' sums bound them.
   double bound = 0.0;
-  for (const SparseMatrix* m : {&impl_->specialOperator, &impl_->patchOperator})
+  const SparseMatrix* operators[] = {&impl_->specialOperator, &impl_->state->patchOperator()};
+  for (const SparseMatrix* m : operators)
     for (Eigen::Index r = 0; r < m->outerSize(); ++r) {
       double sum = 0.0;
       for (SparseMatrix::InnerIterator it(*m, r); it; ++it) sum += std::abs(it.value());
@@ -254,7 +242,7 @@ ClosestPointLocator::ClosestPointLocator(const LimitSurface& surface, int sample
   impl_->sampleWeightBound = bound;
 }
 
-const SparseMatrix& ClosestPointLocator::patchOperator() const { return impl_->patchOperator; }
+const SparseMatrix& ClosestPointLocator::patchOperator() const { return impl_->state->patchOperator(); }
 
 ClosestPointLocator::~ClosestPointLocator() = default;
 ClosestPointLocator::ClosestPointLocator(ClosestPointLocator&&) noexcept = default;
@@ -268,9 +256,8 @@ void ClosestPointLocator::update(const Matrix3X& controlPoints) {
   if (!controlPoints.allFinite()) throw Error("closest-point search got non-finite control points");
   Impl& s = *impl_;
   s.controlPoints = controlPoints;
-  s.grids = applyOperator(s.patchOperator, controlPoints);
-  applyOperator(s.specialOperator, controlPoints, s.specialSamples);
   s.state->reset(controlPoints);
+  applyOperator(s.specialOperator, controlPoints, s.specialSamples);
   if (s.tree) {
     // |sample move| <= sum |weights| * largest control-point move.
     const double moved = (controlPoints - s.treeControlPoints).rowwise().norm().maxCoeff();

@@ -11,6 +11,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "PatchRules.h"
+#include "dynsub/ApplyOperator.h"
 #include "dynsub/CatmullClark.h"
 #include "dynsub/ControlMesh.h"
 #include "dynsub/Error.h"
@@ -846,6 +847,8 @@ struct SurfaceState::Impl {
   static constexpr int kCachedLevels = 12;
   const LimitSurface* surface = nullptr;
   Matrix3X controlPoints;
+  SparseMatrix patchOperator;
+  Matrix3X grids;  // patchOperator * controlPoints
   // Per special element: the grid points of each subpatch a point has needed
   // at this state (slot 3 (level - 1) + child - 1; slot kSlots: the vertex
   // masks), each filled once under `mutex`. grids is sized once, on the
@@ -866,6 +869,7 @@ struct SurfaceState::Impl {
 
 SurfaceState::SurfaceState(const LimitSurface& surface) : impl_(std::make_unique<Impl>()) {
   impl_->surface = &surface;
+  impl_->patchOperator = surface.patchOperator();
   impl_->caches = std::make_unique<Impl::Cache[]>(surface.impl_->specials.size());
 }
 
@@ -874,10 +878,15 @@ SurfaceState::~SurfaceState() = default;
 void SurfaceState::reset(const Matrix3X& controlPoints) {
   checkPoints(controlPoints, impl_->surface->controlVertexCount());
   impl_->controlPoints = controlPoints;
+  impl_->grids = applyOperator(impl_->patchOperator, controlPoints);
   for (size_t i = 0; i < impl_->surface->impl_->specials.size(); ++i) {
     for (std::atomic<bool>& r : impl_->caches[i].ready) r.store(false, std::memory_order_relaxed);
   }
 }
+
+const SparseMatrix& SurfaceState::patchOperator() const { return impl_->patchOperator; }
+
+const Matrix3X& SurfaceState::grids() const { return impl_->grids; }
 
 LimitSample SurfaceState::evaluate(const ElementPoint& point) const {
   const LimitSurface::Impl& s = *impl_->surface->impl_;
@@ -885,7 +894,13 @@ LimitSample SurfaceState::evaluate(const ElementPoint& point) const {
   if (p.rows() != s.controlVertexCount) throw Error("internal: surface state used before reset()");
   s.checkPoint(point);
   const LimitSurface::Impl::Element& element = s.elements[point.element];
-  if (element.type == ElementType::Normal) return limitSampleOf(s.values(point, p));
+  if (element.type == ElementType::Normal) {
+    // NB: lazyProduct: Eigen sends the plain product to its blocked GEMM (a
+    // grid block of a dynamic matrix has a runtime stride), whose packing
+    // cost more than the 288 multiplications.
+    return limitSampleOf(bicubicBsplineWeights(point.u, point.v)
+                             .lazyProduct(impl_->grids.middleRows<16>(16 * static_cast<Eigen::Index>(point.element))));
+  }
   const LimitSurface::Impl::SubpatchPoint at = s.locateSubpatch(element, point, false);
   if (at.level == 0 || at.level > Impl::kCachedLevels) return limitSampleOf(s.values(point, p));
   LimitSurface::Impl::Special& special = *s.specials[element.special];

@@ -1,6 +1,5 @@
 #include "dynsub/Tessellation.h"
 
-#include "dynsub/ApplyOperator.h"
 #include "dynsub/Error.h"
 #include "dynsub/Topology.h"
 
@@ -37,22 +36,11 @@ TriangleSurface tessellate(const LimitSurface& surface, const Matrix3X& controlP
     return edgeBase + e * (n - 1) + fromFirst - 1;
   };
 
-  if (controlPoints.rows() != surface.controlVertexCount()) {
-    throw Error("got " + std::to_string(controlPoints.rows()) + " control points for a surface of " +
-                std::to_string(surface.controlVertexCount()) + " control vertices");
-  }
-  // NB: a normal element's 16 grid points are blended from the control
-  // points once (patchOperator), not at each of its (n + 1)^2 samples, and a
-  // special element's subpatches once per subpatch (SurfaceState); equal to
-  // LimitSurface::evaluate to rounding, at a fraction of its cost.
-  const Matrix3X grids = applyOperator(surface.patchOperator(), controlPoints);
+  // NB: an element's (or subpatch's) 16 grid points are blended from the
+  // control points once (SurfaceState), not at each of its (n + 1)^2
+  // samples; equal to LimitSurface::evaluate to rounding.
   SurfaceState state(surface);
-  state.reset(controlPoints);
-  const auto evaluate = [&](const ElementPoint& point) {
-    if (surface.elementType(point.element) != ElementType::Normal) return state.evaluate(point);
-    return limitSampleOf(bicubicBsplineWeights(point.u, point.v)
-                             .lazyProduct(grids.middleRows<16>(16 * static_cast<Eigen::Index>(point.element))));
-  };
+  state.reset(controlPoints);  // checks the control points' count
 
   TriangleSurface result;
   result.points.setZero(sampleCount, 3);
@@ -64,7 +52,8 @@ TriangleSurface tessellate(const LimitSurface& surface, const Matrix3X& controlP
         const int id = sampleId(f, i, j);
         if (done[id]) continue;
         done[id] = 1;
-        const LimitSample sample = evaluate(ElementPoint{f, static_cast<double>(i) / n, static_cast<double>(j) / n});
+        const LimitSample sample =
+            state.evaluate(ElementPoint{f, static_cast<double>(i) / n, static_cast<double>(j) / n});
         result.points.row(id) = sample.position.transpose();
         result.normals.row(id) = sample.normal.transpose();
       }

@@ -195,12 +195,13 @@ class LimitSurface {
 };
 
 // The limit surface at one state of its control points, for many evaluations
-// at that state (the Newton iterations of closest-point searches). On a
-// special element LimitSurface::evaluate multiplies the subpatch's 16 by m
-// grid by the m control points at every call; here each subpatch's 16 grid
-// points are computed the first time a point needs them and kept until the
-// next reset(), so a point costs one bicubic evaluation down to 12 levels
-// from an extraordinary vertex (deeper points, and normal elements, take
+// at that state (the Newton iterations of closest-point searches, a
+// tessellation). LimitSurface::evaluate multiplies an element's (or
+// subpatch's) 16 by m grid by the m control points at every call; here the
+// normal elements' grid points are computed for all at reset() (grids()),
+// and each special subpatch's the first time a point needs them, kept until
+// the next reset(). So a point costs one bicubic evaluation, down to 12
+// levels from an extraordinary vertex (deeper points take
 // LimitSurface::evaluate). Equal to it to rounding. evaluate() may be called
 // from several threads at once, reset() not.
 class SurfaceState {
@@ -209,6 +210,11 @@ class SurfaceState {
   ~SurfaceState();
   void reset(const Matrix3X& controlPoints);
   LimitSample evaluate(const ElementPoint& point) const;
+  // The surface's patchOperator(), built once, and patchOperator() times the
+  // control points of the last reset(): rows 16 e .. 16 e + 15 are normal
+  // element e's grid points.
+  const SparseMatrix& patchOperator() const;
+  const Matrix3X& grids() const;
 
   struct Impl;
 
