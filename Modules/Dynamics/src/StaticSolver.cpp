@@ -267,8 +267,7 @@ Matrix3X toPoints(const Eigen::VectorXd& x, size_t vertices) {
 }  // namespace
 
 struct StaticSolver::Impl {
-  SymmetricMatrix stiffness;
-  TangentStiffness tangent;
+  TangentStiffness tangent;  // K from construction on; a direction adds the forces' stiffness
   std::vector<bool> fixed;
   SparseCholesky factor;
   bool analysed = false;
@@ -318,7 +317,7 @@ struct StaticSolver::Impl {
   static constexpr double kReuseTolerance = 1e-3;
   static constexpr int kReuseIterations = 20;
 
-  Impl(const LimitSurface& surface, const SymmetricMatrix& k) : stiffness(k), tangent(surface) { tangent.reset(k); }
+  Impl(const LimitSurface& surface, const SymmetricMatrix& k) : tangent(surface) { tangent.reset(k); }
 };
 
 StaticSolver::StaticSolver(const LimitSurface& surface, const SymmetricMatrix& stiffness,
