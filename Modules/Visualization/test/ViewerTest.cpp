@@ -288,7 +288,10 @@ TEST_F(ViewerTest, TheCaudateFitsLiveOnTheRealMri) {
   play(viewer, {mouse("LeftButtonPressEvent", coronal.displayPosition(edge)),
                 mouse("LeftButtonReleaseEvent", coronal.displayPosition(edge))});
   ASSERT_EQ(viewer.landmarks().size(), before + 1) << "the click placed no landmark";
-  EXPECT_TRUE(viewer.fitting()) << "adding a landmark after the fit did not refit";
+  // The refit runs on the worker and takes tens of ms, so on a loaded
+  // machine it may be over before this line: running, or already reported.
+  EXPECT_TRUE(viewer.fitting() || viewer.status().find("refit done") != std::string::npos)
+      << "adding a landmark after the fit did not refit: " << viewer.status();
   ASSERT_TRUE(viewer.waitForFit(300.0)) << viewer.status();
   EXPECT_NE(viewer.status().find("refit done: 386 control vertices"), std::string::npos) << viewer.status();
   std::cout << "after one more landmark: " << viewer.status() << '\n';
