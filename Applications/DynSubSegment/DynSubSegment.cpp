@@ -18,7 +18,6 @@
 #include <CLI/CLI.hpp>
 
 #include "ExecutionModel.h"
-#include "Reporting.h"
 #include "SegmentRun.h"
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/TemporaryFileGuard.h"
@@ -54,7 +53,7 @@ slicer::Module describe(Arguments& a) {
   m.version = DYNSUB_VERSION;
   m.license = "See the DynSub source tree";
   m.contributor = "DynSub developers";
-  m.acknowledgements = "Built on ITK, VTK, Eigen and OpenMesh.";
+  m.acknowledgements = "Built on ITK, VTK and Eigen.";
 
   slicer::ParameterGroup io{"Input and output", "The volume, the points, and what is written.", false, {}};
   io.parameters.push_back({"image", "type=\"scalar\"", "inputVolume", "", "Input volume",
@@ -236,15 +235,14 @@ void run(Arguments a) {
     writeMask(run.result.labelmap, outputs.back()->temporaryPath(), static_cast<std::uint8_t>(a.labelValue));
   }
   if (!a.model.empty()) {
-    const TriangleSurface triangles = app::outputSurface(run.result.mesh);
     std::vector<PointScalars> scalars;
     if (run.result.surfaceEdgeDistances.size()) scalars.push_back({"edge_distance_mm", run.result.surfaceEdgeDistances});
     outputs.push_back(std::make_unique<AtomicOutput>(a.model));
-    writeTriangleSurface(triangles, outputs.back()->temporaryPath(), scalars, "LPS");
+    writeTriangleSurface(run.result.surface, outputs.back()->temporaryPath(), scalars, "LPS");
   }
   if (!a.report.empty()) {
     outputs.push_back(std::make_unique<AtomicOutput>(a.report));
-    app::writeJson(run.report, outputs.back()->temporaryPath());
+    run.report.write(outputs.back()->temporaryPath());
   }
   for (auto& output : outputs) output->commit();
 

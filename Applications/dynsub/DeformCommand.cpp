@@ -5,16 +5,14 @@
 #include <iostream>
 
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
+#include "CommandLine.h"
 #include "Commands.h"
-#include "Reporting.h"
 #include "dynsub/Error.h"
 #include "dynsub/ForceModel.h"
-#include "dynsub/SpringFile.h"
 #include "dynsub/MeshIO.h"
-#include "dynsub/Topology.h"
-#include "dynsub/CatmullClark.h"
+#include "dynsub/ModelOutputs.h"
+#include "dynsub/SpringFile.h"
 
 namespace dynsub::app {
 
@@ -38,7 +36,7 @@ void runDeform(DeformOptions o) {
 
   std::vector<int> fixed;
   if (o.fixBoundary) {
-    const Topology topology = topologyOf(mesh);
+    const Topology& topology = mesh.topology();
     for (int v = 0; v < mesh.vertexCount(); ++v) {
       if (topology.isBoundaryVertex(v)) fixed.push_back(v);
     }
@@ -53,27 +51,27 @@ void runDeform(DeformOptions o) {
   double seconds = 0.0;
   for (const LevelSummary& l : result.levels) seconds += l.seconds;
 
-  nlohmann::ordered_json report;
-  report["input"] = o.mesh;
-  report["springs_file"] = o.springs;
-  report["springs"] = springs.targets.rows();
-  report["fixed_control_vertices"] = fixed.size();
-  report["control_vertices"] = result.mesh.vertexCount();
-  report["levels"] = result.levels.back().level;
-  report["iterations"] = result.steps;
-  report["equilibrium"] = result.levels.back().converged;
-  report["max_spring_length_mm"] = lengths.size() ? lengths.maxCoeff() : 0.0;
-  report["mean_spring_length_mm"] = lengths.size() ? lengths.mean() : 0.0;
-  report["seconds"] = seconds;
-  nlohmann::ordered_json levels = nlohmann::ordered_json::array();
-  for (const LevelSummary& l : result.levels) levels.push_back(levelJson(l, -1, -1));
-  report["per_level"] = levels;
-  nlohmann::ordered_json parameters = simulationJson(options);
-  parameters["default_spring_stiffness"] = o.stiffness;
-  parameters["fix_boundary"] = o.fixBoundary;
-  report["parameters"] = parameters;
+  Report report;
+  report.set("input", o.mesh);
+  report.set("springs_file", o.springs);
+  report.set("springs", springs.targets.rows());
+  report.set("fixed_control_vertices", fixed.size());
+  report.set("control_vertices", result.mesh.vertexCount());
+  report.set("levels", result.levels.back().level);
+  report.set("iterations", result.steps);
+  report.set("equilibrium", result.levels.back().converged);
+  report.set("max_spring_length_mm", lengths.size() ? lengths.maxCoeff() : 0.0);
+  report.set("mean_spring_length_mm", lengths.size() ? lengths.mean() : 0.0);
+  report.set("seconds", seconds);
+  std::vector<Report> levels;
+  for (const LevelSummary& l : result.levels) levels.push_back(levelReport(l, -1, -1));
+  report.set("per_level", levels);
+  Report parameters = simulationReport(options);
+  parameters.set("default_spring_stiffness", o.stiffness);
+  parameters.set("fix_boundary", o.fixBoundary);
+  report.set("parameters", parameters);
 
-  writeModelOutputs(dir, result.mesh, report);
+  writeModelOutputs(dir, result.mesh, outputSurface(result.mesh), report);
   std::cout << std::fixed << std::setprecision(3) << "deformed " << o.mesh << " with " << springs.targets.rows()
             << " springs: " << (result.levels.back().converged ? "equilibrium" : "step limit reached") << " after "
             << result.steps << " steps, " << std::setprecision(2) << seconds << " s; largest spring length "

@@ -13,13 +13,13 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
 #include "Commands.h"
-#include "Reporting.h"
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
 #include "dynsub/Evaluation.h"
+#include "dynsub/OutputSet.h"
+#include "dynsub/Report.h"
 
 namespace dynsub::app {
 
@@ -112,20 +112,31 @@ void writeSummaryCsv(const std::vector<Group>& groups, const std::string& path) 
   if (!out) throw writeFailure(path);
 }
 
-nlohmann::ordered_json summaryJson(const std::vector<Group>& groups, const std::vector<EvaluationRun>& runs,
-                                   const std::string& plan, double seconds) {
-  nlohmann::ordered_json j;
-  j["plan"] = plan;
-  j["runs"] = runs.size();
-  j["wall_seconds"] = seconds;
-  nlohmann::ordered_json list = nlohmann::ordered_json::array();
-  for (const Group& g : groups)
-    list.push_back({{"split", g.split}, {"image", g.image}, {"structure", g.structure}, {"protocol", g.protocol},
-                    {"runs", g.runs}, {"mean_dice", g.meanDice}, {"worst_dice", g.worstDice},
-                    {"mean_leak_percent", g.meanLeakPercent}, {"mean_miss_percent", g.meanMissPercent},
-                    {"collapses", g.collapses}, {"failures", g.failures}, {"mean_seconds", g.meanSeconds}});
-  j["groups"] = list;
-  return j;
+Report summaryReport(const std::vector<Group>& groups, const std::vector<EvaluationRun>& runs,
+                     const std::string& plan, double seconds) {
+  Report summary;
+  summary.set("plan", plan);
+  summary.set("runs", runs.size());
+  summary.set("wall_seconds", seconds);
+  std::vector<Report> list;
+  for (const Group& g : groups) {
+    Report r;
+    r.set("split", g.split);
+    r.set("image", g.image);
+    r.set("structure", g.structure);
+    r.set("protocol", g.protocol);
+    r.set("runs", g.runs);
+    r.set("mean_dice", g.meanDice);
+    r.set("worst_dice", g.worstDice);
+    r.set("mean_leak_percent", g.meanLeakPercent);
+    r.set("mean_miss_percent", g.meanMissPercent);
+    r.set("collapses", g.collapses);
+    r.set("failures", g.failures);
+    r.set("mean_seconds", g.meanSeconds);
+    list.push_back(r);
+  }
+  summary.set("groups", list);
+  return summary;
 }
 
 std::string xmlText(const std::string& text) {
@@ -227,7 +238,7 @@ void runEvaluate(const EvaluateCommandOptions& o) {
   OutputSet outputs(dir);
   writeRunsCsv(runs, outputs.add("runs.csv"));
   writeSummaryCsv(groups, outputs.add("summary.csv"));
-  writeJson(summaryJson(groups, runs, o.plan, seconds), outputs.add("summary.json"));
+  summaryReport(groups, runs, o.plan, seconds).write(outputs.add("summary.json"));
   std::vector<std::string> splits;
   for (const EvaluationRun& r : runs)
     if (std::find(splits.begin(), splits.end(), r.split) == splits.end()) splits.push_back(r.split);

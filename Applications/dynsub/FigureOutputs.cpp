@@ -1,37 +1,13 @@
 #include "FigureOutputs.h"
 
-#include <cmath>
 #include <iostream>
-#include <memory>
 
 #include <CLI/CLI.hpp>
-#include <vtkPolyData.h>
-#include <vtkRenderWindow.h>
 
-#include "Reporting.h"
 #include "dynsub/Figures.h"
-#include "dynsub/LimitSurface.h"
-#include "dynsub/SlicePlanes.h"
-#include "dynsub/SurfacePolyData.h"
-#include "dynsub/SurfaceView.h"
-#include "dynsub/Tessellation.h"
+#include "dynsub/OutputSet.h"
 
 namespace dynsub::app {
-
-ConvergenceRecorder::ConvergenceRecorder(std::string fitErrorName, FitError fitError, int stride)
-    : fitError_(std::move(fitError)), stride_(stride) {
-  history_.fitErrorName = std::move(fitErrorName);
-}
-
-ProgressCallback ConvergenceRecorder::callback(ProgressCallback next) {
-  return [this, next](const Progress& p) {
-    ConvergenceSample sample{p.level, p.step, p.energy, std::nan("")};
-    if (fitError_ && p.surface && p.controlPoints && (p.step == 1 || p.step % stride_ == 0))
-      sample.fitError = fitError_(p);
-    history_.add(sample);
-    if (next) next(p);
-  };
-}
 
 void FigureOptions::addOptions(CLI::App& command) {
   command.add_flag("!--no-figures", figures,
@@ -40,8 +16,8 @@ void FigureOptions::addOptions(CLI::App& command) {
 }
 
 void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const ControlMesh& mesh,
-                      const ConvergenceHistory& history, const Volume* image, const Matrix3X& landmarks,
-                      const Matrix3X& dataPoints) {
+                      const TriangleSurface& surface, const ConvergenceHistory& history, const Volume* image,
+                      const Matrix3X& landmarks, const Matrix3X& dataPoints) {
   writeConvergenceCsv(history, outputs.add("convergence.csv"));
   if (!options.figures) return;
   std::string why;
@@ -49,25 +25,19 @@ void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const Co
     std::cerr << "warning: no figures written: " << why << '\n';
     return;
   }
-  const vtkSmartPointer<vtkPolyData> surface = toPolyData(tessellate(LimitSurface(mesh), mesh.points(), 8));
-  std::unique_ptr<ImageSlices> slices;
-  vtkSmartPointer<vtkPolyData> wireframe;
-  FigureScene scene;
-  scene.surface = surface;
-  scene.landmarks = landmarks;
-  scene.dataPoints = dataPoints;
-  if (image) {
-    slices = std::make_unique<ImageSlices>(*image);
-    scene.image = slices.get();
-  }
-  writePng(slicesFigure(scene), outputs.add("slices.png"));
+  FigureInputs inputs;
+  inputs.surface = &surface;
+  inputs.image = image;
   // Without an image the control mesh shows what the surface is made of.
-  if (!image) {
-    wireframe = controlMeshWireframe(mesh);
-    scene.controlMesh = wireframe;
-  }
-  writePng(surfaceFigure(scene), outputs.add("surface3d.png"));
-  writePng(convergenceFigure(history), outputs.add("convergence.png"));
+  if (!image) inputs.controlMesh = &mesh;
+  inputs.landmarks = landmarks;
+  inputs.dataPoints = dataPoints;
+  inputs.history = &history;
+  FigureFiles files;
+  files.slices = outputs.add("slices.png");
+  files.surface3d = outputs.add("surface3d.png");
+  files.convergence = outputs.add("convergence.png");
+  writeFigures(inputs, files);
 }
 
 }  // namespace dynsub::app

@@ -4,15 +4,15 @@
 #include <iostream>
 
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
+#include "CommandLine.h"
 #include "Commands.h"
 #include "FigureOutputs.h"
-#include "Reporting.h"
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/EnclosingSphere.h"
 #include "dynsub/Error.h"
 #include "dynsub/MeshIO.h"
+#include "dynsub/ModelOutputs.h"
 #include "dynsub/PointCloudIO.h"
 #include "dynsub/ShapeRecovery.h"
 
@@ -79,35 +79,36 @@ void runFit(FitCommandOptions o) {
   const FitResult result = fitPointCloud(data, initial, o.fit, recorder.callback(line.callback()));
   line.finish();
 
-  nlohmann::ordered_json report;
-  report["input"] = o.points;
-  report["points"] = data.rows();
-  report["max_error_percent"] = result.error.maxPercent;
-  report["rms_error_percent"] = result.error.rmsPercent;
-  report["tolerance_percent"] = o.fit.tolerancePercent;
-  report["converged"] = result.error.maxPercent <= o.fit.tolerancePercent;
-  report["enclosing_sphere"] = {{"center_mm", {result.enclosingSphere.center(0), result.enclosingSphere.center(1),
-                                                result.enclosingSphere.center(2)}},
-                                {"diameter_mm", 2.0 * result.enclosingSphere.radius},
-                                {"method", "smallest enclosing sphere (Welzl's algorithm, exact)"}};
-  report["control_vertices"] = result.mesh.vertexCount();
-  report["control_faces"] = result.mesh.faceCount();
-  report["genus"] = result.mesh.genus();
-  report["levels"] = result.levels.back().level;
-  report["iterations"] = result.steps;
-  report["seconds"] = result.seconds;
-  nlohmann::ordered_json levels = nlohmann::ordered_json::array();
-  for (size_t i = 0; i < result.levels.size(); ++i) {
-    levels.push_back(levelJson(result.levels[i], result.levelErrors[i].maxPercent, result.levelErrors[i].rmsPercent));
-  }
-  report["per_level"] = levels;
-  nlohmann::ordered_json parameters = simulationJson(o.fit.simulation);
-  parameters["init"] = o.init;
-  parameters["data_stiffness"] = o.fit.dataStiffness;
-  report["parameters"] = parameters;
+  Report report;
+  report.set("input", o.points);
+  report.set("points", data.rows());
+  report.set("max_error_percent", result.error.maxPercent);
+  report.set("rms_error_percent", result.error.rmsPercent);
+  report.set("tolerance_percent", o.fit.tolerancePercent);
+  report.set("converged", result.error.maxPercent <= o.fit.tolerancePercent);
+  Report sphere;
+  sphere.set("center_mm", result.enclosingSphere.center);
+  sphere.set("diameter_mm", 2.0 * result.enclosingSphere.radius);
+  sphere.set("method", "smallest enclosing sphere (Welzl's algorithm, exact)");
+  report.set("enclosing_sphere", sphere);
+  report.set("control_vertices", result.mesh.vertexCount());
+  report.set("control_faces", result.mesh.faceCount());
+  report.set("genus", result.mesh.genus());
+  report.set("levels", result.levels.back().level);
+  report.set("iterations", result.steps);
+  report.set("seconds", result.seconds);
+  std::vector<Report> levels;
+  for (size_t i = 0; i < result.levels.size(); ++i)
+    levels.push_back(levelReport(result.levels[i], result.levelErrors[i].maxPercent, result.levelErrors[i].rmsPercent));
+  report.set("per_level", levels);
+  Report parameters = simulationReport(o.fit.simulation);
+  parameters.set("init", o.init);
+  parameters.set("data_stiffness", o.fit.dataStiffness);
+  report.set("parameters", parameters);
 
-  writeModelOutputs(dir, result.mesh, report, [&](OutputSet& outputs) {
-    addFigureOutputs(outputs, o.figures, result.mesh, recorder.history(), nullptr, Matrix3X(), data);
+  const TriangleSurface surface = outputSurface(result.mesh);
+  writeModelOutputs(dir, result.mesh, surface, report, [&](OutputSet& outputs) {
+    addFigureOutputs(outputs, o.figures, result.mesh, surface, recorder.history(), nullptr, Matrix3X(), data);
   });
 
   std::cout << std::fixed << std::setprecision(3) << "fitted " << data.rows() << " points with "

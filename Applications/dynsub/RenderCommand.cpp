@@ -4,20 +4,15 @@
 #include <memory>
 
 #include <CLI/CLI.hpp>
-#include <vtkPolyData.h>
-#include <vtkRenderWindow.h>
 
 #include "Commands.h"
-#include "Reporting.h"
 #include "dynsub/Error.h"
 #include "dynsub/Figures.h"
 #include "dynsub/ImageIO.h"
 #include "dynsub/Landmarks.h"
 #include "dynsub/MeshIO.h"
+#include "dynsub/OutputSet.h"
 #include "dynsub/PointCloudIO.h"
-#include "dynsub/SlicePlanes.h"
-#include "dynsub/SurfacePolyData.h"
-#include "dynsub/SurfaceView.h"
 
 namespace dynsub::app {
 
@@ -30,31 +25,36 @@ struct RenderCommandOptions {
 void runRender(const RenderCommandOptions& o) {
   std::string why;
   if (!figureDisplay(&why)) throw Error("rendering needs an X display: " + why);
-  // Every input is read and checked before anything is written.
-  const vtkSmartPointer<vtkPolyData> surface = readSurfacePolyData(o.surface);
-  FigureScene scene;
-  scene.surface = surface;
-  std::unique_ptr<ImageSlices> image;
+  // Every input is read and checked before anything is written (the surface
+  // file when the figures are drawn: a bad one leaves nothing behind).
+  FigureInputs inputs;
+  inputs.surfaceFile = o.surface;
+  std::unique_ptr<Volume> image;
   if (!o.image.empty()) {
-    image = std::make_unique<ImageSlices>(readVolume(o.image));
-    scene.image = image.get();
+    image = std::make_unique<Volume>(readVolume(o.image));
+    inputs.image = image.get();
   }
-  if (!o.landmarks.empty()) scene.landmarks = landmarkPositions(readLandmarks(o.landmarks));
-  if (!o.points.empty()) scene.dataPoints = readPointCloud(o.points);
-  vtkSmartPointer<vtkPolyData> wireframe;
+  if (!o.landmarks.empty()) inputs.landmarks = landmarkPositions(readLandmarks(o.landmarks));
+  if (!o.points.empty()) inputs.dataPoints = readPointCloud(o.points);
+  std::unique_ptr<ControlMesh> controlMesh;
   if (!o.controlMesh.empty()) {
-    wireframe = controlMeshWireframe(readControlMesh(o.controlMesh));
-    scene.controlMesh = wireframe;
+    controlMesh = std::make_unique<ControlMesh>(readControlMesh(o.controlMesh));
+    inputs.controlMesh = controlMesh.get();
   }
   ConvergenceHistory history;
-  if (!o.convergence.empty()) history = readConvergenceCsv(o.convergence);
+  if (!o.convergence.empty()) {
+    history = readConvergenceCsv(o.convergence);
+    inputs.history = &history;
+  }
 
   const std::filesystem::path dir(o.out);
   prepareOutputDirectory(dir);
   OutputSet outputs(dir);
-  writePng(slicesFigure(scene), outputs.add("slices.png"));
-  writePng(surfaceFigure(scene), outputs.add("surface3d.png"));
-  if (!o.convergence.empty()) writePng(convergenceFigure(history), outputs.add("convergence.png"));
+  FigureFiles files;
+  files.slices = outputs.add("slices.png");
+  files.surface3d = outputs.add("surface3d.png");
+  if (!o.convergence.empty()) files.convergence = outputs.add("convergence.png");
+  writeFigures(inputs, files);
   outputs.commit();
   std::cout << "wrote " << (dir / "slices.png").string() << ", surface3d.png"
             << (o.convergence.empty() ? "" : ", convergence.png") << '\n';

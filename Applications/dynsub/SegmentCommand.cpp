@@ -7,15 +7,15 @@
 #include <sstream>
 
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
+#include "CommandLine.h"
 #include "Commands.h"
 #include "FigureOutputs.h"
-#include "Reporting.h"
 #include "SegmentRun.h"
 #include "dynsub/Error.h"
 #include "dynsub/ImageIO.h"
 #include "dynsub/Metrics.h"
+#include "dynsub/ModelOutputs.h"
 #include "dynsub/SeedGrowth.h"
 #include "dynsub/Segmentation.h"
 
@@ -97,11 +97,11 @@ void runSegment(SegmentCommandOptions o) {
   const std::vector<std::string>& warnings = run.warnings;
 
   writeModelOutputs(
-      dir, result.mesh, run.report,
+      dir, result.mesh, result.surface, run.report,
       [&](OutputSet& outputs) {
         writeMask(result.labelmap, outputs.add("labelmap.nii.gz"));
-        addFigureOutputs(outputs, o.figures, result.mesh, run.history, &image, landmarkPositions(run.springs),
-                         Matrix3X());
+        addFigureOutputs(outputs, o.figures, result.mesh, result.surface, run.history, &image,
+                         landmarkPositions(run.springs), Matrix3X());
       },
       result.surfaceEdgeDistances.size()
           ? std::vector<PointScalars>{{"edge_distance_mm", result.surfaceEdgeDistances}}

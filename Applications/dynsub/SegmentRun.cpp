@@ -4,11 +4,10 @@
 #include <cmath>
 #include <sstream>
 
-#include "FigureOutputs.h"
-#include "Reporting.h"
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/Error.h"
 #include "dynsub/MeshIO.h"
+#include "dynsub/ModelOutputs.h"
 
 namespace dynsub::app {
 
@@ -28,15 +27,17 @@ std::vector<double> numbersAfter(const std::string& value, std::size_t prefix, i
   return v;
 }
 
-nlohmann::ordered_json metricsJson(const OverlapMetrics& m) {
-  return {{"dice", m.dice},
-          {"jaccard", m.jaccard},
-          {"volume_difference_percent", m.volumeDifferencePercent},
-          {"mean_surface_distance_mm", m.meanSurfaceDistance},
-          {"hd95_mm", m.hd95},
-          {"hausdorff_mm", m.hausdorff},
-          {"volume_mm3", m.volumeA},
-          {"reference_volume_mm3", m.volumeB}};
+Report metricsReport(const OverlapMetrics& m) {
+  Report r;
+  r.set("dice", m.dice);
+  r.set("jaccard", m.jaccard);
+  r.set("volume_difference_percent", m.volumeDifferencePercent);
+  r.set("mean_surface_distance_mm", m.meanSurfaceDistance);
+  r.set("hd95_mm", m.hd95);
+  r.set("hausdorff_mm", m.hausdorff);
+  r.set("volume_mm3", m.volumeA);
+  r.set("reference_volume_mm3", m.volumeB);
+  return r;
 }
 
 const char* referenceName(EdgeReference reference) {
@@ -127,101 +128,113 @@ SegmentRun runSegmentation(const Volume& image, SegmentInputs in, const Progress
   run.history = recorder.history();
   const SegmentResult& result = run.result;
 
-  nlohmann::ordered_json& report = run.report;
-  report["image"] = in.image;
-  report["landmarks"] = in.landmarkSource;
-  report["landmark_count"] = in.landmarks.size();
-  report["init"] = in.init.text;
+  Report& report = run.report;
+  report.set("image", in.image);
+  report.set("landmarks", in.landmarkSource);
+  report.set("landmark_count", in.landmarks.size());
+  report.set("init", in.init.text);
   if (const SeedRegion* seed = run.seed.get()) {
-    report["seed"] = {{"position_lps_mm", {seed->click.x(), seed->click.y(), seed->click.z()}},
-                      {"median", seed->median},
-                      {"spread", seed->spread},
-                      {"intensity_window", {seed->low, seed->high}},
-                      {"window_spreads", seed->window},
-                      {"opening_mm", seed->opening},
-                      {"region_volume_mm3", seed->mask.count() * seed->mask.geometry.spacing.prod()},
-                      {"boundary_points", seed->boundary.size()},
-                      {"springs", in.landmarks.empty() ? "boundary points" : "landmarks"},
-                      {"leaked", seed->touchesReach}};
+    Report r;
+    r.set("position_lps_mm", seed->click);
+    r.set("median", seed->median);
+    r.set("spread", seed->spread);
+    r.set("intensity_window", std::vector<double>{seed->low, seed->high});
+    r.set("window_spreads", seed->window);
+    r.set("opening_mm", seed->opening);
+    r.set("region_volume_mm3", seed->mask.count() * seed->mask.geometry.spacing.prod());
+    r.set("boundary_points", seed->boundary.size());
+    r.set("springs", in.landmarks.empty() ? "boundary points" : "landmarks");
+    r.set("leaked", seed->touchesReach);
+    report.set("seed", r);
   }
   if (in.reference) {
     run.metrics = compareMasks(result.labelmap, *in.reference);
-    report["reference"] = in.referencePath;
-    report["reference_labels"] = in.referenceLabels;
-    const nlohmann::ordered_json measured = metricsJson(run.metrics);
-    for (const auto& [key, value] : measured.items()) report[key] = value;
+    report.set("reference", in.referencePath);
+    report.set("reference_labels", in.referenceLabels);
+    report.merge(metricsReport(run.metrics));
   } else {
-    report["volume_mm3"] = result.labelmap.count() * image.geometry.spacing.prod();
+    report.set("volume_mm3", result.labelmap.count() * image.geometry.spacing.prod());
   }
-  report["control_vertices"] = result.mesh.vertexCount();
-  report["levels"] = result.levels.back().level;
-  report["iterations"] = result.steps;
-  report["final_energy"] = result.levels.back().energy;
-  report["seconds"] = run.seconds;
-  report["stage_seconds"] = {{"crop", result.seconds.crop},
-                             {"edge_potential", result.seconds.potential},
-                             {"evolution", result.seconds.evolution},
-                             {"voxelize", result.seconds.voxelize}};
+  report.set("control_vertices", result.mesh.vertexCount());
+  report.set("levels", result.levels.back().level);
+  report.set("iterations", result.steps);
+  report.set("final_energy", result.levels.back().energy);
+  report.set("seconds", run.seconds);
+  Report stages;
+  stages.set("crop", result.seconds.crop);
+  stages.set("edge_potential", result.seconds.potential);
+  stages.set("evolution", result.seconds.evolution);
+  stages.set("voxelize", result.seconds.voxelize);
+  report.set("stage_seconds", stages);
   if (in.segment.sliceEnds.enabled) {
     const SliceEnds& ends = result.sliceEnds;
-    nlohmann::ordered_json marched = nlohmann::ordered_json::array(), springs = nlohmann::ordered_json::array();
-    for (const SliceEnd& end : ends.ends)
-      marched.push_back({{"from_lps_mm", {end.start.x(), end.start.y(), end.start.z()}},
-                         {"to_lps_mm", {end.end.x(), end.end.y(), end.end.z()}},
-                         {"length_mm", end.length},
-                         {"stopped_by_reach", end.stoppedByReach}});
-    for (const Landmark& spring : ends.springs)
-      springs.push_back({spring.position.x(), spring.position.y(), spring.position.z()});
-    report["slice_ends"] = {{"axis", ends.axis},
-                            {"slices", ends.slices},
-                            {"median", ends.median},
-                            {"spread", ends.spread},
-                            {"ends", marched},
-                            {"springs", ends.springs.size()},
-                            {"spring_points_lps_mm", springs}};
+    std::vector<Report> marched;
+    for (const SliceEnd& end : ends.ends) {
+      Report r;
+      r.set("from_lps_mm", end.start);
+      r.set("to_lps_mm", end.end);
+      r.set("length_mm", end.length);
+      r.set("stopped_by_reach", end.stoppedByReach);
+      marched.push_back(r);
+    }
+    std::vector<Vector3> springPoints;
+    for (const Landmark& spring : ends.springs) springPoints.push_back(spring.position);
+    Report r;
+    r.set("axis", ends.axis);
+    r.set("slices", ends.slices);
+    r.set("median", ends.median);
+    r.set("spread", ends.spread);
+    r.set("ends", marched);
+    r.set("springs", ends.springs.size());
+    r.set("spring_points_lps_mm", springPoints);
+    report.set("slice_ends", r);
   }
-  report["region_of_interest"] = {{"first_voxel", result.regionFirst}, {"size_voxels", result.regionSize}};
-  report["initial_volume_mm3"] = result.initialVolume;
-  report["surface_volume_mm3"] = result.volume;
-  report["surface_outside_region"] = result.outsideRegion;
-  if (std::isfinite(result.surfaceOnEdges)) report["surface_on_edges"] = result.surfaceOnEdges;
+  Report region;
+  region.set("first_voxel", result.regionFirst);
+  region.set("size_voxels", result.regionSize);
+  report.set("region_of_interest", region);
+  report.set("initial_volume_mm3", result.initialVolume);
+  report.set("surface_volume_mm3", result.volume);
+  report.set("surface_outside_region", result.outsideRegion);
+  if (std::isfinite(result.surfaceOnEdges)) report.set("surface_on_edges", result.surfaceOnEdges);
   run.warnings = result.warnings;
   if (run.seed) {
     const std::vector<std::string> seed = seedWarnings(*run.seed);
     run.warnings.insert(run.warnings.begin(), seed.begin(), seed.end());
   }
-  report["warnings"] = run.warnings;
-  nlohmann::ordered_json residuals = nlohmann::ordered_json::array();
+  report.set("warnings", run.warnings);
+  std::vector<Report> residuals;
   for (std::size_t i = 0; i < springs.size(); ++i) {
-    residuals.push_back({{"label", springs[i].label},
-                         {"position_lps_mm", {springs[i].position.x(), springs[i].position.y(),
-                                              springs[i].position.z()}},
-                         {"distance_mm", result.landmarkDistances[i]}});
+    Report r;
+    r.set("label", springs[i].label);
+    r.set("position_lps_mm", springs[i].position);
+    r.set("distance_mm", result.landmarkDistances[i]);
     if (i < result.landmarkEdgeDistances.size() && std::isfinite(result.landmarkEdgeDistances[i]))
-      residuals.back()["edge_distance_mm"] = result.landmarkEdgeDistances[i];
+      r.set("edge_distance_mm", result.landmarkEdgeDistances[i]);
+    residuals.push_back(r);
   }
-  report["landmark_residuals"] = residuals;
-  nlohmann::ordered_json levels = nlohmann::ordered_json::array();
-  for (const auto& level : result.levels) levels.push_back(levelJson(level, -1, -1));  // no fit error in segmentation
-  report["per_level"] = levels;
-  nlohmann::ordered_json parameters = simulationJson(in.segment.simulation);
-  parameters["potential"] = in.potential;
-  parameters["sigma_mm"] = in.segment.edges.sigma;
+  report.set("landmark_residuals", residuals);
+  std::vector<Report> levels;
+  for (const auto& level : result.levels) levels.push_back(levelReport(level, -1, -1));  // no fit error in segmentation
+  report.set("per_level", levels);
+  Report parameters = simulationReport(in.segment.simulation);
+  parameters.set("potential", in.potential);
+  parameters.set("sigma_mm", in.segment.edges.sigma);
   if (in.segment.edges.method == EdgeMethod::MongaDeriche) {
     const EdgeScale& scale = result.edgeScale;
-    parameters["edge_reference"] = referenceName(scale.reference);
-    parameters["edge_reference_magnitude"] = scale.magnitude;
-    parameters["edge_low"] = scale.fractions.low;
-    parameters["edge_high"] = scale.fractions.high;
+    parameters.set("edge_reference", referenceName(scale.reference));
+    parameters.set("edge_reference_magnitude", scale.magnitude);
+    parameters.set("edge_low", scale.fractions.low);
+    parameters.set("edge_high", scale.fractions.high);
   }
-  parameters["capture_range_mm"] = in.segment.edges.captureRange;
-  parameters["image_force"] = in.segment.imageForce;
-  parameters["landmark_stiffness"] = in.segment.landmarkStiffness;
-  parameters["landmark_dead_zone_mm"] = in.segment.landmarkDeadZone;
-  parameters["landmark_tolerance_mm"] = in.segment.landmarkTolerance;
-  parameters["inflation"] = in.segment.inflation;
-  parameters["margin_mm"] = in.segment.margin;
-  report["parameters"] = parameters;
+  parameters.set("capture_range_mm", in.segment.edges.captureRange);
+  parameters.set("image_force", in.segment.imageForce);
+  parameters.set("landmark_stiffness", in.segment.landmarkStiffness);
+  parameters.set("landmark_dead_zone_mm", in.segment.landmarkDeadZone);
+  parameters.set("landmark_tolerance_mm", in.segment.landmarkTolerance);
+  parameters.set("inflation", in.segment.inflation);
+  parameters.set("margin_mm", in.segment.margin);
+  report.set("parameters", parameters);
   return run;
 }
 

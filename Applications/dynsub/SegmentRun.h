@@ -7,11 +7,10 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "dynsub/ConvergenceHistory.h"
 #include "dynsub/Landmarks.h"
 #include "dynsub/Metrics.h"
+#include "dynsub/Report.h"
 #include "dynsub/SeedGrowth.h"
 #include "dynsub/Segmentation.h"
 
@@ -58,7 +57,7 @@ struct SegmentRun {
   ConvergenceHistory history;
   std::vector<std::string> warnings;  // the seed's and the segmentation's
   double seconds = 0;
-  nlohmann::ordered_json report;
+  Report report;
 };
 
 // Runs the segmentation; `progress` (may be empty) sees every step. Throws

@@ -5,14 +5,13 @@
 #include <iostream>
 
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
-#include <vtkRenderWindow.h>
 
 #include "Commands.h"
-#include "Reporting.h"
 #include "dynsub/Error.h"
 #include "dynsub/Figures.h"
 #include "dynsub/LatticeIO.h"
+#include "dynsub/OutputSet.h"
+#include "dynsub/Report.h"
 #include "dynsub/SculptScript.h"
 #include "dynsub/Sculptor.h"
 #include "dynsub/SolidSubdivision.h"
@@ -43,11 +42,13 @@ struct SculptOptions {
   bool figure = true;
 };
 
-nlohmann::ordered_json countsJson(const Lattice& lattice) {
-  return {{"points", lattice.pointCount()},
-          {"edges", lattice.edgeCount()},
-          {"faces", lattice.faceCount()},
-          {"cells", lattice.cellCount()}};
+Report countsReport(const Lattice& lattice) {
+  Report r;
+  r.set("points", lattice.pointCount());
+  r.set("edges", lattice.edgeCount());
+  r.set("faces", lattice.faceCount());
+  r.set("cells", lattice.cellCount());
+  return r;
 }
 
 // DIR/sculpted.lattice (the control lattice, to sculpt on later),
@@ -55,7 +56,7 @@ nlohmann::ordered_json countsJson(const Lattice& lattice) {
 // DIR/sculpted.png (SolidView's figure, with a display) and DIR/report.json,
 // all together or none. Returns what was written.
 std::string writeSculpture(const std::filesystem::path& dir, const Sculpture& sculpture, const SculptOptions& o,
-                           nlohmann::ordered_json report) {
+                           Report report) {
   prepareOutputDirectory(dir);
   OutputSet outputs(dir);
   const Lattice control = sculpture.control();
@@ -66,28 +67,30 @@ std::string writeSculpture(const std::filesystem::path& dir, const Sculpture& sc
   std::string figure;
   std::string why;
   if (o.figure && figureDisplay(&why)) {
-    writePng(sculptureFigure(sculpture), outputs.add("sculpted.png"));
+    writeSculptureFigure(sculpture, outputs.add("sculpted.png"));
     figure = ", sculpted.png";
   } else if (o.figure) {
     std::cerr << "warning: no figure written: " << why << '\n';
   }
   const SolidMaterial& m = sculpture.settings().material;
-  report["level"] = sculpture.settings().levels;
-  report["time_step_s"] = sculpture.settings().timeStep;
-  report["scheme"] = o.scheme;
-  report["material"] = {{"mass", m.mass},
-                        {"damping_n_s_per_mm", m.damping},
-                        {"spring_stiffness_n_per_mm", m.springStiffness},
-                        {"virtual_stiffness_n_per_mm", m.virtualStiffness},
-                        {"rope_stiffness_n_per_mm", sculpture.settings().ropeStiffness}};
-  report["steps"] = sculpture.steps();
-  report["simulated_seconds"] = sculpture.steps() * sculpture.settings().timeStep;
-  report["control"] = countsJson(control);
-  report["fixed_control_points"] = sculpture.model().fixedPoints().size();
-  report["solid"] = countsJson(solid);
-  report["kinetic_energy_n_mm"] = sculpture.model().kineticEnergy();
-  report["spring_energy_n_mm"] = sculpture.model().springEnergy();
-  writeJson(report, outputs.add("report.json"));
+  report.set("level", sculpture.settings().levels);
+  report.set("time_step_s", sculpture.settings().timeStep);
+  report.set("scheme", o.scheme);
+  Report material;
+  material.set("mass", m.mass);
+  material.set("damping_n_s_per_mm", m.damping);
+  material.set("spring_stiffness_n_per_mm", m.springStiffness);
+  material.set("virtual_stiffness_n_per_mm", m.virtualStiffness);
+  material.set("rope_stiffness_n_per_mm", sculpture.settings().ropeStiffness);
+  report.set("material", material);
+  report.set("steps", sculpture.steps());
+  report.set("simulated_seconds", sculpture.steps() * sculpture.settings().timeStep);
+  report.set("control", countsReport(control));
+  report.set("fixed_control_points", sculpture.model().fixedPoints().size());
+  report.set("solid", countsReport(solid));
+  report.set("kinetic_energy_n_mm", sculpture.model().kineticEnergy());
+  report.set("spring_energy_n_mm", sculpture.model().springEnergy());
+  report.write(outputs.add("report.json"));
   outputs.commit();
   return "saved sculpted.lattice, sculpted.vtu" + figure + ", report.json in " + dir.string();
 }
@@ -96,7 +99,8 @@ void runSculpt(const SculptOptions& options) {
   SculptOptions o = options;
   o.settings.scheme = o.scheme == "explicit" ? SolidScheme::PaperExplicit : SolidScheme::SemiImplicit;
   const Lattice lattice = readLattice(o.lattice);
-  nlohmann::ordered_json report = {{"lattice", o.lattice}};
+  Report report;
+  report.set("lattice", o.lattice);
   if (o.script.empty()) {
     // The window: s saves to --out.
     Sculptor sculptor(lattice, o.settings, [o, report](const Sculpture& s) {
@@ -116,9 +120,9 @@ void runSculpt(const SculptOptions& options) {
     std::cout << "line " << action.line << ": " << action.text << "  (t = " << sculpture.steps() * o.settings.timeStep
               << " s, " << sculpture.rest().cellCount() << " cells)\n";
   });
-  report["script"] = o.script;
-  report["actions"] = actions.size();
-  report["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report.set("script", o.script);
+  report.set("actions", actions.size());
+  report.set("seconds", std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   std::cout << writeSculpture(o.out, sculpture, o, report) << '\n';
 }
 
@@ -138,11 +142,7 @@ void addSolidCommand(CLI::App& app) {
   stats->add_option("--level", statsOptions->level, "Subdivisions")->default_val(0)->check(CLI::Range(0, 6));
   stats->callback([statsOptions] {
     const Lattice lattice = subdivideSolid(readLattice(statsOptions->lattice), statsOptions->level).lattice;
-    nlohmann::ordered_json counts = {{"points", lattice.pointCount()},
-                                     {"edges", lattice.edgeCount()},
-                                     {"faces", lattice.faceCount()},
-                                     {"cells", lattice.cellCount()}};
-    std::cout << counts.dump() << '\n';
+    std::cout << countsReport(lattice).text(-1);
   });
 
   CLI::App* subdivide = solid->add_subcommand(

@@ -3,12 +3,10 @@
 #include <iostream>
 
 #include <CLI/CLI.hpp>
-#include <vtkPolyData.h>
 
 #include "Commands.h"
 #include "dynsub/Error.h"
 #include "dynsub/ImageIO.h"
-#include "dynsub/SurfacePolyData.h"
 #include "dynsub/Viewer.h"
 
 namespace dynsub::app {
@@ -28,7 +26,7 @@ void runView(const ViewCommandOptions& o) {
     // A file that does not exist yet is where the new landmarks will be saved.
     if (std::filesystem::exists(o.landmarks)) input.landmarks = readLandmarks(o.landmarks);
   }
-  if (!o.surface.empty()) input.surface = readSurfacePolyData(o.surface);
+  input.surfacePath = o.surface;
   checkSegmentOptions(o.segment);
   input.segment = o.segment;
   Viewer viewer(std::move(input));

@@ -73,8 +73,7 @@ EvaluationRun runOne(const EvaluationPlan& plan, const Volume& image, const Mask
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
 
   // Scored on the reference's grid (see the header).
-  const LimitSurface surface(result.mesh);
-  const TriangleSurface triangles = tessellate(surface, result.mesh.points(), 8);
+  const TriangleSurface& triangles = result.surface;
   const ImageGeometry& grid = reference.geometry;
   const auto [first, size] = boundingRegion(grid, triangles.points, 2.0);
   const Mask part = voxelizeSurface(triangles.points, triangles.triangles, grid.region(first, size));

@@ -9,7 +9,8 @@ namespace {
 
 int countValence(const dynsub::ControlMesh& mesh, int valence) {
   int count = 0;
-  for (auto v : mesh.polyMesh().vertices()) count += static_cast<int>(mesh.polyMesh().valence(v)) == valence;
+  for (int v = 0; v < mesh.vertexCount(); ++v)
+    count += static_cast<int>(mesh.topology().vertexEdges(v).size()) == valence;
   return count;
 }
 

@@ -253,9 +253,9 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
   result.sliceEnds = std::move(ends);
 
   const auto clock = Clock::now();
-  const LimitSurface surface(result.mesh);
-  const TriangleSurface triangles = tessellate(surface, result.mesh.points(), 8);
-  if (!triangles.points.allFinite()) throw Error("the evolution produced a non-finite surface");
+  if (!result.mesh.points().allFinite()) throw Error("the evolution produced a non-finite surface");
+  result.surface = tessellate(LimitSurface(result.mesh), result.mesh.points(), kOutputSegments);
+  const TriangleSurface& triangles = result.surface;
   // Voxelize on the part of the grid the final surface covers (it may have left the region).
   const ImageGeometry& grid = image.geometry;
   const auto [outFirst, outSize] = boundingRegion(grid, triangles.points, 2.0);
@@ -263,7 +263,7 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
   result.labelmap = pasteMask(part, grid, outFirst);
   result.seconds.voxelize = secondsSince(clock);
 
-  result.initialVolume = enclosedVolume(tessellate(LimitSurface(initial), initial.points(), 8));
+  result.initialVolume = enclosedVolume(tessellate(LimitSurface(initial), initial.points(), kOutputSegments));
   result.volume = enclosedVolume(triangles);
   Eigen::Index outside = 0;
   for (Eigen::Index p = 0; p < triangles.points.rows(); ++p)

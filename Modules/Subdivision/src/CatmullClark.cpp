@@ -90,12 +90,10 @@ Refinement refine(const Topology& topology) {
   return result;
 }
 
-Topology topologyOf(const ControlMesh& mesh) { return Topology(mesh.vertexCount(), mesh.faces()); }
-
 SubdividedMesh subdivide(const ControlMesh& mesh) {
-  Refinement refinement = refine(topologyOf(mesh));
+  Refinement refinement = refine(mesh.topology());
   const Matrix3X points = refinement.subdivisionMatrix * mesh.points();
-  SubdividedMesh result{ControlMesh::fromPolygons(points, refinement.topology.faces(), "refined mesh"),
+  SubdividedMesh result{ControlMesh::fromTopology(points, std::move(refinement.topology), "refined mesh"),
                         std::move(refinement.subdivisionMatrix)};
   return result;
 }

@@ -600,7 +600,7 @@ struct LimitSurface::Impl {
 LimitSurface::LimitSurface(const ControlMesh& mesh) : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   s.controlVertexCount = mesh.vertexCount();
-  s.base = topologyOf(mesh);
+  s.base = mesh.topology();
   for (int f = 0; f < s.base.faceCount(); ++f) s.controlFaceSize.push_back(s.base.faceSize(f));
   s.parametricFaceOffset.push_back(0);
   for (int size : s.controlFaceSize) s.parametricFaceOffset.push_back(s.parametricFaceOffset.back() + (size == 4 ? 1 : size));

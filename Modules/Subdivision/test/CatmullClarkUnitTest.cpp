@@ -31,7 +31,7 @@ TEST(CatmullClark, InteriorRulesOnTheCube) {
   // Old vertices keep their numbers; a valence-3 corner (F + 2R + 0 V)/3 with
   // its three neighbours at distance 0.5 along the axes and faces around it.
   for (int v = 0; v < cube.vertexCount(); ++v) {
-    if (cube.polyMesh().valence(cube.polyMesh().vertex_handle(v)) != 3) continue;
+    if (cube.topology().vertexEdges(v).size() != 3) continue;
     const dynsub::Vector3 corner = before.row(v).transpose();
     // Face points: centres of the 3 corner quads; edge midpoints: 0.25 along each axis.
     const dynsub::Vector3 inward = -corner.cwiseSign();
@@ -65,7 +65,7 @@ TEST(CatmullClark, BoundaryRulesOnTheSheet) {
       0.125 * points.row(id(2, 0)) + 0.75 * points.row(id(3, 0)) + 0.125 * points.row(id(4, 0));
   EXPECT_LE((after.row(id(3, 0)) - expected).norm(), 1e-15);
   // Boundary edge point: the midpoint.
-  const dynsub::Topology topology = dynsub::topologyOf(sheet);
+  const dynsub::Topology topology = sheet.topology();
   const int edge = topology.findEdge(id(3, 0), id(4, 0));
   ASSERT_GE(edge, 0);
   EXPECT_TRUE(topology.isBoundaryEdge(edge));
@@ -76,7 +76,7 @@ TEST(CatmullClark, NgonsBecomeQuadsAroundTheirCentre) {
   dynsub::Matrix3X points(5, 3);
   points << 1, 0, 0, 0.3, 0.95, 0, -0.8, 0.6, 0, -0.8, -0.6, 0, 0.3, -0.95, 0;
   const dynsub::ControlMesh pentagon = dynsub::ControlMesh::fromPolygons(points, {{0, 1, 2, 3, 4}});
-  const dynsub::Refinement refinement = dynsub::refine(dynsub::topologyOf(pentagon));
+  const dynsub::Refinement refinement = dynsub::refine(pentagon.topology());
   EXPECT_EQ(refinement.topology.faceCount(), 5);
   const int centre = 5 + 5;  // after 5 vertex points and 5 edge points
   for (int f = 0; f < 5; ++f) {

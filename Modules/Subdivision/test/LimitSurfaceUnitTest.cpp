@@ -142,7 +142,7 @@ TEST_P(LimitSurfaceProperties, RefinementPreservesTheLimitSurface) {
   const dynsub::Matrix3X coarsePoints = mesh.points();
   const dynsub::Matrix3X finePoints = refined.mesh.points();
   const double tolerance = 1e-10 * diagonalOf(coarsePoints);
-  const dynsub::Topology topology = dynsub::topologyOf(mesh);
+  const dynsub::Topology topology = mesh.topology();
   int parametricFace = 0;
   int childOffset = 0;
   for (int f = 0; f < topology.faceCount(); ++f) {

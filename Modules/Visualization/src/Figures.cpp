@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <memory>
 
 #include <vtkChartXY.h>
 #include <vtkContextActor.h>
@@ -26,7 +27,9 @@
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/ConvergencePlot.h"
 #include "dynsub/Error.h"
+#include "dynsub/SlicePlanes.h"
 #include "dynsub/SliceView.h"
+#include "dynsub/SurfacePolyData.h"
 #include "dynsub/SurfaceView.h"
 
 namespace dynsub {
@@ -148,6 +151,31 @@ void writePng(vtkRenderWindow* window, const std::string& path) {
     throw writeFailure(path, std::string("VTK's PNG writer failed (") +
                                  vtkErrorCode::GetStringFromErrorCode(writer->GetErrorCode()) + ")");
   output.commit();
+}
+
+void writeFigures(const FigureInputs& inputs, const FigureFiles& files) {
+  const vtkSmartPointer<vtkPolyData> surface =
+      inputs.surface ? toPolyData(*inputs.surface) : readSurfacePolyData(inputs.surfaceFile);
+  FigureScene scene;
+  scene.surface = surface;
+  scene.landmarks = inputs.landmarks;
+  scene.dataPoints = inputs.dataPoints;
+  std::unique_ptr<ImageSlices> slices;
+  if (inputs.image) {
+    slices = std::make_unique<ImageSlices>(*inputs.image);
+    scene.image = slices.get();
+  }
+  vtkSmartPointer<vtkPolyData> wireframe;
+  if (inputs.controlMesh) {
+    wireframe = controlMeshWireframe(*inputs.controlMesh);
+    scene.controlMesh = wireframe;
+  }
+  if (!files.slices.empty()) writePng(slicesFigure(scene), files.slices);
+  if (!files.surface3d.empty()) writePng(surfaceFigure(scene), files.surface3d);
+  if (!files.convergence.empty()) {
+    if (!inputs.history) throw Error("internal: a convergence figure without a history");
+    writePng(convergenceFigure(*inputs.history), files.convergence);
+  }
 }
 
 bool displayAvailable(std::string* why) {

@@ -19,6 +19,7 @@
 #include <vtkUnsignedCharArray.h>
 
 #include "SceneStyle.h"
+#include "dynsub/Figures.h"
 #include "dynsub/Sculpting.h"
 
 namespace dynsub {
@@ -215,6 +216,10 @@ vtkSmartPointer<vtkRenderWindow> sculptureFigure(const Sculpture& sculpture) {
   view.resetCamera();
   window->AddRenderer(view.renderer());
   return window;
+}
+
+void writeSculptureFigure(const Sculpture& sculpture, const std::string& path) {
+  writePng(sculptureFigure(sculpture), path);
 }
 
 }  // namespace dynsub

@@ -58,6 +58,7 @@ struct FitCancelled {};
 
 struct Viewer::Impl {
   ViewerInput input;
+  vtkSmartPointer<vtkPolyData> startSurface;  // input.surfacePath's, or null
   ImageSlices slices;
   std::unique_ptr<SliceView> views[3];
   SurfaceView surface3d;
@@ -287,7 +288,7 @@ struct Viewer::Impl {
         text << (start ? "refit" : "fit") << " done: " << result.mesh.vertexCount() << " control vertices, "
              << result.levels.back().level << " refinement(s), " << result.steps << " steps in " << std::fixed
              << std::setprecision(2) << seconds << " s;\nfarthest landmark " << worst << " mm";
-        publish(tessellate(LimitSurface(result.mesh), result.mesh.points(), 8), text.str());
+        publish(tessellate(LimitSurface(result.mesh), result.mesh.points(), kOutputSegments), text.str());
         {
           // The pull moved during the fit, perhaps after its last step (a fit
           // may settle on a step that read the new target before moving to
@@ -362,8 +363,8 @@ struct Viewer::Impl {
       fitText.clear();
       fresh = false;
     }
-    if (input.surface) {
-      liveSurface->ShallowCopy(input.surface);
+    if (startSurface) {
+      liveSurface->ShallowCopy(startSurface);
     } else {
       liveSurface->Initialize();
     }
@@ -550,7 +551,8 @@ Viewer::Impl::Impl(ViewerInput in) : input(std::move(in)), slices(input.image), 
   style->viewer = this;
   interactor->SetInteractorStyle(style);
 
-  if (input.surface) liveSurface->ShallowCopy(input.surface);
+  if (!input.surfacePath.empty()) startSurface = readSurfacePolyData(input.surfacePath);
+  if (startSurface) liveSurface->ShallowCopy(startSurface);
   // Start at the landmarks' centre, else the surface's, else the image's.
   Vector3 centre = slices.geometry().toPhysical(
       0.5 * Vector3(slices.geometry().size[0] - 1, slices.geometry().size[1] - 1, slices.geometry().size[2] - 1));

@@ -26,6 +26,7 @@
 #include "dynsub/Landmarks.h"
 #include "dynsub/Simulation.h"
 #include "dynsub/SliceEnds.h"
+#include "dynsub/Tessellation.h"
 #include "dynsub/Volume.h"
 
 namespace dynsub {
@@ -59,6 +60,9 @@ struct StageSeconds {
 
 struct SegmentResult {
   ControlMesh mesh;
+  // The limit surface of `mesh`, 8 x 8 squares per element (ModelOutputs.h's
+  // outputSurface): what was voxelized, and what every output shows.
+  TriangleSurface surface;
   Mask labelmap;  // on the input's grid
   std::vector<LevelSummary> levels;
   int steps = 0;
@@ -85,8 +89,7 @@ struct SegmentResult {
   // (Documentation/Segmentation.md).
   double surfaceOnEdges = std::numeric_limits<double>::quiet_NaN();
   std::vector<double> landmarkEdgeDistances;
-  // Per point of the result's 8 x 8-per-element tessellation (tessellate()'s
-  // order): the distance to the nearest edge (mm), -1 outside the region
+  // Per point of `surface`: the distance to the nearest edge (mm), -1 outside the region
   // where it is unknown. Empty for the plain gradient potential.
   Eigen::VectorXd surfaceEdgeDistances;
   SliceEnds sliceEnds;  // what options.sliceEnds found (no springs when off)

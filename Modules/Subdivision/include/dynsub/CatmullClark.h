@@ -33,8 +33,6 @@ struct Refinement {
 
 Refinement refine(const Topology& topology);
 
-Topology topologyOf(const ControlMesh& mesh);
-
 // A control mesh refined once: mesh.points() == subdivisionMatrix * old points,
 // and its limit surface is the old one.
 struct SubdividedMesh {

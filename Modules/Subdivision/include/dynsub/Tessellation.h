@@ -19,6 +19,10 @@ struct TriangleSurface {
   std::vector<ElementType> triangleType;      // that element's type
 };
 
+// The tessellation a result is written, voxelized and drawn with: 8 x 8
+// squares per element (about 0.2-0.6 mm apart on a fitted caudate).
+constexpr int kOutputSegments = 8;
+
 // N = segmentsPerElement >= 1. Throws dynsub::Error for N < 1 or N > 1024.
 TriangleSurface tessellate(const LimitSurface& surface, const Matrix3X& controlPoints, int segmentsPerElement);
 

@@ -19,6 +19,7 @@
 #include <vtkSmartPointer.h>
 
 #include "dynsub/ConvergenceHistory.h"
+#include "dynsub/Tessellation.h"
 #include "dynsub/Types.h"
 
 class vtkPolyData;
@@ -26,7 +27,9 @@ class vtkRenderWindow;
 
 namespace dynsub {
 
+class ControlMesh;
 class ImageSlices;
+struct Volume;
 
 // Not owned; one ImageSlices (the image's VTK copy) serves every figure.
 struct FigureScene {
@@ -47,6 +50,25 @@ vtkSmartPointer<vtkRenderWindow> convergenceFigure(const ConvergenceHistory& his
 // Renders the window and writes it as PNG; the file appears complete or not
 // at all. Throws dynsub::Error naming the file.
 void writePng(vtkRenderWindow* window, const std::string& path);
+
+// The figures of a result, for callers that hold no VTK object (the commands).
+// Not owned; the surface is `surface`, or else read from `surfaceFile`.
+struct FigureInputs {
+  const TriangleSurface* surface = nullptr;
+  std::string surfaceFile;                   // any file SurfacePolyData.h reads
+  const Volume* image = nullptr;             // optional
+  const ControlMesh* controlMesh = nullptr;  // optional wireframe, 3D figure only
+  Matrix3X landmarks;                        // #landmarks x 3, LPS mm
+  Matrix3X dataPoints;                       // range data, mm
+  const ConvergenceHistory* history = nullptr;  // needed for the convergence figure
+};
+// The paths to write slices.png, surface3d.png and convergence.png to; an
+// empty path is not rendered. Needs a display (figureDisplay). Throws as the
+// figures and writePng do.
+struct FigureFiles {
+  std::string slices, surface3d, convergence;
+};
+void writeFigures(const FigureInputs& inputs, const FigureFiles& files);
 
 // True when an X display can be opened; otherwise `why` says what is missing.
 bool displayAvailable(std::string* why = nullptr);

@@ -50,5 +50,7 @@ class SolidView {
 // control lattice and fixed points as SolidView draws them; 800 x 800,
 // off screen. Needs an X display (Figures.h).
 vtkSmartPointer<vtkRenderWindow> sculptureFigure(const Sculpture& sculpture);
+// sculptureFigure written as PNG (Figures.h's writePng).
+void writeSculptureFigure(const Sculpture& sculpture, const std::string& path);
 
 }  // namespace dynsub

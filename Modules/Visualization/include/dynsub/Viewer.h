@@ -47,7 +47,7 @@ struct ViewerInput {
   Volume image;
   std::vector<Landmark> landmarks;
   std::string landmarksPath = "landmarks.mrk.json";  // where s saves and l loads
-  vtkSmartPointer<vtkPolyData> surface;              // optional, shown until a fit starts
+  std::string surfacePath;  // optional: a surface file (SurfacePolyData.h) shown until a fit starts
   SegmentOptions segment;
   double pullStiffness = 20.0;  // N/mm, the 3D view's pulling spring
 };

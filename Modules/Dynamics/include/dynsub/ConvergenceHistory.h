@@ -5,9 +5,12 @@
 // dynsub segment: the rms landmark distance in mm). Kept as CSV with the
 // header `level,step,energy,fit_error` (fit_error empty where not measured).
 // No VTK here: the commands record it without rendering.
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
+
+#include "dynsub/Simulation.h"
 
 namespace dynsub {
 
@@ -25,6 +28,22 @@ struct ConvergenceHistory {
   // Adds a step. A step number not after the level's last one means the level
   // restarted (a smaller time step after divergence): its earlier samples go.
   void add(const ConvergenceSample& sample);
+};
+
+// Records every step's energy and, every `stride` steps (and at each level's
+// first), a fit error measured on the current surface.
+class ConvergenceRecorder {
+ public:
+  using FitError = std::function<double(const Progress& progress)>;
+  ConvergenceRecorder(std::string fitErrorName, FitError fitError, int stride);
+  // Records, then calls `next` (may be empty).
+  ProgressCallback callback(ProgressCallback next);
+  const ConvergenceHistory& history() const { return history_; }
+
+ private:
+  ConvergenceHistory history_;
+  FitError fitError_;
+  int stride_;
 };
 
 // The CSV's first line is "# fit_error: <fitErrorName>". Both throw

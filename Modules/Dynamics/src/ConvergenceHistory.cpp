@@ -22,6 +22,21 @@ void ConvergenceHistory::add(const ConvergenceSample& sample) {
   samples.push_back(sample);
 }
 
+ConvergenceRecorder::ConvergenceRecorder(std::string fitErrorName, FitError fitError, int stride)
+    : fitError_(std::move(fitError)), stride_(stride) {
+  history_.fitErrorName = std::move(fitErrorName);
+}
+
+ProgressCallback ConvergenceRecorder::callback(ProgressCallback next) {
+  return [this, next](const Progress& p) {
+    ConvergenceSample sample{p.level, p.step, p.energy, std::nan("")};
+    if (fitError_ && p.surface && p.controlPoints && (p.step == 1 || p.step % stride_ == 0))
+      sample.fitError = fitError_(p);
+    history_.add(sample);
+    if (next) next(p);
+  };
+}
+
 void writeConvergenceCsv(const ConvergenceHistory& history, const std::string& path) {
   AtomicOutput output(path);
   {

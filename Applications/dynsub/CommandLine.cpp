@@ -1,0 +1,82 @@
+#include "CommandLine.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+
+#include <CLI/CLI.hpp>
+
+namespace dynsub::app {
+
+void SimulationArguments::addOptions(CLI::App& command, const SimulationOptions& defaults) {
+  values = defaults;
+  scheme = toString(defaults.integrator.scheme);
+  solver = toString(defaults.integrator.solver);
+  command.add_option("--max-level", values.maxLevel, "Global refinements allowed (0-6)")
+      ->default_val(defaults.maxLevel)
+      ->check(CLI::Range(0, 6));
+  command.add_option("--scheme", scheme,
+                     "How the equilibrium is reached: static (Newton steps on K p = f_p), or time integration, "
+                     "first-order (massless, TVCG eq. 32) or second-order (eq. 31)")
+      ->default_val(scheme)
+      ->check(CLI::IsMember({"static", "first-order", "second-order"}));
+  command.add_option("--solver", solver,
+                     "Linear solver per step: cholesky (factored once per level), cg, or pcg (incomplete Cholesky)")
+      ->default_val(solver)
+      ->check(CLI::IsMember({"cholesky", "cg", "pcg"}));
+  command.add_option("--time-step", values.integrator.timeStep, "Time step, s (halved automatically on divergence)")
+      ->default_val(defaults.integrator.timeStep)
+      ->check(CLI::PositiveNumber);
+  command.add_option("--max-steps", values.equilibrium.maxSteps, "Step limit per level")
+      ->default_val(defaults.equilibrium.maxSteps)
+      ->check(CLI::Range(1, 1000000));
+  command.add_option("--mass", values.material.mass, "Mass density mu, kg per unit parametric area")
+      ->default_val(defaults.material.mass)
+      ->check(CLI::NonNegativeNumber);
+  command.add_option("--damping", values.material.damping, "Damping density gamma, kg/s per unit parametric area")
+      ->default_val(defaults.material.damping)
+      ->check(CLI::NonNegativeNumber);
+  command.add_option("--tension", values.material.tensionU,
+                     "Tension alpha11 = alpha22, N/mm per unit parametric area (membrane: resists stretching)")
+      ->default_val(defaults.material.tensionU)
+      ->check(CLI::NonNegativeNumber);
+  command.add_option("--rigidity", values.material.rigidityUU,
+                     "Rigidity beta11 = beta22 = beta12/2, N/mm per unit parametric area (thin plate: resists bending)")
+      ->default_val(defaults.material.rigidityUU)
+      ->check(CLI::NonNegativeNumber);
+}
+
+SimulationOptions SimulationArguments::apply(SimulationOptions base) const {
+  base.maxLevel = values.maxLevel;
+  base.integrator.scheme = parseIntegrationScheme(scheme);
+  base.integrator.solver = parseLinearSolver(solver);
+  base.integrator.timeStep = values.integrator.timeStep;
+  base.equilibrium.maxSteps = values.equilibrium.maxSteps;
+  base.material.mass = values.material.mass;
+  base.material.damping = values.material.damping;
+  base.material.tensionU = base.material.tensionV = values.material.tensionU;
+  base.material.rigidityUU = base.material.rigidityVV = values.material.rigidityUU;
+  base.material.rigidityUV = 2.0 * values.material.rigidityUU;
+  checkSimulationOptions(base);
+  return base;
+}
+
+ProgressLine::ProgressLine() : terminal_(isatty(fileno(stderr)) != 0) {}
+
+ProgressCallback ProgressLine::callback() {
+  if (!terminal_) return nullptr;
+  return [this](const Progress& p) {
+    if (p.step % 5 != 1) return;
+    std::fprintf(stderr, "\rlevel %d  step %5d  energy %-12.6g  motion %-10.3g mm ", p.level, p.step, p.energy,
+                 p.motion);
+    std::fflush(stderr);
+    written_ = true;
+  };
+}
+
+void ProgressLine::finish() {
+  if (written_) std::fprintf(stderr, "\n");
+  written_ = false;
+}
+
+}  // namespace dynsub::app

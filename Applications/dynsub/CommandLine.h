@@ -1,0 +1,35 @@
+#pragma once
+// What the commands that run a simulation share on the command line: the
+// physics and solver options, and a progress line on a terminal.
+#include <string>
+
+#include "dynsub/Simulation.h"
+
+namespace CLI {
+class App;
+}
+
+namespace dynsub::app {
+
+// Command-line options for SimulationOptions (material, integrator, levels).
+struct SimulationArguments {
+  std::string scheme, solver;
+  SimulationOptions values;
+  void addOptions(CLI::App& command, const SimulationOptions& defaults);
+  // `base` with the options given on the command line; throws dynsub::Error on bad values.
+  SimulationOptions apply(SimulationOptions base) const;
+};
+
+// "\rlevel L  step S  energy E" on stderr while stderr is a terminal; silent otherwise.
+class ProgressLine {
+ public:
+  ProgressLine();
+  ProgressCallback callback();
+  void finish();
+
+ private:
+  bool terminal_;
+  bool written_ = false;
+};
+
+}  // namespace dynsub::app

@@ -1,0 +1,35 @@
+#pragma once
+// What every command that moves a model writes (`fit`, `deform`, `segment`,
+// the 3D Slicer module): the limit surface, the control mesh and report.json,
+// all together or none (OutputSet.h), and the parts of report.json they share.
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "dynsub/OutputSet.h"
+#include "dynsub/Report.h"
+#include "dynsub/Simulation.h"
+#include "dynsub/SurfaceWriter.h"
+
+namespace dynsub {
+
+// report.json's "parameters": the material, the scheme, the levels and the equilibrium rule.
+Report simulationReport(const SimulationOptions& options);
+// One entry of report.json's "per_level"; the fit errors are left out when negative.
+Report levelReport(const LevelSummary& level, double maxErrorPercent, double rmsErrorPercent);
+
+// The limit surface as the programs write it (kOutputSegments, Tessellation.h).
+// Throws dynsub::Error if the control points are not finite.
+TriangleSurface outputSurface(const ControlMesh& mesh);
+
+// DIR/surface.vtp (`surface`, from outputSurface), DIR/control_mesh.obj and
+// DIR/report.json, all or none. `extra` may add further files to the same set
+// (e.g. a labelmap); `surfaceScalars` are point data of surface.vtp (one value
+// per point of `surface`); `space` ("LPS" for surfaces in an image's physical
+// space) is recorded in surface.vtp for 3D Slicer (SurfaceWriter.h).
+void writeModelOutputs(const std::filesystem::path& dir, const ControlMesh& mesh, const TriangleSurface& surface,
+                       const Report& report, const std::function<void(OutputSet&)>& extra = nullptr,
+                       const std::vector<PointScalars>& surfaceScalars = {}, const std::string& space = "");
+
+}  // namespace dynsub

@@ -1,0 +1,71 @@
+#include "dynsub/ModelOutputs.h"
+
+#include "dynsub/Error.h"
+#include "dynsub/LimitSurface.h"
+#include "dynsub/MeshIO.h"
+
+namespace dynsub {
+
+Report simulationReport(const SimulationOptions& o) {
+  Report r;
+  r.set("max_level", o.maxLevel);
+  r.set("scheme", toString(o.integrator.scheme));
+  r.set("solver", toString(o.integrator.solver));
+  r.set("time_step_s", o.integrator.timeStep);
+  Report material;
+  material.set("mass", o.material.mass);
+  material.set("damping", o.material.damping);
+  material.set("tension_u", o.material.tensionU);
+  material.set("tension_v", o.material.tensionV);
+  material.set("rigidity_uu", o.material.rigidityUU);
+  material.set("rigidity_uv", o.material.rigidityUV);
+  material.set("rigidity_vv", o.material.rigidityVV);
+  r.set("material", material);
+  r.set("elasticity_per_level", o.elasticityPerLevel);
+  r.set("plate_levels", o.assembly.plateLevels);
+  Report equilibrium;
+  equilibrium.set("energy_tolerance", o.equilibrium.energyTolerance);
+  equilibrium.set("motion_tolerance", o.equilibrium.motionTolerance);
+  equilibrium.set("coarse_level_factor", o.equilibrium.coarseLevelFactor);
+  equilibrium.set("window", o.equilibrium.window);
+  equilibrium.set("max_steps", o.equilibrium.maxSteps);
+  r.set("equilibrium", equilibrium);
+  return r;
+}
+
+Report levelReport(const LevelSummary& l, double maxErrorPercent, double rmsErrorPercent) {
+  Report r;
+  r.set("level", l.level);
+  r.set("control_vertices", l.controlVertices);
+  r.set("iterations", l.steps);
+  r.set("equilibrium", l.converged);
+  r.set("equilibrium_rule", l.coarse ? "coarse" : "full");  // coarse: a refined level, ended at looser tolerances
+  r.set("time_step_s", l.timeStep);
+  r.set("energy", l.energy);
+  if (maxErrorPercent >= 0) {
+    r.set("max_error_percent", maxErrorPercent);
+    r.set("rms_error_percent", rmsErrorPercent);
+  }
+  r.set("stabilizer_updates", l.stabilizerUpdates);
+  r.set("equilibrium_residual", l.residual);
+  r.set("seconds", l.seconds);
+  return r;
+}
+
+TriangleSurface outputSurface(const ControlMesh& mesh) {
+  if (!mesh.points().allFinite()) throw Error("internal: the control points are not finite; nothing was written");
+  return tessellate(LimitSurface(mesh), mesh.points(), kOutputSegments);
+}
+
+void writeModelOutputs(const std::filesystem::path& dir, const ControlMesh& mesh, const TriangleSurface& surface,
+                       const Report& report, const std::function<void(OutputSet&)>& extra,
+                       const std::vector<PointScalars>& surfaceScalars, const std::string& space) {
+  OutputSet outputs(dir);
+  writeTriangleSurface(surface, outputs.add("surface.vtp"), surfaceScalars, space);
+  writeObj(mesh, outputs.add("control_mesh.obj"));
+  report.write(outputs.add("report.json"));
+  if (extra) extra(outputs);
+  outputs.commit();
+}
+
+}  // namespace dynsub
