@@ -34,8 +34,6 @@ UnitIntegrals unitIntegrals(int points) {
   return result;
 }
 
-bool finiteNonNegative(double x) { return std::isfinite(x) && x >= 0.0; }
-
 void checkOptions(const AssemblyOptions& options) {
   if (!(std::isfinite(options.elementSize) && options.elementSize > 0.0)) {
     throw Error("element size must be positive, got " + std::to_string(options.elementSize));
@@ -58,11 +56,7 @@ void checkOptions(const AssemblyOptions& options) {
 void checkMaterial(const Material& m) {
   const double values[] = {m.mass, m.damping, m.tensionU, m.tensionV, m.rigidityUU, m.rigidityUV, m.rigidityVV};
   const char* names[] = {"mass", "damping", "tension u", "tension v", "rigidity uu", "rigidity uv", "rigidity vv"};
-  for (int i = 0; i < 7; ++i) {
-    if (!finiteNonNegative(values[i])) {
-      throw Error(std::string("material ") + names[i] + " must be finite and >= 0, got " + std::to_string(values[i]));
-    }
-  }
+  for (int i = 0; i < 7; ++i) requireFiniteNonNegative(values[i], std::string("material ") + names[i]);
 }
 
 namespace {

@@ -93,16 +93,12 @@ SimulationOptions SegmentOptions::defaultSimulation() {
 
 void checkSegmentOptions(const SegmentOptions& options) {
   checkEdgeOptions(options.edges);
-  auto finiteNonNegative = [](double value, const std::string& name) {
-    if (!(value >= 0) || !std::isfinite(value))
-      throw Error(name + " must be a finite number >= 0 (got " + std::to_string(value) + ")");
-  };
-  finiteNonNegative(options.imageForce, "image force");
-  finiteNonNegative(options.landmarkStiffness, "landmark stiffness");
-  finiteNonNegative(options.landmarkDeadZone, "landmark dead zone");
+  requireFiniteNonNegative(options.imageForce, "image force");
+  requireFiniteNonNegative(options.landmarkStiffness, "landmark stiffness");
+  requireFiniteNonNegative(options.landmarkDeadZone, "landmark dead zone");
   checkSliceEndOptions(options.sliceEnds);
-  finiteNonNegative(options.margin, "margin");
-  finiteNonNegative(options.landmarkTolerance, "landmark tolerance");
+  requireFiniteNonNegative(options.margin, "margin");
+  requireFiniteNonNegative(options.landmarkTolerance, "landmark tolerance");
   if (!std::isfinite(options.inflation)) throw Error("inflation must be finite");
   if (!std::isfinite(options.regionPressure)) throw Error("the region pressure must be finite");
   if (!(options.regionWindow > 0) || !std::isfinite(options.regionWindow))

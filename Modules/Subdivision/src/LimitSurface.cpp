@@ -724,7 +724,9 @@ namespace {
 // zero in every operator is left out; the operators share one pattern
 // (applyOperators() reads it once for all).
 // `jacobians`, if not empty, holds d(element u, v)/d(point's own u, v) per point.
-std::array<SparseMatrix, 6> assemble(const LimitSurface& surface, const LimitSurface::Impl& impl,
+// `weightsInto(point, w, count)` fills a point's weights (LimitSurface::Impl::weightsInto).
+template <class WeightsInto>
+std::array<SparseMatrix, 6> assemble(const LimitSurface& surface, const WeightsInto& weightsInto,
                                      const std::vector<ElementPoint>& points,
                                      const std::vector<Eigen::Matrix2d>& jacobians, int count) {
   std::array<SparseMatrix, 6> result;
@@ -739,7 +741,7 @@ std::array<SparseMatrix, 6> assemble(const LimitSurface& surface, const LimitSur
   }
   SampleWeights w;
   for (int r = 0; r < rows; ++r) {
-    impl.weightsInto(points[r], w, count);
+    weightsInto(points[r], w, count);
     if (!jacobians.empty()) applyChainRule(w, jacobians[r], count);
     const std::vector<int>& cols = surface.elementColumns(points[r].element);
     for (size_t c = 0; c < cols.size(); ++c) {
@@ -777,23 +779,32 @@ int operatorCount(int order) {
 }  // namespace
 
 LimitOperators LimitSurface::operators(const std::vector<ElementPoint>& points, int order) const {
-  std::array<SparseMatrix, 6> m = assemble(*this, *impl_, points, {}, operatorCount(order));
+  const auto weightsInto = [this](const ElementPoint& p, SampleWeights& w, int count) {
+    impl_->weightsInto(p, w, count);
+  };
+  std::array<SparseMatrix, 6> m = assemble(*this, weightsInto, points, {}, operatorCount(order));
   return toOperators(m);
 }
 
 SparseMatrix LimitSurface::limitOperator(const std::vector<ElementPoint>& points) const {
-  std::array<SparseMatrix, 6> m = assemble(*this, *impl_, points, {}, 1);
+  const auto weightsInto = [this](const ElementPoint& p, SampleWeights& w, int count) {
+    impl_->weightsInto(p, w, count);
+  };
+  std::array<SparseMatrix, 6> m = assemble(*this, weightsInto, points, {}, 1);
   SparseMatrix result;
   result.swap(m[0]);
   return result;
 }
 
 LimitOperators LimitSurface::operators(const std::vector<SurfacePoint>& points, int order) const {
+  const auto weightsInto = [this](const ElementPoint& p, SampleWeights& w, int count) {
+    impl_->weightsInto(p, w, count);
+  };
   const int count = operatorCount(order);
   std::vector<ElementPoint> at(points.size());
   std::vector<Eigen::Matrix2d> jacobians(points.size());
   for (size_t i = 0; i < points.size(); ++i) at[i] = impl_->locate(points[i], jacobians[i]);
-  std::array<SparseMatrix, 6> m = assemble(*this, *impl_, at, jacobians, count);
+  std::array<SparseMatrix, 6> m = assemble(*this, weightsInto, at, jacobians, count);
   return toOperators(m);
 }
 

@@ -1,6 +1,7 @@
 #pragma once
-// The one exception type of DynSub. Its message is meant for the person running
-// the tool: it names the file or value at fault and what was expected, e.g.
+// DynSub's exceptions. Every error DynSub reports is an Error (or derives from
+// it), and its message is meant for the person running the tool: it names
+// the file or value at fault and what was expected, e.g.
 // "cube.obj: line 12: face 7 uses vertex 130, but the file has 98 vertices".
 #include <stdexcept>
 #include <string>
@@ -15,10 +16,14 @@ class Error : public std::runtime_error {
 };
 
 // An Error about landmarks given as points (outside the image, on no edge):
-// a caller that read them from a file names it.
+// a caller that read them from a file catches it to name the file.
 class LandmarkError : public Error {
  public:
   using Error::Error;
 };
+
+// Throws Error("<name> must be a finite number >= 0 (got <value>)") unless
+// `value` is one: the check of every non-negative option and material value.
+void requireFiniteNonNegative(double value, const std::string& name);
 
 }  // namespace dynsub

@@ -53,9 +53,8 @@ class ClosestPointLocator {
   // normal elements without going through the surface's general path.
   const SparseMatrix& patchOperator() const;
 
-  struct Impl;
-
  private:
+  struct Impl;
   ClosestPoint search(const Vector3& query) const;  // the full search on a current tree
   std::unique_ptr<Impl> impl_;
 };

@@ -64,9 +64,8 @@ class Integrator {
   int lastIterations() const;
   const IntegratorOptions& options() const;
 
-  struct Impl;
-
  private:
+  struct Impl;
   std::unique_ptr<Impl> impl_;
 };
 

@@ -58,9 +58,8 @@ class TangentStiffness {
   // until the next reset.
   SymmetricMatrix& matrix();
 
-  struct Impl;
-
  private:
+  struct Impl;
   std::unique_ptr<Impl> impl_;
 };
 
@@ -83,9 +82,8 @@ class StaticSolver {
   // Diagonal shifts applied over all factorizations (0 when none was needed).
   int regularizations() const;
 
-  struct Impl;
-
  private:
+  struct Impl;
   std::unique_ptr<Impl> impl_;
 };
 

@@ -187,9 +187,8 @@ class LimitSurface {
   // Row i gives the limit position of control vertex i (#control by #control).
   SparseMatrix controlVertexLimitOperator() const;
 
-  struct Impl;
-
  private:
+  struct Impl;
   friend class SurfaceState;
   std::unique_ptr<Impl> impl_;
 };
@@ -216,9 +215,8 @@ class SurfaceState {
   const SparseMatrix& patchOperator() const;
   const Matrix3X& grids() const;
 
-  struct Impl;
-
  private:
+  struct Impl;
   std::unique_ptr<Impl> impl_;
 };
 

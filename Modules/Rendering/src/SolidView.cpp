@@ -18,7 +18,7 @@
 #include <vtkRenderer.h>
 #include <vtkUnsignedCharArray.h>
 
-#include "SceneStyle.h"
+#include "dynsub/SceneStyle.h"
 #include "dynsub/Figures.h"
 #include "dynsub/Sculpting.h"
 

@@ -18,7 +18,7 @@
 #include <vtkProperty.h>
 #include <vtkRenderer.h>
 
-#include "SceneStyle.h"
+#include "dynsub/SceneStyle.h"
 #include "dynsub/ControlMesh.h"
 
 namespace dynsub {

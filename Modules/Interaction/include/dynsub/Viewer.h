@@ -3,18 +3,10 @@
 // views and a 3D view of one image, its landmarks and a surface, with live
 // fitting by the segmentation pipeline (Segmentation.h).
 //
-// Bindings (also on screen behind `h`):
-//   slice views   wheel or Up/Down, Page Up/Page Down: next/previous slice
-//                 left click: place a landmark (on a landmark: select it);
-//                 drag: move the selected landmark within the slice
-//                 right click on a landmark, or Delete/BackSpace: delete it
-//   3D view       left drag: rotate; wheel: zoom; Ctrl + left drag on the
-//                 surface: pull it (an interactive spring), while fitting
-//                 or, after a fit, by refitting with the pull on
-//   keys          space: start (after a fit: refit), pause or resume
-//                 fitting; r: stop and forget the fit
-//                 s: save the landmarks (.mrk.json, LPS); l: load them again
-//                 h: show or hide the help; q: quit
+// Bindings: the on-screen help behind `h` (kHelp in Viewer.cpp) is their one
+// list. In short: clicks on a slice place, select, move and delete
+// landmarks (saved as .mrk.json, LPS); Ctrl + drag on the 3D surface pulls
+// it with an interactive spring; space starts, pauses and resumes fitting.
 // Fitting runs on a worker thread: the first fit starts from the landmarks'
 // initial model (at least 4 landmarks), and the surface is redrawn in every
 // view as it moves (about 25 times a second). Editing the landmarks while

@@ -27,9 +27,10 @@
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
 
-#include "SceneStyle.h"
+#include "dynsub/SceneStyle.h"
 #include "dynsub/Error.h"
 #include "dynsub/Figures.h"
+#include "dynsub/PullForce.h"
 #include "dynsub/SliceView.h"
 #include "dynsub/SurfacePolyData.h"
 #include "dynsub/SurfaceView.h"
@@ -50,7 +51,7 @@ const char* const kHelp =
     "3D view:      left drag  rotate;  wheel  zoom\n"
     "              Ctrl + left drag on the surface  pull it (after a fit: refit with the pull)\n"
     "Keys:         space  start (after a fit: refit) / pause / resume;  r  stop and forget the fit\n"
-    "              s  save landmarks;  l  load landmarks;  h  this help;  q  quit";
+    "              s  save landmarks;  l  load landmarks;  h  this help;  q, Escape  quit";
 
 struct FitCancelled {};
 
@@ -594,12 +595,7 @@ Viewer::Impl::Impl(ViewerInput in) : input(std::move(in)), slices(input.image), 
 
   overlay->SetLayer(1);
   overlay->InteractiveOff();
-  style::cornerText(helpText, 0.51, 0.49, style::Corner::TopLeft, 13);
-  helpText->SetInput(kHelp);
-  helpText->GetTextProperty()->SetBackgroundColor(0, 0, 0);
-  helpText->GetTextProperty()->SetBackgroundOpacity(0.7);
-  helpText->VisibilityOff();
-  overlay->AddActor2D(helpText);
+  style::helpOverlay(overlay, helpText, kHelp, 0.51, 0.49);
   style::cornerText(statusText, 0.51, 0.01, style::Corner::BottomLeft, 13);
   statusText->GetTextProperty()->SetBackgroundColor(0, 0, 0);
   statusText->GetTextProperty()->SetBackgroundOpacity(0.6);
@@ -617,13 +613,14 @@ Viewer::Impl::Impl(ViewerInput in) : input(std::move(in)), slices(input.image), 
     if (actor && actor->GetMapper() && actor->GetMapper()->GetInput() == liveSurface.Get()) picker->AddPickList(actor);
   }
 
-  timerCommand->SetClientData(this);
-  timerCommand->SetCallback([](vtkObject*, unsigned long, void* client, void*) {
-    auto* self = static_cast<Viewer::Impl*>(client);
-    const bool updated = self->takeUpdate();
-    if (updated || self->running) self->render();
-  });
-  interactor->AddObserver(vtkCommand::TimerEvent, timerCommand);
+  style::observeTimer(
+      interactor, timerCommand,
+      [](void* client) {
+        auto* self = static_cast<Viewer::Impl*>(client);
+        const bool updated = self->takeUpdate();
+        if (updated || self->running) self->render();
+      },
+      this);
   updateStatus();
 }
 

@@ -19,7 +19,7 @@
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
 
-#include "SceneStyle.h"
+#include "dynsub/SceneStyle.h"
 
 namespace dynsub {
 

@@ -3,22 +3,10 @@
 // clay (Sculpting.h) that moves all the time, drawn by SolidView, and the
 // paper's tools (§5.4) on the mouse and keys.
 //
-// Bindings (also on screen behind `h`):
-//   left drag            rotate the view;  wheel: zoom
-//   Ctrl + left drag     rope: grab the solid where clicked and pull
-//   Shift + left click   select the control face under the cursor (cyan)
-//   e                    extrude the selected face into a new cell
-//   d, Delete            delete the selected face's cell
-//   f / u                fix / unfix the selected face's control points
-//   U                    unfix all
-//   right click on a control point (within 8 px)   fix it, or unfix a fixed one
-//   p                    plasticity: the current shape becomes the rest shape
-//   k / K                stiffness down / up (x 0.8, x 1.25)
-//   g / G                damping down / up (x 0.8, x 1.25)
-//   space                pause or resume the motion
-//   w                    show or hide the control lattice;  c  reset the view
-//   s                    save (through the save action given)
-//   h                    help;  q, Escape  quit
+// Bindings: the on-screen help behind `h` (kHelp in Sculptor.cpp) is their
+// one list: the rope (Ctrl + drag), selecting a control face (Shift +
+// click), extruding and deleting cells, fixing control points, plasticity,
+// stiffness and damping (each step x 0.8 or x 1.25), pausing, saving.
 // The solid moves in real time: every 40 ms the simulation advances by as
 // many time steps as fit in 40 ms of simulated time.
 #include <functional>

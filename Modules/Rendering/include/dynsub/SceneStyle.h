@@ -10,9 +10,11 @@
 #include "dynsub/Types.h"
 
 class vtkActor;
+class vtkCallbackCommand;
 class vtkPolyData;
 class vtkPolyDataMapper;
 class vtkRenderWindow;
+class vtkRenderWindowInteractor;
 class vtkRenderer;
 class vtkTextActor;
 
@@ -52,6 +54,15 @@ vtkSmartPointer<vtkRenderWindow> offScreenWindow(int width, int height);
 enum class Corner { TopLeft, TopRight, BottomLeft, Left, Right, Top, Bottom };
 // White text at a normalized viewport position, justified towards `corner`.
 void cornerText(vtkTextActor* text, double x, double y, Corner corner, int fontSize = kFontSize);
+
+// The interactive windows' help: `help` in a dark box at (x, y), hidden
+// until `h` shows it, added to `overlay`.
+void helpOverlay(vtkRenderer* overlay, vtkTextActor* text, const char* help, double x, double y);
+
+// Calls tick(client) at every timer event of `interactor` (the windows'
+// redraw timers), through `command`.
+void observeTimer(vtkRenderWindowInteractor* interactor, vtkCallbackCommand* command, void (*tick)(void* client),
+                  void* client);
 
 // The anatomical direction a unit LPS vector points to most: L, R, P, A, S or I.
 std::string anatomicalLetter(const Vector3& direction);

@@ -1,8 +1,9 @@
-#include "SceneStyle.h"
+#include "dynsub/SceneStyle.h"
 
 #include <cmath>
 
 #include <vtkActor.h>
+#include <vtkCallbackCommand.h>
 #include <vtkCellArray.h>
 #include <vtkCoordinate.h>
 #include <vtkLookupTable.h>
@@ -13,6 +14,7 @@
 #include <vtkPolyData.h>
 #include <vtkProperty.h>
 #include <vtkRenderWindow.h>
+#include <vtkRenderWindowInteractor.h>
 #include <vtkRenderer.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
@@ -109,6 +111,32 @@ void cornerText(vtkTextActor* text, double x, double y, Corner corner, int fontS
     case Corner::Top: p->SetVerticalJustificationToTop(); break;
     case Corner::Bottom: p->SetVerticalJustificationToBottom(); break;
   }
+}
+
+void helpOverlay(vtkRenderer* overlay, vtkTextActor* text, const char* help, double x, double y) {
+  cornerText(text, x, y, Corner::TopLeft, 13);
+  text->SetInput(help);
+  text->GetTextProperty()->SetBackgroundColor(0, 0, 0);
+  text->GetTextProperty()->SetBackgroundOpacity(0.7);
+  text->VisibilityOff();
+  overlay->AddActor2D(text);
+}
+
+void observeTimer(vtkRenderWindowInteractor* interactor, vtkCallbackCommand* command, void (*tick)(void* client),
+                  void* client) {
+  // The callback gets one pointer: the client's, with `tick` kept beside it.
+  struct Tick {
+    void (*tick)(void*);
+    void* client;
+  };
+  auto* data = new Tick{tick, client};
+  command->SetClientData(data);
+  command->SetClientDataDeleteCallback([](void* d) { delete static_cast<Tick*>(d); });
+  command->SetCallback([](vtkObject*, unsigned long, void* d, void*) {
+    const auto* t = static_cast<Tick*>(d);
+    t->tick(t->client);
+  });
+  interactor->AddObserver(vtkCommand::TimerEvent, command);
 }
 
 std::string anatomicalLetter(const Vector3& direction) {

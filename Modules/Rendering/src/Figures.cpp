@@ -23,7 +23,7 @@
 #include <vtkRenderer.h>
 #include <vtkWindowToImageFilter.h>
 
-#include "SceneStyle.h"
+#include "dynsub/SceneStyle.h"
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/ConvergencePlot.h"
 #include "dynsub/Error.h"

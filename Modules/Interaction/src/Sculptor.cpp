@@ -15,7 +15,7 @@
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
 
-#include "SceneStyle.h"
+#include "dynsub/SceneStyle.h"
 #include "dynsub/Error.h"
 #include "dynsub/Figures.h"
 #include "dynsub/SolidView.h"
@@ -37,7 +37,7 @@ const char* const kHelp =
     "p  plasticity (keep the current shape)\n"
     "k / K  stiffness down / up;  g / G  damping down / up\n"
     "space  pause / resume;  w  control lattice on / off\n"
-    "s  save;  h  this help;  q  quit";
+    "s  save;  h  this help;  q, Escape  quit";
 
 }  // namespace
 
@@ -362,12 +362,7 @@ Sculptor::Sculptor(const Lattice& control, const SculptSettings& settings,
 
   s.overlay->SetLayer(1);
   s.overlay->InteractiveOff();
-  style::cornerText(s.helpText, 0.01, 0.99, style::Corner::TopLeft, 13);
-  s.helpText->SetInput(kHelp);
-  s.helpText->GetTextProperty()->SetBackgroundColor(0, 0, 0);
-  s.helpText->GetTextProperty()->SetBackgroundOpacity(0.7);
-  s.helpText->VisibilityOff();
-  s.overlay->AddActor2D(s.helpText);
+  style::helpOverlay(s.overlay, s.helpText, kHelp, 0.01, 0.99);
   style::cornerText(s.statusText, 0.01, 0.01, style::Corner::BottomLeft, 13);
   s.statusText->GetTextProperty()->SetBackgroundColor(0, 0, 0);
   s.statusText->GetTextProperty()->SetBackgroundOpacity(0.6);
@@ -378,10 +373,9 @@ Sculptor::Sculptor(const Lattice& control, const SculptSettings& settings,
   s.picker->PickFromListOn();
   s.picker->AddPickList(s.view.surfaceActor());
 
-  s.timerCommand->SetClientData(impl_.get());
-  s.timerCommand->SetCallback(
-      [](vtkObject*, unsigned long, void* client, void*) { static_cast<Sculptor::Impl*>(client)->tick(); });
-  s.interactor->AddObserver(vtkCommand::TimerEvent, s.timerCommand);
+  style::observeTimer(
+      s.interactor, s.timerCommand, [](void* client) { static_cast<Sculptor::Impl*>(client)->tick(); },
+      impl_.get());
   s.updateStatus();
 }
 
