@@ -232,7 +232,7 @@ void run(Arguments a) {
   std::vector<std::unique_ptr<AtomicOutput>> outputs;
   if (!a.labelmap.empty()) {
     outputs.push_back(std::make_unique<AtomicOutput>(a.labelmap));
-    writeMask(run.result.labelmap, outputs.back()->temporaryPath(), static_cast<std::uint8_t>(a.labelValue));
+    writeMask(run.labelmap, outputs.back()->temporaryPath(), static_cast<std::uint8_t>(a.labelValue));
   }
   if (!a.model.empty()) {
     std::vector<PointScalars> scalars;
@@ -246,7 +246,7 @@ void run(Arguments a) {
   }
   for (auto& output : outputs) output->commit();
 
-  const double volume = run.result.labelmap.count() * image.geometry.spacing.prod();
+  const double volume = run.labelmap.count() * image.geometry.spacing.prod();
   std::cout << std::fixed << std::setprecision(1) << "segmented " << volume << " mm^3 with "
             << run.result.mesh.vertexCount() << " control vertices in " << run.seconds << " s\n";
   for (const std::string& warning : run.warnings) std::cerr << "warning: " << warning << '\n';

@@ -99,7 +99,7 @@ void runSegment(SegmentCommandOptions o) {
   writeModelOutputs(
       dir, result.mesh, result.surface, run.report,
       [&](OutputSet& outputs) {
-        writeMask(result.labelmap, outputs.add("labelmap.nii.gz"));
+        writeMask(run.labelmap, outputs.add("labelmap.nii.gz"));
         addFigureOutputs(outputs, o.figures, result.mesh, result.surface, run.history, &image,
                          landmarkPositions(run.springs), Matrix3X());
       },
@@ -108,7 +108,7 @@ void runSegment(SegmentCommandOptions o) {
           : std::vector<PointScalars>{},
       "LPS");
 
-  std::cout << std::fixed << std::setprecision(1) << "segmented " << result.labelmap.count() * image.geometry.spacing.prod()
+  std::cout << std::fixed << std::setprecision(1) << "segmented " << run.labelmap.count() * image.geometry.spacing.prod()
             << " mm^3 with " << result.mesh.vertexCount() << " control vertices (" << result.levels.back().level
             << " refinement(s), " << result.steps << " steps) in " << seconds << " s\n";
   for (const std::string& warning : warnings) std::cerr << "warning: " << warning << '\n';

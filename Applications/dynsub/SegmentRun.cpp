@@ -6,6 +6,7 @@
 
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/Error.h"
+#include "dynsub/Labelmap.h"
 #include "dynsub/MeshIO.h"
 #include "dynsub/ModelOutputs.h"
 
@@ -124,6 +125,9 @@ SegmentRun runSegmentation(const Volume& image, SegmentInputs in, const Progress
       throw Error(in.landmarkSource, error.what());
     }
   }();
+  const auto voxelizing = std::chrono::steady_clock::now();
+  run.labelmap = labelmapOf(run.result.surface, image.geometry);
+  const double voxelizeSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - voxelizing).count();
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   run.history = recorder.history();
   const SegmentResult& result = run.result;
@@ -148,12 +152,12 @@ SegmentRun runSegmentation(const Volume& image, SegmentInputs in, const Progress
     report.set("seed", r);
   }
   if (in.reference) {
-    run.metrics = compareMasks(result.labelmap, *in.reference);
+    run.metrics = compareMasks(run.labelmap, *in.reference);
     report.set("reference", in.referencePath);
     report.set("reference_labels", in.referenceLabels);
     report.merge(metricsReport(run.metrics));
   } else {
-    report.set("volume_mm3", result.labelmap.count() * image.geometry.spacing.prod());
+    report.set("volume_mm3", run.labelmap.count() * image.geometry.spacing.prod());
   }
   report.set("control_vertices", result.mesh.vertexCount());
   report.set("levels", result.levels.back().level);
@@ -164,7 +168,7 @@ SegmentRun runSegmentation(const Volume& image, SegmentInputs in, const Progress
   stages.set("crop", result.seconds.crop);
   stages.set("edge_potential", result.seconds.potential);
   stages.set("evolution", result.seconds.evolution);
-  stages.set("voxelize", result.seconds.voxelize);
+  stages.set("voxelize", voxelizeSeconds);
   report.set("stage_seconds", stages);
   if (in.segment.sliceEnds.enabled) {
     const SliceEnds& ends = result.sliceEnds;

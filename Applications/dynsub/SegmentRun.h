@@ -51,6 +51,7 @@ struct SegmentInputs {
 
 struct SegmentRun {
   SegmentResult result;
+  Mask labelmap;                     // result.surface on the image's grid (Labelmap.h)
   std::unique_ptr<SeedRegion> seed;  // for a seed start
   std::vector<Landmark> springs;     // what the springs pulled to
   OverlapMetrics metrics;            // against the reference, when given

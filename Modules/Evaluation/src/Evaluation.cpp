@@ -15,12 +15,10 @@
 
 #include "dynsub/Error.h"
 #include "dynsub/ImageIO.h"
-#include "dynsub/LimitSurface.h"
+#include "dynsub/Labelmap.h"
 #include "dynsub/Metrics.h"
 #include "dynsub/SeedGrowth.h"
 #include "dynsub/Segmentation.h"
-#include "dynsub/Tessellation.h"
-#include "dynsub/Voxelize.h"
 
 namespace dynsub {
 
@@ -73,11 +71,8 @@ EvaluationRun runOne(const EvaluationPlan& plan, const Volume& image, const Mask
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
 
   // Scored on the reference's grid (see the header).
-  const TriangleSurface& triangles = result.surface;
   const ImageGeometry& grid = reference.geometry;
-  const auto [first, size] = boundingRegion(grid, triangles.points, 2.0);
-  const Mask part = voxelizeSurface(triangles.points, triangles.triangles, grid.region(first, size));
-  const Mask mask = pasteMask(part, grid, first);
+  const Mask mask = labelmapOf(result.surface, grid);
   const double voxel = grid.spacing.prod();
   long long overlap = 0;
   for (size_t i = 0; i < mask.voxels.size(); ++i) overlap += mask.voxels[i] && reference.voxels[i];

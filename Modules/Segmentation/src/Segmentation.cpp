@@ -11,12 +11,12 @@
 #include "RobustStatistics.h"
 #include "dynsub/ApplyOperator.h"
 #include "dynsub/ClosestPoint.h"
+#include "dynsub/EdgeForce.h"
 #include "dynsub/Error.h"
 #include "dynsub/Forces.h"
 #include "dynsub/ShapeRecovery.h"
 #include "dynsub/StandardMeshes.h"
 #include "dynsub/Tessellation.h"
-#include "dynsub/Voxelize.h"
 
 namespace dynsub {
 namespace {
@@ -26,18 +26,6 @@ using Clock = std::chrono::steady_clock;
 double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
-
-// eq. 28: k grad(P) / |grad(P)|, as a force per unit area.
-class ImageForceField final : public ForceField {
- public:
-  ImageForceField(const DirectionField& directions, double strength) : directions_(directions), strength_(strength) {}
-  Matrix3X forcesAt(const Matrix3X& points) const override { return strength_ * directions_.sample(points); }
-  double slopeBound() const override { return strength_ * directions_.slopeBound(); }
-
- private:
-  const DirectionField& directions_;
-  double strength_;
-};
 
 // The gated region pressure (SegmentOptions::regionPressure).
 class RegionPressureForceModel final : public ForceModel {
@@ -165,7 +153,7 @@ SegmentationRegion::SegmentationRegion(const Volume& image, const std::vector<La
   geometry_ = region.geometry;
   cropSeconds_ = secondsSince(clock);
   clock = Clock::now();
-  directions_ = std::make_unique<const DirectionField>(region, options.edges, landmarkPoints);
+  edgeField_ = std::make_unique<const EdgeField>(region, options.edges, landmarkPoints);
   potentialSeconds_ = secondsSince(clock);
 }
 
@@ -186,7 +174,7 @@ SegmentResult evolveInRegion(const SegmentationRegion& region, const std::vector
   const Matrix3X landmarkPoints = landmarkPositions(landmarks);
   if (!region.covers(landmarkPoints) || !region.covers(initial.points()))
     throw Error("the landmarks or the initial model reach outside the region of interest: build a new region");
-  const ImageForceField field(region.directions(), options.imageForce);
+  const EdgeForce field(region.edgeField(), options.imageForce);
   FieldForceModel imageForces(field);
   Eigen::VectorXd stiffness = Eigen::VectorXd::Constant(landmarkPoints.rows(), options.landmarkStiffness);
   SpringForceModel springs(landmarkPoints, stiffness, SpringForceModel::Attach::NearestEachStep);
@@ -225,7 +213,7 @@ SegmentResult evolveInRegion(const SegmentationRegion& region, const std::vector
   result.origin = evolved.origin;
   result.regionFirst = region.first();
   result.regionSize = region.size();
-  result.edgeScale = region.directions().scale();
+  result.edgeScale = region.edgeField().scale();
   result.seconds.crop = region.cropSeconds();
   result.seconds.potential = region.potentialSeconds();
   result.seconds.evolution = secondsSince(clock);
@@ -248,16 +236,9 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
   SegmentResult result = evolveInRegion(region, landmarks, initial, {}, options, progress, forces);
   result.sliceEnds = std::move(ends);
 
-  const auto clock = Clock::now();
   if (!result.mesh.points().allFinite()) throw Error("the evolution produced a non-finite surface");
   result.surface = tessellate(LimitSurface(result.mesh), result.mesh.points(), kOutputSegments);
   const TriangleSurface& triangles = result.surface;
-  // Voxelize on the part of the grid the final surface covers (it may have left the region).
-  const ImageGeometry& grid = image.geometry;
-  const auto [outFirst, outSize] = boundingRegion(grid, triangles.points, 2.0);
-  const Mask part = voxelizeSurface(triangles.points, triangles.triangles, grid.region(outFirst, outSize));
-  result.labelmap = pasteMask(part, grid, outFirst);
-  result.seconds.voxelize = secondsSince(clock);
 
   result.initialVolume = enclosedVolume(tessellate(LimitSurface(initial), initial.points(), kOutputSegments));
   result.volume = enclosedVolume(triangles);
@@ -275,7 +256,7 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
     warning.str("");
   }
   if (options.edges.method == EdgeMethod::MongaDeriche) {
-    const DirectionField& field = region.directions();
+    const EdgeField& field = region.edgeField();
     const double voxel = region.image().geometry.spacing.maxCoeff();
     Eigen::Index held = 0;
     result.surfaceEdgeDistances.resize(triangles.points.rows());

@@ -13,6 +13,7 @@
 #include <random>
 
 #include "dynsub/Error.h"
+#include "dynsub/Labelmap.h"
 #include "dynsub/Metrics.h"
 #include "dynsub/Segmentation.h"
 #include "dynsub/ShapeRecovery.h"
@@ -116,7 +117,7 @@ struct Torus {
 Matrix3 skewDirection() { return Eigen::AngleAxisd(0.6, Vector3(1, -2, 3).normalized()).toRotationMatrix(); }
 
 void expectAccurate(const SegmentResult& result, const Phantom& phantom, double minimumDice) {
-  const OverlapMetrics m = compareMasks(result.labelmap, phantom.truth);
+  const OverlapMetrics m = compareMasks(labelmapOf(result.surface, phantom.image.geometry), phantom.truth);
   const double halfVoxel = 0.5 * phantom.image.geometry.spacing.minCoeff();
   EXPECT_GE(m.dice, minimumDice);
   EXPECT_LE(m.meanSurfaceDistance, halfVoxel);
@@ -182,7 +183,7 @@ TEST(Segment, ASeedCollapsesAndIsReportedUnlessTheRegionPressureGrowsIt) {
   options.regionPressure = 0.2;
   const SegmentResult grown = segment(phantom.image, {}, seed, options);
   EXPECT_TRUE(grown.warnings.empty()) << grown.warnings.front();
-  const OverlapMetrics m = compareMasks(grown.labelmap, phantom.truth);
+  const OverlapMetrics m = compareMasks(labelmapOf(grown.surface, phantom.image.geometry), phantom.truth);
   std::printf("seed: collapsed to %.1f mm^3; with the region pressure Dice %.3f, volume %.0f of %.0f mm^3\n",
               collapsed.volume, m.dice, grown.volume, 4.0 / 3.0 * M_PI * 1000.0);
   // Within about a voxel of the ball everywhere (a one-voxel shell of a
@@ -234,7 +235,8 @@ TEST(HostileNumbers, IntensitiesNearTheFloatLimitsSegmentAsOrdinaryOnes) {
     for (float& v : scaled.voxels) v = static_cast<float>(v * scale);
     const SegmentResult result = segment(scaled, c.landmarks, initial, SegmentOptions());
     expectFinite(result);
-    const double dice = compareMasks(result.labelmap, ordinary.labelmap).dice;
+    const double dice =
+        compareMasks(labelmapOf(result.surface, scaled.geometry), labelmapOf(ordinary.surface, scaled.geometry)).dice;
     std::printf("intensities x %g: Dice %.4f with the ordinary result\n", scale, dice);
     // Rounding in float differs at these scales; a voxel or two may flip.
     EXPECT_GT(dice, 0.99) << "scale " << scale;
@@ -260,7 +262,7 @@ TEST(HostileNumbers, AConstantImageIsSaidToBeOrLeavesTheLandmarksToShapeTheSurfa
   const SegmentResult result = segment(c.phantom.image, c.landmarks, initial, fromImage);
   expectFinite(result);
   for (double d : result.landmarkDistances) EXPECT_LT(d, 1.0);
-  const double dice = compareMasks(result.labelmap, c.phantom.truth).dice;
+  const double dice = compareMasks(labelmapOf(result.surface, c.phantom.image.geometry), c.phantom.truth).dice;
   std::printf("constant image, thresholds from the image: Dice %.3f with the ellipsoid the landmarks lie on\n", dice);
   EXPECT_GT(dice, 0.8);
 }

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "dynsub/Error.h"
+#include "dynsub/Labelmap.h"
 #include "dynsub/Metrics.h"
 #include "dynsub/Segmentation.h"
 #include "dynsub/SliceEnds.h"
@@ -108,10 +109,10 @@ TEST(SliceEnds, TheSegmentationReachesTheUnclickedEnds) {
   const ControlMesh initial = initialFromLandmarks(landmarks);
   SegmentOptions options;
   options.sliceEnds.enabled = false;
-  const double without = compareMasks(segment(image, landmarks, initial, options).labelmap, truth).dice;
+  const double without = compareMasks(labelmapOf(segment(image, landmarks, initial, options).surface, image.geometry), truth).dice;
   options.sliceEnds.enabled = true;
   const SegmentResult result = segment(image, landmarks, initial, options);
-  const double with = compareMasks(result.labelmap, truth).dice;
+  const double with = compareMasks(labelmapOf(result.surface, image.geometry), truth).dice;
   std::printf("Dice without the ends' springs %.3f, with %.3f\n", without, with);
   EXPECT_EQ(result.sliceEnds.ends.size(), 2u);
   EXPECT_FALSE(result.sliceEnds.springs.empty());

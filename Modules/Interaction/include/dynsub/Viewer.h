@@ -11,7 +11,7 @@
 // initial model (at least 4 landmarks), and the surface is redrawn in every
 // view as it moves (about 25 times a second). Editing the landmarks while
 // fitting, or after a fit, refits: from the last finished fit if there is one
-// (its control mesh and level), reusing its region and edge directions (with
+// (its control mesh and level), reusing its region and edge field (with
 // the edge thresholds the region was built with) while the landmarks and the
 // surface stay inside; otherwise from the initial model. The status line
 // gives each fit's steps and time.

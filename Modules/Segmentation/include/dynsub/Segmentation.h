@@ -14,7 +14,8 @@
 // The work is confined to a region of interest: the bounding box of the
 // initial model and the landmarks, grown by `margin` mm (enough for the
 // surface to reach edges beyond them); the edge potential is built there only.
-// The result is voxelized on the input image's full grid.
+// The result is the final control mesh and its limit surface; the outputs
+// (Labelmap.h) voxelize that surface on the input image's full grid.
 #include <array>
 #include <limits>
 #include <memory>
@@ -55,15 +56,14 @@ struct SegmentOptions {
 };
 
 struct StageSeconds {
-  double crop = 0, potential = 0, evolution = 0, voxelize = 0;
+  double crop = 0, potential = 0, evolution = 0;
 };
 
 struct SegmentResult {
   ControlMesh mesh;
-  // The limit surface of `mesh`, 8 x 8 squares per element (ModelOutputs.h's
-  // outputSurface): what was voxelized, and what every output shows.
+  // The limit surface of `mesh`, 8 x 8 squares per element (kOutputSegments):
+  // what the labelmap, surface.vtp, the report and the figures show.
   TriangleSurface surface;
-  Mask labelmap;  // on the input's grid
   std::vector<LevelSummary> levels;
   int steps = 0;
   StageSeconds seconds;
@@ -100,7 +100,7 @@ constexpr double kCollapsedBelow = 0.5;
 constexpr double kLeakedAbove = 0.05;
 
 // The image side of a segmentation: the region of interest cropped from the
-// image and its edge directions (EdgePotential.h), with the time each took.
+// image and its edge field (EdgePotential.h), with the time each took.
 // segment() builds one per call; an interactive refit keeps it and reuses it
 // while the model and the landmarks stay inside.
 class SegmentationRegion {
@@ -117,7 +117,7 @@ class SegmentationRegion {
   bool covers(const Matrix3X& points) const;
   bool covers(const Vector3& point) const;
 
-  const DirectionField& directions() const { return *directions_; }
+  const EdgeField& edgeField() const { return *edgeField_; }
   const Volume& image() const { return image_; }  // the image cropped to the region
   const std::array<int, 3>& first() const { return first_; }  // voxel box in the image
   const std::array<int, 3>& size() const { return size_; }
@@ -129,7 +129,7 @@ class SegmentationRegion {
   ImageGeometry geometry_;
   Volume image_;
   double cropSeconds_ = 0, potentialSeconds_ = 0;
-  std::unique_ptr<const DirectionField> directions_;
+  std::unique_ptr<const EdgeField> edgeField_;
 };
 
 // The papers' cube placed inside the landmarks' PCA ellipsoid (`fraction`

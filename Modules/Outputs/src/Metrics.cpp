@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "dynsub/Error.h"
-#include "BridgeGeometry.h"
+#include "dynsub/ImageFilters.h"
 
 namespace dynsub {
 namespace {
@@ -76,8 +76,7 @@ OverlapMetrics compareMasks(const Mask& a, const Mask& b) {
   }
   const Mask partA = cropMask(a, first, size), partB = cropMask(b, first, size);
   const Mask boundaryA = boundaryOf(partA), boundaryB = boundaryOf(partB);
-  const std::vector<float> toA = itkbridge::functions().distanceMap(toBridge(partA.geometry), boundaryA.voxels),
-                           toB = itkbridge::functions().distanceMap(toBridge(partB.geometry), boundaryB.voxels);
+  const std::vector<float> toA = distanceMap(boundaryA).voxels, toB = distanceMap(boundaryB).voxels;
   std::vector<double> distances;
   for (std::size_t v = 0; v < partA.voxels.size(); ++v) {
     if (boundaryA.voxels[v]) distances.push_back(toB[v]);

@@ -7,19 +7,10 @@
 #include <vector>
 
 #include "dynsub/Error.h"
-#include "BridgeGeometry.h"
+#include "dynsub/ImageFilters.h"
 
 namespace dynsub {
 namespace {
-
-// Gradient (LPS, per mm) of the image smoothed by a Gaussian of sigma mm.
-std::vector<Vector3> smoothedGradient(const Volume& image, double sigma) {
-  const std::vector<float> raw =
-      itkbridge::functions().recursiveGaussianGradient(toBridge(image.geometry), image.voxels, sigma);
-  std::vector<Vector3> gradient(image.voxels.size());
-  for (std::size_t v = 0; v < gradient.size(); ++v) gradient[v] = Vector3(raw[3 * v], raw[3 * v + 1], raw[3 * v + 2]);
-  return gradient;
-}
 
 Volume magnitudeOf(const ImageGeometry& geometry, const std::vector<Vector3>& gradient) {
   Volume magnitude{geometry, std::vector<float>(gradient.size())};
@@ -180,7 +171,7 @@ void checkEdgeOptions(const EdgeOptions& options) {
     throw Error("capture range must be a positive number of mm (got " + std::to_string(options.captureRange) + ")");
 }
 
-DirectionField::DirectionField(const Volume& image, const EdgeOptions& options, const Matrix3X& landmarks)
+EdgeField::EdgeField(const Volume& image, const EdgeOptions& options, const Matrix3X& landmarks)
     : geometry_(image.geometry) {
   checkEdgeOptions(options);
   const std::vector<Vector3> gradient = smoothedGradient(image, options.sigma);
@@ -192,7 +183,7 @@ DirectionField::DirectionField(const Volume& image, const EdgeOptions& options, 
   scale_ = edgeScale(magnitude, options, landmarks);
   edges_ = edgeMap(magnitude, gradient, scale_);
   // P = -distance to the nearest edge (see the header).
-  edgeDistance_ = Volume{image.geometry, itkbridge::functions().distanceMap(toBridge(image.geometry), edges_.voxels)};
+  edgeDistance_ = distanceMap(edges_);
   hasEdges_ = edges_.count() > 0;
   Volume potential = edgeDistance_;
   std::vector<std::uint8_t> keep(potential.voxels.size());
@@ -203,15 +194,15 @@ DirectionField::DirectionField(const Volume& image, const EdgeOptions& options, 
   normalizedGradient(potential, keep, components_);
 }
 
-double DirectionField::slopeBound() const { return 2.0 / geometry_.spacing.minCoeff(); }
+double EdgeField::slopeBound() const { return 2.0 / geometry_.spacing.minCoeff(); }
 
-double DirectionField::edgeDistance(const Vector3& point) const {
+double EdgeField::edgeDistance(const Vector3& point) const {
   if (!hasEdges_) return std::numeric_limits<double>::infinity();
   const Vector3 index = geometry_.toIndex(point);
   return geometry_.spans(index) ? edgeDistance_.interpolate(index) : std::numeric_limits<double>::infinity();
 }
 
-Matrix3X DirectionField::sample(const Matrix3X& points) const {
+Matrix3X EdgeField::sample(const Matrix3X& points) const {
   Matrix3X result = Matrix3X::Zero(points.rows(), 3);
   const Matrix3 toIndex = geometry_.indexFromPhysical();
   for (Eigen::Index p = 0; p < points.rows(); ++p) {

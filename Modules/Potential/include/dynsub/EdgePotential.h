@@ -83,13 +83,15 @@ class LandmarksOffEdges : public LandmarkError {
 // Throws dynsub::Error for non-finite or impossible options.
 void checkEdgeOptions(const EdgeOptions& options);
 
-// Unit force directions (LPS) on the image's grid, and the edge map they come from.
-class DirectionField {
+// The edge map of the image's grid, the distance to it, and the unit
+// directions grad(P) / |grad(P)| of eq. 28's force (LPS); EdgeForce.h makes
+// them a force.
+class EdgeField {
  public:
   // `landmarks` (N x 3, mm) are points on the wanted boundary; they set the
   // edge thresholds when options.reference is Landmarks (see above); throws
   // LandmarksOffEdges when they are not on an edge.
-  DirectionField(const Volume& image, const EdgeOptions& options, const Matrix3X& landmarks = Matrix3X());
+  EdgeField(const Volume& image, const EdgeOptions& options, const Matrix3X& landmarks = Matrix3X());
 
   // N points in mm -> N unit (or zero) vectors, trilinearly interpolated.
   Matrix3X sample(const Matrix3X& points) const;

@@ -1,0 +1,20 @@
+#pragma once
+// The image filters DynSub takes from ITK, on the project's own types: the
+// rest of the project samples fields built with these and never sees ITK.
+#include <vector>
+
+#include "dynsub/Types.h"
+#include "dynsub/Volume.h"
+
+namespace dynsub {
+
+// The gradient (LPS axes, per mm) of the image smoothed by a Gaussian of
+// sigma mm, with Deriche's recursive filters: one vector per voxel, in the
+// voxels' order.
+std::vector<Vector3> smoothedGradient(const Volume& image, double sigma);
+
+// The Euclidean distance (mm) from every voxel centre to the nearest voxel
+// of `mask`, on its grid.
+Volume distanceMap(const Mask& mask);
+
+}  // namespace dynsub

@@ -1,0 +1,245 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+
+#include "TestGrids.h"
+#include "dynsub/Error.h"
+#include "dynsub/ImageIO.h"
+
+namespace dynsub {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::path(DYNSUB_BINARY_DIR) / "Testing" / "Temporary" / "Image";
+  fs::create_directories(dir);
+  return dir / name;
+}
+
+TEST(ImageGeometry, IndexAndPhysicalAreInverse) {
+  const ImageGeometry g = grid({10, 20, 30}, Vector3(0.5, 1.0, 2.0), Vector3(-3, 4, 5), skewDirection());
+  const Vector3 index(1.5, -2.25, 7.0);
+  EXPECT_LT((g.toIndex(g.toPhysical(index)) - index).norm(), 1e-12);
+  // One step along k moves 2 mm along the direction's third column.
+  EXPECT_LT((g.toPhysical(Vector3(0, 0, 1)) - g.origin - 2.0 * g.direction.col(2)).norm(), 1e-12);
+}
+
+TEST(ImageIO, MaskRoundTripKeepsGeometryAndVoxels) {
+  Mask mask{grid({7, 5, 4}, Vector3(0.7, 1.1, 2.5), Vector3(12, -30, 8), skewDirection()), {}};
+  mask.voxels.resize(mask.geometry.voxelCount());
+  for (std::size_t v = 0; v < mask.voxels.size(); ++v) mask.voxels[v] = (v * 7919) % 3 == 0;
+  // Every single-file format (the size checks of truncated files must pass whole ones).
+  for (const std::string name : {"roundtrip.nii.gz", "roundtrip.nii", "roundtrip.nrrd", "roundtrip.mha"}) {
+    const fs::path path = scratch(name);
+    writeMask(mask, path.string());
+    const Volume read = readVolume(path.string());
+    EXPECT_EQ(read.geometry.size, mask.geometry.size) << name;
+    // NIfTI stores spacing and the affine in single precision.
+    EXPECT_LT((read.geometry.spacing - mask.geometry.spacing).norm(), 1e-5) << name;
+    EXPECT_LT((read.geometry.origin - mask.geometry.origin).norm(), 1e-4) << name;
+    EXPECT_LT((read.geometry.direction - mask.geometry.direction).norm(), 1e-5) << name;
+    for (std::size_t v = 0; v < mask.voxels.size(); ++v) ASSERT_EQ(read.voxels[v], mask.voxels[v]) << name << v;
+  }
+}
+
+// A MetaImage header with its voxels in a separate raw file, as other tools
+// write it (writeMask refuses to: its header would name a temporary file).
+TEST(ImageIO, MetaImageWithADataFile) {
+  const fs::path header = scratch("detached.mhd"), data = scratch("detached.raw");
+  std::ofstream(header) << "ObjectType = Image\nNDims = 3\nBinaryData = True\nBinaryDataByteOrderMSB = False\n"
+                           "CompressedData = False\nTransformMatrix = 1 0 0 0 1 0 0 0 1\nOffset = 3 -2 1\n"
+                           "ElementSpacing = 0.5 1 2\nDimSize = 4 3 2\nElementType = MET_UCHAR\n"
+                           "ElementDataFile = detached.raw\n";
+  std::string voxels;
+  for (int v = 0; v < 24; ++v) voxels.push_back(static_cast<char>(v));
+  std::ofstream(data, std::ios::binary) << voxels;
+  const Volume read = readVolume(header.string());
+  EXPECT_EQ(read.geometry.size, (std::array<int, 3>{4, 3, 2}));
+  EXPECT_LT((read.geometry.spacing - Vector3(0.5, 1, 2)).norm(), 1e-12);
+  EXPECT_LT((read.geometry.origin - Vector3(3, -2, 1)).norm(), 1e-12);
+  for (int v = 0; v < 24; ++v) ASSERT_EQ(read.voxels[v], v);
+  // The data file cut short: refused, naming it.
+  fs::resize_file(data, 20);
+  try {
+    readVolume(header.string());
+    ADD_FAILURE() << "a short data file was read";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("detached.raw: truncated"), std::string::npos) << e.what();
+  }
+  Mask mask{read.geometry, std::vector<std::uint8_t>(24, 1)};
+  EXPECT_THROW(writeMask(mask, scratch("written.mhd").string()), Error);
+  EXPECT_FALSE(fs::exists(scratch("written.mhd")));
+}
+
+TEST(ImageIO, BadFilesAreRefusedWithTheirName) {
+  EXPECT_THROW(readVolume(scratch("missing.nii.gz").string()), Error);
+  // One slice: not a 3D image.
+  Mask slice{grid({8, 8, 1}, Vector3::Ones(), Vector3::Zero(), Matrix3::Identity()), {}};
+  slice.voxels.assign(64, 1);
+  writeMask(slice, scratch("slice.nii.gz").string());
+  try {
+    readVolume(scratch("slice.nii.gz").string());
+    FAIL() << "a single slice was read as a volume";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("not a 3D image"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("slice.nii.gz"), std::string::npos) << e.what();
+  }
+  // Truncated: the header survives, the voxels do not. The voxels are
+  // pseudo-random so that compressed files are large enough for their header
+  // to survive a cut to 3/4 (a .nii.gz cut short used to read as zeros).
+  Mask big{grid({40, 40, 40}, Vector3::Ones(), Vector3::Zero(), Matrix3::Identity()), {}};
+  big.voxels.resize(big.geometry.voxelCount());
+  unsigned state = 1;
+  for (auto& voxel : big.voxels) voxel = ((state = state * 1103515245u + 12345u) >> 16) & 1u;
+  for (const std::string name : {"whole.nii", "whole.nii.gz", "whole.nrrd", "whole.mha"}) {
+    const fs::path whole = scratch(name);
+    writeMask(big, whole.string());
+    fs::resize_file(whole, fs::file_size(whole) * 3 / 4);
+    try {
+      readVolume(whole.string());
+      ADD_FAILURE() << name << " cut to 3/4 was read";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    }
+  }
+  std::ofstream(scratch("text.nii").string()) << "not an image\n";
+  EXPECT_THROW(readVolume(scratch("text.nii").string()), Error);
+}
+
+// ---- Hostile numbers in image files: a clear error or a correct volume ----
+
+// A NIfTI-1 file of float voxels, written byte by byte (the header fields
+// DynSub and ITK read): `dims` may be larger than the voxels written, to make
+// a header that lies.
+void writeNifti(const fs::path& path, std::array<long, 3> dims, Vector3 spacing, const std::vector<float>& voxels,
+                double srowScale = 1.0) {
+  std::string header(352, '\0');
+  auto put = [&header](std::size_t at, auto value) { std::memcpy(&header[at], &value, sizeof value); };
+  put(0, std::int32_t{348});
+  put(40, std::int16_t{3});
+  for (int a = 0; a < 3; ++a) put(42 + 2 * a, static_cast<std::int16_t>(std::min<long>(dims[a], 32767)));
+  put(70, std::int16_t{16});  // float32
+  put(72, std::int16_t{32});
+  put(76, 1.0f);
+  for (int a = 0; a < 3; ++a) put(80 + 4 * a, static_cast<float>(spacing[a]));
+  put(108, 352.0f);
+  put(112, 1.0f);  // scl_slope
+  header[123] = 10;  // mm, seconds
+  put(254, std::int16_t{1});  // sform_code: scanner
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) put(280 + 16 * r + 4 * c, static_cast<float>(r == c ? srowScale * spacing[r] : 0.0));
+  std::memcpy(&header[344], "n+1\0", 4);
+  std::ofstream out(path, std::ios::binary);
+  out << header;
+  out.write(reinterpret_cast<const char*>(voxels.data()), static_cast<std::streamsize>(voxels.size() * sizeof(float)));
+}
+
+std::vector<float> ramp(std::size_t n, float scale) {
+  std::vector<float> voxels(n);
+  for (std::size_t v = 0; v < n; ++v) voxels[v] = scale * static_cast<float>(v % 17);
+  return voxels;
+}
+
+// The error readVolume gives for `path`, or "" when it reads it.
+std::string readError(const fs::path& path) {
+  try {
+    readVolume(path.string());
+    return "";
+  } catch (const Error& e) {
+    return e.what();
+  }
+}
+
+TEST(HostileImages, NanAndInfiniteVoxelsAreRefusedWithTheFirstIndex) {
+  for (const float bad : {std::numeric_limits<float>::quiet_NaN(), -std::numeric_limits<float>::infinity()}) {
+    std::vector<float> voxels = ramp(6 * 5 * 4, 1.0f);
+    voxels[2 + 6 * (3 + 5 * 1)] = bad;
+    voxels[100] = bad;
+    writeNifti(scratch("bad_voxels.nii"), {6, 5, 4}, Vector3(1, 1, 1), voxels);
+    const std::string error = readError(scratch("bad_voxels.nii"));
+    EXPECT_NE(error.find("bad_voxels.nii: 2 voxel(s) are NaN or infinite, the first at index (2, 3, 1)"),
+              std::string::npos)
+        << error;
+  }
+}
+
+// ITK keeps NaN in MetaImage and NRRD files; readVolume refuses them there too.
+TEST(HostileImages, NanVoxelsInMetaImageAndNrrdFilesAreRefused) {
+  std::vector<float> voxels = ramp(4 * 3 * 2, 1.0f);
+  voxels[7] = std::numeric_limits<float>::quiet_NaN();
+  const std::string data(reinterpret_cast<const char*>(voxels.data()), voxels.size() * sizeof(float));
+  std::ofstream(scratch("nan.mha"), std::ios::binary)
+      << "ObjectType = Image\nNDims = 3\nDimSize = 4 3 2\nElementType = MET_FLOAT\nElementDataFile = LOCAL\n" << data;
+  std::ofstream(scratch("nan.nrrd"), std::ios::binary)
+      << "NRRD0004\ntype: float\ndimension: 3\nsizes: 4 3 2\nencoding: raw\nendian: little\n\n" << data;
+  for (const std::string name : {"nan.mha", "nan.nrrd"}) {
+    const std::string error = readError(scratch(name));
+    EXPECT_NE(error.find(name + ": 1 voxel(s) are NaN or infinite, the first at index (3, 1, 0)"), std::string::npos)
+        << error;
+  }
+}
+
+TEST(HostileImages, ConstantAndExtremeIntensitiesAreReadExactly) {
+  // The ramp goes up to 16 times the scale: 2.4e38 of float's 3.4e38.
+  for (const float scale : {0.0f, 1.5e37f, 1e-37f, -1.5e37f}) {
+    const std::vector<float> voxels = scale == 0.0f ? std::vector<float>(60, 42.0f) : ramp(60, scale);
+    writeNifti(scratch("extreme.nii"), {5, 4, 3}, Vector3(1, 1, 1), voxels);
+    const Volume volume = readVolume(scratch("extreme.nii").string());
+    ASSERT_EQ(volume.voxels.size(), voxels.size());
+    for (std::size_t v = 0; v < voxels.size(); ++v) ASSERT_EQ(volume.voxels[v], voxels[v]) << "scale " << scale;
+  }
+}
+
+TEST(HostileImages, SpacingOutsideWhatDynSubWorksWithIsRefused) {
+  for (const double spacing : {1e-6, 1e5}) {
+    writeNifti(scratch("spacing.nii"), {4, 4, 4}, Vector3(1, spacing, 1), ramp(64, 1.0f));
+    const std::string error = readError(scratch("spacing.nii"));
+    EXPECT_NE(error.find("spacing.nii: voxel spacing"), std::string::npos) << error;
+    EXPECT_NE(error.find("outside the 0.0001 to 10000 mm"), std::string::npos) << error;
+  }
+  // Near the limits (NIfTI stores spacing as float: 1e-4 itself reads as 9.99999975e-5).
+  writeNifti(scratch("spacing.nii"), {4, 4, 4}, Vector3(2e-4, 1, 5e3), ramp(64, 1.0f));
+  EXPECT_EQ(readError(scratch("spacing.nii")), "");
+}
+
+TEST(HostileImages, ADegenerateDirectionIsRefused) {
+  // NRRD space directions with two parallel axes.
+  std::ofstream(scratch("parallel.nrrd"), std::ios::binary)
+      << "NRRD0004\ntype: float\ndimension: 3\nspace: left-posterior-superior\nsizes: 2 2 2\n"
+         "space directions: (1,0,0) (0,1,0) (1,0,0)\nencoding: raw\nendian: little\nspace origin: (0,0,0)\n\n"
+      << std::string(32, '\0');
+  const std::string error = readError(scratch("parallel.nrrd"));
+  EXPECT_NE(error.find("parallel.nrrd"), std::string::npos) << error;
+  EXPECT_FALSE(error.empty());
+}
+
+TEST(HostileImages, HeadersAnnouncingHugeImagesAreRefusedBeforeAllocating) {
+  // 1000^3 float voxels (4 GB) announced by a file of a few bytes: truncated.
+  writeNifti(scratch("huge.nii"), {1000, 1000, 1000}, Vector3(1, 1, 1), ramp(8, 1.0f));
+  std::string error = readError(scratch("huge.nii"));
+  EXPECT_NE(error.find("huge.nii: truncated"), std::string::npos) << error;
+  // 32767^3 (1.3e5 GiB): more than any memory, in NIfTI, MetaImage and NRRD
+  // (the last through ITK's header reader).
+  writeNifti(scratch("huge.nii"), {32767, 32767, 32767}, Vector3(1, 1, 1), ramp(8, 1.0f));
+  error = readError(scratch("huge.nii"));
+  EXPECT_NE(error.find("huge.nii: the header announces 35181150961663 voxels"), std::string::npos) << error;
+  EXPECT_NE(error.find("GiB of memory"), std::string::npos) << error;
+  std::ofstream(scratch("huge.mha"), std::ios::binary)
+      << "ObjectType = Image\nNDims = 3\nDimSize = 100000 100000 100000\nElementType = MET_FLOAT\n"
+         "ElementDataFile = LOCAL\n" << std::string(64, '\0');
+  error = readError(scratch("huge.mha"));
+  EXPECT_NE(error.find("huge.mha: the header announces 1000000000000000 voxels"), std::string::npos) << error;
+  std::ofstream(scratch("huge.nrrd"), std::ios::binary)
+      << "NRRD0004\ntype: float\ndimension: 3\nsizes: 100000 100000 100000\nencoding: raw\nendian: little\n\n"
+      << std::string(64, '\0');
+  error = readError(scratch("huge.nrrd"));
+  EXPECT_NE(error.find("huge.nrrd: the header announces 1000000000000000 voxels"), std::string::npos) << error;
+}
+
+}  // namespace
+}  // namespace dynsub

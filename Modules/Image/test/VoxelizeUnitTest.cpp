@@ -1,0 +1,76 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "TestGrids.h"
+#include "dynsub/Error.h"
+#include "dynsub/Voxelize.h"
+
+namespace dynsub {
+namespace {
+
+// A closed UV sphere (triangles oriented outward).
+void uvSphere(const Vector3& centre, double radius, Matrix3X& points, std::vector<std::array<int, 3>>& triangles) {
+  const int rings = 60, sectors = 120;
+  points.resize(2 + (rings - 1) * sectors, 3);
+  points.row(0) = (centre + Vector3(0, 0, radius)).transpose();
+  points.row(1) = (centre - Vector3(0, 0, radius)).transpose();
+  for (int r = 1; r < rings; ++r)
+    for (int s = 0; s < sectors; ++s) {
+      const double theta = M_PI * r / rings, phi = 2 * M_PI * s / sectors;
+      points.row(2 + (r - 1) * sectors + s) =
+          (centre + radius * Vector3(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                                     std::cos(theta)))
+              .transpose();
+    }
+  auto at = [&](int r, int s) { return 2 + (r - 1) * sectors + (s % sectors); };
+  triangles.clear();
+  for (int s = 0; s < sectors; ++s) {
+    triangles.push_back({0, at(1, s), at(1, s + 1)});
+    triangles.push_back({1, at(rings - 1, s + 1), at(rings - 1, s)});
+    for (int r = 1; r + 1 < rings; ++r) {
+      triangles.push_back({at(r, s), at(r + 1, s), at(r + 1, s + 1)});
+      triangles.push_back({at(r, s), at(r + 1, s + 1), at(r, s + 1)});
+    }
+  }
+}
+
+TEST(Voxelize, SphereOnAnAnisotropicRotatedGrid) {
+  const ImageGeometry g = grid({48, 40, 24}, Vector3(0.6, 0.8, 1.5), Vector3(-14, -15, -16), skewDirection());
+  const Vector3 centre = g.toPhysical(Vector3(23.5, 19.5, 11.5));
+  const double radius = 10.0;
+  Matrix3X points;
+  std::vector<std::array<int, 3>> triangles;
+  uvSphere(centre, radius, points, triangles);
+  const Mask mask = voxelizeSurface(points, triangles, g);
+  // Every voxel centre clearly inside or outside the sphere is classified so;
+  // the polygon lies within radius (1 - cos(pi/60)) ~ 0.014 mm of the sphere.
+  long long inside = 0;
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i) {
+        const double r = (g.toPhysical(Vector3(i, j, k)) - centre).norm();
+        const bool set = mask.voxels[g.offset(i, j, k)];
+        if (r < radius - 0.02) {
+          ASSERT_TRUE(set) << i << ' ' << j << ' ' << k;
+        }
+        if (r > radius + 0.02) {
+          ASSERT_FALSE(set) << i << ' ' << j << ' ' << k;
+        }
+        inside += set;
+      }
+  const double volume = inside * g.spacing.prod(), exact = 4.0 / 3.0 * M_PI * radius * radius * radius;
+  EXPECT_NEAR(volume / exact, 1.0, 0.02);
+}
+
+TEST(Voxelize, OpenSurfaceIsRefused) {
+  const ImageGeometry g = grid({20, 20, 20}, Vector3::Ones(), Vector3::Zero(), Matrix3::Identity());
+  Matrix3X points;
+  std::vector<std::array<int, 3>> triangles;
+  uvSphere(Vector3(10, 10, 10), 5, points, triangles);
+  triangles.pop_back();
+  EXPECT_THROW(voxelizeSurface(points, triangles, g), Error);
+}
+
+}  // namespace
+}  // namespace dynsub
