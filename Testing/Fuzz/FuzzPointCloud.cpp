@@ -5,7 +5,7 @@
 #include "FuzzInput.h"
 #include "dynsub/Error.h"
 #include "dynsub/PointCloudIO.h"
-#include "dynsub/ShapeRecovery.h"
+#include "dynsub/InitialModels.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace dynsub::fuzz;

@@ -4,8 +4,11 @@
 // decides exactly as a locator whose tree is rebuilt at every state.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
 #include <random>
 
+#include "dynsub/CatmullClark.h"
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/LimitSurface.h"
 #include "dynsub/StandardMeshes.h"
@@ -85,6 +88,58 @@ TEST(ClosestPointLocator, TrackingDecidesAsARebuiltTreeDoes) {
       last = tracked;
     }
     EXPECT_GT(moved, 0) << name << ": no query changed element, so the search was never exercised";
+  }
+}
+
+// The stated accuracy (ClosestPoint.h): a query a short way off the surface
+// along the limit normal at a known point has that point as its closest
+// point, at that distance. Points inside elements of both kinds (normal ones,
+// and special ones at the cube's valence-3 corners) on a 10 mm cube; the
+// offset, 0.2 mm, is well inside the radius of curvature (about 5 mm), so the
+// closest point is unique. The header promises the exact closest point to
+// about 1e-8 of the element size (its diagonal); that is the tolerance.
+TEST(ClosestPointLocator, FindsTheExactClosestPointToItsStatedAccuracy) {
+  ControlMesh cube = makeStandardMesh("cube");
+  cube.setPoints(cube.points() * 10.0);
+  const LimitSurface surface(cube);
+  ClosestPointLocator locator(surface);
+  locator.update(cube.points());
+  std::mt19937_64 random(7);
+  std::uniform_real_distribution<double> parameter(0.05, 0.95);
+  int special = 0;
+  double worst = 0;
+  for (int i = 0; i < 1000; ++i) {
+    const ElementPoint at{static_cast<int>(random() % surface.elementCount()), parameter(random), parameter(random)};
+    special += surface.elementType(at.element) == ElementType::Special;
+    const double size = (surface.evaluate(ElementPoint{at.element, 1, 1}, cube.points()).position -
+                         surface.evaluate(ElementPoint{at.element, 0, 0}, cube.points()).position)
+                            .norm();
+    const LimitSample sample = surface.evaluate(at, cube.points());
+    for (const double offset : {0.2, -0.2}) {
+      const ClosestPoint c = locator.find(sample.position + offset * sample.normal);
+      const double error = std::max(std::abs(c.distance - 0.2), (c.position - sample.position).norm()) / size;
+      worst = std::max(worst, error);
+      EXPECT_LT(error, 1e-8) << "element " << at.element << " (" << at.u << ", " << at.v << ")";
+    }
+  }
+  std::printf("worst error %.2e of the element size\n", worst);
+  EXPECT_GT(special, 50);  // special elements were tried
+}
+
+// Samples of the once-refined surface are points of the original one: the
+// locator finds them on it at distance zero (to Newton's stopping step).
+TEST(ClosestPointLocator, FindsTheRefinedSurfacesSamplesOnTheOriginal) {
+  for (const char* name : {"cube", "torus"}) {
+    const ControlMesh mesh = makeStandardMesh(name);
+    const SubdividedMesh refined = subdivide(mesh);
+    const LimitSurface coarse(mesh), fine(refined.mesh);
+    const TriangleSurface samples = tessellate(fine, refined.mesh.points(), 3);
+    ClosestPointLocator locator(coarse, 8, 8);
+    locator.update(mesh.points());
+    double worst = 0.0;
+    for (const ClosestPoint& c : locator.findAll(samples.points)) worst = std::max(worst, c.distance);
+    // Exact in theory; Newton stops at steps of 1e-12 in parameters.
+    EXPECT_LT(worst, 1e-9) << name;
   }
 }
 

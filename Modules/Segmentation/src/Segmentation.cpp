@@ -14,8 +14,7 @@
 #include "dynsub/EdgeForce.h"
 #include "dynsub/Error.h"
 #include "dynsub/Forces.h"
-#include "dynsub/ShapeRecovery.h"
-#include "dynsub/StandardMeshes.h"
+#include "dynsub/InitialModels.h"
 #include "dynsub/Tessellation.h"
 
 namespace dynsub {
@@ -98,16 +97,6 @@ ControlMesh initialFromLandmarks(const std::vector<Landmark>& landmarks, double 
   const Matrix3X points = landmarkPositions(landmarks);
   checkPointCloud(points, "the landmarks");
   return initialModel(points, InitialShape::Sphere, fraction);
-}
-
-ControlMesh initialSphere(const Vector3& centre, double radius) {
-  if (!(radius > 0) || !std::isfinite(radius) || !centre.allFinite())
-    throw Error("the initial sphere needs a finite centre and a radius > 0 mm");
-  ControlMesh cube = makeCube98();
-  const Matrix3X limit = limitPoints(cube, 4);
-  const double scale = radius / limit.rowwise().norm().mean();
-  cube.setPoints((cube.points() * scale).rowwise() + centre.transpose());
-  return cube;
 }
 
 std::vector<double> distancesToSurface(const LimitSurface& surface, const Matrix3X& controlPoints,

@@ -16,7 +16,7 @@
 #include "dynsub/Labelmap.h"
 #include "dynsub/Metrics.h"
 #include "dynsub/Segmentation.h"
-#include "dynsub/ShapeRecovery.h"
+#include "dynsub/InitialModels.h"
 
 namespace dynsub {
 namespace {

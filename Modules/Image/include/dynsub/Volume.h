@@ -11,7 +11,6 @@
 
 namespace dynsub {
 
-using Matrix3 = Eigen::Matrix3d;
 
 struct ImageGeometry {
   std::array<int, 3> size{0, 0, 0};

@@ -24,6 +24,7 @@
 
 #include "dynsub/ControlMesh.h"
 #include "dynsub/EdgePotential.h"
+#include "dynsub/InitialModels.h"
 #include "dynsub/Landmarks.h"
 #include "dynsub/Simulation.h"
 #include "dynsub/SliceEnds.h"
@@ -137,8 +138,6 @@ class SegmentationRegion {
 // landmarks or flat ones.
 ControlMesh initialFromLandmarks(const std::vector<Landmark>& landmarks, double fraction = 0.5);
 
-// The cube's limit surface as a sphere of `radius` mm around `centre`.
-ControlMesh initialSphere(const Vector3& centre, double radius);
 
 // Throws dynsub::Error when the initial model lies outside the image or for
 // impossible options, LandmarkError when a landmark lies outside the image or

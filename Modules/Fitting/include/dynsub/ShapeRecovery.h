@@ -18,24 +18,10 @@
 
 #include "dynsub/ControlMesh.h"
 #include "dynsub/EnclosingSphere.h"
+#include "dynsub/InitialModels.h"
 #include "dynsub/Simulation.h"
 
 namespace dynsub {
-
-// Checks a point cloud read from `source`: at least 4 points, finite
-// coordinates, not all coincident, not all on a plane or a line. Throws
-// dynsub::Error naming the source.
-void checkPointCloud(const Matrix3X& points, const std::string& source);
-
-enum class InitialShape { Sphere, Torus };
-
-// The papers' initial model placed inside the data's PCA ellipsoid. Sphere:
-// the 98-vertex cube, its limit surface scaled to `fraction` (by default
-// half) of the ellipsoid's semi-axes (sqrt(3 lambda_i): exact for points
-// spread over an ellipsoid's surface). Torus: the 32-vertex torus around the
-// axis of least variance, with the data's mean ring radius and half its mean
-// tube radius.
-ControlMesh initialModel(const Matrix3X& points, InitialShape shape, double fraction = 0.5);
 
 struct FitOptions {
   double tolerancePercent = 1.0;  // max_error_percent that stops refinement

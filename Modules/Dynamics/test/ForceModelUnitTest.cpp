@@ -1,0 +1,120 @@
+// Force models (ForceModel.h): a spring's dead zone; a field's stabilizing
+// stiffness and its settling on an edge.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include <cmath>
+
+#include "dynsub/ClosestPoint.h"
+#include "dynsub/Error.h"
+#include "dynsub/ForceModel.h"
+#include "dynsub/Forces.h"
+#include "dynsub/LimitSurface.h"
+#include "dynsub/Simulation.h"
+#include "dynsub/StandardMeshes.h"
+#include "dynsub/Tessellation.h"
+
+namespace dynsub {
+namespace {
+
+// A dead zone of z mm: a spring whose target lies within z of the surface
+// pulls not at all; one at distance L beyond pulls as a plain spring to a
+// target L - z away along the same line. Targets are put on the limit
+// normals a little off the surface (0.01-0.05 of the cube's size of about
+// 2, well inside its curvature radius), so each spring attaches where its
+// target was lifted from, in both models.
+TEST(SpringForceModel, ADeadZonePullsOnlyBeyondIt) {
+  const ControlMesh cube = makeCube98();
+  const LimitSurface surface(cube);
+  const Matrix3X onSurface = tessellate(surface, cube.points(), 1).points;
+  ClosestPointLocator locator(surface);
+  locator.update(cube.points());
+  Matrix3X normals(onSurface.rows(), 3);
+  const std::vector<ClosestPoint> nearest = locator.findAll(onSurface);
+  for (Eigen::Index i = 0; i < onSurface.rows(); ++i) normals.row(i) = nearest[i].normal.transpose();
+  const double zone = 0.02;
+  const SurfaceQuadrature quadrature = makeSurfaceQuadrature(surface);
+  const Eigen::VectorXd k = Eigen::VectorXd::Constant(onSurface.rows(), 3.0);
+  auto forceOf = [&](const Matrix3X& targets, double deadZone, double& potential) {
+    SpringForceModel springs(targets, k, SpringForceModel::Attach::NearestEachStep);
+    springs.setDeadZone(deadZone);
+    springs.beginLevel(surface, quadrature, cube.points());
+    potential = 0.0;
+    return springs.generalizedForce(cube.points(), potential);
+  };
+  double potential = 0.0;
+  const Matrix3X inside = forceOf(onSurface + 0.01 * normals, zone, potential);
+  EXPECT_EQ(inside.cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(potential, 0.0);
+  double beyondPotential = 0.0, plainPotential = 0.0;
+  const Matrix3X beyond = forceOf(onSurface + 0.05 * normals, zone, beyondPotential);
+  const Matrix3X plain = forceOf(onSurface + 0.03 * normals, 0.0, plainPotential);
+  // The attachments agree to the closest-point search's tolerance (1e-9 of the size).
+  EXPECT_LT((beyond - plain).cwiseAbs().maxCoeff(), 1e-7 * plain.cwiseAbs().maxCoeff());
+  EXPECT_NEAR(beyondPotential, plainPotential, 1e-7 * plainPotential);
+  EXPECT_GT(plain.cwiseAbs().maxCoeff(), 0.0);
+  SpringForceModel springs(onSurface, k, SpringForceModel::Attach::NearestEachStep);
+  EXPECT_THROW(springs.setDeadZone(-1.0), Error);
+  EXPECT_THROW(springs.setDeadZone(std::nan("")), Error);
+}
+
+// A radial well like an image force across an edge: k times the unit
+// direction towards the sphere of radius R, falling linearly to zero over the
+// last `width` mm. Its slope is k / width.
+class RadialWell final : public ForceField {
+ public:
+  RadialWell(double radius, double strength, double width) : radius_(radius), strength_(strength), width_(width) {}
+  Matrix3X forcesAt(const Matrix3X& points) const override {
+    Matrix3X forces(points.rows(), 3);
+    for (Eigen::Index i = 0; i < points.rows(); ++i) {
+      const double r = points.row(i).norm();
+      const double towards = std::clamp((radius_ - r) / width_, -1.0, 1.0);
+      forces.row(i) = strength_ * towards * points.row(i) / r;
+    }
+    return forces;
+  }
+  double slopeBound() const override { return strength_ / width_; }
+
+ private:
+  double radius_, strength_, width_;
+};
+
+TEST(FieldForces, StiffnessIntegratesTheSlopeOverTheArea) {
+  // A rigid translation u of the whole surface: u^T S u = slope * area * |u|^2.
+  const ControlMesh cube = makeCube98();
+  const LimitSurface surface(cube);
+  const SurfaceQuadrature quadrature = makeSurfaceQuadrature(surface, 4);
+  const SparseMatrix stiffness = fieldStiffness(quadrature, cube.points(), 3.0);
+  const Matrix3X su = quadrature.Ju * cube.points(), sv = quadrature.Jv * cube.points();
+  double area = 0.0;
+  for (Eigen::Index i = 0; i < su.rows(); ++i) area += quadrature.weights(i) * su.row(i).cross(sv.row(i)).norm();
+  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(cube.vertexCount());
+  EXPECT_NEAR(ones.dot(stiffness * ones), 3.0 * area, 1e-9 * area);
+}
+
+TEST(FieldForces, AReversingFieldSettlesOnItsEdge) {
+  // The well is 0.2 mm wide and 20 times stronger than the surface's tension
+  // at that radius: explicit, its force would swing the surface across the
+  // edge every step. Stabilized by its slope bound, the level must reach
+  // equilibrium, with the surface on the edge to within the well's width plus
+  // the small inward pull of tension (k r / tension ~ 0.1 mm).
+  ControlMesh cube = makeCube98();
+  cube.setPoints(cube.points() * 3.0);  // limit surface radius about 2 mm
+  const RadialWell well(4.0, 1.0, 0.2);
+  FieldForceModel field(well);
+  SimulationOptions options;
+  options.material.tensionU = options.material.tensionV = 0.05;
+  options.material.rigidityUU = options.material.rigidityVV = options.material.rigidityUV = 0.0;
+  const SimulationResult result = simulate(cube, {&field}, {}, options);
+  ASSERT_EQ(result.levels.size(), 1u);
+  EXPECT_TRUE(result.levels[0].converged);
+  const LimitSurface surface(result.mesh);
+  const Matrix3X points = tessellate(surface, result.mesh.points(), 4).points;
+  const Eigen::VectorXd radii = points.rowwise().norm();
+  EXPECT_GT(radii.minCoeff(), 4.0 - 0.35);
+  EXPECT_LT(radii.maxCoeff(), 4.0 + 0.2);
+}
+
+}  // namespace
+}  // namespace dynsub

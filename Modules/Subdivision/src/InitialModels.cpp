@@ -1,0 +1,111 @@
+#include "dynsub/InitialModels.h"
+
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
+
+#include "dynsub/Error.h"
+#include "dynsub/LimitSurface.h"
+#include "dynsub/StandardMeshes.h"
+#include "dynsub/Tessellation.h"
+
+namespace dynsub {
+namespace {
+
+struct Principal {
+  Vector3 mean;
+  Eigen::Matrix3d axes;    // columns: unit eigenvectors, decreasing variance, right-handed
+  Vector3 variances;       // decreasing
+};
+
+Principal principalAxes(const Matrix3X& points) {
+  Principal p;
+  p.mean = points.colwise().mean().transpose();
+  const Matrix3X centred = points.rowwise() - p.mean.transpose();
+  const Eigen::Matrix3d covariance = centred.transpose() * centred / static_cast<double>(points.rows());
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+  for (int i = 0; i < 3; ++i) {
+    p.variances(i) = std::max(0.0, solver.eigenvalues()(2 - i));
+    p.axes.col(i) = solver.eigenvectors().col(2 - i);
+  }
+  if (p.axes.determinant() < 0.0) p.axes.col(2) *= -1.0;  // keep orientation (outward normals)
+  return p;
+}
+
+// The limit positions of the control vertices.
+Matrix3X limitPositions(const ControlMesh& mesh) {
+  const LimitSurface surface(mesh);
+  return surface.controlVertexLimitOperator() * mesh.points();
+}
+
+}  // namespace
+
+void checkPointCloud(const Matrix3X& points, const std::string& source) {
+  if (points.rows() < 4) {
+    throw Error(source, "has " + std::to_string(points.rows()) + " points; a surface needs at least 4");
+  }
+  for (Eigen::Index i = 0; i < points.rows(); ++i) {
+    if (!points.row(i).allFinite()) throw Error(source, "point " + std::to_string(i + 1) + " is not finite");
+  }
+  const Principal p = principalAxes(points);
+  if (!(p.variances(0) > 0.0)) throw Error(source, "all points coincide");
+  // Relative to the largest spread; 1e-12 of the variance is 1e-6 of the size.
+  if (p.variances(2) <= 1e-12 * p.variances(0)) {
+    throw Error(source, p.variances(1) <= 1e-12 * p.variances(0) ? "all points lie on a line"
+                                                                  : "all points lie on a plane");
+  }
+}
+
+ControlMesh cubeInEllipsoid(const Vector3& centre, const Matrix3& axes, const Vector3& semiAxes) {
+  ControlMesh cube = makeCube98();
+  // The cube's limit surface spans [-h, h]^3 around the origin.
+  const double h = limitPositions(cube).cwiseAbs().maxCoeff();
+  const Vector3 scale = semiAxes / h;
+  cube.setPoints(((cube.points() * scale.asDiagonal()) * axes.transpose()).rowwise() + centre.transpose());
+  return cube;
+}
+
+ControlMesh initialModel(const Matrix3X& points, InitialShape shape, double fraction) {
+  if (!(fraction > 0 && fraction <= 1)) throw Error("the initial model's fraction of the data's extent must be in (0, 1]");
+  const Principal p = principalAxes(points);
+  if (shape == InitialShape::Sphere) {
+    Vector3 semiAxes;
+    for (int i = 0; i < 3; ++i) semiAxes(i) = fraction * std::sqrt(3.0 * p.variances(i));
+    return cubeInEllipsoid(p.mean, p.axes, semiAxes);
+  }
+  // Torus: axis along the least-variance direction (third axis).
+  const Matrix3X local = (points.rowwise() - p.mean.transpose()) * p.axes;
+  const Eigen::VectorXd rho = local.leftCols(2).rowwise().norm();
+  const double ring = rho.mean();
+  const double tube = std::sqrt(((rho.array() - ring).square() + local.col(2).array().square()).mean());
+  ControlMesh torus = makeTorus32();
+  // The standard torus: ring radius 1, tube 0.5 (control mesh); measure its limit.
+  const Matrix3X limit = limitPositions(torus);
+  const Eigen::VectorXd limitRho = limit.leftCols(2).rowwise().norm();
+  const double limitRing = limitRho.mean();
+  const double limitTube = std::sqrt(((limitRho.array() - limitRing).square() + limit.col(2).array().square()).mean());
+  Matrix3X control = torus.points();
+  for (Eigen::Index i = 0; i < control.rows(); ++i) {
+    const double r = control.row(i).head<2>().norm();
+    const double radial = ring + (r - limitRing) * 0.5 * tube / limitTube;
+    const double height = control(i, 2) * 0.5 * tube / limitTube;
+    control.row(i).head<2>() *= radial / r;
+    control(i, 2) = height;
+  }
+  torus.setPoints((control * p.axes.transpose()).rowwise() + p.mean.transpose());
+  return torus;
+}
+
+ControlMesh initialSphere(const Vector3& centre, double radius) {
+  if (!(radius > 0) || !std::isfinite(radius) || !centre.allFinite())
+    throw Error("the initial sphere needs a finite centre and a radius > 0 mm");
+  // The cube's limit is not round: its corners reach beyond its half-extent
+  // h along the axes. A sphere's radius is its mean radius m, so the cube
+  // spans r h / m along each axis.
+  const ControlMesh cube = makeCube98();
+  const double h = limitPositions(cube).cwiseAbs().maxCoeff();
+  const double m = tessellate(LimitSurface(cube), cube.points(), 4).points.rowwise().norm().mean();
+  return cubeInEllipsoid(centre, Matrix3::Identity(), Vector3::Constant(radius * h / m));
+}
+
+}  // namespace dynsub
