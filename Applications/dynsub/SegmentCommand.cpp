@@ -41,84 +41,98 @@ struct SegmentCommandOptions {
   FigureOptions figures;
 };
 
-void runSegment(SegmentCommandOptions o) {
-  if (o.potential == "gradient") o.segment.edges.method = EdgeMethod::GradientMagnitude;
-  o.segment.simulation = o.simulation.apply(o.segment.simulation);
+// The options as SegmentOptions; throws dynsub::Error on impossible ones.
+SegmentOptions segmentOptions(const SegmentCommandOptions& o) {
+  SegmentOptions segment = o.segment;
+  if (o.potential == "gradient") segment.edges.method = EdgeMethod::GradientMagnitude;
+  segment.simulation = o.simulation.apply(segment.simulation);
   // --edge-low / --edge-high are fractions of the reference that will be used:
   // the landmarks' whenever there are landmarks and it is not --edge-reference
   // image (landmarks off every edge are an error, not a silent switch).
-  EdgeOptions& edges = o.segment.edges;
+  EdgeOptions& edges = segment.edges;
   edges.reference = o.edgeReference == "image" ? EdgeReference::Image : EdgeReference::Landmarks;
   const bool pointsOnBoundary = !o.landmarks.empty() || o.init.rfind("seed:", 0) == 0;  // see chooseStart
   Hysteresis& thresholds =
       edges.reference == EdgeReference::Landmarks && pointsOnBoundary ? edges.ofLandmarks : edges.ofImage;
   if (o.edgeLowOption->count()) thresholds.low = o.edgeLow;
   if (o.edgeHighOption->count()) thresholds.high = o.edgeHigh;
-  checkSegmentOptions(o.segment);
+  checkSegmentOptions(segment);
   if (!o.reference.empty() && o.referenceLabels.empty())
     throw Error("--reference needs --reference-label N[,M...]: the label value(s) of the structure");
+  return segment;
+}
 
-  // Every input is read and checked before anything is written.
-  const Volume image = readVolume(o.image);
-  const std::vector<Landmark> landmarks = o.landmarks.empty() ? std::vector<Landmark>{} : readLandmarks(o.landmarks);
-  Mask reference;
-  if (!o.reference.empty()) {
-    const Volume labels = readVolume(o.reference);
-    if (!labels.geometry.sameGridAs(image.geometry))
-      throw Error(o.reference, "the reference is not on the image's grid (size, origin, spacing or direction differ)");
-    reference = selectLabels(labels, o.referenceLabels);
-    if (reference.count() == 0) throw Error(o.reference, "no voxel has the reference label(s)");
-  }
-  SegmentInputs inputs;
-  inputs.image = o.image;
-  inputs.landmarkSource = o.landmarks;
-  inputs.landmarks = landmarks;
-  inputs.init = parseInitialModel(o.init, "--init");
-  if (inputs.init.kind == InitialModel::Kind::FromLandmarks && landmarks.size() < 4)
-    throw Error("--init auto builds the initial model from the landmarks: give at least 4 with --landmarks, "
-                "or use --init seed:x,y,z, --init sphere:x,y,z,r or --init MESH");
-  inputs.segment = o.segment;
-  inputs.seed = o.seed;
-  inputs.potential = o.potential;
-  if (!o.reference.empty()) {
-    inputs.reference = &reference;
-    inputs.referencePath = o.reference;
-    inputs.referenceLabels = o.referenceLabels;
-  }
-  const std::filesystem::path dir(o.out);
-  prepareOutputDirectory(dir);
+// The expert's labelmap of the structure, on the image's grid.
+Mask readReference(const SegmentCommandOptions& o, const Volume& image) {
+  const Volume labels = readVolume(o.reference);
+  if (!labels.geometry.sameGridAs(image.geometry))
+    throw Error(o.reference, "the reference is not on the image's grid (size, origin, spacing or direction differ)");
+  Mask reference = selectLabels(labels, o.referenceLabels);
+  if (reference.count() == 0) throw Error(o.reference, "no voxel has the reference label(s)");
+  return reference;
+}
 
-  ProgressLine line;
-  const SegmentRun run = runSegmentation(image, inputs, line.callback());
-  line.finish();
+// surface.vtp, control_mesh.obj, report.json, labelmap.nii.gz, convergence.csv and the figures, all or none.
+void writeSegmentOutputs(const std::filesystem::path& dir, const SegmentRun& run, const Volume& image,
+                         const FigureOptions& figures) {
   const SegmentResult& result = run.result;
-  const OverlapMetrics& metrics = run.metrics;
-  const double seconds = run.seconds;
-  const std::vector<std::string>& warnings = run.warnings;
-
   writeModelOutputs(
       dir, result.mesh, result.surface, run.report,
       [&](OutputSet& outputs) {
         writeMask(run.labelmap, outputs.add("labelmap.nii.gz"));
-        addFigureOutputs(outputs, o.figures, result.mesh, result.surface, run.history, &image,
+        addFigureOutputs(outputs, figures, result.mesh, result.surface, run.history, &image,
                          landmarkPositions(run.springs), Matrix3X());
       },
       result.surfaceEdgeDistances.size()
           ? std::vector<PointScalars>{{"edge_distance_mm", result.surfaceEdgeDistances}}
           : std::vector<PointScalars>{},
       "LPS");
+}
 
+void printSummary(const SegmentCommandOptions& o, const SegmentRun& run, const Volume& image) {
+  const SegmentResult& result = run.result;
   std::cout << std::fixed << std::setprecision(1) << "segmented " << run.labelmap.count() * image.geometry.spacing.prod()
             << " mm^3 with " << result.mesh.vertexCount() << " control vertices (" << result.levels.back().level
-            << " refinement(s), " << result.steps << " steps) in " << seconds << " s\n";
-  for (const std::string& warning : warnings) std::cerr << "warning: " << warning << '\n';
+            << " refinement(s), " << result.steps << " steps) in " << run.seconds << " s\n";
+  for (const std::string& warning : run.warnings) std::cerr << "warning: " << warning << '\n';
   if (!o.reference.empty())
-    std::cout << std::setprecision(3) << "Dice " << metrics.dice << ", mean surface distance "
-              << metrics.meanSurfaceDistance << " mm, HD95 " << metrics.hd95 << " mm against " << o.reference
+    std::cout << std::setprecision(3) << "Dice " << run.metrics.dice << ", mean surface distance "
+              << run.metrics.meanSurfaceDistance << " mm, HD95 " << run.metrics.hd95 << " mm against " << o.reference
               << '\n';
-  std::cout << "wrote " << (dir / "surface.vtp").string()
+  std::cout << "wrote " << (std::filesystem::path(o.out) / "surface.vtp").string()
             << ", control_mesh.obj, labelmap.nii.gz, report.json, convergence.csv"
             << (o.figures.figures ? " and the figures that could be rendered" : "") << '\n';
+}
+
+void runSegment(const SegmentCommandOptions& o) {
+  // Every input is read and checked before anything is written.
+  SegmentInputs inputs;
+  inputs.segment = segmentOptions(o);
+  const Volume image = readVolume(o.image);
+  if (!o.landmarks.empty()) inputs.landmarks = readLandmarks(o.landmarks);
+  Mask reference;
+  if (!o.reference.empty()) {
+    reference = readReference(o, image);
+    inputs.reference = &reference;
+    inputs.referencePath = o.reference;
+    inputs.referenceLabels = o.referenceLabels;
+  }
+  inputs.image = o.image;
+  inputs.landmarkSource = o.landmarks;
+  inputs.init = parseInitialModel(o.init, "--init");
+  if (inputs.init.kind == InitialModel::Kind::FromLandmarks && inputs.landmarks.size() < 4)
+    throw Error("--init auto builds the initial model from the landmarks: give at least 4 with --landmarks, "
+                "or use --init seed:x,y,z, --init sphere:x,y,z,r or --init MESH");
+  inputs.seed = o.seed;
+  inputs.potential = o.potential;
+  const std::filesystem::path dir(o.out);
+  prepareOutputDirectory(dir);
+
+  ProgressLine line;
+  const SegmentRun run = runSegmentation(image, inputs, line.callback());
+  line.finish();
+  writeSegmentOutputs(dir, run, image, o.figures);
+  printSummary(o, run, image);
 }
 
 }  // namespace

@@ -36,22 +36,30 @@ Row averageRow(const std::vector<int>& points) {
   return row;
 }
 
-}  // namespace
+// What the rules average: each face's and cell's centroid as a row of
+// weights on the old points, and how many boundary faces each edge has.
+struct Centroids {
+  std::vector<Row> face, cell;
+  std::vector<int> boundaryFacesOfEdge;
+};
 
-SolidRefinement subdivideSolid(const Lattice& l) {
-  const int P = l.pointCount(), E = l.edgeCount(), F = l.faceCount(), C = l.cellCount();
-  const int edgeStart = P, faceStart = P + E, cellStart = P + E + F;
-
-  // Centroids as rows of weights on the old points.
-  std::vector<Row> faceCentroid(F), cellCentroid(C);
-  for (int f = 0; f < F; ++f) faceCentroid[f] = averageRow(l.faces()[f]);
-  for (int c = 0; c < C; ++c) cellCentroid[c] = averageRow(l.cellPoints()[c]);
-  std::vector<int> boundaryFacesOfEdge(E, 0);
-  for (int f = 0; f < F; ++f)
+Centroids centroidsOf(const Lattice& l) {
+  Centroids c;
+  for (int f = 0; f < l.faceCount(); ++f) c.face.push_back(averageRow(l.faces()[f]));
+  for (int k = 0; k < l.cellCount(); ++k) c.cell.push_back(averageRow(l.cellPoints()[k]));
+  c.boundaryFacesOfEdge.assign(l.edgeCount(), 0);
+  for (int f = 0; f < l.faceCount(); ++f)
     if (l.isBoundaryFace(f))
-      for (int e : l.faceEdges()[f]) ++boundaryFacesOfEdge[e];
+      for (int e : l.faceEdges()[f]) ++c.boundaryFacesOfEdge[e];
+  return c;
+}
 
-  Rows rows(P + E + F + C);
+// The rows of the new cell and face points.
+void addCellAndFacePoints(const Lattice& l, const Centroids& centroids, Rows& rows) {
+  const int P = l.pointCount(), E = l.edgeCount(), F = l.faceCount(), C = l.cellCount();
+  const int faceStart = P + E, cellStart = P + E + F;
+  const std::vector<Row>& faceCentroid = centroids.face;
+  const std::vector<Row>& cellCentroid = centroids.cell;
   // Cell points.
   for (int c = 0; c < C; ++c) rows.addRow(cellStart + c, cellCentroid[c], 1.0);
   // Face points.
@@ -63,6 +71,15 @@ SolidRefinement subdivideSolid(const Lattice& l) {
       for (int c : l.faceCells()[f]) rows.addRow(faceStart + f, cellCentroid[c], 0.25);
     }
   }
+}
+
+// The rows of the new edge points: interior, on the boundary, on a crease.
+void addEdgePoints(const Lattice& l, const Centroids& centroids, Rows& rows) {
+  const int E = l.edgeCount();
+  const int edgeStart = l.pointCount();
+  const std::vector<Row>& faceCentroid = centroids.face;
+  const std::vector<Row>& cellCentroid = centroids.cell;
+  const std::vector<int>& boundaryFacesOfEdge = centroids.boundaryFacesOfEdge;
   // Edge points.
   for (int e = 0; e < E; ++e) {
     const int r = edgeStart + e;
@@ -85,6 +102,14 @@ SolidRefinement subdivideSolid(const Lattice& l) {
       rows.add(r, b, 0.5);
     }
   }
+}
+
+// The rows of the new vertex points: interior, on a crease, on the boundary.
+void addVertexPoints(const Lattice& l, const Centroids& centroids, Rows& rows) {
+  const int P = l.pointCount();
+  const std::vector<Row>& faceCentroid = centroids.face;
+  const std::vector<Row>& cellCentroid = centroids.cell;
+  const std::vector<int>& boundaryFacesOfEdge = centroids.boundaryFacesOfEdge;
   // Vertex points.
   for (int p = 0; p < P; ++p) {
     std::vector<int> boundaryFaces, boundaryEdges;
@@ -119,7 +144,17 @@ SolidRefinement subdivideSolid(const Lattice& l) {
       rows.add(p, p, (n - 3.0) / n);
     }
   }
+}
 
+// The refined lattice's faces (each old face's quads, then the faces inside
+// each old cell) and cells (one per old cell and corner).
+struct RefinedTopology {
+  std::vector<std::vector<int>> faces, cells;
+};
+
+RefinedTopology refinedTopology(const Lattice& l) {
+  const int P = l.pointCount(), E = l.edgeCount(), F = l.faceCount(), C = l.cellCount();
+  const int edgeStart = P, faceStart = P + E, cellStart = P + E + F;
   // Topology of the refined lattice.
   std::vector<int> faceOffset(F + 1, 0);  // first sub-face of each old face
   for (int f = 0; f < F; ++f) faceOffset[f + 1] = faceOffset[f] + static_cast<int>(l.faces()[f].size());
@@ -158,14 +193,28 @@ SolidRefinement subdivideSolid(const Lattice& l) {
       cells.push_back(std::move(shell));
     }
   }
+  return {std::move(faces), std::move(cells)};
+}
+
+}  // namespace
+
+SolidRefinement subdivideSolid(const Lattice& l) {
+  const Centroids centroids = centroidsOf(l);
+  Rows rows(l.pointCount() + l.edgeCount() + l.faceCount() + l.cellCount());
+  addCellAndFacePoints(l, centroids, rows);
+  addEdgePoints(l, centroids, rows);
+  addVertexPoints(l, centroids, rows);
+  RefinedTopology topology = refinedTopology(l);
 
   SolidRefinement refined;
-  for (int f = 0; f < F; ++f) refined.faceOrigin.insert(refined.faceOrigin.end(), l.faces()[f].size(), f);
-  refined.faceOrigin.resize(faces.size(), -1);
-  for (int c = 0; c < C; ++c) refined.cellOrigin.insert(refined.cellOrigin.end(), l.cellPoints()[c].size(), c);
-  refined.A = rows.matrix(P);
+  for (int f = 0; f < l.faceCount(); ++f) refined.faceOrigin.insert(refined.faceOrigin.end(), l.faces()[f].size(), f);
+  refined.faceOrigin.resize(topology.faces.size(), -1);
+  for (int c = 0; c < l.cellCount(); ++c)
+    refined.cellOrigin.insert(refined.cellOrigin.end(), l.cellPoints()[c].size(), c);
+  refined.A = rows.matrix(l.pointCount());
   const Matrix3X points = refined.A * l.points();
-  refined.lattice = Lattice::fromCells(points, std::move(faces), std::move(cells), "subdivided lattice");
+  refined.lattice =
+      Lattice::fromCells(points, std::move(topology.faces), std::move(topology.cells), "subdivided lattice");
   return refined;
 }
 
