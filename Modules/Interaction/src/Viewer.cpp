@@ -1,15 +1,11 @@
 #include "dynsub/Viewer.h"
 
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
 #include <iomanip>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <sstream>
-#include <thread>
 
 #include <vtkActor.h>
 #include <vtkCallbackCommand.h>
@@ -27,10 +23,10 @@
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
 
+#include "FitWorker.h"
 #include "dynsub/SceneStyle.h"
 #include "dynsub/Error.h"
 #include "dynsub/Figures.h"
-#include "dynsub/PullForce.h"
 #include "dynsub/SliceView.h"
 #include "dynsub/SurfacePolyData.h"
 #include "dynsub/SurfaceView.h"
@@ -41,7 +37,6 @@ namespace dynsub {
 namespace {
 
 constexpr double kPickPixels = 8.0;  // how near a click must be to a landmark
-constexpr auto kRedrawInterval = std::chrono::milliseconds(40);
 
 const char* const kHelp =
     "Slice views:  wheel, Up/Down, Page Up/Down  next / previous slice\n"
@@ -53,13 +48,25 @@ const char* const kHelp =
     "Keys:         space  start (after a fit: refit) / pause / resume;  r  stop and forget the fit\n"
     "              s  save landmarks;  l  load landmarks;  h  this help;  q, Escape  quit";
 
-struct FitCancelled {};
-
 }  // namespace
+
+// The landmarks being edited: the list, the selection and the drag.
+struct LandmarkEdits {
+  std::vector<Landmark> landmarks;
+  int selected = -1;
+  int dragView = -1;    // slice view a landmark is being dragged in
+  bool moved = false;   // the dragged landmark moved
+
+  void add(const Vector3& p) {
+    landmarks.push_back({"P-" + std::to_string(landmarks.size() + 1), p});
+    selected = static_cast<int>(landmarks.size()) - 1;
+  }
+};
 
 struct Viewer::Impl {
   ViewerInput input;
   vtkSmartPointer<vtkPolyData> startSurface;  // input.surfacePath's, or null
+  // The scene.
   ImageSlices slices;
   std::unique_ptr<SliceView> views[3];
   SurfaceView surface3d;
@@ -71,40 +78,19 @@ struct Viewer::Impl {
   vtkNew<vtkPolyData> liveSurface;
   vtkNew<vtkCallbackCommand> timerCommand;
   vtkNew<vtkCellPicker> picker;
+  int updates = 0;  // times liveSurface took a new surface
 
-  std::vector<Landmark> landmarks;
-  int selected = -1;
-  int dragView = -1;          // slice view a landmark is being dragged in
-  bool landmarksEdited = false;
+  LandmarkEdits edits;
+  // The pull as the hand holds it.
   bool pulling = false;
-  double pullDepth = 0;       // display depth of the grabbed point
+  double pullDepth = 0;                    // display depth of the grabbed point
   Vector3 grabbedPoint = Vector3::Zero();  // where the pull took hold of the surface
-  std::string message;        // the last action's outcome
+  std::string message;                     // the last action's outcome
 
-  // The fit and what it hands to the interface thread.
-  PullForceModel pull;
-  std::thread worker;
-  std::atomic<bool> running{false};
-  std::mutex mutex;
-  std::condition_variable resume;
-  bool paused = false, cancel = false;
-  bool fresh = false;  // a new surface is waiting
-  TriangleSurface published;
-  std::string fitText;
-  int updates = 0;
-  // What the next fit starts from: the last finished fit (its mesh and
-  // levels) and the region whose edge directions it used; a refit reuses the
-  // region while the landmarks and the surface stay inside it. Written by the
-  // worker, read only while no worker runs; r (reset) forgets them.
-  struct Fitted {
-    ControlMesh mesh;
-    LevelOrigin origin;
-  };
-  std::optional<Fitted> fitted;
-  std::unique_ptr<const SegmentationRegion> region;
+  FitWorker fit;
 
   explicit Impl(ViewerInput in);
-  ~Impl() { stopFit(); }
+  ~Impl() { fit.stop(); }
 
   int viewAt(int x, int y) {
     vtkRenderer* poked = interactor->FindPokedRenderer(x, y);
@@ -117,7 +103,7 @@ struct Viewer::Impl {
     int best = -1;
     double nearest = kPickPixels;
     for (int i : views[view]->landmarksOnSlice()) {
-      const double d = (views[view]->displayPosition(landmarks[i].position) - Eigen::Vector2d(x, y)).norm();
+      const double d = (views[view]->displayPosition(edits.landmarks[i].position) - Eigen::Vector2d(x, y)).norm();
       if (d <= nearest) {
         nearest = d;
         best = i;
@@ -127,9 +113,9 @@ struct Viewer::Impl {
   }
 
   void showLandmarks() {
-    const Matrix3X points = landmarkPositions(landmarks);
-    for (auto& v : views) v->setLandmarks(points, selected);
-    surface3d.setLandmarks(points, selected);
+    const Matrix3X points = landmarkPositions(edits.landmarks);
+    for (auto& v : views) v->setLandmarks(points, edits.selected);
+    surface3d.setLandmarks(points, edits.selected);
   }
 
   void showSlices() {
@@ -138,24 +124,47 @@ struct Viewer::Impl {
 
   void landmarksChanged() {
     showLandmarks();
-    if (running || fitted) {
-      const bool refit = fitted.has_value();  // read before a new worker may write it
+    if (fit.running() || fit.hasFit()) {
+      const bool refit = fit.hasFit();  // read before a new worker may write it
       startFit();  // the fit restarts with the new set, from the last fit if there is one
-      if (running) message = refit ? "landmarks changed: refitting" : "landmarks changed: fitting again";
+      if (fit.running()) message = refit ? "landmarks changed: refitting" : "landmarks changed: fitting again";
     }
   }
 
-  void addLandmark(const Vector3& p) {
-    int number = static_cast<int>(landmarks.size()) + 1;
-    landmarks.push_back({"P-" + std::to_string(number), p});
-    selected = static_cast<int>(landmarks.size()) - 1;
+  // A click on slice view `view`: select the landmark there, or place one.
+  void clickSlice(int view, int x, int y) {
+    const int hit = landmarkNear(view, x, y);
+    if (hit < 0) {
+      edits.add(views[view]->pointAt(x, y));
+      message = "placed " + edits.landmarks.back().label;
+      edits.moved = true;
+    } else {
+      edits.selected = hit;
+      message = "selected " + edits.landmarks[hit].label;
+    }
+    edits.dragView = view;
+    showLandmarks();
+  }
+
+  void dragLandmarkTo(int x, int y) {
+    edits.landmarks[edits.selected].position = views[edits.dragView]->pointAt(x, y);
+    edits.moved = true;
+    showLandmarks();
+  }
+
+  void endDrag() {
+    edits.dragView = -1;
+    if (edits.moved) {
+      edits.moved = false;
+      landmarksChanged();
+    }
   }
 
   void deleteLandmark(int i) {
-    if (i < 0 || i >= static_cast<int>(landmarks.size())) return;
-    message = "deleted " + landmarks[i].label;
-    landmarks.erase(landmarks.begin() + i);
-    selected = -1;
+    if (i < 0 || i >= static_cast<int>(edits.landmarks.size())) return;
+    message = "deleted " + edits.landmarks[i].label;
+    edits.landmarks.erase(edits.landmarks.begin() + i);
+    edits.selected = -1;
     landmarksChanged();
   }
 
@@ -173,8 +182,8 @@ struct Viewer::Impl {
 
   void save() {
     try {
-      writeLandmarks(landmarks, input.landmarksPath, CoordinateSystem::LPS);
-      message = "saved " + std::to_string(landmarks.size()) + " landmarks to " + input.landmarksPath;
+      writeLandmarks(edits.landmarks, input.landmarksPath, CoordinateSystem::LPS);
+      message = "saved " + std::to_string(edits.landmarks.size()) + " landmarks to " + input.landmarksPath;
     } catch (const std::exception& e) {
       message = std::string("not saved: ") + e.what();
     }
@@ -182,13 +191,18 @@ struct Viewer::Impl {
 
   void load() {
     try {
-      landmarks = readLandmarks(input.landmarksPath);
-      selected = -1;
-      message = "loaded " + std::to_string(landmarks.size()) + " landmarks from " + input.landmarksPath;
+      edits.landmarks = readLandmarks(input.landmarksPath);
+      edits.selected = -1;
+      message = "loaded " + std::to_string(edits.landmarks.size()) + " landmarks from " + input.landmarksPath;
       landmarksChanged();
     } catch (const std::exception& e) {
       message = std::string("not loaded: ") + e.what();
     }
+  }
+
+  void stopFit() {
+    fit.stop();  // lets go of the pull
+    pulling = false;
   }
 
   void startFit() {
@@ -196,132 +210,71 @@ struct Viewer::Impl {
     launchFit();
   }
 
+  // A fit of the landmarks as they are now, when there are enough.
+  void launchFit() {
+    if (edits.landmarks.size() < 4) {
+      message = "place at least 4 landmarks to fit (" + std::to_string(edits.landmarks.size()) + " so far)";
+      return;
+    }
+    fit.start(edits.landmarks);
+  }
+
+  // Ctrl + click on the 3D view: take hold of the surface under the cursor.
+  void grabSurface(int x, int y) {
+    if (!fit.running() && !fit.hasFit()) {
+      message = "start fitting (space) to pull the surface";
+      return;
+    }
+    if (!picker->Pick(x, y, 0, surface3d.renderer()) || liveSurface->GetNumberOfPoints() == 0) return;
+    double p[3];
+    picker->GetPickPosition(p);
+    vtkRenderer* r = surface3d.renderer();
+    r->SetWorldPoint(p[0], p[1], p[2], 1.0);
+    r->WorldToDisplay();
+    pullDepth = r->GetDisplayPoint()[2];
+    grabbedPoint = Vector3(p[0], p[1], p[2]);
+    // After a fit, the pull refits from it.
+    pullTo(grabbedPoint, true);
+    message = "pulling";
+  }
+
+  // The hand moved to (x, y) at the grabbed point's depth.
+  void movePull(int x, int y) {
+    vtkRenderer* r = surface3d.renderer();
+    r->SetDisplayPoint(x, y, pullDepth);
+    r->DisplayToWorld();
+    const double* w = r->GetWorldPoint();
+    // A refit may have settled before the hand moved on (it takes tens of
+    // milliseconds): then another starts from where it settled.
+    pullTo(Vector3(w[0] / w[3], w[1] / w[3], w[2] / w[3]), false);
+  }
+
+  void releasePull() {
+    fit.release();
+    pulling = false;
+    message = "released";
+  }
+
   // The pull, held at grabbedPoint, drawn to `target`; `grab`: it takes hold
-  // anew. A running fit takes it, decided under the lock the end of fit()
-  // takes, so the fit cannot end between the test and the move. Otherwise a
+  // anew. A running fit takes it (FitWorker::pullRunningFit). Otherwise a
   // refit starts with the pull on from its first step (held before the worker
   // starts, or a refit that settled at once would never see it).
   void pullTo(const Vector3& target, bool grab) {
-    {
-      std::lock_guard<std::mutex> lock(mutex);
-      if (running) {
-        if (grab) {
-          pull.grab(grabbedPoint, target);
-        } else {
-          pull.moveTo(target);
-        }
-        pulling = true;
-        return;
-      }
+    if (fit.pullRunningFit(grabbedPoint, target, grab)) {
+      pulling = true;
+      return;
     }
     stopFit();  // lets go of the pull
-    pull.grab(grabbedPoint, target);
+    fit.grab(grabbedPoint, target);
     pulling = true;
     launchFit();
   }
 
-  void launchFit() {
-    if (landmarks.size() < 4) {
-      message = "place at least 4 landmarks to fit (" + std::to_string(landmarks.size()) + " so far)";
-      return;
-    }
-    {
-      std::lock_guard<std::mutex> lock(mutex);
-      cancel = false;
-      paused = false;
-      fitText = "fitting: starting";
-    }
-    running = true;
-    worker = std::thread([this, marks = landmarks, start = fitted] { fit(marks, start); });
-  }
-
-  void stopFit() {
-    {
-      std::lock_guard<std::mutex> lock(mutex);
-      cancel = true;
-      paused = false;
-    }
-    resume.notify_all();
-    if (worker.joinable()) worker.join();
-    pull.release();
-    pulling = false;
-  }
-
-  void publish(TriangleSurface surface, const std::string& text) {
-    std::lock_guard<std::mutex> lock(mutex);
-    published = std::move(surface);
-    fresh = true;
-    fitText = text;
-  }
-
-  // The worker thread: the segmentation pipeline with a live observer, from
-  // the cube inside the landmarks or, for a refit, from the last fit.
-  void fit(const std::vector<Landmark>& marks, const std::optional<Fitted>& start) {
-    try {
-      const auto started = std::chrono::steady_clock::now();
-      const ControlMesh initial = start ? start->mesh : initialFromLandmarks(marks);
-      if (!start || !region || !region->covers(landmarkPositions(marks)) || !region->covers(initial.points()))
-        region = std::make_unique<const SegmentationRegion>(input.image, marks, initial, input.segment);
-      auto last = std::chrono::steady_clock::now() - kRedrawInterval;
-      auto observe = [&](const Progress& p) {
-        {
-          std::unique_lock<std::mutex> lock(mutex);
-          resume.wait(lock, [&] { return !paused || cancel; });
-          if (cancel) throw FitCancelled{};
-        }
-        const auto now = std::chrono::steady_clock::now();
-        if (now - last < kRedrawInterval || !p.surface || !p.controlPoints) return;
-        last = now;
-        std::ostringstream text;
-        text << (start ? "refitting" : "fitting") << ": level " << p.level << ", step " << p.step << std::scientific
-             << std::setprecision(3) << ", energy " << p.energy << " N mm";
-        publish(tessellate(*p.surface, *p.controlPoints, 4), text.str());
-      };
-      unsigned moves = pull.moves();
-      SegmentResult result = evolveInRegion(*region, marks, initial, start ? start->origin : LevelOrigin{},
-                                            input.segment, observe, {&pull});
-      for (;;) {
-        fitted = Fitted{result.mesh, result.origin};
-        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-        double worst = 0;
-        for (double d : result.landmarkDistances) worst = std::max(worst, d);
-        std::ostringstream text;
-        text << (start ? "refit" : "fit") << " done: " << result.mesh.vertexCount() << " control vertices, "
-             << result.levels.back().level << " refinement(s), " << result.steps << " steps in " << std::fixed
-             << std::setprecision(2) << seconds << " s;\nfarthest landmark " << worst << " mm";
-        publish(tessellate(LimitSurface(result.mesh), result.mesh.points(), kOutputSegments), text.str());
-        {
-          // The pull moved during the fit, perhaps after its last step (a fit
-          // may settle on a step that read the new target before moving to
-          // it, or the hand moved while this one was being published): go on
-          // from where it settled until a fit has seen the pull stand still.
-          // Decided under the lock the interface takes to move the pull, so
-          // no move falls between this test and the end of the fit.
-          std::lock_guard<std::mutex> lock(mutex);
-          if (!pull.active() || pull.moves() == moves) {
-            running = false;
-            return;
-          }
-          moves = pull.moves();
-        }
-        result = evolveInRegion(*region, marks, result.mesh, result.origin, input.segment, observe, {&pull});
-      }
-    } catch (const FitCancelled&) {
-      std::lock_guard<std::mutex> lock(mutex);
-      fitText = "fitting stopped";
-    } catch (const std::exception& e) {
-      std::lock_guard<std::mutex> lock(mutex);
-      fitText = std::string("fitting failed: ") + e.what();
-    }
-    running = false;
-  }
-
-  // On the interface thread: take what the worker published.
+  // On the interface thread: take what the fit published.
   bool takeUpdate() {
-    std::lock_guard<std::mutex> lock(mutex);
-    if (!fresh) return false;
-    fresh = false;
-    liveSurface->ShallowCopy(toPolyData(published));
+    std::optional<TriangleSurface> surface = fit.take();
+    if (!surface) return false;
+    liveSurface->ShallowCopy(toPolyData(*surface));
     liveSurface->Modified();
     ++updates;
     return true;
@@ -329,11 +282,8 @@ struct Viewer::Impl {
 
   void updateStatus() {
     std::ostringstream text;
-    {
-      std::lock_guard<std::mutex> lock(mutex);
-      text << landmarks.size() << " landmarks  |  " << (fitText.empty() ? "not fitting (space starts)" : fitText);
-      if (paused && running) text << " (paused)";
-    }
+    const std::string fitting = fit.status();
+    text << edits.landmarks.size() << " landmarks  |  " << (fitting.empty() ? "not fitting (space starts)" : fitting);
     if (!message.empty()) text << "\n" << message;
     statusText->SetInput(text.str().c_str());
   }
@@ -344,26 +294,16 @@ struct Viewer::Impl {
   }
 
   void togglePause() {
-    if (!running) {
+    if (!fit.running()) {
       startFit();
       return;
     }
-    {
-      std::lock_guard<std::mutex> lock(mutex);
-      paused = !paused;
-    }
-    resume.notify_all();
+    fit.togglePause();
   }
 
   void reset() {
-    stopFit();
-    fitted.reset();
-    region.reset();
-    {
-      std::lock_guard<std::mutex> lock(mutex);
-      fitText.clear();
-      fresh = false;
-    }
+    fit.forget();
+    pulling = false;
     if (startSurface) {
       liveSurface->ShallowCopy(startSurface);
     } else {
@@ -374,7 +314,7 @@ struct Viewer::Impl {
   }
 };
 
-// Routes the mouse and keys to the viewer; the 3D view keeps the trackball.
+// Routes the mouse and keys to the viewer's actions; the 3D view keeps the trackball.
 class ViewerStyle : public vtkInteractorStyleTrackballCamera {
  public:
   static ViewerStyle* New();
@@ -386,40 +326,13 @@ class ViewerStyle : public vtkInteractorStyleTrackballCamera {
     Interactor->GetEventPosition(x, y);
     const int view = viewer->viewAt(x, y);
     if (view >= 0 && view < 3) {
-      int hit = viewer->landmarkNear(view, x, y);
-      if (hit < 0) {
-        viewer->addLandmark(viewer->views[view]->pointAt(x, y));
-        viewer->message = "placed " + viewer->landmarks.back().label;
-        viewer->landmarksEdited = true;
-      } else {
-        viewer->selected = hit;
-        viewer->message = "selected " + viewer->landmarks[hit].label;
-      }
-      viewer->dragView = view;
-      viewer->showLandmarks();
+      viewer->clickSlice(view, x, y);
       viewer->render();
       return;
     }
     if (view == 3 && Interactor->GetControlKey()) {
-      if (!viewer->running && !viewer->fitted) {
-        viewer->message = "start fitting (space) to pull the surface";
-        viewer->render();
-        return;
-      }
-      if (viewer->picker->Pick(x, y, 0, viewer->surface3d.renderer()) && viewer->liveSurface->GetNumberOfPoints() > 0) {
-        double p[3];
-        viewer->picker->GetPickPosition(p);
-        const Vector3 grabbed(p[0], p[1], p[2]);
-        vtkRenderer* r = viewer->surface3d.renderer();
-        r->SetWorldPoint(p[0], p[1], p[2], 1.0);
-        r->WorldToDisplay();
-        viewer->pullDepth = r->GetDisplayPoint()[2];
-        viewer->grabbedPoint = grabbed;
-        // After a fit, the pull refits from it.
-        viewer->pullTo(grabbed, true);
-        viewer->message = "pulling";
-        viewer->render();
-      }
+      viewer->grabSurface(x, y);
+      viewer->render();
       return;
     }
     vtkInteractorStyleTrackballCamera::OnLeftButtonDown();
@@ -428,40 +341,26 @@ class ViewerStyle : public vtkInteractorStyleTrackballCamera {
   void OnMouseMove() override {
     int x, y;
     Interactor->GetEventPosition(x, y);
-    if (viewer->dragView >= 0 && viewer->selected >= 0) {
-      viewer->landmarks[viewer->selected].position = viewer->views[viewer->dragView]->pointAt(x, y);
-      viewer->landmarksEdited = true;
-      viewer->showLandmarks();
+    if (viewer->edits.dragView >= 0 && viewer->edits.selected >= 0) {
+      viewer->dragLandmarkTo(x, y);
       viewer->render();
       return;
     }
     if (viewer->pulling) {
-      vtkRenderer* r = viewer->surface3d.renderer();
-      r->SetDisplayPoint(x, y, viewer->pullDepth);
-      r->DisplayToWorld();
-      const double* w = r->GetWorldPoint();
-      // A refit may have settled before the hand moved on (it takes tens of
-      // milliseconds): then another starts from where it settled.
-      viewer->pullTo(Vector3(w[0] / w[3], w[1] / w[3], w[2] / w[3]), false);
+      viewer->movePull(x, y);
       return;
     }
     vtkInteractorStyleTrackballCamera::OnMouseMove();
   }
 
   void OnLeftButtonUp() override {
-    if (viewer->dragView >= 0) {
-      viewer->dragView = -1;
-      if (viewer->landmarksEdited) {
-        viewer->landmarksEdited = false;
-        viewer->landmarksChanged();
-      }
+    if (viewer->edits.dragView >= 0) {
+      viewer->endDrag();
       viewer->render();
       return;
     }
     if (viewer->pulling) {
-      viewer->pull.release();
-      viewer->pulling = false;
-      viewer->message = "released";
+      viewer->releasePull();
       viewer->render();
       return;
     }
@@ -513,7 +412,7 @@ class ViewerStyle : public vtkInteractorStyleTrackballCamera {
     } else if (key == "minus" || key == "KP_Subtract") {
       viewer->zoom(view, 0.8);
     } else if (key == "Delete" || key == "BackSpace") {
-      viewer->deleteLandmark(viewer->selected);
+      viewer->deleteLandmark(viewer->edits.selected);
     } else if (key == "space") {
       viewer->togglePause();
     } else if (key == "r") {
@@ -541,8 +440,9 @@ class ViewerStyle : public vtkInteractorStyleTrackballCamera {
 
 vtkStandardNewMacro(ViewerStyle);
 
-Viewer::Impl::Impl(ViewerInput in) : input(std::move(in)), slices(input.image), pull(input.pullStiffness) {
-  landmarks = input.landmarks;
+Viewer::Impl::Impl(ViewerInput in)
+    : input(std::move(in)), slices(input.image), fit(input.image, input.segment, input.pullStiffness) {
+  edits.landmarks = input.landmarks;
   window->SetSize(1200, 900);
   window->SetMultiSamples(0);
   window->SetWindowName("DynSub");
@@ -557,8 +457,8 @@ Viewer::Impl::Impl(ViewerInput in) : input(std::move(in)), slices(input.image), 
   // Start at the landmarks' centre, else the surface's, else the image's.
   Vector3 centre = slices.geometry().toPhysical(
       0.5 * Vector3(slices.geometry().size[0] - 1, slices.geometry().size[1] - 1, slices.geometry().size[2] - 1));
-  if (!landmarks.empty()) {
-    centre = landmarkPositions(landmarks).colwise().mean().transpose();
+  if (!edits.landmarks.empty()) {
+    centre = landmarkPositions(edits.landmarks).colwise().mean().transpose();
   } else if (liveSurface->GetNumberOfPoints() > 0) {
     double b[6];
     liveSurface->GetBounds(b);
@@ -583,9 +483,9 @@ Viewer::Impl::Impl(ViewerInput in) : input(std::move(in)), slices(input.image), 
   window->AddRenderer(surface3d.renderer());
   showSlices();
   showLandmarks();
-  if (landmarks.size() >= 2) {
+  if (edits.landmarks.size() >= 2) {
     // The structure the landmarks outline, with room around it.
-    const Matrix3X points = landmarkPositions(landmarks);
+    const Matrix3X points = landmarkPositions(edits.landmarks);
     const Vector3 low = points.colwise().minCoeff().transpose(), high = points.colwise().maxCoeff().transpose();
     const Vector3 room = 0.25 * (high - low) + Vector3::Constant(5.0);
     surface3d.frame(low - room, high + room);
@@ -618,7 +518,7 @@ Viewer::Impl::Impl(ViewerInput in) : input(std::move(in)), slices(input.image), 
       [](void* client) {
         auto* self = static_cast<Viewer::Impl*>(client);
         const bool updated = self->takeUpdate();
-        if (updated || self->running) self->render();
+        if (updated || self->fit.running()) self->render();
       },
       this);
   updateStatus();
@@ -645,22 +545,22 @@ void Viewer::run() {
 
 SliceView& Viewer::sliceView(SliceOrientation orientation) const { return *impl_->views[static_cast<int>(orientation)]; }
 vtkRenderer* Viewer::surfaceRenderer() const { return impl_->surface3d.renderer(); }
-const std::vector<Landmark>& Viewer::landmarks() const { return impl_->landmarks; }
+const std::vector<Landmark>& Viewer::landmarks() const { return impl_->edits.landmarks; }
 void Viewer::saveLandmarks() { impl_->save(); }
 void Viewer::loadLandmarks() { impl_->load(); }
 void Viewer::startOrPauseFitting() { impl_->togglePause(); }
 void Viewer::resetFitting() { impl_->reset(); }
-bool Viewer::fitting() const { return impl_->running; }
+bool Viewer::fitting() const { return impl_->fit.running(); }
 int Viewer::surfaceUpdates() const { return impl_->updates; }
 
 bool Viewer::waitForFit(double seconds) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  while (impl_->running && std::chrono::steady_clock::now() < end) {
+  while (impl_->fit.running() && std::chrono::steady_clock::now() < end) {
     if (impl_->takeUpdate()) impl_->render();
     std::this_thread::sleep_for(kRedrawInterval / 2);
   }
   if (impl_->takeUpdate()) impl_->render();
-  return !impl_->running;
+  return !impl_->fit.running();
 }
 
 std::string Viewer::status() const {
