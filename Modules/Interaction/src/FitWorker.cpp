@@ -46,9 +46,9 @@ void FitWorker::stop() {
 
 void FitWorker::forget() {
   stop();
-  fitted_.reset();
   region_.reset();
   std::lock_guard<std::mutex> lock(mutex_);
+  fitted_.reset();
   text_.clear();
   fresh_ = false;
 }
@@ -59,6 +59,11 @@ void FitWorker::togglePause() {
     paused_ = !paused_;
   }
   resume_.notify_all();
+}
+
+bool FitWorker::hasFit() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return fitted_.has_value();
 }
 
 std::string FitWorker::status() const {
@@ -117,7 +122,10 @@ void FitWorker::run(const std::vector<Landmark>& marks, const std::optional<Fitt
     SegmentResult result = evolveInRegion(*region_, marks, initial, start ? start->origin : LevelOrigin{}, options_,
                                           observe, {&pull_});
     for (;;) {
-      fitted_ = Fitted{result.mesh, result.origin};
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        fitted_ = Fitted{result.mesh, result.origin};
+      }
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
       double worst = 0;
       for (double d : result.landmarkDistances) worst = std::max(worst, d);

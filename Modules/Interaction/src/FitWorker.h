@@ -44,8 +44,9 @@ class FitWorker {
   void togglePause();
 
   bool running() const { return running_; }
-  // Whether a finished fit is there to refit from (read while no fit runs).
-  bool hasFit() const { return fitted_.has_value(); }
+  // Whether a finished fit is there to refit from (a running fit may be
+  // writing it: read under the lock).
+  bool hasFit() const;
   // The fit's state for the status line ("fitting: level 1, step 40, ..."),
   // empty before the first fit.
   std::string status() const;
@@ -82,8 +83,10 @@ class FitWorker {
   bool fresh_ = false;  // a surface is waiting in published_
   TriangleSurface published_;
   std::string text_;
-  // Written by the worker, read only while no worker runs.
+  // Written by the worker under the lock; start() reads it once the last
+  // worker has ended.
   std::optional<Fitted> fitted_;
+  // The worker's alone while one runs.
   std::unique_ptr<const SegmentationRegion> region_;
 };
 
