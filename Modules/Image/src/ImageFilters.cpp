@@ -12,8 +12,8 @@ std::vector<Vector3> smoothedGradient(const Volume& image, double sigma) {
   return gradient;
 }
 
-Volume distanceMap(const Mask& mask) {
-  return Volume{mask.geometry, itkbridge::functions().distanceMap(toBridge(mask.geometry), mask.voxels)};
+std::vector<float> distanceTo(const Mask& mask) {
+  return itkbridge::functions().distanceMap(toBridge(mask.geometry), mask.voxels);
 }
 
 }  // namespace dynsub

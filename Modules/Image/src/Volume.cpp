@@ -1,7 +1,5 @@
 #include "dynsub/Volume.h"
 
-#include "BridgeGeometry.h"
-
 #include <algorithm>
 #include <cmath>
 
@@ -137,10 +135,6 @@ Mask pasteMask(const Mask& part, const ImageGeometry& full, const std::array<int
       for (int i = 0; i < n[0]; ++i, ++in)
         if (part.voxels[in]) result.voxels[full.offset(first[0] + i, first[1] + j, first[2] + k)] = 1;
   return result;
-}
-
-std::vector<float> distanceTo(const Mask& mask) {
-  return itkbridge::functions().distanceMap(toBridge(mask.geometry), mask.voxels);
 }
 
 }  // namespace dynsub

@@ -76,7 +76,7 @@ OverlapMetrics compareMasks(const Mask& a, const Mask& b) {
   }
   const Mask partA = cropMask(a, first, size), partB = cropMask(b, first, size);
   const Mask boundaryA = boundaryOf(partA), boundaryB = boundaryOf(partB);
-  const std::vector<float> toA = distanceMap(boundaryA).voxels, toB = distanceMap(boundaryB).voxels;
+  const std::vector<float> toA = distanceTo(boundaryA), toB = distanceTo(boundaryB);
   std::vector<double> distances;
   for (std::size_t v = 0; v < partA.voxels.size(); ++v) {
     if (boundaryA.voxels[v]) distances.push_back(toB[v]);

@@ -183,7 +183,7 @@ EdgeField::EdgeField(const Volume& image, const EdgeOptions& options, const Matr
   scale_ = edgeScale(magnitude, options, landmarks);
   edges_ = edgeMap(magnitude, gradient, scale_);
   // P = -distance to the nearest edge (see the header).
-  edgeDistance_ = distanceMap(edges_);
+  edgeDistance_ = Volume{edges_.geometry, distanceTo(edges_)};
   hasEdges_ = edges_.count() > 0;
   Volume potential = edgeDistance_;
   std::vector<std::uint8_t> keep(potential.voxels.size());

@@ -4,6 +4,8 @@
 #include <limits>
 #include <utility>
 
+#include "dynsub/ImageFilters.h"
+
 namespace dynsub {
 
 std::vector<std::uint8_t> connectedTo(const std::vector<std::uint8_t>& allowed, const ImageGeometry& g,

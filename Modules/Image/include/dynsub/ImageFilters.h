@@ -13,8 +13,9 @@ namespace dynsub {
 // voxels' order.
 std::vector<Vector3> smoothedGradient(const Volume& image, double sigma);
 
-// The Euclidean distance (mm) from every voxel centre to the nearest voxel
-// of `mask`, on its grid.
-Volume distanceMap(const Mask& mask);
+// The Euclidean distance (mm, by the grid's spacing) from every voxel centre
+// to the nearest voxel of `mask`, 0 on it, in the voxels' order; exact
+// (ITK's Maurer transform).
+std::vector<float> distanceTo(const Mask& mask);
 
 }  // namespace dynsub

@@ -79,8 +79,4 @@ std::pair<std::array<int, 3>, std::array<int, 3>> boundingRegion(const ImageGeom
 // pasted into an empty mask on the full grid.
 Mask pasteMask(const Mask& part, const ImageGeometry& full, const std::array<int, 3>& first);
 
-// Euclidean distance (mm, by the grid's spacing) from every voxel centre to
-// the nearest voxel of `mask`, 0 on it; exact (ITK's Maurer transform).
-std::vector<float> distanceTo(const Mask& mask);
-
 }  // namespace dynsub
