@@ -38,6 +38,13 @@ Matrix3X limitPositions(const ControlMesh& mesh) {
   return surface.controlVertexLimitOperator() * mesh.points();
 }
 
+// The one placement of the cube: its control points scaled along the
+// coordinate axes, turned onto `axes` and moved to `centre`.
+ControlMesh placeCube(ControlMesh cube, const Vector3& scale, const Matrix3& axes, const Vector3& centre) {
+  cube.setPoints(((cube.points() * scale.asDiagonal()) * axes.transpose()).rowwise() + centre.transpose());
+  return cube;
+}
+
 }  // namespace
 
 void checkPointCloud(const Matrix3X& points, const std::string& source) {
@@ -57,12 +64,10 @@ void checkPointCloud(const Matrix3X& points, const std::string& source) {
 }
 
 ControlMesh cubeInEllipsoid(const Vector3& centre, const Matrix3& axes, const Vector3& semiAxes) {
-  ControlMesh cube = makeCube98();
+  const ControlMesh cube = makeCube98();
   // The cube's limit surface spans [-h, h]^3 around the origin.
   const double h = limitPositions(cube).cwiseAbs().maxCoeff();
-  const Vector3 scale = semiAxes / h;
-  cube.setPoints(((cube.points() * scale.asDiagonal()) * axes.transpose()).rowwise() + centre.transpose());
-  return cube;
+  return placeCube(cube, semiAxes / h, axes, centre);
 }
 
 ControlMesh initialModel(const Matrix3X& points, InitialShape shape, double fraction) {
@@ -100,12 +105,10 @@ ControlMesh initialSphere(const Vector3& centre, double radius) {
   if (!(radius > 0) || !std::isfinite(radius) || !centre.allFinite())
     throw Error("the initial sphere needs a finite centre and a radius > 0 mm");
   // The cube's limit is not round: its corners reach beyond its half-extent
-  // h along the axes. A sphere's radius is its mean radius m, so the cube
-  // spans r h / m along each axis.
+  // along the axes. A sphere's radius is its mean radius m.
   const ControlMesh cube = makeCube98();
-  const double h = limitPositions(cube).cwiseAbs().maxCoeff();
   const double m = tessellate(LimitSurface(cube), cube.points(), 4).points.rowwise().norm().mean();
-  return cubeInEllipsoid(centre, Matrix3::Identity(), Vector3::Constant(radius * h / m));
+  return placeCube(cube, Vector3::Constant(radius / m), Matrix3::Identity(), centre);
 }
 
 }  // namespace dynsub

@@ -138,7 +138,6 @@ class SegmentationRegion {
 // landmarks or flat ones.
 ControlMesh initialFromLandmarks(const std::vector<Landmark>& landmarks, double fraction = 0.5);
 
-
 // Throws dynsub::Error when the initial model lies outside the image or for
 // impossible options, LandmarkError when a landmark lies outside the image or
 // the landmarks are on no edge (EdgePotential.h). extraForces (not owned) act besides the

@@ -29,9 +29,10 @@ enum class InitialShape { Sphere, Torus };
 // data's mean ring radius and half its mean tube radius.
 ControlMesh initialModel(const Matrix3X& points, InitialShape shape, double fraction = 0.5);
 
-// The cube as a sphere of `radius` mm around `centre`: cubeInEllipsoid with
-// equal semi-axes, chosen so that the limit surface's mean distance from the
-// centre is `radius` (its corners reach a little further than its axes).
+// The cube as a sphere of `radius` mm around `centre`: scaled equally along
+// every axis so that its limit surface's mean distance from the centre (on
+// a 4 x 4 tessellation) is `radius`; its corners reach a little further than
+// its axes.
 // Throws dynsub::Error for a radius that is not > 0 or a centre that is not
 // finite.
 ControlMesh initialSphere(const Vector3& centre, double radius);
