@@ -1,5 +1,6 @@
 #include "dynsub/Integrator.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -42,11 +43,19 @@ LinearSolver parseLinearSolver(const std::string& text) {
 
 struct Integrator::Impl {
   IntegratorOptions options;
-  SymmetricMatrix mass, damping, forceStiffness;
+  // The right-hand side is forceWeight f + C p(t) + P p(t-dt). C and P are
+  // symmetric: their lower triangles are kept on one pattern, each entry's
+  // two weights side by side, so one pass over half the entries forms it.
+  double forceWeight = 0.0;
+  std::vector<int> lowerStart, lowerRow;     // column j's rows i >= j, j first: lowerRow[lowerStart[j] ...]
+  std::vector<double> lowerWeights;          // C_ij, P_ij for each of those entries
+  Matrix3X rhs;                              // the right-hand side, by vertex
   std::vector<int> freeIndex;                // free position of each vertex, or -1
   std::vector<int> freeVertices;
   SymmetricMatrix lhsFree, lhsCoupling;      // free x free, free x fixed
   SparseCholesky cholesky;
+  std::vector<int> rowOfUnknown;             // the vertex at each row of the factor (Cholesky)
+  Eigen::MatrixXd unknowns;                  // the factored solve's right-hand sides and solution
   Eigen::ConjugateGradient<SymmetricMatrix, Eigen::Lower | Eigen::Upper, Eigen::IdentityPreconditioner> cg;
   Eigen::ConjugateGradient<SymmetricMatrix, Eigen::Lower | Eigen::Upper, Eigen::IncompleteCholesky<double>> pcg;
   int iterations = 0;
@@ -84,15 +93,46 @@ Integrator::Integrator(const PhysicalMatrices& matrices, const SymmetricMatrix& 
     throw Error("iterative solver tolerance must be > 0 and iterations >= 1");
   }
   const int n = static_cast<int>(matrices.mass.rows());
-  s.mass = matrices.mass;
-  s.damping = matrices.damping;
   SymmetricMatrix stiffness = matrices.stiffness;
+  SymmetricMatrix stabilizing(n, n);
   if (forceStiffness.size() > 0) {
     if (forceStiffness.rows() != n || forceStiffness.cols() != n) {
       throw Error("internal: force stiffness has the wrong size");
     }
-    s.forceStiffness = forceStiffness;
+    stabilizing = forceStiffness;
     stiffness += forceStiffness;
+  }
+  // The force stiffness S is on the left; S p(t) joins the force on the right:
+  //   second order: 2 dt^2 (f + S p(t)) + 4 M p(t) + (D dt - 2M) p(t-dt)
+  //   first order:  2 dt (f + S p(t)) + D p(t-dt)
+  const bool second = options.scheme == IntegrationScheme::SecondOrder;
+  s.forceWeight = second ? 2.0 * dt * dt : 2.0 * dt;
+  const SymmetricMatrix onCurrent = second ? SymmetricMatrix(s.forceWeight * stabilizing + 4.0 * matrices.mass)
+                                           : SymmetricMatrix(s.forceWeight * stabilizing);
+  const SymmetricMatrix onPrevious = second ? SymmetricMatrix(dt * matrices.damping - 2.0 * matrices.mass)
+                                            : matrices.damping;
+  // Each on the union of both patterns and the diagonal (explicit zeros are
+  // kept), so they share one and every column has its diagonal entry.
+  SymmetricMatrix diagonal(n, n);
+  diagonal.setIdentity();
+  SymmetricMatrix current = onCurrent + 0.0 * onPrevious + 0.0 * diagonal;
+  SymmetricMatrix previous = onPrevious + 0.0 * onCurrent + 0.0 * diagonal;
+  current.makeCompressed();
+  previous.makeCompressed();
+  if (current.nonZeros() != previous.nonZeros() ||
+      !std::equal(current.innerIndexPtr(), current.innerIndexPtr() + current.nonZeros(), previous.innerIndexPtr())) {
+    throw Error("internal: the right-hand side's matrices do not share a pattern");
+  }
+  s.lowerStart.assign(1, 0);
+  for (int j = 0; j < n; ++j) {
+    for (int k = current.outerIndexPtr()[j]; k < current.outerIndexPtr()[j + 1]; ++k) {
+      const int i = current.innerIndexPtr()[k];
+      if (i < j) continue;
+      s.lowerRow.push_back(i);
+      s.lowerWeights.push_back(current.valuePtr()[k]);
+      s.lowerWeights.push_back(previous.valuePtr()[k]);
+    }
+    s.lowerStart.push_back(static_cast<int>(s.lowerRow.size()));
   }
   s.freeIndex.assign(n, 0);
   for (int v : fixed) {
@@ -111,9 +151,9 @@ Integrator::Integrator(const PhysicalMatrices& matrices, const SymmetricMatrix& 
   }
   if (free == 0) throw Error("every control vertex is fixed: nothing can move");
 
-  const SymmetricMatrix lhs = options.scheme == IntegrationScheme::SecondOrder
-                                  ? SymmetricMatrix(2.0 * s.mass + dt * s.damping + 2.0 * dt * dt * stiffness)
-                                  : SymmetricMatrix(s.damping + 2.0 * dt * stiffness);
+  const SymmetricMatrix lhs = second ? SymmetricMatrix(2.0 * matrices.mass + dt * matrices.damping +
+                                                       2.0 * dt * dt * stiffness)
+                                     : SymmetricMatrix(matrices.damping + 2.0 * dt * stiffness);
   s.lhsFree = select(lhs, s.freeIndex, free, s.freeIndex, free);
   s.lhsCoupling = select(lhs, s.freeIndex, free, fixedIndex, pinned);
   s.lhsFree.makeCompressed();
@@ -127,6 +167,9 @@ Integrator::Integrator(const PhysicalMatrices& matrices, const SymmetricMatrix& 
         throw Error("the left-hand matrix of the time step is not positive definite (is the surface anchored? "
                     "first-order integration needs damping > 0)");
       }
+      s.rowOfUnknown.resize(free);
+      for (int k = 0; k < free; ++k) s.rowOfUnknown[k] = s.freeVertices[s.cholesky.permutation()[k]];
+      s.unknowns.resize(free, 3);
       break;
     case LinearSolver::ConjugateGradient:
       s.cg.setTolerance(options.solverTolerance);
@@ -147,33 +190,74 @@ Integrator::~Integrator() = default;
 Integrator::Integrator(Integrator&&) noexcept = default;
 Integrator& Integrator::operator=(Integrator&&) noexcept = default;
 
+namespace {
+
+// rhs = w f + C p + P q, with C and P given by their lower triangles (the
+// diagonal first in each column) and their weights side by side. Each stored
+// entry below the diagonal serves both its row and its column.
+void formRightHandSide(double w, const std::vector<int>& start, const std::vector<int>& row,
+                       const std::vector<double>& weights, const Matrix3X& f, const Matrix3X& p, const Matrix3X& q,
+                       Matrix3X& rhs) {
+  const Eigen::Index n = p.rows();
+  rhs.resize(n, 3);
+  rhs = w * f;
+  const double *px = p.data(), *py = px + n, *pz = py + n;
+  const double *qx = q.data(), *qy = qx + n, *qz = qy + n;
+  double *rx = rhs.data(), *ry = rx + n, *rz = ry + n;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const double *c = weights.data() + 2 * start[j];
+    const double pjx = px[j], pjy = py[j], pjz = pz[j], qjx = qx[j], qjy = qy[j], qjz = qz[j];
+    double x = c[0] * pjx + c[1] * qjx, y = c[0] * pjy + c[1] * qjy, z = c[0] * pjz + c[1] * qjz;
+    for (int k = start[j] + 1; k < start[j + 1]; ++k) {
+      const int i = row[k];
+      const double a = weights[2 * k], b = weights[2 * k + 1];
+      x += a * px[i] + b * qx[i];
+      y += a * py[i] + b * qy[i];
+      z += a * pz[i] + b * qz[i];
+      rx[i] += a * pjx + b * qjx;
+      ry[i] += a * pjy + b * qjy;
+      rz[i] += a * pjz + b * qjz;
+    }
+    rx[j] += x;
+    ry[j] += y;
+    rz[j] += z;
+  }
+}
+
+}  // namespace
+
 Matrix3X Integrator::step(const Matrix3X& previous, const Matrix3X& current, const Matrix3X& force) {
   Impl& s = *impl_;
-  const double dt = s.options.timeStep;
-  // The force stiffness S is on the left; S p(t) joins the force on the right.
-  Matrix3X stabilizedForce = force;
-  if (s.forceStiffness.size() > 0) stabilizedForce += s.forceStiffness * current;
-  Matrix3X rhs;
-  if (s.options.scheme == IntegrationScheme::SecondOrder) {
-    rhs = 2.0 * dt * dt * stabilizedForce + (dt * (s.damping * previous) - 2.0 * (s.mass * previous)) +
-          4.0 * (s.mass * current);
-  } else {
-    rhs = 2.0 * dt * stabilizedForce + s.damping * previous;
-  }
-  Matrix3X next = current;
   const int free = static_cast<int>(s.freeVertices.size());
-  Eigen::MatrixXd rhsFree(free, 3), guess(free, 3), pinned(s.lhsCoupling.cols(), 3);
-  for (int i = 0; i < free; ++i) {
-    rhsFree.row(i) = rhs.row(s.freeVertices[i]);
-    guess.row(i) = current.row(s.freeVertices[i]);
-  }
-  for (int v = 0, k = 0; v < static_cast<int>(s.freeIndex.size()); ++v) {
+  const int vertices = static_cast<int>(s.freeIndex.size());
+  Eigen::MatrixXd pinned(s.lhsCoupling.cols(), 3);
+  for (int v = 0, k = 0; v < vertices; ++v) {
     if (s.freeIndex[v] < 0) pinned.row(k++) = current.row(v);
   }
-  if (pinned.rows() > 0) rhsFree -= s.lhsCoupling * pinned;
-
-  Eigen::MatrixXd solution(free, 3);
+  formRightHandSide(s.forceWeight, s.lowerStart, s.lowerRow, s.lowerWeights, force, current, previous, s.rhs);
+  Matrix3X next = current;
   s.iterations = 0;
+  if (s.options.solver == LinearSolver::Cholesky) {
+    // Gathered into the factor's order, solved in place, scattered back.
+    Eigen::MatrixXd& x = s.unknowns;
+    for (int k = 0; k < free; ++k) x.row(k) = s.rhs.row(s.rowOfUnknown[k]);
+    if (pinned.rows() > 0) {
+      const Eigen::MatrixXd coupling = s.lhsCoupling * pinned;
+      const int* perm = s.cholesky.permutation();
+      for (int k = 0; k < free; ++k) x.row(k) -= coupling.row(perm[k]);
+    }
+    s.cholesky.solveInPermutedOrder(x.data(), 3);
+    for (int k = 0; k < free; ++k) next.row(s.rowOfUnknown[k]) = x.row(k);
+    return next;
+  }
+
+  Eigen::MatrixXd rhsFree(free, 3), guess(free, 3);
+  for (int i = 0; i < free; ++i) {
+    rhsFree.row(i) = s.rhs.row(s.freeVertices[i]);
+    guess.row(i) = current.row(s.freeVertices[i]);
+  }
+  if (pinned.rows() > 0) rhsFree -= s.lhsCoupling * pinned;
+  Eigen::MatrixXd solution(free, 3);
   // x, y and z one after the other, each from last step's solution.
   auto iterate = [&](auto& solver, const char* name) {
     for (int c = 0; c < 3; ++c) {
@@ -182,16 +266,10 @@ Matrix3X Integrator::step(const Matrix3X& previous, const Matrix3X& current, con
       if (solver.info() != Eigen::Success) throw Error(std::string(name) + " did not converge");
     }
   };
-  switch (s.options.solver) {
-    case LinearSolver::Cholesky:
-      solution = s.cholesky.solve(rhsFree);
-      break;
-    case LinearSolver::ConjugateGradient:
-      iterate(s.cg, "conjugate gradients");
-      break;
-    case LinearSolver::PreconditionedConjugateGradient:
-      iterate(s.pcg, "preconditioned conjugate gradients");
-      break;
+  if (s.options.solver == LinearSolver::ConjugateGradient) {
+    iterate(s.cg, "conjugate gradients");
+  } else {
+    iterate(s.pcg, "preconditioned conjugate gradients");
   }
   for (int i = 0; i < free; ++i) next.row(s.freeVertices[i]) = solution.row(i);
   return next;

@@ -1,0 +1,38 @@
+#pragma once
+// Triangular solves against a supernodal Cholesky factor L (A = P' L L' P),
+// private to the Dynamics module. CHOLMOD factors (SparseCholesky.h); these
+// solves replace its own, which call BLAS once per supernode and right-hand
+// side block: with the three coordinates' right-hand sides those calls are
+// mostly overhead (a 6146-unknown step's solve: 1.3-1.8 ms in CHOLMOD, about
+// a third of that here; Documentation/Performance.md). They use no BLAS, so
+// unlike CHOLMOD's they need no process-wide lock.
+
+namespace dynsub {
+
+// A view of L as CHOLMOD keeps it (cholmod_factor, supernodal, int indices):
+// supernode s holds columns firstColumn[s] .. firstColumn[s+1]-1 as a dense
+// column-major block of rowStart[s+1]-rowStart[s] rows at values +
+// valueStart[s]; its row numbers are rows[rowStart[s] ...], its own columns'
+// rows first. perm[k] is the row of A at L's row k.
+struct SupernodalFactorView {
+  int unknowns = 0;
+  int supernodes = 0;
+  const int* perm = nullptr;
+  const int* firstColumn = nullptr;
+  const int* rowStart = nullptr;
+  const int* rows = nullptr;
+  const int* valueStart = nullptr;
+  const double* values = nullptr;
+};
+
+// The most rows of any supernode: supernodalSolve's scratch needs three
+// times that many doubles.
+int largestSupernode(const SupernodalFactorView& factor);
+
+// Solves L L' y = x in place for `columns` right-hand sides, each a column of
+// `factor.unknowns` values in L's (permuted) order, one after the other in x.
+// `scratch` holds 3 * largestSupernode(factor) doubles. The sums run in
+// a fixed order, so results do not vary from run to run.
+void supernodalSolve(const SupernodalFactorView& factor, double* x, int columns, double* scratch);
+
+}  // namespace dynsub
