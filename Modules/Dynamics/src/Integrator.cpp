@@ -1,11 +1,11 @@
 #include "dynsub/Integrator.h"
 
-#include <algorithm>
 #include <cmath>
 #include <string>
 
 #include <Eigen/IterativeLinearSolvers>
 
+#include "PairedProduct.h"
 #include "SparseCholesky.h"
 #include "dynsub/Error.h"
 
@@ -43,12 +43,9 @@ LinearSolver parseLinearSolver(const std::string& text) {
 
 struct Integrator::Impl {
   IntegratorOptions options;
-  // The right-hand side is forceWeight f + C p(t) + P p(t-dt). C and P are
-  // symmetric: their lower triangles are kept on one pattern, each entry's
-  // two weights side by side, so one pass over half the entries forms it.
+  // The right-hand side is forceWeight f + C p(t) + P p(t-dt).
   double forceWeight = 0.0;
-  std::vector<int> lowerStart, lowerRow;     // column j's rows i >= j, j first: lowerRow[lowerStart[j] ...]
-  std::vector<double> lowerWeights;          // C_ij, P_ij for each of those entries
+  PairedProduct rightHandSide;
   Matrix3X rhs;                              // the right-hand side, by vertex
   std::vector<int> freeIndex;                // free position of each vertex, or -1
   std::vector<int> freeVertices;
@@ -111,29 +108,7 @@ Integrator::Integrator(const PhysicalMatrices& matrices, const SymmetricMatrix& 
                                            : SymmetricMatrix(s.forceWeight * stabilizing);
   const SymmetricMatrix onPrevious = second ? SymmetricMatrix(dt * matrices.damping - 2.0 * matrices.mass)
                                             : matrices.damping;
-  // Each on the union of both patterns and the diagonal (explicit zeros are
-  // kept), so they share one and every column has its diagonal entry.
-  SymmetricMatrix diagonal(n, n);
-  diagonal.setIdentity();
-  SymmetricMatrix current = onCurrent + 0.0 * onPrevious + 0.0 * diagonal;
-  SymmetricMatrix previous = onPrevious + 0.0 * onCurrent + 0.0 * diagonal;
-  current.makeCompressed();
-  previous.makeCompressed();
-  if (current.nonZeros() != previous.nonZeros() ||
-      !std::equal(current.innerIndexPtr(), current.innerIndexPtr() + current.nonZeros(), previous.innerIndexPtr())) {
-    throw Error("internal: the right-hand side's matrices do not share a pattern");
-  }
-  s.lowerStart.assign(1, 0);
-  for (int j = 0; j < n; ++j) {
-    for (int k = current.outerIndexPtr()[j]; k < current.outerIndexPtr()[j + 1]; ++k) {
-      const int i = current.innerIndexPtr()[k];
-      if (i < j) continue;
-      s.lowerRow.push_back(i);
-      s.lowerWeights.push_back(current.valuePtr()[k]);
-      s.lowerWeights.push_back(previous.valuePtr()[k]);
-    }
-    s.lowerStart.push_back(static_cast<int>(s.lowerRow.size()));
-  }
+  s.rightHandSide = PairedProduct(onCurrent, onPrevious);
   s.freeIndex.assign(n, 0);
   for (int v : fixed) {
     if (v < 0 || v >= n) throw Error("fixed control vertex " + std::to_string(v) + " does not exist");
@@ -190,42 +165,6 @@ Integrator::~Integrator() = default;
 Integrator::Integrator(Integrator&&) noexcept = default;
 Integrator& Integrator::operator=(Integrator&&) noexcept = default;
 
-namespace {
-
-// rhs = w f + C p + P q, with C and P given by their lower triangles (the
-// diagonal first in each column) and their weights side by side. Each stored
-// entry below the diagonal serves both its row and its column.
-void formRightHandSide(double w, const std::vector<int>& start, const std::vector<int>& row,
-                       const std::vector<double>& weights, const Matrix3X& f, const Matrix3X& p, const Matrix3X& q,
-                       Matrix3X& rhs) {
-  const Eigen::Index n = p.rows();
-  rhs.resize(n, 3);
-  rhs = w * f;
-  const double *px = p.data(), *py = px + n, *pz = py + n;
-  const double *qx = q.data(), *qy = qx + n, *qz = qy + n;
-  double *rx = rhs.data(), *ry = rx + n, *rz = ry + n;
-  for (Eigen::Index j = 0; j < n; ++j) {
-    const double *c = weights.data() + 2 * start[j];
-    const double pjx = px[j], pjy = py[j], pjz = pz[j], qjx = qx[j], qjy = qy[j], qjz = qz[j];
-    double x = c[0] * pjx + c[1] * qjx, y = c[0] * pjy + c[1] * qjy, z = c[0] * pjz + c[1] * qjz;
-    for (int k = start[j] + 1; k < start[j + 1]; ++k) {
-      const int i = row[k];
-      const double a = weights[2 * k], b = weights[2 * k + 1];
-      x += a * px[i] + b * qx[i];
-      y += a * py[i] + b * qy[i];
-      z += a * pz[i] + b * qz[i];
-      rx[i] += a * pjx + b * qjx;
-      ry[i] += a * pjy + b * qjy;
-      rz[i] += a * pjz + b * qjz;
-    }
-    rx[j] += x;
-    ry[j] += y;
-    rz[j] += z;
-  }
-}
-
-}  // namespace
-
 Matrix3X Integrator::step(const Matrix3X& previous, const Matrix3X& current, const Matrix3X& force) {
   Impl& s = *impl_;
   const int free = static_cast<int>(s.freeVertices.size());
@@ -234,7 +173,7 @@ Matrix3X Integrator::step(const Matrix3X& previous, const Matrix3X& current, con
   for (int v = 0, k = 0; v < vertices; ++v) {
     if (s.freeIndex[v] < 0) pinned.row(k++) = current.row(v);
   }
-  formRightHandSide(s.forceWeight, s.lowerStart, s.lowerRow, s.lowerWeights, force, current, previous, s.rhs);
+  s.rightHandSide.apply(s.forceWeight, force, current, previous, s.rhs);
   Matrix3X next = current;
   s.iterations = 0;
   if (s.options.solver == LinearSolver::Cholesky) {

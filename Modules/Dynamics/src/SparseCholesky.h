@@ -43,6 +43,10 @@ class SparseCholesky {
     const std::lock_guard<std::mutex> lock(blas());
     factor_.factorize(lower);
     view_ = factor_.view();
+    if (view_.values != nullptr) {
+      inverseDiagonal_ = inverseDiagonalOf(view_);
+      view_.inverseDiagonal = inverseDiagonal_.data();
+    }
     return factor_.info() == Eigen::Success && factor_.reciprocalCondition() > 1e-12;
   }
 
@@ -109,6 +113,7 @@ class SparseCholesky {
   };
   Factor factor_;
   SupernodalFactorView view_;
+  std::vector<double> inverseDiagonal_;
 };
 
 }  // namespace dynsub

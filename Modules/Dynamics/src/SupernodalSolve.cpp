@@ -1,38 +1,23 @@
 #include "SupernodalSolve.h"
 
 #include <algorithm>
-#include <cstring>
+
+#include "Lanes.h"
 
 namespace dynsub {
 namespace {
-
-// The kernels are inlined into two entry points: one compiled for AVX2 and
-// FMA, chosen at run time where the processor has them, and one for the
-// baseline x86-64 (SSE2). The AVX2 one is about twice as fast; the two round
-// differently (fused multiply-adds), each the same from run to run.
-#define DYNSUB_KERNEL inline __attribute__((always_inline))
-
-// Four doubles, summed lane by lane and the lanes added at the end: a fixed
-// order, so the compiler vectorizes the dot products without -ffast-math.
-typedef double Lanes __attribute__((vector_size(32)));
-constexpr int kLanes = 4;
-
-// NB: by reference, not by value: a 32-byte vector passed by value has a
-// different ABI with and without AVX (GCC warns), though these are always inlined.
-DYNSUB_KERNEL void load(Lanes& v, const double* p) { std::memcpy(&v, p, sizeof v); }
-
-DYNSUB_KERNEL double sum(const Lanes& v) { return (v[0] + v[1]) + (v[2] + v[3]); }
 
 // One supernode's columns are solved in blocks of this many: each pass over
 // the rows below a block then reads those rows' right-hand sides once for
 // four columns of L, not once per column.
 constexpr int kBlock = 4;
 
-// Forward: L y = x for one supernode, on its rows gathered into v (K columns
-// of `rows` values, `stride` apart). Columns 0 .. nc-1 of the block Lb
-// (column-major, leading dimension `rows`).
+// Forward, the supernode's own rows: L11 y = x on its first nc rows,
+// gathered into v (K columns, `stride` apart). Lb is the supernode's block
+// (column-major, leading dimension `rows`); inverse holds 1 / L's diagonal.
 template <int K>
-DYNSUB_KERNEL void forward(const double* __restrict Lb, int nc, int rows, double* __restrict v, int stride) {
+DYNSUB_KERNEL void forwardTriangle(const double* __restrict Lb, const double* __restrict inverse, int nc, int rows,
+                                   double* __restrict v, int stride) {
   for (int c = 0; c < nc; c += kBlock) {
     const int width = std::min(kBlock, nc - c);
     // The small triangle of the block's own rows.
@@ -40,11 +25,11 @@ DYNSUB_KERNEL void forward(const double* __restrict Lb, int nc, int rows, double
       const double* column = Lb + static_cast<long>(c + j) * rows;
       for (int k = 0; k < K; ++k) {
         double* vk = v + k * stride;
-        vk[c + j] /= column[c + j];
+        vk[c + j] *= inverse[c + j];
         for (int i = j + 1; i < width; ++i) vk[c + i] -= column[c + i] * vk[c + j];
       }
     }
-    // The rows below the block, four columns at a time.
+    // The own rows below the block, four columns at a time.
     const int below = c + width;
     if (width == kBlock) {
       const double* L0 = Lb + static_cast<long>(c) * rows;
@@ -56,7 +41,7 @@ DYNSUB_KERNEL void forward(const double* __restrict Lb, int nc, int rows, double
       for (int k = 0; k < K; ++k) {
         for (int j = 0; j < kBlock; ++j) a[k][j] = v[k * stride + c + j];
       }
-      for (int r = below; r < rows; ++r) {
+      for (int r = below; r < nc; ++r) {
         const double l0 = L0[r], l1 = L1[r], l2 = L2[r], l3 = L3[r];
         for (int k = 0; k < K; ++k) v[k * stride + r] -= l0 * a[k][0] + l1 * a[k][1] + l2 * a[k][2] + l3 * a[k][3];
       }
@@ -66,10 +51,47 @@ DYNSUB_KERNEL void forward(const double* __restrict Lb, int nc, int rows, double
         for (int k = 0; k < K; ++k) {
           double* __restrict vk = v + k * stride;
           const double a = vk[c + j];
-          for (int r = below; r < rows; ++r) vk[r] -= Lj[r] * a;
+          for (int r = below; r < nc; ++r) vk[r] -= Lj[r] * a;
         }
       }
     }
+  }
+}
+
+// Forward, the rows below: x[below[r]] -= sum over c of L[nc + r, c] y[c],
+// eight rows at a time, each row's sum held in registers over all nc
+// columns, so each right-hand side value is written once.
+template <int K>
+DYNSUB_KERNEL void forwardBelow(const double* __restrict Lb, int nc, int rows, const double* __restrict v, int stride,
+                                const int* __restrict below, double* __restrict x, int n) {
+  int r = nc;
+  for (; r + 2 * kLanes <= rows; r += 2 * kLanes) {
+    Lanes sums[K][2] = {};
+    for (int c = 0; c < nc; ++c) {
+      Lanes l0, l1;
+      load(l0, Lb + static_cast<long>(c) * rows + r);
+      load(l1, Lb + static_cast<long>(c) * rows + r + kLanes);
+      for (int k = 0; k < K; ++k) {
+        const double value = v[k * stride + c];
+        const Lanes y = {value, value, value, value};
+        sums[k][0] += l0 * y;
+        sums[k][1] += l1 * y;
+      }
+    }
+    for (int k = 0; k < K; ++k) {
+      for (int t = 0; t < kLanes; ++t) {
+        x[k * n + below[r - nc + t]] -= sums[k][0][t];
+        x[k * n + below[r - nc + kLanes + t]] -= sums[k][1][t];
+      }
+    }
+  }
+  for (; r < rows; ++r) {
+    double sums[K] = {};
+    for (int c = 0; c < nc; ++c) {
+      const double l = Lb[static_cast<long>(c) * rows + r];
+      for (int k = 0; k < K; ++k) sums[k] += l * v[k * stride + c];
+    }
+    for (int k = 0; k < K; ++k) x[k * n + below[r - nc]] -= sums[k];
   }
 }
 
@@ -91,7 +113,8 @@ DYNSUB_KERNEL double dot(const double* __restrict L, const double* __restrict v,
 // Backward: L' y = x for one supernode, on its rows gathered into v, whose
 // rows below its own columns already hold their solution.
 template <int K>
-DYNSUB_KERNEL void backward(const double* __restrict Lb, int nc, int rows, double* __restrict v, int stride) {
+DYNSUB_KERNEL void backward(const double* __restrict Lb, const double* __restrict inverse, int nc, int rows,
+                            double* __restrict v, int stride) {
   // Blocks from the last columns to the first; the first block takes the remainder.
   for (int end = nc; end > 0;) {
     const int width = end % kBlock == 0 ? kBlock : end % kBlock;
@@ -137,7 +160,7 @@ DYNSUB_KERNEL void backward(const double* __restrict Lb, int nc, int rows, doubl
         double* vk = v + k * stride;
         double value = vk[c + j];
         for (int i = j + 1; i < width; ++i) value -= column[c + i] * vk[c + i];
-        vk[c + j] = value / column[c + j];
+        vk[c + j] = value * inverse[c + j];
       }
     }
     end = c;
@@ -150,18 +173,11 @@ DYNSUB_KERNEL void solve(const SupernodalFactorView& f, double* x, double* v, in
   for (int s = 0; s < f.supernodes; ++s) {
     const int k0 = f.firstColumn[s], nc = f.firstColumn[s + 1] - k0;
     const int rows = f.rowStart[s + 1] - f.rowStart[s];
-    const int* below = f.rows + f.rowStart[s] + nc;
-    for (int k = 0; k < K; ++k) {
-      std::copy(x + k * n + k0, x + k * n + k0 + nc, v + k * stride);
-      std::fill(v + k * stride + nc, v + k * stride + rows, 0.0);
-    }
-    forward<K>(f.values + f.valueStart[s], nc, rows, v, stride);
-    // The rows below started at zero, so they hold minus the supernode's
-    // contribution to the later rows.
-    for (int k = 0; k < K; ++k) {
-      std::copy(v + k * stride, v + k * stride + nc, x + k * n + k0);
-      for (int r = nc; r < rows; ++r) x[k * n + below[r - nc]] += v[k * stride + r];
-    }
+    const double* Lb = f.values + f.valueStart[s];
+    for (int k = 0; k < K; ++k) std::copy(x + k * n + k0, x + k * n + k0 + nc, v + k * stride);
+    forwardTriangle<K>(Lb, f.inverseDiagonal + k0, nc, rows, v, stride);
+    for (int k = 0; k < K; ++k) std::copy(v + k * stride, v + k * stride + nc, x + k * n + k0);
+    forwardBelow<K>(Lb, nc, rows, v, stride, f.rows + f.rowStart[s] + nc, x, n);
   }
   for (int s = f.supernodes - 1; s >= 0; --s) {
     const int k0 = f.firstColumn[s], nc = f.firstColumn[s + 1] - k0;
@@ -171,7 +187,7 @@ DYNSUB_KERNEL void solve(const SupernodalFactorView& f, double* x, double* v, in
       std::copy(x + k * n + k0, x + k * n + k0 + nc, v + k * stride);
       for (int r = nc; r < rows; ++r) v[k * stride + r] = x[k * n + below[r - nc]];
     }
-    backward<K>(f.values + f.valueStart[s], nc, rows, v, stride);
+    backward<K>(f.values + f.valueStart[s], f.inverseDiagonal + k0, nc, rows, v, stride);
     for (int k = 0; k < K; ++k) std::copy(v + k * stride, v + k * stride + nc, x + k * n + k0);
   }
 }
@@ -182,14 +198,13 @@ void solveBaseline(const SupernodalFactorView& f, double* x, double* v, int stri
 }
 
 template <int K>
-__attribute__((target("avx2,fma"))) void solveAvx2(const SupernodalFactorView& f, double* x, double* v, int stride) {
+DYNSUB_AVX2 void solveAvx2(const SupernodalFactorView& f, double* x, double* v, int stride) {
   solve<K>(f, x, v, stride);
 }
 
 template <int K>
 void solveColumns(const SupernodalFactorView& f, double* x, double* v, int stride) {
-  static const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  if (avx2) {
+  if (hasAvx2Fma()) {
     solveAvx2<K>(f, x, v, stride);
   } else {
     solveBaseline<K>(f, x, v, stride);
@@ -197,6 +212,18 @@ void solveColumns(const SupernodalFactorView& f, double* x, double* v, int strid
 }
 
 }  // namespace
+
+std::vector<double> inverseDiagonalOf(const SupernodalFactorView& f) {
+  std::vector<double> inverse(f.unknowns);
+  for (int s = 0; s < f.supernodes; ++s) {
+    const int rows = f.rowStart[s + 1] - f.rowStart[s];
+    const double* Lb = f.values + f.valueStart[s];
+    for (int c = 0; c < f.firstColumn[s + 1] - f.firstColumn[s]; ++c) {
+      inverse[f.firstColumn[s] + c] = 1.0 / Lb[static_cast<long>(c) * rows + c];
+    }
+  }
+  return inverse;
+}
 
 int largestSupernode(const SupernodalFactorView& f) {
   int largest = 0;

@@ -7,13 +7,16 @@
 // a third of that here; Documentation/Performance.md). They use no BLAS, so
 // unlike CHOLMOD's they need no process-wide lock.
 
+#include <vector>
+
 namespace dynsub {
 
 // A view of L as CHOLMOD keeps it (cholmod_factor, supernodal, int indices):
 // supernode s holds columns firstColumn[s] .. firstColumn[s+1]-1 as a dense
 // column-major block of rowStart[s+1]-rowStart[s] rows at values +
 // valueStart[s]; its row numbers are rows[rowStart[s] ...], its own columns'
-// rows first. perm[k] is the row of A at L's row k.
+// rows first. perm[k] is the row of A at L's row k; inverseDiagonal[k] is
+// 1 / L(k, k).
 struct SupernodalFactorView {
   int unknowns = 0;
   int supernodes = 0;
@@ -23,7 +26,11 @@ struct SupernodalFactorView {
   const int* rows = nullptr;
   const int* valueStart = nullptr;
   const double* values = nullptr;
+  const double* inverseDiagonal = nullptr;
 };
+
+// 1 / L(k, k) for each column k, for SupernodalFactorView::inverseDiagonal.
+std::vector<double> inverseDiagonalOf(const SupernodalFactorView& factor);
 
 // The most rows of any supernode: supernodalSolve's scratch needs three
 // times that many doubles.

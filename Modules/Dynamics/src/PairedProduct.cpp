@@ -1,0 +1,113 @@
+#include "PairedProduct.h"
+
+#include <algorithm>
+
+#include "dynsub/Error.h"
+
+namespace dynsub {
+
+PairedProduct::PairedProduct(const SymmetricMatrix& c, const SymmetricMatrix& p) {
+  const Eigen::Index n = c.rows();
+  if (c.cols() != n || p.rows() != n || p.cols() != n) throw Error("internal: paired product of unequal sizes");
+  // Both on the union of the two patterns and the diagonal (explicit zeros are
+  // kept), so they share one and every column has its diagonal entry.
+  SymmetricMatrix diagonal(n, n);
+  diagonal.setIdentity();
+  SymmetricMatrix onC = c + 0.0 * p + 0.0 * diagonal;
+  SymmetricMatrix onP = p + 0.0 * c + 0.0 * diagonal;
+  onC.makeCompressed();
+  onP.makeCompressed();
+  if (onC.nonZeros() != onP.nonZeros() ||
+      !std::equal(onC.innerIndexPtr(), onC.innerIndexPtr() + onC.nonZeros(), onP.innerIndexPtr())) {
+    throw Error("internal: the paired product's matrices do not share a pattern");
+  }
+  start_.assign(1, 0);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    for (int k = onC.outerIndexPtr()[j]; k < onC.outerIndexPtr()[j + 1]; ++k) {
+      const int i = onC.innerIndexPtr()[k];
+      if (i < j) continue;  // rows are sorted: the diagonal comes first
+      row_.push_back(i);
+      weights_.push_back(onC.valuePtr()[k]);
+      weights_.push_back(onP.valuePtr()[k]);
+    }
+    start_.push_back(static_cast<int>(row_.size()));
+  }
+  p_.assign(4 * n, 0.0);
+  q_.assign(4 * n, 0.0);
+  sums_.assign(4 * n, 0.0);
+}
+
+namespace {
+
+// sums = C p + P q, points as [x y z 0]. Two partial sums per column (even and
+// odd entries), so that each addition need not wait for the one before.
+DYNSUB_KERNEL void product(int n, const int* start, const int* row, const double* weights, const double* p,
+                           const double* q, double* sums) {
+  std::fill(sums, sums + 4 * n, 0.0);
+  for (int j = 0; j < n; ++j) {
+    Lanes pj, qj;
+    load(pj, p + 4 * j);
+    load(qj, q + 4 * j);
+    const double* w = weights + 2 * start[j];
+    Lanes even = w[0] * pj + w[1] * qj, odd = {};
+    int k = start[j] + 1;
+    const int end = start[j + 1];
+    for (; k + 2 <= end; k += 2) {
+      const int i0 = row[k], i1 = row[k + 1];
+      const double a0 = weights[2 * k], b0 = weights[2 * k + 1];
+      const double a1 = weights[2 * k + 2], b1 = weights[2 * k + 3];
+      Lanes p0, q0, p1, q1, s0, s1;
+      load(p0, p + 4 * i0), load(q0, q + 4 * i0), load(s0, sums + 4 * i0);
+      load(p1, p + 4 * i1), load(q1, q + 4 * i1), load(s1, sums + 4 * i1);
+      even += a0 * p0 + b0 * q0;
+      odd += a1 * p1 + b1 * q1;
+      store(sums + 4 * i0, s0 + (a0 * pj + b0 * qj));
+      store(sums + 4 * i1, s1 + (a1 * pj + b1 * qj));
+    }
+    if (k < end) {
+      const int i = row[k];
+      const double a = weights[2 * k], b = weights[2 * k + 1];
+      Lanes pi, qi, si;
+      load(pi, p + 4 * i), load(qi, q + 4 * i), load(si, sums + 4 * i);
+      even += a * pi + b * qi;
+      store(sums + 4 * i, si + (a * pj + b * qj));
+    }
+    Lanes sj;
+    load(sj, sums + 4 * j);
+    store(sums + 4 * j, sj + (even + odd));
+  }
+}
+
+void productBaseline(int n, const int* start, const int* row, const double* weights, const double* p,
+                     const double* q, double* sums) {
+  product(n, start, row, weights, p, q, sums);
+}
+
+DYNSUB_AVX2 void productAvx2(int n, const int* start, const int* row, const double* weights, const double* p,
+                             const double* q, double* sums) {
+  product(n, start, row, weights, p, q, sums);
+}
+
+}  // namespace
+
+void PairedProduct::apply(double w, const Matrix3X& f, const Matrix3X& p, const Matrix3X& q, Matrix3X& rhs) {
+  const int n = static_cast<int>(p_.size() / 4);
+  if (f.rows() != n || p.rows() != n || q.rows() != n) throw Error("internal: paired product of unequal sizes");
+  for (int i = 0; i < n; ++i) {
+    for (int a = 0; a < 3; ++a) {
+      p_[4 * i + a] = p(i, a);
+      q_[4 * i + a] = q(i, a);
+    }
+  }
+  if (hasAvx2Fma()) {
+    productAvx2(n, start_.data(), row_.data(), weights_.data(), p_.data(), q_.data(), sums_.data());
+  } else {
+    productBaseline(n, start_.data(), row_.data(), weights_.data(), p_.data(), q_.data(), sums_.data());
+  }
+  rhs.resize(n, 3);
+  for (int i = 0; i < n; ++i) {
+    for (int a = 0; a < 3; ++a) rhs(i, a) = w * f(i, a) + sums_[4 * i + a];
+  }
+}
+
+}  // namespace dynsub

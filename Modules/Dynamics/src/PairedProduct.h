@@ -1,0 +1,34 @@
+#pragma once
+// w f + C p + P q for two symmetric matrices C and P over the control
+// vertices: the right-hand side of every implicit time step (Integrator.cpp).
+// Private to the Dynamics module.
+//
+// Only the lower triangles are kept, on the union of the two patterns, each
+// entry's two weights side by side: one pass over half the entries, each
+// entry below the diagonal serving both its row and its column. The points
+// are read as [x y z 0] groups of four, one vector operation per vertex.
+#include <vector>
+
+#include "Lanes.h"
+#include "dynsub/PhysicalMatrices.h"
+
+namespace dynsub {
+
+class PairedProduct {
+ public:
+  PairedProduct() = default;
+  // C and P stored whole (both triangles), of one size; their patterns may differ.
+  PairedProduct(const SymmetricMatrix& c, const SymmetricMatrix& p);
+
+  // rhs = w f + C p + P q, all #vertices x 3. Not for two threads at once
+  // (it keeps its scratch).
+  void apply(double w, const Matrix3X& f, const Matrix3X& p, const Matrix3X& q, Matrix3X& rhs);
+
+ private:
+  std::vector<int> start_;       // column j's entries: [start_[j], start_[j + 1]), the diagonal first
+  std::vector<int> row_;         // each entry's row i >= j
+  std::vector<double> weights_;  // C_ij, P_ij for each entry
+  std::vector<double> p_, q_, sums_;  // four per vertex: x, y, z, 0
+};
+
+}  // namespace dynsub
