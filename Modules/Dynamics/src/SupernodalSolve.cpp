@@ -1,6 +1,8 @@
 #include "SupernodalSolve.h"
 
 #include <algorithm>
+#include <thread>
+#include <vector>
 
 #include "Lanes.h"
 
@@ -61,9 +63,16 @@ DYNSUB_KERNEL void forwardTriangle(const double* __restrict Lb, const double* __
 // Forward, the rows below: x[below[r]] -= sum over c of L[nc + r, c] y[c],
 // eight rows at a time, each row's sum held in registers over all nc
 // columns, so each right-hand side value is written once.
+// Rows from `outsideFrom` on are not written in x but subtracted from
+// `outside` (K columns of n - outsideFrom values): a second thread's share of
+// the rows that the first thread's supernodes update too.
 template <int K>
 DYNSUB_KERNEL void forwardBelow(const double* __restrict Lb, int nc, int rows, const double* __restrict v, int stride,
-                                const int* __restrict below, double* __restrict x, int n) {
+                                const int* __restrict below, double* __restrict x, int n, int outsideFrom,
+                                double* __restrict outside) {
+  auto target = [&](int k, int row) -> double& {
+    return row < outsideFrom ? x[k * n + row] : outside[k * (n - outsideFrom) + row - outsideFrom];
+  };
   int r = nc;
   for (; r + 2 * kLanes <= rows; r += 2 * kLanes) {
     Lanes sums[K][2] = {};
@@ -80,8 +89,8 @@ DYNSUB_KERNEL void forwardBelow(const double* __restrict Lb, int nc, int rows, c
     }
     for (int k = 0; k < K; ++k) {
       for (int t = 0; t < kLanes; ++t) {
-        x[k * n + below[r - nc + t]] -= sums[k][0][t];
-        x[k * n + below[r - nc + kLanes + t]] -= sums[k][1][t];
+        target(k, below[r - nc + t]) -= sums[k][0][t];
+        target(k, below[r - nc + kLanes + t]) -= sums[k][1][t];
       }
     }
   }
@@ -91,7 +100,7 @@ DYNSUB_KERNEL void forwardBelow(const double* __restrict Lb, int nc, int rows, c
       const double l = Lb[static_cast<long>(c) * rows + r];
       for (int k = 0; k < K; ++k) sums[k] += l * v[k * stride + c];
     }
-    for (int k = 0; k < K; ++k) x[k * n + below[r - nc]] -= sums[k];
+    for (int k = 0; k < K; ++k) target(k, below[r - nc]) -= sums[k];
   }
 }
 
@@ -167,19 +176,27 @@ DYNSUB_KERNEL void backward(const double* __restrict Lb, const double* __restric
   }
 }
 
+// L y = x over supernodes [begin, end), in order.
 template <int K>
-DYNSUB_KERNEL void solve(const SupernodalFactorView& f, double* x, double* v, int stride) {
+DYNSUB_KERNEL void forwardRange(const SupernodalFactorView& f, int begin, int end, double* x, double* v, int stride,
+                                int outsideFrom, double* outside) {
   const int n = f.unknowns;
-  for (int s = 0; s < f.supernodes; ++s) {
+  for (int s = begin; s < end; ++s) {
     const int k0 = f.firstColumn[s], nc = f.firstColumn[s + 1] - k0;
     const int rows = f.rowStart[s + 1] - f.rowStart[s];
     const double* Lb = f.values + f.valueStart[s];
     for (int k = 0; k < K; ++k) std::copy(x + k * n + k0, x + k * n + k0 + nc, v + k * stride);
     forwardTriangle<K>(Lb, f.inverseDiagonal + k0, nc, rows, v, stride);
     for (int k = 0; k < K; ++k) std::copy(v + k * stride, v + k * stride + nc, x + k * n + k0);
-    forwardBelow<K>(Lb, nc, rows, v, stride, f.rows + f.rowStart[s] + nc, x, n);
+    forwardBelow<K>(Lb, nc, rows, v, stride, f.rows + f.rowStart[s] + nc, x, n, outsideFrom, outside);
   }
-  for (int s = f.supernodes - 1; s >= 0; --s) {
+}
+
+// L' y = x over supernodes [begin, end), last first.
+template <int K>
+DYNSUB_KERNEL void backwardRange(const SupernodalFactorView& f, int begin, int end, double* x, double* v, int stride) {
+  const int n = f.unknowns;
+  for (int s = end - 1; s >= begin; --s) {
     const int k0 = f.firstColumn[s], nc = f.firstColumn[s + 1] - k0;
     const int rows = f.rowStart[s + 1] - f.rowStart[s];
     const int* below = f.rows + f.rowStart[s] + nc;
@@ -193,22 +210,81 @@ DYNSUB_KERNEL void solve(const SupernodalFactorView& f, double* x, double* v, in
 }
 
 template <int K>
-void solveBaseline(const SupernodalFactorView& f, double* x, double* v, int stride) {
-  solve<K>(f, x, v, stride);
+void forwardBaseline(const SupernodalFactorView& f, int begin, int end, double* x, double* v, int stride,
+                     int outsideFrom, double* outside) {
+  forwardRange<K>(f, begin, end, x, v, stride, outsideFrom, outside);
 }
 
 template <int K>
-DYNSUB_AVX2 void solveAvx2(const SupernodalFactorView& f, double* x, double* v, int stride) {
-  solve<K>(f, x, v, stride);
+DYNSUB_AVX2 void forwardAvx2(const SupernodalFactorView& f, int begin, int end, double* x, double* v, int stride,
+                             int outsideFrom, double* outside) {
+  forwardRange<K>(f, begin, end, x, v, stride, outsideFrom, outside);
 }
 
 template <int K>
-void solveColumns(const SupernodalFactorView& f, double* x, double* v, int stride) {
+void backwardBaseline(const SupernodalFactorView& f, int begin, int end, double* x, double* v, int stride) {
+  backwardRange<K>(f, begin, end, x, v, stride);
+}
+
+template <int K>
+DYNSUB_AVX2 void backwardAvx2(const SupernodalFactorView& f, int begin, int end, double* x, double* v, int stride) {
+  backwardRange<K>(f, begin, end, x, v, stride);
+}
+
+template <int K>
+void forward(const SupernodalFactorView& f, int begin, int end, double* x, double* v, int stride, int outsideFrom,
+             double* outside) {
   if (hasAvx2Fma()) {
-    solveAvx2<K>(f, x, v, stride);
+    forwardAvx2<K>(f, begin, end, x, v, stride, outsideFrom, outside);
   } else {
-    solveBaseline<K>(f, x, v, stride);
+    forwardBaseline<K>(f, begin, end, x, v, stride, outsideFrom, outside);
   }
+}
+
+template <int K>
+void backward(const SupernodalFactorView& f, int begin, int end, double* x, double* v, int stride) {
+  if (hasAvx2Fma()) {
+    backwardAvx2<K>(f, begin, end, x, v, stride);
+  } else {
+    backwardBaseline<K>(f, begin, end, x, v, stride);
+  }
+}
+
+// K columns of x. With a split (SupernodalFactorView::middle < top), the two
+// subtrees [0, middle) and [middle, top) are solved on two threads: in the
+// forward pass the second one's updates of the rows above both (columns
+// from firstColumn[top] on) are summed apart and subtracted after both, so
+// the sums run in the same order whether one thread or two did them.
+template <int K>
+void solveColumns(const SupernodalFactorView& f, double* x, double* v, int stride, bool threads) {
+  const int n = f.unknowns;
+  if (!(f.middle < f.top)) {
+    forward<K>(f, 0, f.supernodes, x, v, stride, n, nullptr);
+    backward<K>(f, 0, f.supernodes, x, v, stride);
+    return;
+  }
+  const int above = f.firstColumn[f.top];
+  std::vector<double> outside(static_cast<size_t>(K) * (n - above), 0.0);
+  std::vector<double> second(static_cast<size_t>(K) * stride);
+  auto both = [&](auto&& first, auto&& other) {
+    if (threads) {
+      std::thread worker(other);
+      first();
+      worker.join();
+    } else {
+      first();
+      other();
+    }
+  };
+  both([&] { forward<K>(f, 0, f.middle, x, v, stride, n, nullptr); },
+       [&] { forward<K>(f, f.middle, f.top, x, second.data(), stride, above, outside.data()); });
+  for (int k = 0; k < K; ++k) {
+    for (int r = above; r < n; ++r) x[k * n + r] += outside[k * (n - above) + r - above];
+  }
+  forward<K>(f, f.top, f.supernodes, x, v, stride, n, nullptr);
+  backward<K>(f, f.top, f.supernodes, x, v, stride);
+  both([&] { backward<K>(f, 0, f.middle, x, v, stride); },
+       [&] { backward<K>(f, f.middle, f.top, x, second.data(), stride); });
 }
 
 }  // namespace
@@ -233,10 +309,60 @@ int largestSupernode(const SupernodalFactorView& f) {
 
 void supernodalSolve(const SupernodalFactorView& f, double* x, int columns, double* scratch) {
   const int stride = largestSupernode(f);
+  const bool threads = f.middle < f.top && std::thread::hardware_concurrency() > 1;
   // Three columns (x, y and z of the implicit steps) in one pass over L; others one at a time.
   int done = 0;
-  for (; done + 3 <= columns; done += 3) solveColumns<3>(f, x + static_cast<long>(done) * f.unknowns, scratch, stride);
-  for (; done < columns; ++done) solveColumns<1>(f, x + static_cast<long>(done) * f.unknowns, scratch, stride);
+  for (; done + 3 <= columns; done += 3) {
+    solveColumns<3>(f, x + static_cast<long>(done) * f.unknowns, scratch, stride, threads);
+  }
+  for (; done < columns; ++done) solveColumns<1>(f, x + static_cast<long>(done) * f.unknowns, scratch, stride, threads);
+}
+
+void splitForTwoThreads(SupernodalFactorView& f, long minimumShare) {
+  f.middle = f.top = 0;
+  const int count = f.supernodes;
+  if (count < 3) return;
+  // Each supernode's parent: the supernode of its first row below its own
+  // columns (none for a root). CHOLMOD numbers them in postorder, so each
+  // subtree is a contiguous range ending at its root.
+  std::vector<int> supernodeOfColumn(f.unknowns);
+  for (int s = 0; s < count; ++s) {
+    std::fill(supernodeOfColumn.begin() + f.firstColumn[s], supernodeOfColumn.begin() + f.firstColumn[s + 1], s);
+  }
+  std::vector<int> parent(count, count);  // count: a root, child of a virtual root
+  std::vector<long> work(count + 1, 0);   // entries of L in each subtree
+  for (int s = 0; s < count; ++s) {
+    const int nc = f.firstColumn[s + 1] - f.firstColumn[s], rows = f.rowStart[s + 1] - f.rowStart[s];
+    if (rows > nc) parent[s] = supernodeOfColumn[f.rows[f.rowStart[s] + nc]];
+    if (parent[s] <= s) return;  // not in postorder: no split
+    work[s] += static_cast<long>(nc) * rows;
+    work[parent[s]] += work[s];
+  }
+  // Down from the (virtual) root while a node has one child; then split that
+  // node's children, in order, where the two shares are most nearly equal.
+  int node = count;
+  std::vector<int> children;
+  for (;;) {
+    children.clear();
+    for (int s = 0; s < node; ++s) {
+      if (parent[s] == node) children.push_back(s);
+    }
+    if (children.size() != 1) break;
+    node = children[0];
+  }
+  if (children.size() < 2) return;
+  long total = 0;
+  for (int c : children) total += work[c];
+  long left = 0, bestBalance = -1;
+  int bestMiddle = 0;
+  for (size_t i = 0; i + 1 < children.size(); ++i) {
+    left += work[children[i]];
+    const long smaller = std::min(left, total - left);
+    if (smaller > bestBalance) bestBalance = smaller, bestMiddle = children[i] + 1;
+  }
+  if (bestBalance < minimumShare) return;
+  f.middle = bestMiddle;
+  f.top = node == count ? count : node;
 }
 
 }  // namespace dynsub

@@ -27,7 +27,16 @@ struct SupernodalFactorView {
   const int* valueStart = nullptr;
   const double* values = nullptr;
   const double* inverseDiagonal = nullptr;
+  // Supernodes [0, middle) and [middle, top) are two independent subtrees;
+  // the rest lie above both. No split when middle == top (splitForTwoThreads).
+  int middle = 0;
+  int top = 0;
 };
+
+// Finds two subtrees of L's elimination tree that two threads can solve at
+// once, each holding at least `minimumShare` entries of L; sets no split
+// where there are none such. Results do not depend on the split's threads.
+void splitForTwoThreads(SupernodalFactorView& factor, long minimumShare);
 
 // 1 / L(k, k) for each column k, for SupernodalFactorView::inverseDiagonal.
 std::vector<double> inverseDiagonalOf(const SupernodalFactorView& factor);
