@@ -1,6 +1,7 @@
 #include "PairedProduct.h"
 
 #include <algorithm>
+#include <thread>
 
 #include "dynsub/Error.h"
 
@@ -35,24 +36,30 @@ PairedProduct::PairedProduct(const SymmetricMatrix& c, const SymmetricMatrix& p)
   p_.assign(4 * n, 0.0);
   q_.assign(4 * n, 0.0);
   sums_.assign(4 * n, 0.0);
+  // Two halves of the entries for two threads, where each half is worth one.
+  const long entries = static_cast<long>(row_.size());
+  if (entries >= 2 * kThreadShare) {
+    while (start_[split_] < entries / 2) ++split_;
+    secondSums_.assign(4 * n, 0.0);
+  }
 }
 
 namespace {
 
 // sums = C p + P q, points as [x y z 0]. Two partial sums per column (even and
 // odd entries), so that each addition need not wait for the one before.
-DYNSUB_KERNEL void product(int n, const int* start, const int* row, const double* weights, const double* p,
-                           const double* q, double* sums) {
+DYNSUB_KERNEL void product(int n, int begin, int end, const int* start, const int* row, const double* weights,
+                           const double* p, const double* q, double* sums) {
   std::fill(sums, sums + 4 * n, 0.0);
-  for (int j = 0; j < n; ++j) {
+  for (int j = begin; j < end; ++j) {
     Lanes pj, qj;
     load(pj, p + 4 * j);
     load(qj, q + 4 * j);
     const double* w = weights + 2 * start[j];
     Lanes even = w[0] * pj + w[1] * qj, odd = {};
     int k = start[j] + 1;
-    const int end = start[j + 1];
-    for (; k + 2 <= end; k += 2) {
+    const int last = start[j + 1];
+    for (; k + 2 <= last; k += 2) {
       const int i0 = row[k], i1 = row[k + 1];
       const double a0 = weights[2 * k], b0 = weights[2 * k + 1];
       const double a1 = weights[2 * k + 2], b1 = weights[2 * k + 3];
@@ -64,7 +71,7 @@ DYNSUB_KERNEL void product(int n, const int* start, const int* row, const double
       store(sums + 4 * i0, s0 + (a0 * pj + b0 * qj));
       store(sums + 4 * i1, s1 + (a1 * pj + b1 * qj));
     }
-    if (k < end) {
+    if (k < last) {
       const int i = row[k];
       const double a = weights[2 * k], b = weights[2 * k + 1];
       Lanes pi, qi, si;
@@ -78,14 +85,14 @@ DYNSUB_KERNEL void product(int n, const int* start, const int* row, const double
   }
 }
 
-void productBaseline(int n, const int* start, const int* row, const double* weights, const double* p,
-                     const double* q, double* sums) {
-  product(n, start, row, weights, p, q, sums);
+void productBaseline(int n, int begin, int end, const int* start, const int* row, const double* weights,
+                     const double* p, const double* q, double* sums) {
+  product(n, begin, end, start, row, weights, p, q, sums);
 }
 
-DYNSUB_AVX2 void productAvx2(int n, const int* start, const int* row, const double* weights, const double* p,
-                             const double* q, double* sums) {
-  product(n, start, row, weights, p, q, sums);
+DYNSUB_AVX2 void productAvx2(int n, int begin, int end, const int* start, const int* row, const double* weights,
+                             const double* p, const double* q, double* sums) {
+  product(n, begin, end, start, row, weights, p, q, sums);
 }
 
 }  // namespace
@@ -99,14 +106,33 @@ void PairedProduct::apply(double w, const Matrix3X& f, const Matrix3X& p, const 
       q_[4 * i + a] = q(i, a);
     }
   }
-  if (hasAvx2Fma()) {
-    productAvx2(n, start_.data(), row_.data(), weights_.data(), p_.data(), q_.data(), sums_.data());
-  } else {
-    productBaseline(n, start_.data(), row_.data(), weights_.data(), p_.data(), q_.data(), sums_.data());
-  }
+  auto columns = [&](int begin, int end, std::vector<double>& sums) {
+    if (hasAvx2Fma()) {
+      productAvx2(n, begin, end, start_.data(), row_.data(), weights_.data(), p_.data(), q_.data(), sums.data());
+    } else {
+      productBaseline(n, begin, end, start_.data(), row_.data(), weights_.data(), p_.data(), q_.data(), sums.data());
+    }
+  };
   rhs.resize(n, 3);
+  if (split_ == 0) {
+    columns(0, n, sums_);
+    for (int i = 0; i < n; ++i) {
+      for (int a = 0; a < 3; ++a) rhs(i, a) = w * f(i, a) + sums_[4 * i + a];
+    }
+    return;
+  }
+  // The columns from split_ on are summed apart (on a second thread where
+  // there is a second core) and added last, the same order either way.
+  if (std::thread::hardware_concurrency() > 1) {
+    std::thread worker([&] { columns(split_, n, secondSums_); });
+    columns(0, split_, sums_);
+    worker.join();
+  } else {
+    columns(0, split_, sums_);
+    columns(split_, n, secondSums_);
+  }
   for (int i = 0; i < n; ++i) {
-    for (int a = 0; a < 3; ++a) rhs(i, a) = w * f(i, a) + sums_[4 * i + a];
+    for (int a = 0; a < 3; ++a) rhs(i, a) = w * f(i, a) + sums_[4 * i + a] + secondSums_[4 * i + a];
   }
 }
 

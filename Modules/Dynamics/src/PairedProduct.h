@@ -1,7 +1,8 @@
 #pragma once
 // w f + C p + P q for two symmetric matrices C and P over the control
 // vertices: the right-hand side of every implicit time step (Integrator.cpp).
-// Private to the Dynamics module.
+// Private to the Dynamics module. Large products are shared by two threads,
+// with the same results as one.
 //
 // Only the lower triangles are kept, on the union of the two patterns, each
 // entry's two weights side by side: one pass over half the entries, each
@@ -28,7 +29,10 @@ class PairedProduct {
   std::vector<int> start_;       // column j's entries: [start_[j], start_[j + 1]), the diagonal first
   std::vector<int> row_;         // each entry's row i >= j
   std::vector<double> weights_;  // C_ij, P_ij for each entry
-  std::vector<double> p_, q_, sums_;  // four per vertex: x, y, z, 0
+  // NB: starting a thread costs about 50 us, 50 000 entries' worth.
+  static constexpr long kThreadShare = 50000;
+  int split_ = 0;                     // columns from split_ on go to a second thread; 0: none
+  std::vector<double> p_, q_, sums_, secondSums_;  // four per vertex: x, y, z, 0
 };
 
 }  // namespace dynsub
