@@ -155,6 +155,7 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
           {"sigma_mm", &o.edges.sigma},
           {"capture_range_mm", &o.edges.captureRange},
           {"elasticity_per_level", &o.simulation.elasticityPerLevel},
+          {"time_step", &o.simulation.integrator.timeStep},
           {"tension", &o.simulation.material.tensionU},
           {"rigidity", &o.simulation.material.rigidityUU},
           {"initial_fraction", &plan.initialFraction},
