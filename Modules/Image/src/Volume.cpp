@@ -41,7 +41,7 @@ ImageGeometry ImageGeometry::region(const std::array<int, 3>& first, const std::
   return result;
 }
 
-double Volume::interpolate(const Vector3& index) const {
+Trilinear trilinearAt(const ImageGeometry& geometry, const Vector3& index) {
   const auto& n = geometry.size;
   int base[3];
   double t[3];
@@ -50,7 +50,7 @@ double Volume::interpolate(const Vector3& index) const {
     base[a] = std::min(static_cast<int>(std::floor(x)), std::max(n[a] - 2, 0));
     t[a] = x - base[a];
   }
-  double sum = 0;
+  Trilinear corners;
   for (int corner = 0; corner < 8; ++corner) {
     double weight = 1;
     int at[3];
@@ -59,10 +59,13 @@ double Volume::interpolate(const Vector3& index) const {
       weight *= high ? t[a] : 1 - t[a];
       at[a] = std::min(base[a] + high, n[a] - 1);
     }
-    if (weight != 0) sum += weight * this->at(at[0], at[1], at[2]);
+    corners.weight[corner] = weight;
+    corners.offset[corner] = geometry.offset(at[0], at[1], at[2]);
   }
-  return sum;
+  return corners;
 }
+
+double Volume::interpolate(const Vector3& index) const { return interpolate(trilinearAt(geometry, index)); }
 
 long long Mask::count() const {
   return std::count(voxels.begin(), voxels.end(), std::uint8_t{1});

@@ -208,7 +208,8 @@ Matrix3X EdgeField::sample(const Matrix3X& points) const {
   for (Eigen::Index p = 0; p < points.rows(); ++p) {
     const Vector3 index = toIndex * (points.row(p).transpose() - geometry_.origin);
     if (!geometry_.spans(index)) continue;
-    for (int a = 0; a < 3; ++a) result(p, a) = components_[a].interpolate(index);
+    const Trilinear corners = trilinearAt(components_[0].geometry, index);
+    for (int a = 0; a < 3; ++a) result(p, a) = components_[a].interpolate(corners);
   }
   return result;
 }

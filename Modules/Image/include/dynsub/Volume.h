@@ -45,6 +45,17 @@ struct ImageGeometry {
   ImageGeometry region(const std::array<int, 3>& first, const std::array<int, 3>& regionSize) const;
 };
 
+// Where a trilinear interpolation at a continuous index reads (clamped to
+// the image): the eight corners' voxel offsets and weights, corner c at
+// (base + (c & 1, c >> 1 & 1, c >> 2 & 1)). Images of one geometry share
+// them, so several images are sampled at a point for the price of one
+// lookup (the edge field's three components).
+struct Trilinear {
+  long long offset[8];
+  double weight[8];
+};
+Trilinear trilinearAt(const ImageGeometry& geometry, const Vector3& index);
+
 // An intensity image (any pixel type read as float).
 struct Volume {
   ImageGeometry geometry;
@@ -53,6 +64,14 @@ struct Volume {
   float at(int i, int j, int k) const { return voxels[geometry.offset(i, j, k)]; }
   // Trilinear interpolation at a continuous index; clamped to the image.
   double interpolate(const Vector3& index) const;
+  // The same from a lookup made on this image's geometry.
+  double interpolate(const Trilinear& corners) const {
+    double sum = 0;
+    for (int c = 0; c < 8; ++c) {
+      if (corners.weight[c] != 0) sum += corners.weight[c] * voxels[corners.offset[c]];
+    }
+    return sum;
+  }
 };
 
 // A binary image: 1 inside the structure, 0 outside.
