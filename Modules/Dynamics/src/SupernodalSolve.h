@@ -3,10 +3,9 @@
 // private to the Dynamics module. CHOLMOD factors (SparseCholesky.h); these
 // solves replace its own, which call BLAS once per supernode and right-hand
 // side block: with the three coordinates' right-hand sides those calls are
-// mostly overhead (a 6146-unknown step's solve: 1.3-1.8 ms in CHOLMOD, about
-// a third of that here; Documentation/Performance.md). They use no BLAS, so
-// unlike CHOLMOD's they need no process-wide lock.
-
+// mostly overhead (a 6146-unknown step's solve, measured alone: 1.3 ms in
+// CHOLMOD, 0.9 ms here on one thread; Documentation/Performance.md). They
+// use no BLAS, so unlike CHOLMOD's they need no process-wide lock.
 #include <vector>
 
 namespace dynsub {
