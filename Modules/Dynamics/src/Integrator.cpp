@@ -173,13 +173,13 @@ Matrix3X Integrator::step(const Matrix3X& previous, const Matrix3X& current, con
   for (int v = 0, k = 0; v < vertices; ++v) {
     if (s.freeIndex[v] < 0) pinned.row(k++) = current.row(v);
   }
-  s.rightHandSide.apply(s.forceWeight, force, current, previous, s.rhs);
-  Matrix3X next = current;
   s.iterations = 0;
   if (s.options.solver == LinearSolver::Cholesky) {
-    // Gathered into the factor's order, solved in place, scattered back.
+    // Formed in the factor's order, solved in place, scattered back.
     Eigen::MatrixXd& x = s.unknowns;
-    for (int k = 0; k < free; ++k) x.row(k) = s.rhs.row(s.rowOfUnknown[k]);
+    s.rightHandSide.apply(s.forceWeight, force, current, previous, s.rowOfUnknown, x);
+    // Every row of `next` is written below unless some vertices are fixed.
+    Matrix3X next = pinned.rows() > 0 ? current : Matrix3X(current.rows(), 3);
     if (pinned.rows() > 0) {
       const Eigen::MatrixXd coupling = s.lhsCoupling * pinned;
       const int* perm = s.cholesky.permutation();
@@ -190,6 +190,8 @@ Matrix3X Integrator::step(const Matrix3X& previous, const Matrix3X& current, con
     return next;
   }
 
+  s.rightHandSide.apply(s.forceWeight, force, current, previous, s.rhs);
+  Matrix3X next = current;
   Eigen::MatrixXd rhsFree(free, 3), guess(free, 3);
   for (int i = 0; i < free; ++i) {
     rhsFree.row(i) = s.rhs.row(s.freeVertices[i]);

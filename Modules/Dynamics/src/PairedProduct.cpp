@@ -97,9 +97,9 @@ DYNSUB_AVX2 void productAvx2(int n, int begin, int end, const int* start, const 
 
 }  // namespace
 
-void PairedProduct::apply(double w, const Matrix3X& f, const Matrix3X& p, const Matrix3X& q, Matrix3X& rhs) {
+void PairedProduct::sum(const Matrix3X& p, const Matrix3X& q) {
   const int n = static_cast<int>(p_.size() / 4);
-  if (f.rows() != n || p.rows() != n || q.rows() != n) throw Error("internal: paired product of unequal sizes");
+  if (p.rows() != n || q.rows() != n) throw Error("internal: paired product of unequal sizes");
   for (int i = 0; i < n; ++i) {
     for (int a = 0; a < 3; ++a) {
       p_[4 * i + a] = p(i, a);
@@ -113,12 +113,8 @@ void PairedProduct::apply(double w, const Matrix3X& f, const Matrix3X& p, const 
       productBaseline(n, begin, end, start_.data(), row_.data(), weights_.data(), p_.data(), q_.data(), sums.data());
     }
   };
-  rhs.resize(n, 3);
   if (split_ == 0) {
     columns(0, n, sums_);
-    for (int i = 0; i < n; ++i) {
-      for (int a = 0; a < 3; ++a) rhs(i, a) = w * f(i, a) + sums_[4 * i + a];
-    }
     return;
   }
   // The columns from split_ on are summed apart (on a second thread where
@@ -131,8 +127,29 @@ void PairedProduct::apply(double w, const Matrix3X& f, const Matrix3X& p, const 
     columns(0, split_, sums_);
     columns(split_, n, secondSums_);
   }
+  for (size_t i = 0; i < sums_.size(); ++i) sums_[i] += secondSums_[i];
+}
+
+void PairedProduct::apply(double w, const Matrix3X& f, const Matrix3X& p, const Matrix3X& q, Matrix3X& rhs) {
+  const int n = static_cast<int>(p_.size() / 4);
+  if (f.rows() != n) throw Error("internal: paired product of unequal sizes");
+  sum(p, q);
+  rhs.resize(n, 3);
   for (int i = 0; i < n; ++i) {
-    for (int a = 0; a < 3; ++a) rhs(i, a) = w * f(i, a) + sums_[4 * i + a] + secondSums_[4 * i + a];
+    for (int a = 0; a < 3; ++a) rhs(i, a) = w * f(i, a) + sums_[4 * i + a];
+  }
+}
+
+void PairedProduct::apply(double w, const Matrix3X& f, const Matrix3X& p, const Matrix3X& q,
+                          const std::vector<int>& order, Eigen::MatrixXd& out) {
+  const int n = static_cast<int>(p_.size() / 4);
+  if (f.rows() != n) throw Error("internal: paired product of unequal sizes");
+  sum(p, q);
+  const Eigen::Index rows = static_cast<Eigen::Index>(order.size());
+  out.resize(rows, 3);
+  for (Eigen::Index k = 0; k < rows; ++k) {
+    const int i = order[k];
+    for (int a = 0; a < 3; ++a) out(k, a) = w * f(i, a) + sums_[4 * i + a];
   }
 }
 

@@ -24,6 +24,11 @@ class PairedProduct {
   // rhs = w f + C p + P q, all #vertices x 3. Not for two threads at once
   // (it keeps its scratch).
   void apply(double w, const Matrix3X& f, const Matrix3X& p, const Matrix3X& q, Matrix3X& rhs);
+  // The same, its rows in `order`: row k of `out` (rows x 3, column-major) is
+  // the product's row order[k]. The factored step forms its right-hand side
+  // straight in the factor's order this way.
+  void apply(double w, const Matrix3X& f, const Matrix3X& p, const Matrix3X& q, const std::vector<int>& order,
+             Eigen::MatrixXd& out);
 
  private:
   std::vector<int> start_;       // column j's entries: [start_[j], start_[j + 1]), the diagonal first
@@ -32,6 +37,8 @@ class PairedProduct {
   // NB: starting a thread costs about 50 us, 50 000 entries' worth.
   static constexpr long kThreadShare = 50000;
   int split_ = 0;                     // columns from split_ on go to a second thread; 0: none
+  // sums_ (+ secondSums_) = C p + P q, points packed as [x y z 0].
+  void sum(const Matrix3X& p, const Matrix3X& q);
   std::vector<double> p_, q_, sums_, secondSums_;  // four per vertex: x, y, z, 0
 };
 

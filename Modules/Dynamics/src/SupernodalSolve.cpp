@@ -66,12 +66,15 @@ DYNSUB_KERNEL void forwardTriangle(const double* __restrict Lb, const double* __
 // Rows from `outsideFrom` on are not written in x but subtracted from
 // `outside` (K columns of n - outsideFrom values): a second thread's share of
 // the rows that the first thread's supernodes update too.
-template <int K>
+// (Only the second subtree's pass redirects: `Redirect` keeps the test out
+// of the other passes.)
+template <int K, bool Redirect>
 DYNSUB_KERNEL void forwardBelow(const double* __restrict Lb, int nc, int rows, const double* __restrict v, int stride,
                                 const int* __restrict below, double* __restrict x, int n, int outsideFrom,
                                 double* __restrict outside) {
   auto target = [&](int k, int row) -> double& {
-    return row < outsideFrom ? x[k * n + row] : outside[k * (n - outsideFrom) + row - outsideFrom];
+    if (!Redirect || row < outsideFrom) return x[k * n + row];
+    return outside[k * (n - outsideFrom) + row - outsideFrom];
   };
   int r = nc;
   for (; r + 2 * kLanes <= rows; r += 2 * kLanes) {
@@ -188,7 +191,11 @@ DYNSUB_KERNEL void forwardRange(const SupernodalFactorView& f, int begin, int en
     for (int k = 0; k < K; ++k) std::copy(x + k * n + k0, x + k * n + k0 + nc, v + k * stride);
     forwardTriangle<K>(Lb, f.inverseDiagonal + k0, nc, rows, v, stride);
     for (int k = 0; k < K; ++k) std::copy(v + k * stride, v + k * stride + nc, x + k * n + k0);
-    forwardBelow<K>(Lb, nc, rows, v, stride, f.rows + f.rowStart[s] + nc, x, n, outsideFrom, outside);
+    if (outside != nullptr) {
+      forwardBelow<K, true>(Lb, nc, rows, v, stride, f.rows + f.rowStart[s] + nc, x, n, outsideFrom, outside);
+    } else {
+      forwardBelow<K, false>(Lb, nc, rows, v, stride, f.rows + f.rowStart[s] + nc, x, n, outsideFrom, outside);
+    }
   }
 }
 
