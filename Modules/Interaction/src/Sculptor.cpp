@@ -122,21 +122,15 @@ struct Sculptor::Impl {
     if (pick(x, y, &at) < 0) return;
     act([&] {
       sculpture.grab(at);
-      vtkRenderer* r = view.renderer();
-      r->SetWorldPoint(at.x(), at.y(), at.z(), 1.0);
-      r->WorldToDisplay();
-      pullDepth = r->GetDisplayPoint()[2];
+      pullDepth = style::displayAt(view.renderer(), at).z();
       pulling = true;
       message = "rope: pulling";
     });
   }
 
   void pullTo(int x, int y) {
-    vtkRenderer* r = view.renderer();
-    r->SetDisplayPoint(x, y, pullDepth);
-    r->DisplayToWorld();
-    const double* w = r->GetWorldPoint();
-    act([&] { sculpture.pullTo(Vector3(w[0] / w[3], w[1] / w[3], w[2] / w[3])); });
+    const Vector3 to = style::worldAt(view.renderer(), x, y, pullDepth);
+    act([&] { sculpture.pullTo(to); });
   }
 
   void select(int x, int y) {
@@ -193,10 +187,8 @@ struct Sculptor::Impl {
     int best = -1;
     double nearest = kPickPixels;
     for (int i = 0; i < p.rows(); ++i) {
-      r->SetWorldPoint(p(i, 0), p(i, 1), p(i, 2), 1.0);
-      r->WorldToDisplay();
-      const double* d = r->GetDisplayPoint();
-      const double distance = std::hypot(d[0] - x, d[1] - y);
+      const Vector3 d = style::displayAt(r, p.row(i).transpose());
+      const double distance = std::hypot(d.x() - x, d.y() - y);
       if (distance <= nearest) {
         nearest = distance;
         best = i;

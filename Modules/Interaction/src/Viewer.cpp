@@ -228,11 +228,8 @@ struct Viewer::Impl {
     if (!picker->Pick(x, y, 0, surface3d.renderer()) || liveSurface->GetNumberOfPoints() == 0) return;
     double p[3];
     picker->GetPickPosition(p);
-    vtkRenderer* r = surface3d.renderer();
-    r->SetWorldPoint(p[0], p[1], p[2], 1.0);
-    r->WorldToDisplay();
-    pullDepth = r->GetDisplayPoint()[2];
     grabbedPoint = Vector3(p[0], p[1], p[2]);
+    pullDepth = style::displayAt(surface3d.renderer(), grabbedPoint).z();
     // After a fit, the pull refits from it.
     pullTo(grabbedPoint, true);
     message = "pulling";
@@ -240,13 +237,9 @@ struct Viewer::Impl {
 
   // The hand moved to (x, y) at the grabbed point's depth.
   void movePull(int x, int y) {
-    vtkRenderer* r = surface3d.renderer();
-    r->SetDisplayPoint(x, y, pullDepth);
-    r->DisplayToWorld();
-    const double* w = r->GetWorldPoint();
     // A refit may have settled before the hand moved on (it takes tens of
     // milliseconds): then another starts from where it settled.
-    pullTo(Vector3(w[0] / w[3], w[1] / w[3], w[2] / w[3]), false);
+    pullTo(style::worldAt(surface3d.renderer(), x, y, pullDepth), false);
   }
 
   void releasePull() {

@@ -139,6 +139,22 @@ void observeTimer(vtkRenderWindowInteractor* interactor, vtkCallbackCommand* com
   interactor->AddObserver(vtkCommand::TimerEvent, command);
 }
 
+Vector3 displayAt(vtkRenderer* renderer, const Vector3& world) {
+  renderer->SetWorldPoint(world.x(), world.y(), world.z(), 1.0);
+  renderer->WorldToDisplay();
+  double display[3];
+  renderer->GetDisplayPoint(display);
+  return {display[0], display[1], display[2]};
+}
+
+Vector3 worldAt(vtkRenderer* renderer, double x, double y, double depth) {
+  renderer->SetDisplayPoint(x, y, depth);
+  renderer->DisplayToWorld();
+  double world[4];
+  renderer->GetWorldPoint(world);
+  return {world[0] / world[3], world[1] / world[3], world[2] / world[3]};
+}
+
 std::string anatomicalLetter(const Vector3& direction) {
   int axis = 0;
   for (int a = 1; a < 3; ++a)

@@ -200,22 +200,12 @@ void SliceView::setTitle(const std::string& title) {
 }
 
 Vector3 SliceView::pointAt(double displayX, double displayY) const {
-  vtkRenderer* renderer = impl_->renderer;
-  renderer->SetDisplayPoint(displayX, displayY, 0.0);
-  renderer->DisplayToWorld();
-  double world[4];
-  renderer->GetWorldPoint(world);
-  Vector3 p(world[0] / world[3], world[1] / world[3], world[2] / world[3]);
+  const Vector3 p = style::worldAt(impl_->renderer, displayX, displayY, 0.0);
   return p - impl_->plane.distance(p) * impl_->plane.normal;
 }
 
 Eigen::Vector2d SliceView::displayPosition(const Vector3& point) const {
-  vtkRenderer* renderer = impl_->renderer;
-  renderer->SetWorldPoint(point.x(), point.y(), point.z(), 1.0);
-  renderer->WorldToDisplay();
-  double display[3];
-  renderer->GetDisplayPoint(display);
-  return {display[0], display[1]};
+  return style::displayAt(impl_->renderer, point).head<2>();
 }
 
 std::vector<int> SliceView::landmarksOnSlice() const { return impl_->onSlice(impl_->landmarks); }

@@ -1,6 +1,7 @@
 #pragma once
-// The look every view shares: colours, sizes and text placement. Private to
-// the Visualization module.
+// The look every view shares (colours, sizes, text placement) and the
+// conversions between world and display points, for the Rendering module's
+// views and the Interaction module's windows.
 #include <array>
 #include <string>
 #include <vector>
@@ -63,6 +64,12 @@ void helpOverlay(vtkRenderer* overlay, vtkTextActor* text, const char* help, dou
 // redraw timers), through `command`.
 void observeTimer(vtkRenderWindowInteractor* interactor, vtkCallbackCommand* command, void (*tick)(void* client),
                   void* client);
+
+// A world point's display position in `renderer`: x and y in pixels, and
+// its depth (0 near, 1 far), which worldAt takes back to the world.
+Vector3 displayAt(vtkRenderer* renderer, const Vector3& world);
+// The world point at display position (x, y) and depth `depth` in `renderer`.
+Vector3 worldAt(vtkRenderer* renderer, double x, double y, double depth);
 
 // The anatomical direction a unit LPS vector points to most: L, R, P, A, S or I.
 std::string anatomicalLetter(const Vector3& direction);
