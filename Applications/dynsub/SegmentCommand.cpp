@@ -204,6 +204,12 @@ void addSegmentCommand(CLI::App& app) {
                       "For landmarks on slices: follow the tissue between the clicked slices beyond them and add "
                       "soft springs where it ends, so that the structure's unclicked ends are reached (true/false)")
       ->default_val(o->segment.sliceEnds.enabled);
+  command->add_option("--end-pressure", o->segment.sliceEnds.pressure,
+                      "With --slice-ends: the pressure beyond the outermost clicked slices, N/mm^2 at full "
+                      "strength, that grows the surface through tissue like that just inside the clicks and "
+                      "pushes it back from tissue like that just outside them (0: none)")
+      ->default_val(o->segment.sliceEnds.pressure)
+      ->check(CLI::NonNegativeNumber);
   command->add_option("--seed-window", o->seed.window,
                       "With --init seed: the intensity window grown through, in robust spreads (1.4826 MAD) of "
                       "the intensities near the click either side of their median")

@@ -191,6 +191,12 @@ SegmentRun runSegmentation(const Volume& image, SegmentInputs in, const Progress
     r.set("ends", marched);
     r.set("springs", ends.springs.size());
     r.set("spring_points_lps_mm", springPoints);
+    Report pressure;
+    pressure.set("n_per_mm2", ends.pressure);
+    pressure.set("inside_samples", ends.insideSamples);
+    pressure.set("outside_samples", ends.outsideSamples);
+    pressure.set("separation", ends.separation);
+    r.set("pressure", pressure);
     report.set("slice_ends", r);
   }
   Report region;

@@ -20,10 +20,12 @@ require_colin27
 
 segment=("$DYNSUB" segment "$templates/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --no-figures)
 temporaries() { find "$1" -name '.tmp-*' 2>/dev/null | wc -l; }
-# The guard of a killed run removes its temporaries within moments.
+# The guard of a killed run removes its temporaries within moments, and then
+# the output directory it made, if empty: a check between the two saw an
+# empty directory (once in a loaded run of the suite).
 settle() {
   for _ in $(seq 1 30); do
-    [ "$(temporaries "$1")" -eq 0 ] && return
+    [ "$(temporaries "$1")" -eq 0 ] && ! { [ -d "$1/killed" ] && [ -z "$(ls -A "$1/killed")" ]; } && return
     sleep 0.1
   done
 }

@@ -150,11 +150,11 @@ void FieldForceModel::beginLevel(const LimitSurface&, const SurfaceQuadrature& q
 }
 
 Matrix3X FieldForceModel::generalizedForce(const Matrix3X& controlPoints, double&) {
-  return fieldForces(*quadrature_, controlPoints, field_);
+  return fieldForces(*quadrature_, controlPoints, field_, pressure_);
 }
 
 SparseMatrix FieldForceModel::stabilizingStiffness(const Matrix3X& controlPoints) {
-  const double slope = field_.slopeBound();
+  const double slope = field_.slopeBound() + (pressure_ ? pressure_->slopeBound() : 0.0);
   if (!(slope > 0.0)) return SparseMatrix();
   return fieldStiffness(*quadrature_, controlPoints, slope);
 }

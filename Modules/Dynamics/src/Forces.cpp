@@ -93,7 +93,8 @@ Matrix3X pressureForces(const SurfaceQuadrature& q, const Matrix3X& controlPoint
   return integrate(q, area);
 }
 
-Matrix3X fieldForces(const SurfaceQuadrature& q, const Matrix3X& controlPoints, const ForceField& field) {
+Matrix3X fieldForces(const SurfaceQuadrature& q, const Matrix3X& controlPoints, const ForceField& field,
+                     const PressureField* pressure) {
   Matrix3X positions, su, sv;
   applyOperators(q.J, q.Ju, q.Jv, controlPoints, positions, su, sv);  // one pass: they share a pattern
   Matrix3X forces = field.forcesAt(positions);
@@ -102,7 +103,18 @@ Matrix3X fieldForces(const SurfaceQuadrature& q, const Matrix3X& controlPoints, 
                 std::to_string(positions.rows()) + " points");
   }
   if (!forces.allFinite()) throw Error("force field returned a non-finite force");
-  return integrate(q, areaElements(su, sv).asDiagonal() * forces);
+  Matrix3X area = areaElements(su, sv).asDiagonal() * forces;
+  if (pressure) {
+    const Eigen::VectorXd pressures = pressure->pressuresAt(positions);
+    if (pressures.size() != positions.rows()) {
+      throw Error("pressure field returned " + std::to_string(pressures.size()) + " pressures for " +
+                  std::to_string(positions.rows()) + " points");
+    }
+    if (!pressures.allFinite()) throw Error("pressure field returned a non-finite pressure");
+    for (Eigen::Index i = 0; i < positions.rows(); ++i)
+      if (pressures(i) != 0.0) area.row(i) += pressures(i) * su.row(i).cross(sv.row(i));
+  }
+  return integrate(q, area);
 }
 
 SparseMatrix fieldStiffness(const SurfaceQuadrature& q, const Matrix3X& controlPoints, double slope) {

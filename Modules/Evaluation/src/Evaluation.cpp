@@ -163,7 +163,8 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
           {"slice_ends_disk", &o.sliceEnds.disk},
           {"slice_ends_reach", &o.sliceEnds.reach},
           {"slice_ends_gap_mm", &o.sliceEnds.gap},
-          {"slice_ends_stiffness", &o.sliceEnds.stiffness}};
+          {"slice_ends_stiffness", &o.sliceEnds.stiffness},
+          {"slice_ends_pressure", &o.sliceEnds.pressure}};
       const std::map<std::string, bool*> switches = {{"slice_ends", &o.sliceEnds.enabled},
                                                      {"slice_ends_taper", &o.sliceEnds.taper},
                                                      {"slice_ends_spring_at_reach", &o.sliceEnds.springAtReach}};

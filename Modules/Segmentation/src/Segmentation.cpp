@@ -5,11 +5,13 @@
 #include <cmath>
 #include <iomanip>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <tuple>
 
 #include "RobustStatistics.h"
 #include "dynsub/ApplyOperator.h"
+#include "dynsub/ClickAppearance.h"
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/EdgeForce.h"
 #include "dynsub/Error.h"
@@ -67,6 +69,42 @@ double enclosedVolume(const TriangleSurface& s) {
   for (const auto& t : s.triangles)
     six += s.points.row(t[0]).dot(s.points.row(t[1]).cross(s.points.row(t[2])));
   return std::abs(six) / 6.0;
+}
+
+// The pressure beyond the end slices (ClickAppearance.h), filling its part
+// of `ends`. It acts beyond an end unless that end's march found the
+// structure ending within `gap` of the outermost slice (an end the clicks
+// already reach: the bundled caudate's, which stays as it was); none at all
+// when off, when the clicks are not on slices, or when they gave too few
+// samples.
+std::optional<EndPressure> endPressure(const SegmentationRegion& region, const std::vector<Landmark>& landmarks,
+                                       const SliceEndOptions& options, SliceEnds& ends) {
+  if (ends.axis < 0 || !(options.pressure > 0)) return std::nullopt;
+  const Vector3 along = region.image().geometry.direction.col(ends.axis).normalized();
+  double middle = 0;
+  for (const Landmark& l : landmarks) middle += along.dot(l.position) / static_cast<double>(landmarks.size());
+  const double onSlice = 0.25 * region.image().geometry.spacing(ends.axis);  // mm, as SliceEnds.cpp's quarter voxel
+  std::optional<EndPressure::End> beyond[2];  // before and after the clicked span, along the axis
+  for (const SliceEnd& end : ends.ends) {
+    if (!end.stoppedByReach && !(end.length > options.gap)) continue;
+    EndPressure::End e{end.start, 0.0};
+    for (const Landmark& l : landmarks) {
+      Vector3 across = l.position - end.start;
+      if (std::abs(across.dot(along)) > onSlice) continue;  // not on the end slice
+      across -= across.dot(along) * along;
+      e.radius = std::max(e.radius, across.norm());
+    }
+    beyond[along.dot(end.end) > middle] = e;
+  }
+  if (!beyond[0] && !beyond[1]) return std::nullopt;
+  std::optional<ClickAppearance> appearance = ClickAppearance::learn(region.image(), landmarks, ends.axis);
+  if (!appearance) return std::nullopt;
+  ends.pressure = options.pressure;
+  ends.insideSamples = appearance->insideSamples();
+  ends.outsideSamples = appearance->outsideSamples();
+  ends.separation = appearance->separation();
+  return std::optional<EndPressure>(std::in_place, region.image(), std::move(*appearance), landmarks, ends.axis,
+                                    options.pressure, beyond[0], beyond[1]);
 }
 
 }  // namespace
@@ -156,7 +194,8 @@ bool SegmentationRegion::covers(const Vector3& point) const { return geometry_.c
 
 SegmentResult evolveInRegion(const SegmentationRegion& region, const std::vector<Landmark>& landmarks,
                              const ControlMesh& initial, const LevelOrigin& origin, const SegmentOptions& options,
-                             const ProgressCallback& progress, const std::vector<ForceModel*>& extraForces) {
+                             const ProgressCallback& progress, const std::vector<ForceModel*>& extraForces,
+                             const PressureField* pressure) {
   checkSegmentOptions(options);
   if (!initial.isClosed()) throw Error("the initial model must be a closed control mesh");
   const auto clock = Clock::now();
@@ -164,7 +203,7 @@ SegmentResult evolveInRegion(const SegmentationRegion& region, const std::vector
   if (!region.covers(landmarkPoints) || !region.covers(initial.points()))
     throw Error("the landmarks or the initial model reach outside the region of interest: build a new region");
   const EdgeForce field(region.edgeField(), options.imageForce);
-  FieldForceModel imageForces(field);
+  FieldForceModel imageForces(field, pressure);
   Eigen::VectorXd stiffness = Eigen::VectorXd::Constant(landmarkPoints.rows(), options.landmarkStiffness);
   SpringForceModel springs(landmarkPoints, stiffness, SpringForceModel::Attach::NearestEachStep);
   springs.setDeadZone(options.landmarkDeadZone);
@@ -222,7 +261,9 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
                               SpringForceModel::Attach::NearestEachStep);
   std::vector<ForceModel*> forces = extraForces;
   if (endPoints.rows() > 0) forces.push_back(&endSprings);
-  SegmentResult result = evolveInRegion(region, landmarks, initial, {}, options, progress, forces);
+  std::optional<EndPressure> pressure = endPressure(region, landmarks, options.sliceEnds, ends);
+  SegmentResult result = evolveInRegion(region, landmarks, initial, {}, options, progress, forces,
+                                        pressure ? &*pressure : nullptr);
   result.sliceEnds = std::move(ends);
 
   if (!result.mesh.points().allFinite()) throw Error("the evolution produced a non-finite surface");

@@ -56,6 +56,8 @@ void checkSliceEndOptions(const SliceEndOptions& o) {
     if (!(value > 0) || !std::isfinite(value))
       throw Error(std::string("the slice ends' ") + name + " must be a finite number > 0");
   if (!(o.gap >= 0) || !std::isfinite(o.gap)) throw Error("the slice ends' gap must be a finite number >= 0");
+  if (!(o.pressure >= 0) || !std::isfinite(o.pressure))
+    throw Error("the pressure beyond the end slices must be a finite number >= 0");
 }
 
 SliceEnds findSliceEnds(const Volume& image, const std::vector<Landmark>& landmarks, const ControlMesh& initial,

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 
+#include "dynsub/ClickAppearance.h"
 #include "dynsub/Error.h"
 #include "dynsub/Labelmap.h"
 #include "dynsub/Metrics.h"
@@ -120,6 +121,91 @@ TEST(SliceEnds, TheSegmentationReachesTheUnclickedEnds) {
   EXPECT_GE(with, 0.93);
 }
 
+// The clicks' own surroundings teach the two classes: the cigar (100) inside,
+// the background (20) outside, with noise 10 on both.
+TEST(ClickAppearance, LearnsTheInsideAndOutsideOfTheClickedBoundary) {
+  const Cigar shape;
+  Mask truth;
+  const Volume image = cigarImage(shape, &truth);
+  const std::vector<Landmark> landmarks = clicks(shape, 6);
+  const std::optional<ClickAppearance> a = ClickAppearance::learn(image, landmarks, 1);
+  ASSERT_TRUE(a.has_value());
+  // Two samples on each side of each of the 30 clicks.
+  EXPECT_EQ(a->insideSamples(), 60);
+  EXPECT_EQ(a->outsideSamples(), 60);
+  // 1.5 and 3 mm from an edge blurred over about a voxel, the samples are
+  // the classes' own intensities: the densities hardly overlap.
+  EXPECT_GT(a->separation(), 0.9);
+  EXPECT_GT(a->score(100), 0.9);
+  EXPECT_LT(a->score(20), -0.9);
+  // Between the classes the score rises from the outside's to the inside's.
+  for (double i = 20; i < 100; i += 10) EXPECT_LE(a->score(i), a->score(i + 10)) << i;
+  EXPECT_GT(a->largestSlope(), 0.0);
+  // One click per slice gives no inward direction, and so no samples.
+  std::vector<Landmark> single;
+  for (int s = 0; s < 5; ++s) single.push_back(landmarks[6 * s]);
+  EXPECT_FALSE(ClickAppearance::learn(image, single, 1).has_value());
+  EXPECT_THROW(ClickAppearance::learn(image, landmarks, 3), Error);
+}
+
+TEST(ClickAppearance, ThePressureActsOnlyBeyondTheClickedSpan) {
+  const Cigar shape;
+  Mask truth;
+  const Volume image = cigarImage(shape, &truth);
+  const std::vector<Landmark> landmarks = clicks(shape, 6);  // slices at y = -12 .. 12 mm from the centre
+  const auto pressureAt = [&](bool before, bool after) {
+    // Each end's footprint: its slice's centroid (on the axis) and farthest click.
+    const auto end = [&](double y, bool on) {
+      const double radius = shape.axes.x() * std::sqrt(1.0 - (y / shape.axes.y()) * (y / shape.axes.y()));
+      return on ? std::optional<EndPressure::End>({shape.centre + Vector3(0, y, 0), radius}) : std::nullopt;
+    };
+    const EndPressure pressure(image, *ClickAppearance::learn(image, landmarks, 1), landmarks, 1, 0.2,
+                               end(-12, before), end(12, after));
+    Matrix3X points(6, 3);
+    points.row(0) = (shape.centre + Vector3(0, 0, 0)).transpose();    // inside, within the span
+    points.row(1) = (shape.centre + Vector3(0, 16, 0)).transpose();   // inside, beyond the last slice
+    points.row(2) = (shape.centre + Vector3(0, -16, 0)).transpose();  // inside, before the first
+    points.row(3) = (shape.centre + Vector3(0, 25, 0)).transpose();   // background, beyond the last slice
+    points.row(4) = (shape.centre + Vector3(0, 16, 40)).transpose();  // outside the image
+    points.row(5) = (shape.centre + Vector3(7, 16, 0)).transpose();   // beyond the last slice's footprint (6.4 mm)
+    EXPECT_GT(pressure.slopeBound(), 0.0);
+    return pressure.pressuresAt(points);
+  };
+  const Eigen::VectorXd both = pressureAt(true, true);
+  EXPECT_EQ(both(0), 0.0);
+  EXPECT_GT(both(1), 0.15);  // 0.2 at full strength
+  EXPECT_GT(both(2), 0.15);
+  EXPECT_LT(both(3), -0.15);
+  EXPECT_EQ(both(4), 0.0);
+  EXPECT_EQ(both(5), 0.0);
+  const Eigen::VectorXd after = pressureAt(false, true);
+  EXPECT_GT(after(1), 0.15);
+  EXPECT_EQ(after(2), 0.0);
+}
+
+// From clicks over the middle 60 % only, the pressure carries the surface to
+// the cigar's tips, past where the springs' taper leaves it.
+TEST(SliceEnds, ThePressureCarriesTheSurfaceToTheEnds) {
+  const Cigar shape;
+  Mask truth;
+  const Volume image = cigarImage(shape, &truth);
+  const std::vector<Landmark> landmarks = clicks(shape, 6);
+  const ControlMesh initial = initialFromLandmarks(landmarks);
+  SegmentOptions options;
+  options.sliceEnds.pressure = 0;
+  const SegmentResult springsOnly = segment(image, landmarks, initial, options);
+  options.sliceEnds.pressure = 0.2;
+  const SegmentResult result = segment(image, landmarks, initial, options);
+  const double without = compareMasks(labelmapOf(springsOnly.surface, image.geometry), truth).dice;
+  const OverlapMetrics with = compareMasks(labelmapOf(result.surface, image.geometry), truth);
+  std::printf("Dice with the ends' springs only %.3f, with the pressure too %.3f\n", without, with.dice);
+  EXPECT_EQ(springsOnly.sliceEnds.pressure, 0.0);
+  EXPECT_EQ(result.sliceEnds.pressure, 0.2);
+  EXPECT_EQ(result.sliceEnds.insideSamples, 60);
+  EXPECT_GE(with.dice, without);
+  EXPECT_GE(with.dice, 0.95);
+}
+
 TEST(SliceEnds, NoSpringsForLandmarksOffSlicesOrTooFew) {
   const Cigar shape;
   Mask truth;
@@ -143,7 +229,9 @@ TEST(SliceEnds, NoSpringsForLandmarksOffSlicesOrTooFew) {
 TEST(SliceEnds, RefusesImpossibleOptions) {
   for (auto bad : {+[](SliceEndOptions& o) { o.window = 0; }, +[](SliceEndOptions& o) { o.reach = -1; },
                    +[](SliceEndOptions& o) { o.disk = std::nan(""); },
-                   +[](SliceEndOptions& o) { o.stiffness = 0; }, +[](SliceEndOptions& o) { o.gap = -0.5; }}) {
+                   +[](SliceEndOptions& o) { o.stiffness = 0; }, +[](SliceEndOptions& o) { o.gap = -0.5; },
+                   +[](SliceEndOptions& o) { o.pressure = -0.1; },
+                   +[](SliceEndOptions& o) { o.pressure = std::nan(""); }}) {
     SliceEndOptions options;
     bad(options);
     EXPECT_THROW(checkSliceEndOptions(options), Error);

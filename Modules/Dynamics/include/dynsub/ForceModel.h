@@ -109,19 +109,23 @@ class InflationForceModel final : public ForceModel {
 };
 
 // An external force-density field (N/mm^2), e.g. image forces; not owned.
+// A force field, and optionally a pressure field acting with it (evaluated
+// at the same points, Forces.h's fieldForces). Neither is owned.
 class FieldForceModel final : public ForceModel {
  public:
-  explicit FieldForceModel(const ForceField& field) : field_(field) {}
+  explicit FieldForceModel(const ForceField& field, const PressureField* pressure = nullptr)
+      : field_(field), pressure_(pressure) {}
   void beginLevel(const LimitSurface& surface, const SurfaceQuadrature& quadrature,
                   const Matrix3X& controlPoints) override;
   Matrix3X generalizedForce(const Matrix3X& controlPoints, double& potential) override;
-  // fieldStiffness with the field's slopeBound: a field that reverses across
-  // an edge is a stiff explicit force, which the papers' schemes would let
-  // oscillate about the edge instead of settling on it.
+  // fieldStiffness with the field's slopeBound (plus the pressure's): a
+  // field that reverses across an edge is a stiff explicit force, which the
+  // papers' schemes would let oscillate about the edge instead of settling on it.
   SparseMatrix stabilizingStiffness(const Matrix3X& controlPoints) override;
 
  private:
   const ForceField& field_;
+  const PressureField* pressure_ = nullptr;
   const SurfaceQuadrature* quadrature_ = nullptr;
 };
 

@@ -55,7 +55,21 @@ Matrix3X inflationForces(const SurfaceQuadrature& quadrature, const Matrix3X& co
 // A pressure that varies over the surface: one value (N/mm^2) per quadrature point.
 Matrix3X pressureForces(const SurfaceQuadrature& quadrature, const Matrix3X& controlPoints,
                         const Eigen::VectorXd& pressures);
-Matrix3X fieldForces(const SurfaceQuadrature& quadrature, const Matrix3X& controlPoints, const ForceField& field);
+// A pressure along the surface's normal s_u x s_v that depends on where the
+// surface is: N points in mm -> N pressures (N/mm^2; > 0 pushes outward, as
+// inflation does). Must return finite values for every point it is given.
+class PressureField {
+ public:
+  virtual ~PressureField() = default;
+  virtual Eigen::VectorXd pressuresAt(const Matrix3X& points) const = 0;
+  // An upper bound of |dp/dx| (N/mm^3), or 0 if unknown; as ForceField's.
+  virtual double slopeBound() const { return 0.0; }
+};
+
+// The field's forces, and the pressure's (if given) from the same evaluation
+// of the surface at the quadrature points.
+Matrix3X fieldForces(const SurfaceQuadrature& quadrature, const Matrix3X& controlPoints, const ForceField& field,
+                     const PressureField* pressure = nullptr);
 // slope * sum_q w_q |s_u x s_v|_q J_q^T J_q (#control by #control): the
 // stiffness of a field whose force changes by `slope` N/mm^3 in every
 // direction, integrated over the surface at `controlPoints`.

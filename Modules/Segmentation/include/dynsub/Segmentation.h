@@ -150,10 +150,12 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
 // The evolution alone, in a region built for these options (no labelmap; the
 // result's landmarkDistances and levels are filled): what an interactive
 // refit runs. `initial` may be an earlier result's mesh, with its `origin`.
+// `pressure` (not owned), if given, acts with the image force (ForceModel.h's FieldForceModel).
 SegmentResult evolveInRegion(const SegmentationRegion& region, const std::vector<Landmark>& landmarks,
                              const ControlMesh& initial, const LevelOrigin& origin, const SegmentOptions& options,
                              const ProgressCallback& progress = nullptr,
-                             const std::vector<ForceModel*>& extraForces = {});
+                             const std::vector<ForceModel*>& extraForces = {},
+                             const PressureField* pressure = nullptr);
 
 void checkSegmentOptions(const SegmentOptions& options);
 

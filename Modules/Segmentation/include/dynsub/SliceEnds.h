@@ -26,6 +26,13 @@
 //     inside; with `taper`, the end slice's clicks are also copied halfway
 //     there, drawn in toward their centroid by sqrt(3/4) as an ellipsoid's
 //     cross-section narrows, as springs.
+//  5. Beyond the outermost slices, a pressure along the normal from the
+//     appearance the clicks taught (ClickAppearance.h's EndPressure),
+//     `pressure` N/mm^2 at full strength, within the end slice's footprint:
+//     it carries the surface to the structure's own boundary where only the
+//     tip and taper springs held it (a caudate's blunt head, a hemisphere's
+//     lateral ends). Not beyond an end whose march stopped within `gap` of
+//     the slice: the clicks already reach that end.
 // A march through the structure's own tissue is what a one-dimensional
 // region growth from the clicked end sees; it cannot leak sideways into
 // like tissue the way a grown volume does.
@@ -49,6 +56,7 @@ struct SliceEndOptions {
   double stiffness = 10.0;  // N/mm per spring
   bool taper = true;        // also springs halfway, the end slice's clicks drawn in (an ellipsoid's taper)
   bool springAtReach = false;  // a spring also where the march ended at its reach, not at an intensity change
+  double pressure = 0.2;       // N/mm^2 beyond the end slices (step 5; 0: none), chosen on the tuning split
 };
 
 struct SliceEnd {
@@ -64,6 +72,11 @@ struct SliceEnds {
   double median = 0, spread = 0;
   std::vector<SliceEnd> ends;     // the ends marched from (0, 1 or 2)
   std::vector<Landmark> springs;  // for each end that went more than `gap`: its tip (and taper)
+  // Step 5, filled by segment(): the pressure used (0 when off, or when the
+  // clicks gave too few samples), the samples and the classes' separation.
+  double pressure = 0;
+  int insideSamples = 0, outsideSamples = 0;
+  double separation = 0;
 };
 
 void checkSliceEndOptions(const SliceEndOptions& options);

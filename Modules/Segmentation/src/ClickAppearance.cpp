@@ -1,0 +1,149 @@
+#include "dynsub/ClickAppearance.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "dynsub/Error.h"
+
+namespace dynsub {
+namespace {
+
+constexpr double kOnSlice = 0.25;  // voxels, as SliceEnds.cpp
+constexpr int kLeastSamples = 8;   // per side
+constexpr int kTableSize = 256;
+
+double interquartileRange(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  return values[values.size() * 3 / 4] - values[values.size() / 4];
+}
+
+// The 99th percentile of the gradient magnitude (central differences, per
+// mm) over every second voxel of the grid in each direction: how fast the
+// intensity under a moving surface can change, bar the steepest voxels.
+double steepGradient(const Volume& image) {
+  const ImageGeometry& g = image.geometry;
+  std::vector<double> magnitudes;
+  for (int k = 1; k + 1 < g.size[2]; k += 2)
+    for (int j = 1; j + 1 < g.size[1]; j += 2)
+      for (int i = 1; i + 1 < g.size[0]; i += 2) {
+        const double dx = (image.voxels[g.offset(i + 1, j, k)] - image.voxels[g.offset(i - 1, j, k)]) / (2 * g.spacing(0));
+        const double dy = (image.voxels[g.offset(i, j + 1, k)] - image.voxels[g.offset(i, j - 1, k)]) / (2 * g.spacing(1));
+        const double dz = (image.voxels[g.offset(i, j, k + 1)] - image.voxels[g.offset(i, j, k - 1)]) / (2 * g.spacing(2));
+        magnitudes.push_back(std::sqrt(dx * dx + dy * dy + dz * dz));
+      }
+  if (magnitudes.empty()) return 0.0;
+  const auto at = magnitudes.begin() + static_cast<std::ptrdiff_t>(0.99 * (magnitudes.size() - 1));
+  std::nth_element(magnitudes.begin(), at, magnitudes.end());
+  return *at;
+}
+
+}  // namespace
+
+std::optional<ClickAppearance> ClickAppearance::learn(const Volume& image, const std::vector<Landmark>& landmarks,
+                                                      int axis, double offset) {
+  if (axis < 0 || axis > 2) throw Error("internal: the clicks' slice axis must be 0, 1 or 2");
+  if (!(offset > 0) || !std::isfinite(offset)) throw Error("the appearance's sampling offset must be > 0 mm");
+  const ImageGeometry& g = image.geometry;
+  const Vector3 along = g.direction.col(axis).normalized();
+  std::vector<Vector3> index;
+  for (const Landmark& l : landmarks) index.push_back(g.toIndex(l.position));
+  std::vector<double> inside, outside;
+  for (std::size_t i = 0; i < landmarks.size(); ++i) {
+    Vector3 centre = Vector3::Zero();
+    int onSlice = 0;
+    for (std::size_t j = 0; j < landmarks.size(); ++j)
+      if (std::abs(index[j](axis) - index[i](axis)) <= kOnSlice) centre += landmarks[j].position, ++onSlice;
+    if (onSlice < 3) continue;
+    centre /= onSlice;
+    Vector3 outward = landmarks[i].position - centre;
+    outward -= outward.dot(along) * along;  // within the slice
+    if (!(outward.norm() > 1e-6 * g.spacing.minCoeff())) continue;
+    outward.normalize();
+    for (const double t : {offset, 2 * offset}) {
+      const Vector3 in = g.toIndex(landmarks[i].position - t * outward);
+      const Vector3 out = g.toIndex(landmarks[i].position + t * outward);
+      if (g.spans(in)) inside.push_back(image.interpolate(in));
+      if (g.spans(out)) outside.push_back(image.interpolate(out));
+    }
+  }
+  if (inside.size() < kLeastSamples || outside.size() < kLeastSamples) return std::nullopt;
+
+  ClickAppearance a;
+  a.insideSamples_ = static_cast<int>(inside.size());
+  a.outsideSamples_ = static_cast<int>(outside.size());
+  // The kernel's width: half the narrower side's spread (its interquartile
+  // range as a standard deviation), so that two classes a spread apart stay
+  // apart. Chosen on the evaluation's tuning split: half and twice this
+  // moved its mean Dice by less than 0.005.
+  const double spread = std::min(interquartileRange(inside), interquartileRange(outside)) / 1.349;
+  const double width = std::max(0.5 * spread, 1e-3 * (1.0 + std::abs(inside.front())));
+  double low = inside.front(), high = inside.front();
+  for (const auto* side : {&inside, &outside})
+    for (double v : *side) low = std::min(low, v), high = std::max(high, v);
+  a.first_ = low - 3 * width;
+  a.step_ = (high - low + 6 * width) / (kTableSize - 1);
+  a.table_.resize(kTableSize);
+  std::vector<double> pIn(kTableSize), pOut(kTableSize);
+  double sumIn = 0, sumOut = 0;
+  for (int k = 0; k < kTableSize; ++k) {
+    const double x = a.first_ + k * a.step_;
+    for (double v : inside) pIn[k] += std::exp(-0.5 * (x - v) * (x - v) / (width * width));
+    for (double v : outside) pOut[k] += std::exp(-0.5 * (x - v) * (x - v) / (width * width));
+    pIn[k] /= static_cast<double>(inside.size());
+    pOut[k] /= static_cast<double>(outside.size());
+    // NB: far from every sample both densities underflow to 0: no score there.
+    const double total = pIn[k] + pOut[k];
+    a.table_[k] = total > 0 ? (pIn[k] - pOut[k]) / total : 0.0;
+    sumIn += pIn[k], sumOut += pOut[k];
+  }
+  double difference = 0;
+  for (int k = 0; k < kTableSize; ++k) difference += std::abs(pIn[k] / sumIn - pOut[k] / sumOut);
+  a.separation_ = 0.5 * difference;
+  for (int k = 0; k + 1 < kTableSize; ++k)
+    a.largestSlope_ = std::max(a.largestSlope_, std::abs(a.table_[k + 1] - a.table_[k]) / a.step_);
+  return a;
+}
+
+double ClickAppearance::score(double intensity) const {
+  // Linear between table entries; the end entries beyond the table.
+  const double at = std::clamp((intensity - first_) / step_, 0.0, kTableSize - 1.0);
+  const int k = std::min(static_cast<int>(at), kTableSize - 2);
+  const double f = at - k;
+  return (1 - f) * table_[k] + f * table_[k + 1];
+}
+
+EndPressure::EndPressure(const Volume& region, ClickAppearance appearance, const std::vector<Landmark>& landmarks,
+                         int axis, double strength, std::optional<End> before, std::optional<End> after)
+    : region_(region), appearance_(std::move(appearance)), before_(before), after_(after), strength_(strength) {
+  if (axis < 0 || axis > 2) throw Error("internal: the clicks' slice axis must be 0, 1 or 2");
+  if (landmarks.empty()) throw Error("internal: a pressure beyond the clicked slices needs clicks");
+  if (!(strength >= 0) || !std::isfinite(strength)) throw Error("the pressure beyond the end slices must be >= 0");
+  along_ = region.geometry.direction.col(axis).normalized();
+  first_ = last_ = along_.dot(landmarks.front().position);
+  for (const Landmark& l : landmarks) {
+    first_ = std::min(first_, along_.dot(l.position));
+    last_ = std::max(last_, along_.dot(l.position));
+  }
+  slopeBound_ = strength_ * appearance_.largestSlope() * steepGradient(region);
+}
+
+Eigen::VectorXd EndPressure::pressuresAt(const Matrix3X& points) const {
+  const ImageGeometry& g = region_.geometry;
+  Eigen::VectorXd pressures = Eigen::VectorXd::Zero(points.rows());
+  for (Eigen::Index i = 0; i < points.rows(); ++i) {
+    const Vector3 x = points.row(i).transpose();
+    const double t = along_.dot(x);
+    if (t >= first_ && t <= last_) continue;  // the clicked span
+    const std::optional<End>& end = t < first_ ? before_ : after_;
+    if (!end) continue;
+    Vector3 across = x - end->centre;
+    across -= across.dot(along_) * along_;
+    if (across.norm() > end->radius) continue;
+    const Vector3 index = g.toIndex(x);
+    // Outside the region the image is unknown: no push.
+    if (g.spans(index)) pressures(i) = strength_ * appearance_.score(region_.interpolate(index));
+  }
+  return pressures;
+}
+
+}  // namespace dynsub
