@@ -7,9 +7,9 @@
 # (less than a fifth of the reference's volume) was warned of by segment or
 # by the seed's growth, without the reference; and each protocol's mean Dice
 # stays at or above what this code measures today, as a guard against
-# regressions (0.707 for six slices and 0.680 for three since the ends'
-# march reaches a clicked span, SliceEnds.h; 0.41 from one seed click; the
-# floors leave 0.06-0.07: the runs are deterministic, so the margin only
+# regressions (0.761 for six slices and 0.744 for three since the pressure
+# beyond the end slices, ClickAppearance.h; 0.41 from one seed click; the
+# floors leave 0.06: the runs are deterministic, so the margin only
 # absorbs another compiler's rounding). These are NOT the targets of the
 # evaluation's issue (mean Dice >= 0.85 from <= 40 points on <= 6 slices,
 # >= 0.75-0.80 from one click): those are not met yet, see
@@ -40,7 +40,7 @@ for r in rows:
         print("wrong number of clicks:", r); ok = False
     if r["protocol"] != "seed" and not (0 < float(r["dice"]) <= 1):
         print("Dice out of range:", r); ok = False
-for protocol, floor in (("six_slices", 0.64), ("sparse", 0.62), ("seed", 0.35)):
+for protocol, floor in (("six_slices", 0.70), ("sparse", 0.68), ("seed", 0.35)):
     dice = [float(r["dice"]) for r in rows if r["protocol"] == protocol]
     mean = sum(dice) / len(dice)
     print(f"{protocol}: mean Dice {mean:.3f} over {len(dice)} runs (floor {floor})")
