@@ -244,6 +244,8 @@ SegmentRun runSegmentation(const Volume& image, SegmentInputs in, const Progress
   parameters.set("landmark_tolerance_mm", in.segment.landmarkTolerance);
   parameters.set("inflation", in.segment.inflation);
   parameters.set("margin_mm", in.segment.margin);
+  parameters.set("slice_ends", in.segment.sliceEnds.enabled);
+  parameters.set("end_pressure", in.segment.sliceEnds.pressure);
   report.set("parameters", parameters);
   return run;
 }

@@ -172,6 +172,16 @@ check "segment's edge thresholds come from the landmarks" \
 check "segment without landmarks: edge thresholds from the image" \
   grep -q '"edge_reference": "image"' "$work/by_image/report.json"
 check "segment: --edge-high sets the image's fraction" grep -q '"edge_high": 0.3,' "$work/by_image/report.json"
+# The bundled clicks reach both of the caudate's ends (their marches stop
+# within 2 mm), so no pressure acts beyond them.
+check "segment reports the pressure beyond the end slices: none for the demo" python3 -c "
+import json, sys
+r = json.load(open(sys.argv[1]))
+sys.exit(0 if r['parameters']['end_pressure'] == 0.2 and r['slice_ends']['pressure']['n_per_mm2'] == 0 else 1)" \
+  "$work/caudate/report.json"
+expect_error "negative end pressure" 2 "end-pressure" "$work/s13" \
+  "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --end-pressure -0.1 \
+  --out "$work/s13"
 expect_error "NaN edge threshold" 1 "edge thresholds" "$work/s9" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --edge-low nan \
   --out "$work/s9"

@@ -102,23 +102,34 @@ TEST(SliceEnds, NoSpringWhereTheMarchFoundNoEnd) {
   EXPECT_EQ(findSliceEnds(image, landmarks, initialFromLandmarks(landmarks), options).springs.size(), 14u);
 }
 
-TEST(SliceEnds, TheSegmentationReachesTheUnclickedEnds) {
+// The cigar segmented from clicks on its 5 middle slices, and its Dice.
+struct SegmentedCigar {
+  SegmentResult result;
+  double dice = 0;
+};
+
+SegmentedCigar segmentCigar(const SegmentOptions& options) {
   const Cigar shape;
   Mask truth;
   const Volume image = cigarImage(shape, &truth);
   const std::vector<Landmark> landmarks = clicks(shape, 6);
-  const ControlMesh initial = initialFromLandmarks(landmarks);
+  SegmentedCigar s;
+  s.result = segment(image, landmarks, initialFromLandmarks(landmarks), options);
+  s.dice = compareMasks(labelmapOf(s.result.surface, image.geometry), truth).dice;
+  return s;
+}
+
+TEST(SliceEnds, TheSegmentationReachesTheUnclickedEnds) {
   SegmentOptions options;
   options.sliceEnds.enabled = false;
-  const double without = compareMasks(labelmapOf(segment(image, landmarks, initial, options).surface, image.geometry), truth).dice;
+  const double without = segmentCigar(options).dice;
   options.sliceEnds.enabled = true;
-  const SegmentResult result = segment(image, landmarks, initial, options);
-  const double with = compareMasks(labelmapOf(result.surface, image.geometry), truth).dice;
-  std::printf("Dice without the ends' springs %.3f, with %.3f\n", without, with);
-  EXPECT_EQ(result.sliceEnds.ends.size(), 2u);
-  EXPECT_FALSE(result.sliceEnds.springs.empty());
-  EXPECT_GE(with, without + 0.03);
-  EXPECT_GE(with, 0.93);
+  const SegmentedCigar with = segmentCigar(options);
+  std::printf("Dice without the ends' springs and pressure %.3f, with %.3f\n", without, with.dice);
+  EXPECT_EQ(with.result.sliceEnds.ends.size(), 2u);
+  EXPECT_FALSE(with.result.sliceEnds.springs.empty());
+  EXPECT_GE(with.dice, without + 0.03);
+  EXPECT_GE(with.dice, 0.93);
 }
 
 // The clicks' own surroundings teach the two classes: the cigar (100) inside,
@@ -186,23 +197,18 @@ TEST(ClickAppearance, ThePressureActsOnlyBeyondTheClickedSpan) {
 // From clicks over the middle 60 % only, the pressure carries the surface to
 // the cigar's tips, past where the springs' taper leaves it.
 TEST(SliceEnds, ThePressureCarriesTheSurfaceToTheEnds) {
-  const Cigar shape;
-  Mask truth;
-  const Volume image = cigarImage(shape, &truth);
-  const std::vector<Landmark> landmarks = clicks(shape, 6);
-  const ControlMesh initial = initialFromLandmarks(landmarks);
   SegmentOptions options;
   options.sliceEnds.pressure = 0;
-  const SegmentResult springsOnly = segment(image, landmarks, initial, options);
+  const SegmentedCigar springsOnly = segmentCigar(options);
   options.sliceEnds.pressure = 0.2;
-  const SegmentResult result = segment(image, landmarks, initial, options);
-  const double without = compareMasks(labelmapOf(springsOnly.surface, image.geometry), truth).dice;
-  const OverlapMetrics with = compareMasks(labelmapOf(result.surface, image.geometry), truth);
-  std::printf("Dice with the ends' springs only %.3f, with the pressure too %.3f\n", without, with.dice);
-  EXPECT_EQ(springsOnly.sliceEnds.pressure, 0.0);
-  EXPECT_EQ(result.sliceEnds.pressure, 0.2);
-  EXPECT_EQ(result.sliceEnds.insideSamples, 60);
-  EXPECT_GE(with.dice, without);
+  const SegmentedCigar with = segmentCigar(options);
+  std::printf("Dice with the ends' springs only %.3f, with the pressure too %.3f\n", springsOnly.dice, with.dice);
+  EXPECT_EQ(springsOnly.result.sliceEnds.pressure, 0.0);
+  EXPECT_EQ(with.result.sliceEnds.pressure, 0.2);
+  EXPECT_EQ(with.result.sliceEnds.insideSamples, 60);
+  // Measured 0.975 -> 0.981: the tips the taper drew in are filled; half of
+  // that gain is asked for.
+  EXPECT_GE(with.dice, springsOnly.dice + 0.003);
   EXPECT_GE(with.dice, 0.95);
 }
 
