@@ -179,6 +179,7 @@ SegmentRun runSegmentation(const Volume& image, SegmentInputs in, const Progress
       r.set("to_lps_mm", end.end);
       r.set("length_mm", end.length);
       r.set("stopped_by_reach", end.stoppedByReach);
+      r.set("pressure", end.pressed);
       marched.push_back(r);
     }
     std::vector<Vector3> springPoints;

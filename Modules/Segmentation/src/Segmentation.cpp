@@ -81,11 +81,9 @@ std::optional<EndPressure> endPressure(const SegmentationRegion& region, const s
                                        const SliceEndOptions& options, SliceEnds& ends) {
   if (ends.axis < 0 || !(options.pressure > 0)) return std::nullopt;
   const Vector3 along = region.image().geometry.direction.col(ends.axis).normalized();
-  double middle = 0;
-  for (const Landmark& l : landmarks) middle += along.dot(l.position) / static_cast<double>(landmarks.size());
   const double onSlice = 0.25 * region.image().geometry.spacing(ends.axis);  // mm, as SliceEnds.cpp's quarter voxel
   std::optional<EndPressure::End> beyond[2];  // before and after the clicked span, along the axis
-  for (const SliceEnd& end : ends.ends) {
+  for (SliceEnd& end : ends.ends) {
     if (!end.stoppedByReach && !(end.length > options.gap)) continue;
     EndPressure::End e{end.start, 0.0};
     for (const Landmark& l : landmarks) {
@@ -94,11 +92,12 @@ std::optional<EndPressure> endPressure(const SegmentationRegion& region, const s
       across -= across.dot(along) * along;
       e.radius = std::max(e.radius, across.norm());
     }
-    beyond[along.dot(end.end) > middle] = e;
+    beyond[end.side > 0] = e;
   }
   if (!beyond[0] && !beyond[1]) return std::nullopt;
   std::optional<ClickAppearance> appearance = ClickAppearance::learn(region.image(), landmarks, ends.axis);
   if (!appearance) return std::nullopt;
+  for (SliceEnd& end : ends.ends) end.pressed = beyond[end.side > 0].has_value();
   ends.pressure = options.pressure;
   ends.insideSamples = appearance->insideSamples();
   ends.outsideSamples = appearance->outsideSamples();

@@ -102,6 +102,7 @@ SliceEnds findSliceEnds(const Volume& image, const std::vector<Landmark>& landma
     for (const Vector3& p : onSlice) squared += (p - centre).squaredNorm();
     const double radius = std::max(g.spacing.maxCoeff(), options.disk * std::sqrt(squared / onSlice.size()));
     SliceEnd end;
+    end.side = outward < 0 ? -1 : 1;
     end.start = end.end = centre;
     const double longest = options.reach * span;
     int outside = 0;

@@ -177,7 +177,7 @@ TEST(ClickAppearance, ThePressureActsOnlyBeyondTheClickedSpan) {
     points.row(1) = (shape.centre + Vector3(0, 16, 0)).transpose();   // inside, beyond the last slice
     points.row(2) = (shape.centre + Vector3(0, -16, 0)).transpose();  // inside, before the first
     points.row(3) = (shape.centre + Vector3(0, 25, 0)).transpose();   // background, beyond the last slice
-    points.row(4) = (shape.centre + Vector3(0, 16, 40)).transpose();  // outside the image
+    points.row(4) = (shape.centre + Vector3(0, 35, 0)).transpose();   // on the axis, beyond the image's end
     points.row(5) = (shape.centre + Vector3(7, 16, 0)).transpose();   // beyond the last slice's footprint (6.4 mm)
     EXPECT_GT(pressure.slopeBound(), 0.0);
     return pressure.pressuresAt(points);
@@ -210,6 +210,33 @@ TEST(SliceEnds, ThePressureCarriesTheSurfaceToTheEnds) {
   // that gain is asked for.
   EXPECT_GE(with.dice, springsOnly.dice + 0.003);
   EXPECT_GE(with.dice, 0.95);
+}
+
+// Clicks that also reach one tip (a slice 1 mm short of it): the pressure
+// acts beyond the other end only.
+TEST(SliceEnds, NoPressureBeyondAnEndTheClicksReach) {
+  const Cigar shape;
+  Mask truth;
+  const Volume image = cigarImage(shape, &truth);
+  std::vector<Landmark> landmarks = clicks(shape, 6);
+  const double y = 19, radius = shape.axes.x() * std::sqrt(1.0 - (y / shape.axes.y()) * (y / shape.axes.y()));
+  for (int q = 0; q < 6; ++q) {
+    const double angle = 2.0 * M_PI * q / 6;
+    landmarks.push_back({"T" + std::to_string(q), shape.centre + Vector3(radius * std::cos(angle), y,
+                                                                          radius * std::sin(angle))});
+  }
+  const SegmentResult result = segment(image, landmarks, initialFromLandmarks(landmarks), SegmentOptions());
+  ASSERT_EQ(result.sliceEnds.ends.size(), 2u);
+  for (const SliceEnd& end : result.sliceEnds.ends) {
+    if (end.side < 0) {
+      EXPECT_GT(end.length, 2.0);
+      EXPECT_TRUE(end.pressed);
+    } else {
+      EXPECT_LE(end.length, 2.0);
+      EXPECT_FALSE(end.pressed);
+    }
+  }
+  EXPECT_EQ(result.sliceEnds.pressure, 0.2);
 }
 
 TEST(SliceEnds, NoSpringsForLandmarksOffSlicesOrTooFew) {

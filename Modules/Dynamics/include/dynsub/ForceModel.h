@@ -108,9 +108,9 @@ class InflationForceModel final : public ForceModel {
   const SurfaceQuadrature* quadrature_ = nullptr;
 };
 
-// An external force-density field (N/mm^2), e.g. image forces; not owned.
-// A force field, and optionally a pressure field acting with it (evaluated
-// at the same points, Forces.h's fieldForces). Neither is owned.
+// An external force-density field (N/mm^2), e.g. image forces, and
+// optionally a pressure field acting with it (evaluated at the same points,
+// Forces.h's fieldForces). Neither is owned.
 class FieldForceModel final : public ForceModel {
  public:
   explicit FieldForceModel(const ForceField& field, const PressureField* pressure = nullptr)

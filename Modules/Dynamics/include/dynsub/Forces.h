@@ -62,7 +62,9 @@ class PressureField {
  public:
   virtual ~PressureField() = default;
   virtual Eigen::VectorXd pressuresAt(const Matrix3X& points) const = 0;
-  // An upper bound of |dp/dx| (N/mm^3), or 0 if unknown; as ForceField's.
+  // How fast the pressure changes with position (N/mm^3): an upper bound of
+  // |dp/dx| or an estimate of one, 0 if unknown. As ForceField's, it only
+  // serves to stabilize time integration.
   virtual double slopeBound() const { return 0.0; }
 };
 

@@ -48,6 +48,7 @@ class ClickAppearance {
   double separation() const { return separation_; }
 
  private:
+  ClickAppearance() = default;  // only learn() makes one
   std::vector<double> table_;  // scores on a uniform grid of intensities
   double first_ = 0, step_ = 1;
   double largestSlope_ = 0, separation_ = 0;
@@ -78,6 +79,7 @@ class EndPressure final : public PressureField {
  private:
   const Volume& region_;
   ClickAppearance appearance_;
+  Matrix3 toIndex_;
   Vector3 along_;
   double first_ = 0, last_ = 0;  // the clicked span, mm along `along_`
   std::optional<End> before_, after_;

@@ -150,7 +150,9 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
 // The evolution alone, in a region built for these options (no labelmap; the
 // result's landmarkDistances and levels are filled): what an interactive
 // refit runs. `initial` may be an earlier result's mesh, with its `origin`.
-// `pressure` (not owned), if given, acts with the image force (ForceModel.h's FieldForceModel).
+// `pressure` (not owned), if given, acts with the image force (ForceModel.h's
+// FieldForceModel). segment()'s springs and pressure at the ends beyond the
+// clicked slices are not part of this: an interactive refit runs without them.
 SegmentResult evolveInRegion(const SegmentationRegion& region, const std::vector<Landmark>& landmarks,
                              const ControlMesh& initial, const LevelOrigin& origin, const SegmentOptions& options,
                              const ProgressCallback& progress = nullptr,

@@ -60,10 +60,12 @@ struct SliceEndOptions {
 };
 
 struct SliceEnd {
+  int side = 1;                     // -1: towards lower indices along the axis, +1: higher
   Vector3 start = Vector3::Zero();  // the outermost slice's centroid (LPS mm)
   Vector3 end = Vector3::Zero();    // the march's last step inside
   double length = 0;                // mm
   bool stoppedByReach = false;      // the intensity never left the window
+  bool pressed = false;             // step 5's pressure acts beyond this end (set by segment())
 };
 
 struct SliceEnds {
@@ -72,8 +74,10 @@ struct SliceEnds {
   double median = 0, spread = 0;
   std::vector<SliceEnd> ends;     // the ends marched from (0, 1 or 2)
   std::vector<Landmark> springs;  // for each end that went more than `gap`: its tip (and taper)
-  // Step 5, filled by segment(): the pressure used (0 when off, or when the
-  // clicks gave too few samples), the samples and the classes' separation.
+  // Step 5, filled by segment(): the pressure used, the samples and the
+  // classes' separation. 0 when off, when the landmarks are not on slices,
+  // when every end's march stopped within `gap` (the clicks reach both
+  // ends, as the bundled caudate's do), or when the clicks gave too few samples.
   double pressure = 0;
   int insideSamples = 0, outsideSamples = 0;
   double separation = 0;
