@@ -1,5 +1,6 @@
 // Force models (ForceModel.h): a spring's dead zone; a field's stabilizing
-// stiffness and its settling on an edge.
+// stiffness and its settling on an edge; a pressure field evaluated with a
+// force field.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -114,6 +115,47 @@ TEST(FieldForces, AReversingFieldSettlesOnItsEdge) {
   const Eigen::VectorXd radii = points.rowwise().norm();
   EXPECT_GT(radii.minCoeff(), 4.0 - 0.35);
   EXPECT_LT(radii.maxCoeff(), 4.0 + 0.2);
+}
+
+// A pressure that depends on where the surface is: +p above the plane z = 0,
+// -p below. Its slope bound is what FieldForceModel adds to the field's.
+class HalfSpacePressure final : public PressureField {
+ public:
+  explicit HalfSpacePressure(double pressure) : pressure_(pressure) {}
+  Eigen::VectorXd pressuresAt(const Matrix3X& points) const override {
+    return points.col(2).unaryExpr([this](double z) { return z > 0 ? pressure_ : -pressure_; });
+  }
+  double slopeBound() const override { return 2.0; }
+
+ private:
+  double pressure_;
+};
+
+TEST(FieldForces, APressureFieldActsWithTheForceFieldInOnePass) {
+  // The field's forces plus the pressure's equal the two computed apart:
+  // the field alone, and pressureForces at the quadrature points' own
+  // pressures. A pressure of zero everywhere changes nothing.
+  const ControlMesh cube = makeCube98();
+  const LimitSurface surface(cube);
+  const SurfaceQuadrature quadrature = makeSurfaceQuadrature(surface);
+  const RadialWell well(0.8, 0.3, 0.2);
+  const HalfSpacePressure halves(0.05);
+  const Matrix3X positions = quadrature.J * cube.points();
+  const Matrix3X apart = fieldForces(quadrature, cube.points(), well) +
+                         pressureForces(quadrature, cube.points(), halves.pressuresAt(positions));
+  const Matrix3X together = fieldForces(quadrature, cube.points(), well, &halves);
+  EXPECT_LT((together - apart).cwiseAbs().maxCoeff(), 1e-12 * apart.cwiseAbs().maxCoeff());
+  EXPECT_GT((together - fieldForces(quadrature, cube.points(), well)).cwiseAbs().maxCoeff(), 0.0);
+  const HalfSpacePressure uniform(0.0);
+  EXPECT_EQ(fieldForces(quadrature, cube.points(), well, &uniform), fieldForces(quadrature, cube.points(), well));
+  // The stabilizer takes both slopes: 0.3 / 0.2 for the well, 2 for the pressure.
+  FieldForceModel alone(well), both(well, &halves);
+  alone.beginLevel(surface, quadrature, cube.points());
+  both.beginLevel(surface, quadrature, cube.points());
+  const SparseMatrix expected = fieldStiffness(quadrature, cube.points(), 1.5 + 2.0);
+  EXPECT_LT((both.stabilizingStiffness(cube.points()) - expected).norm(), 1e-12 * expected.norm());
+  EXPECT_LT((alone.stabilizingStiffness(cube.points()) - fieldStiffness(quadrature, cube.points(), 1.5)).norm(),
+            1e-12 * expected.norm());
 }
 
 }  // namespace
