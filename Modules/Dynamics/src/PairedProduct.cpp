@@ -1,8 +1,8 @@
 #include "PairedProduct.h"
 
 #include <algorithm>
-#include <thread>
 
+#include "ParallelFor.h"
 #include "dynsub/Error.h"
 
 namespace dynsub {
@@ -118,15 +118,11 @@ void PairedProduct::sum(const Matrix3X& p, const Matrix3X& q) {
     return;
   }
   // The columns from split_ on are summed apart (on a second thread where
-  // there is a second core) and added last, the same order either way.
-  if (std::thread::hardware_concurrency() > 1) {
-    std::thread worker([&] { columns(split_, n, secondSums_); });
-    columns(0, split_, sums_);
-    worker.join();
-  } else {
-    columns(0, split_, sums_);
-    columns(split_, n, secondSums_);
-  }
+  // there is a second core, ParallelFor.h) and added last, the same order either way.
+  parallelFor(2, 2, [&](Eigen::Index half) {
+    if (half == 0) columns(0, split_, sums_);
+    if (half == 1) columns(split_, n, secondSums_);
+  });
   for (size_t i = 0; i < sums_.size(); ++i) sums_[i] += secondSums_[i];
 }
 

@@ -1,10 +1,10 @@
 #include "SupernodalSolve.h"
 
 #include <algorithm>
-#include <thread>
 #include <vector>
 
 #include "Lanes.h"
+#include "ParallelFor.h"
 
 namespace dynsub {
 namespace {
@@ -258,12 +258,13 @@ void backward(const SupernodalFactorView& f, int begin, int end, double* x, doub
 }
 
 // K columns of x. With a split (SupernodalFactorView::middle < top), the two
-// subtrees [0, middle) and [middle, top) are solved on two threads: in the
-// forward pass the second one's updates of the rows above both (columns
-// from firstColumn[top] on) are summed apart and subtracted after both, so
-// the sums run in the same order whether one thread or two did them.
+// subtrees [0, middle) and [middle, top) are solved on two threads (where
+// there are two cores, ParallelFor.h): in the forward pass the second one's
+// updates of the rows above both (columns from firstColumn[top] on) are
+// summed apart and subtracted after both, so the sums run in the same order
+// whether one thread or two did them.
 template <int K>
-void solveColumns(const SupernodalFactorView& f, double* x, double* v, int stride, bool threads) {
+void solveColumns(const SupernodalFactorView& f, double* x, double* v, int stride) {
   const int n = f.unknowns;
   if (!(f.middle < f.top)) {
     forward<K>(f, 0, f.supernodes, x, v, stride, n, nullptr);
@@ -273,25 +274,19 @@ void solveColumns(const SupernodalFactorView& f, double* x, double* v, int strid
   const int above = f.firstColumn[f.top];
   std::vector<double> outside(static_cast<size_t>(K) * (n - above), 0.0);
   std::vector<double> second(static_cast<size_t>(K) * stride);
-  auto both = [&](auto&& first, auto&& other) {
-    if (threads) {
-      std::thread worker(other);
-      first();
-      worker.join();
-    } else {
-      first();
-      other();
-    }
-  };
-  both([&] { forward<K>(f, 0, f.middle, x, v, stride, n, nullptr); },
-       [&] { forward<K>(f, f.middle, f.top, x, second.data(), stride, above, outside.data()); });
+  parallelFor(2, 2, [&](Eigen::Index subtree) {
+    if (subtree == 0) forward<K>(f, 0, f.middle, x, v, stride, n, nullptr);
+    if (subtree == 1) forward<K>(f, f.middle, f.top, x, second.data(), stride, above, outside.data());
+  });
   for (int k = 0; k < K; ++k) {
     for (int r = above; r < n; ++r) x[k * n + r] += outside[k * (n - above) + r - above];
   }
   forward<K>(f, f.top, f.supernodes, x, v, stride, n, nullptr);
   backward<K>(f, f.top, f.supernodes, x, v, stride);
-  both([&] { backward<K>(f, 0, f.middle, x, v, stride); },
-       [&] { backward<K>(f, f.middle, f.top, x, second.data(), stride); });
+  parallelFor(2, 2, [&](Eigen::Index subtree) {
+    if (subtree == 0) backward<K>(f, 0, f.middle, x, v, stride);
+    if (subtree == 1) backward<K>(f, f.middle, f.top, x, second.data(), stride);
+  });
 }
 
 }  // namespace
@@ -316,13 +311,12 @@ int largestSupernode(const SupernodalFactorView& f) {
 
 void supernodalSolve(const SupernodalFactorView& f, double* x, int columns, double* scratch) {
   const int stride = largestSupernode(f);
-  const bool threads = f.middle < f.top && std::thread::hardware_concurrency() > 1;
   // Three columns (x, y and z of the implicit steps) in one pass over L; others one at a time.
   int done = 0;
   for (; done + 3 <= columns; done += 3) {
-    solveColumns<3>(f, x + static_cast<long>(done) * f.unknowns, scratch, stride, threads);
+    solveColumns<3>(f, x + static_cast<long>(done) * f.unknowns, scratch, stride);
   }
-  for (; done < columns; ++done) solveColumns<1>(f, x + static_cast<long>(done) * f.unknowns, scratch, stride, threads);
+  for (; done < columns; ++done) solveColumns<1>(f, x + static_cast<long>(done) * f.unknowns, scratch, stride);
 }
 
 void splitForTwoThreads(SupernodalFactorView& f, long minimumShare) {
