@@ -80,20 +80,9 @@ double enclosedVolume(const TriangleSurface& s) {
 std::optional<EndPressure> endPressure(const SegmentationRegion& region, const std::vector<Landmark>& landmarks,
                                        const SliceEndOptions& options, SliceEnds& ends) {
   if (ends.axis < 0 || !(options.pressure > 0)) return std::nullopt;
-  const Vector3 along = region.image().geometry.direction.col(ends.axis).normalized();
-  const double onSlice = 0.25 * region.image().geometry.spacing(ends.axis);  // mm, as SliceEnds.cpp's quarter voxel
   std::optional<EndPressure::End> beyond[2];  // before and after the clicked span, along the axis
-  for (SliceEnd& end : ends.ends) {
-    if (!end.stoppedByReach && !(end.length > options.gap)) continue;
-    EndPressure::End e{end.start, 0.0};
-    for (const Landmark& l : landmarks) {
-      Vector3 across = l.position - end.start;
-      if (std::abs(across.dot(along)) > onSlice) continue;  // not on the end slice
-      across -= across.dot(along) * along;
-      e.radius = std::max(e.radius, across.norm());
-    }
-    beyond[end.side > 0] = e;
-  }
+  for (const SliceEnd& end : ends.ends)
+    if (end.stoppedByReach || end.length > options.gap) beyond[end.side > 0] = EndPressure::End{end.start, end.sliceRadius};
   if (!beyond[0] && !beyond[1]) return std::nullopt;
   std::optional<ClickAppearance> appearance = ClickAppearance::learn(region.image(), landmarks, ends.axis);
   if (!appearance) return std::nullopt;

@@ -104,6 +104,10 @@ SliceEnds findSliceEnds(const Volume& image, const std::vector<Landmark>& landma
     SliceEnd end;
     end.side = outward < 0 ? -1 : 1;
     end.start = end.end = centre;
+    for (const Vector3& p : onSlice) {
+      const Vector3 across = (p - centre) - (p - centre).dot(along) * along;
+      end.sliceRadius = std::max(end.sliceRadius, across.norm());
+    }
     const double longest = options.reach * span;
     int outside = 0;
     double reached = 0;

@@ -62,6 +62,7 @@ struct SliceEndOptions {
 struct SliceEnd {
   int side = 1;                     // -1: towards lower indices along the axis, +1: higher
   Vector3 start = Vector3::Zero();  // the outermost slice's centroid (LPS mm)
+  double sliceRadius = 0;           // mm: that slice's farthest click from the centroid, across the axis
   Vector3 end = Vector3::Zero();    // the march's last step inside
   double length = 0;                // mm
   bool stoppedByReach = false;      // the intensity never left the window
