@@ -96,6 +96,25 @@ class EquilibriumWindow {
   std::deque<std::pair<double, double>> recent_;
 };
 
+// How far a step from `from` to `to` moved the limit surface across itself:
+// the largest |n . (s(to) - s(from))| over the quadrature points, n the unit
+// normal at `from`. Steps also slide the parametrization along the surface,
+// which changes no shape, for hundreds of steps after the shape has settled
+// (Simulation.h), so control-point motion would keep it "moving".
+double shapeMotion(const SurfaceQuadrature& quadrature, const Matrix3X& from, const Matrix3X& to) {
+  const Matrix3X moved = applyOperator(quadrature.J, Matrix3X(to - from));
+  const Matrix3X su = applyOperator(quadrature.Ju, from), sv = applyOperator(quadrature.Jv, from);
+  double largest = 0.0;
+  for (Eigen::Index i = 0; i < moved.rows(); ++i) {
+    const Eigen::Vector3d n = su.row(i).transpose().cross(sv.row(i).transpose());
+    const double length = n.norm();
+    // A degenerate normal (a collapsed element) counts the whole move.
+    const double across = length > 0.0 ? std::abs(n.dot(moved.row(i).transpose())) / length : moved.row(i).norm();
+    largest = std::max(largest, across);
+  }
+  return largest;
+}
+
 // Coarse: a level below the maximum settled to the looser rule and its fit
 // was not accepted (EquilibriumOptions::coarseLevelFactor).
 enum class LevelEnd { Equilibrium, Coarse, StepLimit, Diverged };
@@ -134,7 +153,7 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
     if (!std::isfinite(energy) || std::abs(energy) > 1e3 * std::max(firstEnergy, 1e-300)) return LevelEnd::Diverged;
     if (step > 1) {
       const double change = relativeChange(energy, lastEnergy);
-      const bool still = window.settled(change, (points - previous).rowwise().norm().maxCoeff() / model.size);
+      const bool still = window.settled(change, shapeMotion(model.quadrature, previous, points) / model.size);
       // The motion is dissipative and re-attaching springs only lowers their
       // energy, so an energy that keeps rising means the forces' stiffness
       // has drifted from the one the integrator was built with. Changes
@@ -165,26 +184,6 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
     if (progress) progress(Progress{model.level, step, energy, motion, &model.surface, &points});
   }
   return LevelEnd::StepLimit;
-}
-
-// How far a step from `from` to `to` moved the limit surface across itself:
-// the largest |n . (s(to) - s(from))| over the quadrature points, n the unit
-// normal at `from`. A static step also slides the parametrization along the
-// surface, which changes no shape (the tangent-plane stiffness leaves that
-// slide to the surface's weak elasticity, StaticSolver.h), so control-point
-// motion would keep a fitted shape "moving" for hundreds of steps.
-double shapeMotion(const SurfaceQuadrature& quadrature, const Matrix3X& from, const Matrix3X& to) {
-  const Matrix3X moved = applyOperator(quadrature.J, Matrix3X(to - from));
-  const Matrix3X su = applyOperator(quadrature.Ju, from), sv = applyOperator(quadrature.Jv, from);
-  double largest = 0.0;
-  for (Eigen::Index i = 0; i < moved.rows(); ++i) {
-    const Eigen::Vector3d n = su.row(i).transpose().cross(sv.row(i).transpose());
-    const double length = n.norm();
-    // A degenerate normal (a collapsed element) counts the whole move.
-    const double across = length > 0.0 ? std::abs(n.dot(moved.row(i).transpose())) / length : moved.row(i).norm();
-    largest = std::max(largest, across);
-  }
-  return largest;
 }
 
 // Newton steps on K p = f_p (StaticSolver.h). When every force has a

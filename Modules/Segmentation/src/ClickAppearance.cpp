@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "dynsub/Error.h"
+#include "RobustStatistics.h"
 
 namespace dynsub {
 namespace {
@@ -14,26 +15,6 @@ constexpr int kLeastSamples = 8;   // per side
 double interquartileRange(std::vector<double> values) {
   std::sort(values.begin(), values.end());
   return values[values.size() * 3 / 4] - values[values.size() / 4];
-}
-
-// The 99th percentile of the gradient magnitude (central differences, per
-// mm) over every second voxel of the grid in each direction: how fast the
-// intensity under a moving surface can change, bar the steepest voxels.
-double steepGradient(const Volume& image) {
-  const ImageGeometry& g = image.geometry;
-  std::vector<double> magnitudes;
-  for (int k = 1; k + 1 < g.size[2]; k += 2)
-    for (int j = 1; j + 1 < g.size[1]; j += 2)
-      for (int i = 1; i + 1 < g.size[0]; i += 2) {
-        const double dx = (image.voxels[g.offset(i + 1, j, k)] - image.voxels[g.offset(i - 1, j, k)]) / (2 * g.spacing(0));
-        const double dy = (image.voxels[g.offset(i, j + 1, k)] - image.voxels[g.offset(i, j - 1, k)]) / (2 * g.spacing(1));
-        const double dz = (image.voxels[g.offset(i, j, k + 1)] - image.voxels[g.offset(i, j, k - 1)]) / (2 * g.spacing(2));
-        magnitudes.push_back(std::sqrt(dx * dx + dy * dy + dz * dz));
-      }
-  if (magnitudes.empty()) return 0.0;
-  const auto at = magnitudes.begin() + static_cast<std::ptrdiff_t>(0.99 * (magnitudes.size() - 1));
-  std::nth_element(magnitudes.begin(), at, magnitudes.end());
-  return *at;
 }
 
 }  // namespace

@@ -1,5 +1,8 @@
 #include "RobustStatistics.h"
 
+#include <cmath>
+#include <vector>
+
 #include "dynsub/LimitSurface.h"
 #include "dynsub/Tessellation.h"
 #include "dynsub/Voxelize.h"
@@ -16,6 +19,26 @@ std::optional<RobustStatistics> insideIntensities(const Volume& image, const Con
     if (inside.voxels[i]) values.push_back(box.voxels[i]);
   if (values.empty()) return std::nullopt;
   return robustStatistics(std::move(values));
+}
+
+// The 99th percentile of the gradient magnitude (central differences, per
+// mm) over every second voxel of the grid in each direction: how fast the
+// intensity under a moving surface can change, bar the steepest voxels.
+double steepGradient(const Volume& image) {
+  const ImageGeometry& g = image.geometry;
+  std::vector<double> magnitudes;
+  for (int k = 1; k + 1 < g.size[2]; k += 2)
+    for (int j = 1; j + 1 < g.size[1]; j += 2)
+      for (int i = 1; i + 1 < g.size[0]; i += 2) {
+        const double dx = (image.voxels[g.offset(i + 1, j, k)] - image.voxels[g.offset(i - 1, j, k)]) / (2 * g.spacing(0));
+        const double dy = (image.voxels[g.offset(i, j + 1, k)] - image.voxels[g.offset(i, j - 1, k)]) / (2 * g.spacing(1));
+        const double dz = (image.voxels[g.offset(i, j, k + 1)] - image.voxels[g.offset(i, j, k - 1)]) / (2 * g.spacing(2));
+        magnitudes.push_back(std::sqrt(dx * dx + dy * dy + dz * dz));
+      }
+  if (magnitudes.empty()) return 0.0;
+  const auto at = magnitudes.begin() + static_cast<std::ptrdiff_t>(0.99 * (magnitudes.size() - 1));
+  std::nth_element(magnitudes.begin(), at, magnitudes.end());
+  return *at;
 }
 
 }  // namespace dynsub

@@ -36,4 +36,10 @@ inline RobustStatistics robustStatistics(std::vector<double> values) {
 // voxel centre.
 std::optional<RobustStatistics> insideIntensities(const Volume& image, const ControlMesh& model);
 
+// The 99th percentile of the gradient magnitude (central differences, per
+// mm) over every second voxel of `image` in each direction: how fast the
+// intensity under a moving surface can change, bar the steepest voxels. What
+// the pressures' slopes are bounded with, to stabilize time steps.
+double steepGradient(const Volume& image);
+
 }  // namespace dynsub
