@@ -63,7 +63,10 @@ std::vector<BoundaryPoint> sliceBoundary(const Mask& m, int axis, int index) {
 void checkClickProtocol(const ClickProtocol& p) {
   const std::string name = "click protocol '" + p.name + "': ";
   if (p.axis < 0 || p.axis > 2) throw Error(name + "the axis must be 0 (sagittal), 1 (coronal) or 2 (axial)");
-  if (p.seedOnly) return;
+  if (p.seedOnly) {
+    if (!(p.seedDepth > 0 && p.seedDepth <= 1)) throw Error(name + "the seed click's depth must be in (0, 1]");
+    return;
+  }
   if (p.slices < 1 || p.slices > 100) throw Error(name + "slices must be in 1..100");
   if (p.pointsPerSlice < 1 || p.pointsPerSlice > 100) throw Error(name + "points per slice must be in 1..100");
   if (!(p.coverageLow > 0 && p.coverageLow <= p.coverageHigh && p.coverageHigh <= 1))
@@ -147,7 +150,8 @@ std::vector<Landmark> expertClicks(const Mask& reference, const ClickProtocol& p
   return clicks;
 }
 
-Vector3 seedClick(const Mask& reference) {
+Vector3 seedClick(const Mask& reference, double depthFraction, unsigned seed) {
+  if (!(depthFraction > 0 && depthFraction <= 1)) throw Error("the seed click's depth must be in (0, 1]");
   const ImageGeometry& g = reference.geometry;
   // Depth: city-block distance (in voxels) to the nearest voxel outside, by
   // two sweeps; the deepest voxel, nearest the centroid among ties.
@@ -198,7 +202,14 @@ Vector3 seedClick(const Mask& reference) {
           best = Vector3(i, j, k);
         }
       }
-  return g.toPhysical(best);
+  if (depthFraction >= 1) return g.toPhysical(best);
+  const int least = std::max(1, static_cast<int>(std::ceil(depthFraction * deepest)));
+  std::vector<long long> deepEnough;
+  for (long long o = 0; o < n; ++o)
+    if (depth[o] >= least) deepEnough.push_back(o);
+  std::mt19937_64 random(seed);
+  const long long o = deepEnough[std::uniform_int_distribution<size_t>(0, deepEnough.size() - 1)(random)];
+  return g.toPhysical(Vector3(o % g.size[0], (o / g.size[0]) % g.size[1], o / (static_cast<long long>(g.size[0]) * g.size[1])));
 }
 
 }  // namespace dynsub

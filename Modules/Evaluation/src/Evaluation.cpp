@@ -58,7 +58,7 @@ EvaluationRun runOne(const EvaluationPlan& plan, const Volume& image, const Mask
   const auto started = std::chrono::steady_clock::now();
   SegmentOptions options = plan.segment;
   if (clicks.seedOnly) {  // as segment --init seed: does without landmarks
-    const SeedRegion grown = growFromSeed(image, seedClick(reference), plan.seed);
+    const SeedRegion grown = growFromSeed(image, seedClick(reference, clicks.seedDepth, run.seed), plan.seed);
     landmarks = grown.boundary;
     options.landmarkStiffness = plan.seed.stiffness;
     for (const std::string& w : seedWarnings(grown)) run.warnings += (run.warnings.empty() ? "" : "; ") + w;
@@ -118,6 +118,7 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
       ClickProtocol& c = protocol.clicks;
       c.name = p.at("name");
       c.seedOnly = p.value("seed_only", false);
+      c.seedDepth = p.value("seed_depth", c.seedDepth);
       c.slices = p.value("slices", c.slices);
       c.pointsPerSlice = p.value("points_per_slice", c.pointsPerSlice);
       if (p.contains("coverage")) {

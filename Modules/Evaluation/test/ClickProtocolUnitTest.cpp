@@ -102,6 +102,19 @@ TEST(ClickProtocol, TheSeedClickIsDeepInside) {
   ClickProtocol seedOnly;
   seedOnly.seedOnly = true;
   EXPECT_TRUE(expertClicks(ball.mask, seedOnly, 1).empty());
+  // Scattered: at least half the deepest (city-block) depth, 11 voxels at
+  // the centre, so at least 6 steps along the axes from outside: a Euclidean
+  // depth of 6 / sqrt(3) = 3.5 mm or more, about 6.5 mm at most from the centre of
+  // the 10 mm ball. Seeded, and not all alike.
+  std::vector<Vector3> clicks;
+  for (unsigned seed = 1; seed <= 5; ++seed) {
+    const Vector3 click = seedClick(ball.mask, 0.5, seed);
+    EXPECT_LT((click - ball.centre).norm(), ball.radius - 6.0 / std::sqrt(3.0) + 0.5) << "seed " << seed;
+    EXPECT_EQ((seedClick(ball.mask, 0.5, seed) - click).norm(), 0.0) << "seed " << seed;
+    clicks.push_back(click);
+  }
+  EXPECT_GT((clicks[0] - clicks[1]).norm() + (clicks[0] - clicks[2]).norm(), 0.0);
+  EXPECT_THROW(seedClick(ball.mask, 0.0, 1), Error);
 }
 
 TEST(ClickProtocol, ImpossibleProtocolsAreRefused) {
@@ -121,6 +134,10 @@ TEST(ClickProtocol, ImpossibleProtocolsAreRefused) {
   std::fill(empty.voxels.begin(), empty.voxels.end(), 0);
   EXPECT_THROW(expertClicks(empty, ClickProtocol(), 1), Error);
   EXPECT_THROW(seedClick(empty), Error);
+  p = ClickProtocol();
+  p.seedOnly = true;
+  p.seedDepth = 1.5;
+  EXPECT_THROW(checkClickProtocol(p), Error);
 }
 
 }  // namespace

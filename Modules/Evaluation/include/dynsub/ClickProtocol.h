@@ -16,9 +16,11 @@
 //    per in-plane axis (a steady hand is about 0.4 mm);
 //  - `mistakes` of the clicks moved `mistakeDistance` mm off the boundary,
 //    in or out across it, in the slice's plane.
-// With `seedOnly`, the protocol is one click inside the structure (the voxel
-// deepest inside it, i.e. farthest from its boundary, nearest the centroid
-// among ties) and no landmarks.
+// With `seedOnly`, the protocol is one click inside the structure and no
+// landmarks: with `seedDepth` 1, the voxel deepest inside it (farthest from
+// its boundary, nearest the centroid among ties); below 1, a voxel drawn
+// from `seed` among those at least that fraction of the deepest depth
+// inside, as a user clicks somewhere well inside, not at its very middle.
 //
 // Everything is drawn from `seed`: the same protocol and seed give the same
 // clicks wherever the same C++ standard library runs (its distributions and
@@ -41,14 +43,16 @@ struct ClickProtocol {
   int mistakes = 0;
   double mistakeDistance = 3.0;  // mm
   bool seedOnly = false;
+  double seedDepth = 1.0;  // seed-only: the least depth of the click, a fraction of the deepest (0, 1]
 };
 
 // Throws dynsub::Error for impossible protocols, an empty reference or a
 // reference without enough boundary on a chosen slice.
 std::vector<Landmark> expertClicks(const Mask& reference, const ClickProtocol& protocol, unsigned seed);
 
-// The one click of a seed-only protocol: LPS mm, inside the reference.
-Vector3 seedClick(const Mask& reference);
+// The one click of a seed-only protocol: LPS mm, inside the reference
+// (`depth`: the protocol's seedDepth).
+Vector3 seedClick(const Mask& reference, double depth = 1.0, unsigned seed = 0);
 
 void checkClickProtocol(const ClickProtocol& protocol);
 
