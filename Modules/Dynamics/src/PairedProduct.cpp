@@ -119,10 +119,7 @@ void PairedProduct::sum(const Matrix3X& p, const Matrix3X& q) {
   }
   // The columns from split_ on are summed apart (on a second thread where
   // there is a second core, ParallelFor.h) and added last, the same order either way.
-  parallelFor(2, 2, [&](Eigen::Index half) {
-    if (half == 0) columns(0, split_, sums_);
-    if (half == 1) columns(split_, n, secondSums_);
-  });
+  bothAtOnce([&] { columns(0, split_, sums_); }, [&] { columns(split_, n, secondSums_); });
   for (size_t i = 0; i < sums_.size(); ++i) sums_[i] += secondSums_[i];
 }
 

@@ -47,4 +47,11 @@ void parallelFor(Eigen::Index count, Eigen::Index threadsWorthIt, const Body& bo
   for (std::thread& w : workers) w.join();
 }
 
+// first() and second() at once, on two threads where there are two cores
+// (one after the other otherwise): the two halves of a split piece of work.
+template <class First, class Second>
+void bothAtOnce(const First& first, const Second& second) {
+  parallelFor(2, 2, [&](Eigen::Index half) { half == 0 ? first() : second(); });
+}
+
 }  // namespace dynsub

@@ -274,19 +274,15 @@ void solveColumns(const SupernodalFactorView& f, double* x, double* v, int strid
   const int above = f.firstColumn[f.top];
   std::vector<double> outside(static_cast<size_t>(K) * (n - above), 0.0);
   std::vector<double> second(static_cast<size_t>(K) * stride);
-  parallelFor(2, 2, [&](Eigen::Index subtree) {
-    if (subtree == 0) forward<K>(f, 0, f.middle, x, v, stride, n, nullptr);
-    if (subtree == 1) forward<K>(f, f.middle, f.top, x, second.data(), stride, above, outside.data());
-  });
+  bothAtOnce([&] { forward<K>(f, 0, f.middle, x, v, stride, n, nullptr); },
+             [&] { forward<K>(f, f.middle, f.top, x, second.data(), stride, above, outside.data()); });
   for (int k = 0; k < K; ++k) {
     for (int r = above; r < n; ++r) x[k * n + r] += outside[k * (n - above) + r - above];
   }
   forward<K>(f, f.top, f.supernodes, x, v, stride, n, nullptr);
   backward<K>(f, f.top, f.supernodes, x, v, stride);
-  parallelFor(2, 2, [&](Eigen::Index subtree) {
-    if (subtree == 0) backward<K>(f, 0, f.middle, x, v, stride);
-    if (subtree == 1) backward<K>(f, f.middle, f.top, x, second.data(), stride);
-  });
+  bothAtOnce([&] { backward<K>(f, 0, f.middle, x, v, stride); },
+             [&] { backward<K>(f, f.middle, f.top, x, second.data(), stride); });
 }
 
 }  // namespace
