@@ -204,12 +204,13 @@ Vector3 seedClick(const Mask& reference, double depthFraction, unsigned seed) {
       }
   if (depthFraction >= 1) return g.toPhysical(best);
   const int least = std::max(1, static_cast<int>(std::ceil(depthFraction * deepest)));
-  std::vector<long long> deepEnough;
-  for (long long o = 0; o < n; ++o)
-    if (depth[o] >= least) deepEnough.push_back(o);
+  std::vector<Vector3> deepEnough;
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i)
+        if (depth[g.offset(i, j, k)] >= least) deepEnough.push_back(Vector3(i, j, k));
   std::mt19937_64 random(seed);
-  const long long o = deepEnough[std::uniform_int_distribution<size_t>(0, deepEnough.size() - 1)(random)];
-  return g.toPhysical(Vector3(o % g.size[0], (o / g.size[0]) % g.size[1], o / (static_cast<long long>(g.size[0]) * g.size[1])));
+  return g.toPhysical(deepEnough[std::uniform_int_distribution<size_t>(0, deepEnough.size() - 1)(random)]);
 }
 
 }  // namespace dynsub
