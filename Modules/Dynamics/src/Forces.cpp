@@ -1,7 +1,9 @@
 #include "dynsub/Forces.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "dynsub/ApplyOperator.h"
 #include "dynsub/Error.h"
@@ -120,7 +122,37 @@ Matrix3X fieldForces(const SurfaceQuadrature& q, const Matrix3X& controlPoints, 
 SparseMatrix fieldStiffness(const SurfaceQuadrature& q, const Matrix3X& controlPoints, double slope) {
   const Matrix3X su = applyOperator(q.Ju, controlPoints), sv = applyOperator(q.Jv, controlPoints);
   const Eigen::VectorXd weights = slope * q.weights.cwiseProduct(areaElements(su, sv));
-  return SparseMatrix(q.J.transpose() * weights.asDiagonal() * q.J);
+  // NB: one element's quadrature points share its columns (J, J_u and J_v
+  // have one pattern), so their rank-one terms are summed in a dense block
+  // per element and only the block goes into the triplets: Eigen's sparse
+  // product J^T W J was 5 % of a segmentation on the 0.5 mm image.
+  const int* outer = q.J.outerIndexPtr();
+  const int* inner = q.J.innerIndexPtr();
+  const double* values = q.J.valuePtr();
+  std::vector<Eigen::Triplet<double>> triplets;
+  Eigen::MatrixXd block;
+  for (Eigen::Index first = 0, last = 0; first < q.J.rows(); first = last) {
+    const int m = outer[first + 1] - outer[first];
+    const int* columns = inner + outer[first];
+    for (last = first + 1; last < q.J.rows(); ++last) {
+      if (outer[last + 1] - outer[last] != m || !std::equal(columns, columns + m, inner + outer[last])) break;
+    }
+    block.setZero(m, m);
+    for (Eigen::Index r = first; r < last; ++r) {
+      const Eigen::Map<const Eigen::VectorXd> row(values + outer[r], m);
+      block.selfadjointView<Eigen::Lower>().rankUpdate(row, weights(r));
+    }
+    for (int j = 0; j < m; ++j) {
+      for (int i = j; i < m; ++i) {
+        if (block(i, j) == 0.0) continue;
+        triplets.emplace_back(columns[i], columns[j], block(i, j));
+        if (i != j) triplets.emplace_back(columns[j], columns[i], block(i, j));
+      }
+    }
+  }
+  SparseMatrix result(q.J.cols(), q.J.cols());
+  result.setFromTriplets(triplets.begin(), triplets.end());
+  return result;
 }
 
 }  // namespace dynsub

@@ -1,5 +1,6 @@
 #include "dynsub/Integrator.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -41,23 +42,6 @@ LinearSolver parseLinearSolver(const std::string& text) {
   throw Error("unknown linear solver '" + text + "' (expected cholesky, cg or pcg)");
 }
 
-struct Integrator::Impl {
-  IntegratorOptions options;
-  // The right-hand side is forceWeight f + C p(t) + P p(t-dt).
-  double forceWeight = 0.0;
-  PairedProduct rightHandSide;
-  Matrix3X rhs;                              // the right-hand side, by vertex
-  std::vector<int> freeIndex;                // free position of each vertex, or -1
-  std::vector<int> freeVertices;
-  SymmetricMatrix lhsFree, lhsCoupling;      // free x free, free x fixed
-  SparseCholesky cholesky;
-  std::vector<int> rowOfUnknown;             // the vertex at each row of the factor (Cholesky)
-  Eigen::MatrixXd unknowns;                  // the factored solve's right-hand sides and solution
-  Eigen::ConjugateGradient<SymmetricMatrix, Eigen::Lower | Eigen::Upper, Eigen::IdentityPreconditioner> cg;
-  Eigen::ConjugateGradient<SymmetricMatrix, Eigen::Lower | Eigen::Upper, Eigen::IncompleteCholesky<double>> pcg;
-  int iterations = 0;
-};
-
 namespace {
 
 // Rows and columns of `m` picked by `rows` and `columns` index lists (-1: dropped).
@@ -78,6 +62,30 @@ SymmetricMatrix select(const SymmetricMatrix& m, const std::vector<int>& rowInde
 
 }  // namespace
 
+struct Integrator::Impl {
+  IntegratorOptions options;
+  // The right-hand side is forceWeight f + C p(t) + P p(t-dt).
+  double forceWeight = 0.0;
+  PairedProduct rightHandSide;
+  Matrix3X rhs;                              // the right-hand side, by vertex
+  std::vector<int> freeIndex;                // free position of each vertex, or -1
+  std::vector<int> freeVertices;
+  SymmetricMatrix lhsFree, lhsCoupling;      // free x free, free x fixed
+  SparseCholesky cholesky;
+  std::vector<int> rowOfUnknown;             // the vertex at each row of the factor (Cholesky)
+  Eigen::MatrixXd unknowns;                  // the factored solve's right-hand sides and solution
+  Eigen::ConjugateGradient<SymmetricMatrix, Eigen::Lower | Eigen::Upper, Eigen::IdentityPreconditioner> cg;
+  Eigen::ConjugateGradient<SymmetricMatrix, Eigen::Lower | Eigen::Upper, Eigen::IncompleteCholesky<double>> pcg;
+  int iterations = 0;
+
+  // The matrices of both sides for `forceStiffness` (Integrator.h); the
+  // factorization's analysis is redone only when `analyze` or when the
+  // left-hand pattern changed.
+  void build(const PhysicalMatrices& matrices, const SymmetricMatrix& forceStiffness, const std::vector<int>& fixed,
+             bool analyze);
+};
+
+
 Integrator::Integrator(const PhysicalMatrices& matrices, const SymmetricMatrix& forceStiffness,
                        const std::vector<int>& fixed, const IntegratorOptions& options)
     : impl_(std::make_unique<Impl>()) {
@@ -89,6 +97,25 @@ Integrator::Integrator(const PhysicalMatrices& matrices, const SymmetricMatrix& 
   if (!(options.solverTolerance > 0.0) || options.solverMaxIterations < 1) {
     throw Error("iterative solver tolerance must be > 0 and iterations >= 1");
   }
+  s.build(matrices, forceStiffness, fixed, true);
+}
+
+void Integrator::restabilize(const PhysicalMatrices& matrices, const SymmetricMatrix& forceStiffness) {
+  Impl& s = *impl_;
+  if (matrices.mass.rows() != static_cast<Eigen::Index>(s.freeIndex.size())) {
+    throw Error("internal: restabilized with matrices of another size");
+  }
+  std::vector<int> fixed;
+  for (int v = 0; v < static_cast<int>(s.freeIndex.size()); ++v) {
+    if (s.freeIndex[v] < 0) fixed.push_back(v);
+  }
+  s.build(matrices, forceStiffness, fixed, false);
+}
+
+void Integrator::Impl::build(const PhysicalMatrices& matrices, const SymmetricMatrix& forceStiffness,
+                             const std::vector<int>& fixed, bool analyze) {
+  Impl& s = *this;
+  const double dt = options.timeStep;
   const int n = static_cast<int>(matrices.mass.rows());
   SymmetricMatrix stiffness = matrices.stiffness;
   SymmetricMatrix stabilizing(n, n);
@@ -110,6 +137,7 @@ Integrator::Integrator(const PhysicalMatrices& matrices, const SymmetricMatrix& 
                                             : matrices.damping;
   s.rightHandSide = PairedProduct(onCurrent, onPrevious);
   s.freeIndex.assign(n, 0);
+  s.freeVertices.clear();
   for (int v : fixed) {
     if (v < 0 || v >= n) throw Error("fixed control vertex " + std::to_string(v) + " does not exist");
     s.freeIndex[v] = -1;
@@ -129,13 +157,20 @@ Integrator::Integrator(const PhysicalMatrices& matrices, const SymmetricMatrix& 
   const SymmetricMatrix lhs = second ? SymmetricMatrix(2.0 * matrices.mass + dt * matrices.damping +
                                                        2.0 * dt * dt * stiffness)
                                      : SymmetricMatrix(matrices.damping + 2.0 * dt * stiffness);
-  s.lhsFree = select(lhs, s.freeIndex, free, s.freeIndex, free);
+  SymmetricMatrix lhsFree = select(lhs, s.freeIndex, free, s.freeIndex, free);
+  lhsFree.makeCompressed();
+  // NB: the stabilizer's updates (Simulation.h) change only values: its
+  // stiffness lies within the elements' pattern, which K and D fill.
+  const bool samePattern =
+      !analyze && lhsFree.rows() == s.lhsFree.rows() && lhsFree.nonZeros() == s.lhsFree.nonZeros() &&
+      std::equal(lhsFree.outerIndexPtr(), lhsFree.outerIndexPtr() + lhsFree.outerSize() + 1, s.lhsFree.outerIndexPtr()) &&
+      std::equal(lhsFree.innerIndexPtr(), lhsFree.innerIndexPtr() + lhsFree.nonZeros(), s.lhsFree.innerIndexPtr());
+  s.lhsFree = std::move(lhsFree);
   s.lhsCoupling = select(lhs, s.freeIndex, free, fixedIndex, pinned);
-  s.lhsFree.makeCompressed();
 
   switch (options.solver) {
     case LinearSolver::Cholesky:
-      s.cholesky.analyzePattern(s.lhsFree);
+      if (!samePattern) s.cholesky.analyzePattern(s.lhsFree);
       // NB: a singular matrix (K alone: translations cost nothing) factors with
       // pivots at rounding level rather than failing; those count as zero.
       if (!s.cholesky.factorize(s.lhsFree)) {

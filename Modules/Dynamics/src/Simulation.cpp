@@ -147,15 +147,15 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
   IntegratorOptions integratorOptions = options.integrator;
   integratorOptions.timeStep = timeStep;
   // The stabilizing stiffness of the forces at `at` (Integrator.h).
-  auto makeIntegrator = [&](const Matrix3X& at) {
+  auto stabilizingAt = [&](const Matrix3X& at) {
     SymmetricMatrix stabilizing(at.rows(), at.rows());
     for (ForceModel* f : forces) {
       const SparseMatrix s = f->stabilizingStiffness(at);
       if (s.size() > 0) stabilizing += SymmetricMatrix(s);
     }
-    return Integrator(model.matrices, stabilizing, fixed, integratorOptions);
+    return stabilizing;
   };
-  Integrator integrator = makeIntegrator(model.start);
+  Integrator integrator(model.matrices, stabilizingAt(model.start), fixed, integratorOptions);
   EquilibriumWindow window(options.equilibrium, options.equilibrium.window);
   Matrix3X previous = model.start;
   points = model.start;
@@ -192,7 +192,7 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
       // make the counted energy wander by that much).
       rises = change > options.equilibrium.energyTolerance && energy > lastEnergy ? rises + 1 : 0;
       if (rises >= 3) {
-        integrator = makeIntegrator(points);
+        integrator.restabilize(model.matrices, stabilizingAt(points));
         ++summary.stabilizerUpdates;
         rises = 0;
         window.clear();

@@ -94,6 +94,25 @@ TEST(FieldForces, StiffnessIntegratesTheSlopeOverTheArea) {
   EXPECT_NEAR(ones.dot(stiffness * ones), 3.0 * area, 1e-9 * area);
 }
 
+TEST(FieldForces, StiffnessEqualsTheProductOverTheQuadrature) {
+  // The element-by-element sums against slope J^T W J formed by Eigen, on a
+  // cube whose eight extraordinary vertices give special elements. The sums
+  // run in another order, so they agree to rounding: 1e-13 of the largest
+  // entry.
+  const ControlMesh cube = makeCube98();
+  const LimitSurface surface(cube);
+  const SurfaceQuadrature quadrature = makeSurfaceQuadrature(surface, 3);
+  const Matrix3X points = cube.points() * 1.7;
+  const SparseMatrix stiffness = fieldStiffness(quadrature, points, 0.6);
+  const Matrix3X su = quadrature.Ju * points, sv = quadrature.Jv * points;
+  Eigen::VectorXd weights(su.rows());
+  for (Eigen::Index i = 0; i < su.rows(); ++i) weights(i) = 0.6 * quadrature.weights(i) * su.row(i).cross(sv.row(i)).norm();
+  const Eigen::MatrixXd expected = Eigen::MatrixXd(SparseMatrix(quadrature.J.transpose() * weights.asDiagonal() * quadrature.J));
+  const Eigen::MatrixXd got = Eigen::MatrixXd(stiffness);
+  EXPECT_LT((got - expected).cwiseAbs().maxCoeff(), 1e-13 * expected.cwiseAbs().maxCoeff());
+  EXPECT_EQ(got, got.transpose());
+}
+
 TEST(FieldForces, AReversingFieldSettlesOnItsEdge) {
   // The well is 0.2 mm wide and 20 times stronger than the surface's tension
   // at that radius: explicit, its force would swing the surface across the

@@ -59,6 +59,11 @@ class Integrator {
   Integrator(Integrator&&) noexcept;
   Integrator& operator=(Integrator&&) noexcept;
 
+  // The same integrator with another force stiffness (the stabilizer's
+  // update, Simulation.h) and the same matrices and fixed vertices. The
+  // factorization's ordering and symbolic analysis are kept while the
+  // left-hand matrix's pattern holds, so only its values are factored again.
+  void restabilize(const PhysicalMatrices& matrices, const SymmetricMatrix& forceStiffness);
   // p(t + dt) from p(t - dt), p(t) and the generalized force at p(t) (all
   // #control x 3). Throws dynsub::Error when an iterative solver fails.
   Matrix3X step(const Matrix3X& previous, const Matrix3X& current, const Matrix3X& force);
