@@ -437,4 +437,11 @@ bool isDicomFile(const fs::path& file) {
 
 bool walkDicomFile(const fs::path& file) { return DicomWalk(file).run(); }
 
+void checkImageFile(const std::string& path) {
+  const std::string extension = lowerCaseExtension(path);
+  if (extension == ".nii" || (extension == ".gz" && lowerCaseExtension(path.substr(0, path.size() - 3)) == ".nii"))
+    checkNiftiFile(path);
+  if (extension == ".mha" || extension == ".mhd") checkMetaImageFile(path);
+}
+
 }  // namespace dynsub::filechecks

@@ -30,6 +30,10 @@ void checkNiftiFile(const std::string& path);
 // compressed. Throws dynsub::Error naming the file that falls short.
 void checkMetaImageFile(const std::string& path);
 
+// The checks above that the file's name calls for: NIfTI for .nii and
+// .nii.gz, MetaImage for .mha and .mhd; none for other names.
+void checkImageFile(const std::string& path);
+
 // Whether a file says it is DICOM: "DICM" after the 128-byte preamble.
 bool isDicomFile(const std::filesystem::path& file);
 

@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <future>
 #include <sstream>
 
 #include "BridgeGeometry.h"
+#include "FileChecks.h"
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
@@ -15,9 +17,18 @@ namespace dynsub {
 Volume readVolume(const std::string& path) {
   std::error_code ignored;
   if (!std::filesystem::exists(path, ignored)) throw Error(path, "no such file or directory");
+  // NB: opening the ITK bridge (ITK's and GDCM's libraries relocated, GDCM's
+  // dictionary loaded) and the file's own checks (a .nii.gz inflated once to
+  // see that all its data is there) do not depend on each other, and each
+  // took about a tenth of the caudate demo's command: the bridge opens on a
+  // second thread meanwhile. A failed check waits for it (the future's
+  // destructor) and is reported as before.
+  std::future<const itkbridge::Functions*> bridge =
+      std::async(std::launch::async, [] { return &itkbridge::functions(); });
+  if (!std::filesystem::is_directory(path, ignored)) filechecks::checkImageFile(path);
   itkbridge::Geometry raw;
   Volume volume;
-  itkbridge::functions().readImage(path, raw, volume.voxels);
+  bridge.get()->readImage(path, raw, volume.voxels);
   volume.geometry = fromBridge(raw);
   for (int a = 0; a < 3; ++a)
     if (volume.geometry.size[a] < 2)

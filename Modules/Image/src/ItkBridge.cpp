@@ -47,16 +47,12 @@ Geometry geometryOf(const FloatImage* image) {
 long long countOf(const Geometry& g) { return static_cast<long long>(g.size[0]) * g.size[1] * g.size[2]; }
 
 
-// The project's own checks of NIfTI and MetaImage files (FileChecks.h) come
-// before ITK parses them; then a clear message for a file ITK has no reader
-// for, and for any format an image too large for memory is refused before it
-// is allocated (the number of dimensions is checked by readVolume, for files
-// and DICOM series alike).
+// After the project's own checks of the file (FileChecks.h: checkImageFile,
+// made by readVolume before it calls readImage): a clear message for a file
+// ITK has no reader for, and for any format an image too large for memory is
+// refused before it is allocated (the number of dimensions is checked by
+// readVolume, for files and DICOM series alike).
 void inspectFile(const std::string& path) {
-  const std::string extension = lowerCaseExtension(path);
-  if (extension == ".nii" || (extension == ".gz" && lowerCaseExtension(path.substr(0, path.size() - 3)) == ".nii"))
-    filechecks::checkNiftiFile(path);
-  if (extension == ".mha" || extension == ".mhd") filechecks::checkMetaImageFile(path);
   auto io = itk::ImageIOFactory::CreateImageIO(path.c_str(), itk::ImageIOFactory::FileModeEnum::ReadMode);
   if (!io) throw Error(path, "unknown or unreadable image format");
   io->SetFileName(path);

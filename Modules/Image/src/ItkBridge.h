@@ -28,7 +28,8 @@ struct Geometry {
 // the library, which exports them through one C symbol (kFunctionsSymbol).
 struct Functions {
   // A file (any format ITK reads) or a directory holding one DICOM series, as
-  // float. Throws dynsub::Error naming the path.
+  // float. Throws dynsub::Error naming the path. A file's own checks
+  // (FileChecks.h: checkImageFile) are the caller's, made before.
   void (*readImage)(const std::string& path, Geometry& geometry, std::vector<float>& voxels);
   // An 8-bit labelmap, compressed when the format allows; throws dynsub::Error.
   void (*writeLabels)(const Geometry& geometry, const std::vector<std::uint8_t>& voxels, const std::string& path);
