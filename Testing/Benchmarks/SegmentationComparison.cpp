@@ -1,8 +1,9 @@
 // DynSub's segmentation beside ITK's threshold level set, geodesic active
 // contour and deformable simplex mesh, in one run, on the same cropped region
 // of the same MRI from the same landmarks:
-//   build/bin/SegmentationComparison [--dynsub-only] [IMAGE LABELS LANDMARKS LABEL]
-// (--dynsub-only: DynSub's segmentation and refit alone, e.g. for profiling)
+//   build/bin/SegmentationComparison [--dynsub-only] [--rounds N] [IMAGE LABELS LANDMARKS LABEL]
+// (--dynsub-only: DynSub's segmentation and refit alone, e.g. for profiling;
+// --rounds: the head-to-head below, 7 rounds unless given, 0 for none)
 // (defaults: the demo's left caudate of Colin27 against AAL label 71).
 // DynSub uses the landmarks as springs; the level set cannot, so it starts
 // from DynSub's own initial model (voxelized) and reads its speed image's
@@ -15,13 +16,19 @@
 // landmark (what the viewer's worker runs when a click is added after a fit):
 // on the reference's lateral edge in the coronal plane y = 16 mm, between the
 // demo's landmark slices.
+// Last, head to head: DynSub's segmentation and ITK's fastest run above (the
+// threshold level set, window mean +- 1 sd, curvature 3) taking turns for N
+// rounds, each one's median and range, because one run each on this virtual
+// machine varies by half its time.
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <exception>
 #include <string>
+#include <vector>
 
 #include "BridgeGeometry.h"
 #include "ItkDeformableSimplexMesh.h"
@@ -83,9 +90,24 @@ void refitAfterOneLandmark(const Volume& image, const Mask& reference, std::vect
               seconds, refit.steps, refit.levels.back().controlVertices, refit.levels.back().seconds, worst);
 }
 
+// Median, lowest and highest of `seconds` (not empty).
+std::string spread(std::vector<double> seconds) {
+  std::sort(seconds.begin(), seconds.end());
+  char text[96];
+  std::snprintf(text, sizeof text, "median %.3f s (%.3f-%.3f)", seconds[seconds.size() / 2], seconds.front(),
+                seconds.back());
+  return text;
+}
+
 int run(int argc, char** argv) {
   const bool dynsubOnly = argc > 1 && std::string(argv[1]) == "--dynsub-only";
   if (dynsubOnly) --argc, ++argv;
+  int rounds = 7;
+  if (argc > 2 && std::string(argv[1]) == "--rounds") {
+    rounds = std::stoi(argv[2]);
+    if (rounds < 0 || rounds > 1000) throw Error("--rounds must be in 0..1000, got " + std::string(argv[2]));
+    argc -= 2, argv += 2;
+  }
   const std::string templates = "/usr/share/mricron/templates/";
   const std::string imagePath = argc > 1 ? argv[1] : templates + "ch2.nii.gz";
   const std::string labelsPath = argc > 2 ? argv[2] : templates + "aal.nii.gz";
@@ -207,6 +229,27 @@ int run(int argc, char** argv) {
     }
   }
   refitAfterOneLandmark(image, reference, landmarks, initial, dynsub);
+
+  if (rounds == 0) return 0;
+  std::vector<double> dynsubRounds, itkRounds;
+  double dynsubDice = 0, itkDice = 0;
+  itkbaseline::ThresholdLevelSetOptions fastest;
+  fastest.window = 1.0;
+  fastest.curvature = 3.0;
+  for (int r = 0; r < rounds; ++r) {
+    const auto started = std::chrono::steady_clock::now();
+    const SegmentResult again = segment(image, landmarks, initial, SegmentOptions());
+    const Mask labelmap = labelmapOf(again.surface, image.geometry);
+    dynsubRounds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+    dynsubDice = compareMasks(labelmap, reference).dice;
+    const itkbaseline::ThresholdLevelSetResult itk =
+        itkbaseline::thresholdLevelSet(toBridge(region), cropped.voxels, initialMask.voxels, edgeVoxels, fastest);
+    itkRounds.push_back(itk.seconds);
+    itkDice = compareMasks(pasteMask(Mask{region, itk.mask}, image.geometry, dynsub.regionFirst), reference).dice;
+  }
+  std::printf("head to head, %d rounds taking turns:\n", rounds);
+  std::printf("  dynsub segment (defaults)          Dice %.3f  %s\n", dynsubDice, spread(dynsubRounds).c_str());
+  std::printf("  ITK threshold LS, 1.0 sd, curv. 3  Dice %.3f  %s\n", itkDice, spread(itkRounds).c_str());
   return 0;
 }
 

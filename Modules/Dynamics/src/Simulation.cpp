@@ -142,8 +142,8 @@ enum class LevelEnd { Equilibrium, Coarse, StepLimit, Diverged };
 // The papers' time stepping (Integrator.h) from model.start; `points` ends at
 // the last state reached.
 LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& forces, const std::vector<int>& fixed,
-                      const SimulationOptions& options, double timeStep, const ProgressCallback& progress,
-                      Matrix3X& points, LevelSummary& summary) {
+                      const SimulationOptions& options, const AcceptFit& coarseAccept, double timeStep,
+                      const ProgressCallback& progress, Matrix3X& points, LevelSummary& summary) {
   IntegratorOptions integratorOptions = options.integrator;
   integratorOptions.timeStep = timeStep;
   // The stabilizing stiffness of the forces at `at` (Integrator.h).
@@ -157,6 +157,13 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
   };
   Integrator integrator(model.matrices, stabilizingAt(model.start), fixed, integratorOptions);
   EquilibriumWindow window(options.equilibrium, options.equilibrium.window);
+  // With `coarseAccept`, the level is asked at the first state that meets the
+  // looser rule whether its fit is accepted, as in runStaticSteps.
+  EquilibriumOptions loose = options.equilibrium;
+  loose.energyTolerance *= loose.coarseLevelFactor;
+  loose.motionTolerance *= loose.coarseLevelFactor;
+  EquilibriumWindow looseWindow(loose, options.equilibrium.window);
+  bool asked = !coarseAccept;
   Matrix3X previous = model.start;
   points = model.start;
   // The frames at `previous` and `points`, computed only for steps whose
@@ -178,12 +185,13 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
     if (step > 1) {
       const double change = relativeChange(energy, lastEnergy);
       double shape = std::numeric_limits<double>::infinity();
-      if (change <= options.equilibrium.energyTolerance) {
+      if (change <= (asked ? options.equilibrium.energyTolerance : loose.energyTolerance)) {
         if (!previousFrame) previousFrame = surfaceFrame(model.quadrature, previous);
         if (!frame) frame = surfaceFrame(model.quadrature, points);
         shape = shapeMotion(*previousFrame, *frame) / model.size;
       }
       const bool still = window.settled(change, shape);
+      const bool looselyStill = !asked && looseWindow.settled(change, shape);
       // The motion is dissipative and re-attaching springs only lowers their
       // energy, so an energy that keeps rising means the forces' stiffness
       // has drifted from the one the integrator was built with. Changes
@@ -196,9 +204,16 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
         ++summary.stabilizerUpdates;
         rises = 0;
         window.clear();
+        looseWindow.clear();
       } else if (still) {
         summary.energy = energy;
         return LevelEnd::Equilibrium;
+      } else if (looselyStill) {
+        asked = true;
+        if (!coarseAccept(model.surface, points, false)) {
+          summary.energy = energy;
+          return LevelEnd::Coarse;
+        }
       }
     }
     lastEnergy = energy;
@@ -372,7 +387,7 @@ Matrix3X runLevel(const LevelModel& model, const std::vector<ForceModel*>& force
                     " (try --scheme first-order or softer forces)");
       }
     } else {
-      end = runTimeSteps(model, forces, fixed, options, timeStep, progress, points, summary);
+      end = runTimeSteps(model, forces, fixed, options, coarseAccept, timeStep, progress, points, summary);
     }
     if (end != LevelEnd::Diverged) {
       summary.converged = end == LevelEnd::Equilibrium || end == LevelEnd::Coarse;
@@ -436,9 +451,8 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
     LevelSummary summary;
     summary.level = level;
     summary.controlVertices = mesh.vertexCount();
-    // The static scheme may end a level that will be refined at a looser rule.
-    const bool coarse = accept && options.integrator.scheme == IntegrationScheme::Static &&
-                        level < options.maxLevel && options.equilibrium.coarseLevelFactor > 1.0;
+    // A level that will be refined may end at a looser rule.
+    const bool coarse = accept && level < options.maxLevel && options.equilibrium.coarseLevelFactor > 1.0;
     LevelEnd end = LevelEnd::Equilibrium;
     const Matrix3X points =
         runLevel(model, forces, fixed, options, coarse ? accept : AcceptFit(), timeStep, progress, summary, end);

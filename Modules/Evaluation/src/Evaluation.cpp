@@ -157,6 +157,7 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
           {"capture_range_mm", &o.edges.captureRange},
           {"elasticity_per_level", &o.simulation.elasticityPerLevel},
           {"time_step", &o.simulation.integrator.timeStep},
+          {"coarse_level_factor", &o.simulation.equilibrium.coarseLevelFactor},
           {"tension", &o.simulation.material.tensionU},
           {"rigidity", &o.simulation.material.rigidityUU},
           {"initial_fraction", &plan.initialFraction},

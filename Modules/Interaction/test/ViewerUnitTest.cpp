@@ -254,9 +254,10 @@ TEST_F(ViewerTest, TheCaudateFitsLiveOnTheRealMri) {
   ASSERT_TRUE(viewer.waitForFit(300.0)) << viewer.status();
   EXPECT_NE(viewer.status().find("fit done: 386 control vertices"), std::string::npos) << viewer.status();
   // Redraws come at most every 40 ms while the worker publishes; this fit
-  // takes about a second (0.9 s here), so 3 is a floor any machine meets that
-  // takes over 0.12 s, yet fails if the surface is drawn only at the end.
-  EXPECT_GE(viewer.surfaceUpdates(), 3) << "too few redraws to watch the fit";
+  // takes 0.14-0.16 s here (3 redraws; 2 when the suite loads both cores), so
+  // 2 is the floor: one while the fit runs and the last, where a surface
+  // drawn only at the end gives 1.
+  EXPECT_GE(viewer.surfaceUpdates(), 2) << "too few redraws to watch the fit";
   std::cout << "caudate: " << viewer.surfaceUpdates() << " redraws; " << viewer.status() << '\n';
   SliceView& axial = viewer.sliceView(SliceOrientation::Axial);
   int* size = axial.renderer()->GetSize();

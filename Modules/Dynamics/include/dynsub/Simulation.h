@@ -54,7 +54,7 @@ struct EquilibriumOptions {
   double motionTolerance = 1e-4;  // per step, fraction of the model size
   int window = 5;                 // steps
   int maxSteps = 1000;            // per level
-  // The static scheme, with a fit to accept (simulate's `accept`): a level
+  // With a fit to accept (simulate's `accept`), in either scheme: a level
   // below the maximum is asked whether its fit is accepted at its first state
   // within tolerances this many times looser. If not, it ends there and is
   // refined (its equilibrium was only where the next level starts); if so, it
@@ -136,8 +136,8 @@ struct Progress {
 };
 
 // Decides whether the fit is good enough (true: stop). Asked at the end of
-// every level, the last one included (`settled`), and in the static scheme
-// also where a level below the maximum first meets the looser rule of
+// every level, the last one included (`settled`), and also where a level
+// below the maximum first meets the looser rule of
 // EquilibriumOptions::coarseLevelFactor (not `settled`; the forces were last
 // evaluated at `controlPoints`). After an acceptance there, the same level
 // is asked again at its end.
