@@ -33,20 +33,17 @@ SimulationOptions FitOptions::defaultSimulation() {
   return o;
 }
 
-FitError fitErrorOf(const Eigen::VectorXd& distances, double diameter) {
-  if (distances.size() == 0) throw Error("internal: a fit error of no distances");
-  return FitError{100.0 * distances.maxCoeff() / diameter,
-                  100.0 * std::sqrt(distances.squaredNorm() / static_cast<double>(distances.size())) / diameter};
-}
-
 FitError measureFitError(const LimitSurface& surface, const Matrix3X& controlPoints, const Matrix3X& data,
                          double diameter) {
   ClosestPointLocator locator(surface, 8, 8);
   locator.update(controlPoints);
   const std::vector<ClosestPoint> nearest = locator.findAll(data);
-  Eigen::VectorXd distances(static_cast<Eigen::Index>(nearest.size()));
-  for (std::size_t i = 0; i < nearest.size(); ++i) distances(static_cast<Eigen::Index>(i)) = nearest[i].distance;
-  return fitErrorOf(distances, diameter);
+  double worst = 0.0, squares = 0.0;
+  for (const ClosestPoint& c : nearest) {
+    worst = std::max(worst, c.distance);
+    squares += c.distance * c.distance;
+  }
+  return FitError{100.0 * worst / diameter, 100.0 * std::sqrt(squares / nearest.size()) / diameter};
 }
 
 FitResult fitPointCloud(const Matrix3X& data, const ControlMesh& initial, const FitOptions& options,
@@ -67,23 +64,18 @@ FitResult fitPointCloud(const Matrix3X& data, const ControlMesh& initial, const 
   SpringForceModel springs(data, stiffness, SpringForceModel::Attach::NearestEachStep);
 
   AcceptFit accept = [&](const LimitSurface& surface, const Matrix3X& points, bool settled) {
-    // NB: the springs' lengths are the data's distances at `points`, measured
-    // by their last evaluation (at a level's end, the equilibrium residual's
-    // there): each the distance to a closest point their tracked search found
-    // and checked against the surface's samples, so never shorter than the
-    // true distance. Mid-level (the looser rule), when they accept, the level
-    // goes on to its end and is asked again; when they do not, a new, finer
-    // search (8 x 8 samples an element) measures the error and decides. At a
-    // level's end they are the error: a new search there built a second
-    // locator over the whole surface (8 % of the kitten's fit, a third of it
-    // faulting in its memory).
+    // NB: mid-level (the static scheme's looser rule) the springs' lengths are
+    // the data's distances at `points`, measured by their last evaluation
+    // (tracked, so never shorter than a new search's). When they accept, a
+    // new search (2 % of the kitten's fit) is saved, and the level goes on to
+    // its end, where the error is measured; when they do not, it is measured
+    // now, and decides.
     const Eigen::VectorXd& lengths = springs.lengths();
-    const bool tracked = lengths.size() == data.rows();
-    if (!settled && tracked && 100.0 * lengths.maxCoeff() / diameter <= options.tolerancePercent) {
+    if (!settled && lengths.size() == data.rows() &&
+        100.0 * lengths.maxCoeff() / diameter <= options.tolerancePercent) {
       return true;  // the level goes on, and is asked again at its end
     }
-    const FitError e = settled && tracked ? fitErrorOf(lengths, diameter)
-                                          : measureFitError(surface, points, data, diameter);
+    const FitError e = measureFitError(surface, points, data, diameter);
     const bool good = e.maxPercent <= options.tolerancePercent;
     if (settled || !good) result.levelErrors.push_back(e);  // one per level, where it ends
     return good;

@@ -46,10 +46,6 @@ struct FitResult {
   double seconds = 0;
 };
 
-// Max and rms of the data's distances (mm) to the surface, as percentages of
-// `diameter`. measureFitError searches for them anew (8 x 8 samples an
-// element); fitPointCloud takes, at a level's end, those its springs tracked.
-FitError fitErrorOf(const Eigen::VectorXd& distances, double diameter);
 FitError measureFitError(const LimitSurface& surface, const Matrix3X& controlPoints, const Matrix3X& data,
                          double diameter);
 
