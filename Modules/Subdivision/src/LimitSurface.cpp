@@ -24,8 +24,8 @@ using detail::SmallStencil;
 
 namespace {
 
-// Special elements keep up to this many levels of subpatches, each tabulated
-// the first time a point needs it (points closer than 2^-24 to the
+// Neighbourhood structures keep up to this many levels of subpatches, each
+// tabulated the first time a point needs it (points closer than 2^-24 to the
 // extraordinary corner are computed on demand without being kept).
 constexpr int kTabulatedLevels = 24;
 // The cross-boundary tangent at a boundary extraordinary vertex has the
@@ -145,6 +145,8 @@ struct LimitSurface::Impl {
     int structure = -1;
     Eigen::MatrixXd structureMap;
   };
+  // A special element's masks at its extraordinary vertex over its columns;
+  // a structure's (below) also its subpatches, level by level.
   // NB: levels are tabulated when a point first needs them, and points are
   // evaluated from several threads at once (closest-point searches), so the
   // table grows under `mutex`. levels[n - 1] is written once, before
@@ -246,7 +248,8 @@ struct LimitSurface::Impl {
 
   // A special element's tables from its neighbourhood `local`, whose
   // vertices are the blends (rows of local.weights) of `columns`.
-  std::unique_ptr<Special> makeSpecial(LocalMesh local, std::vector<int> columns) {
+  // With `tabulate` (a structure), its levels are kept as they are needed.
+  std::unique_ptr<Special> makeSpecial(LocalMesh local, std::vector<int> columns, bool tabulate) {
     auto owned = std::make_unique<Special>();
     Special& special = *owned;
     special.columns = std::move(columns);
@@ -269,9 +272,11 @@ struct LimitSurface::Impl {
     for (const auto& [v, w] : masks.along) along += w * local.weights.row(v);
     local.weights.rowwise() -= special.vertexMasks.row(0);
     zeroRowSums(local.weights);
-    special.levels.resize(kTabulatedLevels);
-    special.deepest = std::move(local);
-    if (masks.boundary) setBoundaryTangents(special, masks, along);
+    if (masks.boundary) setBoundaryTangents(special, local, masks, along);
+    if (tabulate) {
+      special.levels.resize(kTabulatedLevels);
+      special.deepest = std::move(local);
+    }
     return owned;
   }
 
@@ -300,13 +305,19 @@ struct LimitSurface::Impl {
       std::vector<int> vertices(n);
       for (Eigen::Index i = 0; i < n; ++i) vertices[i] = static_cast<int>(i);
       structures.push_back(makeSpecial(LocalMesh{local.topology, Eigen::MatrixXd::Identity(n, n), local.face},
-                                       std::move(vertices)));
+                                       std::move(vertices), true));
     }
     element.structure = found->second;
     element.structureMap = local.weights;
     element.columns = columns;
     element.special = static_cast<int>(specials.size());
-    specials.push_back(makeSpecial(std::move(local), columns));
+    // NB: the element keeps only its masks. Its subpatches are its
+    // structure's times structureMap: subdivision is linear, and a structure's
+    // displacements from its limit point, times the blends, are the element's
+    // (the blends' rows sum to 1). Tabulated per element they were most of
+    // the kitten's fit's memory (80 of 220 MB over its 4500 special elements)
+    // and of the time it spent faulting that memory in.
+    specials.push_back(makeSpecial(std::move(local), columns, false));
   }
 
   // The pieces of a special element's levels 1..levels (three subpatches
@@ -352,8 +363,9 @@ struct LimitSurface::Impl {
   // with the magnitude of the level-48 reading, so that the masks are as
   // before where that reading had converged. Still a fixed linear mask, so
   // J_u and J_v stay linear operators.
-  void setBoundaryTangents(Special& special, const detail::VertexMasks& masks, const Eigen::RowVectorXd& along) {
-    LocalMesh deep = special.deepest;  // level 0
+  void setBoundaryTangents(Special& special, const LocalMesh& level0, const detail::VertexMasks& masks,
+                           const Eigen::RowVectorXd& along) {
+    LocalMesh deep = level0;
     int level = 0;
     for (;; ++level) {
       const detail::CornerStep& step = steps.stepFor(deep);
@@ -425,7 +437,8 @@ struct LimitSurface::Impl {
   }
 
   // Where a point of a special element lies: the regular subpatch (grid rows
-  // of displacements over the element's columns), its own parameters and
+  // of displacements over its structure's neighbourhood vertices; times the
+  // element's structureMap, over its columns), its own parameters and
   // d(patch parameters)/d(element u, v); no patch at the extraordinary corner.
   struct SubpatchPoint {
     const GridMatrix* patch = nullptr;  // null: the point is the extraordinary vertex
@@ -436,7 +449,7 @@ struct LimitSurface::Impl {
   };
   // fetch = false: level, child, parameters and jacobian only (patch stays null).
   SubpatchPoint locateSubpatch(const Element& element, const ElementPoint& point, bool fetch = true) const {
-    Special& special = *specials[element.special];
+    Special& structure = *structures[element.structure];
     SubpatchPoint result;
     // Parameters with the extraordinary vertex at the origin.
     const auto [a, b] = detail::cornerFrame(element.corner, point.u, point.v);
@@ -461,9 +474,9 @@ struct LimitSurface::Impl {
     result.jacobian = std::ldexp(1.0, level) * detail::cornerFrameJacobian(child) * toCorner;
     if (!fetch) return result;
     if (level <= kTabulatedLevels) {
-      result.patch = &Impl::level(special, level)[child - 1];
+      result.patch = &Impl::level(structure, level)[child - 1];
     } else {
-      LocalMesh local = deepestTabulated(special);
+      LocalMesh local = deepestTabulated(structure);
       for (int n = kTabulatedLevels + 1; n <= level; ++n) result.deeper = subdivideDisplacements(local, steps);
       result.patch = &result.deeper[child - 1];
     }
@@ -515,7 +528,29 @@ struct LimitSurface::Impl {
       w.setZero();
       w.topRows(3) = special.vertexMasks;
     } else {
-      product(detail::bsplineWeights(at.u, at.v), *at.patch);
+      // Over the structure's vertices first, then their blends of the columns;
+      // summed in one order whatever `rows` is (positionStencil is row 0 of
+      // stencil to the bit).
+      const int count = rows == 6 ? 6 : rows == 3 ? 3 : 1;
+      const Eigen::Matrix<double, 6, 16> basis = detail::bsplineWeights(at.u, at.v);
+      const GridMatrix& patch = *at.patch;
+      const Eigen::MatrixXd& map = element.structureMap;
+      const Eigen::Index m = patch.cols();
+      Eigen::Matrix<double, 6, Eigen::Dynamic> local(6, m);
+      for (Eigen::Index k = 0; k < m; ++k) {
+        for (int r = 0; r < count; ++r) {
+          double sum = basis(r, 0) * patch(0, k);
+          for (int g = 1; g < 16; ++g) sum += basis(r, g) * patch(g, k);
+          local(r, k) = sum;
+        }
+      }
+      for (Eigen::Index c = 0; c < map.cols(); ++c) {
+        for (int r = 0; r < count; ++r) {
+          double sum = local(r, 0) * map(0, c);
+          for (Eigen::Index k = 1; k < m; ++k) sum += local(r, k) * map(k, c);
+          w(r, c) = sum;
+        }
+      }
       w.row(0) += special.vertexMasks.row(0);  // the patch holds displacements from the limit point
     }
     applyChainRule(w, at.jacobian, rows);
@@ -555,7 +590,9 @@ struct LimitSurface::Impl {
     if (!at.patch) {
       result.topRows(3) = masks;
     } else {
-      blend(*at.patch, element.columns, controlPoints, grid);
+      Eigen::Matrix<double, Eigen::Dynamic, 3> local(element.structureMap.rows(), 3);
+      blend(element.structureMap, element.columns, controlPoints, local);  // the structure's vertices
+      grid.noalias() = *at.patch * local;
       result = detail::bsplineWeights(at.u, at.v) * grid;
       result.row(0) += masks.row(0);
     }
@@ -862,7 +899,7 @@ struct SurfaceState::Impl {
   Matrix3X grids;  // patchOperator * controlPoints
   // Per special element: the grid points of each subpatch a point has needed
   // at this state (slot 3 (level - 1) + child - 1; slot kSlots: the vertex
-  // masks), each filled once under `mutex`. grids is sized once, on the
+  // masks and the structure's vertices), each filled once under `mutex`. grids is sized once, on the
   // first fill, and never moved: a reader that sees ready[slot] set may read
   // that slot without the lock.
   // NB: one subpatch at a time, not whole levels: where most elements are
@@ -873,6 +910,7 @@ struct SurfaceState::Impl {
     std::array<std::atomic<bool>, kSlots + 1> ready{};
     std::mutex mutex;
     Eigen::Matrix<double, 3, 3> masks;                // limit position and tangents at the vertex
+    Eigen::Matrix<double, Eigen::Dynamic, 3> local;   // the structure's vertices (structureMap's blends)
     std::vector<Eigen::Matrix<double, 16, 3>> grids;  // [slot]
   };
   std::unique_ptr<Cache[]> caches;
@@ -922,10 +960,12 @@ LimitSample SurfaceState::evaluate(const ElementPoint& point) const {
     if (cache.grids.empty()) cache.grids.resize(Impl::kSlots);
     if (!cache.ready[Impl::kSlots].load(std::memory_order_relaxed)) {
       LimitSurface::Impl::blend(special.vertexMasks, special.columns, p, cache.masks);
+      cache.local.resize(element.structureMap.rows(), 3);
+      LimitSurface::Impl::blend(element.structureMap, element.columns, p, cache.local);
       cache.ready[Impl::kSlots].store(true, std::memory_order_release);
     }
     if (!cache.ready[slot].load(std::memory_order_relaxed)) {
-      LimitSurface::Impl::blend(s.level(special, at.level)[at.child - 1], special.columns, p, cache.grids[slot]);
+      cache.grids[slot].noalias() = s.level(*s.structures[element.structure], at.level)[at.child - 1] * cache.local;
       cache.ready[slot].store(true, std::memory_order_release);
     }
   }
@@ -962,7 +1002,15 @@ ElementPieces LimitSurface::elementPieces(int element, int levels) const {
     result.pieces.push_back(BsplinePiece{e.grid, Eigen::RowVectorXd::Zero(e.columns.size()), 1.0, false});
     return result;
   }
-  return s.piecesOf(*s.specials[e.special], e.corner, levels);
+  // Its structure's pieces times its blends of its columns.
+  const SharedPieces shared = sharedPieces(element, levels);
+  ElementPieces result;
+  result.columns = e.columns;
+  for (const BsplinePiece& piece : shared.pieces->pieces) {
+    result.pieces.push_back(BsplinePiece{piece.grid * *shared.map, s.specials[e.special]->vertexMasks.row(0),
+                                         piece.size, piece.swapped});
+  }
+  return result;
 }
 
 SharedPieces LimitSurface::sharedPieces(int element, int levels) const {
