@@ -70,13 +70,23 @@ INSTANTIATE_TEST_SUITE_P(Integrator, FactoredStep, testing::Values(2, 3),
                            return std::to_string(info.param == 2 ? 1538 : 6146) + "ControlVertices";
                          });
 
-TEST(Integrator, SolversTakeTheSameStep) {
+// The cube's matrices and one state of it, for the steps compared below.
+struct CubeStep {
+  PhysicalMatrices m;
+  Matrix3X p, previous, force;
+};
+CubeStep cubeStep() {
   const ControlMesh cube = makeCube98();
-  const LimitSurface surface(cube);
-  const PhysicalMatrices m = assemblePhysicalMatrices(surface, Material{});
-  const Matrix3X p = cube.points();
-  const Matrix3X previous = 0.99 * p;
-  const Matrix3X force = 0.1 * p;
+  CubeStep c;
+  c.m = assemblePhysicalMatrices(LimitSurface(cube), Material{});
+  c.p = cube.points();
+  c.previous = 0.99 * c.p;
+  c.force = 0.1 * c.p;
+  return c;
+}
+
+TEST(Integrator, SolversTakeTheSameStep) {
+  const auto [m, p, previous, force] = cubeStep();
   for (IntegrationScheme scheme : {IntegrationScheme::FirstOrder, IntegrationScheme::SecondOrder}) {
     IntegratorOptions options;
     options.scheme = scheme;
@@ -100,12 +110,7 @@ TEST(Integrator, RestabilizedTakesTheStepOfANewIntegrator) {
   // afresh. Same ordering, same numeric factorization: equal to the bit. A
   // stiffness outside the elements' pattern changes the pattern, and then
   // the analysis is redone (equal to rounding: its ordering may differ).
-  const ControlMesh cube = makeCube98();
-  const LimitSurface surface(cube);
-  const PhysicalMatrices m = assemblePhysicalMatrices(surface, Material{});
-  const Matrix3X p = cube.points();
-  const Matrix3X previous = 0.99 * p;
-  const Matrix3X force = 0.1 * p;
+  const auto [m, p, previous, force] = cubeStep();
   const std::vector<int> fixed = {2, 7};
   const int n = static_cast<int>(p.rows());
   SymmetricMatrix outside(n, n);  // couples two vertices no element shares
