@@ -154,6 +154,7 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
           {"region_window", &o.regionWindow},
           {"margin_mm", &o.margin},
           {"sigma_mm", &o.edges.sigma},
+          {"edge_landmark_reach_mm", &o.edges.landmarkReach},
           {"capture_range_mm", &o.edges.captureRange},
           {"elasticity_per_level", &o.simulation.elasticityPerLevel},
           {"time_step", &o.simulation.integrator.timeStep},
