@@ -133,7 +133,8 @@ void FitWorker::run(const std::vector<Landmark>& marks, const std::optional<Fitt
       text << (start ? "refit" : "fit") << " done: " << result.mesh.vertexCount() << " control vertices, "
            << result.levels.back().level << " refinement(s), " << result.steps << " steps in " << std::fixed
            << std::setprecision(2) << seconds << " s;\nfarthest landmark " << worst << " mm";
-      publish(tessellate(LimitSurface(result.mesh), result.mesh.points(), kOutputSegments), text.str());
+      const LimitSurface limit(result.mesh);
+      publish(tessellate(limit, result.mesh.points(), outputSegments(limit)), text.str());
       {
         // The pull moved during the fit, perhaps after its last step (a fit
         // may settle on a step that read the new target before moving to

@@ -54,7 +54,8 @@ Report levelReport(const LevelSummary& l, double maxErrorPercent, double rmsErro
 
 TriangleSurface outputSurface(const ControlMesh& mesh) {
   if (!mesh.points().allFinite()) throw Error("internal: the control points are not finite; nothing was written");
-  return tessellate(LimitSurface(mesh), mesh.points(), kOutputSegments);
+  const LimitSurface surface(mesh);
+  return tessellate(surface, mesh.points(), outputSegments(surface));
 }
 
 void writeModelOutputs(const std::filesystem::path& dir, const ControlMesh& mesh, const TriangleSurface& surface,

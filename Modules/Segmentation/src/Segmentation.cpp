@@ -268,10 +268,12 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
   result.sliceEnds = std::move(ends);
 
   if (!result.mesh.points().allFinite()) throw Error("the evolution produced a non-finite surface");
-  result.surface = tessellate(LimitSurface(result.mesh), result.mesh.points(), kOutputSegments);
+  const LimitSurface limit(result.mesh);
+  result.surface = tessellate(limit, result.mesh.points(), outputSegments(limit));
   const TriangleSurface& triangles = result.surface;
 
-  result.initialVolume = enclosedVolume(tessellate(LimitSurface(initial), initial.points(), kOutputSegments));
+  const LimitSurface initialLimit(initial);
+  result.initialVolume = enclosedVolume(tessellate(initialLimit, initial.points(), outputSegments(initialLimit)));
   result.volume = enclosedVolume(triangles);
   Eigen::Index outside = 0;
   for (Eigen::Index p = 0; p < triangles.points.rows(); ++p)

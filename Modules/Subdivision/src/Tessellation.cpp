@@ -1,9 +1,15 @@
 #include "dynsub/Tessellation.h"
 
+#include <algorithm>
+
 #include "dynsub/Error.h"
 #include "dynsub/Topology.h"
 
 namespace dynsub {
+
+int outputSegments(const LimitSurface& surface) {
+  return std::max(2, kOutputSegments >> surface.isolationLevels());
+}
 
 TriangleSurface tessellate(const LimitSurface& surface, const Matrix3X& controlPoints, int segmentsPerElement) {
   const int n = segmentsPerElement;

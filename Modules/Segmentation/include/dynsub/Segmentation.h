@@ -62,7 +62,7 @@ struct StageSeconds {
 
 struct SegmentResult {
   ControlMesh mesh;
-  // The limit surface of `mesh`, 8 x 8 squares per element (kOutputSegments):
+  // The limit surface of `mesh`, 8 x 8 squares per control face (outputSegments):
   // what the labelmap, surface.vtp, the report and the figures show.
   TriangleSurface surface;
   std::vector<LevelSummary> levels;
