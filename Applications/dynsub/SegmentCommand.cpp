@@ -1,6 +1,7 @@
 // dynsub segment: a structure in a 3D image from image forces and expert landmarks (Segmentation.h).
 #include <cmath>
 #include <filesystem>
+#include <future>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -110,10 +111,17 @@ void runSegment(const SegmentCommandOptions& o) {
   inputs.segment = segmentOptions(o);
   const Volume image = readVolume(o.image);
   if (!o.landmarks.empty()) inputs.landmarks = readLandmarks(o.landmarks);
-  Mask reference;
+  // NB: the reference is needed only to score the result, and reading it
+  // (a whole labelmap, inflated and converted) took a fifth of the caudate
+  // demo's command: it is read on a second thread while the segmentation
+  // runs, and its errors (a missing file at once) still come before any
+  // output is written.
+  std::shared_future<Mask> reference;
   if (!o.reference.empty()) {
-    reference = readReference(o, image);
-    inputs.reference = &reference;
+    std::error_code ignored;
+    if (!std::filesystem::exists(o.reference, ignored)) throw Error(o.reference, "no such file or directory");
+    reference = std::async(std::launch::async, [&o, &image] { return readReference(o, image); }).share();
+    inputs.reference = [reference]() -> const Mask& { return reference.get(); };
     inputs.referencePath = o.reference;
     inputs.referenceLabels = o.referenceLabels;
   }

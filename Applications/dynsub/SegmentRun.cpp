@@ -152,7 +152,7 @@ SegmentRun runSegmentation(const Volume& image, SegmentInputs in, const Progress
     report.set("seed", r);
   }
   if (in.reference) {
-    run.metrics = compareMasks(run.labelmap, *in.reference);
+    run.metrics = compareMasks(run.labelmap, in.reference());
     report.set("reference", in.referencePath);
     report.set("reference_labels", in.referenceLabels);
     report.merge(metricsReport(run.metrics));

@@ -3,6 +3,7 @@
 // evolution with its convergence record, and the numbers and warnings of
 // report.json. Shared by `dynsub segment` and the 3D Slicer module
 // DynSubSegment, so that both run and report the same thing.
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -43,8 +44,10 @@ struct SegmentInputs {
   SegmentOptions segment;
   SeedOptions seed;
   std::string potential = "edges";  // its name, for the report
-  // Optional: the structure in an expert's labelmap on the image's grid.
-  const Mask* reference = nullptr;
+  // Optional: the structure in an expert's labelmap on the image's grid,
+  // asked for once the segmentation is done (so that it can be read
+  // meanwhile); it may throw, as reading it would.
+  std::function<const Mask&()> reference;
   std::string referencePath;
   std::vector<int> referenceLabels;
 };
