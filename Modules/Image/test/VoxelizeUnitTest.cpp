@@ -1,9 +1,12 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "TestGrids.h"
 #include "dynsub/Error.h"
+#include "dynsub/Volume.h"
 #include "dynsub/Voxelize.h"
 
 namespace dynsub {
@@ -70,6 +73,26 @@ TEST(Voxelize, OpenSurfaceIsRefused) {
   uvSphere(Vector3(10, 10, 10), 5, points, triangles);
   triangles.pop_back();
   EXPECT_THROW(voxelizeSurface(points, triangles, g), Error);
+}
+
+// selectLabels takes the voxels whose value rounds to a wanted label, halves
+// away from zero as std::lround, for positive, zero and negative labels (it
+// compares ranges instead of rounding; this checks the ranges' ends).
+TEST(Volume, SelectLabelsRoundsAsLround) {
+  const std::vector<float> values = {-3.5f, -2.5f, -2.4999f, -1.5f, -0.5f, -0.4999f, 0.0f, 0.4999f, 0.5f,
+                                     1.4999f, 1.5f, 2.0f, 2.4999f, 2.5f, 70.5f, 71.0f, 71.4999f, 71.5f, 116.0f};
+  Volume labels;
+  labels.geometry = grid({static_cast<int>(values.size()), 1, 1}, Vector3::Ones(), Vector3::Zero(),
+                         Matrix3::Identity());
+  labels.voxels = values;
+  for (const std::vector<int>& wanted : {std::vector<int>{-3}, {-2}, {-1}, {0}, {1}, {2}, {71}, {2, 71}, {5}}) {
+    const Mask mask = selectLabels(labels, wanted);
+    for (std::size_t v = 0; v < values.size(); ++v) {
+      const long rounded = std::lround(values[v]);
+      const bool expected = std::find(wanted.begin(), wanted.end(), rounded) != wanted.end();
+      EXPECT_EQ(mask.voxels[v], expected ? 1 : 0) << "value " << values[v] << ", first wanted label " << wanted[0];
+    }
+  }
 }
 
 }  // namespace
