@@ -28,7 +28,7 @@ SurfaceQuadrature makeSurfaceQuadrature(const LimitSurface& surface, int pointsP
       }
     }
   }
-  LimitOperators operators = surface.operators(q.points);
+  LimitOperators operators = surface.operators(q.points, 1);  // J, J_u and J_v only
   q.J = std::move(operators.J);
   q.Ju = std::move(operators.Ju);
   q.Jv = std::move(operators.Jv);
