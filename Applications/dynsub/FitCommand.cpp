@@ -106,7 +106,7 @@ void runFit(FitCommandOptions o) {
   parameters.set("data_stiffness", o.fit.dataStiffness);
   report.set("parameters", parameters);
 
-  const TriangleSurface surface = outputSurface(result.mesh);
+  const TriangleSurface surface = outputSurface(result.mesh, *result.surface);
   writeModelOutputs(dir, result.mesh, surface, report, [&](OutputSet& outputs) {
     addFigureOutputs(outputs, o.figures, result.mesh, surface, recorder.history(), nullptr, Matrix3X(), data);
   });

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -33,7 +34,8 @@ double relativeChange(double energy, double last) {
 // matrices and quadrature over it (rebuilt only when the mesh is refined).
 struct LevelModel {
   int level = 0;
-  LimitSurface surface;
+  // Shared so that the last level's can be handed out with the result.
+  std::shared_ptr<const LimitSurface> surface;
   PhysicalMatrices matrices;
   SurfaceQuadrature quadrature;
   Matrix3X start;
@@ -42,11 +44,11 @@ struct LevelModel {
 
 // initialIsolation < 0: `mesh` is the initial model, and sets it.
 LevelModel buildLevel(const ControlMesh& mesh, int level, int& initialIsolation, const SimulationOptions& options) {
-  LevelModel model{level, LimitSurface(mesh), {}, {}, mesh.points(), 0.0};
-  if (initialIsolation < 0) initialIsolation = model.surface.isolationLevels();
+  LevelModel model{level, std::make_shared<const LimitSurface>(mesh), {}, {}, mesh.points(), 0.0};
+  if (initialIsolation < 0) initialIsolation = model.surface->isolationLevels();
   // Element sides are measured in elements of the initial model: a base mesh
   // that is `b` global refinements past the initial one has side 2^-b.
-  const double elementSize = std::ldexp(1.0, initialIsolation - (level + model.surface.isolationLevels()));
+  const double elementSize = std::ldexp(1.0, initialIsolation - (level + model.surface->isolationLevels()));
   AssemblyOptions assembly = options.assembly;
   assembly.elementSize = elementSize;
   Material material = options.material;
@@ -55,8 +57,8 @@ LevelModel buildLevel(const ControlMesh& mesh, int level, int& initialIsolation,
                     &material.rigidityVV}) {
     *m *= elasticity;
   }
-  model.matrices = assemblePhysicalMatrices(model.surface, material, assembly);
-  model.quadrature = makeSurfaceQuadrature(model.surface, options.quadraturePoints, elementSize);
+  model.matrices = assemblePhysicalMatrices(*model.surface, material, assembly);
+  model.quadrature = makeSurfaceQuadrature(*model.surface, options.quadraturePoints, elementSize);
   model.size = modelSize(model.start);
   if (!(model.size > 0.0)) throw Error("the control mesh has no extent");
   return model;
@@ -210,7 +212,7 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
         return LevelEnd::Equilibrium;
       } else if (looselyStill) {
         asked = true;
-        if (!coarseAccept(model.surface, points, false)) {
+        if (!coarseAccept(*model.surface, points, false)) {
           summary.energy = energy;
           return LevelEnd::Coarse;
         }
@@ -228,7 +230,7 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
     previousFrame = std::move(frame);
     frame.reset();
     summary.steps = step;
-    if (progress) progress(Progress{model.level, step, energy, motion, &model.surface, &points});
+    if (progress) progress(Progress{model.level, step, energy, motion, model.surface.get(), &points});
   }
   return LevelEnd::StepLimit;
 }
@@ -247,7 +249,7 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
                         const ProgressCallback& progress, Matrix3X& points, LevelSummary& summary) {
   bool lineSearch = true;
   for (const ForceModel* f : forces) lineSearch = lineSearch && f->hasPotential();
-  StaticSolver solver(model.surface, model.matrices.stiffness, fixed);
+  StaticSolver solver(*model.surface, model.matrices.stiffness, fixed);
   auto finish = [&](LevelEnd end) {
     summary.stabilizerUpdates = solver.regularizations();
     return end;
@@ -336,7 +338,7 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
     energy = trialEnergy;
     summary.energy = energy;
     summary.steps = step;
-    if (progress) progress(Progress{model.level, step, energy, motion, &model.surface, &points});
+    if (progress) progress(Progress{model.level, step, energy, motion, model.surface.get(), &points});
     SurfaceFrame nextFrame = surfaceFrame(model.quadrature, points);
     const double shape = shapeMotion(frame, nextFrame) / model.size;
     frame = std::move(nextFrame);
@@ -344,7 +346,7 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
     lastStill = window.still(change, shape);
     if (!asked && looseWindow.settled(change, shape)) {
       asked = true;
-      if (!coarseAccept(model.surface, points, false)) return finish(LevelEnd::Coarse);
+      if (!coarseAccept(*model.surface, points, false)) return finish(LevelEnd::Coarse);
     }
   }
   return finish(LevelEnd::StepLimit);
@@ -376,7 +378,7 @@ Matrix3X runLevel(const LevelModel& model, const std::vector<ForceModel*>& force
       throw Error("the simulation diverged at level " + std::to_string(model.level) + " even with time step " +
                   std::to_string(timeStep * 2.0) + " s (try a smaller --time-step or softer forces)");
     }
-    for (ForceModel* f : forces) f->beginLevel(model.surface, model.quadrature, model.start);
+    for (ForceModel* f : forces) f->beginLevel(*model.surface, model.quadrature, model.start);
     summary.steps = 0;
     summary.solverIterations = 0;
     summary.stabilizerUpdates = 0;
@@ -463,9 +465,10 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
     result.levels.push_back(summary);
 
     // A coarse end was asked already, and refused.
-    const bool good = end == LevelEnd::Coarse ? false : accept ? accept(model.surface, points, true) : true;
+    const bool good = end == LevelEnd::Coarse ? false : accept ? accept(*model.surface, points, true) : true;
     if (good || level >= options.maxLevel) {
       result.origin = {level, initialIsolation};
+      result.surface = model.surface;
       break;
     }
     mesh = subdivide(mesh).mesh;

@@ -63,7 +63,7 @@ FitResult fitPointCloud(const Matrix3X& data, const ControlMesh& initial, const 
   FitResult result;
   result.enclosingSphere = smallestEnclosingSphere(data);
   const double diameter = 2.0 * result.enclosingSphere.radius;
-  const double area = LimitSurface(initial).elementCount();
+  const double area = LimitSurface::elementCountOf(initial);
   const Eigen::VectorXd stiffness =
       Eigen::VectorXd::Constant(data.rows(), options.dataStiffness * area / static_cast<double>(data.rows()));
   SpringForceModel springs(data, stiffness, SpringForceModel::Attach::NearestEachStep);
@@ -98,6 +98,7 @@ FitResult fitPointCloud(const Matrix3X& data, const ControlMesh& initial, const 
   }
   SimulationResult simulation = simulate(initial, {&springs}, {}, options.simulation, accept, progressWithDistances);
   result.mesh = std::move(simulation.mesh);
+  result.surface = std::move(simulation.surface);
   result.levels = std::move(simulation.levels);
   result.steps = simulation.steps;
   result.error = result.levelErrors.back();

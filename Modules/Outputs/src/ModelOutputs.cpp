@@ -54,7 +54,13 @@ Report levelReport(const LevelSummary& l, double maxErrorPercent, double rmsErro
 
 TriangleSurface outputSurface(const ControlMesh& mesh) {
   if (!mesh.points().allFinite()) throw Error("internal: the control points are not finite; nothing was written");
-  const LimitSurface surface(mesh);
+  return outputSurface(mesh, LimitSurface(mesh));
+}
+
+TriangleSurface outputSurface(const ControlMesh& mesh, const LimitSurface& surface) {
+  if (!mesh.points().allFinite()) throw Error("internal: the control points are not finite; nothing was written");
+  if (surface.controlVertexCount() != mesh.vertexCount())
+    throw Error("internal: the limit surface is not the control mesh's");
   return tessellate(surface, mesh.points(), outputSegments(surface));
 }
 

@@ -684,6 +684,16 @@ LimitSurface::LimitSurface(const ControlMesh& mesh) : impl_(std::make_unique<Imp
   }
 }
 
+int LimitSurface::elementCountOf(const ControlMesh& mesh) {
+  // The constructor's isolation, on the topology alone.
+  Topology base = mesh.topology();
+  for (int levels = 0; needsIsolation(base); ++levels) {
+    if (levels == 2) throw Error("internal: extraordinary vertices are not isolated after two steps");
+    base = refine(base).topology;
+  }
+  return base.faceCount();
+}
+
 LimitSurface::~LimitSurface() = default;
 LimitSurface::LimitSurface(LimitSurface&&) noexcept = default;
 LimitSurface& LimitSurface::operator=(LimitSurface&&) noexcept = default;

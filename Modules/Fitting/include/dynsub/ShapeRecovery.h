@@ -13,6 +13,7 @@
 // Spring stiffness: every data point gets k = dataStiffness x (parametric area
 // of the initial model) / #points, so the balance between data and surface
 // elasticity does not depend on how densely the data were sampled.
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,7 @@ struct FitError {
 
 struct FitResult {
   ControlMesh mesh;
+  std::shared_ptr<const LimitSurface> surface;  // mesh's limit surface (SimulationResult::surface)
   Sphere enclosingSphere;
   FitError error;
   std::vector<LevelSummary> levels;

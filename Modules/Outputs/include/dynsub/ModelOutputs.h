@@ -19,9 +19,11 @@ Report simulationReport(const SimulationOptions& options);
 // One entry of report.json's "per_level"; the fit errors are left out when negative.
 Report levelReport(const LevelSummary& level, double maxErrorPercent, double rmsErrorPercent);
 
-// The limit surface as the programs write it (kOutputSegments, Tessellation.h).
+// The limit surface as the programs write it (outputSegments, Tessellation.h).
 // Throws dynsub::Error if the control points are not finite.
 TriangleSurface outputSurface(const ControlMesh& mesh);
+// The same from `mesh`'s limit surface built already (SimulationResult::surface).
+TriangleSurface outputSurface(const ControlMesh& mesh, const LimitSurface& surface);
 
 // DIR/surface.vtp (`surface`, from outputSurface), DIR/control_mesh.obj and
 // DIR/report.json, all or none. `extra` may add further files to the same set

@@ -127,6 +127,9 @@ class LimitSurface {
   LimitSurface& operator=(LimitSurface&&) noexcept;
 
   int controlVertexCount() const;
+  // elementCount() of `mesh`'s limit surface, from its isolation alone
+  // (without the elements' tables).
+  static int elementCountOf(const ControlMesh& mesh);
   // Global refinements done to isolate extraordinary vertices: 0, 1 or 2.
   int isolationLevels() const;
   // The base mesh (the elements are its faces) and its vertices as a linear
