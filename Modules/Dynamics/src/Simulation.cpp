@@ -4,11 +4,13 @@
 #include <chrono>
 #include <cmath>
 #include <deque>
+#include <exception>
 #include <limits>
 #include <memory>
 #include <optional>
 #include <string>
 
+#include "ParallelFor.h"
 #include "dynsub/ApplyOperator.h"
 #include "dynsub/CatmullClark.h"
 #include "dynsub/Error.h"
@@ -57,8 +59,27 @@ LevelModel buildLevel(const ControlMesh& mesh, int level, int& initialIsolation,
                     &material.rigidityVV}) {
     *m *= elasticity;
   }
-  model.matrices = assemblePhysicalMatrices(*model.surface, material, assembly);
-  model.quadrature = makeSurfaceQuadrature(*model.surface, options.quadraturePoints, elementSize);
+  // NB: the matrices and the quadrature are independent (the surface's
+  // tables are safe to fill from two threads), and one after the other they
+  // were a tenth of the kitten's fit. A failure of either is rethrown here.
+  std::exception_ptr failed[2];
+  bothAtOnce(
+      [&] {
+        try {
+          model.matrices = assemblePhysicalMatrices(*model.surface, material, assembly);
+        } catch (...) {
+          failed[0] = std::current_exception();
+        }
+      },
+      [&] {
+        try {
+          model.quadrature = makeSurfaceQuadrature(*model.surface, options.quadraturePoints, elementSize);
+        } catch (...) {
+          failed[1] = std::current_exception();
+        }
+      });
+  for (const std::exception_ptr& failure : failed)
+    if (failure) std::rethrow_exception(failure);
   model.size = modelSize(model.start);
   if (!(model.size > 0.0)) throw Error("the control mesh has no extent");
   return model;
