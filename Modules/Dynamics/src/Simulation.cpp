@@ -290,7 +290,11 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
   double energy = 0.5 * quadraticForm(model.matrices.stiffness, points) + potential;
   summary.energy = energy;
   if (!std::isfinite(energy)) return LevelEnd::Diverged;
-  SurfaceFrame frame = surfaceFrame(model.quadrature, points);
+  // The frames at `previous` and `points`, computed only for steps whose
+  // energy change is within the tolerance (as in runTimeSteps): the others
+  // are not still whatever their motion.
+  Matrix3X previous;
+  std::optional<SurfaceFrame> previousFrame, frame;
   // The length the last Newton direction was accepted at.
   double lastLength = 1.0;
   // Whether the last step was still by the full rule. (Not the coarse one:
@@ -354,15 +358,21 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
     const double motion = (trial - points).rowwise().norm().maxCoeff();
     const double change = relativeChange(trialEnergy, energy);
     acceptState(forces);
+    previous = std::move(points);
     points = std::move(trial);
+    previousFrame = std::move(frame);
+    frame.reset();
     force = std::move(trialForce);
     energy = trialEnergy;
     summary.energy = energy;
     summary.steps = step;
     if (progress) progress(Progress{model.level, step, energy, motion, model.surface.get(), &points});
-    SurfaceFrame nextFrame = surfaceFrame(model.quadrature, points);
-    const double shape = shapeMotion(frame, nextFrame) / model.size;
-    frame = std::move(nextFrame);
+    double shape = std::numeric_limits<double>::infinity();
+    if (change <= (asked ? options.equilibrium.energyTolerance : loose.energyTolerance)) {
+      if (!previousFrame) previousFrame = surfaceFrame(model.quadrature, previous);
+      frame = surfaceFrame(model.quadrature, points);
+      shape = shapeMotion(*previousFrame, *frame) / model.size;
+    }
     if (window.settled(change, shape)) return finish(LevelEnd::Equilibrium);
     lastStill = window.still(change, shape);
     if (!asked && looseWindow.settled(change, shape)) {
