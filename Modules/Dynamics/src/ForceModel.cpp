@@ -3,6 +3,7 @@
 #include <cmath>
 #include <string>
 
+#include "ParallelFor.h"
 #include "dynsub/ApplyOperator.h"
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/Error.h"
@@ -63,6 +64,19 @@ void SpringForceModel::attach(const Matrix3X& controlPoints) {
     positions_.row(static_cast<Eigen::Index>(i)) = nearest[i].position.transpose();
     normals_.row(static_cast<Eigen::Index>(i)) = nearest[i].normal.transpose();
   }
+  // The special elements' position stencils at the attachments, on both
+  // cores: the force and the static scheme's tangent stiffness both take
+  // them (each evaluated them on its own before, the force on one thread).
+  const Eigen::Index count = static_cast<Eigen::Index>(springs_.size());
+  stencils_.resize(springs_.size());
+  parallelFor(count, threadsWorth(count), [&](Eigen::Index i) {
+    const ElementPoint& q = springs_[i].attachment;
+    if (surface_->elementType(q.element) == ElementType::Normal) {
+      stencils_[i].resize(0);
+    } else {
+      stencils_[i] = surface_->positionStencil(q);
+    }
+  });
 }
 
 Matrix3X SpringForceModel::generalizedForce(const Matrix3X& controlPoints, double& potential) {
@@ -100,7 +114,7 @@ Matrix3X SpringForceModel::generalizedForce(const Matrix3X& controlPoints, doubl
       onGrids.middleRows<16>(16 * static_cast<Eigen::Index>(q.element)).noalias() +=
           bicubicBsplineWeights(q.u, q.v).row(0).transpose() * pull;
     } else {
-      const Eigen::RowVectorXd w = surface_->positionStencil(q);
+      const Eigen::RowVectorXd& w = stencils_[i];
       const std::vector<int>& columns = surface_->elementColumns(q.element);
       for (size_t c = 0; c < columns.size(); ++c) force.row(columns[c]) += w(static_cast<Eigen::Index>(c)) * pull;
     }
@@ -129,7 +143,9 @@ void SpringForceModel::addTangentStiffness(const Matrix3X& controlPoints, Tangen
       block = spring.stiffness * ((1.0 - kTangentialShare) * normal * normal.transpose() +
                                   kTangentialShare * Eigen::Matrix3d::Identity());
     }
-    into.addPoint(spring.attachment, block);
+    // The stencil of the last evaluation, at this attachment (special elements only).
+    const bool taken = i < stencils_.size() && stencils_[i].size() > 0;
+    into.addPoint(spring.attachment, block, taken ? &stencils_[i] : nullptr);
   }
 }
 

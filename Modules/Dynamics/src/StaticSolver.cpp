@@ -34,6 +34,7 @@ struct TangentStiffness::Impl {
   // Points added since the last matrix(), in the order added.
   std::vector<ElementPoint> points;
   std::vector<Eigen::Matrix3d> blocks;
+  std::vector<const Eigen::RowVectorXd*> given;  // the callers' position stencils, or null
   // Scratch of addPoints(), kept from step to step: the points' order by
   // element, where each element's points start in it, their position
   // weights (a row of the element's width each, in that order) and the
@@ -99,8 +100,13 @@ struct TangentStiffness::Impl {
                   const int e = touched[t];
                   const int m = static_cast<int>(surface->elementColumns(e).size());
                   for (int r = start[e]; r < start[e + 1]; ++r) {
-                    Eigen::Map<Eigen::RowVectorXd>(weights.data() + weightStart[e] + (r - start[e]) * m, m) =
-                        surface->positionStencil(points[order[r]]);
+                    Eigen::Map<Eigen::RowVectorXd> row(weights.data() + weightStart[e] + (r - start[e]) * m, m);
+                    const Eigen::RowVectorXd* stencil = given[order[r]];
+                    if (stencil) {
+                      row = *stencil;
+                    } else {
+                      row = surface->positionStencil(points[order[r]]);
+                    }
                   }
                 });
     double* values = matrix.valuePtr();
@@ -146,6 +152,7 @@ struct TangentStiffness::Impl {
     parallelFor(parts, touched.size() >= 64 ? parts : 1, addColumns);
     points.clear();
     blocks.clear();
+    given.clear();
   }
 };
 
@@ -210,6 +217,7 @@ void TangentStiffness::reset(const SymmetricMatrix& scalar) {
   if (scalar.rows() != s.vertices || scalar.cols() != s.vertices) throw Error("internal: stiffness has the wrong size");
   s.points.clear();
   s.blocks.clear();
+  s.given.clear();
   std::fill(s.matrix.valuePtr(), s.matrix.valuePtr() + s.matrix.nonZeros(), 0.0);
   for (int j = 0; j < scalar.outerSize(); ++j) {
     for (SymmetricMatrix::InnerIterator it(scalar, j); it; ++it) {
@@ -224,6 +232,7 @@ void TangentStiffness::resetToLast() {
   if (s.base.empty()) throw Error("internal: TangentStiffness::resetToLast before any reset");
   s.points.clear();
   s.blocks.clear();
+  s.given.clear();
   std::copy(s.base.begin(), s.base.end(), s.matrix.valuePtr());
 }
 
@@ -237,15 +246,19 @@ void TangentStiffness::addScalar(const SparseMatrix& scalar) {
   }
 }
 
-void TangentStiffness::addPoint(const ElementPoint& q, const Eigen::Matrix3d& block) {
+void TangentStiffness::addPoint(const ElementPoint& q, const Eigen::Matrix3d& block,
+                                const Eigen::RowVectorXd* weights) {
   Impl& s = *impl_;
   // Checked here, on the caller's thread: the weights are taken later, on worker threads.
   if (q.element < 0 || q.element >= s.surface->elementCount() || !(q.u >= 0.0 && q.u <= 1.0) ||
       !(q.v >= 0.0 && q.v <= 1.0)) {
     throw Error("internal: stiffness point outside the surface's elements");
   }
+  if (weights && weights->size() != static_cast<Eigen::Index>(s.surface->elementColumns(q.element).size()))
+    throw Error("internal: a stiffness point's stencil has the wrong size");
   s.points.push_back(q);
   s.blocks.push_back(block);
+  s.given.push_back(weights);
 }
 
 SymmetricMatrix& TangentStiffness::matrix() {

@@ -92,6 +92,9 @@ class SpringForceModel final : public ForceModel {
   Matrix3X positions_;                 // the surface at the attachments (NearestEachStep)
   Matrix3X normals_;                   // and its unit normals there
   Eigen::VectorXd lengths_;
+  // Per spring at the last evaluation: its attachment's position stencil on
+  // a special element, empty on a normal one (NearestEachStep).
+  std::vector<Eigen::RowVectorXd> stencils_;
   double deadZone_ = 0;
 };
 

@@ -51,8 +51,10 @@ class TangentStiffness {
   // that share an element (springs' and fields' J^T W J are such).
   void addScalar(const SparseMatrix& scalar);
   // Adds (J_q^T J_q) (x) B: a stiffness B (symmetric 3 x 3, N/mm) acting on
-  // the limit position at q.
-  void addPoint(const ElementPoint& q, const Eigen::Matrix3d& block);
+  // the limit position at q. `weights`, when given, is q's
+  // LimitSurface::positionStencil, taken already by the caller; it must live
+  // until the next matrix().
+  void addPoint(const ElementPoint& q, const Eigen::Matrix3d& block, const Eigen::RowVectorXd* weights = nullptr);
   // The matrix with every addition made, its lower triangle alone stored
   // (the solvers read no other); the caller may change values in place
   // until the next reset.
