@@ -1,6 +1,7 @@
 #pragma once
 // Independent per-item work on the machine's cores, private to the Dynamics module.
 #include <algorithm>
+#include <exception>
 #include <thread>
 #include <vector>
 
@@ -29,6 +30,8 @@ inline Eigen::Index hardwareThreads() {
   return threads;
 }
 
+// An exception thrown by `body` is rethrown here once every thread has
+// ended: the first chunk's that threw, so the same one whatever the timing.
 template <class Body>
 void parallelFor(Eigen::Index count, Eigen::Index threadsWorthIt, const Body& body) {
   const Eigen::Index threads = std::min<Eigen::Index>({hardwareThreads(), count, threadsWorthIt});
@@ -36,15 +39,21 @@ void parallelFor(Eigen::Index count, Eigen::Index threadsWorthIt, const Body& bo
     for (Eigen::Index i = 0; i < count; ++i) body(i);
     return;
   }
-  std::vector<std::thread> workers;
   const Eigen::Index chunk = (count + threads - 1) / threads;
-  for (Eigen::Index t = 1; t < threads; ++t) {
-    workers.emplace_back([&, t] {
+  std::vector<std::exception_ptr> failed(threads);
+  auto run = [&](Eigen::Index t) {
+    try {
       for (Eigen::Index i = t * chunk; i < std::min(count, (t + 1) * chunk); ++i) body(i);
-    });
-  }
-  for (Eigen::Index i = 0; i < std::min(count, chunk); ++i) body(i);
+    } catch (...) {
+      failed[t] = std::current_exception();
+    }
+  };
+  std::vector<std::thread> workers;
+  for (Eigen::Index t = 1; t < threads; ++t) workers.emplace_back(run, t);
+  run(0);
   for (std::thread& w : workers) w.join();
+  for (const std::exception_ptr& failure : failed)
+    if (failure) std::rethrow_exception(failure);
 }
 
 // first() and second() at once, on two threads where there are two cores

@@ -6,11 +6,15 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <random>
+#include <stdexcept>
+#include <string>
 
 #include <Eigen/SparseCholesky>
 #include <unsupported/Eigen/KroneckerProduct>
 
+#include "../src/ParallelFor.h"
 #include "TestPointClouds.h"
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/Error.h"
@@ -95,6 +99,29 @@ TEST(StaticScheme, FixedVerticesStay) {
   EXPECT_EQ(result.mesh.points().row(0), cube.points().row(0));
   EXPECT_EQ(result.mesh.points().row(17), cube.points().row(17));
   EXPECT_GT((result.mesh.points() - cube.points()).cwiseAbs().maxCoeff(), 0.05);
+}
+
+// parallelFor's workers run the forces' and searches' per-item work; an
+// exception from any item must come back to the caller (a thread's uncaught
+// exception ends the process), after every chunk has ended, and it must be
+// the same one whatever the timing: the first chunk's. Both chunks throw
+// here; on one core the items run in order, and item 10 throws first too.
+TEST(ParallelFor, RethrowsTheFirstChunksExceptionOnceEveryChunkHasEnded) {
+  std::atomic<int> done{0};
+  const auto body = [&](Eigen::Index i) {
+    if (i == 10 || i == 900) throw std::runtime_error("item " + std::to_string(i));
+    ++done;
+  };
+  try {
+    parallelFor(1000, 2, body);
+    FAIL() << "no exception came back";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "item 10");
+  }
+  // Each chunk stopped at its own throw: the first after items 0-9, the
+  // second (if there was one) after 500-899; nothing ran after the rethrow.
+  const int expected = hardwareThreads() >= 2 ? 10 + 400 : 10;
+  EXPECT_EQ(done.load(), expected);
 }
 
 }  // namespace
