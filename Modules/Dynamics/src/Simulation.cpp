@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <deque>
-#include <exception>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -61,25 +60,9 @@ LevelModel buildLevel(const ControlMesh& mesh, int level, int& initialIsolation,
   }
   // NB: the matrices and the quadrature are independent (the surface's
   // tables are safe to fill from two threads), and one after the other they
-  // were a tenth of the kitten's fit. A failure of either is rethrown here.
-  std::exception_ptr failed[2];
-  bothAtOnce(
-      [&] {
-        try {
-          model.matrices = assemblePhysicalMatrices(*model.surface, material, assembly);
-        } catch (...) {
-          failed[0] = std::current_exception();
-        }
-      },
-      [&] {
-        try {
-          model.quadrature = makeSurfaceQuadrature(*model.surface, options.quadraturePoints, elementSize);
-        } catch (...) {
-          failed[1] = std::current_exception();
-        }
-      });
-  for (const std::exception_ptr& failure : failed)
-    if (failure) std::rethrow_exception(failure);
+  // were a tenth of the kitten's fit.
+  bothAtOnce([&] { model.matrices = assemblePhysicalMatrices(*model.surface, material, assembly); },
+             [&] { model.quadrature = makeSurfaceQuadrature(*model.surface, options.quadraturePoints, elementSize); });
   model.size = modelSize(model.start);
   if (!(model.size > 0.0)) throw Error("the control mesh has no extent");
   return model;
@@ -160,6 +143,39 @@ double shapeMotion(const SurfaceFrame& from, const SurfaceFrame& to) {
 
 // Coarse: a level below the maximum settled to the looser rule and its fit
 // was not accepted (EquilibriumOptions::coarseLevelFactor).
+// The equilibrium rule `coarseLevelFactor` times looser (Simulation.h).
+EquilibriumOptions loosened(const EquilibriumOptions& options) {
+  EquilibriumOptions loose = options;
+  loose.energyTolerance *= options.coarseLevelFactor;
+  loose.motionTolerance *= options.coarseLevelFactor;
+  return loose;
+}
+
+// The shape's motion over a level's steps (shapeMotion / model size),
+// measured only for steps whose energy change is within the tolerance in
+// force: the others are not still whatever their motion, and most steps are
+// such (they get infinity). Each state's frame is computed at most once.
+class StepShapeMotion {
+ public:
+  explicit StepShapeMotion(const LevelModel& model) : model_(model) {}
+  // The step from `previous` to `current`, whose relative energy change is `change`.
+  double measure(const Matrix3X& previous, const Matrix3X& current, double change, double tolerance) {
+    if (!(change <= tolerance)) return std::numeric_limits<double>::infinity();
+    if (!previousFrame_) previousFrame_ = surfaceFrame(model_.quadrature, previous);
+    if (!frame_) frame_ = surfaceFrame(model_.quadrature, current);
+    return shapeMotion(*previousFrame_, *frame_) / model_.size;
+  }
+  // The state moved on: its frame becomes the previous one.
+  void advance() {
+    previousFrame_ = std::move(frame_);
+    frame_.reset();
+  }
+
+ private:
+  const LevelModel& model_;
+  std::optional<SurfaceFrame> previousFrame_, frame_;  // at `previous` and `current`, once computed
+};
+
 enum class LevelEnd { Equilibrium, Coarse, StepLimit, Diverged };
 
 // The papers' time stepping (Integrator.h) from model.start; `points` ends at
@@ -182,17 +198,12 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
   EquilibriumWindow window(options.equilibrium, options.equilibrium.window);
   // With `coarseAccept`, the level is asked at the first state that meets the
   // looser rule whether its fit is accepted, as in runStaticSteps.
-  EquilibriumOptions loose = options.equilibrium;
-  loose.energyTolerance *= loose.coarseLevelFactor;
-  loose.motionTolerance *= loose.coarseLevelFactor;
+  const EquilibriumOptions loose = loosened(options.equilibrium);
   EquilibriumWindow looseWindow(loose, options.equilibrium.window);
   bool asked = !coarseAccept;
   Matrix3X previous = model.start;
   points = model.start;
-  // The frames at `previous` and `points`, computed only for steps whose
-  // energy change is within the tolerance: the others are not still
-  // whatever their motion, and most steps are such.
-  std::optional<SurfaceFrame> previousFrame, frame;
+  StepShapeMotion stepMotion(model);
   double lastEnergy = std::numeric_limits<double>::quiet_NaN();
   double firstEnergy = 0.0;
   int rises = 0;
@@ -207,12 +218,8 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
     if (!std::isfinite(energy) || std::abs(energy) > 1e3 * std::max(firstEnergy, 1e-300)) return LevelEnd::Diverged;
     if (step > 1) {
       const double change = relativeChange(energy, lastEnergy);
-      double shape = std::numeric_limits<double>::infinity();
-      if (change <= (asked ? options.equilibrium.energyTolerance : loose.energyTolerance)) {
-        if (!previousFrame) previousFrame = surfaceFrame(model.quadrature, previous);
-        if (!frame) frame = surfaceFrame(model.quadrature, points);
-        shape = shapeMotion(*previousFrame, *frame) / model.size;
-      }
+      const double shape = stepMotion.measure(
+          previous, points, change, asked ? options.equilibrium.energyTolerance : loose.energyTolerance);
       const bool still = window.settled(change, shape);
       const bool looselyStill = !asked && looseWindow.settled(change, shape);
       // The motion is dissipative and re-attaching springs only lowers their
@@ -248,8 +255,7 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
     if (!next.allFinite() || motion > model.size) return LevelEnd::Diverged;
     previous = std::move(points);
     points = std::move(next);
-    previousFrame = std::move(frame);
-    frame.reset();
+    stepMotion.advance();
     summary.steps = step;
     if (progress) progress(Progress{model.level, step, energy, motion, model.surface.get(), &points});
   }
@@ -278,9 +284,7 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
   // NB: a static step that moves nothing is conclusive by itself (there is no
   // velocity to carry the state on), so two still steps in a row suffice.
   EquilibriumWindow window(options.equilibrium, std::min(options.equilibrium.window, 2));
-  EquilibriumOptions loose = options.equilibrium;
-  loose.energyTolerance *= loose.coarseLevelFactor;
-  loose.motionTolerance *= loose.coarseLevelFactor;
+  const EquilibriumOptions loose = loosened(options.equilibrium);
   EquilibriumWindow looseWindow(loose, std::min(options.equilibrium.window, 2));
   bool asked = !coarseAccept;
   points = model.start;
@@ -290,11 +294,8 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
   double energy = 0.5 * quadraticForm(model.matrices.stiffness, points) + potential;
   summary.energy = energy;
   if (!std::isfinite(energy)) return LevelEnd::Diverged;
-  // The frames at `previous` and `points`, computed only for steps whose
-  // energy change is within the tolerance (as in runTimeSteps): the others
-  // are not still whatever their motion.
   Matrix3X previous;
-  std::optional<SurfaceFrame> previousFrame, frame;
+  StepShapeMotion stepMotion(model);
   // The length the last Newton direction was accepted at.
   double lastLength = 1.0;
   // Whether the last step was still by the full rule. (Not the coarse one:
@@ -360,19 +361,14 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
     acceptState(forces);
     previous = std::move(points);
     points = std::move(trial);
-    previousFrame = std::move(frame);
-    frame.reset();
+    stepMotion.advance();
     force = std::move(trialForce);
     energy = trialEnergy;
     summary.energy = energy;
     summary.steps = step;
     if (progress) progress(Progress{model.level, step, energy, motion, model.surface.get(), &points});
-    double shape = std::numeric_limits<double>::infinity();
-    if (change <= (asked ? options.equilibrium.energyTolerance : loose.energyTolerance)) {
-      if (!previousFrame) previousFrame = surfaceFrame(model.quadrature, previous);
-      frame = surfaceFrame(model.quadrature, points);
-      shape = shapeMotion(*previousFrame, *frame) / model.size;
-    }
+    const double shape = stepMotion.measure(previous, points, change,
+                                             asked ? options.equilibrium.energyTolerance : loose.energyTolerance);
     if (window.settled(change, shape)) return finish(LevelEnd::Equilibrium);
     lastStill = window.still(change, shape);
     if (!asked && looseWindow.settled(change, shape)) {
