@@ -89,24 +89,32 @@ struct ClosestPointLocator::Impl {
   // tracked closest point at `distance`. Unknown when too many samples of the
   // tree are candidates (a point far off the surface): a current tree is then
   // cheaper than checking them one by one.
+  // `mostChecked` bounds the samples checked one by one (64 by default;
+  // findAll allows more for the few queries it decides on an old tree).
   enum class Nearer { No, Yes, Unknown };
-  Nearer sampleNearer(const Vector3& q, double distance) const {
+  static constexpr std::size_t kMostChecked = 64;
+  Nearer sampleNearer(const Vector3& q, double distance, std::size_t mostChecked = kMostChecked) const {
     if (drift == 0.0) {
       uint32_t index = 0;
       double squared = 0.0;
       tree->knnSearch(q.data(), 1, &index, &squared);
       return distance <= std::sqrt(squared) ? Nearer::No : Nearer::Yes;
     }
-    const double radius = distance + drift * (1.0 + 1e-9) + 1e-12;  // a margin for rounding
-    NearerSampleSearch search{*this, q, distance, radius * radius};
+    const double radius = driftRadius(distance);
+    NearerSampleSearch search{*this, q, distance, radius * radius, mostChecked};
     tree->findNeighbors(search, q.data(), nanoflann::SearchParams(32, 0.0, false));
     return search.answer;
   }
 
+  // The radius on the tree (its samples where they were when it was built)
+  // that holds every sample within `distance` of a point now.
+  // (1e-9 and 1e-12: a margin for rounding.)
+  double driftRadius(double distance) const { return distance + drift * (1.0 + 1e-9) + 1e-12; }
+
   // A nanoflann result set for sampleNearer: each sample of the old tree
   // within `radius` of q is checked where it is now, and the search stops at
-  // the first one nearer than `distance` (Yes) or when over 64 are within
-  // the radius (Unknown). No list of neighbours is kept.
+  // the first one nearer than `distance` (Yes) or when over `mostChecked`
+  // are within the radius (Unknown). No list of neighbours is kept.
   // NB: the ball usually holds a sample or two; searching for the 65 nearest
   // of each of the bear's 13 826 points was measured slower (18.6 s against
   // 13 s), and a radius search that lists every sample in the ball spent its
@@ -114,11 +122,11 @@ struct ClosestPointLocator::Impl {
   struct NearerSampleSearch {
     using DistanceType = double;
     using IndexType = uint32_t;
-    static constexpr std::size_t kMostChecked = 64;
     const Impl& impl;
     const Vector3& q;
     double distance;
     double squaredRadius;
+    std::size_t mostChecked;
     std::size_t checked = 0;
     Nearer answer = Nearer::No;
 
@@ -126,7 +134,7 @@ struct ClosestPointLocator::Impl {
     double worstDist() const { return squaredRadius; }
     bool addPoint(double squared, uint32_t index) {
       if (!(squared < squaredRadius)) return true;
-      if (++checked > kMostChecked) {
+      if (++checked > mostChecked) {
         answer = Nearer::Unknown;
         return false;
       }
@@ -140,6 +148,8 @@ struct ClosestPointLocator::Impl {
 
   // The samples within `radius` of q on the tree (at the positions it was
   // built with), at most kMostInBall of them: `overflow` when there are more.
+  // kMostInBall also bounds sampleNearer's checks for findAll's few queries
+  // decided on an old tree.
   static constexpr std::size_t kMostInBall = 1024;
   struct BallSearch {
     using DistanceType = double;
@@ -167,17 +177,6 @@ struct ClosestPointLocator::Impl {
     return !search.overflow;
   }
 
-  // sampleNearer without its cap, on a tree older than the surface: every
-  // sample that can be nearer than `distance` now is checked where it is now.
-  // Unknown only when that ball holds over kMostInBall samples.
-  Nearer sampleNearerOnOldTree(const Vector3& q, double distance) const {
-    std::vector<uint32_t> found;
-    if (!ball(q, distance + drift * (1.0 + 1e-9) + 1e-12, found)) return Nearer::Unknown;
-    for (uint32_t i : found)
-      if (std::sqrt((sample(i) - q).squaredNorm()) < distance) return Nearer::Yes;
-    return Nearer::No;
-  }
-
   // The `candidates` samples nearest q where they are now, nearest first
   // (ties by index), found on a tree older than the surface: the k nearest
   // of the tree bound the k-th nearest distance now, D, and no sample
@@ -191,7 +190,7 @@ struct ClosestPointLocator::Impl {
     double bound = 0.0;
     for (size_t i = 0; i < found; ++i) bound = std::max(bound, std::sqrt((sample(index[i]) - q).squaredNorm()));
     std::vector<uint32_t> inBall;
-    if (!ball(q, bound + drift * (1.0 + 1e-9) + 1e-12, inBall)) return false;
+    if (!ball(q, driftRadius(bound), inBall)) return false;
     std::vector<std::pair<double, uint32_t>> now;
     for (uint32_t i : inBall) now.emplace_back((sample(i) - q).squaredNorm(), i);
     const size_t kept = std::min(k, now.size());
@@ -386,10 +385,11 @@ std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries,
   // A tracked point is kept when no sample is nearer (Impl::sampleNearer).
   // The checks are made on the tree as it was built, for the samples within
   // the drift. The few queries they leave undecided are decided on that old
-  // tree too, exactly (Impl::sampleNearerOnOldTree, and a full search of the
-  // samples nearest now where one is nearer); when there are more than
-  // kMostUndecided, or a hint is off the surface, or a ball is too full, the
-  // tree is rebuilt and every query is decided on the current one.
+  // tree too, exactly (sampleNearer checking up to kMostInBall samples, and
+  // a full search of the samples nearest now where one is nearer); when
+  // there are more than kMostUndecided, or a hint is off the surface, or a
+  // ball is too full, the tree is rebuilt and every query is decided on the
+  // current one.
   // NB: early in a fit 80-95 % of the kitten's queries came out Unknown
   // (over 64 samples in the ball of the drift): past kMostUndecided the
   // checks stop, as a current tree is cheaper. Late in it, a handful per
@@ -427,7 +427,7 @@ std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries,
                   const Eigen::Index i = open[t];
                   const Vector3 q = queries.row(i).transpose();
                   decided[t] = result[i];
-                  const Impl::Nearer nearer = s.sampleNearerOnOldTree(q, result[i].distance);
+                  const Impl::Nearer nearer = s.sampleNearer(q, result[i].distance, Impl::kMostInBall);
                   if (nearer == Impl::Nearer::No) return;
                   std::vector<uint32_t> nearest;
                   if (nearer == Impl::Nearer::Unknown || !s.nearestSamplesOnOldTree(q, nearest)) {
