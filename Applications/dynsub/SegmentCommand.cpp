@@ -14,6 +14,7 @@
 #include "FigureOutputs.h"
 #include "SegmentRun.h"
 #include "dynsub/Error.h"
+#include "dynsub/FileNames.h"
 #include "dynsub/ImageIO.h"
 #include "dynsub/Metrics.h"
 #include "dynsub/ModelOutputs.h"
@@ -118,8 +119,7 @@ void runSegment(const SegmentCommandOptions& o) {
   // output is written.
   std::shared_future<Mask> reference;
   if (!o.reference.empty()) {
-    std::error_code ignored;
-    if (!std::filesystem::exists(o.reference, ignored)) throw Error(o.reference, "no such file or directory");
+    requireExisting(o.reference);  // before the segmentation; its other errors come with its reading
     reference = std::async(std::launch::async, [&o, &image] { return readReference(o, image); }).share();
     inputs.reference = [reference]() -> const Mask& { return reference.get(); };
     inputs.referencePath = o.reference;

@@ -4,6 +4,8 @@
 #include <cctype>
 #include <filesystem>
 
+#include "dynsub/Error.h"
+
 namespace dynsub {
 
 std::string lowerCaseExtension(const std::string& path) {
@@ -11,6 +13,11 @@ std::string lowerCaseExtension(const std::string& path) {
   std::transform(extension.begin(), extension.end(), extension.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return extension;
+}
+
+void requireExisting(const std::string& path) {
+  std::error_code ignored;
+  if (!std::filesystem::exists(path, ignored)) throw Error(path, "no such file or directory");
 }
 
 }  // namespace dynsub

@@ -143,9 +143,8 @@ void SpringForceModel::addTangentStiffness(const Matrix3X& controlPoints, Tangen
       block = spring.stiffness * ((1.0 - kTangentialShare) * normal * normal.transpose() +
                                   kTangentialShare * Eigen::Matrix3d::Identity());
     }
-    // The stencil of the last evaluation, at this attachment (special elements only).
-    const bool taken = i < stencils_.size() && stencils_[i].size() > 0;
-    into.addPoint(spring.attachment, block, taken ? &stencils_[i] : nullptr);
+    // The stencil attach() took at this attachment (special elements only).
+    into.addPoint(spring.attachment, block, stencils_[i].size() > 0 ? &stencils_[i] : nullptr);
   }
 }
 

@@ -15,8 +15,7 @@
 namespace dynsub {
 
 Volume readVolume(const std::string& path) {
-  std::error_code ignored;
-  if (!std::filesystem::exists(path, ignored)) throw Error(path, "no such file or directory");
+  requireExisting(path);
   // NB: opening the ITK bridge (ITK's and GDCM's libraries relocated, GDCM's
   // dictionary loaded) and the file's own checks (a .nii.gz inflated once to
   // see that all its data is there) do not depend on each other, and each
@@ -25,6 +24,7 @@ Volume readVolume(const std::string& path) {
   // destructor) and is reported as before.
   std::future<const itkbridge::Functions*> bridge =
       std::async(std::launch::async, [] { return &itkbridge::functions(); });
+  std::error_code ignored;
   if (!std::filesystem::is_directory(path, ignored)) filechecks::checkImageFile(path);
   itkbridge::Geometry raw;
   Volume volume;

@@ -52,10 +52,7 @@ Report levelReport(const LevelSummary& l, double maxErrorPercent, double rmsErro
   return r;
 }
 
-TriangleSurface outputSurface(const ControlMesh& mesh) {
-  if (!mesh.points().allFinite()) throw Error("internal: the control points are not finite; nothing was written");
-  return outputSurface(mesh, LimitSurface(mesh));
-}
+TriangleSurface outputSurface(const ControlMesh& mesh) { return outputSurface(mesh, LimitSurface(mesh)); }
 
 TriangleSurface outputSurface(const ControlMesh& mesh, const LimitSurface& surface) {
   if (!mesh.points().allFinite()) throw Error("internal: the control points are not finite; nothing was written");
