@@ -2,8 +2,9 @@
 // contour and deformable simplex mesh, in one run, on the same cropped region
 // of the same MRI from the same landmarks:
 //   build/bin/SegmentationComparison [--dynsub-only] [--rounds N] [IMAGE LABELS LANDMARKS LABEL]
-// (--dynsub-only: DynSub's segmentation and refit alone, e.g. for profiling;
-// --rounds: the head-to-head below, 7 rounds unless given, 0 for none)
+// (--dynsub-only: DynSub's segmentation and refit alone, then its rounds
+// alone, e.g. for profiling; --rounds: the head-to-head below, 7 rounds
+// unless given, 0 for none)
 // (defaults: the demo's left caudate of Colin27 against AAL label 71).
 // DynSub uses the landmarks as springs; the level set cannot, so it starts
 // from DynSub's own initial model (voxelized) and reads its speed image's
@@ -150,6 +151,14 @@ int run(int argc, char** argv) {
               dynsub.seconds.crop, dynsub.seconds.potential, dynsub.seconds.evolution, voxelizeSeconds);
   if (dynsubOnly) {
     refitAfterOneLandmark(image, reference, landmarks, initial, dynsub);
+    std::vector<double> seconds;
+    for (int r = 0; r < rounds; ++r) {
+      const auto started = std::chrono::steady_clock::now();
+      const SegmentResult again = segment(image, landmarks, initial, SegmentOptions());
+      const Mask labelmap = labelmapOf(again.surface, image.geometry);
+      seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+    }
+    if (rounds > 0) std::printf("dynsub segment alone, %d rounds: %s\n", rounds, spread(seconds).c_str());
     return 0;
   }
   printRow("initial model (both methods)", compareMasks(pasteMask(initialMask, image.geometry, dynsub.regionFirst),
