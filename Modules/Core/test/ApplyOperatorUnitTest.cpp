@@ -70,6 +70,19 @@ TEST(ApplyOperators, EqualThreeApplicationsToTheBitAndRefuseOtherPatterns) {
   EXPECT_THROW(dynsub::applyOperators(a, other, c, points, ra, rb, rc), std::invalid_argument);
 }
 
+TEST(ApplyTransposed, EqualsEigensTransposedProductToTheBitAndRefusesAMismatch) {
+  // Many rows into few columns, so each result row sums many terms, where
+  // another order of summation would round otherwise.
+  std::mt19937 random(8);
+  const SparseMatrix op = randomOperator(2000, 40, random);
+  const Matrix3X values = Matrix3X::Random(2000, 3);
+  const Matrix3X expected = op.transpose() * values;
+  const Matrix3X result = dynsub::applyTransposed(op, values);
+  ASSERT_EQ(result.rows(), 40);
+  EXPECT_TRUE((result.array() == expected.array()).all());
+  EXPECT_THROW(dynsub::applyTransposed(op, Matrix3X::Random(1999, 3)), std::invalid_argument);
+}
+
 TEST(ApplyOperator, AnEmptyOperatorGivesNoRows) {
   const SparseMatrix op(0, 4);
   EXPECT_EQ(dynsub::applyOperator(op, Matrix3X::Zero(4, 3)).rows(), 0);

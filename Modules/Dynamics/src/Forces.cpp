@@ -67,7 +67,7 @@ namespace {
 
 // sum_q w_q J_q^T (f_q |s_u x s_v|_q) with f given per point, or P n for inflation.
 Matrix3X integrate(const SurfaceQuadrature& q, const Matrix3X& densityTimesArea) {
-  return q.J.transpose() * (q.weights.asDiagonal() * densityTimesArea);
+  return applyTransposed(q.J, q.weights.asDiagonal() * densityTimesArea);
 }
 
 // |s_u x s_v| at every quadrature point: surface area per unit parametric area.

@@ -124,11 +124,13 @@ Mask edgeMap(const Volume& magnitude, const std::vector<Vector3>& gradient, cons
 
 // Central-difference gradient of a potential, in LPS per mm, normalized;
 // zero where the gradient vanishes or `keep` is false.
-void normalizedGradient(const Volume& potential, const std::vector<std::uint8_t>& keep, Volume components[3]) {
+// The unit gradient of `potential` where `keep` is set, zero elsewhere, as
+// x, y, z side by side per voxel.
+std::vector<float> normalizedGradient(const Volume& potential, const std::vector<std::uint8_t>& keep) {
   const ImageGeometry& g = potential.geometry;
   // d/dx_phys = D^-T (d/dindex / spacing).
   const Matrix3 toPhysical = g.direction.inverse().transpose();
-  for (int a = 0; a < 3; ++a) components[a] = Volume{g, std::vector<float>(potential.voxels.size(), 0.0f)};
+  std::vector<float> vectors(3 * potential.voxels.size(), 0.0f);
   for (int k = 0; k < g.size[2]; ++k)
     for (int j = 0; j < g.size[1]; ++j)
       for (int i = 0; i < g.size[0]; ++i) {
@@ -148,8 +150,9 @@ void normalizedGradient(const Volume& potential, const std::vector<std::uint8_t>
         const Vector3 gradient = toPhysical * derivative;
         const double norm = gradient.norm();
         if (!(norm > 1e-12)) continue;
-        for (int a = 0; a < 3; ++a) components[a].voxels[v] = static_cast<float>(gradient[a] / norm);
+        for (int a = 0; a < 3; ++a) vectors[3 * v + a] = static_cast<float>(gradient[a] / norm);
       }
+  return vectors;
 }
 
 }  // namespace
@@ -177,7 +180,7 @@ EdgeField::EdgeField(const Volume& image, const EdgeOptions& options, const Matr
   const std::vector<Vector3> gradient = smoothedGradient(image, options.sigma);
   const Volume magnitude = magnitudeOf(image.geometry, gradient);
   if (options.method == EdgeMethod::GradientMagnitude) {
-    normalizedGradient(magnitude, std::vector<std::uint8_t>(magnitude.voxels.size(), 1), components_);
+    vectors_ = normalizedGradient(magnitude, std::vector<std::uint8_t>(magnitude.voxels.size(), 1));
     return;
   }
   scale_ = edgeScale(magnitude, options, landmarks);
@@ -191,7 +194,7 @@ EdgeField::EdgeField(const Volume& image, const EdgeOptions& options, const Matr
     keep[v] = potential.voxels[v] <= options.captureRange ? 1 : 0;
     potential.voxels[v] = -potential.voxels[v];
   }
-  normalizedGradient(potential, keep, components_);
+  vectors_ = normalizedGradient(potential, keep);
 }
 
 double EdgeField::slopeBound() const { return 2.0 / geometry_.spacing.minCoeff(); }
@@ -205,11 +208,20 @@ double EdgeField::edgeDistance(const Vector3& point) const {
 Matrix3X EdgeField::sample(const Matrix3X& points) const {
   Matrix3X result = Matrix3X::Zero(points.rows(), 3);
   const Matrix3 toIndex = geometry_.indexFromPhysical();
+  const float* vectors = vectors_.data();
   for (Eigen::Index p = 0; p < points.rows(); ++p) {
     const Vector3 index = toIndex * (points.row(p).transpose() - geometry_.origin);
     if (!geometry_.spans(index)) continue;
-    const Trilinear corners = trilinearAt(components_[0].geometry, index);
-    for (int a = 0; a < 3; ++a) result(p, a) = components_[a].interpolate(corners);
+    // Volume::interpolate's weights and sums (trilinearAt), for the three
+    // components at once.
+    const Trilinear corners = trilinearAt(geometry_, index);
+    double sum[3] = {0.0, 0.0, 0.0};
+    for (int c = 0; c < 8; ++c) {
+      if (corners.weight[c] == 0) continue;
+      const float* v = vectors + 3 * corners.offset[c];
+      for (int a = 0; a < 3; ++a) sum[a] += corners.weight[c] * v[a];
+    }
+    for (int a = 0; a < 3; ++a) result(p, a) = sum[a];
   }
   return result;
 }

@@ -83,6 +83,32 @@ inline void applyOperators(const SparseMatrix& a, const SparseMatrix& b, const S
   }
 }
 
+// op^T * values (values: one row per row of op) in one pass over a compressed
+// operator, all three coordinates at once: the integrals over quadrature
+// points, J^T f. The same sums in the same order as Eigen's
+// op.transpose() * values (each result row summed over op's rows in order),
+// which makes three passes, one per column.
+inline Matrix3X applyTransposed(const SparseMatrix& op, const Matrix3X& values) {
+  if (!op.isCompressed() || op.rows() != values.rows())
+    throw std::invalid_argument("applyTransposed: an uncompressed operator or one row of values per row expected");
+  Matrix3X result = Matrix3X::Zero(op.cols(), 3);
+  const int* outer = op.outerIndexPtr();
+  const int* inner = op.innerIndexPtr();
+  const double* weight = op.valuePtr();
+  double* x = result.data();
+  double* y = x + result.rows();
+  double* z = y + result.rows();
+  for (Eigen::Index row = 0; row < op.rows(); ++row) {
+    const double vx = values(row, 0), vy = values(row, 1), vz = values(row, 2);
+    for (int k = outer[row]; k < outer[row + 1]; ++k) {
+      x[inner[k]] += weight[k] * vx;
+      y[inner[k]] += weight[k] * vy;
+      z[inner[k]] += weight[k] * vz;
+    }
+  }
+  return result;
+}
+
 inline Matrix3X applyOperator(const SparseMatrix& op, const Matrix3X& points) {
   Matrix3X result;
   applyOperator(op, points, result);

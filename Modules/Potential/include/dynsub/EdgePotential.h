@@ -110,7 +110,9 @@ class EdgeField {
  private:
   ImageGeometry geometry_;
   EdgeScale scale_;
-  Volume components_[3];
+  // The unit vectors, x, y and z side by side per voxel: sample() reads a
+  // voxel's three components from one cache line.
+  std::vector<float> vectors_;
   Mask edges_;
   Volume edgeDistance_;  // MongaDeriche only: step 4's distance d
   bool hasEdges_ = false;
