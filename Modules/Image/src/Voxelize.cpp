@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
+#include <cstdint>
+#include <vector>
 
 #include "dynsub/Error.h"
 
@@ -10,19 +11,28 @@ namespace dynsub {
 
 Mask voxelizeSurface(const Matrix3X& points, const std::vector<std::array<int, 3>>& triangles,
                      const ImageGeometry& grid) {
-  std::map<std::pair<int, int>, int> edgeUses;
+  // Every edge must be shared by two triangles. The edges as sorted keys
+  // (the lower point's index, then the higher's), counted in runs.
+  // NB: a std::map of the edges was three quarters of the voxelization (49 000
+  // triangles for a segmentation's output).
+  std::vector<std::uint64_t> edges;
+  edges.reserve(3 * triangles.size());
   for (const auto& t : triangles)
     for (int e = 0; e < 3; ++e) {
       const int a = t[e], b = t[(e + 1) % 3];
       if (a < 0 || b < 0 || a >= points.rows() || b >= points.rows())
         throw Error("cannot voxelize: a triangle names point " + std::to_string(std::max(a, b)) + " of " +
                     std::to_string(points.rows()));
-      ++edgeUses[{std::min(a, b), std::max(a, b)}];
+      edges.push_back(static_cast<std::uint64_t>(std::min(a, b)) << 32 | static_cast<std::uint32_t>(std::max(a, b)));
     }
-  for (const auto& [edge, uses] : edgeUses)
-    if (uses != 2)
-      throw Error("cannot voxelize: the surface is not closed (edge " + std::to_string(edge.first) + "-" +
-                  std::to_string(edge.second) + " is shared by " + std::to_string(uses) + " triangle(s))");
+  std::sort(edges.begin(), edges.end());
+  for (std::size_t first = 0, last = 0; first < edges.size(); first = last) {
+    while (last < edges.size() && edges[last] == edges[first]) ++last;
+    if (last - first != 2)
+      throw Error("cannot voxelize: the surface is not closed (edge " + std::to_string(edges[first] >> 32) + "-" +
+                  std::to_string(edges[first] & 0xffffffffu) + " is shared by " + std::to_string(last - first) +
+                  " triangle(s))");
+  }
 
   Mask mask{grid, std::vector<std::uint8_t>(grid.voxelCount(), 0)};
   const int rowsJ = grid.size[1], rowsK = grid.size[2];

@@ -1,7 +1,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "TestGrids.h"
@@ -71,8 +74,30 @@ TEST(Voxelize, OpenSurfaceIsRefused) {
   Matrix3X points;
   std::vector<std::array<int, 3>> triangles;
   uvSphere(Vector3(10, 10, 10), 5, points, triangles);
-  triangles.pop_back();
-  EXPECT_THROW(voxelizeSurface(points, triangles, g), Error);
+  // The last triangle twice (its edges used 3 times), or not at all (once):
+  // the error names the first of its edges (lower point index first) and the
+  // count.
+  const std::array<int, 3> last = triangles.back();
+  std::pair<int, int> lowest{INT_MAX, INT_MAX};
+  for (int e = 0; e < 3; ++e)
+    lowest = std::min(lowest, std::pair<int, int>(std::minmax(last[e], last[(e + 1) % 3])));
+  const std::string firstEdge = "edge " + std::to_string(lowest.first) + "-" + std::to_string(lowest.second) + " is shared by ";
+  for (const int uses : {3, 1}) {
+    std::vector<std::array<int, 3>> changed = triangles;
+    if (uses == 3) {
+      changed.push_back(last);
+    } else {
+      changed.pop_back();
+    }
+    try {
+      voxelizeSurface(points, changed, g);
+      ADD_FAILURE() << "a surface not closed was voxelized";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("not closed (" + firstEdge + std::to_string(uses) + " triangle(s))"),
+                std::string::npos)
+          << e.what();
+    }
+  }
 }
 
 // selectLabels takes the voxels whose value rounds to a wanted label, halves
