@@ -41,32 +41,6 @@ ImageGeometry ImageGeometry::region(const std::array<int, 3>& first, const std::
   return result;
 }
 
-Trilinear trilinearAt(const ImageGeometry& geometry, const Vector3& index) {
-  const auto& n = geometry.size;
-  int base[3];
-  double t[3];
-  for (int a = 0; a < 3; ++a) {
-    const double x = std::clamp(index[a], 0.0, static_cast<double>(n[a] - 1));
-    base[a] = std::min(static_cast<int>(std::floor(x)), std::max(n[a] - 2, 0));
-    t[a] = x - base[a];
-  }
-  Trilinear corners;
-  for (int corner = 0; corner < 8; ++corner) {
-    double weight = 1;
-    int at[3];
-    for (int a = 0; a < 3; ++a) {
-      const int high = (corner >> a) & 1;
-      weight *= high ? t[a] : 1 - t[a];
-      at[a] = std::min(base[a] + high, n[a] - 1);
-    }
-    corners.weight[corner] = weight;
-    corners.offset[corner] = geometry.offset(at[0], at[1], at[2]);
-  }
-  return corners;
-}
-
-double Volume::interpolate(const Vector3& index) const { return interpolate(trilinearAt(geometry, index)); }
-
 long long Mask::count() const {
   return std::count(voxels.begin(), voxels.end(), std::uint8_t{1});
 }

@@ -3,7 +3,9 @@
 // never includes ITK. Physical space is LPS mm, as in ITK and DICOM:
 //   x_mm = origin + direction * diag(spacing) * index,
 // with index (i, j, k) of a voxel centre and i varying fastest in memory.
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -54,7 +56,30 @@ struct Trilinear {
   long long offset[8];
   double weight[8];
 };
-Trilinear trilinearAt(const ImageGeometry& geometry, const Vector3& index);
+// Inline: the edge field samples it at every quadrature point of every step.
+inline Trilinear trilinearAt(const ImageGeometry& geometry, const Vector3& index) {
+  const auto& n = geometry.size;
+  int base[3];
+  double t[3];
+  for (int a = 0; a < 3; ++a) {
+    const double x = std::clamp(index[a], 0.0, static_cast<double>(n[a] - 1));
+    base[a] = std::min(static_cast<int>(std::floor(x)), std::max(n[a] - 2, 0));
+    t[a] = x - base[a];
+  }
+  Trilinear corners;
+  for (int corner = 0; corner < 8; ++corner) {
+    double weight = 1;
+    int at[3];
+    for (int a = 0; a < 3; ++a) {
+      const int high = (corner >> a) & 1;
+      weight *= high ? t[a] : 1 - t[a];
+      at[a] = std::min(base[a] + high, n[a] - 1);
+    }
+    corners.weight[corner] = weight;
+    corners.offset[corner] = geometry.offset(at[0], at[1], at[2]);
+  }
+  return corners;
+}
 
 // An intensity image (any pixel type read as float).
 struct Volume {
@@ -63,7 +88,7 @@ struct Volume {
 
   float at(int i, int j, int k) const { return voxels[geometry.offset(i, j, k)]; }
   // Trilinear interpolation at a continuous index; clamped to the image.
-  double interpolate(const Vector3& index) const;
+  double interpolate(const Vector3& index) const { return interpolate(trilinearAt(geometry, index)); }
   // The same from a lookup made on this image's geometry.
   double interpolate(const Trilinear& corners) const {
     double sum = 0;
