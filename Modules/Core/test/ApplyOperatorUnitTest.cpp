@@ -70,6 +70,22 @@ TEST(ApplyOperators, EqualThreeApplicationsToTheBitAndRefuseOtherPatterns) {
   EXPECT_THROW(dynsub::applyOperators(a, other, c, points, ra, rb, rc), std::invalid_argument);
 }
 
+TEST(ApplyOperator, EqualsEigensProductToTheBitForAColumnMajorOperator) {
+  // The physical matrices' storage; many entries per result row, so another
+  // order of summation would round otherwise. Also uncompressed (room kept
+  // in each column after reserve()).
+  std::mt19937 random(9);
+  Eigen::SparseMatrix<double, Eigen::ColMajor> op = randomOperator(300, 300, random);
+  const Matrix3X points = Matrix3X::Random(300, 3);
+  const Matrix3X expected = op * points;
+  EXPECT_TRUE((dynsub::applyOperator(op, points).array() == expected.array()).all());
+  op.reserve(Eigen::VectorXi::Constant(300, 3));
+  op.coeffRef(5, 299) += 0.75;
+  ASSERT_FALSE(op.isCompressed());
+  const Matrix3X again = op * points;
+  EXPECT_TRUE((dynsub::applyOperator(op, points).array() == again.array()).all());
+}
+
 TEST(ApplyTransposed, EqualsEigensTransposedProductToTheBitAndRefusesAMismatch) {
   // Many rows into few columns, so each result row sums many terms, where
   // another order of summation would round otherwise.
