@@ -97,6 +97,13 @@ TEST(ApplyTransposed, EqualsEigensTransposedProductToTheBitAndRefusesAMismatch) 
   ASSERT_EQ(result.rows(), 40);
   EXPECT_TRUE((result.array() == expected.array()).all());
   EXPECT_THROW(dynsub::applyTransposed(op, Matrix3X::Random(1999, 3)), std::invalid_argument);
+  // Uncompressed: only each row's counted entries are read.
+  SparseMatrix roomy = op;
+  roomy.reserve(Eigen::VectorXi::Constant(2000, 2));
+  roomy.coeffRef(3, 39) += 0.5;
+  ASSERT_FALSE(roomy.isCompressed());
+  const Matrix3X again = roomy.transpose() * values;
+  EXPECT_TRUE((dynsub::applyTransposed(roomy, values).array() == again.array()).all());
 }
 
 TEST(ApplyOperator, AnEmptyOperatorGivesNoRows) {

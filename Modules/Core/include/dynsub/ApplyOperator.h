@@ -83,14 +83,14 @@ inline void applyOperators(const SparseMatrix& a, const SparseMatrix& b, const S
   }
 }
 
-// op * points for a column-major operator (the physical matrices), in one
-// pass over it, all three coordinates at once. The same sums in the same
-// order as Eigen's op * points, which makes three passes, one per column.
-// NB: the energy's x^T K x and x^T M x at every time step were a twentieth
-// of a segmentation, most of it Eigen's three scattering passes.
-inline Matrix3X applyOperator(const Eigen::SparseMatrix<double, Eigen::ColMajor>& op, const Matrix3X& points) {
-  eigen_assert(op.cols() == points.rows());
-  Matrix3X result = Matrix3X::Zero(op.rows(), 3);
+namespace detail {
+
+// For each outer vector o of `op`'s storage (a column of a column-major
+// matrix, a row of a row-major one), in order: each of its entries (inner
+// index i, weight w) adds w * input.row(o) to result.row(i), x, y and z in
+// one pass. Column-major, this is op * input; row-major, op^T * input.
+template <int Options>
+void scatterAdd(const Eigen::SparseMatrix<double, Options>& op, const Matrix3X& input, Matrix3X& result) {
   const int* outer = op.outerIndexPtr();
   const int* counts = op.innerNonZeroPtr();  // null when compressed
   const int* inner = op.innerIndexPtr();
@@ -98,41 +98,40 @@ inline Matrix3X applyOperator(const Eigen::SparseMatrix<double, Eigen::ColMajor>
   double* x = result.data();
   double* y = x + result.rows();
   double* z = y + result.rows();
-  for (Eigen::Index column = 0; column < op.cols(); ++column) {
-    const double px = points(column, 0), py = points(column, 1), pz = points(column, 2);
-    const int end = counts ? outer[column] + counts[column] : outer[column + 1];
-    for (int k = outer[column]; k < end; ++k) {
+  for (Eigen::Index o = 0; o < op.outerSize(); ++o) {
+    const double px = input(o, 0), py = input(o, 1), pz = input(o, 2);
+    const int end = counts ? outer[o] + counts[o] : outer[o + 1];
+    for (int k = outer[o]; k < end; ++k) {
       x[inner[k]] += weight[k] * px;
       y[inner[k]] += weight[k] * py;
       z[inner[k]] += weight[k] * pz;
     }
   }
+}
+
+}  // namespace detail
+
+// op * points for a column-major operator (the physical matrices), in one
+// pass over it, all three coordinates at once. The same sums in the same
+// order as Eigen's op * points, which makes three passes, one per column.
+// NB: the energy's x^T K x and v^T M v at every time step were a twentieth
+// of a segmentation, most of it Eigen's three scattering passes.
+inline Matrix3X applyOperator(const Eigen::SparseMatrix<double, Eigen::ColMajor>& op, const Matrix3X& points) {
+  eigen_assert(op.cols() == points.rows());
+  Matrix3X result = Matrix3X::Zero(op.rows(), 3);
+  detail::scatterAdd(op, points, result);
   return result;
 }
 
-// op^T * values (values: one row per row of op) in one pass over a compressed
+// op^T * values (values: one row per row of op) in one pass over the
 // operator, all three coordinates at once: the integrals over quadrature
 // points, J^T f. The same sums in the same order as Eigen's
 // op.transpose() * values (each result row summed over op's rows in order),
 // which makes three passes, one per column.
 inline Matrix3X applyTransposed(const SparseMatrix& op, const Matrix3X& values) {
-  if (!op.isCompressed() || op.rows() != values.rows())
-    throw std::invalid_argument("applyTransposed: an uncompressed operator or one row of values per row expected");
+  if (op.rows() != values.rows()) throw std::invalid_argument("applyTransposed: one row of values per row expected");
   Matrix3X result = Matrix3X::Zero(op.cols(), 3);
-  const int* outer = op.outerIndexPtr();
-  const int* inner = op.innerIndexPtr();
-  const double* weight = op.valuePtr();
-  double* x = result.data();
-  double* y = x + result.rows();
-  double* z = y + result.rows();
-  for (Eigen::Index row = 0; row < op.rows(); ++row) {
-    const double vx = values(row, 0), vy = values(row, 1), vz = values(row, 2);
-    for (int k = outer[row]; k < outer[row + 1]; ++k) {
-      x[inner[k]] += weight[k] * vx;
-      y[inner[k]] += weight[k] * vy;
-      z[inner[k]] += weight[k] * vz;
-    }
-  }
+  detail::scatterAdd(op, values, result);
   return result;
 }
 
