@@ -304,7 +304,7 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
   // the path of a level accepted at the looser rule must not depend on it.)
   bool lastStill = false;
   for (int step = 1; step <= options.equilibrium.maxSteps; ++step) {
-    const Matrix3X residual = force - applyOperator(model.matrices.stiffness, points);
+    const Matrix3X residual = force - model.matrices.stiffness * points;
     Matrix3X trial, trialForce;
     double trialEnergy = energy;
     bool accepted = false, evaluated = false;
@@ -387,7 +387,7 @@ double equilibriumResidual(const LevelModel& model, const std::vector<ForceModel
                            const std::vector<int>& fixed) {
   double potential = 0.0;
   Matrix3X force = totalForce(forces, points, potential);
-  Matrix3X elastic = applyOperator(model.matrices.stiffness, points);
+  Matrix3X elastic = model.matrices.stiffness * points;
   for (int v : fixed) {  // fixed vertices are held by their supports
     force.row(v).setZero();
     elastic.row(v).setZero();
