@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <filesystem>
 
+#include <vtkCallbackCommand.h>
 #include <vtkDoubleArray.h>
+#include <vtkExecutive.h>
 #include <vtkFieldData.h>
 #include <vtkErrorCode.h>
 #include <vtkNew.h>
@@ -55,9 +57,17 @@ void writeTriangleSurface(const TriangleSurface& surface, const std::string& pat
   }
   // VTK's writers can return success on a full disk (an XML writer cut
   // short at 16 KiB returned 1, measured): their error code tells.
+  // VTK's own account of a failed write (the writer's error, then its
+  // pipeline's dump of the request) is taken by an observer that drops it:
+  // the error below names the file and the cause in one line.
+  vtkNew<vtkCallbackCommand> quiet;
   auto write = [&](auto& writer) {
     writer->SetFileName(output.temporaryPath().c_str());
     writer->SetInputData(polyData);
+    for (vtkObject* source : {static_cast<vtkObject*>(writer.GetPointer()), static_cast<vtkObject*>(writer->GetExecutive())}) {
+      source->AddObserver(vtkCommand::ErrorEvent, quiet);
+      source->AddObserver(vtkCommand::WarningEvent, quiet);
+    }
     const int written = writer->Write();
     const unsigned long code = writer->GetErrorCode();
     if (written != 1 || code != vtkErrorCode::NoError)

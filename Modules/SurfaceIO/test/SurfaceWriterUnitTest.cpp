@@ -1,7 +1,11 @@
 // Unit tests (no rendering): written surfaces read back through VTK's readers
 // with the same points, triangles and element tags.
+#include <sys/resource.h>
+
 #include <cmath>
+#include <csignal>
 #include <filesystem>
+#include <string>
 
 #include <gtest/gtest.h>
 #include <vtkCellData.h>
@@ -131,6 +135,35 @@ TEST(SurfaceWriter, BadTargetsLeaveNoFile) {
   broken.points(3, 1) = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(dynsub::writeTriangleSurface(broken, scratch("nan.vtp")), dynsub::Error);
   EXPECT_FALSE(fs::exists(scratch("nan.vtp")));
+}
+
+// A write cut short (here by a file-size limit, as a full disk would) fails
+// with one error that names the file and leaves nothing, and VTK's own
+// account of it (the writer's error and its pipeline's dump) is not printed.
+TEST(SurfaceWriter, AWriteCutShortFailsInOneLine) {
+  const dynsub::ControlMesh cube = dynsub::makeCube98();
+  const dynsub::LimitSurface limit(cube);
+  const dynsub::TriangleSurface surface = dynsub::tessellate(limit, cube.points(), 16);  // about 1 MB as .vtp
+  const std::string path = scratch("cut-short.vtp");
+  rlimit was{};
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &was), 0);
+  const auto previousHandler = std::signal(SIGXFSZ, SIG_IGN);  // EFBIG instead of the signal
+  rlimit small = was;
+  small.rlim_cur = 64 * 1024;
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &small), 0);
+  testing::internal::CaptureStderr();
+  std::string message;
+  try {
+    dynsub::writeTriangleSurface(surface, path);
+  } catch (const dynsub::Error& e) {
+    message = e.what();
+  }
+  const std::string printed = testing::internal::GetCapturedStderr();
+  setrlimit(RLIMIT_FSIZE, &was);
+  std::signal(SIGXFSZ, previousHandler);
+  EXPECT_NE(message.find(path), std::string::npos) << "no error naming the file: '" << message << "'";
+  EXPECT_EQ(printed, "");
+  EXPECT_FALSE(fs::exists(path));
 }
 
 }  // namespace
