@@ -149,15 +149,19 @@ int run(int argc, char** argv) {
                std::to_string(static_cast<int>(dynsubPeak)) + " MB");
   std::printf("  stages: crop %.4f s, edge potential %.3f s, evolution %.3f s, voxelize %.3f s\n",
               dynsub.seconds.crop, dynsub.seconds.potential, dynsub.seconds.evolution, voxelizeSeconds);
+  // One timed round of DynSub's segmentation and its labelmap, as the
+  // command makes them: its seconds and its labelmap.
+  auto dynsubRound = [&](std::vector<double>& seconds) {
+    const auto started = std::chrono::steady_clock::now();
+    const SegmentResult again = segment(image, landmarks, initial, SegmentOptions());
+    Mask labelmap = labelmapOf(again.surface, image.geometry);
+    seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+    return labelmap;
+  };
   if (dynsubOnly) {
     refitAfterOneLandmark(image, reference, landmarks, initial, dynsub);
     std::vector<double> seconds;
-    for (int r = 0; r < rounds; ++r) {
-      const auto started = std::chrono::steady_clock::now();
-      const SegmentResult again = segment(image, landmarks, initial, SegmentOptions());
-      const Mask labelmap = labelmapOf(again.surface, image.geometry);
-      seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
-    }
+    for (int r = 0; r < rounds; ++r) dynsubRound(seconds);
     if (rounds > 0) std::printf("dynsub segment alone, %d rounds: %s\n", rounds, spread(seconds).c_str());
     return 0;
   }
@@ -246,11 +250,7 @@ int run(int argc, char** argv) {
   fastest.window = 1.0;
   fastest.curvature = 3.0;
   for (int r = 0; r < rounds; ++r) {
-    const auto started = std::chrono::steady_clock::now();
-    const SegmentResult again = segment(image, landmarks, initial, SegmentOptions());
-    const Mask labelmap = labelmapOf(again.surface, image.geometry);
-    dynsubRounds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
-    dynsubDice = compareMasks(labelmap, reference).dice;
+    dynsubDice = compareMasks(dynsubRound(dynsubRounds), reference).dice;
     const itkbaseline::ThresholdLevelSetResult itk =
         itkbaseline::thresholdLevelSet(toBridge(region), cropped.voxels, initialMask.voxels, edgeVoxels, fastest);
     itkRounds.push_back(itk.seconds);

@@ -385,10 +385,11 @@ std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries,
   // A tracked point is kept when no sample is nearer (Impl::sampleNearer).
   // The checks are made on the tree as it was built, for the samples within
   // the drift. The few queries they leave undecided are decided on that old
-  // tree too, exactly (sampleNearer checking up to kMostInBall samples, and
-  // a full search of the samples nearest now where one is nearer); when
-  // there are more than kMostUndecided, or a hint is off the surface, or a
-  // ball is too full, the tree is rebuilt and every query is decided on the
+  // tree too, exactly (sampleNearer checking up to the share of samples
+  // below, and a full search of the samples nearest now where one is
+  // nearer); when there are more than kMostUndecided, or that share is under
+  // kMostChecked, or a hint is off the surface, or a ball is too full, the
+  // tree is rebuilt and every query is decided on the
   // current one.
   // NB: early in a fit 80-95 % of the kitten's queries came out Unknown
   // (over 64 samples in the ball of the drift): past kMostUndecided the

@@ -143,8 +143,6 @@ double shapeMotion(const SurfaceFrame& from, const SurfaceFrame& to) {
   return largest;
 }
 
-// Coarse: a level below the maximum settled to the looser rule and its fit
-// was not accepted (EquilibriumOptions::coarseLevelFactor).
 // The equilibrium rule `coarseLevelFactor` times looser (Simulation.h).
 EquilibriumOptions loosened(const EquilibriumOptions& options) {
   EquilibriumOptions loose = options;
@@ -178,6 +176,8 @@ class StepShapeMotion {
   std::optional<SurfaceFrame> previousFrame_, frame_;  // at `previous` and `current`, once computed
 };
 
+// Coarse: a level below the maximum settled to the looser rule and its fit
+// was not accepted (EquilibriumOptions::coarseLevelFactor).
 enum class LevelEnd { Equilibrium, Coarse, StepLimit, Diverged };
 
 // The papers' time stepping (Integrator.h) from model.start; `points` ends at

@@ -122,10 +122,9 @@ Mask edgeMap(const Volume& magnitude, const std::vector<Vector3>& gradient, cons
   return edges;
 }
 
-// Central-difference gradient of a potential, in LPS per mm, normalized;
-// zero where the gradient vanishes or `keep` is false.
-// The unit gradient of `potential` where `keep` is set, zero elsewhere, as
-// x, y, z side by side per voxel.
+// The central-difference gradient of a potential, in LPS per mm, normalized,
+// as x, y, z side by side per voxel; zero where the gradient vanishes or
+// `keep` is false.
 std::vector<float> normalizedGradient(const Volume& potential, const std::vector<std::uint8_t>& keep) {
   const ImageGeometry& g = potential.geometry;
   // d/dx_phys = D^-T (d/dindex / spacing).

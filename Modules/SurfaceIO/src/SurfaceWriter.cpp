@@ -64,7 +64,8 @@ void writeTriangleSurface(const TriangleSurface& surface, const std::string& pat
   auto write = [&](auto& writer) {
     writer->SetFileName(output.temporaryPath().c_str());
     writer->SetInputData(polyData);
-    for (vtkObject* source : {static_cast<vtkObject*>(writer.GetPointer()), static_cast<vtkObject*>(writer->GetExecutive())}) {
+    vtkObject* const sources[] = {writer.GetPointer(), writer->GetExecutive()};
+    for (vtkObject* source : sources) {
       source->AddObserver(vtkCommand::ErrorEvent, quiet);
       source->AddObserver(vtkCommand::WarningEvent, quiet);
     }
