@@ -192,6 +192,13 @@ int metaElementBytes(const std::string& type) {
 }
 
 
+// The error for `bad` NaN or infinite voxels, the first at index `first`.
+std::string nonFiniteMessage(std::uintmax_t bad, std::uintmax_t first, const std::array<std::int64_t, 3>& size) {
+  const std::uintmax_t i = first % size[0], j = first / size[0] % size[1], k = first / size[0] / size[1];
+  return std::to_string(bad) + " voxel(s) are NaN or infinite, the first at index (" + std::to_string(i) + ", " +
+         std::to_string(j) + ", " + std::to_string(k) + "); intensities must be finite";
+}
+
 // Scans `voxels` float (4-byte) or double (8-byte) values from byte `offset`
 // of a file (inflated when gzipped); throws naming the count of NaN or
 // infinite ones and the voxel index (i, j, k) of the first.
@@ -222,10 +229,7 @@ void requireFiniteVoxels(const std::string& path, bool gzipped, std::uintmax_t o
   }
   gzclose(file);
   if (!ok) throw Error(path, std::string("cannot read its ") + (gzipped ? "compressed " : "") + "voxels");
-  if (bad == 0) return;
-  const std::uintmax_t i = first % size[0], j = first / size[0] % size[1], k = first / size[0] / size[1];
-  throw Error(path, std::to_string(bad) + " voxel(s) are NaN or infinite, the first at index (" + std::to_string(i) +
-                        ", " + std::to_string(j) + ", " + std::to_string(k) + "); intensities must be finite");
+  if (bad) throw Error(path, nonFiniteMessage(bad, first, size));
 }
 
 }  // namespace
@@ -261,10 +265,94 @@ void requireMemoryFor(const std::string& path, std::uintmax_t voxels) {
   }
 }
 
-// NIfTI-1 (348-byte header) and NIfTI-2 (540), either byte order. ITK's reader
-// fills a truncated .nii, or a .nii.gz whose gzip stream is cut short, with
-// zeros without complaint, and allocates whatever the header announces.
-void checkNiftiFile(const std::string& path) {
+namespace {
+
+// `n` stored values of type T (in the file's byte order) as float, the way
+// ITK's reader turns them into float: static_cast.
+template <class T>
+void storedAsFloat(const unsigned char* bytes, std::size_t n, bool swap, float* out) {
+  for (std::size_t v = 0; v < n; ++v, bytes += sizeof(T)) {
+    unsigned char value[sizeof(T)];
+    std::memcpy(value, bytes, sizeof(T));
+    if (swap) std::reverse(value, value + sizeof(T));
+    T number;
+    std::memcpy(&number, value, sizeof(T));
+    out[v] = static_cast<float>(number);
+  }
+}
+
+using StoredAsFloat = void (*)(const unsigned char*, std::size_t, bool, float*);
+
+// The conversion of a NIfTI datatype DynSub reads itself (readNiftiVoxels),
+// or null.
+StoredAsFloat converterOf(int datatype) {
+  switch (datatype) {
+    case 2: return &storedAsFloat<std::uint8_t>;
+    case 256: return &storedAsFloat<std::int8_t>;
+    case 4: return &storedAsFloat<std::int16_t>;
+    case 512: return &storedAsFloat<std::uint16_t>;
+    case 8: return &storedAsFloat<std::int32_t>;
+    case 768: return &storedAsFloat<std::uint32_t>;
+    case 16: return &storedAsFloat<float>;
+    case 64: return &storedAsFloat<double>;
+    default: return nullptr;
+  }
+}
+
+// The bytes from `offset` on of a .nii or .nii.gz, in chunks: read(into, n)
+// returns how many of n bytes it got (fewer only at the end of the data).
+class DataReader {
+ public:
+  DataReader(const std::string& path, bool gzipped, std::uintmax_t offset) : path_(path), gzipped_(gzipped) {
+    if (gzipped_) {
+      gz_ = gzopen(path.c_str(), "rb");
+      if (!gz_) throw Error(path, "cannot be opened");
+      gzbuffer(gz_, 1 << 17);
+      ok_ = gzseek(gz_, static_cast<z_off_t>(offset), SEEK_SET) >= 0;
+    } else {
+      in_.open(path, std::ios::binary);
+      if (!in_) throw Error(path, "cannot be opened");
+      ok_ = static_cast<bool>(in_.seekg(static_cast<std::streamoff>(offset)));
+    }
+  }
+  ~DataReader() {
+    if (gz_) gzclose(gz_);
+  }
+  DataReader(const DataReader&) = delete;
+  DataReader& operator=(const DataReader&) = delete;
+
+  std::size_t read(unsigned char* into, std::size_t n) {
+    if (!ok_) return 0;
+    if (gzipped_) {
+      const int got = gzread(gz_, into, static_cast<unsigned>(n));
+      if (got < 0) ok_ = false;
+      return got > 0 ? static_cast<std::size_t>(got) : 0;
+    }
+    in_.read(reinterpret_cast<char*>(into), static_cast<std::streamsize>(n));
+    return static_cast<std::size_t>(in_.gcount());
+  }
+  // Why the data ended early, in the words of inflatedSize's error.
+  [[noreturn]] void fail(std::uintmax_t inflated, std::uintmax_t needed) {
+    int code = Z_OK;
+    std::string message = gzipped_ && gz_ ? gzerror(gz_, &code) : "";
+    if (message.rfind(path_ + ": ", 0) == 0) message.erase(0, path_.size() + 2);  // zlib puts the path first
+    if (gzipped_ && code != Z_OK && code != Z_STREAM_END)
+      throw Error(path_, "truncated or corrupt compressed data (" + message + ") after " + std::to_string(inflated) +
+                             " bytes");
+    throw Error(path_, "truncated: " + std::to_string(inflated) + (gzipped_ ? " bytes inflated" : " bytes") +
+                           ", the header announces " + std::to_string(needed));
+  }
+
+ private:
+  std::string path_;
+  bool gzipped_;
+  gzFile gz_ = nullptr;
+  std::ifstream in_;
+  bool ok_ = false;
+};
+
+// checkNiftiFile, and with `voxels` given, readNiftiVoxels.
+bool niftiFile(const std::string& path, std::vector<float>* voxels) {
   const bool gzipped = lowerCaseExtension(path) == ".gz";
   unsigned char header[540] = {};
   std::uintmax_t got = 0;
@@ -309,17 +397,17 @@ void checkNiftiFile(const std::string& path) {
   const std::int64_t dimensions = dim(0);
   if (dimensions < 1 || dimensions > 7)
     throw Error(path, "a NIfTI header with " + std::to_string(dimensions) + " dimensions (1 to 7 are possible)");
-  std::uintmax_t voxels = 1;
+  std::uintmax_t count = 1;
   for (int i = 1; i <= dimensions; ++i) {
     if (dim(i) < 1) throw Error(path, "a NIfTI header with size " + std::to_string(dim(i)) + " along axis " +
                                           std::to_string(i - 1));
-    const auto next = product(voxels, static_cast<std::uintmax_t>(dim(i)));
+    const auto next = product(count, static_cast<std::uintmax_t>(dim(i)));
     if (!next) throw Error(path, "a NIfTI header whose size does not fit in 64 bits");
-    voxels = *next;
+    count = *next;
   }
   const int bytesPerVoxel = niftiBytesPerVoxel(datatype);
   if (!bytesPerVoxel) throw Error(path, "a NIfTI datatype " + std::to_string(datatype) + " that NIfTI does not define");
-  requireMemoryFor(path, voxels);
+  requireMemoryFor(path, count);
   double offset = 0;
   if (version == 1) {
     const auto bits = static_cast<std::uint32_t>(number(108, 4, swap));
@@ -331,20 +419,68 @@ void checkNiftiFile(const std::string& path) {
   }
   if (!(offset >= headerSize) || offset > 1e12)
     throw Error(path, "a NIfTI header whose data offset (vox_offset " + std::to_string(offset) + ") is not after it");
-  const auto needed = static_cast<std::uintmax_t>(offset) + voxels * bytesPerVoxel;
-  const auto actual = gzipped ? inflatedSize(path, needed) : fs::file_size(path);
-  if (actual < needed)
-    throw Error(path, "truncated: " + std::to_string(actual) + (gzipped ? " bytes inflated" : " bytes") +
-                          ", the header announces " + std::to_string(needed));
-  // ITK's NIfTI reader turns NaN and infinite voxels into 0 without a word
-  // (measured with ITK 5.2): float data is scanned for them here.
-  if (datatype == 16 || datatype == 64) {
-    std::array<std::int64_t, 3> size{1, 1, 1};
-    for (int a = 0; a < 3 && a < dimensions; ++a) size[a] = dim(a + 1);
-    requireFiniteVoxels(path, gzipped, static_cast<std::uintmax_t>(offset), voxels, datatype == 16 ? 4 : 8, swap,
-                        size);
+  const auto needed = static_cast<std::uintmax_t>(offset) + count * bytesPerVoxel;
+  std::array<std::int64_t, 3> size{1, 1, 1};
+  for (int a = 0; a < 3 && a < dimensions; ++a) size[a] = dim(a + 1);
+  // ITK reads the data of these as it is stored, then casts it to float:
+  // NIfTI-1 in one file, three dimensions, a plain number type, no intensity
+  // scaling and a whole data offset. Others (scaled, vectors, 4D, NIfTI-2) are
+  // left to ITK.
+  const StoredAsFloat convert = converterOf(datatype);
+  const auto slopeBits = static_cast<std::uint32_t>(number(112, 4, swap)),
+             interceptBits = static_cast<std::uint32_t>(number(116, 4, swap));
+  float slope = 0, intercept = 0;
+  std::memcpy(&slope, &slopeBits, sizeof slope);
+  std::memcpy(&intercept, &interceptBits, sizeof intercept);
+  const bool plain = voxels && version == 1 && std::memcmp(header + 344, "n+1", 4) == 0 && dimensions == 3 &&
+                     convert && slope == 1.0f && intercept == 0.0f && offset == std::floor(offset);
+  if (!plain) {
+    const auto actual = gzipped ? inflatedSize(path, needed) : fs::file_size(path);
+    if (actual < needed)
+      throw Error(path, "truncated: " + std::to_string(actual) + (gzipped ? " bytes inflated" : " bytes") +
+                            ", the header announces " + std::to_string(needed));
+    // ITK's NIfTI reader turns NaN and infinite voxels into 0 without a word
+    // (measured with ITK 5.2): float data is scanned for them here.
+    if (datatype == 16 || datatype == 64)
+      requireFiniteVoxels(path, gzipped, static_cast<std::uintmax_t>(offset), count, datatype == 16 ? 4 : 8, swap,
+                          size);
+    return false;
   }
+  if (!gzipped && fs::file_size(path) < needed)
+    throw Error(path, "truncated: " + std::to_string(fs::file_size(path)) + " bytes, the header announces " +
+                          std::to_string(needed));
+  // One pass: the data inflated chunk by chunk, each chunk converted.
+  DataReader data(path, gzipped, static_cast<std::uintmax_t>(offset));
+  std::vector<float> read(count);
+  std::vector<unsigned char> chunk(static_cast<std::size_t>(bytesPerVoxel) << 16);
+  const bool floating = datatype == 16 || datatype == 64;
+  std::uintmax_t done = 0, bad = 0, firstBad = 0;
+  while (done < count) {
+    const auto want = static_cast<std::size_t>(std::min<std::uintmax_t>(count - done, chunk.size() / bytesPerVoxel));
+    const std::size_t got = data.read(chunk.data(), want * bytesPerVoxel);
+    if (got < want * bytesPerVoxel)
+      data.fail(static_cast<std::uintmax_t>(offset) + done * bytesPerVoxel + got, needed);
+    float* out = read.data() + done;
+    convert(chunk.data(), want, swap, out);
+    if (floating)
+      for (std::size_t v = 0; v < want; ++v)
+        if (!std::isfinite(out[v]) && bad++ == 0) firstBad = done + v;
+    done += want;
+  }
+  // NaN stays NaN through the cast; a double beyond float's range becomes infinite.
+  if (bad) throw Error(path, nonFiniteMessage(bad, firstBad, size));
+  *voxels = std::move(read);
+  return true;
 }
+
+}  // namespace
+
+// NIfTI-1 (348-byte header) and NIfTI-2 (540), either byte order. ITK's reader
+// fills a truncated .nii, or a .nii.gz whose gzip stream is cut short, with
+// zeros without complaint, and allocates whatever the header announces.
+void checkNiftiFile(const std::string& path) { niftiFile(path, nullptr); }
+
+bool readNiftiVoxels(const std::string& path, std::vector<float>& voxels) { return niftiFile(path, &voxels); }
 
 // ITK reads a short compressed .mha without complaint. Lists and patterns of
 // slice files are left to ITK.
@@ -437,10 +573,14 @@ bool isDicomFile(const fs::path& file) {
 
 bool walkDicomFile(const fs::path& file) { return DicomWalk(file).run(); }
 
+bool isNiftiName(const std::string& path) {
+  const std::string extension = lowerCaseExtension(path);
+  return extension == ".nii" || (extension == ".gz" && lowerCaseExtension(path.substr(0, path.size() - 3)) == ".nii");
+}
+
 void checkImageFile(const std::string& path) {
   const std::string extension = lowerCaseExtension(path);
-  if (extension == ".nii" || (extension == ".gz" && lowerCaseExtension(path.substr(0, path.size() - 3)) == ".nii"))
-    checkNiftiFile(path);
+  if (isNiftiName(path)) checkNiftiFile(path);
   if (extension == ".mha" || extension == ".mhd") checkMetaImageFile(path);
 }
 

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace dynsub::filechecks {
 
@@ -24,11 +25,23 @@ void requireMemoryFor(const std::string& path, std::uintmax_t voxels);
 // dynsub::Error naming the file and the problem.
 void checkNiftiFile(const std::string& path);
 
+// checkNiftiFile's checks and, in the same pass over the data, the voxels as
+// float, for a file ITK would read as it is stored and cast to float: NIfTI-1
+// in one file (magic "n+1"), three dimensions, a datatype of 8 to 64 bit
+// integers or floats, no intensity scaling (scl_slope 1, scl_inter 0) and a
+// whole data offset. Returns false, with `voxels` untouched, after the same
+// checks for any other NIfTI file (ITK reads those). Throws as checkNiftiFile
+// does, and for NaN or infinite voxels (which ITK would turn into 0).
+bool readNiftiVoxels(const std::string& path, std::vector<float>& voxels);
+
 // A MetaImage file (.mha, .mhd): NDims, DimSize and ElementType are there and
 // possible, the image fits in memory, and its data is all there, after the
 // header (LOCAL) or in its data file, CompressedDataSize bytes when
 // compressed. Throws dynsub::Error naming the file that falls short.
 void checkMetaImageFile(const std::string& path);
+
+// Whether the file's name says NIfTI: .nii or .nii.gz (any case).
+bool isNiftiName(const std::string& path);
 
 // The checks above that the file's name calls for: NIfTI for .nii and
 // .nii.gz, MetaImage for .mha and .mhd; none for other names.

@@ -183,6 +183,22 @@ void readImage(const std::string& path, Geometry& geometry, std::vector<float>& 
   }
 }
 
+bool readGeometry(const std::string& path, Geometry& geometry) {
+  try {
+    // The reader's own output information, so the geometry is the one its
+    // Update would give (readImage).
+    auto reader = itk::ImageFileReader<FloatImage>::New();
+    reader->SetFileName(path);
+    reader->UpdateOutputInformation();
+    const itk::ImageIOBase* io = reader->GetImageIO();
+    if (io->GetNumberOfDimensions() != 3 || io->GetNumberOfComponents() != 1) return false;
+    geometry = geometryOf(reader->GetOutput());
+    return true;
+  } catch (const itk::ExceptionObject& e) {
+    throw Error(path, std::string("cannot read image: ") + e.GetDescription());
+  }
+}
+
 void writeLabels(const Geometry& geometry, const std::vector<std::uint8_t>& voxels, const std::string& path) {
   try {
     auto writer = itk::ImageFileWriter<MaskImage>::New();
@@ -229,6 +245,6 @@ std::vector<float> distanceMap(const Geometry& geometry, const std::vector<std::
 // The library's one exported symbol (it is built with hidden visibility).
 extern "C" __attribute__((visibility("default"))) const dynsub::itkbridge::Functions* dynsubItkBridgeFunctions() {
   using namespace dynsub::itkbridge;
-  static const Functions table{&readImage, &writeLabels, &recursiveGaussianGradient, &distanceMap};
+  static const Functions table{&readImage, &readGeometry, &writeLabels, &recursiveGaussianGradient, &distanceMap};
   return &table;
 }

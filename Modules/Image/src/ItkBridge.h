@@ -31,6 +31,10 @@ struct Functions {
   // float. Throws dynsub::Error naming the path. A file's own checks
   // (FileChecks.h: checkImageFile) are the caller's, made before.
   void (*readImage)(const std::string& path, Geometry& geometry, std::vector<float>& voxels);
+  // The geometry readImage would give a file, from its header alone; false
+  // when ITK does not see a 3D image of one component (readImage must then
+  // read it). Throws dynsub::Error naming the path.
+  bool (*readGeometry)(const std::string& path, Geometry& geometry);
   // An 8-bit labelmap, compressed when the format allows; throws dynsub::Error.
   void (*writeLabels)(const Geometry& geometry, const std::vector<std::uint8_t>& voxels, const std::string& path);
   // Gradient (physical LPS axes, per mm) of the image smoothed by a Gaussian of
