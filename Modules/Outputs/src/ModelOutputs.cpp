@@ -68,24 +68,27 @@ void writeModelOutputs(const std::filesystem::path& dir, const ControlMesh& mesh
                        const Report& report, const std::function<void(OutputSet&)>& extra,
                        const std::vector<PointScalars>& surfaceScalars, const std::string& space) {
   OutputSet outputs(dir);
-  // NB: surface.vtp is written on a second thread while the other outputs
-  // are written on this one: compressing it and a segmentation's labelmap
+  // NB: the model's files (surface.vtp, control_mesh.obj, report.json) are
+  // written on a second thread while `extra` (a segmentation's labelmap, the
+  // figures) writes on this one: compressing the surface and the labelmap
   // were each about a tenth of the caudate demo's command. Only this thread
-  // adds outputs to the set. An error writing the surface is reported first,
-  // as when it was written first, and nothing is committed unless all went.
-  const std::string surfacePath = outputs.add("surface.vtp");
-  std::future<void> surfaceWritten = std::async(std::launch::async, [&] {
+  // adds outputs to the set. An error writing the model's files is reported
+  // first, as when they were written first, and nothing is committed unless
+  // all went.
+  const std::string surfacePath = outputs.add("surface.vtp"), meshPath = outputs.add("control_mesh.obj"),
+                    reportPath = outputs.add("report.json");
+  std::future<void> modelWritten = std::async(std::launch::async, [&] {
     writeTriangleSurface(surface, surfacePath, surfaceScalars, space);
+    writeObj(mesh, meshPath);
+    report.write(reportPath);
   });
   try {
-    writeObj(mesh, outputs.add("control_mesh.obj"));
-    report.write(outputs.add("report.json"));
     if (extra) extra(outputs);
   } catch (...) {
-    surfaceWritten.get();  // its error, if any, comes first
+    modelWritten.get();  // its error, if any, comes first
     throw;
   }
-  surfaceWritten.get();
+  modelWritten.get();
   outputs.commit();
 }
 
