@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <deque>
+#include <future>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -45,9 +46,16 @@ struct LevelModel {
   double size = 0;  // bounding-box diagonal of the control points, mm
 };
 
+// Sets the model's start, its control points.
+void setStart(LevelModel& model, const Matrix3X& points) {
+  model.start = points;
+  model.size = modelSize(model.start);
+  if (!(model.size > 0.0)) throw Error("the control mesh has no extent");
+}
+
 // initialIsolation < 0: `mesh` is the initial model, and sets it.
 LevelModel buildLevel(const ControlMesh& mesh, int level, int& initialIsolation, const SimulationOptions& options) {
-  LevelModel model{level, std::make_shared<const LimitSurface>(mesh), {}, {}, mesh.points(), 0.0};
+  LevelModel model{level, std::make_shared<const LimitSurface>(mesh), {}, {}, {}, 0.0};
   if (initialIsolation < 0) initialIsolation = model.surface->isolationLevels();
   // Element sides are measured in elements of the initial model: a base mesh
   // that is `b` global refinements past the initial one has side 2^-b.
@@ -65,8 +73,7 @@ LevelModel buildLevel(const ControlMesh& mesh, int level, int& initialIsolation,
   // were a tenth of the kitten's fit.
   bothAtOnce([&] { model.matrices = assemblePhysicalMatrices(*model.surface, material, assembly); },
              [&] { model.quadrature = makeSurfaceQuadrature(*model.surface, options.quadraturePoints, elementSize); });
-  model.size = modelSize(model.start);
-  if (!(model.size > 0.0)) throw Error("the control mesh has no extent");
+  setStart(model, mesh.points());
   return model;
 }
 
@@ -476,9 +483,23 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
   ControlMesh mesh = initial;
   int initialIsolation = options.origin.isolation;  // -1 until the first level's surface sets it
   double timeStep = options.integrator.timeStep;
+  std::future<LevelModel> prepared;  // the next level's, when built ahead
   for (int level = options.origin.level;; ++level) {
     const auto started = std::chrono::steady_clock::now();
-    const LevelModel model = buildLevel(mesh, level, initialIsolation, options);
+    LevelModel model;
+    if (prepared.valid()) {
+      model = prepared.get();
+      setStart(model, mesh.points());
+    } else {
+      model = buildLevel(mesh, level, initialIsolation, options);
+    }
+    if (options.prepareNextLevel && level < options.maxLevel) {
+      // The refined topology does not depend on where this level ends.
+      prepared = std::async(std::launch::async, [next = subdivide(mesh).mesh, level, initialIsolation, &options] {
+        int isolation = initialIsolation;
+        return buildLevel(next, level + 1, isolation, options);
+      });
+    }
     LevelSummary summary;
     summary.level = level;
     summary.controlVertices = mesh.vertexCount();

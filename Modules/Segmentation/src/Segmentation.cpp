@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <iomanip>
 #include <memory>
 #include <optional>
@@ -114,6 +115,9 @@ SimulationOptions SegmentOptions::defaultSimulation() {
   // steps of 4 to 16 s gave the same results, the forces' stabilizing
   // stiffness (Integrator.h) then outweighing the damping.
   o.integrator.timeStep = 4.0;
+  // 386 control vertices: the refined level's tables are built on the
+  // second core while the first level runs on one.
+  o.prepareNextLevel = true;
   return o;
 }
 
@@ -240,6 +244,7 @@ SegmentResult evolveInRegion(const SegmentationRegion& region, const std::vector
   result.levels = std::move(evolved.levels);
   result.steps = evolved.steps;
   result.origin = evolved.origin;
+  result.limit = std::move(evolved.surface);
   result.regionFirst = region.first();
   result.regionSize = region.size();
   result.edgeScale = region.edgeField().scale();
@@ -263,17 +268,21 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
   std::vector<ForceModel*> forces = extraForces;
   if (endPoints.rows() > 0) forces.push_back(&endSprings);
   std::optional<EndPressure> pressure = endPressure(region, landmarks, options.sliceEnds, ends);
+  // NB: the initial model's volume (for the collapse check) is measured on
+  // the second core while the evolution runs on one.
+  std::future<double> initialVolume = std::async(std::launch::async, [&initial] {
+    const LimitSurface limit(initial);
+    return enclosedVolume(tessellate(limit, initial.points(), outputSegments(limit)));
+  });
   SegmentResult result = evolveInRegion(region, landmarks, initial, {}, options, progress, forces,
                                         pressure ? &*pressure : nullptr);
   result.sliceEnds = std::move(ends);
 
   if (!result.mesh.points().allFinite()) throw Error("the evolution produced a non-finite surface");
-  const LimitSurface limit(result.mesh);
+  const LimitSurface& limit = *result.limit;
   result.surface = tessellate(limit, result.mesh.points(), outputSegments(limit));
   const TriangleSurface& triangles = result.surface;
-
-  const LimitSurface initialLimit(initial);
-  result.initialVolume = enclosedVolume(tessellate(initialLimit, initial.points(), outputSegments(initialLimit)));
+  result.initialVolume = initialVolume.get();
   result.volume = enclosedVolume(triangles);
   Eigen::Index outside = 0;
   for (Eigen::Index p = 0; p < triangles.points.rows(); ++p)

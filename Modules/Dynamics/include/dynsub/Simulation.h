@@ -89,6 +89,12 @@ struct SimulationOptions {
   double elasticityPerLevel = 1.0;
   int maxTimeStepHalvings = 8;
   int quadraturePoints = 3;  // per direction per element, for distributed forces
+  // Build the next level's tables (its limit surface, matrices and
+  // quadrature: they depend on the refined mesh's topology alone) on a second
+  // thread while this level runs, up to maxLevel. For small models whose levels
+  // run on one core (segmentation); the results are the same either way. A
+  // level that ends the simulation waits for the build it no longer needs.
+  bool prepareNextLevel = false;
 };
 
 struct LevelSummary {

@@ -62,8 +62,10 @@ struct StageSeconds {
 
 struct SegmentResult {
   ControlMesh mesh;
-  // The limit surface of `mesh`, 8 x 8 squares per control face (outputSegments):
+  // The limit surface of `mesh` (the last level's tables), and its triangles,
+  // 8 x 8 squares per control face (outputSegments):
   // what the labelmap, surface.vtp, the report and the figures show.
+  std::shared_ptr<const LimitSurface> limit;
   TriangleSurface surface;
   std::vector<LevelSummary> levels;
   int steps = 0;
