@@ -8,7 +8,7 @@
 
 #include <nanoflann.hpp>
 
-#include "ParallelFor.h"
+#include "dynsub/ParallelFor.h"
 #include "dynsub/ApplyOperator.h"
 #include "dynsub/Error.h"
 

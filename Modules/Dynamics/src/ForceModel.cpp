@@ -3,7 +3,7 @@
 #include <cmath>
 #include <string>
 
-#include "ParallelFor.h"
+#include "dynsub/ParallelFor.h"
 #include "dynsub/ApplyOperator.h"
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/Error.h"

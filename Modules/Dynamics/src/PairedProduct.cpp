@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "ParallelFor.h"
+#include "dynsub/ParallelFor.h"
 #include "dynsub/Error.h"
 
 namespace dynsub {

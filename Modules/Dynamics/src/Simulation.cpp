@@ -10,7 +10,7 @@
 #include <optional>
 #include <string>
 
-#include "ParallelFor.h"
+#include "dynsub/ParallelFor.h"
 #include "dynsub/ApplyOperator.h"
 #include "dynsub/CatmullClark.h"
 #include "dynsub/Error.h"

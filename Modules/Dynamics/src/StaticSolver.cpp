@@ -5,7 +5,7 @@
 #include <cmath>
 #include <string>
 
-#include "ParallelFor.h"
+#include "dynsub/ParallelFor.h"
 #include "SparseCholesky.h"
 #include "dynsub/Error.h"
 #include "dynsub/ForceModel.h"

@@ -4,7 +4,7 @@
 #include <vector>
 
 #include "Lanes.h"
-#include "ParallelFor.h"
+#include "dynsub/ParallelFor.h"
 
 namespace dynsub {
 namespace {

@@ -14,7 +14,7 @@
 #include <Eigen/SparseCholesky>
 #include <unsupported/Eigen/KroneckerProduct>
 
-#include "../src/ParallelFor.h"
+#include "dynsub/ParallelFor.h"
 #include "TestPointClouds.h"
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/Error.h"

@@ -1,5 +1,5 @@
 #pragma once
-// Independent per-item work on the machine's cores, private to the Dynamics module.
+// Independent per-item work on the machine's cores.
 #include <algorithm>
 #include <exception>
 #include <thread>
