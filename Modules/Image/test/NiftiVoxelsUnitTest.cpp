@@ -41,6 +41,7 @@ struct Layout {
   bool gzip = false;
   float slope = 1.0f, intercept = 0.0f;
   int dimensions = 3;  // dim[0]; dims 4.. are 1
+  int members = 1;     // gzip members of a .nii.gz
 };
 
 // A NIfTI-1 file of 5 x 4 x 3 voxels with a rotated, anisotropic sform and
@@ -84,10 +85,19 @@ void writeNifti(const fs::path& path, const Layout& layout, const std::string& d
   std::memcpy(&header[344], "n+1\0", 4);
   const std::string file = header + data;
   if (layout.gzip) {
+    // Two gzip members when asked (header, then data), as concatenated files are.
+    const std::size_t split = layout.members == 2 ? header.size() : file.size();
     gzFile out = gzopen(path.c_str(), "wb");
     ASSERT_NE(out, nullptr);
-    ASSERT_EQ(gzwrite(out, file.data(), static_cast<unsigned>(file.size())), static_cast<int>(file.size()));
+    ASSERT_EQ(gzwrite(out, file.data(), static_cast<unsigned>(split)), static_cast<int>(split));
     gzclose(out);
+    if (split < file.size()) {
+      out = gzopen(path.c_str(), "ab");
+      ASSERT_NE(out, nullptr);
+      ASSERT_EQ(gzwrite(out, file.data() + split, static_cast<unsigned>(file.size() - split)),
+                static_cast<int>(file.size() - split));
+      gzclose(out);
+    }
   } else {
     std::ofstream(path, std::ios::binary) << file;
   }
@@ -179,6 +189,18 @@ TEST(NiftiVoxels, EveryDatatypeReadsAsItkReadsIt) {
         EXPECT_TRUE(filechecks::readNiftiVoxels(path.string(), voxels)) << path << " was left to ITK";
         expectReadAsItkReadsIt(path);
       }
+}
+
+// A .nii.gz of two gzip members is inflated by zlib's stream, not in one
+// piece (which reads one member).
+TEST(NiftiVoxels, AFileOfTwoGzipMembersReadsAsItkReadsIt) {
+  Layout layout;
+  layout.datatype = 4, layout.bytes = 2, layout.gzip = true, layout.members = 2;
+  const fs::path path = scratch("two_members.nii.gz");
+  writeNifti(path, layout, valuesOf(4, false));
+  std::vector<float> voxels;
+  EXPECT_TRUE(filechecks::readNiftiVoxels(path.string(), voxels));
+  expectReadAsItkReadsIt(path);
 }
 
 TEST(NiftiVoxels, FilesLeftToItkReadAsBefore) {
