@@ -7,6 +7,7 @@
 #include <vtkActor.h>
 #include <vtkCamera.h>
 #include <vtkCutter.h>
+#include <vtkNonMergingPointLocator.h>
 #include <vtkImageProperty.h>
 #include <vtkImageSlice.h>
 #include <vtkImageSliceMapper.h>
@@ -54,6 +55,15 @@ struct SliceView::Impl {
     renderer->AddViewProp(imageActor);
 
     cutter->SetCutFunction(cutPlane);
+    // NB: the contour's points are not merged, and the locator has one bin:
+    // a merging locator's bins for the whole surface were allocated (and their
+    // fresh pages cleared) for each of the slices figure's 15 views, a third
+    // of its time. Only the lines are drawn, so merging their ends changed
+    // nothing.
+    vtkNew<vtkNonMergingPointLocator> locator;
+    locator->AutomaticOff();
+    locator->SetDivisions(1, 1, 1);
+    cutter->SetLocator(locator);
     contourMapper->SetInputConnection(cutter->GetOutputPort());
     style::colourByElementType(contourMapper);
     contourActor->SetMapper(contourMapper);
