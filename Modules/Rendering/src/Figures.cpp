@@ -187,7 +187,7 @@ void writeFigures(const FigureInputs& inputs, const FigureFiles& files) {
   scene.dataPoints = inputs.dataPoints;
   std::unique_ptr<ImageSlices> slices;
   if (inputs.image) {
-    slices = std::make_unique<ImageSlices>(*inputs.image);
+    slices = std::make_unique<ImageSlices>(ImageSlices::borrowing(*inputs.image));  // the image outlives the figures
     scene.image = slices.get();
   }
   vtkSmartPointer<vtkPolyData> wireframe;

@@ -45,7 +45,11 @@ SlicePlane anatomicalPlane(SliceOrientation orientation, const Vector3& point, d
   return plane;
 }
 
-ImageSlices::ImageSlices(const Volume& volume) : geometry_(volume.geometry) {
+ImageSlices::ImageSlices(const Volume& volume) : ImageSlices(volume, false) {}
+
+ImageSlices ImageSlices::borrowing(const Volume& volume) { return ImageSlices(volume, true); }
+
+ImageSlices::ImageSlices(const Volume& volume, bool borrow) : geometry_(volume.geometry) {
   const auto& size = geometry_.size;
   if (volume.voxels.empty() || static_cast<long long>(volume.voxels.size()) != geometry_.voxelCount())
     throw Error("the image to display is empty or its buffer does not match its size");
@@ -55,8 +59,13 @@ ImageSlices::ImageSlices(const Volume& volume) : geometry_(volume.geometry) {
   data_->SetSpacing(1, 1, 1);
   vtkNew<vtkFloatArray> scalars;
   scalars->SetName("intensity");
-  scalars->SetNumberOfTuples(geometry_.voxelCount());
-  std::copy(volume.voxels.begin(), volume.voxels.end(), scalars->GetPointer(0));
+  if (borrow) {
+    // save = 1: VTK neither frees nor (the mappers only read) writes it.
+    scalars->SetArray(const_cast<float*>(volume.voxels.data()), geometry_.voxelCount(), 1);
+  } else {
+    scalars->SetNumberOfTuples(geometry_.voxelCount());
+    std::copy(volume.voxels.begin(), volume.voxels.end(), scalars->GetPointer(0));
+  }
   data_->GetPointData()->SetScalars(scalars);
 
   indexToWorld_ = vtkSmartPointer<vtkMatrix4x4>::New();

@@ -1,13 +1,22 @@
 #include "dynsub/SliceView.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <iomanip>
+#include <vector>
 
 #include <vtkActor.h>
 #include <vtkCamera.h>
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
 #include <vtkCutter.h>
+#include <vtkInformation.h>
+#include <vtkInformationVector.h>
 #include <vtkNonMergingPointLocator.h>
+#include <vtkObjectFactory.h>
+#include <vtkPointData.h>
+#include <vtkPolyDataAlgorithm.h>
 #include <vtkImageProperty.h>
 #include <vtkImageSlice.h>
 #include <vtkImageSliceMapper.h>
@@ -24,6 +33,67 @@
 
 namespace dynsub {
 
+namespace {
+
+// The polygons of a surface that reach a plane (their points on both sides
+// of it, or on it), in their order and with their cell data, on the input's
+// points: all the cutter below can cut. A figure's fifteen views each cut the
+// whole surface otherwise (49 152 triangles for a segmentation), a sixth of
+// the figures' time; the cut is the same, segment for segment. A surface with
+// other cells than polygons is passed whole.
+class PolygonsAtPlane : public vtkPolyDataAlgorithm {
+ public:
+  static PolygonsAtPlane* New();
+  vtkTypeMacro(PolygonsAtPlane, vtkPolyDataAlgorithm);
+
+  void SetPlane(vtkPlane* plane) {
+    plane_ = plane;
+    Modified();
+  }
+  // The plane moves without this filter being told (its own modified time).
+  vtkMTimeType GetMTime() override {
+    const vtkMTimeType own = vtkPolyDataAlgorithm::GetMTime();
+    return plane_ ? std::max(own, plane_->GetMTime()) : own;
+  }
+
+ protected:
+  int RequestData(vtkInformation*, vtkInformationVector** inputs, vtkInformationVector* outputs) override {
+    vtkPolyData* input = vtkPolyData::GetData(inputs[0]);
+    vtkPolyData* output = vtkPolyData::GetData(outputs);
+    if (!plane_ || input->GetNumberOfVerts() + input->GetNumberOfLines() + input->GetNumberOfStrips() > 0) {
+      output->ShallowCopy(input);
+      return 1;
+    }
+    output->SetPoints(input->GetPoints());
+    output->GetPointData()->PassData(input->GetPointData());
+    const vtkIdType pointCount = input->GetNumberOfPoints();
+    std::vector<double> side(static_cast<std::size_t>(pointCount));
+    for (vtkIdType p = 0; p < pointCount; ++p) side[p] = plane_->EvaluateFunction(input->GetPoint(p));
+    vtkCellData* cellsIn = input->GetCellData();
+    vtkCellData* cellsOut = output->GetCellData();
+    cellsOut->CopyAllocate(cellsIn);
+    vtkNew<vtkCellArray> kept;
+    vtkCellArray* polygons = input->GetPolys();
+    vtkIdType count = 0;
+    const vtkIdType* ids = nullptr;
+    polygons->InitTraversal();
+    for (vtkIdType cell = 0; polygons->GetNextCell(count, ids); ++cell) {
+      double low = side[ids[0]], high = low;
+      for (vtkIdType k = 1; k < count; ++k) low = std::min(low, side[ids[k]]), high = std::max(high, side[ids[k]]);
+      if (low > 0.0 || high < 0.0) continue;
+      cellsOut->CopyData(cellsIn, cell, kept->InsertNextCell(count, ids));
+    }
+    output->SetPolys(kept);
+    return 1;
+  }
+
+ private:
+  vtkSmartPointer<vtkPlane> plane_;
+};
+vtkStandardNewMacro(PolygonsAtPlane);
+
+}  // namespace
+
 struct SliceView::Impl {
   SliceOrientation orientation;
   const ImageSlices* image = nullptr;
@@ -37,6 +107,7 @@ struct SliceView::Impl {
   vtkNew<vtkImageSliceMapper> imageMapper;
   vtkNew<vtkImageSlice> imageActor;
   vtkNew<vtkPlane> cutPlane;
+  vtkNew<PolygonsAtPlane> atPlane;
   vtkNew<vtkCutter> cutter;
   vtkNew<vtkPolyDataMapper> contourMapper;
   vtkNew<vtkActor> contourActor;
@@ -54,6 +125,8 @@ struct SliceView::Impl {
     imageActor->VisibilityOff();
     renderer->AddViewProp(imageActor);
 
+    atPlane->SetPlane(cutPlane);
+    cutter->SetInputConnection(atPlane->GetOutputPort());
     cutter->SetCutFunction(cutPlane);
     // NB: the contour's points are not merged, and the locator has one bin:
     // a merging locator's bins for the whole surface were allocated (and their
@@ -165,7 +238,7 @@ void SliceView::setImage(const ImageSlices* image) {
 }
 
 void SliceView::setSurface(vtkPolyData* surface) {
-  impl_->cutter->SetInputData(surface);
+  impl_->atPlane->SetInputData(surface);
   impl_->contourActor->SetVisibility(surface != nullptr);
 }
 
