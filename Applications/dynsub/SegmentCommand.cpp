@@ -81,9 +81,20 @@ void writeSegmentOutputs(const std::filesystem::path& dir, const SegmentRun& run
   writeModelOutputs(
       dir, result.mesh, result.surface, run.report,
       [&](OutputSet& outputs) {
-        writeMask(run.labelmap, outputs.add("labelmap.nii.gz"));
-        addFigureOutputs(outputs, figures, result.mesh, result.surface, run.history, &image,
-                         landmarkPositions(run.springs), Matrix3X());
+        // NB: the labelmap is compressed on a thread of its own while the
+        // figures render on this one (a tenth of them). Its error, if any,
+        // comes first, as when it was written first.
+        const std::string labelmapPath = outputs.add("labelmap.nii.gz");
+        std::future<void> labelmapWritten =
+            std::async(std::launch::async, [&] { writeMask(run.labelmap, labelmapPath); });
+        try {
+          addFigureOutputs(outputs, figures, result.mesh, result.surface, run.history, &image,
+                           landmarkPositions(run.springs), Matrix3X());
+        } catch (...) {
+          labelmapWritten.get();
+          throw;
+        }
+        labelmapWritten.get();
       },
       result.surfaceEdgeDistances.size()
           ? std::vector<PointScalars>{{"edge_distance_mm", result.surfaceEdgeDistances}}
