@@ -15,6 +15,10 @@ void FigureOptions::addOptions(CLI::App& command) {
                    "without DISPLAY a private Xvfb is started for the run)");
 }
 
+void FigureOptions::prepare() const {
+  if (figures) prepareFigureDisplay();
+}
+
 void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const ControlMesh& mesh,
                       const TriangleSurface& surface, const ConvergenceHistory& history, const Volume* image,
                       const Matrix3X& landmarks, const Matrix3X& dataPoints) {

@@ -20,6 +20,10 @@ namespace dynsub::app {
 struct FigureOptions {
   bool figures = true;
   void addOptions(CLI::App& command);
+  // When figures are wanted: their display made ready on a second thread
+  // (Figures.h: prepareFigureDisplay) while the run goes on. Call it once the
+  // inputs are read and checked, before the run's long part.
+  void prepare() const;
 };
 
 // Adds convergence.csv and, if wanted and possible, the three figures to

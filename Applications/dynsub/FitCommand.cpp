@@ -60,6 +60,7 @@ void runFit(FitCommandOptions o) {
   const std::filesystem::path dir(o.out);
   prepareOutputDirectory(dir);
   o.fit.simulation = o.simulation.apply(o.fit.simulation);
+  o.figures.prepare();
 
   ProgressLine line;
   // The papers' max error every 5 steps: the data springs' lengths where the

@@ -146,6 +146,7 @@ void runSegment(const SegmentCommandOptions& o) {
   inputs.potential = o.potential;
   const std::filesystem::path dir(o.out);
   prepareOutputDirectory(dir);
+  o.figures.prepare();
 
   ProgressLine line;
   const SegmentRun run = runSegmentation(image, inputs, line.callback());

@@ -1,13 +1,5 @@
 #include "dynsub/Figures.h"
 
-#include <X11/Xlib.h>
-#include <fcntl.h>
-#include <poll.h>
-#include <signal.h>
-#include <sys/prctl.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cstdlib>
 #include <memory>
@@ -209,96 +201,6 @@ void writeFigures(const FigureInputs& inputs, const FigureFiles& files) {
   draw(files.slices, [&] { drawSlices(scene, window); });
   draw(files.surface3d, [&] { drawSurface(scene, window); });
   draw(files.convergence, [&] { drawConvergence(*inputs.history, window); });
-}
-
-bool displayAvailable(std::string* why) {
-  const char* name = std::getenv("DISPLAY");
-  if (!name || !*name) {
-    if (why) *why = "DISPLAY is not set (run under xvfb-run on a machine without a screen)";
-    return false;
-  }
-  Display* display = XOpenDisplay(nullptr);
-  if (!display) {
-    if (why) *why = std::string("cannot open the X display ") + name;
-    return false;
-  }
-  XCloseDisplay(display);
-  return true;
-}
-
-namespace {
-
-// The virtual X server figureDisplay() starts: stopped when the process
-// exits (the static's destructor), and by the kernel when the process dies
-// (PR_SET_PDEATHSIG), so no server outlives its run.
-struct PrivateXServer {
-  pid_t pid = -1;
-  ~PrivateXServer() {
-    if (pid <= 0) return;
-    kill(pid, SIGTERM);
-    waitpid(pid, nullptr, 0);
-  }
-};
-
-PrivateXServer& privateXServer() {
-  static PrivateXServer server;
-  return server;
-}
-
-// Starts Xvfb on a free display number (it writes the number to the pipe
-// given by -displayfd once it accepts connections) and sets DISPLAY.
-bool startPrivateXServer(std::string* why) {
-  int fds[2];
-  if (pipe(fds) != 0) {
-    if (why) *why = "DISPLAY is not set, and no pipe could be made to start Xvfb";
-    return false;
-  }
-  const std::string writeEnd = std::to_string(fds[1]);
-  const pid_t parent = getpid();
-  const pid_t pid = fork();
-  if (pid == 0) {  // only async-signal-safe calls until exec
-    prctl(PR_SET_PDEATHSIG, SIGTERM);
-    if (getppid() != parent) _exit(1);
-    close(fds[0]);
-    const int null = open("/dev/null", O_RDWR);
-    dup2(null, 0);
-    dup2(null, 1);
-    dup2(null, 2);
-    execlp("Xvfb", "Xvfb", "-displayfd", writeEnd.c_str(), "-screen", "0", "1280x1024x24", "-nolisten", "tcp",
-           "-noreset", static_cast<char*>(nullptr));
-    _exit(127);
-  }
-  close(fds[1]);
-  std::string number;
-  bool complete = false;
-  if (pid > 0) {
-    pollfd wait{fds[0], POLLIN, 0};
-    char c;
-    while (!complete && poll(&wait, 1, 10000) > 0 && read(fds[0], &c, 1) == 1) {
-      if (c == '\n') complete = !number.empty();
-      else number += c;
-    }
-  }
-  close(fds[0]);
-  if (!complete) {
-    if (pid > 0) {
-      kill(pid, SIGTERM);
-      waitpid(pid, nullptr, 0);
-    }
-    if (why) *why = "DISPLAY is not set and no virtual X server could be started (install the xvfb package)";
-    return false;
-  }
-  privateXServer().pid = pid;
-  setenv("DISPLAY", (":" + number).c_str(), 1);
-  return true;
-}
-
-}  // namespace
-
-bool figureDisplay(std::string* why) {
-  const char* name = std::getenv("DISPLAY");
-  if ((!name || !*name) && !startPrivateXServer(why)) return false;
-  return displayAvailable(why);
 }
 
 }  // namespace dynsub
