@@ -483,21 +483,23 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
   ControlMesh mesh = initial;
   int initialIsolation = options.origin.isolation;  // -1 until the first level's surface sets it
   double timeStep = options.integrator.timeStep;
-  std::future<LevelModel> prepared;  // the next level's, when built ahead
+  // NB: levels are held through pointers and built in place: Eigen 3.4's
+  // sparse matrices have no move, so moving a level copied its tables (22 MB
+  // more at the kitten's peak).
+  std::future<std::unique_ptr<LevelModel>> prepared;  // the next level's, when built ahead
   for (int level = options.origin.level;; ++level) {
     const auto started = std::chrono::steady_clock::now();
-    LevelModel model;
-    if (prepared.valid()) {
-      model = prepared.get();
-      setStart(model, mesh.points());
-    } else {
-      model = buildLevel(mesh, level, initialIsolation, options);
-    }
+    const bool wasPrepared = prepared.valid();
+    const std::unique_ptr<LevelModel> built =
+        wasPrepared ? prepared.get()
+                    : std::unique_ptr<LevelModel>(new LevelModel(buildLevel(mesh, level, initialIsolation, options)));
+    if (wasPrepared) setStart(*built, mesh.points());
+    const LevelModel& model = *built;
     if (options.prepareNextLevel && level < options.maxLevel) {
       // The refined topology does not depend on where this level ends.
       prepared = std::async(std::launch::async, [next = subdivide(mesh).mesh, level, initialIsolation, &options] {
         int isolation = initialIsolation;
-        return buildLevel(next, level + 1, isolation, options);
+        return std::unique_ptr<LevelModel>(new LevelModel(buildLevel(next, level + 1, isolation, options)));
       });
     }
     LevelSummary summary;
