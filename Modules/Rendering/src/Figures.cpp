@@ -7,9 +7,8 @@
 #include <vtkChartXY.h>
 #include <vtkContextActor.h>
 #include <vtkContextScene.h>
-#include <vtkErrorCode.h>
 #include <vtkNew.h>
-#include <vtkPNGWriter.h>
+#include <vtkImageData.h>
 #include <vtkPolyData.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
@@ -24,6 +23,7 @@
 #include "dynsub/SliceView.h"
 #include "dynsub/SurfacePolyData.h"
 #include "dynsub/SurfaceView.h"
+#include "PngFile.h"
 
 namespace dynsub {
 
@@ -157,16 +157,14 @@ void writePng(vtkRenderWindow* window, const std::string& path) {
   capture->SetInput(window);
   capture->ReadFrontBufferOff();
   capture->Update();
-  vtkNew<vtkPNGWriter> writer;
-  // zlib's fastest level: the 3D figure compressed at VTK's default (5) took
-  // twice as long as it took to render; the files are about 10 % larger.
-  writer->SetCompressionLevel(1);
-  writer->SetInputConnection(capture->GetOutputPort());
-  writer->SetFileName(output.temporaryPath().c_str());
-  writer->Write();
-  if (writer->GetErrorCode() != 0)
-    throw writeFailure(path, std::string("VTK's PNG writer failed (") +
-                                 vtkErrorCode::GetStringFromErrorCode(writer->GetErrorCode()) + ")");
+  vtkImageData* image = capture->GetOutput();
+  int size[3];
+  image->GetDimensions(size);
+  if (image->GetScalarType() != VTK_UNSIGNED_CHAR)
+    throw writeFailure(path, "internal: the window's capture is not 8-bit");
+  // PngFile.h says why not vtkPNGWriter.
+  writePngFile(output.temporaryPath(), size[0], size[1], image->GetNumberOfScalarComponents(),
+               static_cast<const unsigned char*>(image->GetScalarPointer()));
   output.commit();
 }
 
