@@ -1,0 +1,156 @@
+// Whether two output files hold the same contents, for checking that a change
+// left a run's results alone when their encoding may have changed:
+//   build/bin/SameContents FILE_A FILE_B
+// PNG images are compared pixel by pixel (size, channels, every sample),
+// VTK XML PolyData (.vtp) array by array (points, point, cell and field data,
+// and every cell array), any other file byte by byte. Exit code 0 when the
+// same, 1 when not (what differs is printed), 2 when a file cannot be read.
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+#include <vtkAbstractArray.h>
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkDataArray.h>
+#include <vtkFieldData.h>
+#include <vtkImageData.h>
+#include <vtkNew.h>
+#include <vtkPNGReader.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkXMLPolyDataReader.h>
+
+namespace {
+
+std::string extensionOf(const std::string& path) {
+  const auto dot = path.rfind('.');
+  return dot == std::string::npos ? "" : path.substr(dot);
+}
+
+// Two arrays with the same name, type, shape and values (compared as
+// doubles, bit for bit, so NaN equals NaN and -0 differs from 0).
+bool sameArray(vtkAbstractArray* a, vtkAbstractArray* b, std::string& why) {
+  if (!a || !b) {
+    why = "an array is missing";
+    return a == b;
+  }
+  const std::string name = a->GetName() ? a->GetName() : "(unnamed)";
+  if ((a->GetName() ? std::string(a->GetName()) : "") != (b->GetName() ? std::string(b->GetName()) : "") ||
+      a->GetDataType() != b->GetDataType() || a->GetNumberOfTuples() != b->GetNumberOfTuples() ||
+      a->GetNumberOfComponents() != b->GetNumberOfComponents()) {
+    why = "array " + name + ": name, type or shape differs";
+    return false;
+  }
+  const vtkIdType count = a->GetNumberOfValues();
+  auto* x = vtkDataArray::SafeDownCast(a);
+  auto* y = vtkDataArray::SafeDownCast(b);
+  for (vtkIdType i = 0; i < count; ++i) {
+    bool same = true;
+    if (x && y) {
+      const double u = x->GetComponent(i / x->GetNumberOfComponents(), i % x->GetNumberOfComponents());
+      const double v = y->GetComponent(i / y->GetNumberOfComponents(), i % y->GetNumberOfComponents());
+      same = std::memcmp(&u, &v, sizeof u) == 0;
+    } else {
+      same = a->GetVariantValue(i) == b->GetVariantValue(i);
+    }
+    if (!same) {
+      why = "array " + name + ": value " + std::to_string(i) + " differs";
+      return false;
+    }
+  }
+  return true;
+}
+
+bool sameFieldData(vtkFieldData* a, vtkFieldData* b, const std::string& what, std::string& why) {
+  if (a->GetNumberOfArrays() != b->GetNumberOfArrays()) {
+    why = what + ": a different number of arrays";
+    return false;
+  }
+  for (int i = 0; i < a->GetNumberOfArrays(); ++i)
+    if (!sameArray(a->GetAbstractArray(i), b->GetAbstractArray(i), why)) {
+      why = what + ", " + why;
+      return false;
+    }
+  return true;
+}
+
+bool samePolyData(const std::string& pathA, const std::string& pathB, std::string& why) {
+  vtkNew<vtkXMLPolyDataReader> a, b;
+  a->SetFileName(pathA.c_str());
+  b->SetFileName(pathB.c_str());
+  a->Update();
+  b->Update();
+  vtkPolyData* x = a->GetOutput();
+  vtkPolyData* y = b->GetOutput();
+  if (!x->GetPoints() || !y->GetPoints()) {
+    why = "no points read";
+    return !x->GetPoints() && !y->GetPoints();
+  }
+  if (!sameArray(x->GetPoints()->GetData(), y->GetPoints()->GetData(), why) ||
+      !sameFieldData(x->GetPointData(), y->GetPointData(), "point data", why) ||
+      !sameFieldData(x->GetCellData(), y->GetCellData(), "cell data", why) ||
+      !sameFieldData(x->GetFieldData(), y->GetFieldData(), "field data", why))
+    return false;
+  vtkCellArray* cellsA[] = {x->GetVerts(), x->GetLines(), x->GetPolys(), x->GetStrips()};
+  vtkCellArray* cellsB[] = {y->GetVerts(), y->GetLines(), y->GetPolys(), y->GetStrips()};
+  const char* kinds[] = {"verts", "lines", "polys", "strips"};
+  for (int k = 0; k < 4; ++k) {
+    if (!sameArray(cellsA[k]->GetOffsetsArray(), cellsB[k]->GetOffsetsArray(), why) ||
+        !sameArray(cellsA[k]->GetConnectivityArray(), cellsB[k]->GetConnectivityArray(), why)) {
+      why = std::string(kinds[k]) + ": " + why;
+      return false;
+    }
+  }
+  return true;
+}
+
+bool sameImage(const std::string& pathA, const std::string& pathB, std::string& why) {
+  vtkNew<vtkPNGReader> a, b;
+  a->SetFileName(pathA.c_str());
+  b->SetFileName(pathB.c_str());
+  a->Update();
+  b->Update();
+  int sizeA[3], sizeB[3];
+  a->GetOutput()->GetDimensions(sizeA);
+  b->GetOutput()->GetDimensions(sizeB);
+  if (sizeA[0] != sizeB[0] || sizeA[1] != sizeB[1]) {
+    why = "the images' sizes differ";
+    return false;
+  }
+  return sameArray(a->GetOutput()->GetPointData()->GetScalars(), b->GetOutput()->GetPointData()->GetScalars(), why);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 3) {
+    std::fprintf(stderr, "usage: SameContents FILE_A FILE_B\n");
+    return 2;
+  }
+  const std::string pathA = argv[1], pathB = argv[2];
+  for (const std::string& path : {pathA, pathB})
+    if (!std::ifstream(path)) {
+      std::fprintf(stderr, "SameContents: %s: cannot be read\n", path.c_str());
+      return 2;
+    }
+  const std::string extension = extensionOf(pathA);
+  std::string why;
+  bool same = false;
+  if (extension != extensionOf(pathB)) {
+    why = "the files' extensions differ";
+  } else if (extension == ".png") {
+    same = sameImage(pathA, pathB, why);
+  } else if (extension == ".vtp") {
+    same = samePolyData(pathA, pathB, why);
+  } else {
+    std::ifstream a(pathA, std::ios::binary), b(pathB, std::ios::binary);
+    same = std::string(std::istreambuf_iterator<char>(a), {}) == std::string(std::istreambuf_iterator<char>(b), {});
+    why = "the bytes differ";
+  }
+  if (!same) std::printf("%s and %s differ: %s\n", pathA.c_str(), pathB.c_str(), why.c_str());
+  return same ? 0 : 1;
+}
