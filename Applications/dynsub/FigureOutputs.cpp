@@ -4,7 +4,8 @@
 
 #include <CLI/CLI.hpp>
 
-#include "dynsub/Figures.h"
+#include "dynsub/Error.h"
+#include "dynsub/RenderingLibrary.h"
 #include "dynsub/OutputSet.h"
 
 namespace dynsub::app {
@@ -16,7 +17,12 @@ void FigureOptions::addOptions(CLI::App& command) {
 }
 
 void FigureOptions::prepare() const {
-  if (figures) prepareFigureDisplay();
+  if (!figures) return;
+  try {
+    rendering::functions().prepareFigureDisplay();
+  } catch (const Error&) {
+    // Reported where the figures would be written (addFigureOutputs).
+  }
 }
 
 void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const ControlMesh& mesh,
@@ -25,7 +31,13 @@ void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const Co
   writeConvergenceCsv(history, outputs.add("convergence.csv"));
   if (!options.figures) return;
   std::string why;
-  if (!figureDisplay(&why)) {
+  const rendering::Functions* draw = nullptr;
+  try {
+    draw = &rendering::functions();
+  } catch (const Error& e) {
+    why = e.what();
+  }
+  if (!draw || !draw->figureDisplay(&why)) {
     std::cerr << "warning: no figures written: " << why << '\n';
     return;
   }
@@ -41,7 +53,7 @@ void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const Co
   files.slices = outputs.add("slices.png");
   files.surface3d = outputs.add("surface3d.png");
   files.convergence = outputs.add("convergence.png");
-  writeFigures(inputs, files);
+  draw->writeFigures(inputs, files);
 }
 
 }  // namespace dynsub::app

@@ -8,14 +8,12 @@
 
 #include "Commands.h"
 #include "dynsub/Error.h"
-#include "dynsub/Figures.h"
 #include "dynsub/LatticeIO.h"
 #include "dynsub/OutputSet.h"
 #include "dynsub/Report.h"
 #include "dynsub/SculptScript.h"
-#include "dynsub/Sculptor.h"
+#include "dynsub/RenderingLibrary.h"
 #include "dynsub/SolidSubdivision.h"
-#include "dynsub/SolidView.h"
 
 namespace dynsub::app {
 
@@ -66,8 +64,16 @@ std::string writeSculpture(const std::filesystem::path& dir, const Sculpture& sc
   writeLattice(solid, outputs.add("sculpted.vtu"));
   std::string figure;
   std::string why;
-  if (o.figure && figureDisplay(&why)) {
-    writeSculptureFigure(sculpture, outputs.add("sculpted.png"));
+  const rendering::Functions* draw = nullptr;
+  if (o.figure) {
+    try {
+      draw = &rendering::functions();
+    } catch (const Error& e) {
+      why = e.what();
+    }
+  }
+  if (draw && draw->figureDisplay(&why)) {
+    draw->writeSculptureFigure(sculpture, outputs.add("sculpted.png"));
     figure = ", sculpted.png";
   } else if (o.figure) {
     std::cerr << "warning: no figure written: " << why << '\n';
@@ -103,12 +109,11 @@ void runSculpt(const SculptOptions& options) {
   report.set("lattice", o.lattice);
   if (o.script.empty()) {
     // The window: s saves to --out.
-    Sculptor sculptor(lattice, o.settings, [o, report](const Sculpture& s) {
-      return writeSculpture(o.out, s, o, report);
-    });
     std::cout << "dynsub solid sculpt: press h in the window for the mouse and key bindings; s saves to " << o.out
               << '\n';
-    sculptor.run();
+    rendering::functions().runSculptor(lattice, o.settings, [o, report](const Sculpture& s) {
+      return writeSculpture(o.out, s, o, report);
+    });
     return;
   }
   // The whole script is checked before the solid moves, and nothing is

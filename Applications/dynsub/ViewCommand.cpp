@@ -7,7 +7,7 @@
 #include "Commands.h"
 #include "dynsub/Error.h"
 #include "dynsub/ImageIO.h"
-#include "dynsub/Viewer.h"
+#include "dynsub/RenderingLibrary.h"
 
 namespace dynsub::app {
 
@@ -29,9 +29,8 @@ void runView(const ViewCommandOptions& o) {
   input.surfacePath = o.surface;
   checkSegmentOptions(o.segment);
   input.segment = o.segment;
-  Viewer viewer(std::move(input));
   std::cout << "dynsub view: press h in the window for the mouse and key bindings\n";
-  viewer.run();
+  rendering::functions().runViewer(std::move(input));
 }
 
 }  // namespace

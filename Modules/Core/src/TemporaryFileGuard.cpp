@@ -107,6 +107,8 @@ void created(const std::string& path) { tell('+', path); }
 void finished(const std::string& path) { tell('-', path); }
 void createdDirectory(const std::string& path) { tell('D', path); }
 void finishedDirectory(const std::string& path) { tell('d', path); }
+int channel() { return toGuard; }
+void useChannel(int channel) { toGuard = channel; }
 }  // namespace temporaryfiles
 
 }  // namespace dynsub

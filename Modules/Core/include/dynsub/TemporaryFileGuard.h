@@ -28,6 +28,12 @@ void created(const std::string& path);
 void finished(const std::string& path);
 void createdDirectory(const std::string& path);
 void finishedDirectory(const std::string& path);
+
+// The guard's channel (-1 without a guard). A library of DynSub's own that
+// carries its own copy of this module (OwnLibrary.h) is handed the program's
+// channel, so that its temporary files are told to the same guard.
+int channel();
+void useChannel(int channel);
 }  // namespace temporaryfiles
 
 }  // namespace dynsub

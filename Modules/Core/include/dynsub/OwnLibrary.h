@@ -1,0 +1,19 @@
+#pragma once
+// DynSub's own shared libraries, opened when a program first needs them:
+// the ITK bridge (Image module) and the rendering library (Interaction
+// module). Each holds heavy third-party libraries that most runs never use,
+// and loading those at every start cost every command (Documentation/
+// Performance.md).
+#include <string>
+
+namespace dynsub {
+
+// Opens `name`, looked for in lib/ beside the program's bin/ (the build's and
+// an installation's layout), then at `buildPath` (where this build put it,
+// for a program copied elsewhere), and returns the address of its exported
+// `symbol`. Never closed. Throws dynsub::Error naming the library and what it
+// is for (`purpose`) when it cannot be opened or is not DynSub's.
+void* openOwnLibrary(const std::string& name, const std::string& buildPath, const char* symbol,
+                     const std::string& purpose);
+
+}  // namespace dynsub
