@@ -29,9 +29,11 @@ SurfaceQuadrature makeSurfaceQuadrature(const LimitSurface& surface, int pointsP
     }
   }
   LimitOperators operators = surface.operators(q.points, 1);  // J, J_u and J_v only
-  q.J = std::move(operators.J);
-  q.Ju = std::move(operators.Ju);
-  q.Jv = std::move(operators.Jv);
+  // Swapped in: Eigen 3.4's sparse matrices have no move, so std::move copied
+  // them (three 55 000-row operators at the kitten's finest level).
+  q.J.swap(operators.J);
+  q.Ju.swap(operators.Ju);
+  q.Jv.swap(operators.Jv);
   return q;
 }
 

@@ -71,8 +71,23 @@ LevelModel buildLevel(const ControlMesh& mesh, int level, int& initialIsolation,
   // NB: the matrices and the quadrature are independent (the surface's
   // tables are safe to fill from two threads), and one after the other they
   // were a tenth of the kitten's fit.
-  bothAtOnce([&] { model.matrices = assemblePhysicalMatrices(*model.surface, material, assembly); },
-             [&] { model.quadrature = makeSurfaceQuadrature(*model.surface, options.quadraturePoints, elementSize); });
+  // Swapped in, not assigned: Eigen 3.4's sparse matrices have no move, so
+  // assigning the results copied every table.
+  bothAtOnce(
+      [&] {
+        PhysicalMatrices built = assemblePhysicalMatrices(*model.surface, material, assembly);
+        model.matrices.mass.swap(built.mass);
+        model.matrices.damping.swap(built.damping);
+        model.matrices.stiffness.swap(built.stiffness);
+      },
+      [&] {
+        SurfaceQuadrature built = makeSurfaceQuadrature(*model.surface, options.quadraturePoints, elementSize);
+        model.quadrature.points.swap(built.points);
+        model.quadrature.weights.swap(built.weights);
+        model.quadrature.J.swap(built.J);
+        model.quadrature.Ju.swap(built.Ju);
+        model.quadrature.Jv.swap(built.Jv);
+      });
   setStart(model, mesh.points());
   return model;
 }
