@@ -200,6 +200,32 @@ std::string nonFiniteMessage(std::uintmax_t bad, std::uintmax_t first, const std
          std::to_string(j) + ", " + std::to_string(k) + "); intensities must be finite";
 }
 
+// What zlib says of a gzip stream read so far: whether it failed (corrupt or
+// cut short), and its message without the path zlib puts first.
+struct ZlibState {
+  bool failed;
+  std::string message;
+};
+
+ZlibState zlibState(const std::string& path, gzFile file) {
+  int code = Z_OK;
+  std::string message = gzerror(file, &code);
+  if (message.rfind(path + ": ", 0) == 0) message.erase(0, path.size() + 2);
+  return {code != Z_OK && code != Z_STREAM_END, message};
+}
+
+Error corruptCompressedData(const std::string& path, const std::string& zlibMessage, std::uintmax_t inflated) {
+  return Error(path, "truncated or corrupt compressed data (" + zlibMessage + ") after " + std::to_string(inflated) +
+                         " bytes");
+}
+
+// A NIfTI file whose data ends (`actual` bytes, inflated when gzipped) before
+// the `needed` bytes its header announces.
+Error truncatedData(const std::string& path, std::uintmax_t actual, bool gzipped, std::uintmax_t needed) {
+  return Error(path, "truncated: " + std::to_string(actual) + (gzipped ? " bytes inflated" : " bytes") +
+                         ", the header announces " + std::to_string(needed));
+}
+
 // Scans `voxels` float (4-byte) or double (8-byte) values from byte `offset`
 // of a file (inflated when gzipped); throws naming the count of NaN or
 // infinite ones and the voxel index (i, j, k) of the first.
@@ -243,13 +269,9 @@ std::uintmax_t inflatedSize(const std::string& path, std::uintmax_t enough) {
   int read = 0;
   while (total < enough && (read = gzread(file, buffer.data(), static_cast<unsigned>(buffer.size()))) > 0)
     total += read;
-  int code = Z_OK;
-  std::string message = gzerror(file, &code);
+  const ZlibState state = zlibState(path, file);
   gzclose(file);
-  if (message.rfind(path + ": ", 0) == 0) message.erase(0, path.size() + 2);  // zlib puts the path first
-  if (read < 0 || (code != Z_OK && code != Z_STREAM_END))
-    throw Error(path, "truncated or corrupt compressed data (" + message + ") after " + std::to_string(total) +
-                          " bytes");
+  if (read < 0 || state.failed) throw corruptCompressedData(path, state.message, total);
   return total;
 }
 
@@ -334,14 +356,11 @@ class DataReader {
   }
   // Why the data ended early, in the words of inflatedSize's error.
   [[noreturn]] void fail(std::uintmax_t inflated, std::uintmax_t needed) {
-    int code = Z_OK;
-    std::string message = gzipped_ && gz_ ? gzerror(gz_, &code) : "";
-    if (message.rfind(path_ + ": ", 0) == 0) message.erase(0, path_.size() + 2);  // zlib puts the path first
-    if (gzipped_ && code != Z_OK && code != Z_STREAM_END)
-      throw Error(path_, "truncated or corrupt compressed data (" + message + ") after " + std::to_string(inflated) +
-                             " bytes");
-    throw Error(path_, "truncated: " + std::to_string(inflated) + (gzipped_ ? " bytes inflated" : " bytes") +
-                           ", the header announces " + std::to_string(needed));
+    if (gzipped_ && gz_) {
+      const ZlibState state = zlibState(path_, gz_);
+      if (state.failed) throw corruptCompressedData(path_, state.message, inflated);
+    }
+    throw truncatedData(path_, inflated, gzipped_, needed);
   }
 
  private:
@@ -464,28 +483,26 @@ bool niftiFile(const std::string& path, std::vector<float>* voxels) {
   std::memcpy(&intercept, &interceptBits, sizeof intercept);
   const bool plain = voxels && version == 1 && std::memcmp(header + 344, "n+1", 4) == 0 && dimensions == 3 &&
                      convert && slope == 1.0f && intercept == 0.0f && offset == std::floor(offset);
-  if (!plain) {
+  const bool floating = datatype == 16 || datatype == 64;
+  // A plain .nii.gz is measured as it is read, below; the rest here.
+  if (!plain || !gzipped) {
     const auto actual = gzipped ? inflatedSize(path, needed) : fs::file_size(path);
-    if (actual < needed)
-      throw Error(path, "truncated: " + std::to_string(actual) + (gzipped ? " bytes inflated" : " bytes") +
-                            ", the header announces " + std::to_string(needed));
+    if (actual < needed) throw truncatedData(path, actual, gzipped, needed);
+  }
+  if (!plain) {
     // ITK's NIfTI reader turns NaN and infinite voxels into 0 without a word
     // (measured with ITK 5.2): float data is scanned for them here.
-    if (datatype == 16 || datatype == 64)
+    if (floating)
       requireFiniteVoxels(path, gzipped, static_cast<std::uintmax_t>(offset), count, datatype == 16 ? 4 : 8, swap,
                           size);
     return false;
   }
-  if (!gzipped && fs::file_size(path) < needed)
-    throw Error(path, "truncated: " + std::to_string(fs::file_size(path)) + " bytes, the header announces " +
-                          std::to_string(needed));
   // One pass: the data inflated whole, or else chunk by chunk, and converted.
   const std::vector<unsigned char> whole = gzipped ? inflateWhole(path, needed) : std::vector<unsigned char>();
   std::optional<DataReader> data;
   if (whole.empty()) data.emplace(path, gzipped, static_cast<std::uintmax_t>(offset));
   std::vector<float> read(count);
   std::vector<unsigned char> chunk(static_cast<std::size_t>(bytesPerVoxel) << 16);
-  const bool floating = datatype == 16 || datatype == 64;
   std::uintmax_t done = 0, bad = 0, firstBad = 0;
   while (done < count) {
     const auto want = static_cast<std::size_t>(std::min<std::uintmax_t>(count - done, chunk.size() / bytesPerVoxel));
