@@ -17,6 +17,7 @@
 #include "dynsub/FileNames.h"
 #include "dynsub/ImageIO.h"
 #include "dynsub/Metrics.h"
+#include "dynsub/ParallelFor.h"
 #include "dynsub/ModelOutputs.h"
 #include "dynsub/SeedGrowth.h"
 #include "dynsub/Segmentation.h"
@@ -85,16 +86,11 @@ void writeSegmentOutputs(const std::filesystem::path& dir, const SegmentRun& run
         // figures render on this one (a tenth of them). Its error, if any,
         // comes first, as when it was written first.
         const std::string labelmapPath = outputs.add("labelmap.nii.gz");
-        std::future<void> labelmapWritten =
-            std::async(std::launch::async, [&] { writeMask(run.labelmap, labelmapPath); });
-        try {
-          addFigureOutputs(outputs, figures, result.mesh, result.surface, run.history, &image,
-                           landmarkPositions(run.springs), Matrix3X());
-        } catch (...) {
-          labelmapWritten.get();
-          throw;
-        }
-        labelmapWritten.get();
+        alongside([&] { writeMask(run.labelmap, labelmapPath); },
+                  [&] {
+                    addFigureOutputs(outputs, figures, result.mesh, result.surface, run.history, &image,
+                                     landmarkPositions(run.springs), Matrix3X());
+                  });
       },
       result.surfaceEdgeDistances.size()
           ? std::vector<PointScalars>{{"edge_distance_mm", result.surfaceEdgeDistances}}

@@ -1,11 +1,11 @@
 #include "dynsub/ModelOutputs.h"
 
-#include <future>
 #include <string>
 
 #include "dynsub/Error.h"
 #include "dynsub/LimitSurface.h"
 #include "dynsub/MeshIO.h"
+#include "dynsub/ParallelFor.h"
 
 namespace dynsub {
 
@@ -77,18 +77,15 @@ void writeModelOutputs(const std::filesystem::path& dir, const ControlMesh& mesh
   // all went.
   const std::string surfacePath = outputs.add("surface.vtp"), meshPath = outputs.add("control_mesh.obj"),
                     reportPath = outputs.add("report.json");
-  std::future<void> modelWritten = std::async(std::launch::async, [&] {
-    writeTriangleSurface(surface, surfacePath, surfaceScalars, space);
-    writeObj(mesh, meshPath);
-    report.write(reportPath);
-  });
-  try {
-    if (extra) extra(outputs);
-  } catch (...) {
-    modelWritten.get();  // its error, if any, comes first
-    throw;
-  }
-  modelWritten.get();
+  alongside(
+      [&] {
+        writeTriangleSurface(surface, surfacePath, surfaceScalars, space);
+        writeObj(mesh, meshPath);
+        report.write(reportPath);
+      },
+      [&] {
+        if (extra) extra(outputs);
+      });
   outputs.commit();
 }
 

@@ -2,6 +2,7 @@
 // Independent per-item work on the machine's cores.
 #include <algorithm>
 #include <exception>
+#include <future>
 #include <thread>
 #include <vector>
 
@@ -61,6 +62,22 @@ void parallelFor(Eigen::Index count, Eigen::Index threadsWorthIt, const Body& bo
 template <class First, class Second>
 void bothAtOnce(const First& first, const Second& second) {
   parallelFor(2, 2, [&](Eigen::Index half) { half == 0 ? first() : second(); });
+}
+
+// background() on a second thread while foreground() runs on this one; an
+// exception from background() is rethrown before one from foreground(), as
+// when it ran first. For output written meanwhile, where this thread keeps
+// what must stay on it (adding outputs to a set, rendering).
+template <class Background, class Foreground>
+void alongside(const Background& background, const Foreground& foreground) {
+  std::future<void> done = std::async(std::launch::async, [&] { background(); });
+  try {
+    foreground();
+  } catch (...) {
+    done.get();  // its error, if any, comes first
+    throw;
+  }
+  done.get();
 }
 
 }  // namespace dynsub
