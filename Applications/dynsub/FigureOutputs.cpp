@@ -31,13 +31,8 @@ void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const Co
   writeConvergenceCsv(history, outputs.add("convergence.csv"));
   if (!options.figures) return;
   std::string why;
-  const rendering::Functions* draw = nullptr;
-  try {
-    draw = &rendering::functions();
-  } catch (const Error& e) {
-    why = e.what();
-  }
-  if (!draw || !draw->figureDisplay(&why)) {
+  const rendering::Functions* draw = rendering::figureFunctions(why);
+  if (!draw) {
     std::cerr << "warning: no figures written: " << why << '\n';
     return;
   }

@@ -64,15 +64,8 @@ std::string writeSculpture(const std::filesystem::path& dir, const Sculpture& sc
   writeLattice(solid, outputs.add("sculpted.vtu"));
   std::string figure;
   std::string why;
-  const rendering::Functions* draw = nullptr;
-  if (o.figure) {
-    try {
-      draw = &rendering::functions();
-    } catch (const Error& e) {
-      why = e.what();
-    }
-  }
-  if (draw && draw->figureDisplay(&why)) {
+  const rendering::Functions* draw = o.figure ? rendering::figureFunctions(why) : nullptr;
+  if (draw) {
     draw->writeSculptureFigure(sculpture, outputs.add("sculpted.png"));
     figure = ", sculpted.png";
   } else if (o.figure) {

@@ -1,4 +1,5 @@
 // Opens libDynSubRenderingLibrary.so (RenderingLibrary.h says why it is a library of its own).
+#include "dynsub/Error.h"
 #include "dynsub/OwnLibrary.h"
 #include "dynsub/RenderingLibrary.h"
 #include "dynsub/TemporaryFileGuard.h"
@@ -17,6 +18,16 @@ const Functions& functions() {
     return table;
   }();
   return *loaded;
+}
+
+const Functions* figureFunctions(std::string& why) {
+  try {
+    const Functions& draw = functions();
+    return draw.figureDisplay(&why) ? &draw : nullptr;
+  } catch (const Error& e) {
+    why = e.what();
+    return nullptr;
+  }
 }
 
 }  // namespace dynsub::rendering

@@ -12,6 +12,7 @@
 
 #include <cstdlib>
 #include <future>
+#include <optional>
 #include <string>
 
 #include <GL/glx.h>
@@ -151,10 +152,16 @@ std::future<PreparedDisplay>& displayPreparation() {
   return preparation;
 }
 
+// The display once figureDisplay() has waited for it: one per process.
+std::optional<PreparedDisplay>& preparedDisplay() {
+  static std::optional<PreparedDisplay> prepared;
+  return prepared;
+}
+
 }  // namespace
 
 void prepareFigureDisplay() {
-  if (displayPreparation().valid()) return;
+  if (displayPreparation().valid() || preparedDisplay()) return;
   PreparedDisplay prepared;
   LaunchedServer server;
   const char* name = std::getenv("DISPLAY");
@@ -170,23 +177,14 @@ void prepareFigureDisplay() {
 }
 
 bool figureDisplay(std::string* why) {
-  const char* name = std::getenv("DISPLAY");
+  // Made ready here when no one asked for it ahead.
+  prepareFigureDisplay();
   if (displayPreparation().valid()) {
-    const PreparedDisplay prepared = displayPreparation().get();
-    if (prepared.started) setenv("DISPLAY", prepared.name.c_str(), 1);
-    if (!prepared.ready) {
-      if (why) *why = prepared.why;
-      return false;
-    }
-    return true;
+    preparedDisplay() = displayPreparation().get();
+    if (preparedDisplay()->started) setenv("DISPLAY", preparedDisplay()->name.c_str(), 1);
   }
-  if (!name || !*name) {
-    LaunchedServer server;
-    std::string started;
-    if (!launchPrivateXServer(server, why) || !awaitPrivateXServer(server, started, why)) return false;
-    setenv("DISPLAY", started.c_str(), 1);
-  }
-  return displayAvailable(why);
+  if (!preparedDisplay()->ready && why) *why = preparedDisplay()->why;
+  return preparedDisplay()->ready;
 }
 
 }  // namespace dynsub

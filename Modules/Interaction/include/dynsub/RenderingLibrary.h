@@ -36,4 +36,9 @@ inline constexpr const char* kFunctionsSymbol = "dynsubRenderingFunctions";
 // dynsub::Error when the library cannot be opened.
 const Functions& functions();
 
+// The functions when figures can be drawn: the library opened and a display
+// ready (Figures.h: figureDisplay). Otherwise null, with `why`, for runs whose
+// figures are optional.
+const Functions* figureFunctions(std::string& why);
+
 }  // namespace dynsub::rendering

@@ -77,6 +77,8 @@ bool displayAvailable(std::string* why = nullptr);
 // node, a batch job), a private virtual X server (Xvfb, 1280x1024x24, no TCP)
 // started for this process on a free display number and stopped when the
 // process ends. False, with `why`, when neither works (no xvfb package).
+// The display is made ready once (prepareFigureDisplay) and the answer kept
+// for the rest of the process.
 bool figureDisplay(std::string* why = nullptr);
 
 // What figureDisplay() needs, made ready on a second thread while the caller
