@@ -6,6 +6,7 @@
 #include <fstream>
 #include <limits>
 
+#include "ScratchFiles.h"
 #include "TestGrids.h"
 #include "dynsub/Error.h"
 #include "dynsub/ImageIO.h"
@@ -15,11 +16,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::path(DYNSUB_BINARY_DIR) / "Testing" / "Temporary" / "Image";
-  fs::create_directories(dir);
-  return dir / name;
-}
+fs::path scratch(const std::string& name) { return scratchFile("Image", name); }
 
 TEST(ImageGeometry, IndexAndPhysicalAreInverse) {
   const ImageGeometry g = grid({10, 20, 30}, Vector3(0.5, 1.0, 2.0), Vector3(-3, 4, 5), skewDirection());

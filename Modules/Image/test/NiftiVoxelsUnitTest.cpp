@@ -18,6 +18,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "ScratchFiles.h"
 #include "BridgeGeometry.h"
 #include "FileChecks.h"
 #include "ItkBridge.h"
@@ -28,11 +29,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::path(DYNSUB_BINARY_DIR) / "Testing" / "Temporary" / "NiftiVoxels";
-  fs::create_directories(dir);
-  return dir / name;
-}
+fs::path scratch(const std::string& name) { return scratchFile("NiftiVoxels", name); }
 
 struct Layout {
   int datatype = 2;

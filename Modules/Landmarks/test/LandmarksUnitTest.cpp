@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "ScratchFiles.h"
 #include "dynsub/Error.h"
 #include "dynsub/Landmarks.h"
 
@@ -11,11 +12,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::path(DYNSUB_BINARY_DIR) / "Testing" / "Temporary" / "Landmarks";
-  fs::create_directories(dir);
-  return dir / name;
-}
+fs::path scratch(const std::string& name) { return scratchFile("Landmarks", name); }
 
 std::vector<Landmark> sample() {
   return {{"head", Vector3(-12.5, 30.25, 7.125)}, {"tail", Vector3(1e-3, -2.0, 1234.5678)}, {"", Vector3(0, 0, 0)}};

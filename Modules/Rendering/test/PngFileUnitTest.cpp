@@ -11,6 +11,7 @@
 #include <vtkNew.h>
 #include <vtkPNGReader.h>
 
+#include "ScratchFiles.h"
 #include "PngFile.h"
 #include "dynsub/Error.h"
 
@@ -19,11 +20,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::path(DYNSUB_BINARY_DIR) / "Testing" / "Temporary" / "PngFile";
-  fs::create_directories(dir);
-  return dir / name;
-}
+fs::path scratch(const std::string& name) { return scratchFile("PngFile", name); }
 
 // Samples that exercise the "up" filter's wrap-around (a row below a
 // brighter one) and runs that deflate well, bottom row first.
