@@ -85,14 +85,14 @@ std::string csvField(const std::string& text) {
 void writeRunsCsv(const std::vector<EvaluationRun>& runs, const std::string& path) {
   std::ofstream out(path);
   out << "split,image,structure,protocol,seed,format,landmarks,dice,jaccard,mean_surface_distance_mm,hd95_mm,"
-         "volume_mm3,reference_volume_mm3,leak_mm3,miss_mm3,collapsed,seconds,steps,control_vertices,warnings,error\n";
+         "volume_mm3,reference_volume_mm3,leak_mm3,miss_mm3,collapsed,surface_on_edges,seconds,steps,control_vertices,warnings,error\n";
   out << std::setprecision(6);
   for (const EvaluationRun& r : runs)
     out << csvField(r.split) << ',' << csvField(r.image) << ',' << csvField(r.structure) << ','
         << csvField(r.protocol) << ',' << r.seed << ',' << r.format
         << ',' << r.landmarks << ',' << r.dice << ',' << r.jaccard << ',' << r.meanSurfaceDistance << ',' << r.hd95
         << ',' << r.volume << ',' << r.referenceVolume << ',' << r.leak << ',' << r.miss << ','
-        << (r.collapsed ? 1 : 0) << ',' << r.seconds << ',' << r.steps << ',' << r.controlVertices << ','
+        << (r.collapsed ? 1 : 0) << ',' << r.surfaceOnEdges << ',' << r.seconds << ',' << r.steps << ',' << r.controlVertices << ','
         << csvField(r.warnings) << ',' << csvField(r.error) << '\n';
   out.close();
   if (!out) throw writeFailure(path);

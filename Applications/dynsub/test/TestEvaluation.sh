@@ -38,6 +38,8 @@ for r in rows:
         print("a collapse was not warned of:", r); ok = False
     if r["protocol"] != "seed" and int(r["landmarks"]) != {"six_slices": 36, "sparse": 15}[r["protocol"]]:
         print("wrong number of clicks:", r); ok = False
+    if not (0 <= float(r["surface_on_edges"]) <= 1):
+        print("surface_on_edges out of range:", r); ok = False
     if r["protocol"] != "seed" and not (0 < float(r["dice"]) <= 1):
         print("Dice out of range:", r); ok = False
 for protocol, floor in (("six_slices", 0.70), ("sparse", 0.68), ("seed", 0.35)):

@@ -68,6 +68,7 @@ EvaluationRun runOne(const EvaluationPlan& plan, const Volume& image, const Mask
   run.steps = result.steps;
   for (const std::string& w : result.warnings) run.warnings += (run.warnings.empty() ? "" : "; ") + w;
   run.controlVertices = result.mesh.vertexCount();
+  run.surfaceOnEdges = result.surfaceOnEdges;
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
 
   // Scored on the reference's grid (see the header).

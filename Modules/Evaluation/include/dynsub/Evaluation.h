@@ -74,6 +74,10 @@ struct EvaluationRun {
   double volume = 0, referenceVolume = 0;  // mm^3
   double leak = 0, miss = 0;                // mm^3 outside the reference, reference not covered
   bool collapsed = false;
+  // segment()'s share of the surface within a voxel of an edge (what its
+  // report calls surface_on_edges), to see how far that trust measure
+  // follows the accuracy the reference gives.
+  double surfaceOnEdges = 0;
   std::string warnings;  // segment()'s own (collapse, leak), joined by "; "
   double seconds = 0;  // segment() alone (the image is read once per plan, the clicks made before)
   int steps = 0, controlVertices = 0;
