@@ -168,7 +168,8 @@ def write_report(jobs, out, path):
                          f'{html.escape(row["message"])}</p></section>')
             continue
         figures = bids.figure_paths(out, job.dir, job.stem, job.structure)
-        parts += [_image(figures["slices"], "slices with the contour"), _image(figures["surface3d"], "3D view"),
+        parts += [_image(figures["slices"], "slices with the contour (green on an image edge, magenta 3 mm or more from any)"),
+                  _image(figures["surface3d"], "3D view, coloured the same way"),
                   _image(figures["convergence"], "convergence")]
         report = row["report"]
         facts = [("flags", ", ".join(row["flags"]) or "none"), ("volume (mm³)", row["volume_mm3"]),

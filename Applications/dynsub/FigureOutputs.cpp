@@ -27,7 +27,7 @@ void FigureOptions::prepare() const {
 
 void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const ControlMesh& mesh,
                       const TriangleSurface& surface, const ConvergenceHistory& history, const Volume* image,
-                      const Matrix3X& landmarks, const Matrix3X& dataPoints) {
+                      const Matrix3X& landmarks, const Matrix3X& dataPoints, const Eigen::VectorXd& edgeDistances) {
   writeConvergenceCsv(history, outputs.add("convergence.csv"));
   if (!options.figures) return;
   std::string why;
@@ -44,6 +44,7 @@ void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const Co
   inputs.landmarks = landmarks;
   inputs.dataPoints = dataPoints;
   inputs.history = &history;
+  inputs.edgeDistances = edgeDistances;
   FigureFiles files;
   files.slices = outputs.add("slices.png");
   files.surface3d = outputs.add("surface3d.png");

@@ -30,9 +30,12 @@ struct FigureOptions {
 // `outputs`. Without a display it says so on stderr and writes no figure.
 // `surface` is the result's limit surface (outputSurface); `image` may be
 // null (the control mesh is then drawn too); landmarks and dataPoints are
-// #points x 3 (mm), possibly empty.
+// #points x 3 (mm), possibly empty; edgeDistances, when not empty, colour the
+// surface and its contours (a segmentation's distance to the nearest edge per
+// point of `surface`, Figures.h).
 void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const ControlMesh& mesh,
                       const TriangleSurface& surface, const ConvergenceHistory& history, const Volume* image,
-                      const Matrix3X& landmarks, const Matrix3X& dataPoints);
+                      const Matrix3X& landmarks, const Matrix3X& dataPoints,
+                      const Eigen::VectorXd& edgeDistances = Eigen::VectorXd());
 
 }  // namespace dynsub::app

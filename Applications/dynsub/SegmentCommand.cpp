@@ -20,6 +20,7 @@
 #include "dynsub/ParallelFor.h"
 #include "dynsub/ModelOutputs.h"
 #include "dynsub/SeedGrowth.h"
+#include "dynsub/SurfaceWriter.h"
 #include "dynsub/Segmentation.h"
 
 namespace dynsub::app {
@@ -89,11 +90,11 @@ void writeSegmentOutputs(const std::filesystem::path& dir, const SegmentRun& run
         alongside([&] { writeMask(run.labelmap, labelmapPath); },
                   [&] {
                     addFigureOutputs(outputs, figures, result.mesh, result.surface, run.history, &image,
-                                     landmarkPositions(run.springs), Matrix3X());
+                                     landmarkPositions(run.springs), Matrix3X(), result.surfaceEdgeDistances);
                   });
       },
       result.surfaceEdgeDistances.size()
-          ? std::vector<PointScalars>{{"edge_distance_mm", result.surfaceEdgeDistances}}
+          ? std::vector<PointScalars>{{kEdgeDistanceScalars, result.surfaceEdgeDistances}}
           : std::vector<PointScalars>{},
       "LPS");
 }

@@ -143,6 +143,9 @@ for name in slices.png surface3d.png convergence.png; do
   check "render writes $name" test -s "$work/rendered/$name"
 done
 check "render redraws segment's slices.png pixel for pixel" cmp -s "$work/rendered/slices.png" "$work/caudate/slices.png"
+# Both colour the surface by surface.vtp's edge_distance_mm, with its bar.
+check "render redraws segment's surface3d.png pixel for pixel" \
+  cmp -s "$work/rendered/surface3d.png" "$work/caudate/surface3d.png"
 expect_error "render: missing surface" 1 "no such file" "$work/r1" \
   "$DYNSUB" render --surface "$work/none.vtp" --out "$work/r1"
 expect_error "render: not a surface" 1 "text.vtp" "$work/r2" \

@@ -7,8 +7,10 @@
 #include <vtkChartXY.h>
 #include <vtkContextActor.h>
 #include <vtkContextScene.h>
+#include <vtkDoubleArray.h>
 #include <vtkNew.h>
 #include <vtkImageData.h>
+#include <vtkPointData.h>
 #include <vtkPolyData.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
@@ -22,6 +24,7 @@
 #include "dynsub/SlicePlanes.h"
 #include "dynsub/SliceView.h"
 #include "dynsub/SurfacePolyData.h"
+#include "dynsub/SurfaceWriter.h"
 #include "dynsub/SurfaceView.h"
 #include "PngFile.h"
 
@@ -78,6 +81,7 @@ void drawSlices(const FigureScene& scene, vtkRenderWindow* window) {
       SliceView view(orientation);
       view.setImage(image);
       view.setSurface(scene.surface);
+      view.colourByEdgeDistance(scene.edgeDistances);
       // Interior slices, evenly spread: the end slices would only graze it.
       const double t = along.minCoeff() + (column + 1.0) / (kColumns + 1.0) * (along.maxCoeff() - along.minCoeff());
       const Vector3 through = centre + (t - centre.dot(axes.normal)) * axes.normal;
@@ -102,6 +106,7 @@ void drawSurface(const FigureScene& scene, vtkRenderWindow* window) {
   window->SetSize(800, 800);
   SurfaceView view;
   view.setSurface(scene.surface);
+  view.colourByEdgeDistance(scene.edgeDistances);
   if (scene.controlMesh) view.setControlMesh(scene.controlMesh);
   view.setLandmarks(scene.landmarks);
   if (scene.dataPoints.rows() > 0) view.setDataPoints(scene.dataPoints);
@@ -171,8 +176,18 @@ void writePng(vtkRenderWindow* window, const std::string& path) {
 void writeFigures(const FigureInputs& inputs, const FigureFiles& files) {
   const vtkSmartPointer<vtkPolyData> surface =
       inputs.surface ? toPolyData(*inputs.surface) : readSurfacePolyData(inputs.surfaceFile);
+  if (inputs.edgeDistances.size() > 0) {
+    if (inputs.edgeDistances.size() != surface->GetNumberOfPoints())
+      throw Error("internal: the edge distances are not one per point of the figure's surface");
+    vtkNew<vtkDoubleArray> distances;
+    distances->SetName(kEdgeDistanceScalars);
+    distances->SetNumberOfTuples(surface->GetNumberOfPoints());
+    for (vtkIdType p = 0; p < surface->GetNumberOfPoints(); ++p) distances->SetValue(p, inputs.edgeDistances[p]);
+    surface->GetPointData()->AddArray(distances);
+  }
   FigureScene scene;
   scene.surface = surface;
+  scene.edgeDistances = surface->GetPointData()->GetArray(kEdgeDistanceScalars) != nullptr;
   scene.landmarks = inputs.landmarks;
   scene.dataPoints = inputs.dataPoints;
   std::unique_ptr<ImageSlices> slices;

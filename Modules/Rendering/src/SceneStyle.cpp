@@ -1,5 +1,8 @@
 #include "dynsub/SceneStyle.h"
 
+#include "dynsub/SurfaceWriter.h"
+
+#include <algorithm>
 #include <cmath>
 
 #include <vtkActor.h>
@@ -16,6 +19,7 @@
 #include <vtkRenderWindow.h>
 #include <vtkRenderWindowInteractor.h>
 #include <vtkRenderer.h>
+#include <vtkScalarBarActor.h>
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
 #include <vtkUnsignedCharArray.h>
@@ -35,6 +39,54 @@ void colourByElementType(vtkPolyDataMapper* mapper) {
   mapper->SelectColorArray("ElementType");
   mapper->SetScalarRange(0, 1);
   mapper->ScalarVisibilityOn();
+}
+
+void colourByEdgeDistance(vtkPolyDataMapper* mapper) {
+  vtkNew<vtkLookupTable> table;
+  // Green (on an edge) through yellow to magenta (far from any): not red,
+  // which the landmarks are drawn in.
+  const Vector3 stops[3] = {{0.15, 0.8, 0.25}, {1.0, 0.9, 0.15}, {0.9, 0.2, 0.9}};
+  constexpr int kEntries = 64;
+  table->SetNumberOfTableValues(kEntries);
+  table->SetTableRange(0, kFarFromEdges);
+  for (int e = 0; e < kEntries; ++e) {
+    const double t = 2.0 * e / (kEntries - 1);
+    const int from = std::min(static_cast<int>(t), 1);
+    const Vector3 c = stops[from] + (t - from) * (stops[from + 1] - stops[from]);
+    table->SetTableValue(e, c.x(), c.y(), c.z(), 1.0);
+  }
+  table->SetBelowRangeColor(0.55, 0.55, 0.55, 1.0);  // -1: outside the region, unknown
+  table->UseBelowRangeColorOn();
+  mapper->SetLookupTable(table);
+  mapper->SetColorModeToMapScalars();
+  mapper->SetScalarModeToUsePointFieldData();
+  mapper->SelectColorArray(kEdgeDistanceScalars);
+  mapper->SetScalarRange(0, kFarFromEdges);
+  // NB: mapped per fragment, not per vertex: a triangle between a held and
+  // an unknown point would otherwise blend green into grey.
+  mapper->InterpolateScalarsBeforeMappingOn();
+  mapper->ScalarVisibilityOn();
+}
+
+vtkSmartPointer<vtkScalarBarActor> edgeDistanceBar(vtkPolyDataMapper* mapper) {
+  auto bar = vtkSmartPointer<vtkScalarBarActor>::New();
+  bar->SetLookupTable(mapper->GetLookupTable());
+  bar->SetTitle("mm to an edge");
+  bar->SetNumberOfLabels(4);
+  bar->SetLabelFormat("%.0f");
+  bar->SetOrientationToVertical();
+  bar->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
+  bar->GetPositionCoordinate()->SetValue(0.84, 0.1);
+  bar->SetWidth(0.1);
+  bar->SetHeight(0.5);
+  bar->UnconstrainedFontSizeOn();
+  bar->GetTitleTextProperty()->SetFontSize(kFontSize);
+  bar->GetLabelTextProperty()->SetFontSize(kFontSize);
+  bar->GetTitleTextProperty()->ItalicOff();
+  bar->GetLabelTextProperty()->ItalicOff();
+  bar->GetTitleTextProperty()->ShadowOff();
+  bar->GetLabelTextProperty()->ShadowOff();
+  return bar;
 }
 
 void pointsAsDots(vtkActor* actor, double pixels) {

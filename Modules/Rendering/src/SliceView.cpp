@@ -242,6 +242,14 @@ void SliceView::setSurface(vtkPolyData* surface) {
   impl_->contourActor->SetVisibility(surface != nullptr);
 }
 
+void SliceView::colourByEdgeDistance(bool on) {
+  if (on) {
+    style::colourByEdgeDistance(impl_->contourMapper);
+  } else {
+    style::colourByElementType(impl_->contourMapper);
+  }
+}
+
 void SliceView::setLandmarks(const Matrix3X& landmarks, int selected) {
   impl_->landmarks = landmarks;
   impl_->selected = selected;

@@ -17,6 +17,7 @@
 #include <vtkPolyDataMapper.h>
 #include <vtkProperty.h>
 #include <vtkRenderer.h>
+#include <vtkScalarBarActor.h>
 
 #include "dynsub/SceneStyle.h"
 #include "dynsub/ControlMesh.h"
@@ -57,6 +58,7 @@ struct SurfaceView::Impl {
   const ImageSlices* image = nullptr;
   vtkNew<vtkImageSliceMapper> sliceMappers[3];
   vtkNew<vtkImageSlice> sliceActors[3];
+  vtkSmartPointer<vtkScalarBarActor> edgeDistanceBar;
 
   Impl() {
     renderer->SetBackground(0.1, 0.1, 0.12);
@@ -92,6 +94,20 @@ vtkRenderer* SurfaceView::renderer() const { return impl_->renderer; }
 void SurfaceView::setSurface(vtkPolyData* surface) {
   impl_->surfaceMapper->SetInputData(surface);
   impl_->surfaceActor->SetVisibility(surface != nullptr);
+}
+
+void SurfaceView::colourByEdgeDistance(bool on) {
+  if (on) {
+    style::colourByEdgeDistance(impl_->surfaceMapper);
+    if (!impl_->edgeDistanceBar) {
+      impl_->edgeDistanceBar = style::edgeDistanceBar(impl_->surfaceMapper);
+      impl_->renderer->AddActor2D(impl_->edgeDistanceBar);
+    }
+  } else {
+    style::colourByElementType(impl_->surfaceMapper);
+    if (impl_->edgeDistanceBar) impl_->renderer->RemoveActor2D(impl_->edgeDistanceBar);
+    impl_->edgeDistanceBar = nullptr;
+  }
 }
 
 void SurfaceView::setOpacity(double opacity) { impl_->surfaceActor->GetProperty()->SetOpacity(opacity); }

@@ -16,9 +16,11 @@
 
 #include <vtkCellData.h>
 #include <vtkCutter.h>
+#include <vtkDoubleArray.h>
 #include <vtkImageData.h>
 #include <vtkNew.h>
 #include <vtkPlane.h>
+#include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkRenderWindow.h>
@@ -39,6 +41,7 @@
 #include "dynsub/SliceView.h"
 #include "dynsub/SolidView.h"
 #include "dynsub/SurfacePolyData.h"
+#include "dynsub/SurfaceWriter.h"
 #include "dynsub/SurfaceView.h"
 #include "dynsub/Tessellation.h"
 #include "dynsub/Voxelize.h"
@@ -162,6 +165,85 @@ TEST_F(Rendering, SliceViewPutsImageContourAndLandmarksInOneFrame) {
     const Vector3 back = view.pointAt(200, 210);
     EXPECT_NEAR(plane.distance(back), 0.0, 1e-9);
     EXPECT_NEAR((view.displayPosition(back) - Eigen::Vector2d(200, 210)).norm(), 0.0, 1e-6);
+  }
+}
+
+// A segmentation's contour coloured by its distance to the image's edges:
+// on a ball whose points say 0 mm (held by an edge) on the view's left half,
+// 5 mm (beyond kFarFromEdges) on its upper right quarter and -1 (unknown) on
+// its lower right one, the contour is green, magenta and grey where they are.
+TEST_F(Rendering, SliceViewColoursTheContourByEdgeDistance) {
+  const BallPhantom phantom = makeBallPhantom();
+  const ImageSlices slices(phantom.image);
+  vtkNew<vtkSphereSource> sphere;
+  sphere->SetCenter(phantom.centre.data());
+  sphere->SetRadius(phantom.radius);
+  sphere->SetThetaResolution(128);
+  sphere->SetPhiResolution(128);
+  sphere->Update();
+  vtkNew<vtkPolyData> surface;
+  surface->ShallowCopy(sphere->GetOutput());
+
+  SliceView view(SliceOrientation::Coronal);
+  view.setImage(&slices);
+  view.setSurface(surface);
+  view.colourByEdgeDistance(true);
+  view.showSlice(slices.sliceThrough(SliceOrientation::Coronal, phantom.centre));
+  const SlicePlane& plane = view.plane();
+  vtkNew<vtkDoubleArray> distances;
+  distances->SetName(kEdgeDistanceScalars);
+  distances->SetNumberOfTuples(surface->GetNumberOfPoints());
+  for (vtkIdType p = 0; p < surface->GetNumberOfPoints(); ++p) {
+    double x[3];
+    surface->GetPoint(p, x);
+    const Vector3 d = Vector3(x[0], x[1], x[2]) - phantom.centre;
+    distances->SetValue(p, d.dot(plane.right) < 0 ? 0.0 : d.dot(plane.up) > 0 ? 5.0 : -1.0);
+  }
+  surface->GetPointData()->AddArray(distances);
+  const Vector3 circleCentre = phantom.centre - plane.distance(phantom.centre) * plane.normal;
+  const double circleRadius = std::sqrt(std::pow(phantom.radius, 2) - std::pow(plane.distance(phantom.centre), 2));
+  view.frame(circleCentre, 20.0);
+
+  vtkNew<vtkRenderWindow> window;
+  window->SetOffScreenRendering(1);
+  window->SetMultiSamples(0);
+  window->SetSize(400, 400);
+  window->AddRenderer(view.renderer());
+  window->Render();
+  vtkNew<vtkWindowToImageFilter> capture;
+  capture->SetInput(window);
+  capture->ReadFrontBufferOff();
+  capture->Update();
+  vtkImageData* image = capture->GetOutput();
+
+  // The colours within a pixel of the circle, 15 degrees and more from the
+  // quarters' borders (where the colours blend over a triangle).
+  auto near = [&](const Vector3& direction, auto isColour) {
+    const Eigen::Vector2d on = view.displayPosition(circleCentre + circleRadius * direction);
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        if (isColour(pixel(image, on + Eigen::Vector2d(dx, dy)))) return true;
+    return false;
+  };
+  const auto green = [](const std::array<int, 3>& c) { return c[1] > 150 && c[0] < 100 && c[2] < 120; };
+  const auto magenta = [](const std::array<int, 3>& c) { return c[0] > 180 && c[2] > 180 && c[1] < 100; };
+  const auto grey = [](const std::array<int, 3>& c) {
+    return std::abs(c[0] - c[1]) < 12 && std::abs(c[1] - c[2]) < 12 && c[0] > 110 && c[0] < 170;
+  };
+  for (int a = 0; a < 12; ++a) {
+    const double angle = (a + 0.5) * M_PI / 6.0;  // from the view's right, counter-clockwise
+    if (std::abs(std::remainder(angle, M_PI / 2)) < M_PI / 12) continue;  // a quarter's border
+    const Vector3 direction = std::cos(angle) * plane.right + std::sin(angle) * plane.up;
+    const bool left = std::cos(angle) < 0, up = std::sin(angle) > 0;
+    if (left) {
+      EXPECT_TRUE(near(direction, green)) << "angle " << angle << ": a point held by an edge is not green";
+    } else if (up) {
+      EXPECT_TRUE(near(direction, magenta)) << "angle " << angle << ": a point far from edges is not magenta";
+    } else {
+      EXPECT_TRUE(near(direction, grey)) << "angle " << angle << ": a point of unknown distance is not grey";
+    }
+    EXPECT_FALSE(near(direction, [](const std::array<int, 3>& c) { return c[0] > 200 && c[1] > 150 && c[2] < 100; }))
+        << "angle " << angle << ": the contour is drawn by element type (yellow)";
   }
 }
 

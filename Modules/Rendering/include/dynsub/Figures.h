@@ -7,6 +7,8 @@
 //   surface3d.png    the limit surface coloured by element type, landmarks or
 //                    data, and (with an image) three slices behind the surface
 //                    as a backdrop; 800 x 800;
+//   A surface that carries its distance to the image's edges (a
+//   segmentation's) is coloured by it instead, in both (FigureScene).
 //   convergence.png  the convergence plot (ConvergencePlot.h); 900 x 500.
 // Windows are fixed-size, without multisampling, and render off screen, so
 // the same input gives the same pixels (rendering regression tests rely on it).
@@ -38,6 +40,11 @@ struct FigureScene {
   vtkPolyData* controlMesh = nullptr; // optional wireframe (SurfaceView.h), 3D figure only
   Matrix3X landmarks;                 // #landmarks x 3, LPS mm
   Matrix3X dataPoints;                // range data, mm
+  // The surface and its contours coloured by its point array
+  // kEdgeDistanceScalars (SurfaceWriter.h), with a colour bar in the 3D
+  // figure, instead of by element type: where a segmentation is held by the
+  // image's edges and where by tension and landmarks alone.
+  bool edgeDistances = false;
 };
 
 // Throws dynsub::Error when the scene has no surface, or (slices) when the
@@ -61,6 +68,10 @@ struct FigureInputs {
   Matrix3X landmarks;                        // #landmarks x 3, LPS mm
   Matrix3X dataPoints;                       // range data, mm
   const ConvergenceHistory* history = nullptr;  // needed for the convergence figure
+  // Per point of `surface`: its distance to the nearest edge (mm, -1
+  // unknown), to colour it by (FigureScene::edgeDistances); empty: none. A
+  // surface read from `surfaceFile` is coloured by the same array if it has it.
+  Eigen::VectorXd edgeDistances;
 };
 // The paths to write slices.png, surface3d.png and convergence.png to; an
 // empty path is not rendered. Needs a display (figureDisplay). Throws as the

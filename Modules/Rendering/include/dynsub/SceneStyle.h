@@ -17,6 +17,7 @@ class vtkPolyDataMapper;
 class vtkRenderWindow;
 class vtkRenderWindowInteractor;
 class vtkRenderer;
+class vtkScalarBarActor;
 class vtkTextActor;
 
 namespace dynsub::style {
@@ -33,6 +34,14 @@ constexpr int kFontSize = 14;
 
 // Colours a mapper's cells by the "ElementType" cell array (SurfacePolyData.h).
 void colourByElementType(vtkPolyDataMapper* mapper);
+// Colours a mapper's points by their distance to the nearest edge
+// (kEdgeDistanceScalars, SurfaceWriter.h): green on an edge (0 mm), through
+// yellow, to magenta at kFarFromEdges and beyond; grey where it is unknown
+// (-1). Where only tension and landmarks hold a segmentation, it shows magenta.
+void colourByEdgeDistance(vtkPolyDataMapper* mapper);
+constexpr double kFarFromEdges = 3.0;  // mm: three voxels of the 1 mm MRI
+// The colour bar of colourByEdgeDistance, for `mapper`, at the right of its view.
+vtkSmartPointer<vtkScalarBarActor> edgeDistanceBar(vtkPolyDataMapper* mapper);
 // Vertices drawn as round dots of a fixed size in pixels.
 void pointsAsDots(vtkActor* actor, double pixels);
 

@@ -1,7 +1,8 @@
 #pragma once
 // One slice view (TVCG Figs 10-11): an image slice in grey, the surface's
 // cross-section on that slice as a contour (vtkCutter; yellow on normal
-// elements, green on special ones, as in the papers), the landmarks that lie
+// elements, green on special ones, as in the papers, or coloured by its
+// distance to the image's edges), the landmarks that lie
 // on the slice as red dots (the selected one cyan), and optionally range-data
 // points near the slice. Orientation letters mark the screen edges.
 // Everything is in LPS mm (SlicePlanes.h says how the image is placed).
@@ -32,6 +33,9 @@ class SliceView {
   // The surface whose cross-section is drawn; the contour follows when the
   // polydata is modified (live fitting).
   void setSurface(vtkPolyData* surface);
+  // The contour by element type (the default), or by its points' distance to
+  // the nearest edge (style::colourByEdgeDistance; the surface must carry it).
+  void colourByEdgeDistance(bool on);
   // Landmarks (#landmarks x 3, LPS mm); those within half a slice of the plane are drawn.
   void setLandmarks(const Matrix3X& landmarks, int selected = -1);
   // Range data drawn as small white dots where within half a slice.

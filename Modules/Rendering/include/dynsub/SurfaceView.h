@@ -1,6 +1,7 @@
 #pragma once
 // The 3D view: the limit surface lit and coloured by element type (yellow
-// normal, green special elements, as in the papers), optionally translucent;
+// normal, green special elements, as in the papers) or by its distance to the
+// image's edges (a segmentation's), optionally translucent;
 // the control mesh as a wireframe; landmarks as red dots; range data as white
 // dots; and the image's three slice planes through a point. LPS mm.
 #include <memory>
@@ -29,6 +30,10 @@ class SurfaceView {
 
   void setSurface(vtkPolyData* surface);  // followed when modified
   void setOpacity(double opacity);        // 1 opaque
+  // By element type (the default), or by each point's distance to the
+  // nearest edge (style::colourByEdgeDistance; the surface must carry it),
+  // with its colour bar.
+  void colourByEdgeDistance(bool on);
   void setControlMesh(vtkPolyData* wireframe);  // nullptr hides it
   void setLandmarks(const Matrix3X& landmarks, int selected = -1);  // #landmarks x 3, LPS mm
   void setDataPoints(const Matrix3X& points);

@@ -20,6 +20,11 @@ struct PointScalars {
   Eigen::VectorXd values;  // one per row of TriangleSurface::points, finite
 };
 
+// The point data a segmentation's surface carries: each point's distance to
+// the nearest edge of the edge map (mm; -1 outside the region of interest,
+// where it is unknown). The figures colour a surface that has it by it.
+constexpr char kEdgeDistanceScalars[] = "edge_distance_mm";
+
 // `space`, when not empty, names the coordinate system of a .vtp as the
 // field-data string array "SPACE" that 3D Slicer reads ("LPS" or "RAS";
 // Slicer assumes LPS without it). Throws dynsub::Error naming the file for an
