@@ -146,9 +146,10 @@ SegmentRun runSegmentation(const Volume& image, SegmentInputs in, const Progress
     r.set("window_spreads", seed->window);
     r.set("opening_mm", seed->opening);
     r.set("region_volume_mm3", seed->mask.count() * seed->mask.geometry.spacing.prod());
+    r.set("narrower_window_volume_mm3", seed->narrowerWindowVolume);
     r.set("boundary_points", seed->boundary.size());
     r.set("springs", in.landmarks.empty() ? "boundary points" : "landmarks");
-    r.set("leaked", seed->touchesReach);
+    r.set("leaked", probablyLeaked(*seed));
     report.set("seed", r);
   }
   if (in.reference) {

@@ -15,6 +15,7 @@ namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr double kGuardWindow = 2.5;  // the leak guard's narrower window
+constexpr double kNarrowerWindow = 0.8;  // SeedRegion::narrowerWindowVolume
 
 }  // namespace
 
@@ -185,11 +186,43 @@ SeedRegion growFromSeed(const Volume& image, const Vector3& click, const SeedOpt
         continue;
       }
       result = std::move(attempt);
-      if (!result.touchesReach) return result;
+      if (!result.touchesReach) break;
     }
+    if (!result.boundary.empty() && !result.touchesReach) break;
   }
   if (result.boundary.empty()) throw Error(failure);
+  // How much of the region the last part of its window added: the same growth
+  // and opening through a window kNarrowerWindow as wide.
+  {
+    const double narrower = kNarrowerWindow * result.window;
+    const std::vector<std::uint8_t> grown =
+        growThrough(box, base.median - narrower * base.spread, base.median + narrower * base.spread);
+    SeedRegion smaller = base;
+    long long kept = 0;
+    try {
+      shapeRegion(box, grown, result.opening, options.boundaryPoints, smaller);
+      kept = smaller.mask.count();
+    } catch (const Error&) {
+      kept = 0;  // opened away at the click: nothing is left
+    }
+    result.narrowerWindowVolume = kept * box.image.geometry.spacing.prod();
+  }
   return result;
+}
+
+namespace {
+
+double regionVolume(const SeedRegion& region) { return region.mask.count() * region.mask.geometry.spacing.prod(); }
+
+// Grew more than kLeakGrowth times over the last fifth of its window.
+bool hangsOnWindow(const SeedRegion& region) {
+  return regionVolume(region) > kLeakGrowth * region.narrowerWindowVolume;
+}
+
+}  // namespace
+
+bool probablyLeaked(const SeedRegion& region) {
+  return region.touchesReach || (hangsOnWindow(region) && region.narrowerWindowVolume >= kSmallSeedRegion);
 }
 
 std::vector<std::string> seedWarnings(const SeedRegion& region) {
@@ -203,7 +236,22 @@ std::vector<std::string> seedWarnings(const SeedRegion& region) {
     warnings.push_back(message.str());
     message.str("");
   }
-  const double volume = region.mask.count() * region.mask.geometry.spacing.prod();
+  const double volume = regionVolume(region);
+  if (!region.touchesReach && hangsOnWindow(region)) {
+    message << "the region grown from the seed (" << volume << " mm^3, intensities " << region.low << " to "
+            << region.high << ") is " << std::setprecision(1)
+            << (region.narrowerWindowVolume > 0 ? volume / region.narrowerWindowVolume : kInfinity)
+            << " times the one a window a fifth narrower gives (" << region.narrowerWindowVolume << " mm^3): ";
+    if (probablyLeaked(region)) {
+      message << "the last of its intensities joined like tissue to it, so it has probably leaked into a "
+                 "neighbour of the structure (give landmarks, or click elsewhere inside)";
+    } else {
+      message << "its size hangs on the window, so it may hold only part of the structure, or run into a "
+                 "neighbour (check the figures, give landmarks, or click elsewhere inside)";
+    }
+    warnings.push_back(message.str());
+    message.str("");
+  }
   if (volume < kSmallSeedRegion) {
     message << "the region grown from the seed holds only " << volume << " mm^3 (intensities " << region.low
             << " to " << region.high << ", opening " << region.opening

@@ -56,6 +56,7 @@ TEST(SeedGrowthTest, TheOpeningCutsTheTubeAndKeepsTheBall) {
     EXPECT_GT(region.low, 20.0);
     EXPECT_FALSE(region.touchesReach);
     EXPECT_TRUE(seedWarnings(region).empty());
+    EXPECT_FALSE(probablyLeaked(region));
     EXPECT_NEAR(volumeOf(region.mask), 4.0 / 3.0 * kPi * std::pow(kRadius, 3), 0.1 * 4.0 / 3.0 * kPi * 512);
     EXPECT_GT(region.grownVoxels * spacing.prod(), 20000.0);  // the growth itself reached the block
     ASSERT_EQ(region.boundary.size(), 60u);
@@ -86,6 +87,37 @@ TEST(SeedGrowthTest, AFlatImageLeaksAndSaysSo) {
   EXPECT_TRUE(region.touchesReach);
   ASSERT_EQ(seedWarnings(region).size(), 1u);
   EXPECT_NE(seedWarnings(region)[0].find("leaked"), std::string::npos);
+}
+
+TEST(SeedGrowthTest, ARegionThatOnlyTheLastFifthOfItsWindowJoinedToANeighbourIsWarnedOf) {
+  // A ball (radius 7 mm) joined to a 20 mm block of the same tissue by a
+  // bridge 3 mm in radius (the opening keeps it) whose intensity, 103, lies
+  // in the window (100 +- 4 spreads of 0.8: 1 % of the image's range, the
+  // ball being flat) but not in one 0.8 times as wide (+- 2.56). The region
+  // stays inside its box, so only the narrower window's growth tells the leak.
+  Volume image;
+  image.geometry.size = {64, 64, 64};
+  image.voxels.assign(image.geometry.voxelCount(), 20.0f);
+  const Vector3 ball(20, 32, 32);
+  for (int k = 0; k < 64; ++k)
+    for (int j = 0; j < 64; ++j)
+      for (int i = 0; i < 64; ++i) {
+        float& v = image.voxels[image.geometry.offset(i, j, k)];
+        const bool inBridge = i >= 25 && i <= 37 && std::hypot(j - 32.0, k - 32.0) <= 3.0;
+        if (inBridge) v = 103.0f;
+        if ((Vector3(i, j, k) - ball).norm() <= 7.0) v = 100.0f;
+        if (i >= 36 && i <= 56 && j >= 22 && j <= 42 && k >= 22 && k <= 42) v = 100.0f;
+      }
+  const SeedRegion region = growFromSeed(image, ball);
+  EXPECT_FALSE(region.touchesReach);
+  const double ballVolume = 4.0 / 3.0 * kPi * std::pow(7.0, 3);
+  EXPECT_GT(volumeOf(region.mask), 8000.0);  // the block came in
+  EXPECT_NEAR(region.narrowerWindowVolume, ballVolume, 0.1 * ballVolume);
+  EXPECT_TRUE(probablyLeaked(region));
+  const std::vector<std::string> warnings = seedWarnings(region);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("leaked"), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[0].find("a fifth narrower"), std::string::npos) << warnings[0];
 }
 
 TEST(SeedGrowthTest, BadClicksAndOptionsAreErrors) {

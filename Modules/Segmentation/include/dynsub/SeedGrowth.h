@@ -58,18 +58,34 @@ struct SeedRegion {
   // farthest-point sampling from the one nearest the click.
   std::vector<Landmark> boundary;
   bool touchesReach = false;  // the region reached the edge of its box: it has probably leaked
+  // The region grown and opened the same way through a window 0.8 times as
+  // wide (mm^3). A region many times larger than that sits where a little
+  // more window let it through into like tissue (seedWarnings).
+  double narrowerWindowVolume = 0;
 };
 
 void checkSeedOptions(const SeedOptions& options);
 
 // What a region grown from a click should be trusted for: a warning when it
-// leaked (touchesReach), and one when it holds less than a ball of 5 mm
-// radius (524 mm^3), too little for the surface started from it not to
-// shrink (the guard narrows the window until the growth stays inside its
-// reach, which in textured tissue can leave a few voxels).
+// leaked (touchesReach), one when it is more than kLeakGrowth times the
+// region a window 0.8 times as wide gives (its size hangs on the window:
+// when that narrower region is itself no small one, it leaked without
+// reaching the edge of its box, the last fifth of the window joining a
+// neighbour to it; otherwise it may be part of a textured structure),
+// and one when it holds less than a ball of 5 mm radius (524 mm^3), too
+// little for the surface started from it not to shrink (the guard narrows
+// the window until the growth stays inside its reach, which in textured
+// tissue can leave a few voxels).
 std::vector<std::string> seedWarnings(const SeedRegion& region);
+// The leak signs above: the region reached its box, or the last fifth of its
+// window grew a region of at least kSmallSeedRegion more than kLeakGrowth times.
+bool probablyLeaked(const SeedRegion& region);
 
 constexpr double kSmallSeedRegion = 524.0;  // mm^3
+// Chosen on the evaluation plan's tuning split (Documentation/Segmentation.md,
+// "One seed click"): its regions that did not leak grew at most 2.0 times
+// over the last fifth of their window, those that leaked 3.7-42 times.
+constexpr double kLeakGrowth = 3.0;
 
 // Throws dynsub::Error for a click outside the image or impossible options,
 // and when every opening leaves nothing at the click (a click on a structure
