@@ -13,9 +13,14 @@ namespace dynsub {
 std::vector<std::uint8_t> connectedTo(const std::vector<std::uint8_t>& allowed, const ImageGeometry& grid,
                                       std::vector<long long> starts);
 
-// The voxels deeper than `radius` mm inside `grown` (by exact Euclidean
-// distance): the core of an opening by a ball of that radius.
-std::vector<std::uint8_t> coreOf(const std::vector<std::uint8_t>& grown, const ImageGeometry& grid, double radius);
+// Each voxel of `grown`'s distance (mm, exact Euclidean) to the nearest voxel
+// outside it; computed once, it serves the cores of every opening.
+std::vector<float> depthInside(const std::vector<std::uint8_t>& grown, const ImageGeometry& grid);
+
+// The voxels deeper than `radius` mm inside `grown` (`depth` from
+// depthInside): the core of an opening by a ball of that radius.
+std::vector<std::uint8_t> coreOf(const std::vector<std::uint8_t>& grown, const std::vector<float>& depth,
+                                 double radius);
 
 // The opening of `grown` by a ball of `radius` mm, kept to the part whose
 // core (coreOf) is connected to `coreStarts` (core voxels): that core, grown

@@ -99,15 +99,15 @@ std::vector<std::uint8_t> growThrough(const SeedBox& box, double low, double hig
 
 // Steps 3 and 4 on a grown region, then its boundary: fills `region`'s mask,
 // boundary and touchesReach. Throws when the opening leaves nothing near the click.
-void shapeRegion(const SeedBox& box, const std::vector<std::uint8_t>& grown, double opening, int boundaryPoints,
-                 SeedRegion& region) {
+void shapeRegion(const SeedBox& box, const std::vector<std::uint8_t>& grown, const std::vector<float>& depth,
+                 double opening, int boundaryPoints, SeedRegion& region) {
   const ImageGeometry& g = box.image.geometry;
   const long long seed = box.seedOffset;
   const auto [si, sj, sk] = box.seed;
   // 3. Opening.
   std::vector<std::uint8_t> kept = grown;
   if (opening > 0) {
-    const std::vector<std::uint8_t> core = coreOf(grown, g, opening);
+    const std::vector<std::uint8_t> core = coreOf(grown, depth, opening);
     // The core voxel nearest the click, within the opening's reach of it.
     long long start = -1;
     double nearest = kInfinity;
@@ -176,11 +176,12 @@ SeedRegion growFromSeed(const Volume& image, const Vector3& click, const SeedOpt
     grownThrough.high = base.median + window * base.spread;
     const std::vector<std::uint8_t> grown = growThrough(box, grownThrough.low, grownThrough.high);
     grownThrough.grownVoxels = std::count(grown.begin(), grown.end(), 1);
+    const std::vector<float> depth = depthInside(grown, box.image.geometry);  // for every opening
     for (const double extra : {0.0, 1.0, 2.0}) {
       SeedRegion attempt = grownThrough;
       attempt.opening = options.opening + extra;
       try {
-        shapeRegion(box, grown, attempt.opening, options.boundaryPoints, attempt);
+        shapeRegion(box, grown, depth, attempt.opening, options.boundaryPoints, attempt);
       } catch (const Error& e) {
         failure = e.what();  // opened away at the click: try the next
         continue;
@@ -200,7 +201,8 @@ SeedRegion growFromSeed(const Volume& image, const Vector3& click, const SeedOpt
     SeedRegion smaller = base;
     long long kept = 0;
     try {
-      shapeRegion(box, grown, result.opening, options.boundaryPoints, smaller);
+      shapeRegion(box, grown, depthInside(grown, box.image.geometry), result.opening, options.boundaryPoints,
+                  smaller);
       kept = smaller.mask.count();
     } catch (const Error&) {
       kept = 0;  // opened away at the click: nothing is left
