@@ -41,7 +41,9 @@ struct Functions {
   // sigma mm, with Deriche's recursive filters; three components per voxel.
   std::vector<float> (*recursiveGaussianGradient)(const Geometry& geometry, const std::vector<float>& voxels,
                                                   double sigma);
-  // Euclidean distance (mm) from every voxel centre to the nearest non-zero voxel.
+  // Euclidean distance (mm) from every voxel centre to the nearest non-zero
+  // voxel (ITK's Maurer transform): the oracle DistanceUnitTests holds
+  // distanceTo (ImageFilters.h) to; the project itself uses its own.
   std::vector<float> (*distanceMap)(const Geometry& geometry, const std::vector<std::uint8_t>& mask);
 };
 inline constexpr const char* kFunctionsSymbol = "dynsubItkBridgeFunctions";
