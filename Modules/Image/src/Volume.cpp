@@ -122,6 +122,29 @@ std::pair<std::array<int, 3>, std::array<int, 3>> boundingRegion(const ImageGeom
   return {first, size};
 }
 
+std::pair<std::array<int, 3>, std::array<int, 3>> occupiedRegion(const ImageGeometry& g,
+                                                                 const std::vector<std::uint8_t>& voxels, int margin) {
+  std::array<int, 3> low{g.size[0], g.size[1], g.size[2]}, high{-1, -1, -1};
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j) {
+      const std::uint8_t* row = voxels.data() + g.offset(0, j, k);
+      const std::uint8_t* end = row + g.size[0];
+      const std::uint8_t* first = std::find_if(row, end, [](std::uint8_t v) { return v != 0; });
+      if (first == end) continue;
+      const std::uint8_t* last = end - 1;
+      while (*last == 0) --last;
+      low = {std::min(low[0], static_cast<int>(first - row)), std::min(low[1], j), std::min(low[2], k)};
+      high = {std::max(high[0], static_cast<int>(last - row)), std::max(high[1], j), std::max(high[2], k)};
+    }
+  std::array<int, 3> first{}, size{};
+  if (high[0] < 0) return {first, size};
+  for (int a = 0; a < 3; ++a) {
+    first[a] = std::max(0, low[a] - margin);
+    size[a] = std::min(g.size[a] - 1, high[a] + margin) - first[a] + 1;
+  }
+  return {first, size};
+}
+
 Mask pasteMask(const Mask& part, const ImageGeometry& full, const std::array<int, 3>& first) {
   Mask result{full, std::vector<std::uint8_t>(full.voxelCount(), 0)};
   const auto& n = part.geometry.size;

@@ -56,24 +56,10 @@ OverlapMetrics compareMasks(const Mask& a, const Mask& b) {
   // image's edge too, so the boundaries are the same voxels, and the exact
   // distance maps agree wherever they are read. On a whole 1 mm brain the
   // distance maps took most of a segmentation's time.
-  std::array<int, 3> low{a.geometry.size}, high{-1, -1, -1};
   const ImageGeometry& g = a.geometry;
-  for (int k = 0; k < g.size[2]; ++k)
-    for (int j = 0; j < g.size[1]; ++j)
-      for (int i = 0; i < g.size[0]; ++i) {
-        const long long v = g.offset(i, j, k);
-        if (!a.voxels[v] && !b.voxels[v]) continue;
-        const int index[3] = {i, j, k};
-        for (int d = 0; d < 3; ++d) {
-          low[d] = std::min(low[d], index[d]);
-          high[d] = std::max(high[d], index[d]);
-        }
-      }
-  std::array<int, 3> first{}, size{};
-  for (int d = 0; d < 3; ++d) {
-    first[d] = std::max(0, low[d] - 1);
-    size[d] = std::min(g.size[d] - 1, high[d] + 1) - first[d] + 1;
-  }
+  std::vector<std::uint8_t> either(a.voxels.size());
+  for (std::size_t v = 0; v < either.size(); ++v) either[v] = a.voxels[v] | b.voxels[v];
+  const auto [first, size] = occupiedRegion(g, either, 1);
   const Mask partA = cropMask(a, first, size), partB = cropMask(b, first, size);
   const Mask boundaryA = boundaryOf(partA), boundaryB = boundaryOf(partB);
   const std::vector<float> toA = distanceTo(boundaryA), toB = distanceTo(boundaryB);

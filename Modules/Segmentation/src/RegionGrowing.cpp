@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <iterator>
 #include <limits>
 #include <utility>
 
@@ -35,49 +34,26 @@ std::vector<std::uint8_t> connectedTo(const std::vector<std::uint8_t>& allowed, 
 
 namespace {
 
-// The smallest index box holding every voxel of `region`, grown by one voxel
-// on every side and clamped to the grid; empty (a zero size) when there is none.
-struct IndexBox {
-  std::array<int, 3> first{}, size{};
-};
-
-IndexBox boxAroundVoxels(const std::vector<std::uint8_t>& region, const ImageGeometry& g) {
-  std::array<int, 3> low{g.size[0], g.size[1], g.size[2]}, high{-1, -1, -1};
-  for (int k = 0; k < g.size[2]; ++k)
-    for (int j = 0; j < g.size[1]; ++j) {
-      const std::uint8_t* row = region.data() + g.offset(0, j, k);
-      const std::uint8_t* first = std::find(row, row + g.size[0], 1);
-      if (first == row + g.size[0]) continue;
-      const std::uint8_t* last = std::find(std::make_reverse_iterator(row + g.size[0]),
-                                           std::make_reverse_iterator(row), 1).base() - 1;
-      low = {std::min(low[0], static_cast<int>(first - row)), std::min(low[1], j), std::min(low[2], k)};
-      high = {std::max(high[0], static_cast<int>(last - row)), std::max(high[1], j), std::max(high[2], k)};
-    }
-  IndexBox box;
-  if (high[0] < 0) return box;
-  for (int a = 0; a < 3; ++a) {
-    box.first[a] = std::max(0, low[a] - 1);
-    box.size[a] = std::min(g.size[a] - 1, high[a] + 1) - box.first[a] + 1;
-  }
-  return box;
-}
+// An index box {first, size} (Volume.h: occupiedRegion).
+using IndexBox = std::pair<std::array<int, 3>, std::array<int, 3>>;
 
 // distanceTo(features) at the voxels of `box` (infinity elsewhere), computed
-// on that box alone. Exact wherever the nearest feature voxel lies in the box:
-// the callers ask only at voxels of a region whose box (boxAroundVoxels)
-// holds every feature, or is ringed by them. The distance maps of a seed's
-// 120 mm box were most of a seed run's time; a region is often a tenth of it.
+// on that box alone. Exact wherever the nearest feature voxel lies in the
+// box: the callers ask only at voxels of a region whose box (occupiedRegion,
+// a margin of one voxel) holds every feature or is ringed by them. A seed's
+// region is often a tenth of its 120 mm box.
 std::vector<float> distanceInBox(const std::vector<std::uint8_t>& features, const ImageGeometry& g,
                                  const IndexBox& box) {
   std::vector<float> distance(features.size(), std::numeric_limits<float>::infinity());
-  if (box.size[0] == 0) return distance;
-  const Mask part = cropMask(Mask{g, features}, box.first, box.size);
+  const auto& [first, size] = box;
+  if (size[0] == 0) return distance;
+  const Mask part = cropMask(Mask{g, features}, first, size);
   const std::vector<float> inBox = distanceTo(part);
   const ImageGeometry& b = part.geometry;
   for (int k = 0; k < b.size[2]; ++k)
     for (int j = 0; j < b.size[1]; ++j)
       std::copy_n(inBox.begin() + b.offset(0, j, k), b.size[0],
-                  distance.begin() + g.offset(box.first[0], box.first[1] + j, box.first[2] + k));
+                  distance.begin() + g.offset(first[0], first[1] + j, first[2] + k));
   return distance;
 }
 
@@ -89,7 +65,7 @@ std::vector<float> depthInside(const std::vector<std::uint8_t>& grown, const Ima
   for (long long o = 0; o < n; ++o) outside[o] = !grown[o];
   // NB: the box around `grown` is ringed by outside voxels (or by the grid's
   // side, as the whole grid is): each grown voxel's nearest one is in it.
-  return distanceInBox(outside, g, boxAroundVoxels(grown, g));
+  return distanceInBox(outside, g, occupiedRegion(g, grown, 1));
 }
 
 std::vector<std::uint8_t> coreOf(const std::vector<std::uint8_t>& grown, const std::vector<float>& depth,
@@ -103,7 +79,7 @@ std::vector<std::uint8_t> openFrom(const std::vector<std::uint8_t>& grown, const
                                    const ImageGeometry& g, double radius, std::vector<long long> coreStarts) {
   // The core lies inside `grown`, so inside its box.
   const std::vector<float> away =
-      distanceInBox(connectedTo(core, g, std::move(coreStarts)), g, boxAroundVoxels(grown, g));
+      distanceInBox(connectedTo(core, g, std::move(coreStarts)), g, occupiedRegion(g, grown, 1));
   std::vector<std::uint8_t> kept(grown.size());
   for (std::size_t o = 0; o < grown.size(); ++o) kept[o] = grown[o] && away[o] <= radius;
   return kept;

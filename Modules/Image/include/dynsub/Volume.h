@@ -119,6 +119,12 @@ Mask cropMask(const Mask& mask, const std::array<int, 3>& first, const std::arra
 std::pair<std::array<int, 3>, std::array<int, 3>> boundingRegion(const ImageGeometry& geometry,
                                                                  const Matrix3X& points, double margin);
 
+// The smallest index box holding every non-zero voxel of `voxels` (on
+// `geometry`'s grid, in its order), grown by `margin` voxels on every side and
+// clamped to the grid. Returns {first, size}; size zero when there is none.
+std::pair<std::array<int, 3>, std::array<int, 3>> occupiedRegion(const ImageGeometry& geometry,
+                                                                 const std::vector<std::uint8_t>& voxels, int margin);
+
 // A mask on `region` (a sub-grid of `full`, as from ImageGeometry::region)
 // pasted into an empty mask on the full grid.
 Mask pasteMask(const Mask& part, const ImageGeometry& full, const std::array<int, 3>& first);
