@@ -89,17 +89,41 @@ std::array<int, 3> pixel(vtkImageData* image, const Eigen::Vector2d& at) {
   return {rgb[0], rgb[1], rgb[2]};
 }
 
-TEST_F(Rendering, SliceViewPutsImageContourAndLandmarksInOneFrame) {
-  const BallPhantom phantom = makeBallPhantom();
-  const ImageSlices slices(phantom.image);
+// The phantom's analytic ball as a finely tessellated sphere, for the slice
+// views to cut.
+vtkSmartPointer<vtkPolyData> phantomBall(const BallPhantom& phantom) {
   vtkNew<vtkSphereSource> sphere;
   sphere->SetCenter(phantom.centre.data());
   sphere->SetRadius(phantom.radius);
   sphere->SetThetaResolution(128);
   sphere->SetPhiResolution(128);
   sphere->Update();
-  vtkNew<vtkPolyData> surface;
+  auto surface = vtkSmartPointer<vtkPolyData>::New();
   surface->ShallowCopy(sphere->GetOutput());
+  return surface;
+}
+
+// `view` alone in a 400 x 400 offscreen window: its pixels.
+vtkSmartPointer<vtkImageData> rendered(const SliceView& view) {
+  vtkNew<vtkRenderWindow> window;
+  window->SetOffScreenRendering(1);
+  window->SetMultiSamples(0);
+  window->SetSize(400, 400);
+  window->AddRenderer(view.renderer());
+  window->Render();
+  vtkNew<vtkWindowToImageFilter> capture;
+  capture->SetInput(window);
+  capture->ReadFrontBufferOff();
+  capture->Update();
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->DeepCopy(capture->GetOutput());
+  return image;
+}
+
+TEST_F(Rendering, SliceViewPutsImageContourAndLandmarksInOneFrame) {
+  const BallPhantom phantom = makeBallPhantom();
+  const ImageSlices slices(phantom.image);
+  const vtkSmartPointer<vtkPolyData> surface = phantomBall(phantom);
   vtkNew<vtkUnsignedCharArray> type;  // all normal elements: yellow
   type->SetName("ElementType");
   type->SetNumberOfTuples(surface->GetNumberOfCells());
@@ -123,17 +147,7 @@ TEST_F(Rendering, SliceViewPutsImageContourAndLandmarksInOneFrame) {
     view.setLandmarks(landmarks);
     view.frame(circleCentre, 20.0);
 
-    vtkNew<vtkRenderWindow> window;
-    window->SetOffScreenRendering(1);
-    window->SetMultiSamples(0);
-    window->SetSize(400, 400);
-    window->AddRenderer(view.renderer());
-    window->Render();
-    vtkNew<vtkWindowToImageFilter> capture;
-    capture->SetInput(window);
-    capture->ReadFrontBufferOff();
-    capture->Update();
-    vtkImageData* image = capture->GetOutput();
+    const vtkSmartPointer<vtkImageData> image = rendered(view);
 
     // Inside and outside the circle by 2.5 mm (voxels are at most 1.5 mm; the
     // view shows the nearest voxel) along 12 directions, away from the landmarks.
@@ -175,14 +189,7 @@ TEST_F(Rendering, SliceViewPutsImageContourAndLandmarksInOneFrame) {
 TEST_F(Rendering, SliceViewColoursTheContourByEdgeDistance) {
   const BallPhantom phantom = makeBallPhantom();
   const ImageSlices slices(phantom.image);
-  vtkNew<vtkSphereSource> sphere;
-  sphere->SetCenter(phantom.centre.data());
-  sphere->SetRadius(phantom.radius);
-  sphere->SetThetaResolution(128);
-  sphere->SetPhiResolution(128);
-  sphere->Update();
-  vtkNew<vtkPolyData> surface;
-  surface->ShallowCopy(sphere->GetOutput());
+  const vtkSmartPointer<vtkPolyData> surface = phantomBall(phantom);
 
   SliceView view(SliceOrientation::Coronal);
   view.setImage(&slices);
@@ -204,17 +211,7 @@ TEST_F(Rendering, SliceViewColoursTheContourByEdgeDistance) {
   const double circleRadius = std::sqrt(std::pow(phantom.radius, 2) - std::pow(plane.distance(phantom.centre), 2));
   view.frame(circleCentre, 20.0);
 
-  vtkNew<vtkRenderWindow> window;
-  window->SetOffScreenRendering(1);
-  window->SetMultiSamples(0);
-  window->SetSize(400, 400);
-  window->AddRenderer(view.renderer());
-  window->Render();
-  vtkNew<vtkWindowToImageFilter> capture;
-  capture->SetInput(window);
-  capture->ReadFrontBufferOff();
-  capture->Update();
-  vtkImageData* image = capture->GetOutput();
+  const vtkSmartPointer<vtkImageData> image = rendered(view);
 
   // The colours within a pixel of the circle, 15 degrees and more from the
   // quarters' borders (where the colours blend over a triangle).
