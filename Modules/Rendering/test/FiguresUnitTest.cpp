@@ -103,9 +103,15 @@ vtkSmartPointer<vtkPolyData> phantomBall(const BallPhantom& phantom) {
   return surface;
 }
 
-// `view` alone in a 400 x 400 offscreen window: its pixels.
-vtkSmartPointer<vtkImageData> rendered(const SliceView& view) {
-  vtkNew<vtkRenderWindow> window;
+// `view` alone in a 400 x 400 offscreen window, and its pixels. The window
+// is kept: the view's display positions are the window's.
+struct Rendered {
+  vtkSmartPointer<vtkRenderWindow> window;
+  vtkSmartPointer<vtkImageData> image;
+};
+
+Rendered rendered(const SliceView& view) {
+  auto window = vtkSmartPointer<vtkRenderWindow>::New();
   window->SetOffScreenRendering(1);
   window->SetMultiSamples(0);
   window->SetSize(400, 400);
@@ -117,7 +123,7 @@ vtkSmartPointer<vtkImageData> rendered(const SliceView& view) {
   capture->Update();
   auto image = vtkSmartPointer<vtkImageData>::New();
   image->DeepCopy(capture->GetOutput());
-  return image;
+  return {window, image};
 }
 
 TEST_F(Rendering, SliceViewPutsImageContourAndLandmarksInOneFrame) {
@@ -147,7 +153,8 @@ TEST_F(Rendering, SliceViewPutsImageContourAndLandmarksInOneFrame) {
     view.setLandmarks(landmarks);
     view.frame(circleCentre, 20.0);
 
-    const vtkSmartPointer<vtkImageData> image = rendered(view);
+    const Rendered shown = rendered(view);
+    vtkImageData* image = shown.image;
 
     // Inside and outside the circle by 2.5 mm (voxels are at most 1.5 mm; the
     // view shows the nearest voxel) along 12 directions, away from the landmarks.
@@ -211,7 +218,8 @@ TEST_F(Rendering, SliceViewColoursTheContourByEdgeDistance) {
   const double circleRadius = std::sqrt(std::pow(phantom.radius, 2) - std::pow(plane.distance(phantom.centre), 2));
   view.frame(circleCentre, 20.0);
 
-  const vtkSmartPointer<vtkImageData> image = rendered(view);
+  const Rendered shown = rendered(view);
+  vtkImageData* image = shown.image;
 
   // The colours within a pixel of the circle, 15 degrees and more from the
   // quarters' borders (where the colours blend over a triangle).
