@@ -19,8 +19,8 @@ std::vector<Vector3> smoothedGradient(const Volume& image, double sigma);
 // separable transform of Felzenszwalb and Huttenlocher, one pass per axis);
 // infinity everywhere for an empty mask. It equals ITK's Maurer transform to
 // the bit on grids whose squared distances floats hold exactly (1 mm, 0.5
-// mm: ImageUnitTests), and took a third of ITK's time, which was most of a
-// seed's region growth (Documentation/Performance.md, twentieth session).
+// mm: DistanceUnitTests), elsewhere within a float's rounding; ITK's took a
+// third of a seed's command (Documentation/Performance.md, twentieth session).
 std::vector<float> distanceTo(const Mask& mask);
 
 }  // namespace dynsub
