@@ -12,6 +12,7 @@
 #include <string>
 
 #include <vtkAbstractArray.h>
+#include <vtkCallbackCommand.h>
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
 #include <vtkDataArray.h>
@@ -22,6 +23,7 @@
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
+#include <vtkSmartPointer.h>
 #include <vtkXMLPolyDataReader.h>
 
 namespace {
@@ -78,12 +80,30 @@ bool sameFieldData(vtkFieldData* a, vtkFieldData* b, const std::string& what, st
   return true;
 }
 
+// A file the reader of its extension reports an error for (exit code 2).
+struct Unreadable {
+  std::string path;
+};
+
+// `path` read by a VTK reader of type Reader. Throws Unreadable when the
+// reader reports an error: VTK's readers give an empty output then, which
+// would compare equal to another empty one.
+template <class Reader>
+vtkSmartPointer<Reader> readWith(const std::string& path) {
+  auto reader = vtkSmartPointer<Reader>::New();
+  bool failed = false;
+  vtkNew<vtkCallbackCommand> onError;
+  onError->SetClientData(&failed);
+  onError->SetCallback([](vtkObject*, unsigned long, void* flag, void*) { *static_cast<bool*>(flag) = true; });
+  reader->AddObserver(vtkCommand::ErrorEvent, onError);
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  if (failed) throw Unreadable{path};
+  return reader;
+}
+
 bool samePolyData(const std::string& pathA, const std::string& pathB, std::string& why) {
-  vtkNew<vtkXMLPolyDataReader> a, b;
-  a->SetFileName(pathA.c_str());
-  b->SetFileName(pathB.c_str());
-  a->Update();
-  b->Update();
+  const auto a = readWith<vtkXMLPolyDataReader>(pathA), b = readWith<vtkXMLPolyDataReader>(pathB);
   vtkPolyData* x = a->GetOutput();
   vtkPolyData* y = b->GetOutput();
   if (!x->GetPoints() || !y->GetPoints()) {
@@ -109,11 +129,7 @@ bool samePolyData(const std::string& pathA, const std::string& pathB, std::strin
 }
 
 bool sameImage(const std::string& pathA, const std::string& pathB, std::string& why) {
-  vtkNew<vtkPNGReader> a, b;
-  a->SetFileName(pathA.c_str());
-  b->SetFileName(pathB.c_str());
-  a->Update();
-  b->Update();
+  const auto a = readWith<vtkPNGReader>(pathA), b = readWith<vtkPNGReader>(pathB);
   int sizeA[3], sizeB[3];
   a->GetOutput()->GetDimensions(sizeA);
   b->GetOutput()->GetDimensions(sizeB);
@@ -122,6 +138,12 @@ bool sameImage(const std::string& pathA, const std::string& pathB, std::string& 
     return false;
   }
   return sameArray(a->GetOutput()->GetPointData()->GetScalars(), b->GetOutput()->GetPointData()->GetScalars(), why);
+}
+
+bool sameBytes(const std::string& pathA, const std::string& pathB, std::string& why) {
+  std::ifstream a(pathA, std::ios::binary), b(pathB, std::ios::binary);
+  why = "the bytes differ";
+  return std::string(std::istreambuf_iterator<char>(a), {}) == std::string(std::istreambuf_iterator<char>(b), {});
 }
 
 }  // namespace
@@ -140,16 +162,19 @@ int main(int argc, char** argv) {
   const std::string extension = extensionOf(pathA);
   std::string why;
   bool same = false;
-  if (extension != extensionOf(pathB)) {
-    why = "the files' extensions differ";
-  } else if (extension == ".png") {
-    same = sameImage(pathA, pathB, why);
-  } else if (extension == ".vtp") {
-    same = samePolyData(pathA, pathB, why);
-  } else {
-    std::ifstream a(pathA, std::ios::binary), b(pathB, std::ios::binary);
-    same = std::string(std::istreambuf_iterator<char>(a), {}) == std::string(std::istreambuf_iterator<char>(b), {});
-    why = "the bytes differ";
+  try {
+    if (extension != extensionOf(pathB)) {
+      why = "the files' extensions differ";
+    } else if (extension == ".png") {
+      same = sameImage(pathA, pathB, why);
+    } else if (extension == ".vtp") {
+      same = samePolyData(pathA, pathB, why);
+    } else {
+      same = sameBytes(pathA, pathB, why);
+    }
+  } catch (const Unreadable& e) {
+    std::fprintf(stderr, "SameContents: %s: not a readable %s file\n", e.path.c_str(), extension.c_str());
+    return 2;
   }
   if (!same) std::printf("%s and %s differ: %s\n", pathA.c_str(), pathB.c_str(), why.c_str());
   return same ? 0 : 1;
