@@ -147,24 +147,12 @@ void shapeRegion(const SeedBox& box, const std::vector<std::uint8_t>& grown, con
 
 }  // namespace
 
-SeedRegion growFromSeed(const Volume& image, const Vector3& click, const SeedOptions& options) {
-  checkSeedOptions(options);
-  if (!click.allFinite() || !image.geometry.covers(click)) {
-    std::ostringstream message;
-    message << "the seed (" << click.x() << ", " << click.y() << ", " << click.z()
-            << ") mm LPS lies outside the image";
-    throw Error(message.str());
-  }
-  // The box and the appearance at the click are the same for every attempt.
-  const SeedBox box = boxAround(image, click, options.reach);
-  SeedRegion base;
-  base.click = click;
-  base.first = box.first;
-  const RobustStatistics appearance = appearanceAt(box, options.statsRadius);
-  base.median = appearance.median;
-  base.spread = appearance.spread;
-  // The leak guard (see the header): a narrower window, then wider openings,
-  // until the region stays inside its reach; the last region grown otherwise.
+namespace {
+
+// The leak guard (see the header): a narrower window, then wider openings,
+// until the region stays inside its reach; the last region grown otherwise.
+// `base` holds the click and its appearance.
+SeedRegion guardedRegion(const SeedBox& box, const SeedRegion& base, const SeedOptions& options) {
   std::vector<double> windows = {options.window};
   if (options.window > kGuardWindow) windows.push_back(kGuardWindow);
   SeedRegion result;
@@ -187,28 +175,50 @@ SeedRegion growFromSeed(const Volume& image, const Vector3& click, const SeedOpt
         continue;
       }
       result = std::move(attempt);
-      if (!result.touchesReach) break;
+      if (!result.touchesReach) return result;
     }
-    if (!result.boundary.empty() && !result.touchesReach) break;
   }
   if (result.boundary.empty()) throw Error(failure);
-  // How much of the region the last part of its window added: the same growth
-  // and opening through a window kNarrowerWindow as wide.
-  {
-    const double narrower = kNarrowerWindow * result.window;
-    const std::vector<std::uint8_t> grown =
-        growThrough(box, base.median - narrower * base.spread, base.median + narrower * base.spread);
-    SeedRegion smaller = base;
-    long long kept = 0;
-    try {
-      shapeRegion(box, grown, depthInside(grown, box.image.geometry), result.opening, options.boundaryPoints,
-                  smaller);
-      kept = smaller.mask.count();
-    } catch (const Error&) {
-      kept = 0;  // opened away at the click: nothing is left
-    }
-    result.narrowerWindowVolume = kept * box.image.geometry.spacing.prod();
+  return result;
+}
+
+// How much of `region` the last part of its window added: the volume (mm^3)
+// of the region the same growth and opening give through a window
+// kNarrowerWindow as wide, 0 when that opening leaves nothing at the click.
+double narrowerWindowVolume(const SeedBox& box, const SeedRegion& region, int boundaryPoints) {
+  const double window = kNarrowerWindow * region.window;
+  const std::vector<std::uint8_t> grown =
+      growThrough(box, region.median - window * region.spread, region.median + window * region.spread);
+  SeedRegion smaller;
+  smaller.click = region.click;  // what shapeRegion spreads the boundary points from
+  try {
+    shapeRegion(box, grown, depthInside(grown, box.image.geometry), region.opening, boundaryPoints, smaller);
+  } catch (const Error&) {
+    return 0.0;
   }
+  return smaller.mask.count() * box.image.geometry.spacing.prod();
+}
+
+}  // namespace
+
+SeedRegion growFromSeed(const Volume& image, const Vector3& click, const SeedOptions& options) {
+  checkSeedOptions(options);
+  if (!click.allFinite() || !image.geometry.covers(click)) {
+    std::ostringstream message;
+    message << "the seed (" << click.x() << ", " << click.y() << ", " << click.z()
+            << ") mm LPS lies outside the image";
+    throw Error(message.str());
+  }
+  // The box and the appearance at the click are the same for every attempt.
+  const SeedBox box = boxAround(image, click, options.reach);
+  SeedRegion base;
+  base.click = click;
+  base.first = box.first;
+  const RobustStatistics appearance = appearanceAt(box, options.statsRadius);
+  base.median = appearance.median;
+  base.spread = appearance.spread;
+  SeedRegion result = guardedRegion(box, base, options);
+  result.narrowerWindowVolume = narrowerWindowVolume(box, result, options.boundaryPoints);
   return result;
 }
 
