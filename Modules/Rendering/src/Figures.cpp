@@ -7,7 +7,6 @@
 #include <vtkChartXY.h>
 #include <vtkContextActor.h>
 #include <vtkContextScene.h>
-#include <vtkDoubleArray.h>
 #include <vtkNew.h>
 #include <vtkImageData.h>
 #include <vtkPointData.h>
@@ -179,11 +178,7 @@ void writeFigures(const FigureInputs& inputs, const FigureFiles& files) {
   if (inputs.edgeDistances.size() > 0) {
     if (inputs.edgeDistances.size() != surface->GetNumberOfPoints())
       throw Error("internal: the edge distances are not one per point of the figure's surface");
-    vtkNew<vtkDoubleArray> distances;
-    distances->SetName(kEdgeDistanceScalars);
-    distances->SetNumberOfTuples(surface->GetNumberOfPoints());
-    for (vtkIdType p = 0; p < surface->GetNumberOfPoints(); ++p) distances->SetValue(p, inputs.edgeDistances[p]);
-    surface->GetPointData()->AddArray(distances);
+    addPointData(surface, kEdgeDistanceScalars, inputs.edgeDistances);
   }
   FigureScene scene;
   scene.surface = surface;

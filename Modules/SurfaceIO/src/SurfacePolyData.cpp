@@ -61,6 +61,14 @@ vtkSmartPointer<vtkPolyData> toPolyData(const TriangleSurface& surface) {
   return polyData;
 }
 
+void addPointData(vtkPolyData* polyData, const std::string& name, const Eigen::VectorXd& values) {
+  vtkNew<vtkDoubleArray> array;
+  array->SetName(name.c_str());
+  array->SetNumberOfValues(values.size());
+  for (Eigen::Index i = 0; i < values.size(); ++i) array->SetValue(i, values(i));
+  polyData->GetPointData()->AddArray(array);
+}
+
 namespace {
 
 // Collects VTK's error messages instead of letting them go to stderr unnamed.

@@ -4,14 +4,12 @@
 #include <filesystem>
 
 #include <vtkCallbackCommand.h>
-#include <vtkDoubleArray.h>
 #include <vtkExecutive.h>
 #include <vtkFieldData.h>
 #include <vtkErrorCode.h>
 #include <vtkNew.h>
 #include <vtkOBJWriter.h>
 #include <vtkPLYWriter.h>
-#include <vtkPointData.h>
 #include <vtkPolyData.h>
 #include <vtkSTLWriter.h>
 #include <vtkStringArray.h>
@@ -42,13 +40,7 @@ void writeTriangleSurface(const TriangleSurface& surface, const std::string& pat
     throw Error(path, "unknown coordinate space '" + space + "' (expected LPS or RAS)");
   AtomicOutput output(path);
   vtkSmartPointer<vtkPolyData> polyData = toPolyData(surface);
-  for (const PointScalars& s : scalars) {
-    vtkNew<vtkDoubleArray> array;
-    array->SetName(s.name.c_str());
-    array->SetNumberOfValues(s.values.size());
-    for (Eigen::Index i = 0; i < s.values.size(); ++i) array->SetValue(i, s.values(i));
-    polyData->GetPointData()->AddArray(array);
-  }
+  for (const PointScalars& s : scalars) addPointData(polyData, s.name, s.values);
   if (!space.empty()) {
     vtkNew<vtkStringArray> array;
     array->SetName("SPACE");

@@ -15,6 +15,10 @@ namespace dynsub {
 
 vtkSmartPointer<vtkPolyData> toPolyData(const TriangleSurface& surface);
 
+// Adds `values` (one per point of `polyData`, the caller's to check) as the
+// point-data array `name`, in doubles.
+void addPointData(vtkPolyData* polyData, const std::string& name, const Eigen::VectorXd& values);
+
 // Reads a triangle surface (.vtp, .obj, .ply or .stl, by extension). Throws
 // dynsub::Error naming the file when it is missing, unreadable, has no
 // triangles, or has non-finite coordinates.
