@@ -17,11 +17,11 @@
 #include "dynsub/FileNames.h"
 #include "dynsub/ImageIO.h"
 #include "dynsub/Metrics.h"
-#include "dynsub/ParallelFor.h"
 #include "dynsub/ModelOutputs.h"
+#include "dynsub/ParallelFor.h"
 #include "dynsub/SeedGrowth.h"
-#include "dynsub/SurfaceWriter.h"
 #include "dynsub/Segmentation.h"
+#include "dynsub/SurfaceWriter.h"
 
 namespace dynsub::app {
 

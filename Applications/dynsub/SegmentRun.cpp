@@ -145,7 +145,7 @@ SegmentRun runSegmentation(const Volume& image, SegmentInputs in, const Progress
     r.set("intensity_window", std::vector<double>{seed->low, seed->high});
     r.set("window_spreads", seed->window);
     r.set("opening_mm", seed->opening);
-    r.set("region_volume_mm3", seed->mask.count() * seed->mask.geometry.spacing.prod());
+    r.set("region_volume_mm3", regionVolume(*seed));
     r.set("narrower_window_volume_mm3", seed->narrowerWindowVolume);
     r.set("boundary_points", seed->boundary.size());
     r.set("springs", in.landmarks.empty() ? "boundary points" : "landmarks");

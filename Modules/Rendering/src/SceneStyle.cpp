@@ -1,7 +1,5 @@
 #include "dynsub/SceneStyle.h"
 
-#include "dynsub/SurfaceWriter.h"
-
 #include <algorithm>
 #include <cmath>
 
@@ -23,6 +21,8 @@
 #include <vtkTextActor.h>
 #include <vtkTextProperty.h>
 #include <vtkUnsignedCharArray.h>
+
+#include "dynsub/SurfaceWriter.h"  // kEdgeDistanceScalars
 
 namespace dynsub::style {
 

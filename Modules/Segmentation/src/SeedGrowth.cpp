@@ -196,7 +196,7 @@ double narrowerWindowVolume(const SeedBox& box, const SeedRegion& region, int bo
   } catch (const Error&) {
     return 0.0;
   }
-  return smaller.mask.count() * box.image.geometry.spacing.prod();
+  return regionVolume(smaller);
 }
 
 }  // namespace
@@ -222,9 +222,9 @@ SeedRegion growFromSeed(const Volume& image, const Vector3& click, const SeedOpt
   return result;
 }
 
-namespace {
-
 double regionVolume(const SeedRegion& region) { return region.mask.count() * region.mask.geometry.spacing.prod(); }
+
+namespace {
 
 // Grew more than kLeakGrowth times over the last fifth of its window.
 bool hangsOnWindow(const SeedRegion& region) {

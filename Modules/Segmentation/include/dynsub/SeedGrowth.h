@@ -66,6 +66,9 @@ struct SeedRegion {
 
 void checkSeedOptions(const SeedOptions& options);
 
+// The region's volume (mm^3).
+double regionVolume(const SeedRegion& region);
+
 // What a region grown from a click should be trusted for: a warning when it
 // leaked (touchesReach), one when it is more than kLeakGrowth times the
 // region a window 0.8 times as wide gives (its size hangs on the window:
