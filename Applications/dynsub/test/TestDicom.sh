@@ -7,7 +7,9 @@
 #    labelmap (NIfTI) is accepted as being on the series' grid;
 #  - from the NIfTI: the same labelmap, to within 0.5 % of the ball's voxels
 #    (the NIfTI stores the axes as 32-bit floats, DICOM as decimals, so a few
-#    boundary voxels may fall the other way).
+#    boundary voxels may fall the other way); and the NIfTI is read without
+#    opening GDCM's libraries or DynSub's DICOM library (the loader's record).
+# One slice's file is refused as 2D, one cut short as truncated.
 # And a broken series gets a clear error, exit code 1 and no output (not the
 # abort Debian's GDCM gives for some): a truncated slice (in its header, in a
 # sequence of undefined length, after its meta header, in its pixels), a
@@ -37,9 +39,13 @@ distance=$(sed -n 's/^  "mean_surface_distance_mm": \([-0-9.e+]*\),$/\1/p' "$wor
 check "DICOM: Dice $dice >= 0.95" awk -v d="$dice" 'BEGIN { exit !(d != "" && d >= 0.95) }'
 check "DICOM: mean surface distance $distance <= 0.375 mm" awk -v d="$distance" 'BEGIN { exit !(d != "" && d <= 0.375) }'
 
-"$DYNSUB" segment "$work/phantom/phantom.nii.gz" --landmarks "$work/phantom/ball.csv" --no-figures \
-  --out "$work/nifti" >/dev/null 2>&1
+# The dynamic loader's record of the libraries it opened, in files $work/ld.*.
+LD_DEBUG=files LD_DEBUG_OUTPUT="$work/ld" "$DYNSUB" segment "$work/phantom/phantom.nii.gz" \
+  --landmarks "$work/phantom/ball.csv" --no-figures --out "$work/nifti" >/dev/null 2>&1
 check "segment reads the same phantom as NIfTI" test $? -eq 0
+# GDCM's libraries and dictionary cost 40-50 ms to load; a NIfTI file needs none.
+check "the NIfTI file is read without opening GDCM" sh -c "! grep -q 'file=libgdcm' $work/ld.*"
+check "the DICOM library is not opened for it either" sh -c "! grep -q 'file=.*libDynSubItkDicom' $work/ld.*"
 check "the DICOM and NIfTI labelmaps agree" python3 - "$work/dicom/labelmap.nii.gz" "$work/nifti/labelmap.nii.gz" <<'PY'
 import gzip, struct, sys
 def read(path):
@@ -78,6 +84,12 @@ rejects "a missing slice" "not evenly spaced" gap
 broken two
 dcmodify -nb -m "(0020,000e)=1.2.826.0.1.3680043.10.1347.9" "$work/two/slice_005.dcm"
 rejects "two series" "holds 2 DICOM series" two
+# One file of the series: read (by GDCM) and refused as the 2D image it is.
+expect_error "one slice file" "slice_007.dcm: not a 3D image (1 voxel(s) along axis 2)" "$work/out_one" \
+  "$DYNSUB" segment "$work/phantom/series/slice_007.dcm" --landmarks "$work/phantom/ball.csv" --out "$work/out_one"
+# One file cut short is walked before GDCM sees it, as a series's files are.
+expect_error "one file cut short in its header" "slice_007.dcm: a truncated DICOM file" "$work/out_cut" \
+  "$DYNSUB" segment "$work/header/slice_007.dcm" --landmarks "$work/phantom/ball.csv" --out "$work/out_cut"
 mkdir "$work/none"
 echo "not an image" >"$work/none/README.txt"
 rejects "no series" "holds no DICOM series" none

@@ -16,31 +16,35 @@ namespace dynsub {
 
 Volume readVolume(const std::string& path) {
   requireExisting(path);
-  // NB: opening the ITK bridge (ITK's and GDCM's libraries relocated, GDCM's
-  // dictionary loaded) and the file's own checks (a .nii.gz inflated once to
-  // see that all its data is there, and its voxels kept when they can be) do
-  // not depend on each other, and each took about a tenth of the caudate
-  // demo's command: the bridge opens on a second thread meanwhile. A failed
-  // check waits for it (the future's destructor) and is reported as before.
-  std::future<const itkbridge::Functions*> bridge =
-      std::async(std::launch::async, [] { return &itkbridge::functions(); });
   std::error_code ignored;
-  const bool directory = std::filesystem::is_directory(path, ignored);
   Volume volume;
-  // A NIfTI file that ITK would read as stored has its voxels read in the
-  // pass that checks them, and ITK gives its geometry from the header: ITK
-  // inflating the data a second time was a fifth of the caudate demo's command.
-  bool voxelsRead = false;
-  if (!directory && filechecks::isNiftiName(path)) {
-    voxelsRead = filechecks::readNiftiVoxels(path, volume.voxels);
-  } else if (!directory) {
-    filechecks::checkImageFile(path);
-  }
-  const itkbridge::Functions& itk = *bridge.get();
   itkbridge::Geometry raw;
-  const bool whole = voxelsRead && itk.readGeometry(path, raw) &&
-                     static_cast<std::size_t>(raw.size[0]) * raw.size[1] * raw.size[2] == volume.voxels.size();
-  if (!whole) itk.readImage(path, raw, volume.voxels);
+  const bool nifti = filechecks::isNiftiName(path);
+  if (std::filesystem::is_directory(path, ignored) || (!nifti && filechecks::isDicomFile(path))) {
+    itkbridge::dicomFunctions().readImage(path, raw, volume.voxels);
+  } else {
+    // NB: opening the ITK library (its libraries relocated, its factories
+    // registered) and the file's own checks (a .nii.gz inflated once to see
+    // that all its data is there, and its voxels kept when they can be) do
+    // not depend on each other: the library opens on a second thread
+    // meanwhile. A failed check waits for it (the future's destructor) and is
+    // reported as before.
+    std::future<const itkbridge::Functions*> bridge =
+        std::async(std::launch::async, [] { return &itkbridge::functions(); });
+    // A NIfTI file that ITK would read as stored has its voxels read in the
+    // pass that checks them, and ITK gives its geometry from the header: ITK
+    // inflating the data a second time was a fifth of the caudate demo's command.
+    bool voxelsRead = false;
+    if (nifti) {
+      voxelsRead = filechecks::readNiftiVoxels(path, volume.voxels);
+    } else {
+      filechecks::checkImageFile(path);
+    }
+    const itkbridge::Functions& itk = *bridge.get();
+    const bool whole = voxelsRead && itk.readGeometry(path, raw) &&
+                       static_cast<std::size_t>(raw.size[0]) * raw.size[1] * raw.size[2] == volume.voxels.size();
+    if (!whole) itk.readImage(path, raw, volume.voxels);
+  }
   volume.geometry = fromBridge(raw);
   for (int a = 0; a < 3; ++a)
     if (volume.geometry.size[a] < 2)

@@ -7,9 +7,11 @@
 // ItkBridge.cpp is a library of its own, libDynSubItkBridge.so in the build's
 // lib/ directory, opened at the first call of functions() (ItkBridgeLoader.cpp).
 // A program that never reads, writes or filters an image (`dynsub fit`,
-// `deform`, `limit`) then starts without ITK's and GDCM's libraries: loading
-// them, and GDCM's building and freeing of its DICOM dictionary, took about
-// 0.08 s of every run (Documentation/Performance.md).
+// `deform`, `limit`) then starts without ITK's libraries. DICOM is read by a
+// third library, libDynSubItkDicom.so (ItkDicom.cpp, dicomFunctions()): GDCM's
+// libraries and the building of its DICOM dictionary took 40-50 ms of the
+// 50-65 ms that opening one library for both took, and a NIfTI file, the
+// common case, needs none of it (Documentation/Performance.md).
 #include <array>
 #include <cstdint>
 #include <string>
@@ -27,7 +29,7 @@ struct Geometry {
 // What ITK does for DynSub, as function pointers: ItkBridge.cpp fills them in
 // the library, which exports them through one C symbol (kFunctionsSymbol).
 struct Functions {
-  // A file (any format ITK reads) or a directory holding one DICOM series, as
+  // A file in a format ITK reads without GDCM (NIfTI, NRRD, MetaImage), as
   // float. Throws dynsub::Error naming the path. A file's own checks
   // (FileChecks.h: checkImageFile) are the caller's, made before.
   void (*readImage)(const std::string& path, Geometry& geometry, std::vector<float>& voxels);
@@ -48,8 +50,17 @@ struct Functions {
 };
 inline constexpr const char* kFunctionsSymbol = "dynsubItkBridgeFunctions";
 
-// The library's functions, loaded at the first call (thread-safe). Throws
+// What ITK and GDCM do for DICOM, in libDynSubItkDicom.so.
+struct DicomFunctions {
+  // A directory holding one DICOM series, or one DICOM file (FileChecks.h:
+  // isDicomFile), as float. Throws dynsub::Error naming the path.
+  void (*readImage)(const std::string& path, Geometry& geometry, std::vector<float>& voxels);
+};
+inline constexpr const char* kDicomFunctionsSymbol = "dynsubItkDicomFunctions";
+
+// Each library's functions, loaded at the first call (thread-safe). Throws
 // dynsub::Error when the library cannot be opened.
 const Functions& functions();
+const DicomFunctions& dicomFunctions();
 
 }  // namespace dynsub::itkbridge

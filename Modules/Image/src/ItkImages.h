@@ -1,7 +1,7 @@
 #pragma once
 // Private to the Image module (and the benchmark that compares DynSub with
-// ITK's own filters): ITK images made from the bridge's plain buffers. ITK
-// headers only, never with DynSub's Eigen (see ItkBridge.h).
+// ITK's own filters): ITK images made from the ITK libraries' plain buffers
+// and back. ITK headers only, never with DynSub's Eigen (see ItkBridge.h).
 #include <algorithm>
 #include <vector>
 
@@ -36,5 +36,18 @@ typename Image::Pointer makeImage(const Geometry& g, const std::vector<Pixel>& v
   std::copy(voxels.begin(), voxels.end(), image->GetBufferPointer());
   return image;
 }
+
+inline Geometry geometryOf(const FloatImage* image) {
+  Geometry g;
+  for (int a = 0; a < 3; ++a) {
+    g.size[a] = static_cast<int>(image->GetLargestPossibleRegion().GetSize()[a]);
+    g.spacing[a] = image->GetSpacing()[a];
+    g.origin[a] = image->GetOrigin()[a];
+    for (int b = 0; b < 3; ++b) g.direction[3 * a + b] = image->GetDirection()(a, b);
+  }
+  return g;
+}
+
+inline long long countOf(const Geometry& g) { return static_cast<long long>(g.size[0]) * g.size[1] * g.size[2]; }
 
 }  // namespace dynsub::itkbridge

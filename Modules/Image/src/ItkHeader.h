@@ -1,0 +1,31 @@
+#pragma once
+// Private to the Image module's two ITK libraries (ItkBridge.h): the check of
+// an image file's header that both make before ITK reads its voxels.
+#include <cstdint>
+#include <string>
+
+#include <itkImageIOBase.h>
+
+#include "FileChecks.h"
+#include "dynsub/Error.h"
+
+namespace dynsub::itkbridge {
+
+// After the project's own checks of the file (FileChecks.h), made by
+// readVolume before it calls a library's readImage: `io` reads the header of
+// `path`, and an image too large for memory is refused before it is allocated
+// (the number of dimensions is checked by readVolume, for files and DICOM
+// series alike).
+inline void inspectHeader(const std::string& path, itk::ImageIOBase& io) {
+  io.SetFileName(path);
+  io.ReadImageInformation();
+  std::uintmax_t voxels = 1;
+  for (unsigned a = 0; a < io.GetNumberOfDimensions(); ++a) {
+    const std::uintmax_t size = io.GetDimensions(a);
+    if (size != 0 && voxels > UINTMAX_MAX / size) throw Error(path, "an image size that does not fit in 64 bits");
+    voxels *= size;
+  }
+  filechecks::requireMemoryFor(path, voxels);
+}
+
+}  // namespace dynsub::itkbridge
