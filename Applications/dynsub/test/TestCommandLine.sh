@@ -28,6 +28,16 @@ for extension in obj ply stl; do
   "$DYNSUB" limit "$DATA/Meshes/sheet.obj" --samples-per-face 2 --out "$work/sheet.$extension" >/dev/null
   check "limit writes .$extension" test -s "$work/sheet.$extension"
 done
+# VTK's geometry IO, and the thirty libraries it brings, is opened for an OBJ,
+# PLY or STL surface only (the dynamic loader's record of what it opened).
+LD_DEBUG=files LD_DEBUG_OUTPUT="$work/ld-vtp" "$DYNSUB" limit "$DATA/Meshes/sheet.obj" --samples-per-face 2 \
+  --out "$work/sheet.vtp" >/dev/null
+check "limit writing .vtp opens no VTK geometry IO" sh -c "! grep -q 'file=libvtkIOGeometry' $work/ld-vtp.*"
+LD_DEBUG=files LD_DEBUG_OUTPUT="$work/ld-stl" "$DYNSUB" limit "$DATA/Meshes/sheet.obj" --samples-per-face 2 \
+  --out "$work/sheet-again.stl" >/dev/null
+check "limit writing .stl opens DynSub's geometry formats library" \
+  sh -c "grep -q 'file=.*libDynSubGeometryFormats' $work/ld-stl.*"
+rm -f "$work"/ld-*
 
 expect_error "missing mesh" 1 "no such file" "$work/a.vtp" "$DYNSUB" limit "$work/none.obj" --out "$work/a.vtp"
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 0 -1 0\nf 1 2 3\nf 2 1 4\nf 1 2 5\n' >"$work/fin.obj"

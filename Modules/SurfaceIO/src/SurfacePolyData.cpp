@@ -9,17 +9,16 @@
 #include <vtkDoubleArray.h>
 #include <vtkIntArray.h>
 #include <vtkNew.h>
-#include <vtkOBJReader.h>
-#include <vtkPLYReader.h>
+#include <vtkAbstractPolyDataReader.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
-#include <vtkSTLReader.h>
 #include <vtkUnsignedCharArray.h>
 #include <vtkXMLPolyDataReader.h>
 
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
+#include "GeometryFormats.h"
 
 namespace dynsub {
 
@@ -84,12 +83,10 @@ struct ErrorCatcher {
   }
 };
 
-template <typename Reader>
-vtkSmartPointer<vtkPolyData> readWith(const std::string& path) {
-  vtkNew<Reader> reader;
+// `reader`'s file name is set.
+vtkSmartPointer<vtkPolyData> readWith(vtkAlgorithm* reader, const std::string& path) {
   ErrorCatcher errors;
   reader->AddObserver(vtkCommand::ErrorEvent, errors.command);
-  reader->SetFileName(path.c_str());
   reader->Update();
   if (!errors.message.empty()) {
     // The first line is enough: VTK's messages carry source locations after it.
@@ -97,7 +94,7 @@ vtkSmartPointer<vtkPolyData> readWith(const std::string& path) {
     throw Error(path, "VTK could not read the surface: " + first);
   }
   auto polyData = vtkSmartPointer<vtkPolyData>::New();
-  polyData->ShallowCopy(reader->GetOutput());
+  polyData->ShallowCopy(vtkPolyData::SafeDownCast(reader->GetOutputDataObject(0)));
   return polyData;
 }
 
@@ -108,13 +105,13 @@ vtkSmartPointer<vtkPolyData> readSurfacePolyData(const std::string& path) {
   const std::string extension = lowerCaseExtension(path);
   vtkSmartPointer<vtkPolyData> polyData;
   if (extension == ".vtp") {
-    polyData = readWith<vtkXMLPolyDataReader>(path);
-  } else if (extension == ".obj") {
-    polyData = readWith<vtkOBJReader>(path);
-  } else if (extension == ".ply") {
-    polyData = readWith<vtkPLYReader>(path);
-  } else if (extension == ".stl") {
-    polyData = readWith<vtkSTLReader>(path);
+    vtkNew<vtkXMLPolyDataReader> reader;
+    reader->SetFileName(path.c_str());
+    polyData = readWith(reader.GetPointer(), path);
+  } else if (extension == ".obj" || extension == ".ply" || extension == ".stl") {
+    const auto reader = vtkSmartPointer<vtkAbstractPolyDataReader>::Take(
+        geometryformats::functions().newReader(extension, path));
+    polyData = readWith(reader, path);
   } else {
     throw Error(path, "unknown surface format '" + extension + "' (expected .vtp, .obj, .ply or .stl)");
   }

@@ -8,11 +8,9 @@
 #include <vtkFieldData.h>
 #include <vtkErrorCode.h>
 #include <vtkNew.h>
-#include <vtkOBJWriter.h>
-#include <vtkPLYWriter.h>
 #include <vtkPolyData.h>
-#include <vtkSTLWriter.h>
 #include <vtkStringArray.h>
+#include <vtkWriter.h>
 #include <vtkXMLPolyDataWriter.h>
 #include <vtkLZ4DataCompressor.h>
 
@@ -20,6 +18,7 @@
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
 #include "dynsub/SurfacePolyData.h"
+#include "GeometryFormats.h"
 
 namespace dynsub {
 
@@ -53,10 +52,10 @@ void writeTriangleSurface(const TriangleSurface& surface, const std::string& pat
   // pipeline's dump of the request) is taken by an observer that drops it:
   // the error below names the file and the cause in one line.
   vtkNew<vtkCallbackCommand> quiet;
-  auto write = [&](auto& writer) {
-    writer->SetFileName(output.temporaryPath().c_str());
+  // `writer`'s file name is set (the temporary file).
+  auto write = [&](auto* writer) {
     writer->SetInputData(polyData);
-    vtkObject* const sources[] = {writer.GetPointer(), writer->GetExecutive()};
+    vtkObject* const sources[] = {writer, writer->GetExecutive()};
     for (vtkObject* source : sources) {
       source->AddObserver(vtkCommand::ErrorEvent, quiet);
       source->AddObserver(vtkCommand::WarningEvent, quiet);
@@ -81,18 +80,12 @@ void writeTriangleSurface(const TriangleSurface& surface, const std::string& pat
     // it from 8.1 on (ParaView 5.5, 3D Slicer 4.10).
     vtkNew<vtkLZ4DataCompressor> compressor;
     writer->SetCompressor(compressor);
-    write(writer);
-  } else if (extension == ".obj") {
-    vtkNew<vtkOBJWriter> writer;
-    write(writer);
-  } else if (extension == ".ply") {
-    vtkNew<vtkPLYWriter> writer;
-    writer->SetFileTypeToBinary();
-    write(writer);
+    writer->SetFileName(output.temporaryPath().c_str());
+    write(writer.GetPointer());
   } else {
-    vtkNew<vtkSTLWriter> writer;
-    writer->SetFileTypeToBinary();
-    write(writer);
+    const auto writer =
+        vtkSmartPointer<vtkWriter>::Take(geometryformats::functions().newWriter(extension, output.temporaryPath()));
+    write(writer.GetPointer());
   }
   output.commit();
 }
