@@ -9,6 +9,7 @@
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -378,25 +379,36 @@ class DataReader {
 // then reports in zlib's words.
 constexpr std::uintmax_t kWholeInflateLimit = std::uintmax_t{1} << 29;
 
-std::vector<unsigned char> inflateWhole(const std::string& path, std::uintmax_t needed) {
+// Bytes left uninitialized until written: value-initializing (std::vector's
+// resize) the compressed and inflated copies of an image wrote every byte
+// once more before it was read or inflated into.
+struct Bytes {
+  std::unique_ptr<unsigned char[]> data;
+  std::size_t size = 0;
+  Bytes() = default;
+  explicit Bytes(std::size_t n) : data(new unsigned char[n]), size(n) {}
+  bool empty() const { return size == 0; }
+};
+
+Bytes inflateWhole(const std::string& path, std::uintmax_t needed) {
   std::error_code failed;
   const std::uintmax_t size = fs::file_size(path, failed);
   if (failed || size < 18 || size > kWholeInflateLimit) return {};
   std::ifstream in(path, std::ios::binary);
-  std::vector<unsigned char> compressed(static_cast<std::size_t>(size));
-  if (!in.read(reinterpret_cast<char*>(compressed.data()), static_cast<std::streamsize>(size))) return {};
+  Bytes compressed(static_cast<std::size_t>(size));
+  if (!in.read(reinterpret_cast<char*>(compressed.data.get()), static_cast<std::streamsize>(size))) return {};
   // The trailer's ISIZE: the inflated size modulo 2^32 (a larger file fails below).
   std::uint32_t inflatedSize = 0;
-  for (int b = 3; b >= 0; --b) inflatedSize = (inflatedSize << 8) | compressed[size - 4 + b];
+  for (int b = 3; b >= 0; --b) inflatedSize = (inflatedSize << 8) | compressed.data[size - 4 + b];
   if (inflatedSize < needed || inflatedSize > kWholeInflateLimit) return {};
-  std::vector<unsigned char> inflated(inflatedSize);
+  Bytes inflated(inflatedSize);
   libdeflate_decompressor* decompressor = libdeflate_alloc_decompressor();
   if (!decompressor) return {};
   std::size_t used = 0, produced = 0;
   const libdeflate_result result = libdeflate_gzip_decompress_ex(
-      decompressor, compressed.data(), compressed.size(), inflated.data(), inflated.size(), &used, &produced);
+      decompressor, compressed.data.get(), compressed.size, inflated.data.get(), inflated.size, &used, &produced);
   libdeflate_free_decompressor(decompressor);
-  if (result != LIBDEFLATE_SUCCESS || used != compressed.size() || produced != inflated.size()) return {};
+  if (result != LIBDEFLATE_SUCCESS || used != compressed.size || produced != inflated.size) return {};
   return inflated;
 }
 
@@ -498,10 +510,14 @@ bool niftiFile(const std::string& path, std::vector<float>* voxels) {
     return false;
   }
   // One pass: the data inflated whole, or else chunk by chunk, and converted.
-  const std::vector<unsigned char> whole = gzipped ? inflateWhole(path, needed) : std::vector<unsigned char>();
+  const Bytes whole = gzipped ? inflateWhole(path, needed) : Bytes();
   std::optional<DataReader> data;
   if (whole.empty()) data.emplace(path, gzipped, static_cast<std::uintmax_t>(offset));
-  std::vector<float> read(count);
+  // Converted a chunk at a time into `converted`, in the cache, and appended:
+  // a vector of `count` zeros first would write the whole image once more.
+  std::vector<float> read;
+  read.reserve(static_cast<std::size_t>(count));
+  std::vector<float> converted(std::size_t{1} << 16);
   std::vector<unsigned char> chunk(static_cast<std::size_t>(bytesPerVoxel) << 16);
   std::uintmax_t done = 0, bad = 0, firstBad = 0;
   while (done < count) {
@@ -512,13 +528,14 @@ bool niftiFile(const std::string& path, std::vector<float>* voxels) {
       if (got < want * bytesPerVoxel)
         data->fail(static_cast<std::uintmax_t>(offset) + done * bytesPerVoxel + got, needed);
     } else {
-      bytes = whole.data() + static_cast<std::size_t>(offset) + done * bytesPerVoxel;
+      bytes = whole.data.get() + static_cast<std::size_t>(offset) + done * bytesPerVoxel;
     }
-    float* out = read.data() + done;
+    float* out = converted.data();
     convert(bytes, want, swap, out);
     if (floating)
       for (std::size_t v = 0; v < want; ++v)
         if (!std::isfinite(out[v]) && bad++ == 0) firstBad = done + v;
+    read.insert(read.end(), out, out + want);
     done += want;
   }
   // NaN stays NaN through the cast; a double beyond float's range becomes infinite.
