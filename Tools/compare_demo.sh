@@ -6,10 +6,11 @@
 #
 # The commands are those of `./run demo` (limit, fit, deform, segment, solid
 # sculpt) plus `solid stats` and `render`. Files must be byte-identical; a
-# report.json may differ only in its timings (seconds, stage seconds); a PNG
-# or .vtp whose bytes differ is compared by its contents (pixels, arrays)
-# with NEW_BIN_DIR/SameContents when it is there, and named "same contents"
-# when they agree (their compression may differ between builds). Needs an X
+# report.json may differ only in its timings (seconds, stage seconds); a PNG,
+# .vtp or .nii.gz whose bytes differ is compared by its contents (pixels,
+# arrays, header fields and voxels) with NEW_BIN_DIR/SameContents when it is
+# there, and named "same contents" when they agree (their compression may
+# differ between builds). Needs an X
 # display or xvfb-run for the figures. Exits 1 when anything differs.
 set -euo pipefail
 if [ $# -lt 2 ]; then
@@ -58,7 +59,7 @@ while IFS= read -r file; do
       differ=1
     fi
   elif ! cmp -s "$work/old/$file" "$work/new/$file"; then
-    if [[ $file == *.png || $file == *.vtp ]] && [ -x "$new/SameContents" ] &&
+    if [[ $file == *.png || $file == *.vtp || $file == *.nii.gz ]] && [ -x "$new/SameContents" ] &&
       "$new/SameContents" "$work/old/$file" "$work/new/$file" >/dev/null; then
       echo "same contents, other bytes: $file"
     else
@@ -71,5 +72,5 @@ if [ "$(cd "$work/old" && find . -type f | wc -l)" != "$(cd "$work/new" && find 
   echo "the two runs wrote different sets of files"
   differ=1
 fi
-echo "$count files compared in $work: $([ $differ = 0 ] && echo 'all equal (report.json but for timings; figures and surfaces by contents where their bytes differ)' || echo 'some differ')"
+echo "$count files compared in $work: $([ $differ = 0 ] && echo 'all equal (report.json but for timings; figures, surfaces and labelmaps by contents where their bytes differ)' || echo 'some differ')"
 exit $differ

@@ -3,8 +3,10 @@
 //   build/bin/SameContents FILE_A FILE_B
 // PNG images are compared pixel by pixel (size, channels, every sample),
 // VTK XML PolyData (.vtp) array by array (points, point, cell and field data,
-// and every cell array), any other file byte by byte. Exit code 0 when the
-// same, 1 when not (what differs is printed), 2 when a file cannot be read.
+// and every cell array), NIfTI-1 files (.nii, .nii.gz, inflated) by their
+// header's fields as numbers and their voxels byte by byte, any other file
+// byte by byte. Exit code 0 when the same, 1 when not (what differs is
+// printed), 2 when a file cannot be read.
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -25,6 +27,8 @@
 #include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
 #include <vtkXMLPolyDataReader.h>
+
+#include <zlib.h>
 
 namespace {
 
@@ -140,6 +144,46 @@ bool sameImage(const std::string& pathA, const std::string& pathB, std::string& 
   return sameArray(a->GetOutput()->GetPointData()->GetScalars(), b->GetOutput()->GetPointData()->GetScalars(), why);
 }
 
+// A NIfTI file's bytes, inflated when gzipped (zlib reads plain files as they are).
+std::string niftiBytes(const std::string& path) {
+  gzFile file = gzopen(path.c_str(), "rb");
+  if (!file) throw Unreadable{path};
+  std::string bytes;
+  char buffer[1 << 16];
+  int got = 0;
+  while ((got = gzread(file, buffer, sizeof buffer)) > 0) bytes.append(buffer, static_cast<std::size_t>(got));
+  const bool failed = got < 0;
+  gzclose(file);
+  if (failed || bytes.size() < 352 || bytes.compare(344, 3, "n+1") != 0) throw Unreadable{path};
+  return bytes;
+}
+
+// Two NIfTI-1 files: the header's float fields (pixdim, vox_offset, scaling,
+// quaternion, offsets, affine rows) equal as numbers, so that 0 equals -0 (a
+// writer may give either); every other byte, voxels included, the same.
+bool sameNifti(const std::string& pathA, const std::string& pathB, std::string& why) {
+  const std::string a = niftiBytes(pathA), b = niftiBytes(pathB);
+  if (a.size() != b.size()) {
+    why = "the inflated sizes differ";
+    return false;
+  }
+  auto isFloatField = [](std::size_t at) { return (at >= 76 && at < 120) || (at >= 256 && at < 328); };
+  for (std::size_t at = 0; at < 352; at += isFloatField(at) ? 4 : 1) {
+    if (isFloatField(at)) {
+      float x, y;
+      std::memcpy(&x, a.data() + at, 4);
+      std::memcpy(&y, b.data() + at, 4);
+      if (x == y || (x != x && y != y)) continue;
+    } else if (a[at] == b[at]) {
+      continue;
+    }
+    why = "the header differs at byte " + std::to_string(at);
+    return false;
+  }
+  why = "the voxels differ";
+  return a.compare(352, std::string::npos, b, 352, std::string::npos) == 0;
+}
+
 bool sameBytes(const std::string& pathA, const std::string& pathB, std::string& why) {
   std::ifstream a(pathA, std::ios::binary), b(pathB, std::ios::binary);
   why = "the bytes differ";
@@ -169,6 +213,8 @@ int main(int argc, char** argv) {
       same = sameImage(pathA, pathB, why);
     } else if (extension == ".vtp") {
       same = samePolyData(pathA, pathB, why);
+    } else if (extension == ".nii" || (pathA.size() > 7 && pathA.compare(pathA.size() - 7, 7, ".nii.gz") == 0)) {
+      same = sameNifti(pathA, pathB, why);
     } else {
       same = sameBytes(pathA, pathB, why);
     }

@@ -8,6 +8,7 @@
 
 #include "BridgeGeometry.h"
 #include "FileChecks.h"
+#include "NiftiLabelmap.h"
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
@@ -87,6 +88,10 @@ void writeMask(const Mask& mask, const std::string& path, std::uint8_t label) {
     throw Error(path, "a header with a separate data file is not written; use .nii.gz, .nii, .nrrd or .mha");
   if (label == 0) throw Error(path, "the structure's label value must be 1-255 (0 is the background)");
   requireWritableDirectoryFor(path);
+  if (isNiftiLabelmapName(path)) {
+    writeNiftiLabelmap(mask, label, path);
+    return;
+  }
   AtomicOutput output(path);
   if (label == 1) {
     itkbridge::functions().writeLabels(toBridge(mask.geometry), mask.voxels, output.temporaryPath());

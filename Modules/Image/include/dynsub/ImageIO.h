@@ -1,7 +1,9 @@
 #pragma once
-// Reading volumes and writing labelmaps through ITK, in physical LPS mm with
-// the file's origin, spacing and direction (NIfTI's RAS qform/sform is turned
-// into LPS by ITK when reading and back when writing).
+// Reading volumes and writing labelmaps, in physical LPS mm with the file's
+// origin, spacing and direction (NIfTI's RAS qform/sform is turned into LPS
+// when reading and back when writing). ITK reads the headers and the formats
+// DynSub does not read itself; NIfTI labelmaps are written by DynSub, .nrrd
+// and .mha ones by ITK.
 //
 // Readable: NIfTI (.nii, .nii.gz), NRRD (.nrrd, .nhdr), MetaImage (.mha,
 // .mhd) and DICOM series (a directory holding one series, via GDCM). Any pixel
@@ -26,8 +28,9 @@ Volume readVolume(const std::string& path);
 
 // Writes a mask as an unsigned 8-bit labelmap (`label` = structure, 0 =
 // background; 3D Slicer colours a segment by its label value) on its grid, in
-// any single-file format ITK writes by extension (.nii.gz for ITK-SNAP and 3D
-// Slicer; .mhd, .nhdr and .hdr, with their separate data file, are refused).
+// a single-file format chosen by extension (.nii.gz for ITK-SNAP and 3D
+// Slicer, .nii, .nrrd, .mha; .mhd, .nhdr and .hdr, with their separate data
+// file, are refused).
 // The file appears complete or not at all.
 void writeMask(const Mask& mask, const std::string& path, std::uint8_t label = 1);
 
