@@ -83,15 +83,24 @@ void writeSegmentOutputs(const std::filesystem::path& dir, const SegmentRun& run
   writeModelOutputs(
       dir, result.mesh, result.surface, run.report,
       [&](OutputSet& outputs) {
-        // NB: the labelmap is compressed on a thread of its own while the
-        // figures render on this one (a tenth of them). Its error, if any,
-        // comes first, as when it was written first.
         const std::string labelmapPath = outputs.add("labelmap.nii.gz");
-        alongside([&] { writeMask(run.labelmap, labelmapPath); },
-                  [&] {
-                    addFigureOutputs(outputs, figures, result.mesh, result.surface, run.history, &image,
-                                     landmarkPositions(run.springs), Matrix3X(), result.surfaceEdgeDistances);
-                  });
+        const auto labelmap = [&] { writeMask(run.labelmap, labelmapPath); };
+        const auto figuresAndRecord = [&] {
+          addFigureOutputs(outputs, figures, result.mesh, result.surface, run.history, &image,
+                           landmarkPositions(run.springs), Matrix3X(), result.surfaceEdgeDistances);
+        };
+        // NB: with figures, the labelmap is compressed on a thread of its own
+        // while they render on this one (a tenth of them). Without, this
+        // thread has only convergence.csv to write, and writes the labelmap
+        // too: a thread of its own took fresh 4 kB pages for the labelmap's
+        // 7 MB where this one reuses the main heap's. The labelmap's error,
+        // if any, comes first either way.
+        if (figures.figures) {
+          alongside(labelmap, figuresAndRecord);
+        } else {
+          labelmap();
+          figuresAndRecord();
+        }
       },
       result.surfaceEdgeDistances.size()
           ? std::vector<PointScalars>{{kEdgeDistanceScalars, result.surfaceEdgeDistances}}
