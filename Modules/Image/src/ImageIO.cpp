@@ -20,6 +20,8 @@ Volume readVolume(const std::string& path) {
   std::error_code ignored;
   Volume volume;
   itkbridge::Geometry raw;
+  // Voxels DynSub read itself were checked to be finite as they were read.
+  bool checkedFinite = false;
   const bool nifti = filechecks::isNiftiName(path);
   if (std::filesystem::is_directory(path, ignored) || (!nifti && filechecks::isDicomFile(path))) {
     itkbridge::dicomFunctions().readImage(path, raw, volume.voxels);
@@ -45,6 +47,7 @@ Volume readVolume(const std::string& path) {
     const bool whole = voxelsRead && itk.readGeometry(path, raw) &&
                        static_cast<std::size_t>(raw.size[0]) * raw.size[1] * raw.size[2] == volume.voxels.size();
     if (!whole) itk.readImage(path, raw, volume.voxels);
+    checkedFinite = whole;
   }
   volume.geometry = fromBridge(raw);
   for (int a = 0; a < 3; ++a)
@@ -67,7 +70,9 @@ Volume readVolume(const std::string& path) {
   }
   // NaN or infinite intensities would spread through the smoothing into every
   // force near them.
-  const auto bad = std::find_if(volume.voxels.begin(), volume.voxels.end(), [](float v) { return !std::isfinite(v); });
+  const auto bad = checkedFinite ? volume.voxels.end()
+                                 : std::find_if(volume.voxels.begin(), volume.voxels.end(),
+                                                [](float v) { return !std::isfinite(v); });
   if (bad != volume.voxels.end()) {
     const long long first = bad - volume.voxels.begin(), count = std::count_if(bad, volume.voxels.end(), [](float v) {
       return !std::isfinite(v);
