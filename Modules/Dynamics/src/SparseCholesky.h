@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <Eigen/CholmodSupport>
+#include <omp.h>
 
 #include "SupernodalSolve.h"
 #include "dynsub/Error.h"
@@ -34,13 +35,17 @@ class SparseCholesky {
   }
 
   // The pattern of `lower` (its lower triangle is read); once per pattern.
-  void analyzePattern(const SymmetricMatrix& lower) { factor_.analyzePattern(lower); }
+  void analyzePattern(const SymmetricMatrix& lower) {
+    withoutOpenMpThreads();
+    factor_.analyzePattern(lower);
+  }
 
   // True when `lower` factored as positive definite and not near-singular:
   // the smallest pivot (the square of L's smallest diagonal entry) above
   // 1e-12 of the largest, the test the simplicial LDLᵀ's D had.
   bool factorize(const SymmetricMatrix& lower) {
     const std::lock_guard<std::mutex> lock(blas());
+    withoutOpenMpThreads();
     factor_.factorize(lower);
     view_ = factor_.view();
     if (view_.values != nullptr) {
@@ -83,6 +88,17 @@ class SparseCholesky {
   }
 
  private:
+  // NB: Debian's CHOLMOD opens OpenMP parallel regions of up to four threads
+  // for small loops of its supernodal factorization. On two cores each one
+  // woke libgomp's threads and waited for them through the kernel: the
+  // kitten's fit made 43 600 futex calls, waiting 3.1 s in all, and took
+  // 3.26 s (median) against 2.92 s with the regions run by the calling thread
+  // alone (the same control mesh to the byte; Documentation/Performance.md).
+  // OpenMP's max-active-levels 0 makes every region inactive on this thread
+  // (the setting is per thread, and factorizations run on several); DynSub
+  // itself uses no OpenMP.
+  static void withoutOpenMpThreads() { omp_set_max_active_levels(0); }
+
   // NB: one factorization at a time in the process. CHOLMOD is thread-safe,
   // but the BLAS under it need not be: Debian's serial OpenBLAS fails when
   // two threads call it at once (`dynsub evaluate --jobs 2` runs two
