@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <exception>
 #include <future>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -31,8 +32,25 @@ inline Eigen::Index hardwareThreads() {
   return threads;
 }
 
+namespace detail {
+
+// The process's helper threads, one per hardware thread beyond the first,
+// started at the first call and kept, waiting, until the process ends.
+// startOnHelper hands run(context, part) to an idle one and returns its
+// number, or -1 when every one is busy (with another caller's work);
+// waitForHelper(number) returns once that work has ended and frees the
+// helper. `run` must not throw.
+int startOnHelper(void (*run)(void* context, Eigen::Index part), void* context, Eigen::Index part);
+void waitForHelper(int helper);
+
+}  // namespace detail
+
 // An exception thrown by `body` is rethrown here once every thread has
 // ended: the first chunk's that threw, so the same one whatever the timing.
+// NB: chunks go to the waiting helper threads (detail::startOnHelper), or,
+// when another caller has them busy, to threads started for the call:
+// starting a thread took 50-100 us on this virtual machine, and the implicit
+// step, about a millisecond, split its solves in two twice per step.
 template <class Body>
 void parallelFor(Eigen::Index count, Eigen::Index threadsWorthIt, const Body& body) {
   const Eigen::Index threads = std::min<Eigen::Index>({hardwareThreads(), count, threadsWorthIt});
@@ -49,9 +67,26 @@ void parallelFor(Eigen::Index count, Eigen::Index threadsWorthIt, const Body& bo
       failed[t] = std::current_exception();
     }
   };
+  using Run = decltype(run);
+  const auto onHelper = [](void* context, Eigen::Index t) { (*static_cast<Run*>(context))(t); };
+  std::vector<int> helpers;
   std::vector<std::thread> workers;
-  for (Eigen::Index t = 1; t < threads; ++t) workers.emplace_back(run, t);
+  helpers.reserve(threads);
+  workers.reserve(threads);
+  for (Eigen::Index t = 1; t < threads; ++t) {
+    const int helper = detail::startOnHelper(onHelper, &run, t);
+    if (helper >= 0) {
+      helpers.push_back(helper);
+      continue;
+    }
+    try {
+      workers.emplace_back(run, t);
+    } catch (const std::system_error&) {
+      run(t);  // no thread to be had: this one does the chunk
+    }
+  }
   run(0);
+  for (int helper : helpers) detail::waitForHelper(helper);
   for (std::thread& w : workers) w.join();
   for (const std::exception_ptr& failure : failed)
     if (failure) std::rethrow_exception(failure);
