@@ -12,14 +12,14 @@
 namespace dynsub {
 
 // body(i) for i in [0, count): one contiguous chunk per thread, on at most
-// `threadsWorthIt` threads (the caller's measure of its work: starting a
-// thread costs about 50 us, a few closest-point queries' worth), at most one
-// per hardware thread; on this thread alone when that is 1 or less. Each item
-// must be independent of the others, so that results do not depend on the
-// thread count.
-// NB: plain threads started per call instead of OpenMP: libgomp's workers
-// spin-wait between parallel loops, which took a third of the CPU time of a
-// segmentation whose loops are mostly small.
+// `threadsWorthIt` threads (the caller's measure of its work: handing a chunk
+// to another thread costs tens of microseconds, a few closest-point queries'
+// worth), at most one per hardware thread; on this thread alone when that is
+// 1 or less. Each item must be independent of the others, so that results do
+// not depend on the thread count.
+// NB: DynSub's own helper threads, which sleep between calls, instead of
+// OpenMP: libgomp's workers spin-wait between parallel loops, which took a
+// third of the CPU time of a segmentation whose loops are mostly small.
 // The threads `items` independent pieces of per-point work (a closest-point
 // query, a point's stiffness) are worth: one per 128, so none below 256.
 inline Eigen::Index threadsWorth(Eigen::Index items) { return items / 128; }
