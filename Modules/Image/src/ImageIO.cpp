@@ -93,7 +93,7 @@ void writeMask(const Mask& mask, const std::string& path, std::uint8_t label) {
     throw Error(path, "a header with a separate data file is not written; use .nii.gz, .nii, .nrrd or .mha");
   if (label == 0) throw Error(path, "the structure's label value must be 1-255 (0 is the background)");
   requireWritableDirectoryFor(path);
-  if (isNiftiLabelmapName(path)) {
+  if (filechecks::isNiftiName(path)) {
     writeNiftiLabelmap(mask, label, path);
     return;
   }

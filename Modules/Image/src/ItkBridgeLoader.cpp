@@ -8,19 +8,17 @@ namespace dynsub::itkbridge {
 
 // Never closed: ITK's factories and GDCM's dictionary live until exit.
 const Functions& functions() {
-  using Entry = const Functions* (*)();
-  static const Functions* const loaded = reinterpret_cast<Entry>(
-      openOwnLibrary(DYNSUB_ITK_BRIDGE_NAME, DYNSUB_ITK_BRIDGE_BUILD_PATH, kFunctionsSymbol,
-                     "library that reads and filters images through ITK"))();
-  return *loaded;
+  static const Functions& loaded =
+      ownLibraryTable<Functions>(DYNSUB_ITK_BRIDGE_NAME, DYNSUB_ITK_BRIDGE_BUILD_PATH, kFunctionsSymbol,
+                                 "library that reads and filters images through ITK");
+  return loaded;
 }
 
 const DicomFunctions& dicomFunctions() {
-  using Entry = const DicomFunctions* (*)();
-  static const DicomFunctions* const loaded = reinterpret_cast<Entry>(
-      openOwnLibrary(DYNSUB_ITK_DICOM_NAME, DYNSUB_ITK_DICOM_BUILD_PATH, kDicomFunctionsSymbol,
-                     "library that reads DICOM through ITK and GDCM"))();
-  return *loaded;
+  static const DicomFunctions& loaded =
+      ownLibraryTable<DicomFunctions>(DYNSUB_ITK_DICOM_NAME, DYNSUB_ITK_DICOM_BUILD_PATH, kDicomFunctionsSymbol,
+                                      "library that reads DICOM through ITK and GDCM");
+  return loaded;
 }
 
 }  // namespace dynsub::itkbridge

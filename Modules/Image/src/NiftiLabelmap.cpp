@@ -98,11 +98,6 @@ void writeHeader(unsigned char* file, const ImageGeometry& g) {
 
 }  // namespace
 
-bool isNiftiLabelmapName(const std::string& path) {
-  const std::string extension = lowerCaseExtension(path);
-  return extension == ".nii" || (extension == ".gz" && lowerCaseExtension(path.substr(0, path.size() - 3)) == ".nii");
-}
-
 void writeNiftiLabelmap(const Mask& mask, std::uint8_t label, const std::string& path) {
   const ImageGeometry& g = mask.geometry;
   for (int a = 0; a < 3; ++a)

@@ -8,20 +8,17 @@
 // each other through ITK's reader).
 #include <cstdint>
 #include <string>
-#include <vector>
 
 #include "dynsub/Volume.h"
 
 namespace dynsub {
 
-// Whether `path` is a NIfTI name this writer takes (.nii or .nii.gz).
-bool isNiftiLabelmapName(const std::string& path);
-
 // The NIfTI-1 file, one piece (.nii), or that compressed as one gzip member
 // (.nii.gz, by libdeflate), of `mask` on its geometry with `label` where the
-// mask is set and 0 elsewhere, as unsigned 8-bit values. Throws dynsub::Error
-// naming `path` when the grid does not fit NIfTI-1 (more than 32 767 voxels
-// along an axis) or the file cannot be written.
+// mask is set and 0 elsewhere, as unsigned 8-bit values; `path` is a NIfTI
+// name (FileChecks.h: isNiftiName). Throws dynsub::Error naming `path` when
+// the grid does not fit NIfTI-1 (more than 32 767 voxels along an axis) or
+// the file cannot be written.
 void writeNiftiLabelmap(const Mask& mask, std::uint8_t label, const std::string& path);
 
 }  // namespace dynsub

@@ -8,16 +8,15 @@ namespace dynsub::rendering {
 
 const Functions& functions() {
   // Never closed: VTK's object factories live until exit.
-  static const Functions* const loaded = [] {
-    using Entry = const Functions* (*)();
-    const Functions* table = reinterpret_cast<Entry>(
-        openOwnLibrary(DYNSUB_RENDERING_LIBRARY_NAME, DYNSUB_RENDERING_LIBRARY_BUILD_PATH, kFunctionsSymbol,
-                       "library that draws figures and windows with VTK"))();
+  static const Functions& loaded = [] () -> const Functions& {
+    const Functions& table =
+        ownLibraryTable<Functions>(DYNSUB_RENDERING_LIBRARY_NAME, DYNSUB_RENDERING_LIBRARY_BUILD_PATH,
+                                   kFunctionsSymbol, "library that draws figures and windows with VTK");
     // Its own copy of the Core module tells the program's guard of its temporary files.
-    table->useTemporaryFileGuard(temporaryfiles::channel());
+    table.useTemporaryFileGuard(temporaryfiles::channel());
     return table;
   }();
-  return *loaded;
+  return loaded;
 }
 
 const Functions* figureFunctions(std::string& why) {

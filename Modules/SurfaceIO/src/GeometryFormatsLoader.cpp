@@ -7,11 +7,10 @@
 namespace dynsub::geometryformats {
 
 const Functions& functions() {
-  using Entry = const Functions* (*)();
-  static const Functions* const loaded = reinterpret_cast<Entry>(
-      openOwnLibrary(DYNSUB_GEOMETRY_FORMATS_NAME, DYNSUB_GEOMETRY_FORMATS_BUILD_PATH, kFunctionsSymbol,
-                     "library that reads and writes OBJ, PLY and STL files through VTK"))();
-  return *loaded;
+  static const Functions& loaded =
+      ownLibraryTable<Functions>(DYNSUB_GEOMETRY_FORMATS_NAME, DYNSUB_GEOMETRY_FORMATS_BUILD_PATH, kFunctionsSymbol,
+                                 "library that reads and writes OBJ, PLY and STL files through VTK");
+  return loaded;
 }
 
 }  // namespace dynsub::geometryformats

@@ -16,4 +16,15 @@ namespace dynsub {
 void* openOwnLibrary(const std::string& name, const std::string& buildPath, const char* symbol,
                      const std::string& purpose);
 
+// The table of functions a library exports through `symbol`, a function
+// taking nothing and returning `const Table*`: opens the library
+// (openOwnLibrary) and calls it. Callers keep the result in a function-local
+// static, so that the library is opened once, at the first call, thread-safely.
+template <class Table>
+const Table& ownLibraryTable(const std::string& name, const std::string& buildPath, const char* symbol,
+                             const std::string& purpose) {
+  using Entry = const Table* (*)();
+  return *reinterpret_cast<Entry>(openOwnLibrary(name, buildPath, symbol, purpose))();
+}
+
 }  // namespace dynsub
