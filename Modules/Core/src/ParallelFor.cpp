@@ -47,7 +47,7 @@ const Helpers& helpers() {
     for (; h.count < wanted; ++h.count) {
       try {
         std::thread(serve, &h.helpers[h.count]).detach();
-      } catch (const std::system_error&) {
+      } catch (...) {
         break;  // fewer helpers; parallelFor starts threads of its own for the rest
       }
     }

@@ -105,6 +105,9 @@ void writeNiftiLabelmap(const Mask& mask, std::uint8_t label, const std::string&
       throw Error(path, "a grid of " + std::to_string(g.size[a]) + " voxels along axis " + std::to_string(a) +
                             " does not fit a NIfTI-1 header (1 to 32767)");
   const auto count = static_cast<std::size_t>(g.voxelCount());
+  if (mask.voxels.size() != count)
+    throw Error(path, "internal: a mask of " + std::to_string(mask.voxels.size()) + " voxels on a grid of " +
+                          std::to_string(count) + "; nothing written");
   // NB: the header zeroed, the voxels written once (a vector's resize would
   // zero them first), through plain pointers so that the loop vectorizes
   // (stores through unsigned char may alias anything, even a vector's own
@@ -119,12 +122,12 @@ void writeNiftiLabelmap(const Mask& mask, std::uint8_t label, const std::string&
   AtomicOutput output(path);
   std::ofstream out(output.temporaryPath(), std::ios::binary);
   if (compressed) {
-    libdeflate_compressor* compressor = libdeflate_alloc_compressor(kCompressionLevel);
+    const std::unique_ptr<libdeflate_compressor, void (*)(libdeflate_compressor*)> compressor(
+        libdeflate_alloc_compressor(kCompressionLevel), &libdeflate_free_compressor);
     if (!compressor) throw Error(path, "cannot start compressing the labelmap (out of memory?)");
-    Bytes packed(libdeflate_gzip_compress_bound(compressor, file.size));
+    Bytes packed(libdeflate_gzip_compress_bound(compressor.get(), file.size));
     const std::size_t size =
-        libdeflate_gzip_compress(compressor, file.data.get(), file.size, packed.data.get(), packed.size);
-    libdeflate_free_compressor(compressor);
+        libdeflate_gzip_compress(compressor.get(), file.data.get(), file.size, packed.data.get(), packed.size);
     if (size == 0) throw Error(path, "the labelmap could not be compressed");
     out.write(reinterpret_cast<const char*>(packed.data.get()), static_cast<std::streamsize>(size));
   } else {

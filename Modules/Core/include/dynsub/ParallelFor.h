@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <exception>
 #include <future>
-#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -79,10 +78,12 @@ void parallelFor(Eigen::Index count, Eigen::Index threadsWorthIt, const Body& bo
       helpers.push_back(helper);
       continue;
     }
+    // NB: nothing may leave this loop by an exception while helpers run
+    // `run`, which lives on this frame.
     try {
       workers.emplace_back(run, t);
-    } catch (const std::system_error&) {
-      run(t);  // no thread to be had: this one does the chunk
+    } catch (...) {
+      run(t);  // no thread to be had (system_error, bad_alloc): this one does the chunk
     }
   }
   run(0);

@@ -6,7 +6,8 @@
 // and .mha ones by ITK.
 //
 // Readable: NIfTI (.nii, .nii.gz), NRRD (.nrrd, .nhdr), MetaImage (.mha,
-// .mhd) and DICOM series (a directory holding one series, via GDCM). Any pixel
+// .mhd) and DICOM series (a directory holding one series, via GDCM; a single
+// DICOM file, a multi-frame volume, when it has the standard "DICM" preamble). Any pixel
 // type is read as float; an image that is not 3D (a single slice counts as 2D)
 // or has no voxels is refused.
 #include <cstdint>
