@@ -228,7 +228,8 @@ void addSegmentCommand(CLI::App& app) {
       ->default_val(o->segment.margin);
   command->add_option("--slice-ends", o->segment.sliceEnds.enabled,
                       "For landmarks on slices: follow the tissue between the clicked slices beyond them and add "
-                      "soft springs where it ends, so that the structure's unclicked ends are reached (true/false)")
+                      "soft springs where it ends, so that the structure's unclicked ends are reached (true/false; "
+                      "false when your clicks reach both ends: the march then goes on into like tissue)")
       ->default_val(o->segment.sliceEnds.enabled);
   command->add_option("--end-pressure", o->segment.sliceEnds.pressure,
                       "With --slice-ends: the pressure beyond the outermost clicked slices, N/mm^2 at full "
