@@ -36,6 +36,7 @@ struct Arguments {
   std::string image, landmarks, inside, labelmap, model, report;
   std::vector<std::string> seeds;
   int labelValue = 1;
+  bool pointsReachEnds = false;
   std::string potential = "edges";
   SegmentOptions segment;
   SeedOptions seed;
@@ -110,6 +111,12 @@ slicer::Module describe(Arguments& a) {
   model.parameters.push_back({"double", "", "margin", "margin", "Margin (mm)",
                               "The region of interest around the initial model and the points.", &a.segment.margin,
                               "", "1", "100", "1", {}, -1});
+  model.parameters.push_back({"boolean", "", "pointsReachEnds", "pointsReachEnds", "Points reach both ends",
+                              "Check when the boundary points include the structure's first and last slices. "
+                              "Unchecked, the surface is carried past the outermost slices with points to where "
+                              "the structure's tissue ends, since experts seldom place points there; when the "
+                              "points already reach the ends, that carries it on into like tissue.",
+                              &a.pointsReachEnds, "", "", "", "", {}, -1});
   model.parameters.push_back({"integer", "", "maxLevel", "maxLevel", "Refinements",
                               "Global refinements of the control mesh allowed.", &a.segment.simulation.maxLevel, "",
                               "0", "6", "1", {}, -1});
@@ -185,6 +192,7 @@ void run(Arguments a) {
   for (const std::string* path : {&a.labelmap, &a.model, &a.report})
     if (!path->empty()) requireWritableDirectoryFor(*path);
   if (a.potential == "gradient") a.segment.edges.method = EdgeMethod::GradientMagnitude;
+  a.segment.sliceEnds.enabled = !a.pointsReachEnds;
   checkSegmentOptions(a.segment);
 
   SlicerProgress progress(a.segment.simulation.maxLevel + 1);

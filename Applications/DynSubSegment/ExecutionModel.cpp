@@ -2,6 +2,7 @@
 
 #include <iomanip>
 #include <sstream>
+#include <type_traits>
 
 #include <CLI/CLI.hpp>
 
@@ -33,6 +34,7 @@ std::string defaultOf(const Parameter& p) {
   if (const auto* d = std::get_if<double*>(&p.target)) return number(**d);
   if (const auto* i = std::get_if<int*>(&p.target)) return std::to_string(**i);
   if (const auto* s = std::get_if<std::string*>(&p.target)) return **s;
+  if (const auto* b = std::get_if<bool*>(&p.target)) return **b ? "true" : "false";
   return "";
 }
 
@@ -86,8 +88,16 @@ void addOptions(CLI::App& app, const Module& module) {
   for (const ParameterGroup& group : module.groups) {
     for (const Parameter& p : group.parameters) {
       const std::string name = p.index >= 0 ? p.name : "--" + p.flag;
-      CLI::Option* option = std::visit([&](auto* target) { return app.add_option(name, *target, p.description); },
-                                       p.target);
+      if (bool* const* flag = std::get_if<bool*>(&p.target)) {  // a flag alone, as Slicer passes a boolean
+        app.add_flag(name, **flag, p.description);
+        continue;
+      }
+      CLI::Option* option = std::visit(
+          [&](auto* target) -> CLI::Option* {
+            if constexpr (std::is_same_v<decltype(target), bool*>) return nullptr;  // handled above
+            else return app.add_option(name, *target, p.description);
+          },
+          p.target);
       if (std::holds_alternative<std::vector<std::string>*>(p.target)) {
         // One value per occurrence, so that "--seed a --seed b IMAGE" leaves IMAGE positional.
         option->expected(1)->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);

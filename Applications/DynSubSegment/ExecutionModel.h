@@ -21,7 +21,9 @@ struct Parameter {
   std::string label, description;
   // Where the value goes. A vector takes one value per occurrence of the flag
   // (Slicer's multiple="true" points: "--seed x,y,z" once per point).
-  std::variant<std::string*, std::vector<std::string>*, double*, int*> target;
+  // A bool is a <boolean>: Slicer passes its flag alone when it is checked,
+  // and nothing when not, so its default must be false.
+  std::variant<std::string*, std::vector<std::string>*, double*, int*, bool*> target;
   std::string channel;                  // input or output for data parameters; empty for plain values
   std::string minimum, maximum, step;   // constraints of a number; empty: none
   std::vector<std::string> choices;     // the elements of an enumeration

@@ -46,6 +46,12 @@ check "caudate: report written" grep -q '"landmark_count": 36' "$work/report.jso
 check "caudate: progress rises to 1.00" awk -F'[<>]' '/<filter-progress>/ { if ($3 < last) bad = 1; last = $3; n++ }
   END { exit !(n >= 5 && !bad && last == 1.00) }' "$work/run.out"
 check "caudate: stdout is tags and the summary only" test -z "$(grep -v -e '^<filter-' -e '^segmented ' "$work/run.out")"
+check "caudate: the ends beyond the points are followed by default" grep -q '"slice_ends": true' "$work/report.json"
+
+"$MODULE" "${seeds[@]}" --pointsReachEnds --labelmap "$work/ends.nrrd" --report "$work/ends.json" "$work/ch2.nrrd" \
+  >"$work/ends.out" 2>&1
+check "points reaching both ends: exit 0" test $? -eq 0
+check "points reaching both ends: nothing followed beyond them" grep -q '"slice_ends": false' "$work/ends.json"
 
 "$MODULE" --seed 15.4,-1.5,16.0 --labelmap "$work/inside.nrrd" --report "$work/inside.json" "$work/ch2.nrrd" \
   >"$work/inside.out" 2>&1

@@ -97,6 +97,9 @@ def check_descriptor(module):
                 elements = [e.text for e in p.findall("element")]
                 if not elements or default not in elements:
                     fail(f"{name}: default {default!r} is not one of {elements}")
+            if p.tag == "boolean" and default != "false":
+                # Slicer passes a boolean's flag only when it is checked: a true default could not be unset.
+                fail(f"{name}: a boolean's default must be false, got {default!r}")
             if p.tag in ("integer", "double", "float"):
                 value = float(default)
                 if p.tag == "integer" and not re.fullmatch(r"-?[0-9]+", default):
@@ -120,8 +123,10 @@ def check_descriptor(module):
     node.inputs.labelmap = "out.nrrd"
     node.inputs.sigma = 1.5
     node.inputs.potential = "gradient"
+    node.inputs.pointsReachEnds = True
     line = node.cmdline
-    for expected in ("DynSubSegment ", "--labelmap out.nrrd", "--sigma 1.500000", "--potential gradient", os.path.basename(__file__)):
+    for expected in ("DynSubSegment ", "--labelmap out.nrrd", "--sigma 1.500000", "--potential gradient",
+                     "--pointsReachEnds ", os.path.basename(__file__)):
         if expected not in line:
             fail(f"nipype's command line {line!r} lacks {expected!r}")
     print(f"descriptor: {len(names)} parameters, {len(flags)} flags, Slicer's rules kept; nipype built "
