@@ -257,6 +257,11 @@ void run(Arguments a) {
   const double volume = run.labelmap.count() * image.geometry.spacing.prod();
   std::cout << std::fixed << std::setprecision(1) << "segmented " << volume << " mm^3 with "
             << run.result.mesh.vertexCount() << " control vertices in " << run.seconds << " s\n";
+  const std::string carried = app::carriedPastSlices(run.result, a.segment.sliceEnds);
+  if (!carried.empty())
+    std::cout << "<filter-comment>carried the surface past the outermost slices with points to where the tissue "
+                 "seemed to end: "
+              << carried << " (check Points reach both ends if your points already reach them)</filter-comment>\n";
   for (const std::string& warning : run.warnings) std::cerr << "warning: " << warning << '\n';
   progress.report(1.0);
   std::cout << "<filter-end><filter-name>DynSubSegment</filter-name></filter-end>" << std::endl;

@@ -113,16 +113,7 @@ void printSummary(const SegmentCommandOptions& o, const SegmentRun& run, const V
   std::cout << std::fixed << std::setprecision(1) << "segmented " << run.labelmap.count() * image.geometry.spacing.prod()
             << " mm^3 with " << result.mesh.vertexCount() << " control vertices (" << result.levels.back().level
             << " refinement(s), " << result.steps << " steps) in " << run.seconds << " s\n";
-  // Where the surface was carried past the outermost clicked slices: what a
-  // user who clicked the structure's ends needs to know to turn it off.
-  std::string carried;
-  for (const SliceEnd& end : result.sliceEnds.ends) {
-    if (!end.pressed && end.length <= o.segment.sliceEnds.gap) continue;
-    std::ostringstream part;
-    part << std::fixed << std::setprecision(1) << (carried.empty() ? "" : ", ") << end.length << " mm "
-         << (end.side < 0 ? "before the first" : "after the last") << (end.stoppedByReach ? " (no end seen)" : "");
-    carried += part.str();
-  }
+  const std::string carried = carriedPastSlices(run.result, o.segment.sliceEnds);
   if (!carried.empty())
     std::cout << "carried the surface past the outermost clicked slices to where the tissue seemed to end: "
               << carried << " (--slice-ends false if your clicks already reach the structure's ends)\n";

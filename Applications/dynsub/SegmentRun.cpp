@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 
 #include "dynsub/ClosestPoint.h"
@@ -250,6 +251,19 @@ SegmentRun runSegmentation(const Volume& image, SegmentInputs in, const Progress
   parameters.set("end_pressure", in.segment.sliceEnds.pressure);
   report.set("parameters", parameters);
   return run;
+}
+
+std::string carriedPastSlices(const SegmentResult& result, const SliceEndOptions& options) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(1);
+  bool first = true;
+  for (const SliceEnd& end : result.sliceEnds.ends) {
+    if (!end.pressed && end.length <= options.gap) continue;
+    out << (first ? "" : ", ") << end.length << " mm " << (end.side < 0 ? "before the first" : "after the last")
+        << (end.stoppedByReach ? " (no end seen)" : "");
+    first = false;
+  }
+  return out.str();
 }
 
 }  // namespace dynsub::app
