@@ -115,7 +115,7 @@ slicer::Module describe(Arguments& a) {
                               "Check when the boundary points include the structure's first and last slices. "
                               "Unchecked, the surface is carried past the outermost slices with points to where "
                               "the structure's tissue ends, since experts seldom place points there; when the "
-                              "points already reach the ends, that carries it on into like tissue.",
+                              "points already reach the ends, that can carry it on into like tissue.",
                               &a.pointsReachEnds, "", "", "", "", {}, -1});
   model.parameters.push_back({"integer", "", "maxLevel", "maxLevel", "Refinements",
                               "Global refinements of the control mesh allowed.", &a.segment.simulation.maxLevel, "",
@@ -259,8 +259,8 @@ void run(Arguments a) {
             << run.result.mesh.vertexCount() << " control vertices in " << run.seconds << " s\n";
   const std::string carried = app::carriedPastSlices(run.result, a.segment.sliceEnds);
   if (!carried.empty())
-    std::cout << "<filter-comment>carried the surface past the outermost slices with points to where the tissue "
-                 "seemed to end: "
+    std::cout << "<filter-comment>followed the structure's tissue past the outermost slices with points and "
+                 "pulled the surface there: "
               << carried << " (check Points reach both ends if your points already reach them)</filter-comment>\n";
   for (const std::string& warning : run.warnings) std::cerr << "warning: " << warning << '\n';
   progress.report(1.0);

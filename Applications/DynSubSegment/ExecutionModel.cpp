@@ -2,6 +2,7 @@
 
 #include <iomanip>
 #include <sstream>
+#include <stdexcept>
 #include <type_traits>
 
 #include <CLI/CLI.hpp>
@@ -88,13 +89,12 @@ void addOptions(CLI::App& app, const Module& module) {
   for (const ParameterGroup& group : module.groups) {
     for (const Parameter& p : group.parameters) {
       const std::string name = p.index >= 0 ? p.name : "--" + p.flag;
-      if (bool* const* flag = std::get_if<bool*>(&p.target)) {  // a flag alone, as Slicer passes a boolean
-        app.add_flag(name, **flag, p.description);
-        continue;
-      }
+      if (bool* const* flag = std::get_if<bool*>(&p.target); flag && (**flag || p.index >= 0))
+        throw std::logic_error(p.name + ": a <boolean> is a flag that defaults to false");
       CLI::Option* option = std::visit(
           [&](auto* target) -> CLI::Option* {
-            if constexpr (std::is_same_v<decltype(target), bool*>) return nullptr;  // handled above
+            // A boolean is its flag alone, as Slicer passes it when checked.
+            if constexpr (std::is_same_v<decltype(target), bool*>) return app.add_flag(name, *target, p.description);
             else return app.add_option(name, *target, p.description);
           },
           p.target);
@@ -107,7 +107,7 @@ void addOptions(CLI::App& app, const Module& module) {
       if (!p.minimum.empty() && !p.maximum.empty())
         option->check(CLI::Range(std::stod(p.minimum), std::stod(p.maximum)));
       const std::string value = defaultOf(p);
-      if (!value.empty()) option->default_str(value);
+      if (!value.empty() && !std::holds_alternative<bool*>(p.target)) option->default_str(value);
     }
   }
 }

@@ -115,8 +115,8 @@ void printSummary(const SegmentCommandOptions& o, const SegmentRun& run, const V
             << " refinement(s), " << result.steps << " steps) in " << run.seconds << " s\n";
   const std::string carried = carriedPastSlices(run.result, o.segment.sliceEnds);
   if (!carried.empty())
-    std::cout << "carried the surface past the outermost clicked slices to where the tissue seemed to end: "
-              << carried << " (--slice-ends false if your clicks already reach the structure's ends)\n";
+    std::cout << "followed the structure's tissue past the outermost clicked slices and pulled the surface there: "
+              << carried << " (--slice-ends false if your clicks already reach its ends)\n";
   for (const std::string& warning : run.warnings) std::cerr << "warning: " << warning << '\n';
   if (!o.reference.empty())
     std::cout << std::setprecision(3) << "Dice " << run.metrics.dice << ", mean surface distance "
@@ -233,7 +233,7 @@ void addSegmentCommand(CLI::App& app) {
   command->add_option("--slice-ends", o->segment.sliceEnds.enabled,
                       "For landmarks on slices: follow the tissue between the clicked slices beyond them and add "
                       "soft springs where it ends, so that the structure's unclicked ends are reached (true/false; "
-                      "false when your clicks reach both ends: the march then goes on into like tissue)")
+                      "false when your clicks reach both ends: the march can then go on into like tissue)")
       ->default_val(o->segment.sliceEnds.enabled);
   command->add_option("--end-pressure", o->segment.sliceEnds.pressure,
                       "With --slice-ends: the pressure beyond the outermost clicked slices, N/mm^2 at full "

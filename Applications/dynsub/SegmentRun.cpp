@@ -56,7 +56,11 @@ ControlMesh chooseStart(const Volume& image, SegmentInputs& in, SegmentRun& run)
       if (in.landmarks.size() < 4)
         throw Error("the initial model is built from the landmarks: give at least 4, or start from a seed "
                     "click inside the structure, a sphere or a control mesh");
-      return initialFromLandmarks(in.landmarks);
+      try {
+        return initialFromLandmarks(in.landmarks);
+      } catch (const LandmarkError& error) {
+        throw Error(in.landmarkSource, error.what());
+      }
     case InitialModel::Kind::Sphere:
       return initialSphere(in.init.center, in.init.radius);
     case InitialModel::Kind::Seed: {
@@ -258,7 +262,10 @@ std::string carriedPastSlices(const SegmentResult& result, const SliceEndOptions
   out << std::fixed << std::setprecision(1);
   bool first = true;
   for (const SliceEnd& end : result.sliceEnds.ends) {
-    if (!end.pressed && end.length <= options.gap) continue;
+    // Only ends beyond which something acted: a spring where the march
+    // stopped (SliceEnds.h, step 4) or the pressure (step 5).
+    const bool spring = end.length > options.gap && (!end.stoppedByReach || options.springAtReach);
+    if (!end.pressed && !spring) continue;
     out << (first ? "" : ", ") << end.length << " mm " << (end.side < 0 ? "before the first" : "after the last")
         << (end.stoppedByReach ? " (no end seen)" : "");
     first = false;

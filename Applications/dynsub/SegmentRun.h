@@ -68,10 +68,11 @@ struct SegmentRun {
 // dynsub::Error naming the landmark source when the landmarks cannot be used.
 SegmentRun runSegmentation(const Volume& image, SegmentInputs inputs, const ProgressCallback& progress);
 
-// How far the surface was carried past the outermost clicked slices
-// (SliceEnds.h), e.g. "10.0 mm before the first, 4.5 mm after the last (no
-// end seen)"; empty when it was carried past neither. A user whose clicks
-// reach the structure's ends needs this to know to turn it off.
+// How far the structure's tissue was followed past the outermost clicked
+// slices where a spring or the pressure then acted (SliceEnds.h), e.g. "10.0
+// mm before the first, 4.5 mm after the last (no end seen)"; empty when
+// nothing acted past either. A user whose clicks reach the structure's ends
+// needs this to know to turn it off.
 std::string carriedPastSlices(const SegmentResult& result, const SliceEndOptions& options);
 
 }  // namespace dynsub::app

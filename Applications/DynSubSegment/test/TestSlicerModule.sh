@@ -53,6 +53,20 @@ check "caudate: the ends beyond the points are followed by default" grep -q '"sl
 check "points reaching both ends: exit 0" test $? -eq 0
 check "points reaching both ends: nothing followed beyond them" grep -q '"slice_ends": false' "$work/ends.json"
 
+# The same points less their two outermost slices: the module says how far it
+# followed the tissue past the slices left, and what to check if that is wrong.
+mapfile -t inner < <("$python" -c '
+import json, sys
+points = [p["position"] for p in json.load(open(sys.argv[1]))["markups"][0]["controlPoints"]]
+ys = sorted({round(p[1], 3) for p in points})
+for p in points:
+    if round(p[1], 3) not in (ys[0], ys[-1]): print("--seed"); print("%r,%r,%r" % tuple(p))' \
+  "$DATA/Landmarks/caudate_left.mrk.json")
+"$MODULE" "${inner[@]}" --maxLevel 0 --labelmap "$work/inner.nrrd" "$work/ch2.nrrd" >"$work/inner.out" 2>&1
+check "points short of the ends: exit 0" test $? -eq 0
+check "points short of the ends: says how far it followed the tissue, and what to check" \
+  grep -q "<filter-comment>followed the structure's tissue past .* mm.*Points reach both ends" "$work/inner.out"
+
 "$MODULE" --seed 15.4,-1.5,16.0 --labelmap "$work/inside.nrrd" --report "$work/inside.json" "$work/ch2.nrrd" \
   >"$work/inside.out" 2>&1
 check "one point: exit 0" test $? -eq 0

@@ -113,6 +113,7 @@ mri=/usr/share/mricron/templates
 "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" \
   --reference "$mri/aal.nii.gz" --reference-label 71 --out "$work/caudate" >"$work/stdout" 2>&1
 check "segment succeeds" test $? -eq 0
+cp "$work/stdout" "$work/caudate.out"  # later checks write $work/stdout again
 for name in surface.vtp control_mesh.obj labelmap.nii.gz report.json convergence.csv slices.png surface3d.png \
   convergence.png; do
   check "segment writes $name" test -s "$work/caudate/$name"
@@ -193,7 +194,7 @@ r = json.load(open(sys.argv[1]))
 sys.exit(0 if r['parameters']['end_pressure'] == 0.2 and r['slice_ends']['pressure']['n_per_mm2'] == 0 else 1)" \
   "$work/caudate/report.json"
 check "segment: nothing said of ends followed when the clicks reach them" \
-  bash -c "! grep -q 'past the outermost clicked slices' '$work/stdout'"
+  bash -c "! grep -q 'past the outermost clicked slices' '$work/caudate.out'"
 # The same clicks without their two outermost slices: the surface is carried
 # past the slices left, and stdout says how far, and how to turn it off.
 python3 -c "
@@ -205,12 +206,22 @@ d['markups'][0]['controlPoints'] = [p for p in points if round(p['position'][1],
 json.dump(d, open(sys.argv[2], 'w'))" "$DATA/Landmarks/caudate_left.mrk.json" "$work/inner.mrk.json"
 "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/inner.mrk.json" --max-level 0 --no-figures \
   --out "$work/inner" >"$work/inner.out" 2>&1
-check "segment: says how far it carried the surface past the clicked slices" \
+check "segment: says how far it followed the tissue past the clicked slices" \
   grep -q 'past the outermost clicked slices.*mm.*--slice-ends false' "$work/inner.out"
 "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/inner.mrk.json" --max-level 0 --no-figures \
   --slice-ends false --out "$work/inner_off" >"$work/inner_off.out" 2>&1
 check "segment --slice-ends false: carries nothing past them" \
   bash -c "! grep -q 'past the outermost' '$work/inner_off.out' && grep -q '\"slice_ends\": false' '$work/inner_off/report.json'"
+# Clicks on one slice only: refused, naming the file and what would do.
+python3 -c "
+import json, sys
+d = json.load(open(sys.argv[1]))
+points = d['markups'][0]['controlPoints']
+y = sorted({round(p['position'][1], 3) for p in points})[2]
+d['markups'][0]['controlPoints'] = [p for p in points if round(p['position'][1], 3) == y]
+json.dump(d, open(sys.argv[2], 'w'))" "$DATA/Landmarks/caudate_left.mrk.json" "$work/one_slice.mrk.json"
+expect_error "landmarks on one slice" 1 "one_slice.mrk.json: all [0-9]* landmarks lie on one plane.*two slices" \
+  "$work/s14" "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/one_slice.mrk.json" --no-figures --out "$work/s14"
 expect_error "negative end pressure" 2 "end-pressure" "$work/s13" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --end-pressure -0.1 \
   --out "$work/s13"

@@ -137,7 +137,7 @@ class SegmentationRegion {
 
 // The papers' cube placed inside the landmarks' PCA ellipsoid (`fraction`
 // of its semi-axes, by default half). Throws dynsub::Error for fewer than 4
-// landmarks or flat ones.
+// landmarks or flat ones (LandmarkError for landmarks on one plane).
 ControlMesh initialFromLandmarks(const std::vector<Landmark>& landmarks, double fraction = 0.5);
 
 // Throws dynsub::Error when the initial model lies outside the image or for
