@@ -148,7 +148,8 @@ ControlMesh initialFromLandmarks(const std::vector<Landmark>& landmarks, double 
   if (points.rows() >= 4 && points.allFinite()) {
     const Matrix3X centred = points.rowwise() - points.colwise().mean();
     const Vector3 variances = Eigen::SelfAdjointEigenSolver<Matrix3>(centred.transpose() * centred).eigenvalues();
-    if (variances(2) > 0.0 && variances(0) <= 1e-12 * variances(2))
+    // (Points on a line, or at one point, get checkPointCloud's own words.)
+    if (variances(1) > 1e-12 * variances(2) && variances(0) <= 1e-12 * variances(2))
       throw LandmarkError("all " + std::to_string(points.rows()) +
                           " landmarks lie on one plane, as clicks on a single slice do: a surface needs the "
                           "boundary clicked on at least two slices across the structure, or one click inside it "
