@@ -205,8 +205,9 @@ enum class LevelEnd { Equilibrium, Coarse, StepLimit, Diverged };
 // The papers' time stepping (Integrator.h) from model.start; `points` ends at
 // the last state reached.
 LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& forces, const std::vector<int>& fixed,
-                      const SimulationOptions& options, const AcceptFit& coarseAccept, double timeStep,
-                      const ProgressCallback& progress, Matrix3X& points, LevelSummary& summary) {
+                      const SimulationOptions& options, const AcceptFit& coarseAccept, double& timeStep,
+                      double regrowCeiling, const ProgressCallback& progress, Matrix3X& points,
+                      LevelSummary& summary) {
   IntegratorOptions integratorOptions = options.integrator;
   integratorOptions.timeStep = timeStep;
   // The stabilizing stiffness of the forces at `at` (Integrator.h).
@@ -231,6 +232,8 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
   double lastEnergy = std::numeric_limits<double>::quiet_NaN();
   double firstEnergy = 0.0;
   int rises = 0;
+  int falling = 0;  // steps in a row whose energy fell
+  double energyTwoBefore = std::numeric_limits<double>::quiet_NaN();
   for (int step = 1; step <= options.equilibrium.maxSteps; ++step) {
     double potential = 0.0;
     const Matrix3X force = totalForce(forces, points, potential);
@@ -269,6 +272,20 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
           return LevelEnd::Coarse;
         }
       }
+    }
+    // A halved step grows back once the energy has fallen for a while
+    // (Simulation.h), compared with two steps before: the first-order step
+    // spans two (p(t - dt) to p(t + dt)), and the kinetic energy of odd and
+    // even steps can alternate on the way down.
+    falling = step > 2 && energy < energyTwoBefore ? falling + 1 : 0;
+    energyTwoBefore = lastEnergy;
+    if (options.timeStepRegrowth > 0 && falling >= options.timeStepRegrowth && timeStep < regrowCeiling) {
+      timeStep = std::min(2.0 * timeStep, regrowCeiling);
+      integratorOptions.timeStep = timeStep;
+      integrator = Integrator(model.matrices, stabilizingAt(points), fixed, integratorOptions);
+      falling = 0;
+      window.clear();
+      looseWindow.clear();
     }
     lastEnergy = energy;
     summary.energy = energy;
@@ -424,11 +441,15 @@ Matrix3X runLevel(const LevelModel& model, const std::vector<ForceModel*>& force
                   const SimulationOptions& options, const AcceptFit& coarseAccept, double& timeStep,
                   const ProgressCallback& progress, LevelSummary& summary, LevelEnd& end) {
   Matrix3X points;
+  // The largest step a halved one may grow back to: the step asked for, then
+  // half of any regrown step that diverged.
+  double regrowCeiling = std::max(timeStep, options.integrator.timeStep);
   for (int halvings = 0;; ++halvings) {
     if (halvings > options.maxTimeStepHalvings) {
       throw Error("the simulation diverged at level " + std::to_string(model.level) + " even with time step " +
                   std::to_string(timeStep * 2.0) + " s (try a smaller --time-step or softer forces)");
     }
+    const double startStep = timeStep;
     for (ForceModel* f : forces) f->beginLevel(*model.surface, model.quadrature, model.start);
     summary.steps = 0;
     summary.solverIterations = 0;
@@ -440,7 +461,8 @@ Matrix3X runLevel(const LevelModel& model, const std::vector<ForceModel*>& force
                     " (try --scheme first-order or softer forces)");
       }
     } else {
-      end = runTimeSteps(model, forces, fixed, options, coarseAccept, timeStep, progress, points, summary);
+      end = runTimeSteps(model, forces, fixed, options, coarseAccept, timeStep, regrowCeiling, progress, points,
+                         summary);
     }
     if (end != LevelEnd::Diverged) {
       summary.converged = end == LevelEnd::Equilibrium || end == LevelEnd::Coarse;
@@ -448,7 +470,15 @@ Matrix3X runLevel(const LevelModel& model, const std::vector<ForceModel*>& force
       summary.timeStep = timeStep;
       return points;
     }
-    timeStep *= 0.5;
+    if (timeStep > startStep) {
+      // Diverged at a regrown step: start again where the level started, and
+      // grow no further than below the step that diverged.
+      regrowCeiling = 0.5 * timeStep;
+      timeStep = startStep;
+      --halvings;  // the ceiling halves each time, so this ends
+    } else {
+      timeStep *= 0.5;
+    }
   }
 }
 
@@ -470,6 +500,7 @@ void checkSimulationOptions(const SimulationOptions& o) {
                 std::to_string(o.origin.level) + " (isolation " + std::to_string(o.origin.isolation) + ")");
   }
   if (o.maxTimeStepHalvings < 0) throw Error("time-step halvings must be >= 0");
+  if (o.timeStepRegrowth < 0) throw Error("the time step's regrowth must be >= 0 steps (0: none)");
   if (!(o.elasticityPerLevel > 0.0 && o.elasticityPerLevel <= 1.0)) {
     throw Error("the elasticity factor per level must be in (0, 1], got " + std::to_string(o.elasticityPerLevel));
   }

@@ -101,6 +101,71 @@ TEST(StaticScheme, FixedVerticesStay) {
   EXPECT_GT((result.mesh.points() - cube.points()).cwiseAbs().maxCoeff(), 0.05);
 }
 
+// Springs from each control point to a target, stabilized exactly (their
+// stiffness k I is the integrator's S): the steps are stable at any time step,
+// but a large one moves the points farther than the model's size when the
+// targets lie farther than that, which counts as a divergence (Simulation.h).
+// With `jumpAfter` > 0, the targets move as far again after that many
+// evaluations of a level.
+class PullToTargets final : public ForceModel {
+ public:
+  PullToTargets(Matrix3X targets, double stiffness, int jumpAfter = 0)
+      : targets_(std::move(targets)), k_(stiffness), jumpAfter_(jumpAfter) {}
+  void beginLevel(const LimitSurface&, const SurfaceQuadrature&, const Matrix3X&) override { evaluations_ = 0; }
+  Matrix3X generalizedForce(const Matrix3X& controlPoints, double&) override {
+    const bool jumped = jumpAfter_ > 0 && ++evaluations_ > jumpAfter_;
+    return k_ * ((jumped ? Matrix3X(targets_.rowwise() + kJump) : targets_) - controlPoints);
+  }
+  inline static const Eigen::RowVector3d kJump{10.0, 0.0, 0.0};
+  SparseMatrix stabilizingStiffness(const Matrix3X& controlPoints) override {
+    SparseMatrix s(controlPoints.rows(), controlPoints.rows());
+    s.setIdentity();
+    return k_ * s;
+  }
+
+ private:
+  Matrix3X targets_;
+  double k_;
+  int jumpAfter_, evaluations_ = 0;
+};
+
+// A level that diverged in its first steps grows its halved time step back
+// to the one asked for once the energy falls, and reaches the same
+// equilibrium in fewer steps.
+TEST(TimeSteps, AHalvedStepGrowsBackOnceTheEnergyFalls) {
+  const ControlMesh cube = makeCube98();
+  // Targets 3 model sizes away: the first steps at 4 s jump there at once.
+  const Matrix3X targets = cube.points().rowwise() + PullToTargets::kJump;
+  auto run = [&](int regrowth, int jumpAfter = 0) {
+    PullToTargets pull(targets, 1.0, jumpAfter);
+    SimulationOptions options;
+    options.integrator.timeStep = 4.0;
+    options.equilibrium.maxSteps = 5000;
+    options.timeStepRegrowth = regrowth;
+    return simulate(cube, {&pull}, {}, options);
+  };
+  const SimulationResult halved = run(0), regrown = run(30);
+  ASSERT_TRUE(halved.levels.back().converged);
+  ASSERT_TRUE(regrown.levels.back().converged);
+  EXPECT_LT(halved.levels.back().timeStep, 4.0);   // the first steps diverged at 4 s
+  EXPECT_EQ(regrown.levels.back().timeStep, 4.0);  // and the step grew back
+  EXPECT_LT(regrown.steps, halved.steps);
+  // The same equilibrium K p = f_p, to the rule's tolerance (1e-4 of the
+  // model's size a step, over the steps each took to stop).
+  EXPECT_LT((regrown.mesh.points() - halved.mesh.points()).cwiseAbs().maxCoeff(), 0.05);
+
+  // When the targets jump again after the step has grown back, the level
+  // diverges at the regrown step: it restarts at the step it started with and
+  // grows no more to a step that diverged, so it ends as it does without
+  // regrowth (not with the halvings used up).
+  const SimulationResult jumpHalved = run(0, 60), jumpRegrown = run(30, 60);
+  ASSERT_TRUE(jumpHalved.levels.back().converged);
+  ASSERT_TRUE(jumpRegrown.levels.back().converged);
+  EXPECT_EQ(jumpRegrown.levels.back().timeStep, jumpHalved.levels.back().timeStep);
+  EXPECT_EQ(jumpRegrown.steps, jumpHalved.steps);
+  EXPECT_EQ(jumpRegrown.mesh.points(), jumpHalved.mesh.points());
+}
+
 // parallelFor's workers run the forces' and searches' per-item work; an
 // exception from any item must come back to the caller (a thread's uncaught
 // exception ends the process), after every chunk has ended, and it must be

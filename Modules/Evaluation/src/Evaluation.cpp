@@ -177,6 +177,10 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
           o.simulation.maxLevel = value.get<int>();
           continue;
         }
+        if (name == "time_step_regrowth") {
+          o.simulation.timeStepRegrowth = value.get<int>();
+          continue;
+        }
         if (const auto setting = switches.find(name); setting != switches.end()) {
           *setting->second = value.get<bool>();
           continue;
