@@ -24,7 +24,7 @@ void SimulationArguments::addOptions(CLI::App& command, const SimulationOptions&
                      "Linear solver per step: cholesky (factored once per level), cg, or pcg (incomplete Cholesky)")
       ->default_val(solver)
       ->check(CLI::IsMember({"cholesky", "cg", "pcg"}));
-  command.add_option("--time-step", values.integrator.timeStep, "Time step, s (halved automatically on divergence)")
+  command.add_option("--time-step", values.integrator.timeStep, "Time step, s (halved automatically on divergence, and doubled back once the energy falls)")
       ->default_val(defaults.integrator.timeStep)
       ->check(CLI::PositiveNumber);
   command.add_option("--max-steps", values.equilibrium.maxSteps, "Step limit per level")

@@ -280,6 +280,10 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
     falling = step > 2 && energy < energyTwoBefore ? falling + 1 : 0;
     energyTwoBefore = lastEnergy;
     if (options.timeStepRegrowth > 0 && falling >= options.timeStepRegrowth && timeStep < regrowCeiling) {
+      // NB: the next step takes `previous`, one old step back, for one new
+      // step back; the steps after it correct that, and the equilibrium does
+      // not depend on it. The stabilizer is frozen anew here too (not counted
+      // in stabilizerUpdates, which counts the energy's rises).
       timeStep = std::min(2.0 * timeStep, regrowCeiling);
       integratorOptions.timeStep = timeStep;
       integrator = Integrator(model.matrices, stabilizingAt(points), fixed, integratorOptions);

@@ -111,7 +111,11 @@ class PullToTargets final : public ForceModel {
  public:
   PullToTargets(Matrix3X targets, double stiffness, int jumpAfter = 0)
       : targets_(std::move(targets)), k_(stiffness), jumpAfter_(jumpAfter) {}
-  void beginLevel(const LimitSurface&, const SurfaceQuadrature&, const Matrix3X&) override { evaluations_ = 0; }
+  void beginLevel(const LimitSurface&, const SurfaceQuadrature&, const Matrix3X&) override {
+    // A level restarted this often is a simulation that no longer ends.
+    if (++levels_ > 50) throw std::runtime_error("the level was restarted over 50 times");
+    evaluations_ = 0;
+  }
   Matrix3X generalizedForce(const Matrix3X& controlPoints, double&) override {
     const bool jumped = jumpAfter_ > 0 && ++evaluations_ > jumpAfter_;
     return k_ * ((jumped ? Matrix3X(targets_.rowwise() + kJump) : targets_) - controlPoints);
@@ -126,7 +130,7 @@ class PullToTargets final : public ForceModel {
  private:
   Matrix3X targets_;
   double k_;
-  int jumpAfter_, evaluations_ = 0;
+  int jumpAfter_, evaluations_ = 0, levels_ = 0;
 };
 
 // A level that diverged in its first steps grows its halved time step back
@@ -142,6 +146,9 @@ TEST(TimeSteps, AHalvedStepGrowsBackOnceTheEnergyFalls) {
     options.integrator.timeStep = 4.0;
     options.equilibrium.maxSteps = 5000;
     options.timeStepRegrowth = regrowth;
+    // The two halvings these runs need (4 -> 2 -> 1 s) and no more: a restart
+    // at a regrown step must not count as one.
+    options.maxTimeStepHalvings = 2;
     return simulate(cube, {&pull}, {}, options);
   };
   const SimulationResult halved = run(0), regrown = run(30);
@@ -150,9 +157,10 @@ TEST(TimeSteps, AHalvedStepGrowsBackOnceTheEnergyFalls) {
   EXPECT_LT(halved.levels.back().timeStep, 4.0);   // the first steps diverged at 4 s
   EXPECT_EQ(regrown.levels.back().timeStep, 4.0);  // and the step grew back
   EXPECT_LT(regrown.steps, halved.steps);
-  // The same equilibrium K p = f_p, to the rule's tolerance (1e-4 of the
-  // model's size a step, over the steps each took to stop).
-  EXPECT_LT((regrown.mesh.points() - halved.mesh.points()).cwiseAbs().maxCoeff(), 0.05);
+  // The same equilibrium K p = f_p. Each run stops once steps move the
+  // surface by under 1e-4 of the model's size (3.5 mm), so each may stop some
+  // 1e-3 mm short of it; measured 0.001 mm apart.
+  EXPECT_LT((regrown.mesh.points() - halved.mesh.points()).cwiseAbs().maxCoeff(), 0.01);
 
   // When the targets jump again after the step has grown back, the level
   // diverges at the regrown step: it restarts at the step it started with and

@@ -41,8 +41,8 @@
 // the forces are strongest: once the energy has fallen for
 // `timeStepRegrowth` steps running, a halved step is doubled again (the
 // left-hand matrix refactored), up to the step asked for. A level that then
-// diverges at a regrown step restarts at the step it started with, and no
-// longer grows to the step that diverged.
+// diverges at a regrown step restarts at the step it started with, and grows
+// no more to half of the step that diverged, or beyond.
 // NB: a halved step used to stay halved for the rest of the simulation: on
 // the evaluation's tuning split, two caudates ran their first level's 1000
 // steps at 0.5 s instead of 4 s and ended at the step limit
@@ -99,7 +99,8 @@ struct SimulationOptions {
   int maxTimeStepHalvings = 8;
   // Steps of falling energy after which a halved time step is doubled again
   // (see above; 0: a halved step stays halved). Chosen on the evaluation's
-  // tuning split; only levels that diverged are affected.
+  // tuning split; only simulations in which a level diverged are affected
+  // (a later level starts at the step the last one ended with).
   int timeStepRegrowth = 30;
   int quadraturePoints = 3;  // per direction per element, for distributed forces
   // Build the next level's tables (its limit surface, matrices and
