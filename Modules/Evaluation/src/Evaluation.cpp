@@ -172,13 +172,11 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
       const std::map<std::string, bool*> switches = {{"slice_ends", &o.sliceEnds.enabled},
                                                      {"slice_ends_taper", &o.sliceEnds.taper},
                                                      {"slice_ends_spring_at_reach", &o.sliceEnds.springAtReach}};
+      const std::map<std::string, int*> counts = {{"max_level", &o.simulation.maxLevel},
+                                                  {"time_step_regrowth", &o.simulation.timeStepRegrowth}};
       for (const auto& [name, value] : j.at("segment").items()) {
-        if (name == "max_level") {
-          o.simulation.maxLevel = value.get<int>();
-          continue;
-        }
-        if (name == "time_step_regrowth") {
-          o.simulation.timeStepRegrowth = value.get<int>();
+        if (const auto count = counts.find(name); count != counts.end()) {
+          *count->second = value.get<int>();
           continue;
         }
         if (const auto setting = switches.find(name); setting != switches.end()) {

@@ -10,8 +10,6 @@
 #include <sstream>
 #include <tuple>
 
-#include <Eigen/Eigenvalues>
-
 #include "RobustStatistics.h"
 #include "dynsub/ApplyOperator.h"
 #include "dynsub/ClickAppearance.h"
@@ -140,21 +138,16 @@ void checkSegmentOptions(const SegmentOptions& options) {
 
 ControlMesh initialFromLandmarks(const std::vector<Landmark>& landmarks, double fraction) {
   const Matrix3X points = landmarkPositions(landmarks);
-  // Clicks on one slice are the flat set users give; say what would do
-  // (checkPointCloud's own test of flatness, with the remedy).
+  // Clicks on one slice are the flat set users give; say what would do.
+  // (Points on a line, or at one point, get checkPointCloud's own words.)
   // NB: one slice of clicks with a seed click at their centre was tried: the
   // surface collapsed or leaked (Dice 0.00-0.63 over 15 structures), so such
   // landmarks are refused rather than guessed at.
-  if (points.rows() >= 4 && points.allFinite()) {
-    const Matrix3X centred = points.rowwise() - points.colwise().mean();
-    const Vector3 variances = Eigen::SelfAdjointEigenSolver<Matrix3>(centred.transpose() * centred).eigenvalues();
-    // (Points on a line, or at one point, get checkPointCloud's own words.)
-    if (variances(1) > 1e-12 * variances(2) && variances(0) <= 1e-12 * variances(2))
-      throw LandmarkError("all " + std::to_string(points.rows()) +
-                          " landmarks lie on one plane, as clicks on a single slice do: a surface needs the "
-                          "boundary clicked on at least two slices across the structure, or one click inside it "
-                          "(--init seed:x,y,z)");
-  }
+  if (points.rows() >= 4 && points.allFinite() && spannedDimensions(points) == 2)
+    throw LandmarkError("all " + std::to_string(points.rows()) +
+                        " landmarks lie on one plane, as clicks on a single slice do: a surface needs the boundary "
+                        "clicked on at least two slices across the structure, or one click inside it "
+                        "(--init seed:x,y,z)");
   checkPointCloud(points, "the landmarks");
   return initialModel(points, InitialShape::Sphere, fraction);
 }

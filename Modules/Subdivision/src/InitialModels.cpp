@@ -54,13 +54,21 @@ void checkPointCloud(const Matrix3X& points, const std::string& source) {
   for (Eigen::Index i = 0; i < points.rows(); ++i) {
     if (!points.row(i).allFinite()) throw Error(source, "point " + std::to_string(i + 1) + " is not finite");
   }
-  const Principal p = principalAxes(points);
-  if (!(p.variances(0) > 0.0)) throw Error(source, "all points coincide");
-  // Relative to the largest spread; 1e-12 of the variance is 1e-6 of the size.
-  if (p.variances(2) <= 1e-12 * p.variances(0)) {
-    throw Error(source, p.variances(1) <= 1e-12 * p.variances(0) ? "all points lie on a line"
-                                                                  : "all points lie on a plane");
+  switch (spannedDimensions(points)) {
+    case 0: throw Error(source, "all points coincide");
+    case 1: throw Error(source, "all points lie on a line");
+    case 2: throw Error(source, "all points lie on a plane");
+    default: return;
   }
+}
+
+int spannedDimensions(const Matrix3X& points) {
+  const Principal p = principalAxes(points);
+  if (!(p.variances(0) > 0.0)) return 0;
+  // Relative to the largest spread; 1e-12 of the variance is 1e-6 of the size.
+  if (p.variances(1) <= 1e-12 * p.variances(0)) return 1;
+  if (p.variances(2) <= 1e-12 * p.variances(0)) return 2;
+  return 3;
 }
 
 ControlMesh cubeInEllipsoid(const Vector3& centre, const Matrix3& axes, const Vector3& semiAxes) {

@@ -14,6 +14,10 @@ namespace dynsub {
 // dynsub::Error naming the source.
 void checkPointCloud(const Matrix3X& points, const std::string& source);
 
+// The dimensions finite points span, by checkPointCloud's test: 0 when they
+// all coincide, 1 on a line, 2 on a plane, 3 when they enclose a volume.
+int spannedDimensions(const Matrix3X& points);
+
 // The 98-vertex cube whose limit surface spans `semiAxes` (mm) along the
 // columns of `axes` (orthonormal, right-handed) around `centre`: its
 // control points scaled so that the limit surface's largest coordinate along
