@@ -1,10 +1,12 @@
 // DynSub's segmentation beside ITK's threshold level set, geodesic active
 // contour and deformable simplex mesh, in one run, on the same cropped region
 // of the same MRI from the same landmarks:
-//   build/bin/SegmentationComparison [--dynsub-only] [--rounds N] [IMAGE LABELS LANDMARKS LABEL]
+//   build/bin/SegmentationComparison [--dynsub-only] [--rounds N] [--write-initial MASK]
+//                                    [IMAGE LABELS LANDMARKS LABEL]
 // (--dynsub-only: DynSub's segmentation and refit alone, then its rounds
 // alone, e.g. for profiling; --rounds: the head-to-head below, 7 rounds
-// unless given, 0 for none)
+// unless given, 0 for none; --write-initial: only write the level set's
+// initial mask on DynSub's region of interest, for ItkThresholdLevelSetCommand)
 // (defaults: the demo's left caudate of Colin27 against AAL label 71).
 // DynSub uses the landmarks as springs; the level set cannot, so it starts
 // from DynSub's own initial model (voxelized) and reads its speed image's
@@ -109,6 +111,11 @@ int run(int argc, char** argv) {
     if (rounds < 0 || rounds > 1000) throw Error("--rounds must be in 0..1000, got " + std::string(argv[2]));
     argc -= 2, argv += 2;
   }
+  std::string initialPath;  // --write-initial: write the initial mask and stop
+  if (argc > 2 && std::string(argv[1]) == "--write-initial") {
+    initialPath = argv[2];
+    argc -= 2, argv += 2;
+  }
   const std::string templates = "/usr/share/mricron/templates/";
   const std::string imagePath = argc > 1 ? argv[1] : templates + "ch2.nii.gz";
   const std::string labelsPath = argc > 2 ? argv[2] : templates + "aal.nii.gz";
@@ -137,6 +144,11 @@ int run(int argc, char** argv) {
   const LimitSurface surface(initial);
   const TriangleSurface start = tessellate(surface, initial.points(), 8);
   const Mask initialMask = voxelizeSurface(start.points, start.triangles, region);
+  if (!initialPath.empty()) {
+    writeMask(initialMask, initialPath);
+    std::printf("initial mask on the region written to %s\n", initialPath.c_str());
+    return 0;
+  }
   std::vector<std::array<int, 3>> edgeVoxels;
   for (const Landmark& l : landmarks) {
     const Vector3 index = region.toIndex(l.position);
