@@ -73,6 +73,16 @@ print(json.dumps(p))")" "unknown structure 'nucleus_x'"
 bad bad_protocol "$(python3 -c "
 import json; p = json.load(open('$DATA/Evaluation/ci_plan.json')); p['protocols'][0]['coverage'] = [0.9, 0.2]
 print(json.dumps(p))")" "coverage"
+# Whole numbers are whole: 1.5 slices or a seed of -1 is refused, not read as 1 or 4294967295.
+bad fractional_slices "$(python3 -c "
+import json; p = json.load(open('$DATA/Evaluation/ci_plan.json')); p['protocols'][0]['slices'] = 1.5
+print(json.dumps(p))")" "slices must be a whole number in 0..[0-9]*, got 1.5"
+bad negative_seed "$(python3 -c "
+import json; p = json.load(open('$DATA/Evaluation/ci_plan.json')); p['splits'][0]['seeds'] = [-1]
+print(json.dumps(p))")" "a seed must be a whole number in 0..4294967295, got -1"
+bad fractional_level "$(python3 -c "
+import json; p = json.load(open('$DATA/Evaluation/ci_plan.json')); p['segment'] = {'max_level': 1.5}
+print(json.dumps(p))")" "segment setting max_level must be a whole number"
 bad duplicate_structure "$(python3 -c "
 import json; p = json.load(open('$DATA/Evaluation/ci_plan.json')); p['structures'].append(p['structures'][0])
 print(json.dumps(p))")" "two structures are named 'caudate_left'"

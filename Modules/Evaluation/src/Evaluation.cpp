@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -38,6 +39,20 @@ std::string resolve(const std::string& path, const std::filesystem::path& base) 
 }
 
 // A result keeping less than this fraction of the reference's volume has collapsed.
+// A whole number in the plan. nlohmann's get<int>() would read 1.5 as 1 and
+// get<unsigned>() -1 as 4294967295, silently; 2.0 is taken as 2.
+long long wholeNumber(const nlohmann::json& value, const std::string& what, long long low, long long high) {
+  const double number = value.is_number() ? value.get<double>() : std::numeric_limits<double>::quiet_NaN();
+  if (!(number == std::floor(number) && number >= low && number <= high))
+    throw Error(what + " must be a whole number in " + std::to_string(low) + ".." + std::to_string(high) + ", got " +
+                value.dump());
+  return static_cast<long long>(number);
+}
+int wholeNumber(const nlohmann::json& object, const char* key, int fallback, const std::string& where) {
+  if (!object.contains(key)) return fallback;
+  return static_cast<int>(wholeNumber(object.at(key), where + key, 0, std::numeric_limits<int>::max()));
+}
+
 constexpr double kCollapsedBelowReference = 0.2;
 
 EvaluationRun runOne(const EvaluationPlan& plan, const Volume& image, const Mask& reference,
@@ -111,8 +126,10 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
     for (const auto& i : j.at("images")) plan.images.push_back({i.at("name"), resolve(i.at("path"), base)});
     for (const auto& s : j.at("structures")) {
       const std::string name = s.at("name");
-      plan.structures.push_back({name, s.at("labels").get<std::vector<int>>(),
-                                 axisOf(s.at("orientation"), "structure '" + name + "'")});
+      std::vector<int> labels;
+      for (const auto& label : s.at("labels"))
+        labels.push_back(static_cast<int>(wholeNumber(label, "structure '" + name + "': a label", 0, 1 << 30)));
+      plan.structures.push_back({name, labels, axisOf(s.at("orientation"), "structure '" + name + "'")});
     }
     for (const auto& p : j.at("protocols")) {
       EvaluationProtocol protocol;
@@ -120,8 +137,9 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
       c.name = p.at("name");
       c.seedOnly = p.value("seed_only", false);
       c.seedDepth = p.value("seed_depth", c.seedDepth);
-      c.slices = p.value("slices", c.slices);
-      c.pointsPerSlice = p.value("points_per_slice", c.pointsPerSlice);
+      const std::string where = "protocol '" + c.name + "': ";
+      c.slices = wholeNumber(p, "slices", c.slices, where);
+      c.pointsPerSlice = wholeNumber(p, "points_per_slice", c.pointsPerSlice, where);
       if (p.contains("coverage")) {
         const auto coverage = p.at("coverage").get<std::vector<double>>();
         if (coverage.size() != 2) throw Error(path, "protocol '" + c.name + "': coverage is [low, high]");
@@ -129,7 +147,7 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
         c.coverageHigh = coverage[1];
       }
       c.scatter = p.value("scatter_mm", c.scatter);
-      c.mistakes = p.value("mistakes", c.mistakes);
+      c.mistakes = wholeNumber(p, "mistakes", c.mistakes, where);
       c.mistakeDistance = p.value("mistake_distance_mm", c.mistakeDistance);
       if (p.contains("orientation")) {
         protocol.ownAxis = true;
@@ -176,7 +194,7 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
                                                   {"time_step_regrowth", &o.simulation.timeStepRegrowth}};
       for (const auto& [name, value] : j.at("segment").items()) {
         if (const auto count = counts.find(name); count != counts.end()) {
-          *count->second = value.get<int>();
+          *count->second = static_cast<int>(wholeNumber(value, "segment setting " + name, 0, 1 << 30));
           continue;
         }
         if (const auto setting = switches.find(name); setting != switches.end()) {
@@ -205,7 +223,7 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
                                                        {"stiffness", &o.stiffness}};
       for (const auto& [name, value] : j.at("seed").items()) {
         if (name == "boundary_points") {
-          o.boundaryPoints = value.get<int>();
+          o.boundaryPoints = static_cast<int>(wholeNumber(value, "seed setting boundary_points", 0, 1 << 30));
           continue;
         }
         const auto setting = settings.find(name);
@@ -215,8 +233,10 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
       checkSeedOptions(o);
     }
     for (const auto& s : j.at("splits")) {
-      EvaluationSplit split{s.at("name"), s.value("structures", std::vector<std::string>{}),
-                            s.at("seeds").get<std::vector<unsigned>>()};
+      EvaluationSplit split{s.at("name"), s.value("structures", std::vector<std::string>{}), {}};
+      for (const auto& seed : s.at("seeds"))
+        split.seeds.push_back(static_cast<unsigned>(
+            wholeNumber(seed, "split '" + split.name + "': a seed", 0, std::numeric_limits<unsigned>::max())));
       for (const std::string& name : split.structures) {
         bool known = false;
         for (const auto& structure : plan.structures) known = known || structure.name == name;
