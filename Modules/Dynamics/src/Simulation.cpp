@@ -474,6 +474,7 @@ Matrix3X runLevel(const LevelModel& model, const std::vector<ForceModel*>& force
       summary.timeStep = timeStep;
       return points;
     }
+    ++summary.divergences;
     if (timeStep > startStep) {
       // Diverged at a regrown step: start again where the level started, and
       // grow no further than below the step that diverged.

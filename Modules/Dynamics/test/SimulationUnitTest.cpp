@@ -156,6 +156,9 @@ TEST(TimeSteps, AHalvedStepGrowsBackOnceTheEnergyFalls) {
   ASSERT_TRUE(regrown.levels.back().converged);
   EXPECT_LT(halved.levels.back().timeStep, 4.0);   // the first steps diverged at 4 s
   EXPECT_EQ(regrown.levels.back().timeStep, 4.0);  // and the step grew back
+  // report.json's record of it: the level's restarts, at 4 and at 2 s.
+  EXPECT_EQ(halved.levels.back().divergences, 2);
+  EXPECT_EQ(regrown.levels.back().divergences, 2);
   EXPECT_LT(regrown.steps, halved.steps);
   // The same equilibrium K p = f_p. Each run stops once steps move the
   // surface by under 1e-4 of the model's size (3.5 mm), so each may stop some
@@ -170,6 +173,8 @@ TEST(TimeSteps, AHalvedStepGrowsBackOnceTheEnergyFalls) {
   ASSERT_TRUE(jumpHalved.levels.back().converged);
   ASSERT_TRUE(jumpRegrown.levels.back().converged);
   EXPECT_EQ(jumpRegrown.levels.back().timeStep, jumpHalved.levels.back().timeStep);
+  // One restart more than without regrowth: the divergence at the regrown step.
+  EXPECT_EQ(jumpRegrown.levels.back().divergences, jumpHalved.levels.back().divergences + 1);
   EXPECT_EQ(jumpRegrown.steps, jumpHalved.steps);
   EXPECT_EQ(jumpRegrown.mesh.points(), jumpHalved.mesh.points());
 }

@@ -44,6 +44,7 @@ Report levelReport(const LevelSummary& l, double maxErrorPercent, double rmsErro
   r.set("equilibrium", l.converged);
   r.set("equilibrium_rule", l.coarse ? "coarse" : "full");  // coarse: a refined level, ended at looser tolerances
   r.set("time_step_s", l.timeStep);
+  r.set("divergences", l.divergences);
   r.set("energy", l.energy);
   if (maxErrorPercent >= 0) {
     r.set("max_error_percent", maxErrorPercent);

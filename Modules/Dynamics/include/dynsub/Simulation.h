@@ -119,7 +119,10 @@ struct LevelSummary {
   // The level ended at the looser rule of EquilibriumOptions::coarseLevelFactor
   // (its fit was not accepted there, and it was refined).
   bool coarse = false;
-  double timeStep = 0;
+  double timeStep = 0;  // the step the level ended with
+  // Times the level diverged and started again (with half the step, or at its
+  // starting step after a regrown one diverged); `steps` counts the last start.
+  int divergences = 0;
   double energy = 0;    // N mm, at the end of the level
   double seconds = 0;   // wall time of the level, assembly included
   int solverIterations = 0;
