@@ -163,18 +163,32 @@ int run(int argc, char** argv) {
               dynsub.seconds.crop, dynsub.seconds.potential, dynsub.seconds.evolution, voxelizeSeconds);
   // One timed round of DynSub's segmentation and its labelmap, as the
   // command makes them: its seconds and its labelmap.
+  // Each round's stages too: crop and edge potential, evolution, labelmap.
+  std::vector<double> potentialRounds, evolutionRounds, labelmapRounds;
   auto dynsubRound = [&](std::vector<double>& seconds) {
     const auto started = std::chrono::steady_clock::now();
     const SegmentResult again = segment(image, landmarks, initial, SegmentOptions());
+    const auto evolved = std::chrono::steady_clock::now();
     Mask labelmap = labelmapOf(again.surface, image.geometry);
-    seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+    const auto ended = std::chrono::steady_clock::now();
+    seconds.push_back(std::chrono::duration<double>(ended - started).count());
+    potentialRounds.push_back(again.seconds.crop + again.seconds.potential);
+    evolutionRounds.push_back(again.seconds.evolution);
+    labelmapRounds.push_back(std::chrono::duration<double>(ended - evolved).count());
     return labelmap;
+  };
+  auto printStages = [&] {
+    std::printf("  its stages: crop and edge potential %s; evolution %s; labelmap %s\n",
+                spread(potentialRounds).c_str(), spread(evolutionRounds).c_str(), spread(labelmapRounds).c_str());
   };
   if (dynsubOnly) {
     refitAfterOneLandmark(image, reference, landmarks, initial, dynsub);
     std::vector<double> seconds;
     for (int r = 0; r < rounds; ++r) dynsubRound(seconds);
-    if (rounds > 0) std::printf("dynsub segment alone, %d rounds: %s\n", rounds, spread(seconds).c_str());
+    if (rounds > 0) {
+      std::printf("dynsub segment alone, %d rounds: %s\n", rounds, spread(seconds).c_str());
+      printStages();
+    }
     return 0;
   }
   printRow("initial model (both methods)", compareMasks(pasteMask(initialMask, image.geometry, dynsub.regionFirst),
@@ -270,6 +284,7 @@ int run(int argc, char** argv) {
   }
   std::printf("head to head, %d rounds taking turns:\n", rounds);
   std::printf("  dynsub segment (defaults)          Dice %.3f  %s\n", dynsubDice, spread(dynsubRounds).c_str());
+  printStages();
   std::printf("  ITK threshold LS, 1.0 sd, curv. 3  Dice %.3f  %s\n", itkDice, spread(itkRounds).c_str());
   return 0;
 }
