@@ -64,28 +64,21 @@ bad() {  # bad NAME PLAN-TEXT EXPECTED-MESSAGE
   check "$name: the error names the plan and the problem" grep -q "$name.json.*$expected" "$work/$name.log"
   check "$name: no output" test ! -e "$work/out_$name/runs.csv"
 }
+# edited 'STATEMENT': the CI plan with the Python statement applied to it (as p).
+edited() {
+  python3 -c "import json, sys; p = json.load(open(sys.argv[1])); $1; print(json.dumps(p))" \
+    "$DATA/Evaluation/ci_plan.json"
+}
 bad not_json '{"reference": ' "not valid JSON"
 bad no_splits '{"reference": "x.nii.gz", "images": [], "structures": [], "protocols": [], "splits": []}' \
   "needs images, structures, protocols and splits"
-bad unknown_structure "$(python3 -c "
-import json, sys; p = json.load(open('$DATA/Evaluation/ci_plan.json')); p['splits'][0]['structures'] = ['nucleus_x']
-print(json.dumps(p))")" "unknown structure 'nucleus_x'"
-bad bad_protocol "$(python3 -c "
-import json; p = json.load(open('$DATA/Evaluation/ci_plan.json')); p['protocols'][0]['coverage'] = [0.9, 0.2]
-print(json.dumps(p))")" "coverage"
+bad unknown_structure "$(edited "p['splits'][0]['structures'] = ['nucleus_x']")" "unknown structure 'nucleus_x'"
+bad bad_protocol "$(edited "p['protocols'][0]['coverage'] = [0.9, 0.2]")" "coverage"
 # Whole numbers are whole: 1.5 slices or a seed of -1 is refused, not read as 1 or 4294967295.
-bad fractional_slices "$(python3 -c "
-import json; p = json.load(open('$DATA/Evaluation/ci_plan.json')); p['protocols'][0]['slices'] = 1.5
-print(json.dumps(p))")" "slices must be a whole number in 0..[0-9]*, got 1.5"
-bad negative_seed "$(python3 -c "
-import json; p = json.load(open('$DATA/Evaluation/ci_plan.json')); p['splits'][0]['seeds'] = [-1]
-print(json.dumps(p))")" "a seed must be a whole number in 0..4294967295, got -1"
-bad fractional_level "$(python3 -c "
-import json; p = json.load(open('$DATA/Evaluation/ci_plan.json')); p['segment'] = {'max_level': 1.5}
-print(json.dumps(p))")" "segment setting max_level must be a whole number"
-bad duplicate_structure "$(python3 -c "
-import json; p = json.load(open('$DATA/Evaluation/ci_plan.json')); p['structures'].append(p['structures'][0])
-print(json.dumps(p))")" "two structures are named 'caudate_left'"
+bad fractional_slices "$(edited "p['protocols'][0]['slices'] = 1.5")" "slices must be a whole number in 0..[0-9]*, got 1.5"
+bad negative_seed "$(edited "p['splits'][0]['seeds'] = [-1]")" "a seed must be a whole number in 0..4294967295, got -1"
+bad fractional_level "$(edited "p['segment'] = {'max_level': 1.5}")" "segment setting max_level must be a whole number"
+bad duplicate_structure "$(edited "p['structures'].append(p['structures'][0])")" "two structures are named 'caudate_left'"
 "$DYNSUB" evaluate "$work/missing.json" --out "$work/out_missing" >"$work/missing.log" 2>&1
 check "missing plan: non-zero exit and the file named" grep -q "missing.json" "$work/missing.log"
 
