@@ -14,6 +14,7 @@ set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 build=${1:-$here/build}
 rounds=${2:-9}
+[[ $rounds =~ ^[1-9][0-9]*$ ]] || { echo "usage: $0 [BUILD_DIR [ROUNDS >= 1]]" >&2; exit 2; }
 image=/usr/share/mricron/templates/ch2.nii.gz
 labels=/usr/share/mricron/templates/aal.nii.gz
 landmarks=$here/Data/Landmarks/caudate_left.mrk.json
@@ -46,16 +47,11 @@ a = nibabel.load(sys.argv[1]).get_fdata() > 0
 r = nibabel.load(sys.argv[2]).get_fdata() == 71
 print("%.3f" % (2 * (a & r).sum() / (a.sum() + r.sum())))' "$1" "$labels"
 }
-summary() {  # summary NAME LABELMAP TITLE
-  local times
-  times=$(cut -d' ' -f1 "$work/$1.times" | sort -n)
-  local median low high kb
-  median=$(echo "$times" | sed -n "$(( (rounds + 1) / 2 ))p")
-  low=$(echo "$times" | head -1) high=$(echo "$times" | tail -1)
-  kb=$(cut -d' ' -f2 "$work/$1.times" | sort -n | tail -1)
-  printf "%-34s median %.3f s (%.3f-%.3f), peak %d MB, Dice %s\n" "$3" \
-    "$(echo "$median / 1000000" | bc -l)" "$(echo "$low / 1000000" | bc -l)" "$(echo "$high / 1000000" | bc -l)" \
-    $((kb / 1024)) "$(dice "$2")"
+summary() {  # summary NAME LABELMAP TITLE: the median (the upper middle for even ROUNDS, as
+  # SegmentationComparison's) and range of the times, the peak memory, the Dice.
+  sort -n "$work/$1.times" | awk -v title="$3" -v dice="$(dice "$2")" '{ t[NR] = $1; if ($2 > kb) kb = $2 }
+    END { n = NR; printf "%-34s median %.3f s (%.3f-%.3f), peak %d MB, Dice %s\n", title,
+          t[int(n / 2) + 1] / 1e6, t[1] / 1e6, t[n] / 1e6, kb / 1024, dice }'
 }
 echo "$rounds rounds taking turns:"
 summary dynsub "$work/dynsub/labelmap.nii.gz" "dynsub segment (whole command)"

@@ -13,7 +13,7 @@ Defaults: Colin27 (ch2.nii.gz), AAL (aal.nii.gz) and the brain-extracted
 ch2bet.nii.gz from Debian's mricron-data, and AAL's caudates (71, 72). The
 modes are the histogram peaks of the brain's voxels below 45 (CSF), 45-100
 (grey matter) and above 100 (white matter), ranges that hold for this T1
-image's intensities (0-130). Needs nibabel and numpy (python3-nibabel).
+image's intensities (0-133 in the brain). Needs nibabel and numpy (python3-nibabel).
 """
 import argparse
 
@@ -24,8 +24,9 @@ TEMPLATES = "/usr/share/mricron/templates/"
 
 
 def mode(values, low, high):
-    counts, edges = numpy.histogram(values[(values >= low) & (values < high)], bins=int(high - low), range=(low, high))
-    return 0.5 * (edges[counts.argmax()] + edges[counts.argmax() + 1])
+    """The most frequent intensity in [low, high), to whole units."""
+    units, counts = numpy.unique(numpy.round(values[(values >= low) & (values < high)]), return_counts=True)
+    return units[counts.argmax()]
 
 
 def main():

@@ -8,13 +8,14 @@
 // SegmentationComparison's head to head.) Tools/compare_segment_commands.sh
 // times it against `dynsub segment`, taking turns; SegmentationComparison
 // --write-initial writes the initial mask (DynSub's initial model, voxelized
-// on DynSub's region of interest). Exit code 1 with a message on any error,
-// and no output file then.
+// on DynSub's region of interest). Exit code 2 for a wrong command line, 1
+// with a message on any other error, and no output file then.
 #include <cmath>
 #include <cstdio>
 #include <exception>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <itkImageFileReader.h>
 #include <itkImageFileWriter.h>
@@ -51,6 +52,20 @@ std::vector<Pixel> voxelsOf(const Image* image) {
   return voxels;
 }
 
+// The whole of `text` as a finite number, or an error naming `what`.
+double number(const std::string& text, const char* what) {
+  std::size_t used = 0;
+  double value = 0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || !std::isfinite(value))
+    throw std::runtime_error(std::string(what) + " must be a number, got '" + text + "'");
+  return value;
+}
+
 int run(int argc, char** argv) {
   if (argc != 4 && argc != 6) {
     std::fprintf(stderr, "usage: %s IMAGE INITIAL_MASK OUTPUT [WINDOW CURVATURE]\n", argv[0]);
@@ -59,8 +74,8 @@ int run(int argc, char** argv) {
   const std::string output = argv[3];
   itk::NiftiImageIOFactory::RegisterOneFactory();  // NIfTI alone: see CMakeLists.txt
   itkbaseline::ThresholdLevelSetOptions options;
-  options.window = argc == 6 ? std::stod(argv[4]) : 1.0;
-  options.curvature = argc == 6 ? std::stod(argv[5]) : 3.0;
+  options.window = argc == 6 ? number(argv[4], "WINDOW") : 1.0;
+  options.curvature = argc == 6 ? number(argv[5], "CURVATURE") : 3.0;
 
   const FloatImage::Pointer image = read<FloatImage>(argv[1]);
   const MaskImage::Pointer initial = read<MaskImage>(argv[2]);

@@ -38,21 +38,26 @@ std::string resolve(const std::string& path, const std::filesystem::path& base) 
   return p.is_absolute() ? path : (base / p).lexically_normal().string();
 }
 
-// A result keeping less than this fraction of the reference's volume has collapsed.
-// A whole number in the plan. nlohmann's get<int>() would read 1.5 as 1 and
-// get<unsigned>() -1 as 4294967295, silently; 2.0 is taken as 2.
+// A whole number in the plan, in low..high: what its field can hold (the
+// settings' own checks hold it to their ranges after). nlohmann's get<int>()
+// would read 1.5 as 1 and get<unsigned>() -1 as 4294967295, silently; 2.0 is
+// taken as 2.
 long long wholeNumber(const nlohmann::json& value, const std::string& what, long long low, long long high) {
   const double number = value.is_number() ? value.get<double>() : std::numeric_limits<double>::quiet_NaN();
-  if (!(number == std::floor(number) && number >= low && number <= high))
-    throw Error(what + " must be a whole number in " + std::to_string(low) + ".." + std::to_string(high) + ", got " +
-                value.dump());
+  if (!(number == std::floor(number))) throw Error(what + " must be a whole number, got " + value.dump());
+  if (!(number >= low && number <= high))
+    throw Error(what + " must be in " + std::to_string(low) + ".." + std::to_string(high) + ", got " + value.dump());
   return static_cast<long long>(number);
 }
-int wholeNumber(const nlohmann::json& object, const char* key, int fallback, const std::string& where) {
+// The largest count, level or label a plan may give: beyond any it means, and an int.
+constexpr long long kLargestSetting = 1 << 30;
+// `object`'s `key` as a whole number in 0..kLargestSetting, or `fallback` when it has none.
+int optionalWholeNumber(const nlohmann::json& object, const char* key, int fallback, const std::string& where) {
   if (!object.contains(key)) return fallback;
-  return static_cast<int>(wholeNumber(object.at(key), where + key, 0, std::numeric_limits<int>::max()));
+  return static_cast<int>(wholeNumber(object.at(key), where + key, 0, kLargestSetting));
 }
 
+// A result keeping less than this fraction of the reference's volume has collapsed.
 constexpr double kCollapsedBelowReference = 0.2;
 
 EvaluationRun runOne(const EvaluationPlan& plan, const Volume& image, const Mask& reference,
@@ -128,7 +133,7 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
       const std::string name = s.at("name");
       std::vector<int> labels;
       for (const auto& label : s.at("labels"))
-        labels.push_back(static_cast<int>(wholeNumber(label, "structure '" + name + "': a label", 0, 1 << 30)));
+        labels.push_back(static_cast<int>(wholeNumber(label, "structure '" + name + "': a label", 0, kLargestSetting)));
       plan.structures.push_back({name, labels, axisOf(s.at("orientation"), "structure '" + name + "'")});
     }
     for (const auto& p : j.at("protocols")) {
@@ -138,8 +143,8 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
       c.seedOnly = p.value("seed_only", false);
       c.seedDepth = p.value("seed_depth", c.seedDepth);
       const std::string where = "protocol '" + c.name + "': ";
-      c.slices = wholeNumber(p, "slices", c.slices, where);
-      c.pointsPerSlice = wholeNumber(p, "points_per_slice", c.pointsPerSlice, where);
+      c.slices = optionalWholeNumber(p, "slices", c.slices, where);
+      c.pointsPerSlice = optionalWholeNumber(p, "points_per_slice", c.pointsPerSlice, where);
       if (p.contains("coverage")) {
         const auto coverage = p.at("coverage").get<std::vector<double>>();
         if (coverage.size() != 2) throw Error(path, "protocol '" + c.name + "': coverage is [low, high]");
@@ -147,7 +152,7 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
         c.coverageHigh = coverage[1];
       }
       c.scatter = p.value("scatter_mm", c.scatter);
-      c.mistakes = wholeNumber(p, "mistakes", c.mistakes, where);
+      c.mistakes = optionalWholeNumber(p, "mistakes", c.mistakes, where);
       c.mistakeDistance = p.value("mistake_distance_mm", c.mistakeDistance);
       if (p.contains("orientation")) {
         protocol.ownAxis = true;
@@ -194,7 +199,7 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
                                                   {"time_step_regrowth", &o.simulation.timeStepRegrowth}};
       for (const auto& [name, value] : j.at("segment").items()) {
         if (const auto count = counts.find(name); count != counts.end()) {
-          *count->second = static_cast<int>(wholeNumber(value, "segment setting " + name, 0, 1 << 30));
+          *count->second = static_cast<int>(wholeNumber(value, "segment setting " + name, 0, kLargestSetting));
           continue;
         }
         if (const auto setting = switches.find(name); setting != switches.end()) {
@@ -223,7 +228,7 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
                                                        {"stiffness", &o.stiffness}};
       for (const auto& [name, value] : j.at("seed").items()) {
         if (name == "boundary_points") {
-          o.boundaryPoints = static_cast<int>(wholeNumber(value, "seed setting boundary_points", 0, 1 << 30));
+          o.boundaryPoints = static_cast<int>(wholeNumber(value, "seed setting boundary_points", 0, kLargestSetting));
           continue;
         }
         const auto setting = settings.find(name);
