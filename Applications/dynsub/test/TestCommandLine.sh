@@ -179,6 +179,22 @@ for key in dice jaccard volume_difference_percent mean_surface_distance_mm hd95_
 done
 check "segment's edge thresholds come from the landmarks" \
   grep -q '"edge_reference": "landmarks"' "$work/caudate/report.json"
+# Each level's record agrees with the totals: levels 0..levels in order, the
+# last one's control vertices, the steps summed (equal when no level diverged
+# and started again; the demo never does), finite energies, and residuals in
+# [0, 1] (a ratio of norms).
+check "segment report: the per-level records agree with the totals" python3 -c "
+import json, math, sys
+r = json.load(open(sys.argv[1]))
+levels = r['per_level']
+ok = [l['level'] for l in levels] == list(range(r['levels'] + 1))
+ok = ok and levels[-1]['control_vertices'] == r['control_vertices']
+ok = ok and all(l['divergences'] == 0 for l in levels)
+ok = ok and sum(l['iterations'] for l in levels) == r['iterations']
+ok = ok and all(l['time_step_s'] > 0 and math.isfinite(l['energy']) and 0 <= l['equilibrium_residual'] <= 1
+                and isinstance(l['equilibrium'], bool) and l['equilibrium_rule'] in ('full', 'coarse')
+                for l in levels)
+sys.exit(0 if ok else 1)" "$work/caudate/report.json"
 # --edge-reference image, and no landmarks, use the image's percentile; the
 # thresholds given apply to the reference in use.
 "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:-12,10,12,5 --max-level 0 --edge-high 0.3 --no-figures \
