@@ -257,7 +257,7 @@ void run(Arguments a) {
   const double volume = run.labelmap.count() * image.geometry.spacing.prod();
   std::cout << std::fixed << std::setprecision(1) << "segmented " << volume << " mm^3 with "
             << run.result.mesh.vertexCount() << " control vertices in " << run.seconds << " s\n";
-  const std::string carried = app::carriedPastSlices(run.result, a.segment.sliceEnds);
+  const std::string carried = app::carriedPastSlices(run.result);
   if (!carried.empty())
     std::cout << "<filter-comment>followed the structure's tissue past the outermost slices with points and "
                  "pulled the surface there: "

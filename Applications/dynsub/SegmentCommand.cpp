@@ -113,7 +113,7 @@ void printSummary(const SegmentCommandOptions& o, const SegmentRun& run, const V
   std::cout << std::fixed << std::setprecision(1) << "segmented " << run.labelmap.count() * image.geometry.spacing.prod()
             << " mm^3 with " << result.mesh.vertexCount() << " control vertices (" << result.levels.back().level
             << " refinement(s), " << result.steps << " steps) in " << run.seconds << " s\n";
-  const std::string carried = carriedPastSlices(run.result, o.segment.sliceEnds);
+  const std::string carried = carriedPastSlices(run.result);
   if (!carried.empty())
     std::cout << "followed the structure's tissue past the outermost clicked slices and pulled the surface there: "
               << carried << " (--slice-ends false if your clicks already reach its ends)\n";

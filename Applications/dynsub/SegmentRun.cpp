@@ -257,15 +257,14 @@ SegmentRun runSegmentation(const Volume& image, SegmentInputs in, const Progress
   return run;
 }
 
-std::string carriedPastSlices(const SegmentResult& result, const SliceEndOptions& options) {
+std::string carriedPastSlices(const SegmentResult& result) {
   std::ostringstream out;
   out << std::fixed << std::setprecision(1);
   bool first = true;
   for (const SliceEnd& end : result.sliceEnds.ends) {
     // Only ends beyond which something acted: a spring where the march
     // stopped (SliceEnds.h, step 4) or the pressure (step 5).
-    const bool spring = end.length > options.gap && (!end.stoppedByReach || options.springAtReach);
-    if (!end.pressed && !spring) continue;
+    if (!end.pressed && !end.sprung) continue;
     out << (first ? "" : ", ") << end.length << " mm " << (end.side < 0 ? "before the first" : "after the last")
         << (end.stoppedByReach ? " (no end seen)" : "");
     first = false;

@@ -73,6 +73,6 @@ SegmentRun runSegmentation(const Volume& image, SegmentInputs inputs, const Prog
 // mm before the first, 4.5 mm after the last (no end seen)"; empty when
 // nothing acted past either. A user whose clicks reach the structure's ends
 // needs this to know to turn it off.
-std::string carriedPastSlices(const SegmentResult& result, const SliceEndOptions& options);
+std::string carriedPastSlices(const SegmentResult& result);
 
 }  // namespace dynsub::app

@@ -124,9 +124,10 @@ SliceEnds findSliceEnds(const Volume& image, const std::vector<Landmark>& landma
     end.stoppedByReach = outside < 2 && reached + 2 * step > longest;
     end.length = reached;
     end.end = centre + outward * reached * along;
-    result.ends.push_back(end);
     // Step 4.
-    if (reached > options.gap && (!end.stoppedByReach || options.springAtReach)) {
+    end.sprung = reached > options.gap && (!end.stoppedByReach || options.springAtReach);
+    result.ends.push_back(end);
+    if (end.sprung) {
       const std::string name = outward < 0 ? "slice end (first)" : "slice end (last)";
       result.springs.push_back({name, end.end});
       // Halfway, the end slice's clicks drawn in as an ellipsoid's cross-section narrows.

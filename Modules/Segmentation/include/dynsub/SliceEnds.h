@@ -66,6 +66,7 @@ struct SliceEnd {
   Vector3 end = Vector3::Zero();    // the march's last step inside
   double length = 0;                // mm
   bool stoppedByReach = false;      // the intensity never left the window
+  bool sprung = false;              // step 4 put springs at this end (it went more than `gap`)
   bool pressed = false;             // step 5's pressure acts beyond this end (set by segment())
 };
 
