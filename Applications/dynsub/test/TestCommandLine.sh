@@ -211,15 +211,21 @@ sys.exit(0 if r['parameters']['end_pressure'] == 0.2 and r['slice_ends']['pressu
   "$work/caudate/report.json"
 check "segment: nothing said of ends followed when the clicks reach them" \
   bash -c "! grep -q 'past the outermost clicked slices' '$work/caudate.out'"
-# The same clicks without their two outermost slices: the surface is carried
-# past the slices left, and stdout says how far, and how to turn it off.
-python3 -c "
+# demo_slices 'KEEP' OUT: the demo's clicks on the coronal slices for which
+# the Python expression KEEP holds (of y, the slice's, and ys, all of them
+# sorted), as a .mrk.json file.
+demo_slices() {
+  python3 -c "
 import json, sys
 d = json.load(open(sys.argv[1]))
 points = d['markups'][0]['controlPoints']
 ys = sorted({round(p['position'][1], 3) for p in points})
-d['markups'][0]['controlPoints'] = [p for p in points if round(p['position'][1], 3) not in (ys[0], ys[-1])]
-json.dump(d, open(sys.argv[2], 'w'))" "$DATA/Landmarks/caudate_left.mrk.json" "$work/inner.mrk.json"
+d['markups'][0]['controlPoints'] = [p for p in points if (lambda y: $1)(round(p['position'][1], 3))]
+json.dump(d, open(sys.argv[2], 'w'))" "$DATA/Landmarks/caudate_left.mrk.json" "$2"
+}
+# The same clicks without their two outermost slices: the surface is carried
+# past the slices left, and stdout says how far, and how to turn it off.
+demo_slices "y not in (ys[0], ys[-1])" "$work/inner.mrk.json"
 "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/inner.mrk.json" --max-level 0 --no-figures \
   --out "$work/inner" >"$work/inner.out" 2>&1
 check "segment: says how far it followed the tissue past the clicked slices" \
@@ -229,13 +235,7 @@ check "segment: says how far it followed the tissue past the clicked slices" \
 check "segment --slice-ends false: carries nothing past them" \
   bash -c "! grep -q 'past the outermost' '$work/inner_off.out' && grep -q '\"slice_ends\": false' '$work/inner_off/report.json'"
 # Clicks on one slice only: refused, naming the file and what would do.
-python3 -c "
-import json, sys
-d = json.load(open(sys.argv[1]))
-points = d['markups'][0]['controlPoints']
-y = sorted({round(p['position'][1], 3) for p in points})[2]
-d['markups'][0]['controlPoints'] = [p for p in points if round(p['position'][1], 3) == y]
-json.dump(d, open(sys.argv[2], 'w'))" "$DATA/Landmarks/caudate_left.mrk.json" "$work/one_slice.mrk.json"
+demo_slices "y == ys[2]" "$work/one_slice.mrk.json"
 expect_error "landmarks on one slice" 1 "one_slice.mrk.json: all [0-9]* landmarks lie on one plane.*two slices" \
   "$work/s14" "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/one_slice.mrk.json" --no-figures --out "$work/s14"
 expect_error "negative end pressure" 2 "end-pressure" "$work/s13" \
