@@ -28,15 +28,19 @@ for extension in obj ply stl; do
   "$DYNSUB" limit "$DATA/Meshes/sheet.obj" --samples-per-face 2 --out "$work/sheet.$extension" >/dev/null
   check "limit writes .$extension" test -s "$work/sheet.$extension"
 done
-# VTK's geometry IO, and the thirty libraries it brings, is opened for an OBJ,
-# PLY or STL surface only (the dynamic loader's record of what it opened).
-LD_DEBUG=files LD_DEBUG_OUTPUT="$work/ld-vtp" "$DYNSUB" limit "$DATA/Meshes/sheet.obj" --samples-per-face 2 \
-  --out "$work/sheet.vtp" >/dev/null
-check "limit writing .vtp opens no VTK geometry IO" sh -c "! grep -q 'file=libvtkIOGeometry' $work/ld-vtp.*"
-LD_DEBUG=files LD_DEBUG_OUTPUT="$work/ld-stl" "$DYNSUB" limit "$DATA/Meshes/sheet.obj" --samples-per-face 2 \
-  --out "$work/sheet-again.stl" >/dev/null
-check "limit writing .stl opens DynSub's geometry formats library" \
-  sh -c "grep -q 'file=.*libDynSubGeometryFormats' $work/ld-stl.*"
+# DynSub writes its surfaces itself: no VTK library is opened to write one,
+# in any format. VTK's readers (a library of DynSub's, and VTK's IO behind it)
+# are opened to read a .vtp point cloud (the dynamic loader's record of what
+# it opened).
+for extension in vtp stl; do
+  LD_DEBUG=files LD_DEBUG_OUTPUT="$work/ld-$extension" "$DYNSUB" limit "$DATA/Meshes/sheet.obj" --samples-per-face 2 \
+    --out "$work/sheet-again.$extension" >/dev/null
+  check "limit writing .$extension opens no VTK library" sh -c "! grep -q 'file=libvtk' $work/ld-$extension.*"
+done
+LD_DEBUG=files LD_DEBUG_OUTPUT="$work/ld-fit" "$DYNSUB" fit "$work/torus.vtp" --init torus --max-level 0 \
+  --max-steps 2 --no-figures --out "$work/fit-vtp" >/dev/null 2>&1
+check "fit reading a .vtp cloud opens DynSub's geometry formats library" \
+  sh -c "grep -q 'file=.*libDynSubGeometryFormats' $work/ld-fit.*"
 rm -f "$work"/ld-*
 
 expect_error "missing mesh" 1 "no such file" "$work/a.vtp" "$DYNSUB" limit "$work/none.obj" --out "$work/a.vtp"

@@ -2,9 +2,11 @@
 // figures, the viewer and the sculpting window behind function pointers.
 #include "dynsub/RenderingLibrary.h"
 
+#include "dynsub/Figures.h"
 #include "dynsub/Sculptor.h"
 #include "dynsub/SolidView.h"
 #include "dynsub/TemporaryFileGuard.h"
+#include "dynsub/Viewer.h"
 
 namespace dynsub::rendering {
 namespace {

@@ -1,22 +1,15 @@
 #include "dynsub/LatticeIO.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
 
-#include <vtkCellData.h>
-#include <vtkIdList.h>
-#include <vtkIntArray.h>
-#include <vtkErrorCode.h>
-#include <vtkNew.h>
-#include <vtkPoints.h>
-#include <vtkUnstructuredGrid.h>
-#include <vtkXMLUnstructuredGridWriter.h>
-
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
+#include "dynsub/VtkXmlWriter.h"
 
 namespace dynsub {
 
@@ -135,35 +128,49 @@ void writeText(const Lattice& l, const std::string& path) {
   if (!out) throw Error(path, "writing the file failed");
 }
 
+// Every cell as a VTK_POLYHEDRON (type 42) with its faces, as VTK's writer
+// gives it: the connectivity holds a cell's distinct points in increasing
+// order, the face stream its face count and then each face's size and points,
+// and the offsets (of both) end each cell.
 void writeVtu(const Lattice& l, const std::string& path, const std::string& name) {
-  vtkNew<vtkPoints> points;
-  points->SetDataTypeToDouble();
-  for (int i = 0; i < l.pointCount(); ++i) points->InsertNextPoint(l.points()(i, 0), l.points()(i, 1), l.points()(i, 2));
-  vtkNew<vtkUnstructuredGrid> grid;
-  grid->SetPoints(points);
-  vtkNew<vtkIntArray> boundaryFaces;
-  boundaryFaces->SetName("BoundaryFaces");
-  for (int c = 0; c < l.cellCount(); ++c) {
-    vtkNew<vtkIdList> stream;  // faces: count, then each face's size and points
+  constexpr uint8_t kPolyhedron = 42;
+  std::vector<double> points(3 * static_cast<std::size_t>(l.pointCount()));
+  for (int i = 0; i < l.pointCount(); ++i)
+    for (int a = 0; a < 3; ++a) points[3 * i + a] = l.points()(i, a);
+  std::vector<int64_t> connectivity, offsets, faces, faceOffsets;
+  std::vector<int32_t> boundaryFaces;
+  for (const std::vector<int>& cell : l.cells()) {
+    std::vector<int64_t> corners;
     int boundary = 0;
-    stream->InsertNextId(static_cast<vtkIdType>(l.cells()[c].size()));
-    for (int f : l.cells()[c]) {
+    faces.push_back(static_cast<int64_t>(cell.size()));
+    for (int f : cell) {
       boundary += l.isBoundaryFace(f);
-      stream->InsertNextId(static_cast<vtkIdType>(l.faces()[f].size()));
-      for (int p : l.faces()[f]) stream->InsertNextId(p);
+      faces.push_back(static_cast<int64_t>(l.faces()[f].size()));
+      for (int p : l.faces()[f]) {
+        faces.push_back(p);
+        corners.push_back(p);
+      }
     }
-    grid->InsertNextCell(VTK_POLYHEDRON, stream);
-    boundaryFaces->InsertNextValue(boundary);
+    std::sort(corners.begin(), corners.end());
+    corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+    connectivity.insert(connectivity.end(), corners.begin(), corners.end());
+    offsets.push_back(static_cast<int64_t>(connectivity.size()));
+    faceOffsets.push_back(static_cast<int64_t>(faces.size()));
+    boundaryFaces.push_back(boundary);
   }
-  grid->GetCellData()->AddArray(boundaryFaces);
-  vtkNew<vtkXMLUnstructuredGridWriter> writer;
-  writer->SetFileName(path.c_str());
-  writer->SetInputData(grid);
-  writer->SetDataModeToAppended();
-  // VTK's XML writers can return success on a full disk; the error code tells.
-  if (writer->Write() != 1 || writer->GetErrorCode() != vtkErrorCode::NoError)
-    throw writeFailure(name, std::string("VTK's writer failed (") +
-                                 vtkErrorCode::GetStringFromErrorCode(writer->GetErrorCode()) + ")");
+  vtkxml::Dataset data;
+  data.type = "UnstructuredGrid";
+  data.pieceAttributes = " NumberOfPoints=\"" + std::to_string(l.pointCount()) + "\" NumberOfCells=\"" +
+                         std::to_string(l.cellCount()) + "\"";
+  data.sections.push_back({"PointData", "", {}});
+  data.sections.push_back({"CellData", "", {vtkxml::int32Array("BoundaryFaces", boundaryFaces, true)}});
+  data.sections.push_back({"Points", "", {vtkxml::float64Array("Points", points, 3)}});
+  data.sections.push_back({"Cells",
+                           "",
+                           {vtkxml::int64Array("connectivity", connectivity), vtkxml::int64Array("offsets", offsets),
+                            vtkxml::uint8Array("types", std::vector<uint8_t>(l.cells().size(), kPolyhedron)),
+                            vtkxml::int64Array("faces", faces), vtkxml::int64Array("faceoffsets", faceOffsets)}});
+  vtkxml::writeDataset(data, path, name);
 }
 
 }  // namespace

@@ -7,6 +7,13 @@
 #include <fstream>
 #include <random>
 
+#include <vtkCellData.h>
+#include <vtkDataArray.h>
+#include <vtkIdList.h>
+#include <vtkNew.h>
+#include <vtkUnstructuredGrid.h>
+#include <vtkXMLUnstructuredGridReader.h>
+
 #include "dynsub/Error.h"
 #include "dynsub/LatticeIO.h"
 #include "dynsub/SolidSubdivision.h"
@@ -209,7 +216,37 @@ TEST_F(LatticeFiles, RoundTrip) {
   const std::string vtu = (std::filesystem::temp_directory_path() / "dynsub_solids.vtu").string();
   paths_.push_back(vtu);
   writeLattice(cube4, vtu);
-  EXPECT_GT(std::filesystem::file_size(vtu), 1000u);
+  // VTK reads every cell back as a polyhedron with the lattice's faces, and
+  // each cell's count of boundary faces.
+  vtkNew<vtkXMLUnstructuredGridReader> reader;
+  reader->SetFileName(vtu.c_str());
+  reader->Update();
+  ASSERT_EQ(reader->GetErrorCode(), 0);
+  vtkUnstructuredGrid* grid = reader->GetOutput();
+  ASSERT_EQ(grid->GetNumberOfPoints(), cube4.pointCount());
+  ASSERT_EQ(grid->GetNumberOfCells(), cube4.cellCount());
+  for (int i = 0; i < cube4.pointCount(); ++i) {
+    double p[3];
+    grid->GetPoint(i, p);
+    for (int a = 0; a < 3; ++a) ASSERT_EQ(p[a], cube4.points()(i, a));
+  }
+  vtkDataArray* boundary = grid->GetCellData()->GetArray("BoundaryFaces");
+  ASSERT_NE(boundary, nullptr);
+  vtkNew<vtkIdList> stream;
+  for (int c = 0; c < cube4.cellCount(); ++c) {
+    ASSERT_EQ(grid->GetCellType(c), VTK_POLYHEDRON);
+    grid->GetFaceStream(c, stream);
+    std::vector<int> expected{static_cast<int>(cube4.cells()[c].size())};
+    int boundaryFaces = 0;
+    for (int f : cube4.cells()[c]) {
+      boundaryFaces += cube4.isBoundaryFace(f);
+      expected.push_back(static_cast<int>(cube4.faces()[f].size()));
+      expected.insert(expected.end(), cube4.faces()[f].begin(), cube4.faces()[f].end());
+    }
+    ASSERT_EQ(stream->GetNumberOfIds(), static_cast<vtkIdType>(expected.size()));
+    for (size_t k = 0; k < expected.size(); ++k) ASSERT_EQ(stream->GetId(static_cast<vtkIdType>(k)), expected[k]);
+    EXPECT_EQ(boundary->GetTuple1(c), boundaryFaces);
+  }
 }
 
 TEST_F(LatticeFiles, InvalidLatticesAreNamed) {

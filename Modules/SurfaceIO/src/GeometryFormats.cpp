@@ -1,13 +1,13 @@
-// libDynSubGeometryFormats.so: VTK's OBJ, PLY and STL readers and writers
-// (GeometryFormats.h says why this is a library of its own).
+// libDynSubGeometryFormats.so: VTK's readers of OBJ, PLY, STL and VTK XML
+// polydata (GeometryFormats.h says why this is a library of its own).
 #include "GeometryFormats.h"
 
+#include <vtkNew.h>
 #include <vtkOBJReader.h>
-#include <vtkOBJWriter.h>
 #include <vtkPLYReader.h>
-#include <vtkPLYWriter.h>
+#include <vtkPolyData.h>
 #include <vtkSTLReader.h>
-#include <vtkSTLWriter.h>
+#include <vtkXMLPolyDataReader.h>
 
 namespace dynsub::geometryformats {
 namespace {
@@ -25,19 +25,17 @@ vtkAbstractPolyDataReader* newReader(const std::string& extension, const std::st
   return nullptr;
 }
 
-vtkWriter* newWriter(const std::string& extension, const std::string& path) {
-  if (extension == ".obj") return named(vtkOBJWriter::New(), path);
-  if (extension == ".ply") {
-    vtkPLYWriter* writer = named(vtkPLYWriter::New(), path);
-    writer->SetFileTypeToBinary();
-    return writer;
-  }
-  if (extension == ".stl") {
-    vtkSTLWriter* writer = named(vtkSTLWriter::New(), path);
-    writer->SetFileTypeToBinary();
-    return writer;
-  }
-  return nullptr;
+std::string readXmlPolyDataPoints(const std::string& path, std::vector<double>& xyz) {
+  vtkNew<vtkXMLPolyDataReader> reader;
+  if (!reader->CanReadFile(path.c_str())) return "is not a VTK XML polydata file";
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  if (reader->GetErrorCode() != 0) return "could not be read (truncated or corrupt?)";
+  vtkPolyData* data = reader->GetOutput();
+  if (!data || !data->GetPoints() || data->GetNumberOfPoints() == 0) return "has no points";
+  xyz.resize(3 * static_cast<std::size_t>(data->GetNumberOfPoints()));
+  for (vtkIdType i = 0; i < data->GetNumberOfPoints(); ++i) data->GetPoint(i, xyz.data() + 3 * i);
+  return "";
 }
 
 }  // namespace
@@ -47,6 +45,6 @@ vtkWriter* newWriter(const std::string& extension, const std::string& path) {
 extern "C" __attribute__((visibility("default"))) const dynsub::geometryformats::Functions*
 dynsubGeometryFormatsFunctions() {
   static const dynsub::geometryformats::Functions table{&dynsub::geometryformats::newReader,
-                                                        &dynsub::geometryformats::newWriter};
+                                                        &dynsub::geometryformats::readXmlPolyDataPoints};
   return &table;
 }

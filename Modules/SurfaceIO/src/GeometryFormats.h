@@ -1,15 +1,16 @@
 #pragma once
-// Private to the SurfaceIO module: VTK's readers and writers of OBJ, PLY and
-// STL files, in a library of their own (libDynSubGeometryFormats.so,
-// GeometryFormats.cpp) opened when a program first reads or writes one of
-// those files. VTK's geometry IO brings about thirty libraries with it
-// (image IO, rendering core, codecs), which every command loaded at start,
-// 7-15 ms each time, while most (segment, fit on points, the outputs'
-// .vtp) never use them (Documentation/Performance.md).
+// Private to the SurfaceIO module: VTK's readers of surface and point files
+// (OBJ, PLY, STL and VTK XML polydata), in a library of their own
+// (libDynSubGeometryFormats.so, GeometryFormats.cpp) opened when a program
+// first reads one of those files. VTK's IO brings its core, data model and
+// codecs, and its geometry IO about thirty libraries more (image IO,
+// rendering core), which every command loaded at start while most (segment,
+// fit on points, the outputs, which SurfaceWriter.cpp and VtkXmlWriter.h
+// write themselves) never use them (Documentation/Performance.md).
 #include <string>
+#include <vector>
 
 class vtkAbstractPolyDataReader;
-class vtkWriter;
 
 namespace dynsub::geometryformats {
 
@@ -18,8 +19,10 @@ struct Functions {
   // `extension` (".obj", ".ply" or ".stl"), its file name set; nullptr for
   // another extension.
   vtkAbstractPolyDataReader* (*newReader)(const std::string& extension, const std::string& path);
-  // A new writer of the same formats (PLY and STL binary), its file name set.
-  vtkWriter* (*newWriter)(const std::string& extension, const std::string& path);
+  // Reads the points of the VTK XML polydata file `path` into `xyz` (x, y, z
+  // of each in turn). Returns "" when it could, else what was wrong, for the
+  // caller's error naming the file.
+  std::string (*readXmlPolyDataPoints)(const std::string& path, std::vector<double>& xyz);
 };
 inline constexpr const char* kFunctionsSymbol = "dynsubGeometryFormatsFunctions";
 

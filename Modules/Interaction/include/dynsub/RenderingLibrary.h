@@ -9,9 +9,9 @@
 #include <functional>
 #include <string>
 
-#include "dynsub/Figures.h"
+#include "dynsub/FigureInputs.h"
 #include "dynsub/Sculpting.h"
-#include "dynsub/Viewer.h"
+#include "dynsub/ViewerInput.h"
 
 namespace dynsub::rendering {
 

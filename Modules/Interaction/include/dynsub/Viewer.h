@@ -21,9 +21,8 @@
 
 #include <vtkSmartPointer.h>
 
-#include "dynsub/Landmarks.h"
-#include "dynsub/Segmentation.h"
 #include "dynsub/SlicePlanes.h"
+#include "dynsub/ViewerInput.h"
 
 class vtkPolyData;
 class vtkRenderWindow;
@@ -35,14 +34,6 @@ namespace dynsub {
 class SliceView;
 class ViewerStyle;
 
-struct ViewerInput {
-  Volume image;
-  std::vector<Landmark> landmarks;
-  std::string landmarksPath = "landmarks.mrk.json";  // where s saves and l loads
-  std::string surfacePath;  // optional: a surface file (SurfacePolyData.h) shown until a fit starts
-  SegmentOptions segment;
-  double pullStiffness = 20.0;  // N/mm, the 3D view's pulling spring
-};
 
 class Viewer {
  public:

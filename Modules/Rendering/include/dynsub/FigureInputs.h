@@ -1,0 +1,60 @@
+#pragma once
+// The figures of a result as the commands ask for them (Figures.h draws
+// them), without VTK: the commands reach them through RenderingLibrary.h,
+// and a header of VTK's in a command's sources would load VTK's core at
+// every start (vtkSystemIncludes.h's static objects), figures or not.
+#include <string>
+
+#include "dynsub/ConvergenceHistory.h"
+#include "dynsub/Tessellation.h"
+#include "dynsub/Types.h"
+
+namespace dynsub {
+
+class ControlMesh;
+struct Volume;
+
+// The figures of a result, for callers that hold no VTK object (the commands).
+// Not owned; the surface is `surface`, or else read from `surfaceFile`.
+struct FigureInputs {
+  const TriangleSurface* surface = nullptr;
+  std::string surfaceFile;                   // any file SurfacePolyData.h reads
+  const Volume* image = nullptr;             // optional
+  const ControlMesh* controlMesh = nullptr;  // optional wireframe, 3D figure only
+  Matrix3X landmarks;                        // #landmarks x 3, LPS mm
+  Matrix3X dataPoints;                       // range data, mm
+  const ConvergenceHistory* history = nullptr;  // needed for the convergence figure
+  // Per point of `surface`: its distance to the nearest edge (mm, -1
+  // unknown), to colour it by (FigureScene::edgeDistances); empty: none. A
+  // surface read from `surfaceFile` is coloured by the same array if it has it.
+  Eigen::VectorXd edgeDistances;
+};
+// The paths to write slices.png, surface3d.png and convergence.png to; an
+// empty path is not rendered. Needs a display (figureDisplay). Throws as the
+// figures and writePng do.
+struct FigureFiles {
+  std::string slices, surface3d, convergence;
+};
+void writeFigures(const FigureInputs& inputs, const FigureFiles& files);
+
+// True when an X display can be opened; otherwise `why` says what is missing.
+bool displayAvailable(std::string* why = nullptr);
+
+// For writing figures: the X display, or, when DISPLAY is not set (a cluster
+// node, a batch job), a private virtual X server (Xvfb, 1280x1024x24, no TCP)
+// started for this process on a free display number and stopped when the
+// process ends. False, with `why`, when neither works (no xvfb package).
+// The display is made ready once (prepareFigureDisplay) and the answer kept
+// for the rest of the process.
+bool figureDisplay(std::string* why = nullptr);
+
+// What figureDisplay() needs, made ready on a second thread while the caller
+// goes on: the private X server started when DISPLAY is not set, and the
+// OpenGL driver loaded (for Mesa's software renderer, loading it and LLVM
+// took longer than rendering a figure). Call it once a run knows it will
+// write figures, as early as it can; figureDisplay() then waits for it and
+// answers as it would have. DISPLAY is set by figureDisplay(), on the
+// caller's thread, never by the second one.
+void prepareFigureDisplay();
+
+}  // namespace dynsub
