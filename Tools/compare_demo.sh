@@ -7,7 +7,7 @@
 # The commands are those of `./run demo` (limit, fit, deform, segment, solid
 # sculpt) plus `solid stats` and `render`. Files must be byte-identical; a
 # report.json may differ only in its timings (seconds, stage seconds); a PNG,
-# .vtp or .nii.gz whose bytes differ is compared by its contents (pixels,
+# .vtp, .vtu or .nii.gz whose bytes differ is compared by its contents (pixels,
 # arrays, header fields and voxels) with NEW_BIN_DIR/SameContents when it is
 # there, and named "same contents" when they agree (their compression may
 # differ between builds). Needs an X
@@ -59,7 +59,7 @@ while IFS= read -r file; do
       differ=1
     fi
   elif ! cmp -s "$work/old/$file" "$work/new/$file"; then
-    if [[ $file == *.png || $file == *.vtp || $file == *.nii.gz ]] && [ -x "$new/SameContents" ] &&
+    if [[ $file == *.png || $file == *.vtp || $file == *.vtu || $file == *.nii.gz ]] && [ -x "$new/SameContents" ] &&
       "$new/SameContents" "$work/old/$file" "$work/new/$file" >/dev/null; then
       echo "same contents, other bytes: $file"
     else

@@ -3,7 +3,8 @@
 //   build/bin/SameContents FILE_A FILE_B
 // PNG images are compared pixel by pixel (size, channels, every sample),
 // VTK XML PolyData (.vtp) array by array (points, point, cell and field data,
-// and every cell array), NIfTI-1 files (.nii, .nii.gz, inflated) by their
+// and every cell array), VTK XML unstructured grids (.vtu) likewise (with the
+// cell types and each polyhedron's faces), NIfTI-1 files (.nii, .nii.gz, inflated) by their
 // header's fields as numbers and their voxels byte by byte, any other file
 // byte by byte. Exit code 0 when the same, 1 when not (what differs is
 // printed), 2 when a file cannot be read.
@@ -26,7 +27,10 @@
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
+#include <vtkUnsignedCharArray.h>
+#include <vtkUnstructuredGrid.h>
 #include <vtkXMLPolyDataReader.h>
+#include <vtkXMLUnstructuredGridReader.h>
 
 #include <zlib.h>
 
@@ -132,6 +136,36 @@ bool samePolyData(const std::string& pathA, const std::string& pathB, std::strin
   return true;
 }
 
+bool sameGrid(const std::string& pathA, const std::string& pathB, std::string& why) {
+  const auto a = readWith<vtkXMLUnstructuredGridReader>(pathA), b = readWith<vtkXMLUnstructuredGridReader>(pathB);
+  vtkUnstructuredGrid* x = a->GetOutput();
+  vtkUnstructuredGrid* y = b->GetOutput();
+  if (!x->GetPoints() || !y->GetPoints()) {
+    why = "no points read";
+    return !x->GetPoints() && !y->GetPoints();
+  }
+  if (!sameArray(x->GetPoints()->GetData(), y->GetPoints()->GetData(), why) ||
+      !sameFieldData(x->GetPointData(), y->GetPointData(), "point data", why) ||
+      !sameFieldData(x->GetCellData(), y->GetCellData(), "cell data", why) ||
+      !sameFieldData(x->GetFieldData(), y->GetFieldData(), "field data", why) ||
+      !sameArray(x->GetCellTypesArray(), y->GetCellTypesArray(), why) ||
+      !sameArray(x->GetCells()->GetOffsetsArray(), y->GetCells()->GetOffsetsArray(), why) ||
+      !sameArray(x->GetCells()->GetConnectivityArray(), y->GetCells()->GetConnectivityArray(), why))
+    return false;
+  vtkNew<vtkIdList> facesA, facesB;
+  for (vtkIdType c = 0; c < x->GetNumberOfCells(); ++c) {
+    x->GetFaceStream(c, facesA);
+    y->GetFaceStream(c, facesB);
+    bool same = facesA->GetNumberOfIds() == facesB->GetNumberOfIds();
+    for (vtkIdType k = 0; same && k < facesA->GetNumberOfIds(); ++k) same = facesA->GetId(k) == facesB->GetId(k);
+    if (!same) {
+      why = "cell " + std::to_string(c) + ": the faces differ";
+      return false;
+    }
+  }
+  return true;
+}
+
 bool sameImage(const std::string& pathA, const std::string& pathB, std::string& why) {
   const auto a = readWith<vtkPNGReader>(pathA), b = readWith<vtkPNGReader>(pathB);
   int sizeA[3], sizeB[3];
@@ -213,6 +247,8 @@ int main(int argc, char** argv) {
       same = sameImage(pathA, pathB, why);
     } else if (extension == ".vtp") {
       same = samePolyData(pathA, pathB, why);
+    } else if (extension == ".vtu") {
+      same = sameGrid(pathA, pathB, why);
     } else if (extension == ".nii" || (pathA.size() > 7 && pathA.compare(pathA.size() - 7, 7, ".nii.gz") == 0)) {
       same = sameNifti(pathA, pathB, why);
     } else {
