@@ -110,19 +110,23 @@ vtkSmartPointer<Reader> readWith(const std::string& path) {
   return reader;
 }
 
-bool samePolyData(const std::string& pathA, const std::string& pathB, std::string& why) {
-  const auto a = readWith<vtkXMLPolyDataReader>(pathA), b = readWith<vtkXMLPolyDataReader>(pathB);
-  vtkPolyData* x = a->GetOutput();
-  vtkPolyData* y = b->GetOutput();
+// The same points, and the same point, cell and field data.
+bool samePointsAndData(vtkPointSet* x, vtkPointSet* y, std::string& why) {
   if (!x->GetPoints() || !y->GetPoints()) {
     why = "no points read";
     return !x->GetPoints() && !y->GetPoints();
   }
-  if (!sameArray(x->GetPoints()->GetData(), y->GetPoints()->GetData(), why) ||
-      !sameFieldData(x->GetPointData(), y->GetPointData(), "point data", why) ||
-      !sameFieldData(x->GetCellData(), y->GetCellData(), "cell data", why) ||
-      !sameFieldData(x->GetFieldData(), y->GetFieldData(), "field data", why))
-    return false;
+  return sameArray(x->GetPoints()->GetData(), y->GetPoints()->GetData(), why) &&
+         sameFieldData(x->GetPointData(), y->GetPointData(), "point data", why) &&
+         sameFieldData(x->GetCellData(), y->GetCellData(), "cell data", why) &&
+         sameFieldData(x->GetFieldData(), y->GetFieldData(), "field data", why);
+}
+
+bool samePolyData(const std::string& pathA, const std::string& pathB, std::string& why) {
+  const auto a = readWith<vtkXMLPolyDataReader>(pathA), b = readWith<vtkXMLPolyDataReader>(pathB);
+  vtkPolyData* x = a->GetOutput();
+  vtkPolyData* y = b->GetOutput();
+  if (!samePointsAndData(x, y, why)) return false;
   vtkCellArray* cellsA[] = {x->GetVerts(), x->GetLines(), x->GetPolys(), x->GetStrips()};
   vtkCellArray* cellsB[] = {y->GetVerts(), y->GetLines(), y->GetPolys(), y->GetStrips()};
   const char* kinds[] = {"verts", "lines", "polys", "strips"};
@@ -140,15 +144,7 @@ bool sameGrid(const std::string& pathA, const std::string& pathB, std::string& w
   const auto a = readWith<vtkXMLUnstructuredGridReader>(pathA), b = readWith<vtkXMLUnstructuredGridReader>(pathB);
   vtkUnstructuredGrid* x = a->GetOutput();
   vtkUnstructuredGrid* y = b->GetOutput();
-  if (!x->GetPoints() || !y->GetPoints()) {
-    why = "no points read";
-    return !x->GetPoints() && !y->GetPoints();
-  }
-  if (!sameArray(x->GetPoints()->GetData(), y->GetPoints()->GetData(), why) ||
-      !sameFieldData(x->GetPointData(), y->GetPointData(), "point data", why) ||
-      !sameFieldData(x->GetCellData(), y->GetCellData(), "cell data", why) ||
-      !sameFieldData(x->GetFieldData(), y->GetFieldData(), "field data", why) ||
-      !sameArray(x->GetCellTypesArray(), y->GetCellTypesArray(), why) ||
+  if (!samePointsAndData(x, y, why) || !sameArray(x->GetCellTypesArray(), y->GetCellTypesArray(), why) ||
       !sameArray(x->GetCells()->GetOffsetsArray(), y->GetCells()->GetOffsetsArray(), why) ||
       !sameArray(x->GetCells()->GetConnectivityArray(), y->GetCells()->GetConnectivityArray(), why))
     return false;

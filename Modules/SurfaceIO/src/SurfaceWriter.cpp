@@ -15,6 +15,19 @@ namespace dynsub {
 
 namespace {
 
+// The triangles' point ids and the end of each one's, as Id.
+template <typename Id>
+vtkxml::Section polys(const TriangleSurface& surface,
+                      vtkxml::DataArray (*array)(const std::string&, const std::vector<Id>&, bool)) {
+  const std::size_t triangles = surface.triangles.size();
+  std::vector<Id> connectivity(3 * triangles), offsets(triangles);
+  for (std::size_t t = 0; t < triangles; ++t) {
+    std::copy(surface.triangles[t].begin(), surface.triangles[t].end(), connectivity.begin() + 3 * t);
+    offsets[t] = static_cast<Id>(3 * (t + 1));
+  }
+  return {"Polys", "", {array("connectivity", connectivity, false), array("offsets", offsets, false)}};
+}
+
 // VTK XML polydata as VTK's XML writer gives it (VtkXmlWriter.h), with the
 // arrays SurfacePolyData.h's toPolyData makes, so that a file read back is
 // the polydata the figures draw.
@@ -52,23 +65,9 @@ void writeVtp(const TriangleSurface& surface, const std::string& path, const std
     data.sections.push_back({empty, "", {vtkxml::int64Array("connectivity", {}), vtkxml::int64Array("offsets", {})}});
   // NB: 32-bit point ids where they fit: the connectivity and offsets were
   // half of a fitted surface's bytes as 64-bit ids, all to be compressed and written.
-  if (n < (Eigen::Index{1} << 31) && 3 * triangles < (std::size_t{1} << 31)) {
-    std::vector<int32_t> connectivity(3 * triangles), offsets(triangles);
-    for (std::size_t t = 0; t < triangles; ++t) {
-      std::copy(surface.triangles[t].begin(), surface.triangles[t].end(), connectivity.begin() + 3 * t);
-      offsets[t] = static_cast<int32_t>(3 * (t + 1));
-    }
-    data.sections.push_back(
-        {"Polys", "", {vtkxml::int32Array("connectivity", connectivity), vtkxml::int32Array("offsets", offsets)}});
-  } else {
-    std::vector<int64_t> connectivity(3 * triangles), offsets(triangles);
-    for (std::size_t t = 0; t < triangles; ++t) {
-      std::copy(surface.triangles[t].begin(), surface.triangles[t].end(), connectivity.begin() + 3 * t);
-      offsets[t] = static_cast<int64_t>(3 * (t + 1));
-    }
-    data.sections.push_back(
-        {"Polys", "", {vtkxml::int64Array("connectivity", connectivity), vtkxml::int64Array("offsets", offsets)}});
-  }
+  const bool small = n < (Eigen::Index{1} << 31) && 3 * triangles < (std::size_t{1} << 31);
+  data.sections.push_back(small ? polys<int32_t>(surface, &vtkxml::int32Array)
+                                : polys<int64_t>(surface, &vtkxml::int64Array));
   vtkxml::writeDataset(data, path, name);
 }
 
