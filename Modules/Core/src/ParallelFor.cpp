@@ -4,6 +4,8 @@
 #include <condition_variable>
 #include <mutex>
 
+#include "dynsub/ResidentHeap.h"
+
 namespace dynsub::detail {
 namespace {
 
@@ -19,6 +21,7 @@ struct Helper {
 };
 
 void serve(Helper* helper) {
+  useResidentArena();
   std::unique_lock<std::mutex> lock(helper->mutex);
   for (;;) {
     helper->wake.wait(lock, [helper] { return helper->hasWork; });

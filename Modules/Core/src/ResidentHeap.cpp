@@ -9,6 +9,13 @@
 
 namespace dynsub {
 
+namespace {
+
+// Where the main heap began when useResidentHeap() was called; 0 before.
+std::uintptr_t mainHeapBegin = 0;
+
+}  // namespace
+
 void useResidentHeap() {
   constexpr int kMiB = 1 << 20;
   // 32 MB is the most glibc takes for the threshold of blocks that get their
@@ -23,6 +30,7 @@ void useResidentHeap() {
   // Grow the heap once by 512 MB of address space, then mark it for huge pages.
   const auto top = [] { return reinterpret_cast<std::uintptr_t>(sbrk(0)); };
   const std::uintptr_t before = top();
+  mainHeapBegin = before;
   mallopt(M_TOP_PAD, 512 * kMiB);
   // volatile: a malloc freed unused may otherwise be left out by the compiler.
   void* volatile block = std::malloc(16 * kMiB);
@@ -35,6 +43,29 @@ void useResidentHeap() {
   // The heap did not grow by sbrk (another allocator, or no room): nothing to mark.
   // A kernel without transparent huge pages refuses the advice; 4 kB pages then.
   if (to > from) madvise(reinterpret_cast<void*>(from), to - from, MADV_HUGEPAGE);
+}
+
+void useResidentArena() {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  return;  // the sanitizer's allocator is not glibc's
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
+  return;
+#endif
+#endif
+  if (mainHeapBegin == 0) return;
+  // glibc gives a thread's arena heaps of HEAP_MAX_SIZE, twice the largest
+  // mmap threshold (2 x 32 MB on 64 bits), each aligned to its size: the one
+  // holding a block starts at the block's address rounded down to 64 MB.
+  // With M_TOP_PAD at 64 MB (useResidentHeap) a new heap is made readable and
+  // writable whole, so the advice covers all of it.
+  constexpr std::uintptr_t kArenaHeap = std::uintptr_t{64} << 20;
+  void* volatile probe = std::malloc(1);
+  const auto address = reinterpret_cast<std::uintptr_t>(probe);
+  std::free(probe);
+  const auto top = reinterpret_cast<std::uintptr_t>(sbrk(0));
+  if (address == 0 || (address >= mainHeapBegin && address < top)) return;  // the main heap's own
+  madvise(reinterpret_cast<void*>(address & ~(kArenaHeap - 1)), kArenaHeap, MADV_HUGEPAGE);
 }
 
 }  // namespace dynsub

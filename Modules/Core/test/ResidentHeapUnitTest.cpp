@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -21,6 +22,25 @@ struct HeapMapping {
   std::uintptr_t largest = 0;
   int hugePageEligible = -1;
 };
+
+// Whether the kernel may back the mapping that holds `address` with huge
+// pages (its THPeligible in /proc/self/smaps); -1 when no mapping holds it.
+int hugePageEligibleAt(std::uintptr_t address) {
+  std::ifstream smaps("/proc/self/smaps");
+  std::string line;
+  bool inside = false;
+  while (std::getline(smaps, line)) {
+    std::uintptr_t begin = 0, end = 0;
+    char dash = 0;
+    std::istringstream range(line);
+    if (range >> std::hex >> begin >> dash >> end && dash == '-') {
+      inside = address >= begin && address < end;
+    } else if (inside && line.rfind("THPeligible:", 0) == 0) {
+      return std::stoi(line.substr(12));
+    }
+  }
+  return -1;
+}
 
 HeapMapping heapMapping() {
   HeapMapping heap;
@@ -77,6 +97,29 @@ TEST(ResidentHeap, LargeBlocksComeFromAHeapOfHugePages) {
   if (mode == "madvise" || mode == "always") {
     EXPECT_EQ(heap.hugePageEligible, 1) << "kernel mode " << mode;
   }
+}
+
+// A thread's own arena (glibc maps one per thread that allocates while
+// another holds the main heap) is eligible for huge pages once the thread
+// has called useResidentArena, and not before (the kernel's madvise mode).
+TEST(ResidentHeap, AThreadsArenaGetsHugePages) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer's allocator replaces glibc's";
+#endif
+  if (kernelHugePageMode() != "madvise") GTEST_SKIP() << "the kernel's huge pages are not in madvise mode";
+  dynsub::useResidentHeap();
+  int before = -2, after = -2;
+  std::thread([&] {
+    void* volatile first = std::malloc(1 << 20);
+    before = hugePageEligibleAt(reinterpret_cast<std::uintptr_t>(first));
+    dynsub::useResidentArena();
+    void* volatile second = std::malloc(1 << 20);
+    after = hugePageEligibleAt(reinterpret_cast<std::uintptr_t>(second));
+    std::free(first);
+    std::free(second);
+  }).join();
+  EXPECT_EQ(before, 0) << "the thread's arena was eligible before the advice";
+  EXPECT_EQ(after, 1);
 }
 
 }  // namespace

@@ -8,6 +8,8 @@
 
 #include <Eigen/Core>
 
+#include "dynsub/ResidentHeap.h"
+
 namespace dynsub {
 
 // body(i) for i in [0, count): one contiguous chunk per thread, on at most
@@ -106,7 +108,10 @@ void bothAtOnce(const First& first, const Second& second) {
 // what must stay on it (adding outputs to a set, rendering).
 template <class Background, class Foreground>
 void alongside(const Background& background, const Foreground& foreground) {
-  std::future<void> done = std::async(std::launch::async, [&] { background(); });
+  std::future<void> done = std::async(std::launch::async, [&] {
+    useResidentArena();
+    background();
+  });
   try {
     foreground();
   } catch (...) {

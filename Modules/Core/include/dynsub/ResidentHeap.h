@@ -17,4 +17,16 @@ namespace dynsub {
 // where touched. Other allocators (a sanitizer's) are left alone.
 void useResidentHeap();
 
+// Call first thing on a thread DynSub starts, in a program that called
+// useResidentHeap(): the thread's own arena (a 64 MB region glibc maps for
+// it, kept, since the heap is never trimmed) gets transparent huge pages too.
+// Nothing when the thread allocates from the main heap, when no arena is
+// glibc's (a sanitizer's allocator), or when useResidentHeap() was not called.
+// NB: threads did most of a run's page faults: 60 % of the caudate
+// segmentation's 5 100 (its outputs written alongside, the next level's
+// operators built ahead) and 87 % of the kitten's fit's 14 000, at 12-15 us
+// each here against under 4 us a 4 kB share of a huge page
+// (Documentation/Performance.md, twenty-fourth session).
+void useResidentArena();
+
 }  // namespace dynsub
