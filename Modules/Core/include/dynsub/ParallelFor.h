@@ -83,7 +83,10 @@ void parallelFor(Eigen::Index count, Eigen::Index threadsWorthIt, const Body& bo
     // NB: nothing may leave this loop by an exception while helpers run
     // `run`, which lives on this frame.
     try {
-      workers.emplace_back(run, t);
+      workers.emplace_back([&run, t] {
+        useResidentArena();
+        run(t);
+      });
     } catch (...) {
       run(t);  // no thread to be had (system_error, bad_alloc): this one does the chunk
     }
