@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <cstring>
 #include <limits>
 
 #include "dynsub/AtomicOutput.h"
@@ -22,7 +21,7 @@ constexpr std::size_t kBlockSize = 32768;
 
 template <typename T>
 std::string bytesOf(const std::vector<T>& values) {
-  // NB: this machine's order is VTK's "LittleEndian" (checked at compile time below).
+  // The bytes as they lie in memory: the header's byte_order is "LittleEndian".
   static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "the files are written little-endian as in memory");
   return std::string(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
 }
