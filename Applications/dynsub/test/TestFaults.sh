@@ -92,14 +92,8 @@ mkdir -p "$work/readonly"
 # full_disk NAME KIB FRAGMENT COMMAND... (COMMAND writes into $work/full): on
 # a tmpfs of KIB KiB as root, else under a file size limit of KIB KiB (with
 # SIGXFSZ ignored, a write beyond it fails as on a full disk).
-#   In a sanitizer build (./run sanitize) the run unwinds every allocation
-# fully (fast_unwind_on_malloc=0; ignored by other builds): VTK's XML writer,
-# cut short, leaks its compression header, and only the full stack names that
-# function for Testing/Sanitizers/lsan.supp.
 full_disk() {
   local name=$1 kib=$2 fragment=$3; shift 3
-  local ASAN_OPTIONS="${ASAN_OPTIONS:-}${ASAN_OPTIONS:+:}fast_unwind_on_malloc=0"
-  export ASAN_OPTIONS
   mkdir -p "$work/full"
   if [ "$(id -u)" -eq 0 ] && mount -t tmpfs -o size="${kib}k" tmpfs "$work/full" 2>/dev/null; then
     expect_refusal "$name (a $kib KiB tmpfs)" "$fragment: No space left on device" "$work/full" "$@"

@@ -9,7 +9,7 @@ namespace dynsub::geometryformats {
 const Functions& functions() {
   static const Functions& loaded =
       ownLibraryTable<Functions>(DYNSUB_GEOMETRY_FORMATS_NAME, DYNSUB_GEOMETRY_FORMATS_BUILD_PATH, kFunctionsSymbol,
-                                 "library that reads and writes OBJ, PLY and STL files through VTK");
+                                 "library that reads OBJ, PLY, STL and VTK XML polydata files through VTK");
   return loaded;
 }
 

@@ -138,10 +138,11 @@ std::string plyBytes(const TriangleSurface& surface) {
 
 // Binary STL: an 80-byte header, the triangle count, then each triangle's
 // unit normal (from its corners, as STL readers expect) and corners in floats.
-std::string stlBytes(const TriangleSurface& surface) {
+std::string stlBytes(const TriangleSurface& surface, const std::string& path) {
   std::string bytes = "DynSub binary STL";
   bytes.resize(80, ' ');
-  if (surface.triangles.size() > 0xffffffffu) throw Error("internal: too many triangles for binary STL");
+  if (surface.triangles.size() > 0xffffffffu)
+    throw Error(path, "more triangles than a binary STL file can count (4 294 967 295); nothing written");
   appendBinary(bytes, static_cast<uint32_t>(surface.triangles.size()));
   for (const auto& t : surface.triangles) {
     const Vector3 a = surface.points.row(t[0]).transpose(), b = surface.points.row(t[1]).transpose(),
@@ -182,7 +183,7 @@ void writeTriangleSurface(const TriangleSurface& surface, const std::string& pat
   } else if (extension == ".ply") {
     writeFile(output.temporaryPath(), path, plyBytes(surface));
   } else {
-    writeFile(output.temporaryPath(), path, stlBytes(surface));
+    writeFile(output.temporaryPath(), path, stlBytes(surface, path));
   }
   output.commit();
 }

@@ -12,6 +12,7 @@
 #include <vtkPointData.h>
 #include <vtkDataArray.h>
 #include <vtkFieldData.h>
+#include <vtkIdList.h>
 #include <vtkStringArray.h>
 #include <vtkNew.h>
 #include <vtkOBJReader.h>
@@ -112,18 +113,45 @@ TEST(SurfaceWriter, ObjPlyStlReadBack) {
   const dynsub::TriangleSurface surface = cubeSurface();
   const std::string obj = scratch("cube.obj"), ply = scratch("cube.ply"), stl = scratch("cube.stl");
   for (const std::string& path : {obj, ply, stl}) dynsub::writeTriangleSurface(surface, path);
+  // Each triangle's corners where the surface has them, to float: PLY and
+  // STL hold floats (as VTK's writers give them), and VTK's OBJ reader reads
+  // floats (the OBJ file's numbers read back as the same doubles).
+  auto expectTriangles = [&](vtkPolyData* data, const std::string& what) {
+    ASSERT_EQ(data->GetNumberOfCells(), static_cast<vtkIdType>(surface.triangles.size())) << what;
+    vtkNew<vtkIdList> ids;
+    for (vtkIdType t = 0; t < data->GetNumberOfCells(); ++t) {
+      data->GetCellPoints(t, ids);
+      ASSERT_EQ(ids->GetNumberOfIds(), 3) << what;
+      for (int k = 0; k < 3; ++k) {
+        double p[3];
+        data->GetPoint(ids->GetId(k), p);
+        for (int a = 0; a < 3; ++a) {
+          const double expected = surface.points(surface.triangles[t][k], a);
+          ASSERT_EQ(p[a], static_cast<double>(static_cast<float>(expected)))
+              << what << ", triangle " << t << ", corner " << k;
+        }
+      }
+    }
+  };
   vtkNew<vtkOBJReader> objReader;
   objReader->SetFileName(obj.c_str());
   objReader->Update();
-  EXPECT_EQ(objReader->GetOutput()->GetNumberOfCells(), static_cast<vtkIdType>(surface.triangles.size()));
+  expectTriangles(objReader->GetOutput(), "OBJ");
   vtkNew<vtkPLYReader> plyReader;
   plyReader->SetFileName(ply.c_str());
   plyReader->Update();
   EXPECT_EQ(plyReader->GetOutput()->GetNumberOfPoints(), surface.points.rows());
+  expectTriangles(plyReader->GetOutput(), "PLY");
+  // PLY keeps the points in order, with their normals.
+  vtkDataArray* normals = plyReader->GetOutput()->GetPointData()->GetNormals();
+  ASSERT_NE(normals, nullptr);
+  for (vtkIdType i = 0; i < normals->GetNumberOfTuples(); i += 5)
+    for (int a = 0; a < 3; ++a)
+      EXPECT_EQ(normals->GetComponent(i, a), static_cast<double>(static_cast<float>(surface.normals(i, a))));
   vtkNew<vtkSTLReader> stlReader;
   stlReader->SetFileName(stl.c_str());
   stlReader->Update();
-  EXPECT_EQ(stlReader->GetOutput()->GetNumberOfCells(), static_cast<vtkIdType>(surface.triangles.size()));
+  expectTriangles(stlReader->GetOutput(), "STL");
 }
 
 TEST(SurfaceWriter, BadTargetsLeaveNoFile) {

@@ -3,8 +3,8 @@
 #include <lz4.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <fstream>
 #include <limits>
 
@@ -76,17 +76,20 @@ std::string escaped(const std::string& text) {
   return out;
 }
 
+// 11 significant digits, as VTK gives ranges, whatever the locale.
 std::string number(double value) {
   char text[32];
-  std::snprintf(text, sizeof text, "%.11g", value);
-  return text;
+  const auto written = std::to_chars(text, text + sizeof text, value, std::chars_format::general, 11);
+  return std::string(text, written.ptr);
 }
 
-// The DataArray element for `array`, its data at `offset` in the appended block.
-std::string element(const DataArray& array, std::size_t offset, const std::string& indent) {
+// The DataArray element for `array`, its data at `offset` in the appended
+// block. Field data and strings carry their count (VTK's reader sizes them by
+// it); a piece's arrays take theirs from the piece.
+std::string element(const DataArray& array, std::size_t offset, const std::string& indent, bool fieldData) {
   std::string xml = indent + "<DataArray type=\"" + array.type + "\" Name=\"" + escaped(array.name) + "\"";
   if (array.components != 1) xml += " NumberOfComponents=\"" + std::to_string(array.components) + "\"";
-  if (array.type == "String") xml += " NumberOfTuples=\"" + std::to_string(array.tuples) + "\"";
+  if (fieldData || array.type == "String") xml += " NumberOfTuples=\"" + std::to_string(array.tuples) + "\"";
   xml += " format=\"appended\"";
   if (array.hasRange) xml += " RangeMin=\"" + number(array.rangeMin) + "\" RangeMax=\"" + number(array.rangeMax) + "\"";
   return xml + " offset=\"" + std::to_string(offset) + "\"/>\n";
@@ -142,22 +145,22 @@ DataArray stringArray(const std::string& name, const std::vector<std::string>& s
 
 void writeDataset(const Dataset& data, const std::string& path, const std::string& name) {
   std::string xml = "<?xml version=\"1.0\"?>\n<VTKFile type=\"" + data.type +
-                    "\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt32\" "
+                    "\" version=\"0.1\" byte_order=\"LittleEndian\" header_type=\"UInt32\" "
                     "compressor=\"vtkLZ4DataCompressor\">\n  <" + data.type + ">\n";
   std::string appended;
-  auto add = [&](const DataArray& array, const std::string& indent) {
-    xml += element(array, appended.size(), indent);
+  auto add = [&](const DataArray& array, const std::string& indent, bool fieldData) {
+    xml += element(array, appended.size(), indent, fieldData);
     appended += compressed(array.bytes, name);
   };
   if (!data.fieldData.empty()) {
     xml += "    <FieldData>\n";
-    for (const DataArray& array : data.fieldData) add(array, "      ");
+    for (const DataArray& array : data.fieldData) add(array, "      ", true);
     xml += "    </FieldData>\n";
   }
   xml += "    <Piece" + data.pieceAttributes + ">\n";
   for (const Section& section : data.sections) {
     xml += "      <" + section.tag + section.attributes + ">\n";
-    for (const DataArray& array : section.arrays) add(array, "        ");
+    for (const DataArray& array : section.arrays) add(array, "        ", false);
     xml += "      </" + section.tag + ">\n";
   }
   xml += "    </Piece>\n  </" + data.type + ">\n  <AppendedData encoding=\"raw\">\n   _";

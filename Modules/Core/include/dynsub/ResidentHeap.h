@@ -12,21 +12,25 @@ namespace dynsub {
 // to 32 MB in the heap, never trims it below 1 GB, grows it 64 MB at a time
 // and asks for transparent huge pages on what it has grown (the kernel's
 // "madvise" mode, this machine's; "always" needs no asking, "never" refuses).
-// That is the main heap; threads' arenas keep glibc's 4 kB pages
-// (ResidentHeap.cpp says why). Address space is reserved, memory is only used
-// where touched. Other allocators (a sanitizer's) are left alone.
+// That is the main heap; threads keep arenas of their own (ResidentHeap.cpp
+// says why), which useResidentArena gives huge pages. Address space is
+// reserved, memory is only used where touched. Other allocators (a
+// sanitizer's) are left alone.
 void useResidentHeap();
 
 // Call first thing on a thread DynSub starts, in a program that called
-// useResidentHeap(): the thread's own arena (a 64 MB region glibc maps for
-// it, kept, since the heap is never trimmed) gets transparent huge pages too.
-// Nothing when the thread allocates from the main heap, when no arena is
-// glibc's (a sanitizer's allocator), or when useResidentHeap() was not called.
+// useResidentHeap(): the first heap of the thread's own arena (a 64 MB region
+// glibc maps for it, kept, since heaps are never trimmed; an arena that
+// outgrows it gets more, which stay in 4 kB pages) gets transparent huge
+// pages too. Nothing when the thread allocates from the main heap, in a
+// sanitizer build, or when useResidentHeap() was not called. Assumes glibc's
+// malloc (as useResidentHeap does): an allocator put in with LD_PRELOAD is
+// not supported. Never throws.
 // NB: threads did most of a run's page faults: 60 % of the caudate
 // segmentation's 5 100 (its outputs written alongside, the next level's
 // operators built ahead) and 87 % of the kitten's fit's 14 000, at 12-15 us
 // each here against under 4 us a 4 kB share of a huge page
 // (Documentation/Performance.md, twenty-fourth session).
-void useResidentArena();
+void useResidentArena() noexcept;
 
 }  // namespace dynsub
