@@ -12,6 +12,9 @@
 
 // The main heap (sbrk's) lies between the end of the program's data, which
 // the linker marks `end`, and the break.
+// NB: in a shared library (DynSub's drawing library carries its own copy of
+// this module) `end` is the library's own; there useResidentHeap is never
+// called, so useResidentArena does nothing.
 extern "C" char end;
 
 namespace dynsub {
