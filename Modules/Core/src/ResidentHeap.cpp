@@ -42,24 +42,13 @@ void useResidentHeap() {
   const std::uintptr_t before = top();
   residentHeapUsed = true;
   mallopt(M_TOP_PAD, 512 * kMiB);
-  // NB: glibc keeps a record at the start of the heap's free top. Growing
-  // the heap by a large block wrote it inside the range about to get huge
-  // pages, and a 2 MB range whose page table exists (a 4 kB page was once in
-  // it) faults 4 kB at a time for good: the caudate's compressed image was
-  // read into such a range in 387 faults. So the free top is first taken
-  // (`filler`), and the heap is grown by a small block: the record lands a
-  // few kB above the old break, and the huge pages start past it.
   // volatile: a malloc freed unused may otherwise be left out by the compiler.
-  const std::size_t freeTop = mallinfo2().keepcost;
-  void* volatile filler = freeTop > 8192 ? std::malloc(freeTop - 4096) : nullptr;
-  void* volatile block = std::malloc(8192);
-  const std::uintptr_t record = reinterpret_cast<std::uintptr_t>(block) + 8192;
+  void* volatile block = std::malloc(16 * kMiB);
   std::free(block);
-  std::free(filler);
   mallopt(M_TOP_PAD, 64 * kMiB);
   const std::uintptr_t after = top();
   constexpr std::uintptr_t kHugePage = 2 * kMiB;
-  const std::uintptr_t from = (std::max(before, record + 4096) + kHugePage - 1) & ~(kHugePage - 1);
+  const std::uintptr_t from = (before + kHugePage - 1) & ~(kHugePage - 1);
   const std::uintptr_t to = after & ~(kHugePage - 1);
   // The heap did not grow by sbrk (another allocator, or no room): nothing to mark.
   // A kernel without transparent huge pages refuses the advice; 4 kB pages then.
