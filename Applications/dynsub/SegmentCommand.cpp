@@ -19,7 +19,6 @@
 #include "dynsub/Metrics.h"
 #include "dynsub/ModelOutputs.h"
 #include "dynsub/ParallelFor.h"
-#include "dynsub/ResidentHeap.h"
 #include "dynsub/SeedGrowth.h"
 #include "dynsub/Segmentation.h"
 #include "dynsub/SurfaceWriter.h"
@@ -142,10 +141,7 @@ void runSegment(const SegmentCommandOptions& o) {
   std::shared_future<Mask> reference;
   if (!o.reference.empty()) {
     requireExisting(o.reference);  // before the segmentation; its other errors come with its reading
-    reference = std::async(std::launch::async, [&o, &image] {
-                  useResidentArena();
-                  return readReference(o, image);
-                }).share();
+    reference = onOwnThread([&o, &image] { return readReference(o, image); }).share();
     inputs.reference = [reference]() -> const Mask& { return reference.get(); };
     inputs.referencePath = o.reference;
     inputs.referenceLabels = o.referenceLabels;

@@ -56,14 +56,7 @@ void useResidentHeap() {
 }
 
 void useResidentArena() noexcept {
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-  return;  // the sanitizer's allocator is not glibc's
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
-  return;
-#endif
-#endif
-  if (!residentHeapUsed) return;
+  if (!kGlibcMalloc || !residentHeapUsed) return;
   // glibc gives a thread's arena heaps of HEAP_MAX_SIZE, twice the largest
   // mmap threshold (2 x 32 MB on 64 bits), each aligned to its size: the one
   // holding a block starts at the block's address rounded down to 64 MB.

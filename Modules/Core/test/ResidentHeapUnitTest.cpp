@@ -103,13 +103,7 @@ TEST(ResidentHeap, LargeBlocksComeFromAHeapOfHugePages) {
 // another holds the main heap) is eligible for huge pages once the thread
 // has called useResidentArena, and not before (the kernel's madvise mode).
 TEST(ResidentHeap, AThreadsArenaGetsHugePages) {
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-  GTEST_SKIP() << "the sanitizer's allocator replaces glibc's";
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
-  GTEST_SKIP() << "the sanitizer's allocator replaces glibc's";
-#endif
-#endif
+  if (!dynsub::kGlibcMalloc) GTEST_SKIP() << "the sanitizer's allocator replaces glibc's";
   if (kernelHugePageMode() != "madvise") GTEST_SKIP() << "the kernel's huge pages are not in madvise mode";
   dynsub::useResidentHeap();
   int before = -2, after = -2;

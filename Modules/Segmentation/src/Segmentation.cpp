@@ -18,7 +18,7 @@
 #include "dynsub/Error.h"
 #include "dynsub/Forces.h"
 #include "dynsub/InitialModels.h"
-#include "dynsub/ResidentHeap.h"
+#include "dynsub/ParallelFor.h"
 #include "dynsub/Tessellation.h"
 
 namespace dynsub {
@@ -281,8 +281,7 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
   std::optional<EndPressure> pressure = endPressure(region, landmarks, options.sliceEnds, ends);
   // NB: the initial model's volume (for the collapse check) is measured on
   // the second core while the evolution runs on one.
-  std::future<double> initialVolume = std::async(std::launch::async, [&initial] {
-    useResidentArena();
+  std::future<double> initialVolume = onOwnThread([&initial] {
     const LimitSurface limit(initial);
     return enclosedVolume(tessellate(limit, initial.points(), outputSegments(limit)));
   });

@@ -105,16 +105,24 @@ void bothAtOnce(const First& first, const Second& second) {
   parallelFor(2, 2, [&](Eigen::Index half) { half == 0 ? first() : second(); });
 }
 
+// work() on a thread of its own, its result in the future (as
+// std::async(std::launch::async, work) gives it), the thread's memory on
+// huge pages (useResidentArena): for work begun here and waited for later.
+template <class Work>
+auto onOwnThread(Work work) {
+  return std::async(std::launch::async, [work = std::move(work)]() mutable {
+    useResidentArena();
+    return work();
+  });
+}
+
 // background() on a second thread while foreground() runs on this one; an
 // exception from background() is rethrown before one from foreground(), as
 // when it ran first. For output written meanwhile, where this thread keeps
 // what must stay on it (adding outputs to a set, rendering).
 template <class Background, class Foreground>
 void alongside(const Background& background, const Foreground& foreground) {
-  std::future<void> done = std::async(std::launch::async, [&] {
-    useResidentArena();
-    background();
-  });
+  std::future<void> done = onOwnThread([&] { background(); });
   try {
     foreground();
   } catch (...) {

@@ -8,6 +8,20 @@
 
 namespace dynsub {
 
+// Whether malloc is glibc's, whose heap and arenas these functions shape: not
+// in a build with a sanitizer, whose allocator replaces it.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+inline constexpr bool kGlibcMalloc = false;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
+inline constexpr bool kGlibcMalloc = false;
+#else
+inline constexpr bool kGlibcMalloc = true;
+#endif
+#else
+inline constexpr bool kGlibcMalloc = true;
+#endif
+
 // Call once, first thing in main(), before any thread exists: keeps blocks up
 // to 32 MB in the heap, never trims it below 1 GB, grows it 64 MB at a time
 // and asks for transparent huge pages on what it has grown (the kernel's
