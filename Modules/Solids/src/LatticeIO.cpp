@@ -134,9 +134,6 @@ void writeText(const Lattice& l, const std::string& path) {
 // and the offsets (of both) end each cell.
 void writeVtu(const Lattice& l, const std::string& path, const std::string& name) {
   constexpr uint8_t kPolyhedron = 42;
-  std::vector<double> points(3 * static_cast<std::size_t>(l.pointCount()));
-  for (int i = 0; i < l.pointCount(); ++i)
-    for (int a = 0; a < 3; ++a) points[3 * i + a] = l.points()(i, a);
   std::vector<int64_t> connectivity, offsets, faces, faceOffsets;
   std::vector<int32_t> boundaryFaces;
   for (const std::vector<int>& cell : l.cells()) {
@@ -164,7 +161,7 @@ void writeVtu(const Lattice& l, const std::string& path, const std::string& name
                          std::to_string(l.cellCount()) + "\"";
   data.sections.push_back({"PointData", "", {}});
   data.sections.push_back({"CellData", "", {vtkxml::int32Array("BoundaryFaces", boundaryFaces, true)}});
-  data.sections.push_back({"Points", "", {vtkxml::float64Array("Points", points, 3)}});
+  data.sections.push_back({"Points", "", {vtkxml::float64Array("Points", l.points())}});
   data.sections.push_back({"Cells",
                            "",
                            {vtkxml::int64Array("connectivity", connectivity), vtkxml::int64Array("offsets", offsets),

@@ -35,13 +35,6 @@ void writeVtp(const TriangleSurface& surface, const std::string& path, const std
               const std::vector<PointScalars>& scalars, const std::string& space) {
   const Eigen::Index n = surface.points.rows();
   const std::size_t triangles = surface.triangles.size();
-  std::vector<double> points(3 * static_cast<std::size_t>(n)), normals(3 * static_cast<std::size_t>(n));
-  for (Eigen::Index i = 0; i < n; ++i) {
-    for (int a = 0; a < 3; ++a) {
-      points[3 * i + a] = surface.points(i, a);
-      normals[3 * i + a] = surface.normals(i, a);
-    }
-  }
   std::vector<uint8_t> type(triangles);
   std::vector<int32_t> element(triangles);
   for (std::size_t t = 0; t < triangles; ++t) {
@@ -54,13 +47,12 @@ void writeVtp(const TriangleSurface& surface, const std::string& path, const std
   data.pieceAttributes = " NumberOfPoints=\"" + std::to_string(n) +
                          "\" NumberOfVerts=\"0\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"" +
                          std::to_string(triangles) + "\"";
-  vtkxml::Section pointData{"PointData", " Normals=\"Normals\"", {vtkxml::float64Array("Normals", normals, 3)}};
-  for (const PointScalars& s : scalars)
-    pointData.arrays.push_back(vtkxml::float64Array(s.name, std::vector<double>(s.values.begin(), s.values.end())));
+  vtkxml::Section pointData{"PointData", " Normals=\"Normals\"", {vtkxml::float64Array("Normals", surface.normals)}};
+  for (const PointScalars& s : scalars) pointData.arrays.push_back(vtkxml::float64Array(s.name, s.values));
   data.sections.push_back(std::move(pointData));
   data.sections.push_back(
       {"CellData", "", {vtkxml::uint8Array("ElementType", type, true), vtkxml::int32Array("Element", element, true)}});
-  data.sections.push_back({"Points", "", {vtkxml::float64Array("Points", points, 3)}});
+  data.sections.push_back({"Points", "", {vtkxml::float64Array("Points", surface.points)}});
   for (const char* empty : {"Verts", "Lines", "Strips"})
     data.sections.push_back({empty, "", {vtkxml::int64Array("connectivity", {}), vtkxml::int64Array("offsets", {})}});
   // NB: 32-bit point ids where they fit: the connectivity and offsets were

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <charconv>
-#include <cmath>
 #include <fstream>
 #include <limits>
 
@@ -97,28 +96,29 @@ std::string element(const DataArray& array, std::size_t offset, const std::strin
 
 }  // namespace
 
+DataArray float64Array(const std::string& name, const Eigen::Ref<const Eigen::MatrixXd>& rows) {
+  const auto components = static_cast<int>(rows.cols());
+  if (components < 1) throw Error("internal: a VTK array's tuples have no values");
+  DataArray array{name, "Float64", components, std::string(sizeof(double) * rows.size(), '\0'),
+                  static_cast<int64_t>(rows.rows())};
+  // The tuples one after the other, as VTK reads them.
+  Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+      reinterpret_cast<double*>(array.bytes.data()), rows.rows(), rows.cols()) = rows;
+  if (array.tuples > 0) {
+    // VTK's range of a vector array is that of its magnitudes.
+    const Eigen::VectorXd values = components > 1 ? Eigen::VectorXd(rows.rowwise().norm()) : Eigen::VectorXd(rows.col(0));
+    array.hasRange = true;
+    array.rangeMin = values.minCoeff();
+    array.rangeMax = values.maxCoeff();
+  }
+  return array;
+}
+
 DataArray float64Array(const std::string& name, const std::vector<double>& values, int components) {
   if (components < 1 || values.size() % static_cast<std::size_t>(components) != 0)
     throw Error("internal: a VTK array's values do not fill its tuples");
-  DataArray array{name, "Float64", components, bytesOf(values),
-                  static_cast<int64_t>(values.size() / static_cast<std::size_t>(components))};
-  if (array.tuples > 0) {
-    array.hasRange = true;
-    array.rangeMin = std::numeric_limits<double>::infinity();
-    array.rangeMax = -std::numeric_limits<double>::infinity();
-    for (int64_t t = 0; t < array.tuples; ++t) {
-      const double* tuple = values.data() + t * components;
-      double value = tuple[0];
-      if (components > 1) {  // VTK's range of a vector array is that of its magnitudes
-        double squared = 0.0;
-        for (int c = 0; c < components; ++c) squared += tuple[c] * tuple[c];
-        value = std::sqrt(squared);
-      }
-      array.rangeMin = std::min(array.rangeMin, value);
-      array.rangeMax = std::max(array.rangeMax, value);
-    }
-  }
-  return array;
+  return float64Array(name, Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+                                values.data(), static_cast<Eigen::Index>(values.size()) / components, components));
 }
 
 DataArray int64Array(const std::string& name, const std::vector<int64_t>& values, bool withRange) {

@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 namespace dynsub::vtkxml {
 
 // One DataArray: its values' bytes as VTK reads them, in VTK's type names.
@@ -29,6 +31,8 @@ struct DataArray {
 };
 
 DataArray float64Array(const std::string& name, const std::vector<double>& values, int components = 1);
+// A tuple per row of `rows` (x, y, z of a point; one value of a vector).
+DataArray float64Array(const std::string& name, const Eigen::Ref<const Eigen::MatrixXd>& rows);
 DataArray int64Array(const std::string& name, const std::vector<int64_t>& values, bool withRange = false);
 DataArray int32Array(const std::string& name, const std::vector<int32_t>& values, bool withRange = false);
 DataArray uint8Array(const std::string& name, const std::vector<uint8_t>& values, bool withRange = false);
