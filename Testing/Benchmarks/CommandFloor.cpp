@@ -1,6 +1,6 @@
 // What a segmentation command pays besides segmenting, each part timed alone
-// in one process (the issue-16 bar compares the whole `dynsub segment` with
-// ITK's filter alone, which pays none of them):
+// in one process (ITK's filter alone, which the whole `dynsub segment` is
+// compared with, pays none of them):
 //   build/bin/CommandFloor IMAGE.nii.gz LABELMAP.nii.gz
 // prints, in ms: opening CHOLMOD's chain of libraries (as every simulating
 // command links it), opening DynSub's ITK bridge (ITK's IO and filters, as

@@ -21,8 +21,8 @@
 // demo's landmark slices.
 // Last, head to head: DynSub's segmentation and ITK's fastest run above (the
 // threshold level set, window mean +- 1 sd, curvature 3) taking turns for N
-// rounds, each one's median and range, because one run each on this virtual
-// machine varies by half its time.
+// rounds, each one's median and range, because one run each on a shared
+// virtual machine can vary by half its time.
 #include <sys/resource.h>
 
 #include <algorithm>

@@ -4,8 +4,9 @@
 // every case: extraordinary vertices of valence 3-8 inside and on boundaries,
 // triangles and n-gons in the input, corners, genus 0 and 1.
 //
-// Tolerance: 1e-6 of the control mesh's bounding-box diagonal, the bar
-// (OpenSubdiv's own regression tests use 1e-6 against its legacy code).
+// Tolerance: 1e-6 of the control mesh's bounding-box diagonal, the accuracy
+// required of DynSub (OpenSubdiv's own regression tests use 1e-6 against its
+// legacy code).
 //
 // Differences explained, not hidden:
 //  - Within 2^-9 (in parameters) of a Ptex corner, but not at it, OpenSubdiv
@@ -162,7 +163,7 @@ INSTANTIATE_TEST_SUITE_P(AllMeshes, OracleTest, ::testing::ValuesIn(dynsub::test
 // need their deepest tabulated levels (it agrees like valence 3-8, 3e-16),
 // and boundary vertices of 12 and 50 faces, whose cross-boundary tangent
 // comes from the eigenstructure of the local subdivision (LimitSurface.cpp;
-// read from level 48 instead, the normal there was off by 2e-2 and 1.5 rad).
+// a reading at level 48 puts the normal there off by 2e-2 and 1.5 rad).
 INSTANTIATE_TEST_SUITE_P(Valence50, OracleTest,
                          ::testing::Values(dynsub::testing::NamedMesh{"fan50", dynsub::testing::makeFan(50, true)},
                                            dynsub::testing::NamedMesh{"openfan12", dynsub::testing::makeFan(12, false)},

@@ -50,8 +50,8 @@ struct ClosestPointLocator::Impl {
   Matrix3X controlPoints;
   // specialOperator * controlPoints.
   // NB: computed at every update: the checks for a nearer sample read the
-  // special elements' samples many times over (tens of millions of sparse
-  // rows on the kitten, 7 % of its fit).
+  // special elements' samples many times over, and a sparse row each time
+  // would cost far more.
   Matrix3X specialSamples;
   // The surface at controlPoints: the normal elements' grids (its
   // patchOperator times them) and the special elements' pieces.
@@ -77,9 +77,9 @@ struct ClosestPointLocator::Impl {
       }
     }
     // NB: 64 samples a leaf, not nanoflann's usual 10-16: the tree is rebuilt
-    // at most evaluations of a fit (the kitten's 111 000 samples: 56 of 62),
-    // and its queries are few per rebuild; its build took 9.5 ms at 16, 7 ms
-    // at 64, and the searches no longer.
+    // at most evaluations of a fit and queried only a few times per rebuild,
+    // so its build time counts most; larger leaves build faster and do not
+    // slow these searches.
     tree = std::make_unique<Tree>(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(64));
     treeControlPoints = controlPoints;
     drift = 0.0;
@@ -115,10 +115,9 @@ struct ClosestPointLocator::Impl {
   // within `radius` of q is checked where it is now, and the search stops at
   // the first one nearer than `distance` (Yes) or when over `mostChecked`
   // are within the radius (Unknown). No list of neighbours is kept.
-  // NB: the ball usually holds a sample or two; searching for the 65 nearest
-  // of each of the bear's 13 826 points was measured slower (18.6 s against
-  // 13 s), and a radius search that lists every sample in the ball spent its
-  // time growing the list.
+  // NB: the ball usually holds a sample or two, so stopping at the first
+  // nearer one is cheaper than a search for the 65 nearest, and keeping no
+  // list saves a radius search's time growing one.
   struct NearerSampleSearch {
     using DistanceType = double;
     using IndexType = uint32_t;
@@ -250,8 +249,8 @@ struct ClosestPointLocator::Impl {
       bool improved = false;
       // NB: near the minimum Newton converges quadratically, so a short full
       // step that does not improve means the distance is at its rounding
-      // floor; halving it 20 times more (an evaluation each) was most of the
-      // evaluations of a fit (13 per search on the bear, 5 without them).
+      // floor; halving it 20 times more (an evaluation each) would be most of
+      // a search's evaluations, for nothing.
       const int halvings = step.norm() < kShortStep ? 1 : 20;
       for (int halving = 0; halving < halvings; ++halving) {
         ElementPoint trial{p.element, std::clamp(p.u + step(0), 0.0, 1.0), std::clamp(p.v + step(1), 0.0, 1.0)};
@@ -391,12 +390,12 @@ std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries,
   // kMostChecked, or a hint is off the surface, or a ball is too full, the
   // tree is rebuilt and every query is decided on the
   // current one.
-  // NB: early in a fit 80-95 % of the kitten's queries came out Unknown
-  // (over 64 samples in the ball of the drift): past kMostUndecided the
-  // checks stop, as a current tree is cheaper. Late in it, a handful per
-  // evaluation were undecided, and rebuilding the tree for them (49 times,
-  // 5.9 ms each for its 111 000 samples) was 8 % of the fit. Every decision
-  // depends on the queries alone, not on which thread made it.
+  // NB: early in a fit, while the surface moves fast, most queries come out
+  // Unknown (over 64 samples in the ball of the drift): past kMostUndecided
+  // the checks stop, as a current tree is cheaper. Late in it only a handful
+  // per evaluation are undecided, and deciding them on the old tree saves a
+  // rebuild at nearly every evaluation. Every decision depends on the
+  // queries alone, not on which thread made it.
   constexpr Eigen::Index kMostUndecided = 64;
   std::vector<ClosestPoint> result(queries.rows());
   std::vector<char> undecided(queries.rows(), 0);
@@ -420,10 +419,9 @@ std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries,
   // The old tree's decisions check at most a quarter of the tree's samples
   // in all, shared out among the undecided queries; a rebuild evaluates
   // every sample and sorts them again.
-  // NB: without this bound the caudate's 36 landmarks, whose balls hold
-  // hundreds of its 13 824 samples when the surface moves fast, checked 22
-  // million samples over a segmentation (a fifth of its time, 25 % slower
-  // than rebuilding); with it the kitten's decisions are as before.
+  // NB: without this bound a few queries whose balls hold hundreds of
+  // samples (a segmentation's landmarks while the surface moves fast) would
+  // check more samples than a rebuild evaluates.
   const std::size_t undecidedQueries = static_cast<std::size_t>(std::max<Eigen::Index>(1, undecidedCount));
   const std::size_t mostChecked = std::min(Impl::kMostInBall, s.samples.size() / 4 / undecidedQueries);
   if (!rebuild && s.drift > 0.0 && mostChecked >= Impl::kMostChecked) {

@@ -66,7 +66,7 @@ void SpringForceModel::attach(const Matrix3X& controlPoints) {
   }
   // The special elements' position stencils at the attachments, on both
   // cores: the force and the static scheme's tangent stiffness both take
-  // them (each evaluated them on its own before, the force on one thread).
+  // them, so they are evaluated once, here.
   const Eigen::Index count = static_cast<Eigen::Index>(springs_.size());
   stencils_.resize(springs_.size());
   parallelFor(count, threadsWorth(count), [&](Eigen::Index i) {

@@ -29,8 +29,8 @@ SurfaceQuadrature makeSurfaceQuadrature(const LimitSurface& surface, int pointsP
     }
   }
   LimitOperators operators = surface.operators(q.points, 1);  // J, J_u and J_v only
-  // Swapped in: Eigen 3.4's sparse matrices have no move, so std::move copied
-  // them (three 55 000-row operators at the kitten's finest level).
+  // Swapped in: Eigen 3.4's sparse matrices have no move, so std::move would
+  // copy them (three operators of a row per quadrature point).
   q.J.swap(operators.J);
   q.Ju.swap(operators.Ju);
   q.Jv.swap(operators.Jv);
@@ -126,8 +126,8 @@ SparseMatrix fieldStiffness(const SurfaceQuadrature& q, const Matrix3X& controlP
   const Eigen::VectorXd weights = slope * q.weights.cwiseProduct(areaElements(su, sv));
   // NB: one element's quadrature points share its columns (J, J_u and J_v
   // have one pattern), so their rank-one terms are summed in a dense block
-  // per element and only the block goes into the triplets: Eigen's sparse
-  // product J^T W J was 5 % of a segmentation on the 0.5 mm image.
+  // per element and only the block goes into the triplets, which costs less
+  // than Eigen's sparse product J^T W J.
   const int* outer = q.J.outerIndexPtr();
   const int* inner = q.J.innerIndexPtr();
   const double* values = q.J.valuePtr();

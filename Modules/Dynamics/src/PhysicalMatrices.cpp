@@ -121,7 +121,7 @@ std::vector<int> permutationSlots(const Eigen::Matrix<double, 16, Eigen::Dynamic
 // A normal element's integrals when its grid is a permutation P: each
 // P^T U P is U's entries rearranged, the same values the products give (their
 // other terms are exact zeros), without the 12 dense 16 x 16 products.
-// NB: those products were 8 % of the caudate demo's segmentation.
+// NB: the dense products would be a sizeable share of the assembly.
 ElementIntegrals permutedIntegrals(const UnitIntegrals& unit, const std::vector<int>& slots,
                                    const std::vector<int>& columns, double side) {
   ElementIntegrals result;
@@ -202,8 +202,8 @@ SymmetricMatrix elementPattern(const LimitSurface& surface) {
     for (int j : surface.elementColumns(e)) elementsOf[next[j]++] = e;
   // NB: each column's rows are gathered once each (a stamp per vertex marks
   // the rows seen) and only those sorted: appending every element's columns
-  // and sorting out the repeats (tenfold on an isolated mesh) was 4 % of the
-  // kitten's fit, for this and the Newton matrix's pattern.
+  // would repeat each row up to tenfold on an isolated mesh, all to be sorted
+  // out again (this pattern is also the Newton matrix's).
   std::vector<int> outer(vertices + 1, 0), inner, seen(vertices, -1);
   for (int j = 0; j < vertices; ++j) {
     const auto begin = inner.size();
@@ -232,9 +232,9 @@ PhysicalMatrices assemblePhysicalMatrices(const LimitSurface& surface, const std
   for (const Material& m : materials) checkMaterial(m);
 
   // NB: summed in place on the pattern of every pair of control vertices
-  // sharing an element, in element order (the sums setFromTriplets made from
-  // m^2 triplets per matrix and element, millions on a fine mesh, whose
-  // building and sorting took most of the assembly).
+  // sharing an element, in element order: setFromTriplets would need m^2
+  // triplets per matrix and element, millions on a fine mesh, and building
+  // and sorting them would cost more than the integrals.
   const SymmetricMatrix pattern = elementPattern(surface);
   PhysicalMatrices result;
   result.mass = pattern;

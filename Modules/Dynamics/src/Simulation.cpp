@@ -69,10 +69,10 @@ LevelModel buildLevel(const ControlMesh& mesh, int level, int& initialIsolation,
     *m *= elasticity;
   }
   // NB: the matrices and the quadrature are independent (the surface's
-  // tables are safe to fill from two threads), and one after the other they
-  // were a tenth of the kitten's fit.
+  // tables are safe to fill from two threads), and each is a sizeable share
+  // of a level, so they are built side by side.
   // Swapped in, not assigned: Eigen 3.4's sparse matrices have no move, so
-  // assigning the results copied every table.
+  // assigning the results would copy every table.
   bothAtOnce(
       [&] {
         PhysicalMatrices built = assemblePhysicalMatrices(*model.surface, material, assembly);
@@ -152,8 +152,8 @@ SurfaceFrame surfaceFrame(const SurfaceQuadrature& quadrature, const Matrix3X& p
 // which changes no shape, for hundreds of steps after the shape has settled
 // (Simulation.h), so control-point motion would keep it "moving".
 // NB: each state's frame is computed once and compared with the next
-// state's, one pass over the operators (three before: J on the move, J_u and
-// J_v at `from`; 8 % of the caudate demo's segmentation).
+// state's: one pass over the operators per state, not three per step (J on
+// the move, J_u and J_v at `from`).
 double shapeMotion(const SurfaceFrame& from, const SurfaceFrame& to) {
   double largest = 0.0;
   for (Eigen::Index i = 0; i < from.positions.rows(); ++i) {
@@ -359,14 +359,13 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
       // The energy's slope along the direction: its gradient is K p - f_p.
       const double slope = -(residual.array() * direction.array()).sum();
       // NB: a Newton direction first tries the length the last one was
-      // accepted at. Near the kitten's equilibrium the full step raised the
-      // energy step after step and 0.1-0.5 of it was accepted, the best
-      // length shrinking slowly. After a still step the next starts at 1
+      // accepted at: near an equilibrium the full step can raise the energy
+      // step after step while a fraction of it is accepted, and the best
+      // length changes slowly. After a still step the next starts at 1
       // again: a step started short may look still only because it was
-      // short, and a level must not end on two such steps. Chosen on the
-      // tuning clouds (force evaluations, all four): always 1: 102; the last
-      // length times 1.0: 80, 1.2: 92, 1.5: 88 (two sessions' choice, with
-      // the conjugate gradients' tolerance 1e-6 then 1e-3), 2: 88-90, 4: 102.
+      // short, and a level must not end on two such steps. On the tuning
+      // clouds this takes fewer force evaluations than starting at 1 or at a
+      // multiple of the last length.
       double length = isotropic || !lineSearch || lastStill ? 1.0 : lastLength;
       const double largestMove = direction.rowwise().norm().maxCoeff();
       for (int shortening = 0; shortening <= 20 && !accepted; ++shortening) {
@@ -385,9 +384,9 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
         // The next length is the lowest point of the parabola through the
         // energy here, its slope here and the energy at the rejected length,
         // kept within 0.1-0.5 of that length (safeguarded backtracking).
-        // NB: the kitten's trace showed steps accepted at 1/8-1/16 of the
-        // Newton step, each halving a whole closest-point search: 151 force
-        // evaluations in 51 steps, against 65 in 33 with this rule.
+        // NB: steps are often accepted at 1/8-1/16 of the Newton step, and
+        // every trial is a whole closest-point search: plain halving would
+        // take several trials to get there, the parabola's minimum fewer.
         const double rise = trialEnergy - energy - slope * tried;
         if (slope < 0.0 && rise > 0.0) {
           length = std::clamp(-slope * tried * tried / (2.0 * rise), 0.1 * tried, 0.5 * tried);
@@ -535,8 +534,7 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
   int initialIsolation = options.origin.isolation;  // -1 until the first level's surface sets it
   double timeStep = options.integrator.timeStep;
   // NB: levels are held through pointers and built in place: Eigen 3.4's
-  // sparse matrices have no move, so moving a level copied its tables (22 MB
-  // more at the kitten's peak).
+  // sparse matrices have no move, so moving a level would copy its tables.
   std::future<std::unique_ptr<LevelModel>> prepared;  // the next level's, when built ahead
   for (int level = options.origin.level;; ++level) {
     const auto started = std::chrono::steady_clock::now();

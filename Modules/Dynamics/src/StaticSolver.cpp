@@ -32,8 +32,8 @@ struct TangentStiffness::Impl {
   // the elements' blocks (i >= j, one per pair, counted in column j) are
   // split in half.
   // NB: an element's smallest columns own most of its pairs (column c[j] of
-  // m has m - j), so halving the columns by number gave the first thread
-  // 73 % of the kitten's sums (`perf report -s pid`).
+  // m has m - j), so halving the columns by number would give the first
+  // thread most of the sums.
   int splitColumn = 0;
   SymmetricMatrix matrix;  // 3N by 3N, the lower triangle of the expanded pattern
   // matrix's values right after the last reset(): resetToLast() copies them
@@ -83,9 +83,9 @@ struct TangentStiffness::Impl {
   // increasing order. The columns are split in two halves, on two threads
   // when there are enough elements, so each value is summed by one thread
   // in one order whatever the thread count. Summing straight into the
-  // matrix, instead of into per-element m x m sums first, reads and writes
-  // a tenth of the memory on the kitten (1.7 points per element, whose six
-  // sums per element were 89 MB to zero, fill and read at every step).
+  // matrix, instead of into per-element m x m sums first, spares zeroing,
+  // filling and reading six such sums per element at every step, where
+  // elements hold only a point or two each.
   void addPoints() {
     touched.clear();
     if (points.empty()) return;
@@ -302,8 +302,9 @@ struct StaticSolver::Impl {
   // Steps to factor directly before trying the earlier factor again, and the
   // next such wait: it doubles with each failed try (up to 16 steps) and
   // returns to 1 after one that converged.
-  // NB: on the kitten the first 19 tries all failed, each 20 iterations (18-28
-  // ms) before a factorization (37-60 ms) anyway; later ones converged in 12-18.
+  // NB: early in a fit, while H changes fast, the earlier factor seldom
+  // preconditions well enough, and each failed try costs its iterations on
+  // top of the factorization; the growing wait keeps such tries few.
   int skip = 0, backoff = 1;
 
   // Conjugate gradients on h x = rhs preconditioned by the earlier step's
@@ -335,11 +336,9 @@ struct StaticSolver::Impl {
   // changes little, so an earlier factor preconditions it well: a few
   // triangular solves instead of a new factorization, which at thousands of
   // control vertices costs ten times a whole force evaluation.
-  // The relative residual 1e-3 was chosen on the tuning clouds (sphere,
-  // ellipsoid, noisy peanut, torus) against 1e-6, 1e-4, 1e-2 and 1e-1: the
-  // loosest whose max errors stayed within 5 % of 1e-6's (1e-2 raised the
-  // ellipsoid's by 8 %, 1e-1 by 60 %); the peanut's conjugate gradients took
-  // 0.35 s at 1e-6 and 0.17 s at 1e-3.
+  // The relative residual 1e-3 is the loosest that keeps the tuning clouds'
+  // max errors within 5 % of a near-exact solve's (1e-6); a looser one
+  // raises them, a tighter one takes more iterations.
   static constexpr double kReuseTolerance = 1e-3;
   static constexpr int kReuseIterations = 20;
 

@@ -25,11 +25,10 @@ SimulationOptions FitOptions::defaultSimulation() {
   // The data springs do not stiffen with refinement; weakening the surface's
   // elasticity 4-fold per level lets the finer levels follow the data closer.
   o.elasticityPerLevel = 0.25;
-  // A level that is refined ends within 30 times looser tolerances: on the
-  // tuning clouds (Documentation/Performance.md) the peanut, the one that is
-  // refined, took 39 / 36 / 37 / 30 / 21 steps at 1 / 3 / 10 / 30 / 100, in
-  // the same time from 30 on (its finest level is most of it); the others,
-  // accepted at their first level, are unchanged.
+  // A level that is refined ends within 30 times looser tolerances: its
+  // equilibrium is only where the next level starts. Looser saves no more
+  // time, the finest level being most of a fit; a level whose fit is
+  // accepted still ends by the full rule.
   o.equilibrium.coarseLevelFactor = 30.0;
   return o;
 }
@@ -37,9 +36,9 @@ SimulationOptions FitOptions::defaultSimulation() {
 FitError measureFitError(const LimitSurface& surface, const Matrix3X& controlPoints, const Matrix3X& data,
                          double diameter) {
   // NB: 8 x 8 samples per control face, as the outputs (Tessellation.h):
-  // isolation's elements are a half or a quarter of a face on a side. On the
-  // kitten (isolated once) 8 x 8 per element made the locator's samples 197 000
-  // and this measurement 6 % of the fit.
+  // isolation's elements are a half or a quarter of a face on a side, and
+  // 8 x 8 per element would make the locator's samples, and this
+  // measurement, four or sixteen times as costly.
   ClosestPointLocator locator(surface, outputSegments(surface), 8);
   locator.update(controlPoints);
   const std::vector<ClosestPoint> nearest = locator.findAll(data);
@@ -72,7 +71,7 @@ FitResult fitPointCloud(const Matrix3X& data, const ControlMesh& initial, const 
     // NB: mid-level (the static scheme's looser rule) the springs' lengths are
     // the data's distances at `points`, measured by their last evaluation
     // (tracked, so never shorter than a new search's). When they accept, a
-    // new search (2 % of the kitten's fit) is saved, and the level goes on to
+    // new closest-point search is saved, and the level goes on to
     // its end, where the error is measured; when they do not, it is measured
     // now, and decides.
     const Eigen::VectorXd& lengths = springs.lengths();

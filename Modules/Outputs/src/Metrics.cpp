@@ -54,8 +54,8 @@ OverlapMetrics compareMasks(const Mask& a, const Mask& b) {
   // are computed on the box around both, one voxel wider on every side
   // (clamped to the image): a mask voxel on that box's edge is then on the
   // image's edge too, so the boundaries are the same voxels, and the exact
-  // distance maps agree wherever they are read. On a whole 1 mm brain the
-  // distance maps took most of a segmentation's time.
+  // distance maps agree wherever they are read. Over a whole image the
+  // distance maps would take most of a segmentation's time.
   const ImageGeometry& g = a.geometry;
   std::vector<std::uint8_t> either(a.voxels.size());
   for (std::size_t v = 0; v < either.size(); ++v) either[v] = a.voxels[v] | b.voxels[v];

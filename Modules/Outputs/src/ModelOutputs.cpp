@@ -72,9 +72,9 @@ void writeModelOutputs(const std::filesystem::path& dir, const ControlMesh& mesh
   // NB: the model's files (surface.vtp, control_mesh.obj, report.json) are
   // written on a second thread while `extra` (a segmentation's labelmap, the
   // figures) writes on this one: compressing the surface and the labelmap
-  // were each about a tenth of the caudate demo's command. Only this thread
+  // each take a sizeable share of a segmentation command. Only this thread
   // adds outputs to the set. An error writing the model's files is reported
-  // first, as when they were written first, and nothing is committed unless
+  // first, as if they were written first, and nothing is committed unless
   // all went.
   const std::string surfacePath = outputs.add("surface.vtp"), meshPath = outputs.add("control_mesh.obj"),
                     reportPath = outputs.add("report.json");

@@ -197,8 +197,9 @@ void writeFigures(const FigureInputs& inputs, const FigureFiles& files) {
   }
   if (!files.convergence.empty() && !inputs.history) throw Error("internal: a convergence figure without a history");
   // NB: one window for all three: creating a window (choosing its GLX
-  // framebuffer configuration, starting its context) was a fifth of the
-  // figures' time. Each figure's renderers leave it before the next's come.
+  // framebuffer configuration, starting its context) costs a sizeable share
+  // of the figures' time. Each figure's renderers leave it before the next's
+  // come.
   const vtkSmartPointer<vtkRenderWindow> window = style::offScreenWindow(kColumns * kCell, 3 * kCell);
   auto draw = [&](const std::string& path, const auto& figure) {
     if (path.empty()) return;

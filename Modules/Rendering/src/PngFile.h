@@ -1,7 +1,7 @@
 #pragma once
 // Private to the Rendering module: PNG files of captured windows, written
 // here rather than by vtkPNGWriter. VTK's writer lets libpng try its five
-// row filters on every row, which took longer than rendering the 3D figure;
+// row filters on every row, which takes longer than rendering the 3D figure;
 // here every row gets the "up" filter (the row above subtracted) and the
 // data is deflated by libdeflate: the same pixels, in files about the size
 // of VTK's at its default level, in a fraction of the time.

@@ -37,10 +37,10 @@ namespace {
 
 // The polygons of a surface that reach a plane (their points on both sides
 // of it, or on it), in their order and with their cell data, on the input's
-// points: all the cutter below can cut. A figure's fifteen views each cut the
-// whole surface otherwise (49 152 triangles for a segmentation), a sixth of
-// the figures' time; the cut is the same, segment for segment. A surface with
-// other cells than polygons is passed whole.
+// points: all the cutter below can cut. Otherwise a figure's fifteen views
+// would each cut the whole surface (49 152 triangles for a segmentation);
+// the cut is the same, segment for segment. A surface with other cells than
+// polygons is passed whole.
 class PolygonsAtPlane : public vtkPolyDataAlgorithm {
  public:
   static PolygonsAtPlane* New();
@@ -129,10 +129,9 @@ struct SliceView::Impl {
     cutter->SetInputConnection(atPlane->GetOutputPort());
     cutter->SetCutFunction(cutPlane);
     // NB: the contour's points are not merged, and the locator has one bin:
-    // a merging locator's bins for the whole surface were allocated (and their
-    // fresh pages cleared) for each of the slices figure's 15 views, a third
-    // of its time. Only the lines are drawn, so merging their ends changed
-    // nothing.
+    // a merging locator allocates bins for the whole surface (and the kernel
+    // clears their fresh pages) in each of the slices figure's 15 views. Only
+    // the lines are drawn, so merging their ends would change nothing.
     vtkNew<vtkNonMergingPointLocator> locator;
     locator->AutomaticOff();
     locator->SetDivisions(1, 1, 1);

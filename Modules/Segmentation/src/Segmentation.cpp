@@ -54,8 +54,8 @@ class RegionPressureForceModel final : public ForceModel {
   }
   // The gate changes by 1 / width_ per unit of intensity, and the intensity
   // at most by about the steep gradient per mm: without this slope in the
-  // stabilizer, the pressure overshoots at long time steps (a ball grown
-  // from a 3 mm seed collapsed at 4 s: SegmentationUnitTest).
+  // stabilizer, the pressure overshoots at long time steps (the ball that
+  // SegmentationUnitTest grows from a 3 mm seed would collapse at 4 s).
   SparseMatrix stabilizingStiffness(const Matrix3X& controlPoints) override {
     return fieldStiffness(*quadrature_, controlPoints, slope_);
   }
@@ -84,7 +84,7 @@ double enclosedVolume(const TriangleSurface& s) {
 // The pressure beyond the end slices (ClickAppearance.h), filling its part
 // of `ends`. It acts beyond an end unless that end's march found the
 // structure ending within `gap` of the outermost slice (an end the clicks
-// already reach: the bundled caudate's, which stays as it was); none at all
+// already reach, as the bundled caudate's do); none at all
 // when off, when the clicks are not on slices, or when they gave too few
 // samples.
 std::optional<EndPressure> endPressure(const SegmentationRegion& region, const std::vector<Landmark>& landmarks,
@@ -111,10 +111,10 @@ SimulationOptions SegmentOptions::defaultSimulation() {
   SimulationOptions o;
   o.maxLevel = 1;  // the papers' 98 -> 386 control vertices
   o.elasticityPerLevel = 0.25;
-  // Chosen on the evaluation plan's tuning split (Documentation/Segmentation.md,
-  // "The time step"): at 0.5 s half its runs crept on to the step limit, and
-  // steps of 4 to 16 s gave the same results, the forces' stabilizing
-  // stiffness (Integrator.h) then outweighing the damping.
+  // Shorter steps let a level creep on to the step limit; from 4 s on the
+  // forces' stabilizing stiffness (Integrator.h) outweighs the damping and
+  // longer steps give the same results (the evaluation plan's tuning split,
+  // Documentation/Segmentation.md, "The time step").
   o.integrator.timeStep = 4.0;
   // 386 control vertices: the refined level's tables are built on the
   // second core while the first level runs on one.
@@ -141,9 +141,9 @@ ControlMesh initialFromLandmarks(const std::vector<Landmark>& landmarks, double 
   const Matrix3X points = landmarkPositions(landmarks);
   // Clicks on one slice are the flat set users give; say what would do.
   // (Points on a line, or at one point, get checkPointCloud's own words.)
-  // NB: one slice of clicks with a seed click at their centre was tried: the
-  // surface collapsed or leaked (Dice 0.00-0.63 over 15 structures), so such
-  // landmarks are refused rather than guessed at.
+  // NB: one slice of clicks says nothing of the structure across the slice:
+  // even with a seed click at their centre the surface collapses or leaks, so
+  // such landmarks are refused rather than guessed at.
   if (points.rows() >= 4 && points.allFinite() && spannedDimensions(points) == 2)
     throw LandmarkError("all " + std::to_string(points.rows()) +
                         " landmarks lie on one plane, as clicks on a single slice do: a surface needs the boundary "

@@ -314,9 +314,9 @@ struct LimitSurface::Impl {
     // NB: the element keeps only its masks. Its subpatches are its
     // structure's times structureMap: subdivision is linear, and a structure's
     // displacements from its limit point, times the blends, are the element's
-    // (the blends' rows sum to 1). Tabulated per element they were most of
-    // the kitten's fit's memory (80 of 220 MB over its 4500 special elements)
-    // and of the time it spent faulting that memory in.
+    // (the blends' rows sum to 1). Tabulated per element they would take
+    // memory, and time to fault it in, for every special element rather than
+    // for the few structures.
     specials.push_back(makeSpecial(std::move(local), columns, false));
   }
 
@@ -356,13 +356,13 @@ struct LimitSurface::Impl {
   // eigenvalues lambda_j, right eigenvectors r_j and left ones l_j of S. The
   // displacement of an interior neighbour of the vertex, scaled by 2^L, turns
   // across the boundary at the rate of the largest eigenvalue it holds; read
-  // at a finite level (48 before) the next eigenvalues still pull it off by
-  // (lambda_next / lambda_top)^L, which is 2e-2 rad at 12 faces and 1.5 rad at
-  // 50, where the eigenvalues crowd together. Here only the top eigenvalue's
-  // terms are kept: the limit direction, exact to the eigensolver's accuracy,
-  // with the magnitude of the level-48 reading, so that the masks are as
-  // before where that reading had converged. Still a fixed linear mask, so
-  // J_u and J_v stay linear operators.
+  // at a finite level L the next eigenvalues still pull it off by
+  // (lambda_next / lambda_top)^L, which at L = 48 is 2e-2 rad at 12 faces and
+  // 1.5 rad at 50, where the eigenvalues crowd together. Here only the top
+  // eigenvalue's terms are kept: the limit direction, exact to the
+  // eigensolver's accuracy, with the magnitude of a reading at
+  // kCrossTangentLevel, so that the masks equal such a reading wherever it
+  // converges. Still a fixed linear mask, so J_u and J_v stay linear operators.
   void setBoundaryTangents(Special& special, const LocalMesh& level0, const detail::VertexMasks& masks,
                            const Eigen::RowVectorXd& along) {
     LocalMesh deep = level0;
@@ -491,7 +491,7 @@ struct LimitSurface::Impl {
     checkPoint(point);
     const Element& element = elements[point.element];
     // NB: lazyProduct: these products are too small for Eigen's blocked GEMM,
-    // whose packing and allocation dominated closest-point searches.
+    // whose packing and allocation would dominate closest-point searches.
     auto product = [&](const Eigen::Matrix<double, 6, 16>& b, const auto& grid) {
       if (rows == 6) {
         w.noalias() = b.lazyProduct(grid);
@@ -913,8 +913,8 @@ struct SurfaceState::Impl {
   // first fill, and never moved: a reader that sees ready[slot] set may read
   // that slot without the lock.
   // NB: one subpatch at a time, not whole levels: where most elements are
-  // special and hold few points (the eight: 315 points on 184 special
-  // elements) filling all three children cost more than it saved.
+  // special and hold few points, filling all three children costs more than
+  // it saves.
   static constexpr int kSlots = 3 * kCachedLevels;
   struct Cache {
     std::array<std::atomic<bool>, kSlots + 1> ready{};
@@ -956,7 +956,7 @@ LimitSample SurfaceState::evaluate(const ElementPoint& point) const {
   if (element.type == ElementType::Normal) {
     // NB: lazyProduct: Eigen sends the plain product to its blocked GEMM (a
     // grid block of a dynamic matrix has a runtime stride), whose packing
-    // cost more than the 288 multiplications.
+    // costs more than the 288 multiplications.
     return limitSampleOf(bicubicBsplineWeights(point.u, point.v)
                              .lazyProduct(impl_->grids.middleRows<16>(16 * static_cast<Eigen::Index>(point.element))));
   }

@@ -66,9 +66,8 @@ class SpringForceModel final : public ForceModel {
   // scheme: enough to keep each step's slide along the surface bounded where
   // the surface's elasticity is weak (with none, Newton steps slide the
   // control mesh along itself by up to the model's size and the energy rises),
-  // small enough not to hold the slide back. Chosen on synthetic clouds only
-  // (sphere, ellipsoid, a noisy peanut, the bundled torus: 0, 0.003, 0.01,
-  // 0.03, 0.05 tried; Documentation/Performance.md), never on CGAL's scans.
+  // small enough not to hold the slide back. Chosen on the synthetic tuning
+  // clouds (Tools/tuning_clouds.py), not on CGAL's scans, which stay a test set.
   static constexpr double kTangentialShare = 0.01;
 
   // Spring lengths (distances target - attachment, mm) at the last evaluation.

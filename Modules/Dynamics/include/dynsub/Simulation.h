@@ -21,11 +21,9 @@
 // The motion along the surface is left out: steps also slide the
 // parametrization along the surface, a creep that changes neither the shape
 // nor the fit. The static scheme leaves that slide to the surface's weak
-// elasticity (StaticSolver.h), and it took 80 % of its steps (the kitten 269
-// steps, 47 without it); time steps creep the same way (the caudate demo's
-// level 0 at the 0.5 s step: 672 steps by control-point motion, 176 by the
-// shape's). What it leaves is reported: LevelSummary::residual includes the
-// tangential imbalance.
+// elasticity (StaticSolver.h), so waiting for it to stop would take most of
+// a level's steps; time steps creep the same way. What it leaves is
+// reported: LevelSummary::residual includes the tangential imbalance.
 //
 // Stabilizer updates (time stepping): the forces' stiffness that stabilizes the integration
 // (Integrator.h) is frozen when a level starts; when the energy rises by more
@@ -43,10 +41,9 @@
 // left-hand matrix refactored), up to the step asked for. A level that then
 // diverges at a regrown step restarts at the step it started with, and grows
 // no more to half of the step that diverged, or beyond.
-// NB: a halved step used to stay halved for the rest of the simulation: on
-// the evaluation's tuning split, two caudates ran their first level's 1000
-// steps at 0.5 s instead of 4 s and ended at the step limit
-// (Documentation/Segmentation.md, "The time step after a divergence").
+// NB: a step left halved for the rest of the simulation can make a level too
+// slow to settle within maxSteps (Documentation/Segmentation.md, "The time
+// step after a divergence").
 #include <functional>
 #include <memory>
 #include <string>
@@ -140,8 +137,8 @@ struct SimulationResult {
   std::vector<LevelSummary> levels;
   int steps = 0;  // over all levels
   LevelOrigin origin;  // of `mesh`: what a refit from it passes as SimulationOptions::origin
-  // The last level's limit surface (of `mesh`'s topology), for the outputs:
-  // building it again took 3 % of the kitten's fit.
+  // The last level's limit surface (of `mesh`'s topology), for the outputs,
+  // so that they need not build it again.
   std::shared_ptr<const LimitSurface> surface;
 };
 

@@ -51,7 +51,7 @@ bool figureDisplay(std::string* why = nullptr);
 // What figureDisplay() needs, made ready on a second thread while the caller
 // goes on: the private X server started when DISPLAY is not set, and the
 // OpenGL driver loaded (for Mesa's software renderer, loading it and LLVM
-// took longer than rendering a figure). Call it once a run knows it will
+// takes longer than rendering a figure). Call it once a run knows it will
 // write figures, as early as it can; figureDisplay() then waits for it and
 // answers as it would have. DISPLAY is set by figureDisplay(), on the
 // caller's thread, never by the second one.

@@ -48,8 +48,8 @@ class ImageSlices {
   // A copy of the volume's intensities.
   explicit ImageSlices(const Volume& volume);
   // The volume's own intensities, not copied: `volume` must outlive the
-  // slices and stay unchanged. (Copying Colin27's 28 MB into fresh memory was
-  // a tenth of writing a segmentation's figures.)
+  // slices and stay unchanged. (Copying a whole MRI into fresh memory would
+  // be a sizeable share of writing a segmentation's figures.)
   static ImageSlices borrowing(const Volume& volume);
 
   const ImageGeometry& geometry() const { return geometry_; }

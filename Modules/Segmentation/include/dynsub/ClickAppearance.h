@@ -19,8 +19,8 @@
 // score's largest slope per intensity times the region's 99th-percentile
 // gradient magnitude, joins the edge force's in the integrator's stabilizer
 // (Integrator.h): without it the pressure flips sign across the boundary
-// from step to step, and half the evaluation's tuning runs ended at the step
-// limit instead of an equilibrium.
+// from step to step, and a level can run to its step limit instead of
+// settling.
 #include <optional>
 #include <vector>
 
@@ -61,8 +61,8 @@ class EndPressure final : public PressureField {
   // `radius` of the line along the axis through `centre`, the end slice's
   // clicks' centroid (radius: its farthest click). A structure's unclicked
   // end is taken to be no wider than its last clicked section: without this
-  // bound, twelve clicks on four sagittal slices of the cerebellum let the
-  // pressure grow its lateral ends into the temporal lobes (Dice 0.85 -> 0.69).
+  // bound the pressure can grow an end sideways into like tissue beside it
+  // (a cerebellum's lateral ends into the temporal lobes).
   struct End {
     Vector3 centre = Vector3::Zero();
     double radius = 0;

@@ -24,10 +24,9 @@ struct TriangleSurface {
 // caudate), i.e. outputSegments() per element.
 constexpr int kOutputSegments = 8;
 // kOutputSegments halved for each isolation level (at least 2): isolation
-// splits each face into 4 or 16 elements, and 8 x 8 squares on each made the
-// kitten's surface.vtp (772 faces, 3088 elements) 395 000 triangles, four
-// times as dense as any model without isolation, and its compression a tenth
-// of the whole fit's time.
+// splits each face into 4 or 16 elements, and 8 x 8 squares on each would
+// make the surface four or sixteen times as dense as a model's without
+// isolation, and as slow to compress and write.
 int outputSegments(const LimitSurface& surface);
 
 // N = segmentsPerElement >= 1. Throws dynsub::Error for N < 1 or N > 1024.
