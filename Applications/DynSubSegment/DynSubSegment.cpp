@@ -20,11 +20,9 @@
 #include "ExecutionModel.h"
 #include "SegmentRun.h"
 #include "dynsub/AtomicOutput.h"
-#include "dynsub/TemporaryFileGuard.h"
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
 #include "dynsub/ImageIO.h"
-#include "dynsub/ResidentHeap.h"
 #include "dynsub/SurfaceWriter.h"
 
 namespace {
@@ -270,9 +268,6 @@ void run(Arguments a) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  dynsub::useResidentHeap();
-  // Before any thread exists: a run Slicer cancels (SIGKILL) leaves no temporary file.
-  dynsub::startTemporaryFileGuard();
   Arguments arguments;
   const slicer::Module module = describe(arguments);
   // Slicer reads the descriptor from stdout, which must start with "<?xml".

@@ -5,7 +5,7 @@
 #include <CLI/CLI.hpp>
 
 #include "dynsub/Error.h"
-#include "dynsub/RenderingLibrary.h"
+#include "dynsub/FigureInputs.h"
 #include "dynsub/OutputSet.h"
 
 namespace dynsub::app {
@@ -18,11 +18,7 @@ void FigureOptions::addOptions(CLI::App& command) {
 
 void FigureOptions::prepare() const {
   if (!figures) return;
-  try {
-    rendering::functions().prepareFigureDisplay();
-  } catch (const Error&) {
-    // Reported where the figures would be written (addFigureOutputs).
-  }
+  prepareFigureDisplay();
 }
 
 void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const ControlMesh& mesh,
@@ -31,8 +27,7 @@ void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const Co
   writeConvergenceCsv(history, outputs.add("convergence.csv"));
   if (!options.figures) return;
   std::string why;
-  const rendering::Functions* draw = rendering::figureFunctions(why);
-  if (!draw) {
+  if (!figureDisplay(&why)) {
     std::cerr << "warning: no figures written: " << why << '\n';
     return;
   }
@@ -49,7 +44,7 @@ void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const Co
   files.slices = outputs.add("slices.png");
   files.surface3d = outputs.add("surface3d.png");
   files.convergence = outputs.add("convergence.png");
-  draw->writeFigures(inputs, files);
+  writeFigures(inputs, files);
 }
 
 }  // namespace dynsub::app

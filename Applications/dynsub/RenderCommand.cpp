@@ -7,7 +7,7 @@
 
 #include "Commands.h"
 #include "dynsub/Error.h"
-#include "dynsub/RenderingLibrary.h"
+#include "dynsub/FigureInputs.h"
 #include "dynsub/ImageIO.h"
 #include "dynsub/Landmarks.h"
 #include "dynsub/MeshIO.h"
@@ -24,8 +24,7 @@ struct RenderCommandOptions {
 
 void runRender(const RenderCommandOptions& o) {
   std::string why;
-  const rendering::Functions& draw = rendering::functions();
-  if (!draw.figureDisplay(&why)) throw Error("rendering needs an X display: " + why);
+  if (!figureDisplay(&why)) throw Error("rendering needs an X display: " + why);
   // Every input is read and checked before anything is written (the surface
   // file when the figures are drawn: a bad one leaves nothing behind).
   FigureInputs inputs;
@@ -55,7 +54,7 @@ void runRender(const RenderCommandOptions& o) {
   files.slices = outputs.add("slices.png");
   files.surface3d = outputs.add("surface3d.png");
   if (!o.convergence.empty()) files.convergence = outputs.add("convergence.png");
-  draw.writeFigures(inputs, files);
+  writeFigures(inputs, files);
   outputs.commit();
   std::cout << "wrote " << (dir / "slices.png").string() << ", surface3d.png"
             << (o.convergence.empty() ? "" : ", convergence.png") << '\n';

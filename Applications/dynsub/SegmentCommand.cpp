@@ -141,7 +141,7 @@ void runSegment(const SegmentCommandOptions& o) {
   std::shared_future<Mask> reference;
   if (!o.reference.empty()) {
     requireExisting(o.reference);  // before the segmentation; its other errors come with its reading
-    reference = onOwnThread([&o, &image] { return readReference(o, image); }).share();
+    reference = std::async(std::launch::async, [&o, &image] { return readReference(o, image); }).share();
     inputs.reference = [reference]() -> const Mask& { return reference.get(); };
     inputs.referencePath = o.reference;
     inputs.referenceLabels = o.referenceLabels;

@@ -12,7 +12,9 @@
 #include "dynsub/OutputSet.h"
 #include "dynsub/Report.h"
 #include "dynsub/SculptScript.h"
-#include "dynsub/RenderingLibrary.h"
+#include "dynsub/FigureInputs.h"
+#include "dynsub/Sculptor.h"
+#include "dynsub/SolidView.h"
 #include "dynsub/SolidSubdivision.h"
 
 namespace dynsub::app {
@@ -64,9 +66,8 @@ std::string writeSculpture(const std::filesystem::path& dir, const Sculpture& sc
   writeLattice(solid, outputs.add("sculpted.vtu"));
   std::string figure;
   std::string why;
-  const rendering::Functions* draw = o.figure ? rendering::figureFunctions(why) : nullptr;
-  if (draw) {
-    draw->writeSculptureFigure(sculpture, outputs.add("sculpted.png"));
+  if (o.figure && figureDisplay(&why)) {
+    writeSculptureFigure(sculpture, outputs.add("sculpted.png"));
     figure = ", sculpted.png";
   } else if (o.figure) {
     std::cerr << "warning: no figure written: " << why << '\n';
@@ -104,9 +105,10 @@ void runSculpt(const SculptOptions& options) {
     // The window: s saves to --out.
     std::cout << "dynsub solid sculpt: press h in the window for the mouse and key bindings; s saves to " << o.out
               << '\n';
-    rendering::functions().runSculptor(lattice, o.settings, [o, report](const Sculpture& s) {
+    Sculptor sculptor(lattice, o.settings, [o, report](const Sculpture& s) {
       return writeSculpture(o.out, s, o, report);
     });
+    sculptor.run();
     return;
   }
   // The whole script is checked before the solid moves, and nothing is

@@ -7,7 +7,7 @@
 #include "Commands.h"
 #include "dynsub/Error.h"
 #include "dynsub/ImageIO.h"
-#include "dynsub/RenderingLibrary.h"
+#include "dynsub/Viewer.h"
 
 namespace dynsub::app {
 
@@ -30,7 +30,8 @@ void runView(const ViewCommandOptions& o) {
   checkSegmentOptions(o.segment);
   input.segment = o.segment;
   std::cout << "dynsub view: press h in the window for the mouse and key bindings\n";
-  rendering::functions().runViewer(std::move(input));
+  Viewer viewer(std::move(input));
+  viewer.run();
 }
 
 }  // namespace

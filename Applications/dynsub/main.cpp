@@ -8,13 +8,8 @@
 #include "Commands.h"
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
-#include "dynsub/ResidentHeap.h"
-#include "dynsub/TemporaryFileGuard.h"
 
 int main(int argc, char** argv) {
-  dynsub::useResidentHeap();
-  // Before any thread exists: a run killed at any moment leaves no temporary file.
-  dynsub::startTemporaryFileGuard();
   CLI::App app{
       "DynSub: dynamic Catmull-Clark subdivision surfaces for segmenting 3D medical images and "
       "recovering shapes.\n"

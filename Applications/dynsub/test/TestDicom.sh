@@ -39,13 +39,9 @@ distance=$(sed -n 's/^  "mean_surface_distance_mm": \([-0-9.e+]*\),$/\1/p' "$wor
 check "DICOM: Dice $dice >= 0.95" awk -v d="$dice" 'BEGIN { exit !(d != "" && d >= 0.95) }'
 check "DICOM: mean surface distance $distance <= 0.375 mm" awk -v d="$distance" 'BEGIN { exit !(d != "" && d <= 0.375) }'
 
-# The dynamic loader's record of the libraries it opened, in files $work/ld.*.
-LD_DEBUG=files LD_DEBUG_OUTPUT="$work/ld" "$DYNSUB" segment "$work/phantom/phantom.nii.gz" \
+"$DYNSUB" segment "$work/phantom/phantom.nii.gz" \
   --landmarks "$work/phantom/ball.csv" --no-figures --out "$work/nifti" >/dev/null 2>&1
 check "segment reads the same phantom as NIfTI" test $? -eq 0
-# GDCM's libraries and dictionary cost 40-50 ms to load; a NIfTI file needs none.
-check "the NIfTI file is read without opening GDCM" sh -c "! grep -q 'file=libgdcm' $work/ld.*"
-check "the DICOM library is not opened for it either" sh -c "! grep -q 'file=.*libDynSubItkDicom' $work/ld.*"
 check "the DICOM and NIfTI labelmaps agree" python3 - "$work/dicom/labelmap.nii.gz" "$work/nifti/labelmap.nii.gz" <<'PY'
 import gzip, struct, sys
 def read(path):

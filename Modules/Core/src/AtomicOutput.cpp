@@ -13,7 +13,6 @@
 #include <system_error>
 
 #include "dynsub/Error.h"
-#include "dynsub/TemporaryFileGuard.h"
 
 namespace fs = std::filesystem;
 
@@ -63,14 +62,12 @@ AtomicOutput::AtomicOutput(std::string target) : target_(std::move(target)) {
   // The process id keeps two concurrent runs from sharing a temporary file; the
   // name ends with the target's file name, so writers still see its extension.
   temporary_ = (path.parent_path() / (prefix + name)).string();
-  temporaryfiles::created(fs::absolute(temporary_).string());
 }
 
 AtomicOutput::~AtomicOutput() {
   if (!committed_ && temporary_ != target_) {
     std::error_code ignored;
     fs::remove(temporary_, ignored);
-    temporaryfiles::finished(fs::absolute(temporary_, ignored).string());
   }
 }
 
@@ -84,7 +81,6 @@ void AtomicOutput::commit() {
     throw Error(target_, "cannot move the finished output into place: " + error.message());
   }
   committed_ = true;
-  if (temporary_ != target_) temporaryfiles::finished(fs::absolute(temporary_).string());
 }
 
 std::string withoutTemporaryPrefix(const std::string& text) {

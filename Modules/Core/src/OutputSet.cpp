@@ -10,7 +10,6 @@
 
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
-#include "dynsub/TemporaryFileGuard.h"
 
 namespace dynsub {
 
@@ -33,7 +32,6 @@ OutputSet::OutputSet(std::filesystem::path dir) : dir_(std::move(dir)) {
   if (!std::filesystem::exists(dir_, error)) {
     if (!std::filesystem::create_directory(dir_, error)) throw Error(dir_.string(), "cannot be created: " + error.message());
     created_ = true;
-    temporaryfiles::createdDirectory(std::filesystem::absolute(dir_).string());
   }
   // Two runs writing to one directory at once take turns: each holds a lock
   // on the directory from its first file to its commit, so their files never
@@ -53,7 +51,6 @@ OutputSet::~OutputSet() {
     std::error_code error;
     std::filesystem::remove(dir_, error);
   }
-  if (created_) temporaryfiles::finishedDirectory(std::filesystem::absolute(dir_).string());
   if (lock_ >= 0) ::close(lock_);  // releases the lock
 }
 

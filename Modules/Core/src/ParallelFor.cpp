@@ -4,7 +4,6 @@
 #include <condition_variable>
 #include <mutex>
 
-#include "dynsub/ResidentHeap.h"
 
 namespace dynsub::detail {
 namespace {
@@ -21,7 +20,6 @@ struct Helper {
 };
 
 void serve(Helper* helper) {
-  useResidentArena();
   std::unique_lock<std::mutex> lock(helper->mutex);
   for (;;) {
     helper->wake.wait(lock, [helper] { return helper->hasWork; });

@@ -72,8 +72,6 @@ struct Integrator::Impl {
   std::vector<int> freeVertices;
   SymmetricMatrix lhsFree, lhsCoupling;      // free x free, free x fixed
   SparseCholesky cholesky;
-  std::vector<int> rowOfUnknown;             // the vertex at each row of the factor (Cholesky)
-  Eigen::MatrixXd unknowns;                  // the factored solve's right-hand sides and solution
   Eigen::ConjugateGradient<SymmetricMatrix, Eigen::Lower | Eigen::Upper, Eigen::IdentityPreconditioner> cg;
   Eigen::ConjugateGradient<SymmetricMatrix, Eigen::Lower | Eigen::Upper, Eigen::IncompleteCholesky<double>> pcg;
   int iterations = 0;
@@ -177,9 +175,6 @@ void Integrator::Impl::build(const PhysicalMatrices& matrices, const SymmetricMa
         throw Error("the left-hand matrix of the time step is not positive definite (is the surface anchored? "
                     "first-order integration needs damping > 0)");
       }
-      s.rowOfUnknown.resize(free);
-      for (int k = 0; k < free; ++k) s.rowOfUnknown[k] = s.freeVertices[s.cholesky.permutation()[k]];
-      s.unknowns.resize(free, 3);
       break;
     case LinearSolver::ConjugateGradient:
       s.cg.setTolerance(options.solverTolerance);
@@ -209,22 +204,6 @@ Matrix3X Integrator::step(const Matrix3X& previous, const Matrix3X& current, con
     if (s.freeIndex[v] < 0) pinned.row(k++) = current.row(v);
   }
   s.iterations = 0;
-  if (s.options.solver == LinearSolver::Cholesky) {
-    // Formed in the factor's order, solved in place, scattered back.
-    Eigen::MatrixXd& x = s.unknowns;
-    s.rightHandSide.apply(s.forceWeight, force, current, previous, s.rowOfUnknown, x);
-    // Every row of `next` is written below unless some vertices are fixed.
-    Matrix3X next = pinned.rows() > 0 ? current : Matrix3X(current.rows(), 3);
-    if (pinned.rows() > 0) {
-      const Eigen::MatrixXd coupling = s.lhsCoupling * pinned;
-      const int* perm = s.cholesky.permutation();
-      for (int k = 0; k < free; ++k) x.row(k) -= coupling.row(perm[k]);
-    }
-    s.cholesky.solveInPermutedOrder(x.data(), 3);
-    for (int k = 0; k < free; ++k) next.row(s.rowOfUnknown[k]) = x.row(k);
-    return next;
-  }
-
   s.rightHandSide.apply(s.forceWeight, force, current, previous, s.rhs);
   Matrix3X next = current;
   Eigen::MatrixXd rhsFree(free, 3), guess(free, 3);
@@ -234,6 +213,11 @@ Matrix3X Integrator::step(const Matrix3X& previous, const Matrix3X& current, con
   }
   if (pinned.rows() > 0) rhsFree -= s.lhsCoupling * pinned;
   Eigen::MatrixXd solution(free, 3);
+  if (s.options.solver == LinearSolver::Cholesky) {
+    solution = s.cholesky.solve(rhsFree);
+    for (int i = 0; i < free; ++i) next.row(s.freeVertices[i]) = solution.row(i);
+    return next;
+  }
   // x, y and z one after the other, each from last step's solution.
   auto iterate = [&](auto& solver, const char* name) {
     for (int c = 0; c < 3; ++c) {

@@ -1,6 +1,6 @@
 #pragma once
 // Four doubles in one value for the Dynamics module's hand-vectorized
-// kernels (SupernodalSolve.cpp, PairedProduct.cpp), private to it.
+// kernels (PairedProduct.cpp), private to it.
 //
 // Each kernel is inlined into two entry points: one compiled for AVX2 and
 // FMA, chosen at run time where the processor has them (hasAvx2Fma()), and

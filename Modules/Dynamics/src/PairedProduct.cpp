@@ -133,17 +133,4 @@ void PairedProduct::apply(double w, const Matrix3X& f, const Matrix3X& p, const 
   }
 }
 
-void PairedProduct::apply(double w, const Matrix3X& f, const Matrix3X& p, const Matrix3X& q,
-                          const std::vector<int>& order, Eigen::MatrixXd& out) {
-  const int n = static_cast<int>(p_.size() / 4);
-  if (f.rows() != n) throw Error("internal: paired product of unequal sizes");
-  sum(p, q);
-  const Eigen::Index rows = static_cast<Eigen::Index>(order.size());
-  out.resize(rows, 3);
-  for (Eigen::Index k = 0; k < rows; ++k) {
-    const int i = order[k];
-    for (int a = 0; a < 3; ++a) out(k, a) = w * f(i, a) + sums_[4 * i + a];
-  }
-}
-
 }  // namespace dynsub

@@ -24,11 +24,6 @@ class PairedProduct {
   // rhs = w f + C p + P q, all #vertices x 3. Not for two threads at once
   // (it keeps its scratch).
   void apply(double w, const Matrix3X& f, const Matrix3X& p, const Matrix3X& q, Matrix3X& rhs);
-  // The same, its rows in `order`: row k of `out` (rows x 3, column-major) is
-  // the product's row order[k]. The factored step forms its right-hand side
-  // straight in the factor's order this way.
-  void apply(double w, const Matrix3X& f, const Matrix3X& p, const Matrix3X& q, const std::vector<int>& order,
-             Eigen::MatrixXd& out);
 
  private:
   std::vector<int> start_;       // column j's entries: [start_[j], start_[j + 1]), the diagonal first

@@ -546,7 +546,7 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
     const LevelModel& model = *built;
     if (options.prepareNextLevel && level < options.maxLevel) {
       // The refined topology does not depend on where this level ends.
-      prepared = onOwnThread([next = subdivide(mesh).mesh, level, initialIsolation, &options] {
+      prepared = std::async(std::launch::async, [next = subdivide(mesh).mesh, level, initialIsolation, &options] {
         int isolation = initialIsolation;
         return std::unique_ptr<LevelModel>(new LevelModel(buildLevel(next, level + 1, isolation, options)));
       });

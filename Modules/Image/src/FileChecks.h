@@ -1,13 +1,22 @@
 #pragma once
 // Private to the Image module: checks of image files that ITK and GDCM leave
 // out, made before either reads the file. They read bytes only (no ITK), so
-// they can be tested and fuzzed on their own (Testing/Fuzz).
+// they can be tested and fuzzed on their own (Testing/Fuzz). One source per
+// format: NiftiCheck.cpp, MetaImageCheck.cpp, DicomCheck.cpp; what they
+// share is in FileChecks.cpp.
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
-#include <vector>
 
 namespace dynsub::filechecks {
+
+// a * b, or nothing when the product does not fit in 64 bits.
+inline std::optional<std::uintmax_t> checkedProduct(std::uintmax_t a, std::uintmax_t b) {
+  std::uintmax_t result = 0;
+  if (__builtin_mul_overflow(a, b, &result)) return std::nullopt;
+  return result;
+}
 
 // The number of bytes a gzip file inflates to, or at least `enough` when it
 // inflates to that many or more (inflating stops there). Throws
@@ -22,17 +31,9 @@ void requireMemoryFor(const std::string& path, std::uintmax_t voxels);
 // A NIfTI file (.nii, or .nii.gz when `path` ends in .gz): its header is
 // NIfTI-1 or NIfTI-2 in either byte order, its sizes and datatype possible,
 // the image fits in memory, and its data (inflated) is all there. Throws
-// dynsub::Error naming the file and the problem.
+// dynsub::Error naming the file and the problem, and for NaN or infinite
+// float voxels (which ITK's reader would turn into 0).
 void checkNiftiFile(const std::string& path);
-
-// checkNiftiFile's checks and, in the same pass over the data, the voxels as
-// float, for a file ITK would read as it is stored and cast to float: NIfTI-1
-// in one file (magic "n+1"), three dimensions, a datatype of 8 to 64 bit
-// integers or floats, no intensity scaling (scl_slope 1, scl_inter 0) and a
-// whole data offset. Returns false, with `voxels` untouched, after the same
-// checks for any other NIfTI file (ITK reads those). Throws as checkNiftiFile
-// does, and for NaN or infinite voxels (which ITK would turn into 0).
-bool readNiftiVoxels(const std::string& path, std::vector<float>& voxels);
 
 // A MetaImage file (.mha, .mhd): NDims, DimSize and ElementType are there and
 // possible, the image fits in memory, and its data is all there, after the

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <future>
 #include <sstream>
 
 #include "BridgeGeometry.h"
@@ -20,34 +19,11 @@ Volume readVolume(const std::string& path) {
   std::error_code ignored;
   Volume volume;
   itkbridge::Geometry raw;
-  // Voxels DynSub read itself were checked to be finite as they were read.
-  bool checkedFinite = false;
-  const bool nifti = filechecks::isNiftiName(path);
-  if (std::filesystem::is_directory(path, ignored) || (!nifti && filechecks::isDicomFile(path))) {
-    itkbridge::dicomFunctions().readImage(path, raw, volume.voxels);
+  if (std::filesystem::is_directory(path, ignored) || (!filechecks::isNiftiName(path) && filechecks::isDicomFile(path))) {
+    itkbridge::readDicom(path, raw, volume.voxels);
   } else {
-    // NB: opening the ITK library (its libraries relocated, its factories
-    // registered) and the file's own checks (a .nii.gz inflated once to see
-    // that all its data is there, and its voxels kept when they can be) do
-    // not depend on each other: the library opens on a second thread
-    // meanwhile. A failed check waits for it (the future's destructor) and is
-    // reported as before.
-    std::future<const itkbridge::Functions*> bridge =
-        std::async(std::launch::async, [] { return &itkbridge::functions(); });
-    // A NIfTI file that ITK would read as stored has its voxels read in the
-    // pass that checks them, and ITK gives its geometry from the header: ITK
-    // inflating the data a second time was a fifth of the caudate demo's command.
-    bool voxelsRead = false;
-    if (nifti) {
-      voxelsRead = filechecks::readNiftiVoxels(path, volume.voxels);
-    } else {
-      filechecks::checkImageFile(path);
-    }
-    const itkbridge::Functions& itk = *bridge.get();
-    const bool whole = voxelsRead && itk.readGeometry(path, raw) &&
-                       static_cast<std::size_t>(raw.size[0]) * raw.size[1] * raw.size[2] == volume.voxels.size();
-    if (!whole) itk.readImage(path, raw, volume.voxels);
-    checkedFinite = whole;
+    filechecks::checkImageFile(path);
+    itkbridge::readImage(path, raw, volume.voxels);
   }
   volume.geometry = fromBridge(raw);
   for (int a = 0; a < 3; ++a)
@@ -70,9 +46,8 @@ Volume readVolume(const std::string& path) {
   }
   // NaN or infinite intensities would spread through the smoothing into every
   // force near them.
-  const auto bad = checkedFinite ? volume.voxels.end()
-                                 : std::find_if(volume.voxels.begin(), volume.voxels.end(),
-                                                [](float v) { return !std::isfinite(v); });
+  const auto bad =
+      std::find_if(volume.voxels.begin(), volume.voxels.end(), [](float v) { return !std::isfinite(v); });
   if (bad != volume.voxels.end()) {
     const long long first = bad - volume.voxels.begin(), count = std::count_if(bad, volume.voxels.end(), [](float v) {
       return !std::isfinite(v);
@@ -99,11 +74,11 @@ void writeMask(const Mask& mask, const std::string& path, std::uint8_t label) {
   }
   AtomicOutput output(path);
   if (label == 1) {
-    itkbridge::functions().writeLabels(toBridge(mask.geometry), mask.voxels, output.temporaryPath());
+    itkbridge::writeLabels(toBridge(mask.geometry), mask.voxels, output.temporaryPath());
   } else {
     std::vector<std::uint8_t> labels(mask.voxels.size());
     for (std::size_t i = 0; i < labels.size(); ++i) labels[i] = mask.voxels[i] ? label : 0;
-    itkbridge::functions().writeLabels(toBridge(mask.geometry), labels, output.temporaryPath());
+    itkbridge::writeLabels(toBridge(mask.geometry), labels, output.temporaryPath());
   }
   output.commit();
 }

@@ -32,7 +32,22 @@ void inspectFile(const std::string& path) {
   inspectHeader(path, *io);
 }
 
+// The formats ITK reads and writes here, registered explicitly once (GDCM's
+// reader is made by readDicom itself).
+void registerFormats() {
+  static const bool registered = [] {
+    itk::NiftiImageIOFactory::RegisterOneFactory();
+    itk::NrrdImageIOFactory::RegisterOneFactory();
+    itk::MetaImageIOFactory::RegisterOneFactory();
+    return true;
+  }();
+  (void)registered;
+}
+
+}  // namespace
+
 void readImage(const std::string& path, Geometry& geometry, std::vector<float>& voxels) {
+  registerFormats();
   try {
     inspectFile(path);
     auto reader = itk::ImageFileReader<FloatImage>::New();
@@ -47,23 +62,8 @@ void readImage(const std::string& path, Geometry& geometry, std::vector<float>& 
   }
 }
 
-bool readGeometry(const std::string& path, Geometry& geometry) {
-  try {
-    // The reader's own output information, so the geometry is the one its
-    // Update would give (readImage).
-    auto reader = itk::ImageFileReader<FloatImage>::New();
-    reader->SetFileName(path);
-    reader->UpdateOutputInformation();
-    const itk::ImageIOBase* io = reader->GetImageIO();
-    if (io->GetNumberOfDimensions() != 3 || io->GetNumberOfComponents() != 1) return false;
-    geometry = geometryOf(reader->GetOutput());
-    return true;
-  } catch (const itk::ExceptionObject& e) {
-    throw Error(path, std::string("cannot read image: ") + e.GetDescription());
-  }
-}
-
 void writeLabels(const Geometry& geometry, const std::vector<std::uint8_t>& voxels, const std::string& path) {
+  registerFormats();
   try {
     auto writer = itk::ImageFileWriter<MaskImage>::New();
     writer->SetFileName(path);
@@ -103,19 +103,4 @@ std::vector<float> distanceMap(const Geometry& geometry, const std::vector<std::
   return distance;
 }
 
-}  // namespace
 }  // namespace dynsub::itkbridge
-
-// The library's one exported symbol (it is built with hidden visibility).
-extern "C" __attribute__((visibility("default"))) const dynsub::itkbridge::Functions* dynsubItkBridgeFunctions() {
-  using namespace dynsub::itkbridge;
-  // The formats ITK reads and writes here, registered explicitly: GDCM's
-  // factory is left out (it is in libDynSubItkDicom.so, ItkBridge.h).
-  static const Functions table = [] {
-    itk::NiftiImageIOFactory::RegisterOneFactory();
-    itk::NrrdImageIOFactory::RegisterOneFactory();
-    itk::MetaImageIOFactory::RegisterOneFactory();
-    return Functions{&readImage, &readGeometry, &writeLabels, &recursiveGaussianGradient, &distanceMap};
-  }();
-  return &table;
-}

@@ -1,5 +1,4 @@
-// libDynSubItkDicom.so: DICOM read through ITK and GDCM (ItkBridge.h says
-// why this is a library apart from the other formats').
+// DICOM read through ITK and GDCM, for the ITK bridge (ItkBridge.h).
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
@@ -141,7 +140,9 @@ FloatImage::Pointer readFile(const std::string& path) {
   return reader->GetOutput();
 }
 
-void readImage(const std::string& path, Geometry& geometry, std::vector<float>& voxels) {
+}  // namespace
+
+void readDicom(const std::string& path, Geometry& geometry, std::vector<float>& voxels) {
   try {
     std::error_code ignored;
     const FloatImage::Pointer image = fs::is_directory(path, ignored) ? readSeries(path) : readFile(path);
@@ -153,11 +154,4 @@ void readImage(const std::string& path, Geometry& geometry, std::vector<float>& 
   }
 }
 
-}  // namespace
 }  // namespace dynsub::itkbridge
-
-// The library's one exported symbol (it is built with hidden visibility).
-extern "C" __attribute__((visibility("default"))) const dynsub::itkbridge::DicomFunctions* dynsubItkDicomFunctions() {
-  static const dynsub::itkbridge::DicomFunctions table{&dynsub::itkbridge::readImage};
-  return &table;
-}

@@ -24,7 +24,7 @@ Mask randomMask(const std::array<int, 3>& size, const Vector3& spacing, double s
 }
 
 std::vector<float> itksDistances(const Mask& m) {
-  return itkbridge::functions().distanceMap(toBridge(m.geometry), m.voxels);
+  return itkbridge::distanceMap(toBridge(m.geometry), m.voxels);
 }
 
 TEST(DistanceTo, EqualsItksMaurerTransformToTheBitOnOneAndHalfMillimetreGrids) {

@@ -98,7 +98,6 @@ std::vector<std::pair<std::string, ImageGeometry>> grids() {
 }
 
 TEST(NiftiLabelmap, ItksReaderSeesWhatItsWriterWrote) {
-  const itkbridge::Functions& itk = itkbridge::functions();
   for (const auto& [name, g] : grids()) {
     SCOPED_TRACE(name);
     const Mask mask = ballOn(g);
@@ -108,12 +107,12 @@ TEST(NiftiLabelmap, ItksReaderSeesWhatItsWriterWrote) {
       writeMask(mask, ours.string(), 7);
       std::vector<std::uint8_t> labels(mask.voxels.size());
       for (std::size_t v = 0; v < labels.size(); ++v) labels[v] = mask.voxels[v] ? 7 : 0;
-      itk.writeLabels(toBridge(g), labels, theirs.string());
+      itkbridge::writeLabels(toBridge(g), labels, theirs.string());
 
       itkbridge::Geometry readOurs, readTheirs;
       std::vector<float> voxelsOurs, voxelsTheirs;
-      itk.readImage(ours.string(), readOurs, voxelsOurs);
-      itk.readImage(theirs.string(), readTheirs, voxelsTheirs);
+      itkbridge::readImage(ours.string(), readOurs, voxelsOurs);
+      itkbridge::readImage(theirs.string(), readTheirs, voxelsTheirs);
       EXPECT_EQ(voxelsOurs, voxelsTheirs);
       EXPECT_EQ(readOurs.size, readTheirs.size);
       // Both headers hold floats: the geometry read back agrees to a float's

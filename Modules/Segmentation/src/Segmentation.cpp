@@ -281,7 +281,7 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
   std::optional<EndPressure> pressure = endPressure(region, landmarks, options.sliceEnds, ends);
   // NB: the initial model's volume (for the collapse check) is measured on
   // the second core while the evolution runs on one.
-  std::future<double> initialVolume = onOwnThread([&initial] {
+  std::future<double> initialVolume = std::async(std::launch::async, [&initial] {
     const LimitSurface limit(initial);
     return enclosedVolume(tessellate(limit, initial.points(), outputSegments(limit)));
   });

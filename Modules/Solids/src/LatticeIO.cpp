@@ -6,6 +6,12 @@
 #include <iomanip>
 #include <sstream>
 
+#include <vtkCellData.h>
+#include <vtkIntArray.h>
+#include <vtkNew.h>
+#include <vtkPoints.h>
+#include <vtkUnstructuredGrid.h>
+
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
@@ -128,21 +134,24 @@ void writeText(const Lattice& l, const std::string& path) {
   if (!out) throw Error(path, "writing the file failed");
 }
 
-// Every cell as a VTK_POLYHEDRON (type 42) with its faces, as VTK's writer
-// gives it: the connectivity holds a cell's distinct points in increasing
-// order, the face stream its face count and then each face's size and points,
-// and the offsets (of both) end each cell.
+// Every cell as a VTK_POLYHEDRON with its faces, and per cell the number of
+// its faces on the lattice's boundary (cell data "BoundaryFaces").
 void writeVtu(const Lattice& l, const std::string& path, const std::string& name) {
-  constexpr uint8_t kPolyhedron = 42;
-  std::vector<int64_t> connectivity, offsets, faces, faceOffsets;
-  std::vector<int32_t> boundaryFaces;
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(l.pointCount());
+  for (int p = 0; p < l.pointCount(); ++p) points->SetPoint(p, l.points()(p, 0), l.points()(p, 1), l.points()(p, 2));
+  vtkNew<vtkUnstructuredGrid> grid;
+  grid->SetPoints(points);
+  grid->Allocate(l.cellCount());
+  vtkNew<vtkIntArray> boundaryFaces;
+  boundaryFaces->SetName("BoundaryFaces");
   for (const std::vector<int>& cell : l.cells()) {
-    std::vector<int64_t> corners;
+    std::vector<vtkIdType> corners, faces;
     int boundary = 0;
-    faces.push_back(static_cast<int64_t>(cell.size()));
     for (int f : cell) {
       boundary += l.isBoundaryFace(f);
-      faces.push_back(static_cast<int64_t>(l.faces()[f].size()));
+      faces.push_back(static_cast<vtkIdType>(l.faces()[f].size()));
       for (int p : l.faces()[f]) {
         faces.push_back(p);
         corners.push_back(p);
@@ -150,24 +159,12 @@ void writeVtu(const Lattice& l, const std::string& path, const std::string& name
     }
     std::sort(corners.begin(), corners.end());
     corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
-    connectivity.insert(connectivity.end(), corners.begin(), corners.end());
-    offsets.push_back(static_cast<int64_t>(connectivity.size()));
-    faceOffsets.push_back(static_cast<int64_t>(faces.size()));
-    boundaryFaces.push_back(boundary);
+    grid->InsertNextCell(VTK_POLYHEDRON, static_cast<vtkIdType>(corners.size()), corners.data(),
+                         static_cast<vtkIdType>(cell.size()), faces.data());
+    boundaryFaces->InsertNextValue(boundary);
   }
-  vtkxml::Dataset data;
-  data.type = "UnstructuredGrid";
-  data.pieceAttributes = " NumberOfPoints=\"" + std::to_string(l.pointCount()) + "\" NumberOfCells=\"" +
-                         std::to_string(l.cellCount()) + "\"";
-  data.sections.push_back({"PointData", "", {}});
-  data.sections.push_back({"CellData", "", {vtkxml::int32Array("BoundaryFaces", boundaryFaces, true)}});
-  data.sections.push_back({"Points", "", {vtkxml::float64Array("Points", l.points())}});
-  data.sections.push_back({"Cells",
-                           "",
-                           {vtkxml::int64Array("connectivity", connectivity), vtkxml::int64Array("offsets", offsets),
-                            vtkxml::uint8Array("types", std::vector<uint8_t>(l.cells().size(), kPolyhedron)),
-                            vtkxml::int64Array("faces", faces), vtkxml::int64Array("faceoffsets", faceOffsets)}});
-  vtkxml::writeDataset(data, path, name);
+  grid->GetCellData()->AddArray(boundaryFaces);
+  writeVtkXml(grid, path, name);
 }
 
 }  // namespace

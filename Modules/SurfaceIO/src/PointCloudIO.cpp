@@ -9,11 +9,14 @@
 #include <sstream>
 #include <vector>
 
+#include <vtkNew.h>
+#include <vtkPolyData.h>
+#include <vtkXMLPolyDataReader.h>
+
 #include "dynsub/Error.h"
 #include "dynsub/TextFields.h"
 #include "dynsub/FileNames.h"
 #include "dynsub/MeshIO.h"
-#include "GeometryFormats.h"
 
 namespace dynsub {
 
@@ -86,11 +89,19 @@ void checkVtpCounts(const std::string& path) {
 
 Matrix3X readVtp(const std::string& path) {
   checkVtpCounts(path);
-  std::vector<double> xyz;
-  const std::string problem = geometryformats::functions().readXmlPolyDataPoints(path, xyz);
-  if (!problem.empty()) throw Error(path, problem);
-  Matrix3X result(static_cast<Eigen::Index>(xyz.size() / 3), 3);
-  for (Eigen::Index i = 0; i < result.rows(); ++i) result.row(i) << xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2];
+  vtkNew<vtkXMLPolyDataReader> reader;
+  if (!reader->CanReadFile(path.c_str())) throw Error(path, "is not a VTK XML polydata file");
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  if (reader->GetErrorCode() != 0) throw Error(path, "could not be read (truncated or corrupt?)");
+  vtkPolyData* data = reader->GetOutput();
+  if (!data || !data->GetPoints() || data->GetNumberOfPoints() == 0) throw Error(path, "has no points");
+  Matrix3X result(static_cast<Eigen::Index>(data->GetNumberOfPoints()), 3);
+  for (vtkIdType i = 0; i < data->GetNumberOfPoints(); ++i) {
+    double p[3];
+    data->GetPoint(i, p);
+    result.row(i) << p[0], p[1], p[2];
+  }
   return result;
 }
 

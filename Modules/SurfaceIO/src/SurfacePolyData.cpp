@@ -9,6 +9,9 @@
 #include <vtkDoubleArray.h>
 #include <vtkIntArray.h>
 #include <vtkNew.h>
+#include <vtkOBJReader.h>
+#include <vtkPLYReader.h>
+#include <vtkSTLReader.h>
 #include <vtkAbstractPolyDataReader.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
@@ -18,7 +21,6 @@
 
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
-#include "GeometryFormats.h"
 
 namespace dynsub {
 
@@ -109,8 +111,11 @@ vtkSmartPointer<vtkPolyData> readSurfacePolyData(const std::string& path) {
     reader->SetFileName(path.c_str());
     polyData = readWith(reader.GetPointer(), path);
   } else if (extension == ".obj" || extension == ".ply" || extension == ".stl") {
-    const auto reader = vtkSmartPointer<vtkAbstractPolyDataReader>::Take(
-        geometryformats::functions().newReader(extension, path));
+    vtkSmartPointer<vtkAbstractPolyDataReader> reader;
+    if (extension == ".obj") reader = vtkSmartPointer<vtkOBJReader>::New();
+    if (extension == ".ply") reader = vtkSmartPointer<vtkPLYReader>::New();
+    if (extension == ".stl") reader = vtkSmartPointer<vtkSTLReader>::New();
+    reader->SetFileName(path.c_str());
     polyData = readWith(reader, path);
   } else {
     throw Error(path, "unknown surface format '" + extension + "' (expected .vtp, .obj, .ply or .stl)");

@@ -6,61 +6,34 @@
 #include <cstring>
 #include <fstream>
 
+#include <vtkFieldData.h>
+#include <vtkNew.h>
+#include <vtkPolyData.h>
+#include <vtkStringArray.h>
+
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
+#include "dynsub/SurfacePolyData.h"
 #include "dynsub/VtkXmlWriter.h"
 
 namespace dynsub {
 
 namespace {
 
-// The triangles' point ids and the end of each one's, as Id.
-template <typename Id>
-vtkxml::Section polys(const TriangleSurface& surface,
-                      vtkxml::DataArray (*array)(const std::string&, const std::vector<Id>&, bool)) {
-  const std::size_t triangles = surface.triangles.size();
-  std::vector<Id> connectivity(3 * triangles), offsets(triangles);
-  for (std::size_t t = 0; t < triangles; ++t) {
-    std::copy(surface.triangles[t].begin(), surface.triangles[t].end(), connectivity.begin() + 3 * t);
-    offsets[t] = static_cast<Id>(3 * (t + 1));
-  }
-  return {"Polys", "", {array("connectivity", connectivity, false), array("offsets", offsets, false)}};
-}
-
-// VTK XML polydata as VTK's XML writer gives it (VtkXmlWriter.h), with the
-// arrays SurfacePolyData.h's toPolyData makes, so that a file read back is
-// the polydata the figures draw.
+// VTK XML polydata with the arrays SurfacePolyData.h's toPolyData makes, so
+// that a file read back is the polydata the figures draw.
 void writeVtp(const TriangleSurface& surface, const std::string& path, const std::string& name,
               const std::vector<PointScalars>& scalars, const std::string& space) {
-  const Eigen::Index n = surface.points.rows();
-  const std::size_t triangles = surface.triangles.size();
-  std::vector<uint8_t> type(triangles);
-  std::vector<int32_t> element(triangles);
-  for (std::size_t t = 0; t < triangles; ++t) {
-    type[t] = static_cast<uint8_t>(surface.triangleType[t]);
-    element[t] = surface.triangleElement[t];
+  const vtkSmartPointer<vtkPolyData> data = toPolyData(surface);
+  for (const PointScalars& s : scalars) addPointData(data, s.name, s.values);
+  if (!space.empty()) {
+    vtkNew<vtkStringArray> spaceName;
+    spaceName->SetName("SPACE");
+    spaceName->InsertNextValue(space);
+    data->GetFieldData()->AddArray(spaceName);
   }
-  vtkxml::Dataset data;
-  data.type = "PolyData";
-  if (!space.empty()) data.fieldData.push_back(vtkxml::stringArray("SPACE", {space}));
-  data.pieceAttributes = " NumberOfPoints=\"" + std::to_string(n) +
-                         "\" NumberOfVerts=\"0\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"" +
-                         std::to_string(triangles) + "\"";
-  vtkxml::Section pointData{"PointData", " Normals=\"Normals\"", {vtkxml::float64Array("Normals", surface.normals)}};
-  for (const PointScalars& s : scalars) pointData.arrays.push_back(vtkxml::float64Array(s.name, s.values));
-  data.sections.push_back(std::move(pointData));
-  data.sections.push_back(
-      {"CellData", "", {vtkxml::uint8Array("ElementType", type, true), vtkxml::int32Array("Element", element, true)}});
-  data.sections.push_back({"Points", "", {vtkxml::float64Array("Points", surface.points)}});
-  for (const char* empty : {"Verts", "Lines", "Strips"})
-    data.sections.push_back({empty, "", {vtkxml::int64Array("connectivity", {}), vtkxml::int64Array("offsets", {})}});
-  // NB: 32-bit point ids where they fit: the connectivity and offsets were
-  // half of a fitted surface's bytes as 64-bit ids, all to be compressed and written.
-  const bool small = n < (Eigen::Index{1} << 31) && 3 * triangles < (std::size_t{1} << 31);
-  data.sections.push_back(small ? polys<int32_t>(surface, &vtkxml::int32Array)
-                                : polys<int64_t>(surface, &vtkxml::int64Array));
-  vtkxml::writeDataset(data, path, name);
+  writeVtkXml(data, path, name);
 }
 
 // Writes `bytes` to `path`, a new file; errors name `name`.

@@ -1,154 +1,119 @@
-// Files written by VtkXmlWriter read back through VTK's own XML reader, value
-// for value: arrays across block boundaries, a block exactly full, empty
-// arrays, strings, and several components.
+#include "dynsub/VtkXmlWriter.h"
+
+#include <unistd.h>
+
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <string>
 
 #include <gtest/gtest.h>
-#include <vtkCallbackCommand.h>
 #include <vtkCellArray.h>
-#include <vtkCellData.h>
-#include <vtkDataArray.h>
-#include <vtkFieldData.h>
+#include <vtkDoubleArray.h>
+#include <vtkIdList.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
+#include <vtkPoints.h>
 #include <vtkPolyData.h>
-#include <vtkStringArray.h>
+#include <vtkUnstructuredGrid.h>
 #include <vtkXMLPolyDataReader.h>
+#include <vtkXMLUnstructuredGridReader.h>
 
 #include "dynsub/Error.h"
-#include "dynsub/VtkXmlWriter.h"
 
 namespace fs = std::filesystem;
-using namespace dynsub;
 
 namespace {
 
-std::string scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / "dynsub-vtkxml";
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("dynsub-vtkxml-" + std::to_string(::getpid()));
   fs::create_directories(dir);
-  return (dir / name).string();
+  return dir / name;
 }
 
-// n triangles over points 0..n+1, as a strip of fans would have them.
-vtkxml::Dataset triangles(int points, int triangles, std::vector<double>& xyz) {
-  xyz.resize(3 * static_cast<std::size_t>(points));
-  for (std::size_t i = 0; i < xyz.size(); ++i) xyz[i] = std::sin(0.37 * static_cast<double>(i)) * 1e3 + 1e-9 * i;
-  std::vector<int32_t> connectivity, offsets, element;
-  std::vector<uint8_t> type;
-  for (int t = 0; t < triangles; ++t) {
-    for (int k = 0; k < 3; ++k) connectivity.push_back((t + k) % points);
-    offsets.push_back(3 * (t + 1));
-    element.push_back(t * 7 - 5);
-    type.push_back(static_cast<uint8_t>(t % 2));
-  }
-  vtkxml::Dataset data;
-  data.type = "PolyData";
-  data.fieldData.push_back(vtkxml::stringArray("SPACE", {"LPS", "second & <third>"}));
-  data.pieceAttributes = " NumberOfPoints=\"" + std::to_string(points) +
-                         "\" NumberOfVerts=\"0\" NumberOfLines=\"0\" NumberOfStrips=\"0\" NumberOfPolys=\"" +
-                         std::to_string(triangles) + "\"";
-  data.sections.push_back({"PointData", "", {vtkxml::float64Array("Normals", xyz, 3)}});
-  data.sections.push_back(
-      {"CellData", "", {vtkxml::uint8Array("ElementType", type, true), vtkxml::int32Array("Element", element, true)}});
-  data.sections.push_back({"Points", "", {vtkxml::float64Array("Points", xyz, 3)}});
-  for (const char* empty : {"Verts", "Lines", "Strips"})
-    data.sections.push_back({empty, "", {vtkxml::int64Array("connectivity", {}), vtkxml::int64Array("offsets", {})}});
-  data.sections.push_back(
-      {"Polys", "", {vtkxml::int32Array("connectivity", connectivity), vtkxml::int32Array("offsets", offsets)}});
-  return data;
-}
-
-// Reads `path` with VTK, failing the test on any error VTK reports.
-vtkSmartPointer<vtkPolyData> readBack(const std::string& path) {
-  vtkNew<vtkXMLPolyDataReader> reader;
-  vtkNew<vtkCallbackCommand> onError;
-  bool failed = false;
-  onError->SetClientData(&failed);
-  onError->SetCallback([](vtkObject*, unsigned long, void* client, void*) { *static_cast<bool*>(client) = true; });
-  reader->AddObserver(vtkCommand::ErrorEvent, onError);
-  reader->SetFileName(path.c_str());
-  reader->Update();
-  EXPECT_FALSE(failed) << "VTK reported an error reading " << path;
-  EXPECT_EQ(reader->GetErrorCode(), 0);
-  auto data = vtkSmartPointer<vtkPolyData>::New();
-  data->ShallowCopy(reader->GetOutput());
-  return data;
-}
-
-void expectSame(int points, int cells) {
-  std::vector<double> xyz;
-  const vtkxml::Dataset data = triangles(points, cells, xyz);
-  const std::string path = scratch("p" + std::to_string(points) + "c" + std::to_string(cells) + ".vtp");
-  vtkxml::writeDataset(data, path, path);
-  vtkSmartPointer<vtkPolyData> back = readBack(path);
-  ASSERT_EQ(back->GetNumberOfPoints(), points);
-  ASSERT_EQ(back->GetNumberOfPolys(), cells);
-  vtkDataArray* normals = back->GetPointData()->GetArray("Normals");
-  ASSERT_NE(normals, nullptr);
-  ASSERT_EQ(normals->GetNumberOfComponents(), 3);
-  for (int i = 0; i < points; ++i) {
-    double p[3];
-    back->GetPoint(i, p);
-    for (int a = 0; a < 3; ++a) {
-      ASSERT_EQ(p[a], xyz[3 * i + a]) << "point " << i;  // exact: the bytes are the doubles
-      ASSERT_EQ(normals->GetComponent(i, a), xyz[3 * i + a]);
+// A triangle fan of n triangles around the origin with one value per point:
+// more than one LZ4 block (32 KiB) of points for n = 5000.
+vtkNew<vtkPolyData> fan(int n) {
+  vtkNew<vtkPolyData> data;
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  vtkNew<vtkDoubleArray> values;
+  values->SetName("Value");
+  points->InsertNextPoint(0, 0, 0);
+  values->InsertNextValue(0);
+  vtkNew<vtkCellArray> triangles;
+  for (int i = 0; i <= n; ++i) {
+    const double a = 6.283185307179586 * i / n;
+    points->InsertNextPoint(std::cos(a), std::sin(a), 0.001 * i);
+    values->InsertNextValue(1.0 / (i + 1));
+    if (i > 0) {
+      const vtkIdType ids[3] = {0, i, i + 1};
+      triangles->InsertNextCell(3, ids);
     }
   }
-  vtkDataArray* element = back->GetCellData()->GetArray("Element");
-  vtkDataArray* type = back->GetCellData()->GetArray("ElementType");
-  ASSERT_NE(element, nullptr);
-  ASSERT_NE(type, nullptr);
-  EXPECT_EQ(element->GetDataType(), VTK_INT);
-  EXPECT_EQ(type->GetDataType(), VTK_UNSIGNED_CHAR);
-  vtkNew<vtkIdList> ids;
-  for (int t = 0; t < cells; ++t) {
-    ASSERT_EQ(element->GetTuple1(t), t * 7 - 5);
-    ASSERT_EQ(type->GetTuple1(t), t % 2);
-    back->GetPolys()->GetCellAtId(t, ids);
-    ASSERT_EQ(ids->GetNumberOfIds(), 3);
-    for (int k = 0; k < 3; ++k) ASSERT_EQ(ids->GetId(k), (t + k) % points);
+  data->SetPoints(points);
+  data->SetPolys(triangles);
+  data->GetPointData()->AddArray(values);
+  return data;
+}
+
+TEST(VtkXmlWriter, VtkReadsBackEveryPolyDataValue) {
+  const vtkNew<vtkPolyData> written = fan(5000);
+  const fs::path path = scratch("fan.vtp");
+  dynsub::writeVtkXml(written, path.string(), "fan.vtp");
+  vtkNew<vtkXMLPolyDataReader> reader;
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  vtkPolyData* read = reader->GetOutput();
+  ASSERT_EQ(read->GetNumberOfPoints(), written->GetNumberOfPoints());
+  ASSERT_EQ(read->GetNumberOfPolys(), written->GetNumberOfPolys());
+  auto* values = vtkDoubleArray::SafeDownCast(read->GetPointData()->GetArray("Value"));
+  ASSERT_NE(values, nullptr);
+  for (vtkIdType i = 0; i < read->GetNumberOfPoints(); ++i) {
+    double a[3], b[3];
+    read->GetPoint(i, a);
+    written->GetPoint(i, b);
+    for (int c = 0; c < 3; ++c) ASSERT_EQ(a[c], b[c]);  // doubles, written losslessly
+    ASSERT_EQ(values->GetValue(i), i == 0 ? 0.0 : 1.0 / static_cast<double>(i));
   }
-  auto* space = vtkStringArray::SafeDownCast(back->GetFieldData()->GetAbstractArray("SPACE"));
-  ASSERT_NE(space, nullptr);
-  ASSERT_EQ(space->GetNumberOfValues(), 2);
-  EXPECT_EQ(space->GetValue(0), "LPS");
-  EXPECT_EQ(space->GetValue(1), "second & <third>");
 }
 
-TEST(VtkXmlWriter, VtkReadsBackEveryValue) {
-  expectSame(5, 3);  // every array shorter than a block
-  // 8192 triangles: the Int32 cell arrays fill exactly one 32 KiB block (the
-  // header's last-block size 0); 5000 points: 120 000 bytes, four blocks.
-  expectSame(5000, 8192);
-  expectSame(20000, 40001);  // many blocks, the last one short
-}
-
-TEST(VtkXmlWriter, RangesAreTheMagnitudesForVectors) {
-  const vtkxml::DataArray vectors = vtkxml::float64Array("v", {3, 4, 0, 0, 0, -2}, 3);
-  ASSERT_TRUE(vectors.hasRange);
-  EXPECT_EQ(vectors.tuples, 2);
-  EXPECT_EQ(vectors.rangeMin, 2.0);
-  EXPECT_EQ(vectors.rangeMax, 5.0);
-  const vtkxml::DataArray values = vtkxml::int32Array("i", {4, -7, 2}, true);
-  EXPECT_EQ(values.rangeMin, -7.0);
-  EXPECT_EQ(values.rangeMax, 4.0);
-  EXPECT_FALSE(vtkxml::int32Array("topology", {1, 2}).hasRange);
-  EXPECT_THROW(vtkxml::float64Array("v", {1, 2}, 3), Error);  // values that do not fill the tuples
+TEST(VtkXmlWriter, VtkReadsBackAPolyhedron) {
+  // A unit cube as one VTK_POLYHEDRON with its six faces.
+  vtkNew<vtkUnstructuredGrid> grid;
+  vtkNew<vtkPoints> points;
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i) points->InsertNextPoint(i, j, k);
+  grid->SetPoints(points);
+  const vtkIdType corners[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+  const vtkIdType faces[] = {4, 0, 2, 3, 1, 4, 4, 5, 7, 6, 4, 0, 1, 5, 4, 4, 2, 6, 7, 3, 4, 0, 4, 6, 2, 4, 1, 3, 7, 5};
+  grid->InsertNextCell(VTK_POLYHEDRON, 8, corners, 6, faces);
+  const fs::path path = scratch("cube.vtu");
+  dynsub::writeVtkXml(grid, path.string(), "cube.vtu");
+  vtkNew<vtkXMLUnstructuredGridReader> reader;
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  vtkUnstructuredGrid* read = reader->GetOutput();
+  ASSERT_EQ(read->GetNumberOfCells(), 1);
+  EXPECT_EQ(read->GetCellType(0), VTK_POLYHEDRON);
+  vtkNew<vtkIdList> stream;
+  read->GetFaceStream(0, stream);
+  ASSERT_EQ(stream->GetNumberOfIds(), 1 + 30);
+  EXPECT_EQ(stream->GetId(0), 6);
+  for (int f = 0; f < 30; ++f) EXPECT_EQ(stream->GetId(1 + f), faces[f]);
 }
 
 TEST(VtkXmlWriter, AFileThatCannotBeWrittenIsNamed) {
-  std::vector<double> xyz;
-  const vtkxml::Dataset data = triangles(5, 3, xyz);
+  const vtkNew<vtkPolyData> written = fan(10);
+  const std::string path = (scratch("") / "no-such-directory" / "fan.vtp").string();
   try {
-    vtkxml::writeDataset(data, "/nonexistent-dynsub/out.vtp", "asked-for.vtp");
+    dynsub::writeVtkXml(written, path, "fan.vtp");
     FAIL() << "no error";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("asked-for.vtp"), std::string::npos) << e.what();
+  } catch (const dynsub::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("fan.vtp"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("could not be written"), std::string::npos) << e.what();
   }
+  EXPECT_FALSE(fs::exists(path));
 }
 
 }  // namespace

@@ -4,12 +4,13 @@
 // target by commit(). If commit() is never called (an exception, a failed
 // check), the destructor removes the temporary file and the target is untouched.
 //
-// The temporary file is ".tmp-<pid>-<name>". A program that started the
-// guard of TemporaryFileGuard.h has those of a killed run removed at once;
-// otherwise those of runs that were killed (their process is gone) are
-// removed when the next output of that name is opened. A target that is already this process's temporary file (a writer
-// given the path of an enclosing output) is written in place: the enclosing
-// output removes it or makes it appear.
+// The temporary file is ".tmp-<pid>-<name>". A run killed by a signal that
+// cannot be caught (SIGKILL, a scheduler's hard limit) leaves its temporary
+// files behind; the next output of the same name removes those whose process
+// is gone (the sweep), so a rerun of the job cleans up after the killed one.
+// A target that is already this process's temporary file (a writer given the
+// path of an enclosing output) is written in place: the enclosing output
+// removes it or makes it appear.
 #include <string>
 
 #include "dynsub/Error.h"

@@ -8,8 +8,6 @@
 
 #include <Eigen/Core>
 
-#include "dynsub/ResidentHeap.h"
-
 namespace dynsub {
 
 // body(i) for i in [0, count): one contiguous chunk per thread, on at most
@@ -83,10 +81,7 @@ void parallelFor(Eigen::Index count, Eigen::Index threadsWorthIt, const Body& bo
     // NB: nothing may leave this loop by an exception while helpers run
     // `run`, which lives on this frame.
     try {
-      workers.emplace_back([&run, t] {
-        useResidentArena();
-        run(t);
-      });
+      workers.emplace_back([&run, t] { run(t); });
     } catch (...) {
       run(t);  // no thread to be had (system_error, bad_alloc): this one does the chunk
     }
@@ -105,24 +100,13 @@ void bothAtOnce(const First& first, const Second& second) {
   parallelFor(2, 2, [&](Eigen::Index half) { half == 0 ? first() : second(); });
 }
 
-// work() on a thread of its own, its result in the future (as
-// std::async(std::launch::async, work) gives it), the thread's memory on
-// huge pages (useResidentArena): for work begun here and waited for later.
-template <class Work>
-auto onOwnThread(Work work) {
-  return std::async(std::launch::async, [work = std::move(work)]() mutable {
-    useResidentArena();
-    return work();
-  });
-}
-
 // background() on a second thread while foreground() runs on this one; an
 // exception from background() is rethrown before one from foreground(), as
 // when it ran first. For output written meanwhile, where this thread keeps
 // what must stay on it (adding outputs to a set, rendering).
 template <class Background, class Foreground>
 void alongside(const Background& background, const Foreground& foreground) {
-  std::future<void> done = onOwnThread([&] { background(); });
+  std::future<void> done = std::async(std::launch::async, [&] { background(); });
   try {
     foreground();
   } catch (...) {

@@ -16,9 +16,9 @@
 // S terms cancel, so equilibria are those of the papers' equations; only the
 // path to them is damped. An empty S gives the papers' schemes unchanged.
 //
-// Solvers: sparse Cholesky (CHOLMOD's supernodal LL^T, factored once; the
-// triangular solves and the right-hand side are the module's own, on two
-// threads for large systems with the same results as one), conjugate
+// Solvers: sparse Cholesky (CHOLMOD's supernodal LL^T, factored once and
+// solved by CHOLMOD; the right-hand side on two threads for large systems,
+// with the same results as one), conjugate
 // gradients (the papers' solver) and conjugate gradients with an incomplete
 // Cholesky preconditioner (the speed-up TVCG §5 asks for), both warm-started
 // from p(t). Fixed control vertices keep their positions.

@@ -1,7 +1,5 @@
 #pragma once
-// What the viewer (Viewer.h) is opened with, without VTK: `dynsub view`
-// hands it over through RenderingLibrary.h (FigureInputs.h says why a
-// command's sources hold no header of VTK's).
+// What the viewer (Viewer.h) is opened with, in the project's own types.
 #include <string>
 #include <vector>
 

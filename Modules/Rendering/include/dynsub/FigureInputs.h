@@ -1,8 +1,7 @@
 #pragma once
 // The figures of a result as the commands ask for them (Figures.h draws
-// them), without VTK: the commands reach them through RenderingLibrary.h,
-// and a header of VTK's in a command's sources would load VTK's core at
-// every start (vtkSystemIncludes.h's static objects), figures or not.
+// them), in the project's own types: the commands hold no VTK object, and
+// their sources compile without VTK's headers.
 #include <string>
 
 #include "dynsub/ConvergenceHistory.h"

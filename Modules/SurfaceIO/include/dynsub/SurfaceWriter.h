@@ -1,8 +1,7 @@
 #pragma once
 // Writes a tessellated limit surface (Tessellation.h) in a format chosen by the
-// file extension, in the forms VTK's writers give, so that ParaView, 3D Slicer
-// and other tools open it (DynSub writes them itself: VtkXmlWriter.h says why):
-//   .vtp  VTK XML polydata (binary, LZ4 blocks): point data "Normals", cell data
+// file extension, so that ParaView, 3D Slicer and other tools open it:
+//   .vtp  VTK XML polydata by VTK's writer (binary, LZ4 blocks): point data "Normals", cell data
 //         "ElementType" (0 normal element, 1 special element) and "Element";
 //   .obj  Wavefront OBJ with vertex normals;  .ply  binary PLY (float
 //         positions and normals);  .stl  binary STL.

@@ -1,0 +1,115 @@
+// MetaImage files: the checks made before ITK reads them (FileChecks.h).
+#include "FileChecks.h"
+
+#include <cerrno>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <vector>
+
+#include "dynsub/Error.h"
+
+namespace dynsub::filechecks {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string trim(const std::string& text) {
+  const auto first = text.find_first_not_of(" \t\r"), last = text.find_last_not_of(" \t\r");
+  return first == std::string::npos ? std::string() : text.substr(first, last - first + 1);
+}
+
+// The bytes of one MetaImage element type, 0 for an unknown type.
+int metaElementBytes(const std::string& type) {
+  static const std::map<std::string, int> bytes = {
+      {"MET_CHAR", 1},   {"MET_UCHAR", 1}, {"MET_SHORT", 2},     {"MET_USHORT", 2},   {"MET_INT", 4},
+      {"MET_UINT", 4},   {"MET_LONG", 4},  {"MET_ULONG", 4},     {"MET_LONG_LONG", 8}, {"MET_ULONG_LONG", 8},
+      {"MET_FLOAT", 4},  {"MET_DOUBLE", 8}};
+  const auto found = bytes.find(type);
+  return found == bytes.end() ? 0 : found->second;
+}
+
+}  // namespace
+
+// ITK reads a short compressed .mha without complaint. Lists and patterns of
+// slice files are left to ITK.
+void checkMetaImageFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path, "cannot be opened");
+  std::string line, dataFile, elementType;
+  bool compressed = false;
+  std::uintmax_t compressedSize = 0, channels = 1;
+  std::vector<std::int64_t> size;
+  long long dimensions = -1;
+  auto whole = [&](const std::string& key, const std::string& value) {
+    char* end = nullptr;
+    errno = 0;
+    const long long n = std::strtoll(value.c_str(), &end, 10);
+    if (value.empty() || *end != '\0' || errno) throw Error(path, "MetaImage " + key + " '" + value + "' is not a whole number");
+    return n;
+  };
+  while (dataFile.empty() && std::getline(in, line)) {
+    const auto equals = line.find('=');
+    if (equals == std::string::npos) continue;
+    const std::string key = trim(line.substr(0, equals)), value = trim(line.substr(equals + 1));
+    if (key == "NDims") dimensions = whole(key, value);
+    if (key == "DimSize") {
+      std::istringstream fields(value);
+      std::string field;
+      size.clear();
+      while (fields >> field) size.push_back(whole(key, field));
+    }
+    if (key == "ElementType") elementType = value;
+    if (key == "ElementNumberOfChannels") {
+      const long long n = whole(key, value);
+      if (n < 1 || n > 1024) throw Error(path, "MetaImage ElementNumberOfChannels " + value + " (1 to 1024 are read)");
+      channels = static_cast<std::uintmax_t>(n);
+    }
+    if (key == "CompressedData") compressed = value == "True" || value == "true";
+    if (key == "CompressedDataSize") {
+      const long long n = whole(key, value);
+      if (n < 0) throw Error(path, "MetaImage CompressedDataSize is negative");
+      compressedSize = static_cast<std::uintmax_t>(n);
+    }
+    if (key == "ElementDataFile") dataFile = value;
+  }
+  if (dataFile.empty()) throw Error(path, "a MetaImage header without ElementDataFile");
+  if (dimensions < 1 || dimensions > 10)
+    throw Error(path, "a MetaImage header with NDims " + std::to_string(dimensions) + " (1 to 10 are read)");
+  if (static_cast<long long>(size.size()) != dimensions)
+    throw Error(path, "MetaImage DimSize has " + std::to_string(size.size()) + " sizes for NDims " +
+                          std::to_string(dimensions));
+  std::uintmax_t voxels = 1;
+  for (std::size_t a = 0; a < size.size(); ++a) {
+    if (size[a] < 1)
+      throw Error(path, "MetaImage DimSize " + std::to_string(size[a]) + " along axis " + std::to_string(a));
+    const auto next = checkedProduct(voxels, static_cast<std::uintmax_t>(size[a]));
+    if (!next) throw Error(path, "a MetaImage header whose size does not fit in 64 bits");
+    voxels = *next;
+  }
+  const int elementBytes = metaElementBytes(elementType);
+  if (!elementBytes) throw Error(path, "MetaImage ElementType '" + elementType + "' is not one that is read");
+  requireMemoryFor(path, voxels);
+  const auto voxelBytes = checkedProduct(voxels, channels * static_cast<std::uintmax_t>(elementBytes));
+  if (!voxelBytes) throw Error(path, "a MetaImage header whose size does not fit in 64 bits");
+  std::uintmax_t available = 0;
+  std::string source = path;
+  if (dataFile == "LOCAL") {
+    const std::streamoff at = in.tellg();
+    available = at < 0 ? 0 : fs::file_size(path) - static_cast<std::uintmax_t>(at);
+  } else if (dataFile.find_first_of("% ") == std::string::npos && dataFile != "LIST") {
+    source = (fs::path(path).parent_path() / dataFile).string();
+    std::error_code error;
+    available = fs::file_size(source, error);
+    if (error) throw Error(path, "its data file " + source + " cannot be read");
+  } else {
+    return;
+  }
+  const std::uintmax_t needed = compressed ? compressedSize : *voxelBytes;
+  if (available < needed)
+    throw Error(source, "truncated: " + std::to_string(available) + " bytes of data, the header announces " +
+                            std::to_string(needed));
+}
+
+}  // namespace dynsub::filechecks
