@@ -206,30 +206,24 @@ Matrix3X Integrator::step(const Matrix3X& previous, const Matrix3X& current, con
   s.iterations = 0;
   s.rightHandSide.apply(s.forceWeight, force, current, previous, s.rhs);
   Matrix3X next = current;
-  Eigen::MatrixXd rhsFree(free, 3), guess(free, 3);
-  for (int i = 0; i < free; ++i) {
-    rhsFree.row(i) = s.rhs.row(s.freeVertices[i]);
-    guess.row(i) = current.row(s.freeVertices[i]);
-  }
+  Eigen::MatrixXd rhsFree(free, 3);
+  for (int i = 0; i < free; ++i) rhsFree.row(i) = s.rhs.row(s.freeVertices[i]);
   if (pinned.rows() > 0) rhsFree -= s.lhsCoupling * pinned;
   Eigen::MatrixXd solution(free, 3);
-  if (s.options.solver == LinearSolver::Cholesky) {
-    solution = s.cholesky.solve(rhsFree);
-    for (int i = 0; i < free; ++i) next.row(s.freeVertices[i]) = solution.row(i);
-    return next;
-  }
   // x, y and z one after the other, each from last step's solution.
   auto iterate = [&](auto& solver, const char* name) {
+    Eigen::MatrixXd guess(free, 3);
+    for (int i = 0; i < free; ++i) guess.row(i) = current.row(s.freeVertices[i]);
     for (int c = 0; c < 3; ++c) {
       solution.col(c) = solver.solveWithGuess(rhsFree.col(c), guess.col(c));
       s.iterations += static_cast<int>(solver.iterations());
       if (solver.info() != Eigen::Success) throw Error(std::string(name) + " did not converge");
     }
   };
-  if (s.options.solver == LinearSolver::ConjugateGradient) {
-    iterate(s.cg, "conjugate gradients");
-  } else {
-    iterate(s.pcg, "preconditioned conjugate gradients");
+  switch (s.options.solver) {
+    case LinearSolver::Cholesky: solution = s.cholesky.solve(rhsFree); break;
+    case LinearSolver::ConjugateGradient: iterate(s.cg, "conjugate gradients"); break;
+    case LinearSolver::PreconditionedConjugateGradient: iterate(s.pcg, "preconditioned conjugate gradients"); break;
   }
   for (int i = 0; i < free; ++i) next.row(s.freeVertices[i]) = solution.row(i);
   return next;

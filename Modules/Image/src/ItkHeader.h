@@ -1,6 +1,7 @@
 #pragma once
-// Private to the Image module's two ITK libraries (ItkBridge.h): the check of
-// an image file's header that both make before ITK reads its voxels.
+// Private to the Image module's ITK bridge (ItkBridge.h): the check of an
+// image file's header that ItkBridge.cpp and ItkDicom.cpp make before ITK
+// reads its voxels.
 #include <cstdint>
 #include <string>
 

@@ -3,7 +3,6 @@
 #include <cmath>
 #include <filesystem>
 
-#include <vtkCallbackCommand.h>
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
 #include <vtkDoubleArray.h>
@@ -21,6 +20,7 @@
 
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
+#include "dynsub/VtkErrors.h"
 
 namespace dynsub {
 
@@ -72,27 +72,14 @@ void addPointData(vtkPolyData* polyData, const std::string& name, const Eigen::V
 
 namespace {
 
-// Collects VTK's error messages instead of letting them go to stderr unnamed.
-struct ErrorCatcher {
-  std::string message;
-  vtkNew<vtkCallbackCommand> command;
-  ErrorCatcher() {
-    command->SetClientData(this);
-    command->SetCallback([](vtkObject*, unsigned long, void* client, void* data) {
-      auto* self = static_cast<ErrorCatcher*>(client);
-      if (self->message.empty() && data) self->message = static_cast<const char*>(data);
-    });
-  }
-};
-
 // `reader`'s file name is set.
 vtkSmartPointer<vtkPolyData> readWith(vtkAlgorithm* reader, const std::string& path) {
-  ErrorCatcher errors;
-  reader->AddObserver(vtkCommand::ErrorEvent, errors.command);
+  VtkErrors errors;
+  errors.watch(reader);
   reader->Update();
-  if (!errors.message.empty()) {
+  if (!errors.first().empty()) {
     // The first line is enough: VTK's messages carry source locations after it.
-    const std::string first = errors.message.substr(0, errors.message.find('\n'));
+    const std::string first = errors.first().substr(0, errors.first().find('\n'));
     throw Error(path, "VTK could not read the surface: " + first);
   }
   auto polyData = vtkSmartPointer<vtkPolyData>::New();

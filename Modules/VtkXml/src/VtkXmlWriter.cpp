@@ -1,9 +1,5 @@
 #include "dynsub/VtkXmlWriter.h"
 
-#include <vtkCallbackCommand.h>
-#include <vtkCommand.h>
-#include <vtkExecutive.h>
-#include <vtkNew.h>
 #include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
 #include <vtkUnstructuredGrid.h>
@@ -12,6 +8,7 @@
 
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
+#include "dynsub/VtkErrors.h"
 
 namespace dynsub {
 
@@ -24,26 +21,17 @@ void writeVtkXml(vtkDataObject* data, const std::string& path, const std::string
   } else {
     throw Error(name, "internal: no VTK XML writer for this data");
   }
-  // VTK reports a failed write (a full disk, a closed stream) as error events
-  // of the writer and of its pipeline's executive; the first is kept for the
-  // exception instead of going to stderr unnamed.
-  std::string message;
-  vtkNew<vtkCallbackCommand> onError;
-  onError->SetClientData(&message);
-  onError->SetCallback([](vtkObject*, unsigned long, void* client, void* text) {
-    auto* kept = static_cast<std::string*>(client);
-    if (kept->empty() && text) *kept = static_cast<const char*>(text);
-  });
-  writer->AddObserver(vtkCommand::ErrorEvent, onError);
-  writer->GetExecutive()->AddObserver(vtkCommand::ErrorEvent, onError);
+  // A failed write (a full disk, a closed stream) is reported in the error.
+  VtkErrors errors;
+  errors.watch(writer);
   writer->SetInputData(data);
   writer->SetFileName(path.c_str());
   writer->SetDataModeToAppended();
   writer->EncodeAppendedDataOff();
   writer->SetCompressorTypeToLZ4();
   if (writer->Write() != 1 || writer->GetErrorCode() != 0) {
-    // VTK's message starts with its source file and line, then the class and
-    // address: the reason is what follows them.
+    // The reason is what follows VTK's source location, class and address.
+    std::string message = errors.first();
     const std::size_t reason = message.rfind("): ");
     if (reason != std::string::npos) message.erase(0, reason + 3);
     while (!message.empty() && (message.back() == '\n' || message.back() == ' ')) message.pop_back();

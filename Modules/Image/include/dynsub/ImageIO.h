@@ -1,9 +1,9 @@
 #pragma once
 // Reading volumes and writing labelmaps, in physical LPS mm with the file's
 // origin, spacing and direction (NIfTI's RAS qform/sform is turned into LPS
-// when reading and back when writing). ITK reads the headers and the formats
-// DynSub does not read itself; NIfTI labelmaps are written by DynSub, .nrrd
-// and .mha ones by ITK.
+// when reading and back when writing). ITK reads every image, after
+// DynSub's checks of its file (truncation, sizes, NaN); NIfTI labelmaps are
+// written by DynSub, .nrrd and .mha ones by ITK.
 //
 // Readable: NIfTI (.nii, .nii.gz), NRRD (.nrrd, .nhdr), MetaImage (.mha,
 // .mhd) and DICOM series (a directory holding one series, via GDCM; a single
