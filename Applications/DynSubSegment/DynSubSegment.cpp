@@ -11,34 +11,96 @@
 #include <cstring>
 #include <filesystem>
 #include <iomanip>
+#include <functional>
 #include <iostream>
+#include <list>
 #include <memory>
 #include <sstream>
 
 #include <CLI/CLI.hpp>
 
 #include "ExecutionModel.h"
-#include "SegmentRun.h"
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
 #include "dynsub/ImageIO.h"
+#include "dynsub/SegmentImage.h"
 #include "dynsub/SurfaceWriter.h"
 
 namespace {
 
 using namespace dynsub;
-using dynsub::slicer::Parameter;
 
 struct Arguments {
   std::string image, landmarks, inside, labelmap, model, report;
   std::vector<std::string> seeds;
   int labelValue = 1;
-  bool pointsReachEnds = false;
-  std::string potential = "edges";
-  SegmentOptions segment;
-  SeedOptions seed;
+  SegmentParameters parameters;
+  // What Slicer passes for the table's choices and for its switches that are
+  // on by default (as their opposites), given to `parameters` after parsing.
+  std::list<std::string> choices;
+  std::list<bool> opposites;
+  std::vector<std::function<void(Arguments&)>> afterParsing;
 };
+
+// The table's rows (SegmentParameters.h) as the panel's parameters, in the
+// table's groups. Slicer has no unset number, so the optional ones (the edge
+// thresholds, whose default depends on the reference) are left to `dynsub
+// segment`.
+std::vector<slicer::ParameterGroup> parameterGroups(Arguments& a) {
+  std::vector<slicer::ParameterGroup> groups;
+  for (const dynsub::ParameterGroup& g : segmentParameterGroups()) {
+    slicer::ParameterGroup group{g.name, g.help, g.advanced, {}};
+    for (const dynsub::Parameter& row : segmentParameters()) {
+      if (row.group != g.name) continue;
+      const std::string label = row.label + (row.unit.empty() ? "" : " (" + row.unit + ")");
+      slicer::Parameter p{"", "", row.camelName(), row.camelName(), label, row.help + ".", {}, "", "", "", "", {}, -1};
+      const auto number = [](double v) {
+        std::ostringstream out;
+        out << std::setprecision(12) << v;
+        return std::isfinite(v) ? out.str() : std::string();
+      };
+      p.minimum = number(row.low);
+      p.maximum = number(row.high);
+      p.step = row.step > 0 ? number(row.step) : "";
+      if (const auto* real = std::get_if<dynsub::Parameter::Real>(&row.value)) {
+        p.element = "double";
+        p.target = &(*real)(a.parameters);
+      } else if (const auto* whole = std::get_if<dynsub::Parameter::Whole>(&row.value)) {
+        p.element = "integer";
+        p.target = &(*whole)(a.parameters);
+      } else if (const auto* choice = std::get_if<dynsub::Parameter::Choice>(&row.value)) {
+        p.element = "string-enumeration";
+        p.choices = choice->names;
+        p.minimum = p.maximum = p.step = "";
+        std::string& value = a.choices.emplace_back(choice->get(a.parameters));
+        p.target = &value;
+        a.afterParsing.push_back([set = choice->set, &value](Arguments& arguments) { set(arguments.parameters, value); });
+      } else if (const auto* on = std::get_if<dynsub::Parameter::Switch>(&row.value)) {
+        p.element = "boolean";
+        p.minimum = p.maximum = p.step = "";
+        if (!(*on)(a.parameters)) {
+          p.target = &(*on)(a.parameters);
+        } else {
+          // On by default: Slicer can only switch on, so the panel offers its opposite.
+          p.name = p.flag = row.opposite->name;
+          p.label = row.opposite->label;
+          p.description = row.opposite->help;
+          bool& opposite = a.opposites.emplace_back(false);
+          p.target = &opposite;
+          a.afterParsing.push_back([access = *on, &opposite](Arguments& arguments) {
+            access(arguments.parameters) = !opposite;
+          });
+        }
+      } else {
+        continue;  // an optional number
+      }
+      group.parameters.push_back(p);
+    }
+    groups.push_back(group);
+  }
+  return groups;
+}
 
 slicer::Module describe(Arguments& a) {
   slicer::Module m;
@@ -83,54 +145,8 @@ slicer::Module describe(Arguments& a) {
                            "The structure's value in the output labelmap (Slicer colours it by this value).",
                            &a.labelValue, "", "1", "255", "1", {}, -1});
 
-  slicer::ParameterGroup model{"Surface", "How the surface moves and when it is refined.", false, {}};
-  model.parameters.push_back({"string-enumeration", "", "potential", "potential", "Edges",
-                              "edges: distance to edges found by a 3D Monga-Deriche detector; gradient: the "
-                              "smoothed gradient magnitude.",
-                              &a.potential, "", "", "", "", {"edges", "gradient"}, -1});
-  model.parameters.push_back({"double", "", "sigma", "sigma", "Edge smoothing (mm)",
-                              "Gaussian smoothing of the edge detector.", &a.segment.edges.sigma, "", "0.2", "5",
-                              "0.1", {}, -1});
-  model.parameters.push_back({"double", "", "captureRange", "captureRange", "Capture range (mm)",
-                              "How far from an edge the image still pulls the surface.",
-                              &a.segment.edges.captureRange, "", "1", "30", "0.5", {}, -1});
-  model.parameters.push_back({"double", "", "imageForce", "imageForce", "Image force (N/mm^2)",
-                              "Strength of the pull toward edges per unit of surface.", &a.segment.imageForce, "",
-                              "0", "10", "0.01", {}, -1});
-  model.parameters.push_back({"double", "", "landmarkStiffness", "landmarkStiffness", "Point stiffness (N/mm)",
-                              "Spring stiffness of each boundary point.", &a.segment.landmarkStiffness, "", "0",
-                              "1000", "0.5", {}, -1});
-  model.parameters.push_back({"double", "", "landmarkTolerance", "landmarkTolerance", "Point tolerance (mm)",
-                              "The surface is refined while a boundary point is farther than this from it.",
-                              &a.segment.landmarkTolerance, "", "0.05", "10", "0.05", {}, -1});
-  model.parameters.push_back({"double", "", "inflation", "inflation", "Inflation (N/mm^2)",
-                              "Pressure along the normal: positive grows the surface, negative shrinks it.",
-                              &a.segment.inflation, "", "-1", "1", "0.01", {}, -1});
-  model.parameters.push_back({"double", "", "margin", "margin", "Margin (mm)",
-                              "The region of interest around the initial model and the points.", &a.segment.margin,
-                              "", "1", "100", "1", {}, -1});
-  model.parameters.push_back({"boolean", "", "pointsReachEnds", "pointsReachEnds", "Points reach both ends",
-                              "Check when the boundary points include the structure's first and last slices. "
-                              "Unchecked, the surface is carried past the outermost slices with points to where "
-                              "the structure's tissue ends, since experts seldom place points there; when the "
-                              "points already reach the ends, that can carry it on into like tissue.",
-                              &a.pointsReachEnds, "", "", "", "", {}, -1});
-  model.parameters.push_back({"integer", "", "maxLevel", "maxLevel", "Refinements",
-                              "Global refinements of the control mesh allowed.", &a.segment.simulation.maxLevel, "",
-                              "0", "6", "1", {}, -1});
-
-  slicer::ParameterGroup seed{"Point inside", "How the region is grown from a point inside the structure.", true, {}};
-  seed.parameters.push_back({"double", "", "seedWindow", "seedWindow", "Intensity window (spreads)",
-                             "The intensities grown through: this many robust spreads either side of the median "
-                             "near the click.",
-                             &a.seed.window, "", "0.5", "20", "0.5", {}, -1});
-  seed.parameters.push_back({"double", "", "seedOpening", "seedOpening", "Opening (mm)",
-                             "Radius of the opening that cuts thin bridges to like tissue nearby.", &a.seed.opening,
-                             "", "0", "10", "0.5", {}, -1});
-  seed.parameters.push_back({"double", "", "seedReach", "seedReach", "Reach (mm)",
-                             "How far from the click the region may grow.", &a.seed.reach, "", "5", "200", "5", {},
-                             -1});
-  m.groups = {io, model, seed};
+  m.groups = {io};
+  for (slicer::ParameterGroup& group : parameterGroups(a)) m.groups.push_back(group);
   return m;
 }
 
@@ -181,7 +197,7 @@ void requireExtension(const std::string& path, const std::vector<std::string>& k
   throw Error(path, "unknown " + what + " format '" + extension + "' (expected " + list + ")");
 }
 
-void run(Arguments a) {
+void run(Arguments& a) {
   if (a.labelmap.empty() && a.model.empty() && a.report.empty())
     throw Error("nothing to write: give --labelmap, --model and/or --report");
   if (!a.labelmap.empty()) requireExtension(a.labelmap, {".nrrd", ".nii", ".gz", ".mha"}, "labelmap");
@@ -189,14 +205,13 @@ void run(Arguments a) {
   if (!a.report.empty()) requireExtension(a.report, {".json"}, "report");
   for (const std::string* path : {&a.labelmap, &a.model, &a.report})
     if (!path->empty()) requireWritableDirectoryFor(*path);
-  if (a.potential == "gradient") a.segment.edges.method = EdgeMethod::GradientMagnitude;
-  a.segment.sliceEnds.enabled = !a.pointsReachEnds;
-  checkSegmentOptions(a.segment);
+  for (const auto& apply : a.afterParsing) apply(a);
+  checkSegmentParameters(a.parameters);
 
-  SlicerProgress progress(a.segment.simulation.maxLevel + 1);
+  SlicerProgress progress(a.parameters.segment.simulation.maxLevel + 1);
   std::cout << "<filter-start><filter-name>DynSubSegment</filter-name></filter-start>" << std::endl;
   progress.stage(0.0, "reading the volume and the points");
-  app::SegmentInputs in;
+  SegmentInputs in;
   in.image = a.image;
   const Volume image = readVolume(a.image);
   for (std::size_t i = 0; i < a.seeds.size(); ++i)
@@ -208,59 +223,49 @@ void run(Arguments a) {
     in.landmarkSource = a.seeds.empty() ? a.landmarks : "--seed and " + a.landmarks;
   }
   if (!a.inside.empty()) {
-    in.init.kind = app::InitialModel::Kind::Seed;
-    in.init.center = parsePoint(a.inside, "inside");
-    in.init.text = "inside:" + a.inside;
+    in.start.kind = SegmentStart::Kind::Seed;
+    in.start.center = parsePoint(a.inside, "inside");
+    in.start.text = "inside:" + a.inside;
   } else if (in.landmarks.size() == 1) {
     // One point cannot outline a structure: it is read as a click inside it.
-    in.init.kind = app::InitialModel::Kind::Seed;
-    in.init.center = in.landmarks.front().position;
-    in.init.text = "inside:" + (a.seeds.empty() ? std::string("the one point of ") + a.landmarks : a.seeds.front());
+    in.start.kind = SegmentStart::Kind::Seed;
+    in.start.center = in.landmarks.front().position;
+    in.start.text = "inside:" + (a.seeds.empty() ? std::string("the one point of ") + a.landmarks : a.seeds.front());
     in.landmarks.clear();
-  } else if (in.landmarks.size() < 4) {
-    throw Error(in.landmarks.empty() ? std::string("no points: give at least 4 boundary points (--seed x,y,z "
-                                                   "each) or one point inside the structure (--inside x,y,z)")
-                                     : in.landmarkSource + ": " + std::to_string(in.landmarks.size()) +
-                                           " boundary points are too few to outline a structure: give at least 4, "
-                                           "or one point inside it (--inside x,y,z)");
-  } else {
-    in.init.text = "auto";
   }
-  in.segment = a.segment;
-  in.seed = a.seed;
-  in.potential = a.potential;
+  checkSegmentInputs(in, a.parameters);
 
   progress.stage(0.05, "evolving the surface");
-  const app::SegmentRun run = app::runSegmentation(image, in, progress.callback());
+  const SegmentOutcome outcome = segmentImage(image, in, a.parameters, progress.callback());
   progress.stage(0.95, "writing the results");
 
   // All outputs appear together or none does.
   std::vector<std::unique_ptr<AtomicOutput>> outputs;
   if (!a.labelmap.empty()) {
     outputs.push_back(std::make_unique<AtomicOutput>(a.labelmap));
-    writeMask(run.labelmap, outputs.back()->temporaryPath(), static_cast<std::uint8_t>(a.labelValue));
+    writeMask(outcome.labelmap, outputs.back()->temporaryPath(), static_cast<std::uint8_t>(a.labelValue));
   }
   if (!a.model.empty()) {
     std::vector<PointScalars> scalars;
-    if (run.result.surfaceEdgeDistances.size()) scalars.push_back({"edge_distance_mm", run.result.surfaceEdgeDistances});
+    if (outcome.result.surfaceEdgeDistances.size()) scalars.push_back({"edge_distance_mm", outcome.result.surfaceEdgeDistances});
     outputs.push_back(std::make_unique<AtomicOutput>(a.model));
-    writeTriangleSurface(run.result.surface, outputs.back()->temporaryPath(), scalars, "LPS");
+    writeTriangleSurface(outcome.result.surface, outputs.back()->temporaryPath(), scalars, "LPS");
   }
   if (!a.report.empty()) {
     outputs.push_back(std::make_unique<AtomicOutput>(a.report));
-    run.report.write(outputs.back()->temporaryPath());
+    outcome.report.write(outputs.back()->temporaryPath());
   }
   for (auto& output : outputs) output->commit();
 
-  const double volume = run.labelmap.count() * image.geometry.spacing.prod();
+  const double volume = outcome.labelmap.count() * image.geometry.spacing.prod();
   std::cout << std::fixed << std::setprecision(1) << "segmented " << volume << " mm^3 with "
-            << run.result.mesh.vertexCount() << " control vertices in " << run.seconds << " s\n";
-  const std::string carried = app::carriedPastSlices(run.result);
+            << outcome.result.mesh.vertexCount() << " control vertices in " << outcome.seconds << " s\n";
+  const std::string carried = carriedPastSlices(outcome.result);
   if (!carried.empty())
     std::cout << "<filter-comment>followed the structure's tissue past the outermost slices with points and "
                  "pulled the surface there: "
               << carried << " (check Points reach both ends if your points already reach them)</filter-comment>\n";
-  for (const std::string& warning : run.warnings) std::cerr << "warning: " << warning << '\n';
+  for (const std::string& warning : outcome.warnings) std::cerr << "warning: " << warning << '\n';
   progress.report(1.0);
   std::cout << "<filter-end><filter-name>DynSubSegment</filter-name></filter-end>" << std::endl;
 }

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <variant>
 
 #include <CLI/CLI.hpp>
 
@@ -59,6 +60,34 @@ SimulationOptions SimulationArguments::apply(SimulationOptions base) const {
   base.material.rigidityUV = 2.0 * values.material.rigidityUU;
   checkSimulationOptions(base);
   return base;
+}
+
+void addSegmentParameterOptions(CLI::App& command, SegmentParameters& parameters) {
+  SegmentParameters* p = &parameters;
+  for (const Parameter& row : segmentParameters()) {
+    const std::string help = row.help + (row.unit.empty() ? "" : " (" + row.unit + ")");
+    const std::string shown = toText(parameterValue(parameters, row));
+    CLI::Option* option = std::visit(
+        [&](const auto& access) -> CLI::Option* {
+          using A = std::decay_t<decltype(access)>;
+          if constexpr (std::is_same_v<A, Parameter::Choice>) {
+            return command
+                .add_option_function<std::string>(
+                    row.flag(), [p, set = access.set](const std::string& v) { set(*p, v); }, help)
+                ->check(CLI::IsMember(access.names));
+          } else if constexpr (std::is_same_v<A, Parameter::OptionalReal>) {
+            return command.add_option_function<double>(
+                row.flag(), [p, access](double v) { access(*p) = v; }, help);
+          } else {
+            return command.add_option(row.flag(), access(parameters), help);
+          }
+        },
+        row.value);
+    if (!std::holds_alternative<Parameter::Switch>(row.value) && !std::holds_alternative<Parameter::Choice>(row.value))
+      option->check(CLI::Range(row.low, row.high));
+    if (!std::holds_alternative<Parameter::OptionalReal>(row.value)) option->default_str(shown);
+    option->group(row.group);
+  }
 }
 
 ProgressLine::ProgressLine() : terminal_(isatty(fileno(stderr)) != 0) {}

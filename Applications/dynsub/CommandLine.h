@@ -3,6 +3,7 @@
 // physics and solver options, and a progress line on a terminal.
 #include <string>
 
+#include "dynsub/SegmentParameters.h"
 #include "dynsub/Simulation.h"
 
 namespace CLI {
@@ -19,6 +20,12 @@ struct SimulationArguments {
   // `base` with the options given on the command line; throws dynsub::Error on bad values.
   SimulationOptions apply(SimulationOptions base) const;
 };
+
+// One option per row of the segmentation parameters' table
+// (SegmentParameters.h), under its group's heading, with its range as a check
+// and the value in `parameters` now as its default; `parameters` must outlive
+// the parsing.
+void addSegmentParameterOptions(CLI::App& command, SegmentParameters& parameters);
 
 // "\rlevel L  step S  energy E" on stderr while stderr is a terminal; silent otherwise.
 class ProgressLine {

@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "CommandLine.h"
 #include "Commands.h"
 #include "dynsub/Error.h"
 #include "dynsub/ImageIO.h"
@@ -13,12 +14,12 @@ namespace dynsub::app {
 
 namespace {
 
-struct ViewCommandOptions {
+struct Arguments {
   std::string image, landmarks, surface;
-  SegmentOptions segment;
+  SegmentParameters parameters;
 };
 
-void runView(const ViewCommandOptions& o) {
+void runView(const Arguments& o) {
   ViewerInput input;
   input.image = readVolume(o.image);
   if (!o.landmarks.empty()) {
@@ -27,8 +28,9 @@ void runView(const ViewCommandOptions& o) {
     if (std::filesystem::exists(o.landmarks)) input.landmarks = readLandmarks(o.landmarks);
   }
   input.surfacePath = o.surface;
-  checkSegmentOptions(o.segment);
-  input.segment = o.segment;
+  // A live fit pulls the surface to the landmarks on the slices.
+  input.segment = segmentOptions(o.parameters, true);
+  input.initialFraction = o.parameters.initialFraction;
   std::cout << "dynsub view: press h in the window for the mouse and key bindings\n";
   Viewer viewer(std::move(input));
   viewer.run();
@@ -37,7 +39,7 @@ void runView(const ViewCommandOptions& o) {
 }  // namespace
 
 void addViewCommand(CLI::App& app) {
-  auto o = std::make_shared<ViewCommandOptions>();
+  auto o = std::make_shared<Arguments>();
   CLI::App* command = app.add_subcommand(
       "view",
       "Interactive viewer: axial, coronal and sagittal slices and a 3D view. Place, move and delete landmarks "
@@ -49,10 +51,7 @@ void addViewCommand(CLI::App& app) {
                       "Landmarks to show and edit (.mrk.json, .fcsv, .csv); read if the file exists, and where "
                       "s saves them (default landmarks.mrk.json)");
   command->add_option("--surface", o->surface, "A surface to show (e.g. segment's surface.vtp), LPS mm");
-  command->add_option("--image-force", o->segment.imageForce, "Image force k for fitting, N/mm^2")
-      ->default_val(o->segment.imageForce);
-  command->add_option("--landmark-stiffness", o->segment.landmarkStiffness, "Spring stiffness per landmark, N/mm")
-      ->default_val(o->segment.landmarkStiffness);
+  addSegmentParameterOptions(*command, o->parameters);
   command->callback([o] { runView(*o); });
 }
 

@@ -18,8 +18,7 @@
 #include "dynsub/ImageIO.h"
 #include "dynsub/Labelmap.h"
 #include "dynsub/Metrics.h"
-#include "dynsub/SeedGrowth.h"
-#include "dynsub/Segmentation.h"
+#include "dynsub/SegmentImage.h"
 
 namespace dynsub {
 
@@ -67,34 +66,34 @@ EvaluationRun runOne(const EvaluationPlan& plan, const Volume& image, const Mask
   if (!protocol.ownAxis) clicks.axis = axis;
   // The clicks go through a file in the protocol's format, as a user's would.
   std::vector<Landmark> landmarks = expertClicks(reference, clicks, run.seed);
+  SegmentInputs inputs;
+  inputs.landmarkSource = run.protocol;
   if (!landmarks.empty()) {
     const std::string path = (std::filesystem::path(landmarkDirectory) /
                               (run.split + "_" + run.image + "_" + run.structure + "_" + run.protocol + "_" +
                                std::to_string(run.seed) + "." + run.format)).string();
     writeLandmarks(landmarks, path);
     landmarks = readLandmarks(path);
+    inputs.landmarkSource = path;
   }
   run.landmarks = static_cast<int>(landmarks.size());
-  const auto started = std::chrono::steady_clock::now();
-  SegmentOptions options = plan.segment;
+  inputs.landmarks = landmarks;
   if (clicks.seedOnly) {  // as segment --init seed: does without landmarks
-    const SeedRegion grown = growFromSeed(image, seedClick(reference, clicks.seedDepth, run.seed), plan.seed);
-    landmarks = grown.boundary;
-    options.landmarkStiffness = plan.seed.stiffness;
-    for (const std::string& w : seedWarnings(grown)) run.warnings += (run.warnings.empty() ? "" : "; ") + w;
+    inputs.start.kind = SegmentStart::Kind::Seed;
+    inputs.start.center = seedClick(reference, clicks.seedDepth, run.seed);
   }
-  const ControlMesh initial = initialFromLandmarks(landmarks, plan.initialFraction);
-  const SegmentResult result = segment(image, landmarks, initial, options);
+  // Scored on the reference's grid (see the header).
+  inputs.labelmapGrid = reference.geometry;
+  const SegmentOutcome outcome = segmentImage(image, inputs, plan.parameters);
+  const SegmentResult& result = outcome.result;
   run.steps = result.steps;
-  for (const std::string& w : result.warnings) run.warnings += (run.warnings.empty() ? "" : "; ") + w;
+  for (const std::string& w : outcome.warnings) run.warnings += (run.warnings.empty() ? "" : "; ") + w;
   run.controlVertices = result.mesh.vertexCount();
   run.surfaceOnEdges = result.surfaceOnEdges;
-  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  run.seconds = outcome.seconds;
 
-  // Scored on the reference's grid (see the header).
-  const ImageGeometry& grid = reference.geometry;
-  const Mask mask = labelmapOf(result.surface, grid);
-  const double voxel = grid.spacing.prod();
+  const Mask& mask = outcome.labelmap;
+  const double voxel = reference.geometry.spacing.prod();
   long long overlap = 0;
   for (size_t i = 0; i < mask.voxels.size(); ++i) overlap += mask.voxels[i] && reference.voxels[i];
   run.volume = mask.count() * voxel;
@@ -166,76 +165,24 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
       plan.protocols.push_back(protocol);
     }
     if (j.contains("segment")) {
-      // Settings to compare on the tuning split; an unknown name is an error, not a silent default.
-      SegmentOptions& o = plan.segment;
-      const std::map<std::string, double*> settings = {
-          {"image_force", &o.imageForce},
-          {"landmark_stiffness", &o.landmarkStiffness},
-          {"landmark_dead_zone_mm", &o.landmarkDeadZone},
-          {"landmark_tolerance_mm", &o.landmarkTolerance},
-          {"inflation", &o.inflation},
-          {"region_pressure", &o.regionPressure},
-          {"region_window", &o.regionWindow},
-          {"margin_mm", &o.margin},
-          {"sigma_mm", &o.edges.sigma},
-          {"edge_landmark_reach_mm", &o.edges.landmarkReach},
-          {"capture_range_mm", &o.edges.captureRange},
-          {"elasticity_per_level", &o.simulation.elasticityPerLevel},
-          {"time_step", &o.simulation.integrator.timeStep},
-          {"coarse_level_factor", &o.simulation.equilibrium.coarseLevelFactor},
-          {"tension", &o.simulation.material.tensionU},
-          {"rigidity", &o.simulation.material.rigidityUU},
-          {"initial_fraction", &plan.initialFraction},
-          {"slice_ends_window", &o.sliceEnds.window},
-          {"slice_ends_disk", &o.sliceEnds.disk},
-          {"slice_ends_reach", &o.sliceEnds.reach},
-          {"slice_ends_gap_mm", &o.sliceEnds.gap},
-          {"slice_ends_stiffness", &o.sliceEnds.stiffness},
-          {"slice_ends_pressure", &o.sliceEnds.pressure}};
-      const std::map<std::string, bool*> switches = {{"slice_ends", &o.sliceEnds.enabled},
-                                                     {"slice_ends_taper", &o.sliceEnds.taper},
-                                                     {"slice_ends_spring_at_reach", &o.sliceEnds.springAtReach}};
-      const std::map<std::string, int*> counts = {{"max_level", &o.simulation.maxLevel},
-                                                  {"time_step_regrowth", &o.simulation.timeStepRegrowth}};
-      for (const auto& [name, value] : j.at("segment").items()) {
-        if (const auto count = counts.find(name); count != counts.end()) {
-          *count->second = static_cast<int>(wholeNumber(value, "segment setting " + name, 0, kLargestSetting));
-          continue;
+      // Settings to compare on the tuning split, by the keys of report.json's
+      // "parameters" (SegmentParameters.h); an unknown key is an error, not a
+      // silent default.
+      for (const auto& [key, value] : j.at("segment").items()) {
+        const Parameter* parameter = findSegmentParameter(key);
+        if (!parameter) throw Error(path, "unknown segment setting '" + key + "'");
+        ParameterValue v;
+        if (value.is_boolean()) v = value.get<bool>();
+        else if (value.is_string()) v = value.get<std::string>();
+        else if (value.is_number()) v = value.get<double>();
+        else if (!value.is_null()) throw Error("segment setting " + key + ": not a number, string or boolean");
+        try {
+          setParameter(plan.parameters, *parameter, v);
+        } catch (const Error& e) {
+          throw Error("segment setting " + std::string(e.what()));
         }
-        if (const auto setting = switches.find(name); setting != switches.end()) {
-          *setting->second = value.get<bool>();
-          continue;
-        }
-        const auto setting = settings.find(name);
-        if (setting == settings.end()) throw Error(path, "unknown segment setting '" + name + "'");
-        *setting->second = value.get<double>();
       }
-      // One tension and one rigidity for every direction (rigidity_uv is twice rigidity_uu, as by default).
-      o.simulation.material.tensionV = o.simulation.material.tensionU;
-      o.simulation.material.rigidityVV = o.simulation.material.rigidityUU;
-      o.simulation.material.rigidityUV = 2 * o.simulation.material.rigidityUU;
-      checkSegmentOptions(o);
-      if (!(plan.initialFraction > 0 && plan.initialFraction <= 1))
-        throw Error(path, "initial_fraction must be in (0, 1]");
-    }
-    if (j.contains("seed")) {
-      // The seed-only runs' region growth, likewise.
-      SeedOptions& o = plan.seed;
-      const std::map<std::string, double*> settings = {{"stats_radius_mm", &o.statsRadius},
-                                                       {"window", &o.window},
-                                                       {"reach_mm", &o.reach},
-                                                       {"opening_mm", &o.opening},
-                                                       {"stiffness", &o.stiffness}};
-      for (const auto& [name, value] : j.at("seed").items()) {
-        if (name == "boundary_points") {
-          o.boundaryPoints = static_cast<int>(wholeNumber(value, "seed setting boundary_points", 0, kLargestSetting));
-          continue;
-        }
-        const auto setting = settings.find(name);
-        if (setting == settings.end()) throw Error(path, "unknown seed setting '" + name + "'");
-        *setting->second = value.get<double>();
-      }
-      checkSeedOptions(o);
+      checkSegmentParameters(plan.parameters);
     }
     for (const auto& s : j.at("splits")) {
       EvaluationSplit split{s.at("name"), s.value("structures", std::vector<std::string>{}), {}};

@@ -12,8 +12,8 @@ struct FitCancelled {};
 
 }  // namespace
 
-FitWorker::FitWorker(const Volume& image, const SegmentOptions& options, double pullStiffness)
-    : image_(image), options_(options), pull_(pullStiffness) {}
+FitWorker::FitWorker(const Volume& image, const SegmentOptions& options, double initialFraction, double pullStiffness)
+    : image_(image), options_(options), initialFraction_(initialFraction), pull_(pullStiffness) {}
 
 FitWorker::~FitWorker() { stop(); }
 
@@ -100,7 +100,7 @@ void FitWorker::publish(TriangleSurface surface, const std::string& text) {
 void FitWorker::run(const std::vector<Landmark>& marks, const std::optional<Fitted>& start) {
   try {
     const auto started = std::chrono::steady_clock::now();
-    const ControlMesh initial = start ? start->mesh : initialFromLandmarks(marks);
+    const ControlMesh initial = start ? start->mesh : initialFromLandmarks(marks, initialFraction_);
     if (!start || !region_ || !region_->covers(landmarkPositions(marks)) || !region_->covers(initial.points()))
       region_ = std::make_unique<const SegmentationRegion>(image_, marks, initial, options_);
     auto last = std::chrono::steady_clock::now() - kRedrawInterval;

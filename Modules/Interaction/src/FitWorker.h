@@ -26,7 +26,7 @@ constexpr auto kRedrawInterval = std::chrono::milliseconds(40);
 class FitWorker {
  public:
   // `image` must outlive the worker.
-  FitWorker(const Volume& image, const SegmentOptions& options, double pullStiffness);
+  FitWorker(const Volume& image, const SegmentOptions& options, double initialFraction, double pullStiffness);
   ~FitWorker();
   FitWorker(const FitWorker&) = delete;
   FitWorker& operator=(const FitWorker&) = delete;
@@ -74,6 +74,7 @@ class FitWorker {
 
   const Volume& image_;
   SegmentOptions options_;
+  double initialFraction_;
   PullForceModel pull_;
   std::thread worker_;
   std::atomic<bool> running_{false};

@@ -434,7 +434,7 @@ class ViewerStyle : public vtkInteractorStyleTrackballCamera {
 vtkStandardNewMacro(ViewerStyle);
 
 Viewer::Impl::Impl(ViewerInput in)
-    : input(std::move(in)), slices(input.image), fit(input.image, input.segment, input.pullStiffness) {
+    : input(std::move(in)), slices(input.image), fit(input.image, input.segment, input.initialFraction, input.pullStiffness) {
   edits.landmarks = input.landmarks;
   window->SetSize(1200, 900);
   window->SetMultiSamples(0);

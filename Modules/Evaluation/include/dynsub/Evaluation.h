@@ -21,8 +21,7 @@
 #include <vector>
 
 #include "dynsub/ClickProtocol.h"
-#include "dynsub/SeedGrowth.h"
-#include "dynsub/Segmentation.h"
+#include "dynsub/SegmentParameters.h"
 
 namespace dynsub {
 
@@ -52,9 +51,7 @@ struct EvaluationSplit {
 struct EvaluationPlan {
   // What every run segments with: the defaults unless the plan's "segment"
   // object sets some (for comparing settings on the tuning split).
-  SegmentOptions segment;
-  double initialFraction = 0.5;  // initialFromLandmarks
-  SeedOptions seed;  // seed-only runs: the region grown from the click (SeedGrowth.h)
+  SegmentParameters parameters;
   std::string reference;  // labelmap path
   std::vector<EvaluationImage> images;
   std::vector<EvaluationStructure> structures;
@@ -79,7 +76,7 @@ struct EvaluationRun {
   // follows the accuracy the reference gives.
   double surfaceOnEdges = 0;
   std::string warnings;  // segment()'s own (collapse, leak), joined by "; "
-  double seconds = 0;  // segment() alone (the image is read once per plan, the clicks made before)
+  double seconds = 0;  // segmentImage()'s own (the image is read once per plan, the clicks made before)
   int steps = 0, controlVertices = 0;
 };
 

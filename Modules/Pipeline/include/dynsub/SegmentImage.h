@@ -1,10 +1,13 @@
 #pragma once
-// One segmentation from its inputs to its report: the initial model, the
-// evolution with its convergence record, and the numbers and warnings of
-// report.json. Shared by `dynsub segment` and the 3D Slicer module
-// DynSubSegment, so that both run and report the same thing.
+// One segmentation from its inputs to its report: the start (from the
+// landmarks, a click inside, a sphere or a control mesh), the evolution
+// (Segmentation.h) with its convergence record, the labelmap, the scores
+// against a reference, and report.json. `dynsub segment`, the 3D Slicer module
+// DynSubSegment and `dynsub evaluate` all run this, so all three segment and
+// report alike; they only read their arguments and write what it returns.
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -12,15 +15,14 @@
 #include "dynsub/Landmarks.h"
 #include "dynsub/Metrics.h"
 #include "dynsub/Report.h"
-#include "dynsub/SeedGrowth.h"
-#include "dynsub/Segmentation.h"
+#include "dynsub/SegmentParameters.h"
 
-namespace dynsub::app {
+namespace dynsub {
 
 // Where the evolution starts.
-struct InitialModel {
+struct SegmentStart {
   enum class Kind {
-    FromLandmarks,  // the 98-vertex cube inside the landmarks' PCA ellipsoid
+    FromLandmarks,  // the papers' cube inside the landmarks' PCA ellipsoid
     Sphere,         // `center`, `radius`
     Seed,           // one click inside the structure at `center` (SeedGrowth.h)
     Mesh,           // a closed control mesh read from `meshPath`
@@ -29,44 +31,52 @@ struct InitialModel {
   Vector3 center = Vector3::Zero();  // LPS mm
   double radius = 0;
   std::string meshPath;
-  std::string text;  // as the user gave it, for report.json
+  std::string text = "auto";  // as the user gave it, for report.json
 };
 
 // "auto", "sphere:x,y,z,r", "seed:x,y,z" or a mesh path; `option` names the
 // flag in errors. Throws dynsub::Error on malformed or non-finite numbers.
-InitialModel parseInitialModel(const std::string& value, const std::string& option);
+SegmentStart parseSegmentStart(const std::string& value, const std::string& option);
 
 struct SegmentInputs {
   std::string image;                // the file, for the report
   std::string landmarkSource;       // the file or flag the landmarks came from, for messages
   std::vector<Landmark> landmarks;  // may be empty with a seed, sphere or mesh start
-  InitialModel init;
-  SegmentOptions segment;
-  SeedOptions seed;
-  std::string potential = "edges";  // its name, for the report
-  // Optional: the structure in an expert's labelmap on the image's grid,
+  SegmentStart start;
+  // Optional: the structure in an expert's labelmap on the labelmap's grid,
   // asked for once the segmentation is done (so that it can be read
   // meanwhile); it may throw, as reading it would.
   std::function<const Mask&()> reference;
   std::string referencePath;
   std::vector<int> referenceLabels;
+  // The labelmap's grid; the image's when not given (an evaluation scores
+  // on its reference's own grid).
+  std::optional<ImageGeometry> labelmapGrid;
 };
 
-struct SegmentRun {
+struct SegmentOutcome {
   SegmentResult result;
-  Mask labelmap;                     // result.surface on the image's grid (Labelmap.h)
+  Mask labelmap;                     // result.surface voxelized (Labelmap.h)
   std::unique_ptr<SeedRegion> seed;  // for a seed start
   std::vector<Landmark> springs;     // what the springs pulled to
   OverlapMetrics metrics;            // against the reference, when given
   ConvergenceHistory history;
   std::vector<std::string> warnings;  // the seed's and the segmentation's
-  double seconds = 0;
+  double seconds = 0;                 // the start, the evolution and the labelmap
   Report report;
 };
 
-// Runs the segmentation; `progress` (may be empty) sees every step. Throws
-// dynsub::Error naming the landmark source when the landmarks cannot be used.
-SegmentRun runSegmentation(const Volume& image, SegmentInputs inputs, const ProgressCallback& progress);
+// Whether the start can be built from what the inputs give (at least 4
+// landmarks for a start from them) and the parameters are possible with
+// them; throws dynsub::Error saying what would do. segmentImage() checks
+// this first; a command checks it before it writes anything.
+void checkSegmentInputs(const SegmentInputs& inputs, const SegmentParameters& parameters);
+
+// Throws dynsub::Error naming the landmark source when the landmarks cannot
+// be used, and for impossible parameters; `progress` (may be empty) sees
+// every step.
+SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& inputs, const SegmentParameters& parameters,
+                            const ProgressCallback& progress = nullptr);
 
 // How far the structure's tissue was followed past the outermost clicked
 // slices where a spring or the pressure then acted (SliceEnds.h), e.g. "10.0
@@ -75,4 +85,4 @@ SegmentRun runSegmentation(const Volume& image, SegmentInputs inputs, const Prog
 // needs this to know to turn it off.
 std::string carriedPastSlices(const SegmentResult& result);
 
-}  // namespace dynsub::app
+}  // namespace dynsub

@@ -1,0 +1,300 @@
+#include "dynsub/SegmentImage.h"
+
+#include <chrono>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+
+#include "dynsub/ClosestPoint.h"
+#include "dynsub/Error.h"
+#include "dynsub/Labelmap.h"
+#include "dynsub/MeshIO.h"
+#include "dynsub/ModelOutputs.h"
+
+namespace dynsub {
+
+namespace {
+
+// "x,y,z[,r]" after a prefix: `count` finite numbers.
+std::vector<double> numbersAfter(const std::string& value, std::size_t prefix, int count, const char* expected,
+                                 const std::string& option) {
+  std::stringstream in(value.substr(prefix));
+  std::vector<double> v(count);
+  char comma = ',';
+  const std::string message = option + " " + value + ": expected " + expected + " (LPS mm)";
+  for (int i = 0; i < count; ++i)
+    if (!(in >> v[i]) || !std::isfinite(v[i]) || (i + 1 < count && (!(in >> comma) || comma != ',')))
+      throw Error(message);
+  if (in >> comma) throw Error(message);
+  return v;
+}
+
+Report metricsReport(const OverlapMetrics& m) {
+  Report r;
+  r.set("dice", m.dice);
+  r.set("jaccard", m.jaccard);
+  r.set("volume_difference_percent", m.volumeDifferencePercent);
+  r.set("mean_surface_distance_mm", m.meanSurfaceDistance);
+  r.set("hd95_mm", m.hd95);
+  r.set("hausdorff_mm", m.hausdorff);
+  r.set("volume_mm3", m.volumeA);
+  r.set("reference_volume_mm3", m.volumeB);
+  return r;
+}
+
+// Every row of the table with its value, then what the edge detector used
+// in the end: the reference (the image's when there were no points on the
+// boundary) and its thresholds.
+Report parametersReport(const SegmentParameters& parameters, const SegmentResult& result) {
+  Report r;
+  for (const Parameter& row : segmentParameters()) {
+    std::visit(
+        [&](const auto& v) {
+          using V = std::decay_t<decltype(v)>;
+          if constexpr (!std::is_same_v<V, std::monostate>) r.set(row.key(), v);
+        },
+        parameterValue(parameters, row));
+  }
+  if (parameters.segment.edges.method == EdgeMethod::MongaDeriche) {
+    const EdgeScale& scale = result.edgeScale;
+    r.set("edge_reference", scale.reference == EdgeReference::Landmarks ? "landmarks" : "image");
+    r.set("edge_reference_magnitude", scale.magnitude);
+    r.set("edge_low", scale.fractions.low);
+    r.set("edge_high", scale.fractions.high);
+  }
+  return r;
+}
+
+Report seedReport(const SeedRegion& seed, bool fromLandmarks) {
+  Report r;
+  r.set("position_lps_mm", seed.click);
+  r.set("median", seed.median);
+  r.set("spread", seed.spread);
+  r.set("intensity_window", std::vector<double>{seed.low, seed.high});
+  r.set("window_spreads", seed.window);
+  r.set("opening_mm", seed.opening);
+  r.set("region_volume_mm3", regionVolume(seed));
+  r.set("narrower_window_volume_mm3", seed.narrowerWindowVolume);
+  r.set("boundary_points", seed.boundary.size());
+  r.set("springs", fromLandmarks ? "landmarks" : "boundary points");
+  r.set("leaked", probablyLeaked(seed));
+  return r;
+}
+
+Report sliceEndsReport(const SliceEnds& ends) {
+  std::vector<Report> marched;
+  for (const SliceEnd& end : ends.ends) {
+    Report r;
+    r.set("from_lps_mm", end.start);
+    r.set("to_lps_mm", end.end);
+    r.set("length_mm", end.length);
+    r.set("stopped_by_reach", end.stoppedByReach);
+    r.set("pressure", end.pressed);
+    marched.push_back(r);
+  }
+  std::vector<Vector3> springPoints;
+  for (const Landmark& spring : ends.springs) springPoints.push_back(spring.position);
+  Report r;
+  r.set("axis", ends.axis);
+  r.set("slices", ends.slices);
+  r.set("median", ends.median);
+  r.set("spread", ends.spread);
+  r.set("ends", marched);
+  r.set("springs", ends.springs.size());
+  r.set("spring_points_lps_mm", springPoints);
+  Report pressure;
+  pressure.set("n_per_mm2", ends.pressure);
+  pressure.set("inside_samples", ends.insideSamples);
+  pressure.set("outside_samples", ends.outsideSamples);
+  pressure.set("separation", ends.separation);
+  r.set("pressure", pressure);
+  return r;
+}
+
+// The initial control mesh, and the springs: the user's landmarks, or for a
+// seed start without landmarks the seed region's boundary points, softer than
+// an expert's clicks.
+ControlMesh chooseStart(const Volume& image, const SegmentInputs& in, const SegmentParameters& parameters,
+                        SegmentOptions& options, SegmentOutcome& outcome) {
+  outcome.springs = in.landmarks;
+  switch (in.start.kind) {
+    case SegmentStart::Kind::FromLandmarks:
+      try {
+        return initialFromLandmarks(in.landmarks, parameters.initialFraction);
+      } catch (const LandmarkError& error) {
+        throw Error(in.landmarkSource, error.what());
+      }
+    case SegmentStart::Kind::Sphere:
+      return initialSphere(in.start.center, in.start.radius);
+    case SegmentStart::Kind::Seed: {
+      outcome.seed = std::make_unique<SeedRegion>(growFromSeed(image, in.start.center, parameters.seed));
+      if (in.landmarks.empty()) {
+        outcome.springs = outcome.seed->boundary;
+        options.landmarkStiffness = parameters.seed.stiffness;
+      }
+      return initialFromLandmarks(outcome.seed->boundary, parameters.initialFraction);
+    }
+    case SegmentStart::Kind::Mesh: {
+      ControlMesh mesh = readControlMesh(in.start.meshPath);
+      if (!mesh.isClosed()) throw Error(in.start.meshPath, "the initial model must be a closed control mesh");
+      return mesh;
+    }
+  }
+  throw Error("internal: unknown initial model");
+}
+
+}  // namespace
+
+SegmentStart parseSegmentStart(const std::string& value, const std::string& option) {
+  SegmentStart start;
+  start.text = value;
+  if (value == "auto") {
+    start.kind = SegmentStart::Kind::FromLandmarks;
+  } else if (value.rfind("sphere:", 0) == 0) {
+    const std::vector<double> v = numbersAfter(value, 7, 4, "sphere:x,y,z,r", option);
+    start.kind = SegmentStart::Kind::Sphere;
+    start.center = Vector3(v[0], v[1], v[2]);
+    start.radius = v[3];
+  } else if (value.rfind("seed:", 0) == 0) {
+    const std::vector<double> v = numbersAfter(value, 5, 3, "seed:x,y,z", option);
+    start.kind = SegmentStart::Kind::Seed;
+    start.center = Vector3(v[0], v[1], v[2]);
+  } else {
+    start.kind = SegmentStart::Kind::Mesh;
+    start.meshPath = value;
+  }
+  return start;
+}
+
+namespace {
+
+// The evolution's options for these inputs (segmentOptions()).
+SegmentOptions optionsFor(const SegmentInputs& in, const SegmentParameters& parameters) {
+  const bool pointsOnBoundary = !in.landmarks.empty() || in.start.kind == SegmentStart::Kind::Seed;
+  return segmentOptions(parameters, pointsOnBoundary);
+}
+
+}  // namespace
+
+void checkSegmentInputs(const SegmentInputs& in, const SegmentParameters& parameters) {
+  optionsFor(in, parameters);
+  if (in.start.kind != SegmentStart::Kind::FromLandmarks || in.landmarks.size() >= 4) return;
+  const std::string alternatives = "give at least 4 on the structure's boundary, or start from one click inside it";
+  if (in.landmarks.empty()) throw Error("no landmarks to build the initial model from: " + alternatives);
+  throw Error(in.landmarkSource, std::to_string(in.landmarks.size()) +
+                                     " landmarks are too few to outline a structure: " + alternatives);
+}
+
+SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& in, const SegmentParameters& parameters,
+                            const ProgressCallback& progress) {
+  checkSegmentInputs(in, parameters);
+  SegmentOptions options = optionsFor(in, parameters);
+
+  SegmentOutcome outcome;
+  const auto started = std::chrono::steady_clock::now();
+  const ControlMesh initial = chooseStart(image, in, parameters, options, outcome);
+  const std::vector<Landmark>& springs = outcome.springs;
+
+  // The rms landmark distance every 5 steps, the landmarks' nearest points
+  // tracked from sample to sample (a new locator only when the level changes).
+  TrackedDistances tracked(landmarkPositions(springs));
+  ConvergenceRecorder recorder(
+      "rms landmark distance (mm)",
+      springs.empty() ? ConvergenceRecorder::FitError()
+                      : [&](const Progress& p) {
+                          const Eigen::VectorXd d = tracked.measure(*p.surface, p.level, *p.controlPoints);
+                          return std::sqrt(d.squaredNorm() / static_cast<double>(d.size()));
+                        },
+      5);
+  outcome.result = [&] {
+    try {
+      return segment(image, springs, initial, options, recorder.callback(progress));
+    } catch (const LandmarksOffEdges& error) {
+      // Name where the points came from, and the options that help.
+      throw Error(in.landmarkSource, std::string(error.what()) + " (--edge-landmark-reach, --edge-reference image)");
+    } catch (const LandmarkError& error) {
+      throw Error(in.landmarkSource, error.what());
+    }
+  }();
+  const auto voxelizing = std::chrono::steady_clock::now();
+  const ImageGeometry& grid = in.labelmapGrid ? *in.labelmapGrid : image.geometry;
+  outcome.labelmap = labelmapOf(outcome.result.surface, grid);
+  const auto finished = std::chrono::steady_clock::now();
+  outcome.seconds = std::chrono::duration<double>(finished - started).count();
+  outcome.history = recorder.history();
+  const SegmentResult& result = outcome.result;
+  outcome.warnings = result.warnings;
+  if (outcome.seed) {
+    const std::vector<std::string> seed = seedWarnings(*outcome.seed);
+    outcome.warnings.insert(outcome.warnings.begin(), seed.begin(), seed.end());
+  }
+
+  Report& report = outcome.report;
+  report.set("image", in.image);
+  report.set("landmarks", in.landmarkSource);
+  report.set("landmark_count", in.landmarks.size());
+  report.set("init", in.start.text);
+  if (outcome.seed) report.set("seed", seedReport(*outcome.seed, !in.landmarks.empty()));
+  if (in.reference) {
+    outcome.metrics = compareMasks(outcome.labelmap, in.reference());
+    report.set("reference", in.referencePath);
+    report.set("reference_labels", in.referenceLabels);
+    report.merge(metricsReport(outcome.metrics));
+  } else {
+    report.set("volume_mm3", outcome.labelmap.count() * grid.spacing.prod());
+  }
+  report.set("control_vertices", result.mesh.vertexCount());
+  report.set("levels", result.levels.back().level);
+  report.set("iterations", result.steps);
+  report.set("final_energy", result.levels.back().energy);
+  report.set("seconds", outcome.seconds);
+  Report stages;
+  stages.set("crop", result.seconds.crop);
+  stages.set("edge_potential", result.seconds.potential);
+  stages.set("evolution", result.seconds.evolution);
+  stages.set("voxelize", std::chrono::duration<double>(finished - voxelizing).count());
+  report.set("stage_seconds", stages);
+  if (options.sliceEnds.enabled) report.set("slice_ends", sliceEndsReport(result.sliceEnds));
+  Report region;
+  region.set("first_voxel", result.regionFirst);
+  region.set("size_voxels", result.regionSize);
+  report.set("region_of_interest", region);
+  report.set("initial_volume_mm3", result.initialVolume);
+  report.set("surface_volume_mm3", result.volume);
+  report.set("surface_outside_region", result.outsideRegion);
+  if (std::isfinite(result.surfaceOnEdges)) report.set("surface_on_edges", result.surfaceOnEdges);
+  report.set("warnings", outcome.warnings);
+  std::vector<Report> residuals;
+  for (std::size_t i = 0; i < springs.size(); ++i) {
+    Report r;
+    r.set("label", springs[i].label);
+    r.set("position_lps_mm", springs[i].position);
+    r.set("distance_mm", result.landmarkDistances[i]);
+    if (i < result.landmarkEdgeDistances.size() && std::isfinite(result.landmarkEdgeDistances[i]))
+      r.set("edge_distance_mm", result.landmarkEdgeDistances[i]);
+    residuals.push_back(r);
+  }
+  report.set("landmark_residuals", residuals);
+  std::vector<Report> levels;
+  for (const auto& level : result.levels) levels.push_back(levelReport(level, -1, -1));  // no fit error in segmentation
+  report.set("per_level", levels);
+  report.set("parameters", parametersReport(parameters, result));
+  return outcome;
+}
+
+std::string carriedPastSlices(const SegmentResult& result) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(1);
+  bool first = true;
+  for (const SliceEnd& end : result.sliceEnds.ends) {
+    // Only ends beyond which something acted: a spring where the march
+    // stopped (SliceEnds.h, step 4) or the pressure (step 5).
+    if (!end.pressed && !end.sprung) continue;
+    out << (first ? "" : ", ") << end.length << " mm " << (end.side < 0 ? "before the first" : "after the last")
+        << (end.stoppedByReach ? " (no end seen)" : "");
+    first = false;
+  }
+  return out.str();
+}
+
+}  // namespace dynsub
