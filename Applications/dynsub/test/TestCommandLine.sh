@@ -235,7 +235,7 @@ expect_error "landmarks on one slice" 1 "one_slice.mrk.json: all [0-9]* landmark
 expect_error "negative end pressure" 2 "end-pressure" "$work/s13" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --end-pressure -0.1 \
   --out "$work/s13"
-expect_error "NaN edge threshold" 1 "edge thresholds" "$work/s9" \
+expect_error "NaN edge threshold" 1 "edge_low (--edge-low) must be in 0..10, got nan" "$work/s9" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --edge-low nan \
   --out "$work/s9"
 # The MRI cut to half its bytes: the gzip stream ends early (ITK alone read
@@ -259,9 +259,9 @@ expect_error "unknown landmark format" 1 "unknown landmark format" "$work/s3" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/points.txt" --out "$work/s3"
 expect_error "init outside the image" 1 "outside the image" "$work/s4" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:900,0,0,10 --out "$work/s4"
-expect_error "NaN image force" 1 "image force" "$work/s5" \
+expect_error "NaN image force" 1 "image_force (--image-force) must be in" "$work/s5" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:-10,10,10,5 --image-force nan --out "$work/s5"
-expect_error "negative landmark tolerance" 1 "landmark tolerance" "$work/s8" \
+expect_error "negative landmark tolerance" 2 "landmark-tolerance: Value -1 not in range" "$work/s8" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:-10,10,10,5 --landmark-tolerance -1 --out "$work/s8"
 expect_error "reference label absent" 1 "no voxel" "$work/s6" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:-10,10,10,5 --reference "$mri/aal.nii.gz" \

@@ -77,7 +77,8 @@ bad bad_protocol "$(edited "p['protocols'][0]['coverage'] = [0.9, 0.2]")" "cover
 # Whole numbers are whole: 1.5 slices or a seed of -1 is refused, not read as 1 or 4294967295.
 bad fractional_slices "$(edited "p['protocols'][0]['slices'] = 1.5")" "slices must be a whole number, got 1.5"
 bad negative_seed "$(edited "p['splits'][0]['seeds'] = [-1]")" "a seed must be in 0..4294967295, got -1"
-bad fractional_level "$(edited "p['segment'] = {'max_level': 1.5}")" "segment setting max_level must be a whole number"
+bad fractional_level "$(edited "p['segment'] = {'max_level': 1.5}")" "segment setting max_level (--max-level) must be a whole number"
+bad unknown_setting "$(edited "p['segment'] = {'sigma': 1}")" "unknown segment setting 'sigma'"
 bad duplicate_structure "$(edited "p['structures'].append(p['structures'][0])")" "two structures are named 'caudate_left'"
 "$DYNSUB" evaluate "$work/missing.json" --out "$work/out_missing" >"$work/missing.log" 2>&1
 check "missing plan: non-zero exit and the file named" grep -q "missing.json" "$work/missing.log"
