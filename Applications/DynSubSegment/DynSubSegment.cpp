@@ -206,7 +206,6 @@ void run(Arguments& a) {
   for (const std::string* path : {&a.labelmap, &a.model, &a.report})
     if (!path->empty()) requireWritableDirectoryFor(*path);
   for (const auto& apply : a.afterParsing) apply(a);
-  checkSegmentParameters(a.parameters);
 
   SlicerProgress progress(a.parameters.segment.simulation.maxLevel + 1);
   std::cout << "<filter-start><filter-name>DynSubSegment</filter-name></filter-start>" << std::endl;

@@ -102,7 +102,6 @@ void runSegment(const Arguments& o) {
   // Every input is read and checked before anything is written.
   if (!o.reference.empty() && o.referenceLabels.empty())
     throw Error("--reference needs --reference-label N[,M...]: the label value(s) of the structure");
-  checkSegmentParameters(o.parameters);
   SegmentInputs inputs;
   inputs.start = parseSegmentStart(o.init, "--init");
   const Volume image = readVolume(o.image);

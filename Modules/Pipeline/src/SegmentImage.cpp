@@ -174,10 +174,7 @@ SegmentOptions optionsFor(const SegmentInputs& in, const SegmentParameters& para
   return segmentOptions(parameters, pointsOnBoundary);
 }
 
-}  // namespace
-
-void checkSegmentInputs(const SegmentInputs& in, const SegmentParameters& parameters) {
-  optionsFor(in, parameters);
+void checkStart(const SegmentInputs& in) {
   if (in.start.kind != SegmentStart::Kind::FromLandmarks || in.landmarks.size() >= 4) return;
   const std::string alternatives = "give at least 4 on the structure's boundary, or start from one click inside it";
   if (in.landmarks.empty()) throw Error("no landmarks to build the initial model from: " + alternatives);
@@ -185,10 +182,17 @@ void checkSegmentInputs(const SegmentInputs& in, const SegmentParameters& parame
                                      " landmarks are too few to outline a structure: " + alternatives);
 }
 
+}  // namespace
+
+void checkSegmentInputs(const SegmentInputs& in, const SegmentParameters& parameters) {
+  optionsFor(in, parameters);
+  checkStart(in);
+}
+
 SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& in, const SegmentParameters& parameters,
                             const ProgressCallback& progress) {
-  checkSegmentInputs(in, parameters);
   SegmentOptions options = optionsFor(in, parameters);
+  checkStart(in);
 
   SegmentOutcome outcome;
   const auto started = std::chrono::steady_clock::now();

@@ -337,26 +337,29 @@ std::string toText(const ParameterValue& value) {
       value);
 }
 
-void checkSegmentParameters(const SegmentParameters& parameters) {
-  // Each number within its row's range (a plan's values were checked as they
-  // were set; the command line's by its options; this holds for a caller
-  // that fills the struct itself).
+namespace {
+
+// Each number within its row's range (a plan's values are checked as they
+// are set, the command line's by its options; this holds for a caller that
+// fills the struct itself).
+void checkRanges(const SegmentParameters& parameters) {
   for (const Parameter& row : segmentParameters()) {
     const ParameterValue v = parameterValue(parameters, row);
-    const double number = std::holds_alternative<double>(v) ? std::get<double>(v)
-                          : std::holds_alternative<int>(v)  ? std::get<int>(v)
-                                                            : 0.0;
-    if ((std::holds_alternative<double>(v) || std::holds_alternative<int>(v)) &&
-        !(number >= row.low && number <= row.high))
-      throw Error(row.key() + " (" + row.flag() + ") must be in " + dynsub::number(row.low) + ".." +
-                  dynsub::number(row.high) + ", got " + toText(v));
+    const double* real = std::get_if<double>(&v);
+    const int* whole = std::get_if<int>(&v);
+    if (!real && !whole) continue;
+    const double x = real ? *real : *whole;
+    if (!(x >= row.low && x <= row.high))
+      throw Error(row.key() + " (" + row.flag() + ") must be in " + number(row.low) + ".." + number(row.high) +
+                  ", got " + toText(v));
   }
-  checkSegmentOptions(parameters.segment);
-  checkSeedOptions(parameters.seed);
 }
 
+}  // namespace
+
 SegmentOptions segmentOptions(const SegmentParameters& parameters, bool pointsOnBoundary) {
-  checkSegmentParameters(parameters);
+  checkRanges(parameters);
+  checkSeedOptions(parameters.seed);
   SegmentOptions o = parameters.segment;
   EdgeOptions& edges = o.edges;
   // Landmarks off every edge are an error, not a silent switch to the image's reference (EdgePotential.h).
@@ -370,6 +373,12 @@ SegmentOptions segmentOptions(const SegmentParameters& parameters, bool pointsOn
   m.rigidityUV = 2 * m.rigidityUU;
   checkSegmentOptions(o);
   return o;
+}
+
+void checkSegmentParameters(const SegmentParameters& parameters) {
+  // The thresholds are checked against both references they may go to.
+  segmentOptions(parameters, true);
+  segmentOptions(parameters, false);
 }
 
 }  // namespace dynsub

@@ -88,10 +88,11 @@ std::string toText(const ParameterValue& value);
 // given to the reference they are fractions of (the landmarks' when
 // `pointsOnBoundary` and the reference is the landmarks, else the image's)
 // and one tension and one rigidity for every direction. Throws dynsub::Error
-// for a value outside its range and for impossible options.
+// for a value outside its row's range and for impossible options
+// (checkSegmentOptions, checkSeedOptions).
 SegmentOptions segmentOptions(const SegmentParameters& parameters, bool pointsOnBoundary);
-// Every row's range, then the library's own checks (checkSegmentOptions,
-// checkSeedOptions).
+// Whether segmentOptions() would accept the parameters whatever the inputs
+// (a plan's, before any run).
 void checkSegmentParameters(const SegmentParameters& parameters);
 
 }  // namespace dynsub
