@@ -23,7 +23,7 @@ void FigureOptions::prepare() const {
 
 void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const ControlMesh& mesh,
                       const TriangleSurface& surface, const ConvergenceHistory& history, const Volume* image,
-                      const Matrix3X& landmarks, const Matrix3X& dataPoints, const Eigen::VectorXd& edgeDistances) {
+                      const MatrixX3& landmarks, const MatrixX3& dataPoints, const Eigen::VectorXd& edgeDistances) {
   writeConvergenceCsv(history, outputs.add("convergence.csv"));
   if (!options.figures) return;
   std::string why;

@@ -35,7 +35,7 @@ struct FigureOptions {
 // point of `surface`, Figures.h).
 void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const ControlMesh& mesh,
                       const TriangleSurface& surface, const ConvergenceHistory& history, const Volume* image,
-                      const Matrix3X& landmarks, const Matrix3X& dataPoints,
+                      const MatrixX3& landmarks, const MatrixX3& dataPoints,
                       const Eigen::VectorXd& edgeDistances = Eigen::VectorXd());
 
 }  // namespace dynsub::app

@@ -30,7 +30,7 @@ struct FitCommandOptions {
   FigureOptions figures;
 };
 
-ControlMesh chooseInitialModel(const FitCommandOptions& o, const Matrix3X& data) {
+ControlMesh chooseInitialModel(const FitCommandOptions& o, const MatrixX3& data) {
   ControlMesh mesh;
   if (o.init == "auto" || o.init == "sphere") {
     mesh = initialModel(data, InitialShape::Sphere);
@@ -54,7 +54,7 @@ ControlMesh chooseInitialModel(const FitCommandOptions& o, const Matrix3X& data)
 }
 
 void runFit(FitCommandOptions o) {
-  const Matrix3X data = readPointCloud(o.points);
+  const MatrixX3 data = readPointCloud(o.points);
   checkPointCloud(data, o.points);
   const ControlMesh initial = chooseInitialModel(o, data);
   const std::filesystem::path dir(o.out);
@@ -109,7 +109,7 @@ void runFit(FitCommandOptions o) {
 
   const TriangleSurface surface = outputSurface(result.mesh, *result.surface);
   writeModelOutputs(dir, result.mesh, surface, report, [&](OutputSet& outputs) {
-    addFigureOutputs(outputs, o.figures, result.mesh, surface, recorder.history(), nullptr, Matrix3X(), data);
+    addFigureOutputs(outputs, o.figures, result.mesh, surface, recorder.history(), nullptr, MatrixX3(), data);
   });
 
   std::cout << std::fixed << std::setprecision(3) << "fitted " << data.rows() << " points with "

@@ -58,7 +58,7 @@ void writeSegmentOutputs(const std::filesystem::path& dir, const SegmentOutcome&
         const auto labelmap = [&] { writeMask(outcome.labelmap, labelmapPath); };
         const auto figuresAndRecord = [&] {
           addFigureOutputs(outputs, figures, result.mesh, result.surface, outcome.history, &image,
-                           landmarkPositions(outcome.springs), Matrix3X(), result.surfaceEdgeDistances);
+                           landmarkPositions(outcome.springs), MatrixX3(), result.surfaceEdgeDistances);
         };
         // NB: with figures, the labelmap is compressed on a thread of its own
         // while they render on this one (a tenth of them). Without, this

@@ -31,8 +31,8 @@ ControlMesh cubeAtLevel(int level) {
 double elementSize(int level) { return std::ldexp(1.0, -level); }
 
 // Targets: the cube's limit surface pushed out onto a sphere of radius 1.2.
-Matrix3X sphereTargets(const LimitSurface& surface, const Matrix3X& points) {
-  Matrix3X targets = tessellate(surface, points, 2).points;
+MatrixX3 sphereTargets(const LimitSurface& surface, const MatrixX3& points) {
+  MatrixX3 targets = tessellate(surface, points, 2).points;
   for (Eigen::Index i = 0; i < targets.rows(); ++i) targets.row(i) *= 1.2 / targets.row(i).norm();
   return targets;
 }
@@ -57,14 +57,14 @@ struct StepProblem {
   std::unique_ptr<LimitSurface> surface;
   PhysicalMatrices matrices;
   SymmetricMatrix stabilizing;
-  Matrix3X force;
+  MatrixX3 force;
 
   explicit StepProblem(int level) : mesh(cubeAtLevel(level)), surface(std::make_unique<LimitSurface>(mesh)) {
     AssemblyOptions options;
     options.elementSize = elementSize(level);
     matrices = assemblePhysicalMatrices(*surface, Material{}, options);
-    const Matrix3X points = mesh.points();
-    const Matrix3X targets = sphereTargets(*surface, points);
+    const MatrixX3 points = mesh.points();
+    const MatrixX3 targets = sphereTargets(*surface, points);
     SpringForceModel springs(targets, Eigen::VectorXd::Constant(targets.rows(), 100.0 * 96 / targets.rows()),
                              SpringForceModel::Attach::NearestAtLevelStart);
     SurfaceQuadrature none;
@@ -88,7 +88,7 @@ void BM_Step(benchmark::State& state) {
   IntegratorOptions options;
   options.solver = solverOf(state.range(1));
   Integrator integrator(problem.matrices, problem.stabilizing, {}, options);
-  const Matrix3X p = problem.mesh.points();
+  const MatrixX3 p = problem.mesh.points();
   for (auto _ : state) benchmark::DoNotOptimize(integrator.step(p, p, problem.force));
   state.counters["control_vertices"] = problem.mesh.vertexCount();
   state.counters["solver_iterations"] = integrator.lastIterations();
@@ -101,14 +101,14 @@ void BM_NewtonDirection(benchmark::State& state) {
   AssemblyOptions assembly;
   assembly.elementSize = elementSize(level);
   const PhysicalMatrices matrices = assemblePhysicalMatrices(surface, Material{}, assembly);
-  const Matrix3X points = mesh.points();
-  const Matrix3X targets = sphereTargets(surface, points);
+  const MatrixX3 points = mesh.points();
+  const MatrixX3 targets = sphereTargets(surface, points);
   SpringForceModel springs(targets, Eigen::VectorXd::Constant(targets.rows(), 100.0 * 96 / targets.rows()),
                            SpringForceModel::Attach::NearestEachStep);
   SurfaceQuadrature none;
   springs.beginLevel(surface, none, points);
   double potential = 0.0;
-  const Matrix3X residual = springs.generalizedForce(points, potential) - matrices.stiffness * points;
+  const MatrixX3 residual = springs.generalizedForce(points, potential) - matrices.stiffness * points;
   for (auto _ : state) {
     StaticSolver solver(surface, matrices.stiffness, {});
     benchmark::DoNotOptimize(solver.direction({&springs}, points, residual, false));
@@ -121,7 +121,7 @@ void BM_TimeToEquilibrium(benchmark::State& state) {
   const int level = static_cast<int>(state.range(0));
   const ControlMesh mesh = cubeAtLevel(level);
   const LimitSurface surface(mesh);
-  const Matrix3X targets = sphereTargets(surface, mesh.points());
+  const MatrixX3 targets = sphereTargets(surface, mesh.points());
   SimulationOptions options;
   options.integrator.solver = solverOf(state.range(1));
   int steps = 0;

@@ -49,9 +49,9 @@ void DynSubApplyOperators(benchmark::State& state) {
   const dynsub::ControlMesh mesh = cubeAtLevel(static_cast<int>(state.range(0)));
   const dynsub::LimitSurface surface(mesh);
   const dynsub::LimitOperators ops = surface.operators(samples(mesh.faceCount()), 1);  // J, J_u, J_v
-  const dynsub::Matrix3X control = mesh.points();
+  const dynsub::MatrixX3 control = mesh.points();
   // Into arrays allocated once, as OpenSubdiv's side below writes into its own.
-  dynsub::Matrix3X s, su, sv;
+  dynsub::MatrixX3 s, su, sv;
   for (auto _ : state) {
     dynsub::applyOperators(ops.J, ops.Ju, ops.Jv, control, s, su, sv);
     benchmark::DoNotOptimize(s.data());
@@ -104,7 +104,7 @@ void OpenSubdivApplyStencils(benchmark::State& state) {
   refiner->RefineAdaptive(Far::TopologyRefiner::AdaptiveOptions(10));
   std::unique_ptr<const Far::LimitStencilTableReal<double>> table(
       Far::LimitStencilTableFactoryReal<double>::Create(*refiner, locations));
-  const dynsub::Matrix3X control = mesh.points();
+  const dynsub::MatrixX3 control = mesh.points();
   struct Point {
     double p[3];
     void Clear() { p[0] = p[1] = p[2] = 0; }

@@ -252,7 +252,7 @@ int run(int argc, char** argv) {
     options.iterations = run.iterations;
     const itkbaseline::SimplexResult simplex =
         itkbaseline::deformableSimplexMesh(toBridge(region), cropped.voxels, startIndices, start.triangles, options);
-    Matrix3X points(simplex.points.size(), 3);
+    MatrixX3 points(simplex.points.size(), 3);
     for (std::size_t p = 0; p < simplex.points.size(); ++p)
       points.row(p) = region.toPhysical(Vector3(simplex.points[p][0], simplex.points[p][1], simplex.points[p][2])).transpose();
     char name[64], extra[128];

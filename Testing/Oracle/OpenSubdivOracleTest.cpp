@@ -65,7 +65,7 @@ class OracleTest : public ::testing::TestWithParam<dynsub::testing::NamedMesh> {
 
 TEST_P(OracleTest, LimitSurfaceMatchesOpenSubdiv) {
   const dynsub::ControlMesh& mesh = GetParam().mesh;
-  const dynsub::Matrix3X control = mesh.points();
+  const dynsub::MatrixX3 control = mesh.points();
   const double diagonal = (control.colwise().maxCoeff() - control.colwise().minCoeff()).norm();
   const double tolerance = 1e-6 * diagonal;
 
@@ -118,7 +118,7 @@ TEST_P(OracleTest, LimitSurfaceMatchesOpenSubdiv) {
 // that are not powers of two; N = 8 puts points at 1/8 from extraordinary vertices).
 TEST_P(OracleTest, TessellationMatchesOpenSubdivAtEveryOutputPoint) {
   const dynsub::ControlMesh& mesh = GetParam().mesh;
-  const dynsub::Matrix3X control = mesh.points();
+  const dynsub::MatrixX3 control = mesh.points();
   const double diagonal = (control.colwise().maxCoeff() - control.colwise().minCoeff()).norm();
   const dynsub::LimitSurface surface(mesh);
   for (int n : {5, 8}) {

@@ -50,7 +50,7 @@ std::vector<ReferenceSample> openSubdivLimit(const ControlMesh& mesh, const std:
   std::unique_ptr<const Far::LimitStencilTableReal<double>> table(
       Far::LimitStencilTableFactoryReal<double>::Create(*refiner, locations));
 
-  const Matrix3X control = mesh.points();
+  const MatrixX3 control = mesh.points();
   std::vector<ReferenceSample> result(points.size());
   for (size_t i = 0; i < points.size(); ++i) {
     const Far::LimitStencilReal<double> stencil = table->GetLimitStencil(static_cast<Far::Index>(i));

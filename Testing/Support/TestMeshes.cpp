@@ -10,7 +10,7 @@ ControlMesh makeFan(int n, bool closed) {
   // Centre 0; spokes 1..s; diagonals between consecutive spokes.
   const int spokes = closed ? n : n + 1;
   const double sector = (closed ? 2.0 : 1.5) * M_PI / n;
-  Matrix3X points(1 + spokes + n, 3);
+  MatrixX3 points(1 + spokes + n, 3);
   points.row(0) << 0.0, 0.0, 0.3;
   auto bowl = [](double x, double y) { return 0.25 * (x * x + y * y) + 0.1 * x * y; };
   for (int i = 0; i < spokes; ++i) {
@@ -29,7 +29,7 @@ ControlMesh makeFan(int n, bool closed) {
 }
 
 ControlMesh makePrism(int n) {
-  Matrix3X points(2 * n, 3);
+  MatrixX3 points(2 * n, 3);
   for (int i = 0; i < n; ++i) {
     const double angle = 2.0 * M_PI * i / n;
     // Radii vary so the shape is not symmetric.
@@ -50,20 +50,20 @@ ControlMesh makePrism(int n) {
 }
 
 ControlMesh makePyramid() {
-  Matrix3X points(5, 3);
+  MatrixX3 points(5, 3);
   points << -1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0, 0.2, 0.1, 1.4;
   return ControlMesh::fromPolygons(points, {{3, 2, 1, 0}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}}, "pyramid");
 }
 
 ControlMesh makeTetrahedron() {
-  Matrix3X points(4, 3);
+  MatrixX3 points(4, 3);
   points << 1, 1, 1, -1, -1, 1, -1, 1, -1, 1, -1, -1;
   return ControlMesh::fromPolygons(points, {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}, "tetrahedron");
 }
 
 ControlMesh makeLShape() {
   constexpr int n = 4;  // 4 x 4 vertices, 3 x 3 quads
-  Matrix3X points(n * n, 3);
+  MatrixX3 points(n * n, 3);
   for (int j = 0; j < n; ++j) {
     for (int i = 0; i < n; ++i) {
       const double x = i - 1.5, y = j - 1.5;
@@ -83,7 +83,7 @@ ControlMesh makeLShape() {
 
 ControlMesh makeBumpyTorus() {
   ControlMesh torus = makeTorus32();
-  Matrix3X points = torus.points();
+  MatrixX3 points = torus.points();
   for (Eigen::Index v = 0; v < points.rows(); ++v) {
     points.row(v) *= 1.0 + 0.1 * std::sin(3.0 * points(v, 0) + 2.0 * points(v, 2));
   }

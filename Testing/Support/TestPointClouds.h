@@ -17,18 +17,18 @@ inline Vector3 randomDirection(std::mt19937_64& random) {
 }
 
 // n points on the ellipsoid of semi-axes `axes` around the origin.
-inline Matrix3X ellipsoidPoints(int n, const Vector3& axes, unsigned seed) {
+inline MatrixX3 ellipsoidPoints(int n, const Vector3& axes, unsigned seed) {
   std::mt19937_64 random(seed);
-  Matrix3X points(n, 3);
+  MatrixX3 points(n, 3);
   for (int i = 0; i < n; ++i) points.row(i) = randomDirection(random).cwiseProduct(axes).transpose();
   return points;
 }
 
 // n points on the torus of ring radius `ring` and tube radius `tube` around the z axis.
-inline Matrix3X torusPoints(int n, double ring, double tube, unsigned seed) {
+inline MatrixX3 torusPoints(int n, double ring, double tube, unsigned seed) {
   std::mt19937_64 random(seed);
   std::uniform_real_distribution<double> angle(0.0, 2.0 * M_PI);
-  Matrix3X points(n, 3);
+  MatrixX3 points(n, 3);
   for (int i = 0; i < n; ++i) {
     const double theta = angle(random), phi = angle(random);
     const double r = ring + tube * std::cos(phi);

@@ -7,7 +7,7 @@
 
 namespace {
 
-using dynsub::Matrix3X;
+using dynsub::MatrixX3;
 using dynsub::SparseMatrix;
 
 SparseMatrix randomOperator(int rows, int cols, std::mt19937& random) {
@@ -26,13 +26,13 @@ TEST(ApplyOperator, EqualsEigensProductToTheBit) {
   // The same sums in the same order: equal, not merely close.
   std::mt19937 random(5);
   const SparseMatrix op = randomOperator(500, 120, random);
-  const Matrix3X points = Matrix3X::Random(120, 3);
-  const Matrix3X expected = op * points;
-  const Matrix3X result = dynsub::applyOperator(op, points);
+  const MatrixX3 points = MatrixX3::Random(120, 3);
+  const MatrixX3 expected = op * points;
+  const MatrixX3 result = dynsub::applyOperator(op, points);
   ASSERT_EQ(result.rows(), 500);
   EXPECT_TRUE((result.array() == expected.array()).all());
   // Into a reused array of another size.
-  Matrix3X reused = Matrix3X::Constant(7, 3, 1.0);
+  MatrixX3 reused = MatrixX3::Constant(7, 3, 1.0);
   dynsub::applyOperator(op, points, reused);
   EXPECT_TRUE((reused.array() == expected.array()).all());
 }
@@ -44,8 +44,8 @@ TEST(ApplyOperator, ReadsAnUncompressedOperator) {
   op.reserve(Eigen::VectorXi::Constant(50, 4));
   op.coeffRef(7, 29) = 2.5;  // found or inserted; the rows keep their spare room
   ASSERT_FALSE(op.isCompressed());
-  const Matrix3X points = Matrix3X::Random(30, 3);
-  const Matrix3X expected = op * points;
+  const MatrixX3 points = MatrixX3::Random(30, 3);
+  const MatrixX3 expected = op * points;
   EXPECT_TRUE((dynsub::applyOperator(op, points).array() == expected.array()).all());
 }
 
@@ -59,8 +59,8 @@ TEST(ApplyOperators, EqualThreeApplicationsToTheBitAndRefuseOtherPatterns) {
     b.valuePtr()[k] = k % 5 == 0 ? 0.0 : weight(random);
     c.valuePtr()[k] = weight(random);
   }
-  const Matrix3X points = Matrix3X::Random(90, 3);
-  Matrix3X ra, rb, rc;
+  const MatrixX3 points = MatrixX3::Random(90, 3);
+  MatrixX3 ra, rb, rc;
   dynsub::applyOperators(a, b, c, points, ra, rb, rc);
   EXPECT_TRUE((ra.array() == dynsub::applyOperator(a, points).array()).all());
   EXPECT_TRUE((rb.array() == dynsub::applyOperator(b, points).array()).all());
@@ -76,13 +76,13 @@ TEST(ApplyOperator, EqualsEigensProductToTheBitForAColumnMajorOperator) {
   // in each column after reserve()).
   std::mt19937 random(9);
   Eigen::SparseMatrix<double, Eigen::ColMajor> op = randomOperator(300, 300, random);
-  const Matrix3X points = Matrix3X::Random(300, 3);
-  const Matrix3X expected = op * points;
+  const MatrixX3 points = MatrixX3::Random(300, 3);
+  const MatrixX3 expected = op * points;
   EXPECT_TRUE((dynsub::applyOperator(op, points).array() == expected.array()).all());
   op.reserve(Eigen::VectorXi::Constant(300, 3));
   op.coeffRef(5, 299) += 0.75;
   ASSERT_FALSE(op.isCompressed());
-  const Matrix3X again = op * points;
+  const MatrixX3 again = op * points;
   EXPECT_TRUE((dynsub::applyOperator(op, points).array() == again.array()).all());
 }
 
@@ -91,24 +91,24 @@ TEST(ApplyTransposed, EqualsEigensTransposedProductToTheBitAndRefusesAMismatch) 
   // another order of summation would round otherwise.
   std::mt19937 random(8);
   const SparseMatrix op = randomOperator(2000, 40, random);
-  const Matrix3X values = Matrix3X::Random(2000, 3);
-  const Matrix3X expected = op.transpose() * values;
-  const Matrix3X result = dynsub::applyTransposed(op, values);
+  const MatrixX3 values = MatrixX3::Random(2000, 3);
+  const MatrixX3 expected = op.transpose() * values;
+  const MatrixX3 result = dynsub::applyTransposed(op, values);
   ASSERT_EQ(result.rows(), 40);
   EXPECT_TRUE((result.array() == expected.array()).all());
-  EXPECT_THROW(dynsub::applyTransposed(op, Matrix3X::Random(1999, 3)), std::invalid_argument);
+  EXPECT_THROW(dynsub::applyTransposed(op, MatrixX3::Random(1999, 3)), std::invalid_argument);
   // Uncompressed: only each row's counted entries are read.
   SparseMatrix roomy = op;
   roomy.reserve(Eigen::VectorXi::Constant(2000, 2));
   roomy.coeffRef(3, 39) += 0.5;
   ASSERT_FALSE(roomy.isCompressed());
-  const Matrix3X again = roomy.transpose() * values;
+  const MatrixX3 again = roomy.transpose() * values;
   EXPECT_TRUE((dynsub::applyTransposed(roomy, values).array() == again.array()).all());
 }
 
 TEST(ApplyOperator, AnEmptyOperatorGivesNoRows) {
   const SparseMatrix op(0, 4);
-  EXPECT_EQ(dynsub::applyOperator(op, Matrix3X::Zero(4, 3)).rows(), 0);
+  EXPECT_EQ(dynsub::applyOperator(op, MatrixX3::Zero(4, 3)).rows(), 0);
 }
 
 }  // namespace

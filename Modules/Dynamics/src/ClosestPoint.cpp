@@ -17,7 +17,7 @@ namespace dynsub {
 namespace {
 
 struct SampleCloud {
-  Matrix3X points;
+  MatrixX3 points;
   size_t kdtree_get_point_count() const { return static_cast<size_t>(points.rows()); }
   double kdtree_get_pt(size_t i, size_t d) const { return points(static_cast<Eigen::Index>(i), d); }
   template <class Box>
@@ -44,15 +44,15 @@ struct ClosestPointLocator::Impl {
   std::vector<char> normal;  // per element
   SampleCloud cloud;
   std::unique_ptr<Tree> tree;
-  Matrix3X treeControlPoints;
+  MatrixX3 treeControlPoints;
   double drift = std::numeric_limits<double>::infinity();
   double sampleWeightBound = 0;  // max over samples of the sum of |weights|
-  Matrix3X controlPoints;
+  MatrixX3 controlPoints;
   // specialOperator * controlPoints.
   // NB: computed at every update: the checks for a nearer sample read the
   // special elements' samples many times over, and a sparse row each time
   // would cost far more.
-  Matrix3X specialSamples;
+  MatrixX3 specialSamples;
   // The surface at controlPoints: the normal elements' grids (its
   // patchOperator times them) and the special elements' pieces.
   std::unique_ptr<SurfaceState> state;
@@ -325,7 +325,7 @@ ClosestPointLocator::~ClosestPointLocator() = default;
 ClosestPointLocator::ClosestPointLocator(ClosestPointLocator&&) noexcept = default;
 ClosestPointLocator& ClosestPointLocator::operator=(ClosestPointLocator&&) noexcept = default;
 
-void ClosestPointLocator::update(const Matrix3X& controlPoints) {
+void ClosestPointLocator::update(const MatrixX3& controlPoints) {
   if (controlPoints.rows() != impl_->surface->controlVertexCount()) {
     throw Error("closest-point search got " + std::to_string(controlPoints.rows()) + " control points for " +
                 std::to_string(impl_->surface->controlVertexCount()));
@@ -364,7 +364,7 @@ ClosestPoint ClosestPointLocator::search(const Vector3& query) const {
   return s.refineFrom(index, query);
 }
 
-std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries) const {
+std::vector<ClosestPoint> ClosestPointLocator::findAll(const MatrixX3& queries) const {
   if (impl_->controlPoints.size() == 0) throw Error("internal: closest-point search used before update()");
   if (!queries.allFinite()) throw Error("closest-point query is not finite");  // before the workers start
   impl_->updateTree();
@@ -374,7 +374,7 @@ std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries) 
   return result;
 }
 
-std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries,
+std::vector<ClosestPoint> ClosestPointLocator::findAll(const MatrixX3& queries,
                                                        const std::vector<ElementPoint>& hints) const {
   Impl& s = *impl_;
   if (s.controlPoints.size() == 0) throw Error("internal: closest-point search used before update()");
@@ -465,10 +465,10 @@ std::vector<ClosestPoint> ClosestPointLocator::findAll(const Matrix3X& queries,
   return result;
 }
 
-TrackedDistances::TrackedDistances(Matrix3X points) : points_(std::move(points)) {}
+TrackedDistances::TrackedDistances(MatrixX3 points) : points_(std::move(points)) {}
 TrackedDistances::~TrackedDistances() = default;
 
-Eigen::VectorXd TrackedDistances::measure(const LimitSurface& surface, int level, const Matrix3X& controlPoints) {
+Eigen::VectorXd TrackedDistances::measure(const LimitSurface& surface, int level, const MatrixX3& controlPoints) {
   if (&surface != surface_ || level != level_ || !locator_) {
     locator_ = std::make_unique<ClosestPointLocator>(surface);
     surface_ = &surface;

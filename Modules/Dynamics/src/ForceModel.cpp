@@ -7,18 +7,18 @@
 #include "dynsub/ApplyOperator.h"
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/Error.h"
-#include "dynsub/StaticSolver.h"
+#include "dynsub/TangentStiffness.h"
 
 namespace dynsub {
 
-SparseMatrix ForceModel::stabilizingStiffness(const Matrix3X&) { return SparseMatrix(); }
+SparseMatrix ForceModel::stabilizingStiffness(const MatrixX3&) { return SparseMatrix(); }
 
-void ForceModel::addTangentStiffness(const Matrix3X& controlPoints, TangentStiffness& into) {
+void ForceModel::addTangentStiffness(const MatrixX3& controlPoints, TangentStiffness& into) {
   const SparseMatrix s = stabilizingStiffness(controlPoints);
   if (s.size() > 0) into.addScalar(s);
 }
 
-SpringForceModel::SpringForceModel(Matrix3X targets, Eigen::VectorXd stiffness, Attach attach)
+SpringForceModel::SpringForceModel(MatrixX3 targets, Eigen::VectorXd stiffness, Attach attach)
     : targets_(std::move(targets)), stiffness_(std::move(stiffness)), attach_(attach) {
   if (targets_.rows() != stiffness_.size()) {
     throw Error("got " + std::to_string(stiffness_.size()) + " spring stiffnesses for " +
@@ -36,7 +36,7 @@ SpringForceModel::SpringForceModel(Matrix3X targets, Eigen::VectorXd stiffness, 
 SpringForceModel::~SpringForceModel() = default;
 
 void SpringForceModel::beginLevel(const LimitSurface& surface, const SurfaceQuadrature&,
-                                  const Matrix3X& controlPoints) {
+                                  const MatrixX3& controlPoints) {
   surface_ = &surface;
   locator_ = std::make_unique<ClosestPointLocator>(surface);
   springs_.clear();  // attachments of the previous level mean nothing on the new surface
@@ -50,7 +50,7 @@ void SpringForceModel::acceptState() {
   for (size_t i = 0; i < springs_.size(); ++i) tracked_[i] = springs_[i].attachment;
 }
 
-void SpringForceModel::attach(const Matrix3X& controlPoints) {
+void SpringForceModel::attach(const MatrixX3& controlPoints) {
   locator_->update(controlPoints);
   // Track the last accepted state's attachments where there are some (same level).
   const std::vector<ClosestPoint> nearest = tracked_.size() == static_cast<size_t>(targets_.rows())
@@ -79,19 +79,19 @@ void SpringForceModel::attach(const Matrix3X& controlPoints) {
   });
 }
 
-Matrix3X SpringForceModel::generalizedForce(const Matrix3X& controlPoints, double& potential) {
+MatrixX3 SpringForceModel::generalizedForce(const MatrixX3& controlPoints, double& potential) {
   if (attach_ == Attach::NearestAtLevelStart) {
     std::vector<ElementPoint> at;
     at.reserve(springs_.size());
     for (const Spring& s : springs_) at.push_back(s.attachment);
     const SparseMatrix J = surface_->limitOperator(at);
-    const Matrix3X stretch = targets_ - applyOperator(J, controlPoints);  // d - s per spring
+    const MatrixX3 stretch = targets_ - applyOperator(J, controlPoints);  // d - s per spring
     lengths_ = stretch.rowwise().norm();
     potential += 0.5 * stiffness_.dot(lengths_.cwiseAbs2());
     return J.transpose() * (stiffness_.asDiagonal() * stretch);
   }
   attach(controlPoints);
-  Matrix3X stretch = targets_ - positions_;  // the locator's positions at these control points
+  MatrixX3 stretch = targets_ - positions_;  // the locator's positions at these control points
   lengths_ = stretch.rowwise().norm();
   if (deadZone_ > 0) {
     const Eigen::ArrayXd beyond = (lengths_.array() - deadZone_).max(0.0);
@@ -104,8 +104,8 @@ Matrix3X SpringForceModel::generalizedForce(const Matrix3X& controlPoints, doubl
   // points go back through the patch operator in one product; the few on
   // special elements through their stencils.
   const SparseMatrix& patches = locator_->patchOperator();
-  Matrix3X onGrids = Matrix3X::Zero(patches.rows(), 3);
-  Matrix3X force = Matrix3X::Zero(controlPoints.rows(), 3);
+  MatrixX3 onGrids = MatrixX3::Zero(patches.rows(), 3);
+  MatrixX3 force = MatrixX3::Zero(controlPoints.rows(), 3);
   for (size_t i = 0; i < springs_.size(); ++i) {
     const ElementPoint& q = springs_[i].attachment;
     const Eigen::Index row = static_cast<Eigen::Index>(i);
@@ -128,9 +128,9 @@ void SpringForceModel::setDeadZone(double zone) {
   deadZone_ = zone;
 }
 
-SparseMatrix SpringForceModel::stabilizingStiffness(const Matrix3X&) { return springStiffness(*surface_, springs_); }
+SparseMatrix SpringForceModel::stabilizingStiffness(const MatrixX3&) { return springStiffness(*surface_, springs_); }
 
-void SpringForceModel::addTangentStiffness(const Matrix3X& controlPoints, TangentStiffness& into) {
+void SpringForceModel::addTangentStiffness(const MatrixX3& controlPoints, TangentStiffness& into) {
   // Springs held at their attachments: k J^T J is the exact derivative.
   if (attach_ == Attach::NearestAtLevelStart) return ForceModel::addTangentStiffness(controlPoints, into);
   // The normals are the last evaluation's, the state the Newton step starts from.
@@ -152,23 +152,23 @@ InflationForceModel::InflationForceModel(double pressure) : pressure_(pressure) 
   if (!std::isfinite(pressure)) throw Error("inflation pressure is not finite");
 }
 
-void InflationForceModel::beginLevel(const LimitSurface&, const SurfaceQuadrature& quadrature, const Matrix3X&) {
+void InflationForceModel::beginLevel(const LimitSurface&, const SurfaceQuadrature& quadrature, const MatrixX3&) {
   quadrature_ = &quadrature;
 }
 
-Matrix3X InflationForceModel::generalizedForce(const Matrix3X& controlPoints, double&) {
+MatrixX3 InflationForceModel::generalizedForce(const MatrixX3& controlPoints, double&) {
   return inflationForces(*quadrature_, controlPoints, pressure_);
 }
 
-void FieldForceModel::beginLevel(const LimitSurface&, const SurfaceQuadrature& quadrature, const Matrix3X&) {
+void FieldForceModel::beginLevel(const LimitSurface&, const SurfaceQuadrature& quadrature, const MatrixX3&) {
   quadrature_ = &quadrature;
 }
 
-Matrix3X FieldForceModel::generalizedForce(const Matrix3X& controlPoints, double&) {
+MatrixX3 FieldForceModel::generalizedForce(const MatrixX3& controlPoints, double&) {
   return fieldForces(*quadrature_, controlPoints, field_, pressure_);
 }
 
-SparseMatrix FieldForceModel::stabilizingStiffness(const Matrix3X& controlPoints) {
+SparseMatrix FieldForceModel::stabilizingStiffness(const MatrixX3& controlPoints) {
   const double slope = field_.slopeBound() + (pressure_ ? pressure_->slopeBound() : 0.0);
   if (!(slope > 0.0)) return SparseMatrix();
   return fieldStiffness(*quadrature_, controlPoints, slope);

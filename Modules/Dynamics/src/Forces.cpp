@@ -37,13 +37,13 @@ SurfaceQuadrature makeSurfaceQuadrature(const LimitSurface& surface, int pointsP
   return q;
 }
 
-Matrix3X springForces(const LimitSurface& surface, const Matrix3X& controlPoints, const std::vector<Spring>& springs,
+MatrixX3 springForces(const LimitSurface& surface, const MatrixX3& controlPoints, const std::vector<Spring>& springs,
                       double* energy) {
   std::vector<ElementPoint> at;
   at.reserve(springs.size());
   for (const Spring& s : springs) at.push_back(s.attachment);
   const SparseMatrix J = surface.limitOperator(at);
-  Matrix3X pull = applyOperator(J, controlPoints);  // s at the attachments
+  MatrixX3 pull = applyOperator(J, controlPoints);  // s at the attachments
   double total = 0.0;
   for (size_t i = 0; i < springs.size(); ++i) {
     const Vector3 stretch = springs[i].target - pull.row(i).transpose();
@@ -68,12 +68,12 @@ SparseMatrix springStiffness(const LimitSurface& surface, const std::vector<Spri
 namespace {
 
 // sum_q w_q J_q^T (f_q |s_u x s_v|_q) with f given per point, or P n for inflation.
-Matrix3X integrate(const SurfaceQuadrature& q, const Matrix3X& densityTimesArea) {
+MatrixX3 integrate(const SurfaceQuadrature& q, const MatrixX3& densityTimesArea) {
   return applyTransposed(q.J, q.weights.asDiagonal() * densityTimesArea);
 }
 
 // |s_u x s_v| at every quadrature point: surface area per unit parametric area.
-Eigen::VectorXd areaElements(const Matrix3X& su, const Matrix3X& sv) {
+Eigen::VectorXd areaElements(const MatrixX3& su, const MatrixX3& sv) {
   Eigen::VectorXd area(su.rows());
   for (Eigen::Index i = 0; i < su.rows(); ++i) area(i) = su.row(i).cross(sv.row(i)).norm();
   return area;
@@ -81,33 +81,33 @@ Eigen::VectorXd areaElements(const Matrix3X& su, const Matrix3X& sv) {
 
 }  // namespace
 
-Matrix3X inflationForces(const SurfaceQuadrature& q, const Matrix3X& controlPoints, double pressure) {
+MatrixX3 inflationForces(const SurfaceQuadrature& q, const MatrixX3& controlPoints, double pressure) {
   if (!std::isfinite(pressure)) throw Error("inflation pressure is not finite");
   return pressureForces(q, controlPoints, Eigen::VectorXd::Constant(q.J.rows(), pressure));
 }
 
-Matrix3X pressureForces(const SurfaceQuadrature& q, const Matrix3X& controlPoints, const Eigen::VectorXd& pressures) {
+MatrixX3 pressureForces(const SurfaceQuadrature& q, const MatrixX3& controlPoints, const Eigen::VectorXd& pressures) {
   if (pressures.size() != q.J.rows()) throw Error("internal: one pressure per quadrature point expected");
   if (!pressures.allFinite()) throw Error("a pressure is not finite");
-  const Matrix3X su = applyOperator(q.Ju, controlPoints), sv = applyOperator(q.Jv, controlPoints);
-  Matrix3X area(su.rows(), 3);
+  const MatrixX3 su = applyOperator(q.Ju, controlPoints), sv = applyOperator(q.Jv, controlPoints);
+  MatrixX3 area(su.rows(), 3);
   for (Eigen::Index i = 0; i < su.rows(); ++i) {
     area.row(i) = pressures(i) * su.row(i).cross(sv.row(i));
   }
   return integrate(q, area);
 }
 
-Matrix3X fieldForces(const SurfaceQuadrature& q, const Matrix3X& controlPoints, const ForceField& field,
+MatrixX3 fieldForces(const SurfaceQuadrature& q, const MatrixX3& controlPoints, const ForceField& field,
                      const PressureField* pressure) {
-  Matrix3X positions, su, sv;
+  MatrixX3 positions, su, sv;
   applyOperators(q.J, q.Ju, q.Jv, controlPoints, positions, su, sv);  // one pass: they share a pattern
-  Matrix3X forces = field.forcesAt(positions);
+  MatrixX3 forces = field.forcesAt(positions);
   if (forces.rows() != positions.rows()) {
     throw Error("force field returned " + std::to_string(forces.rows()) + " forces for " +
                 std::to_string(positions.rows()) + " points");
   }
   if (!forces.allFinite()) throw Error("force field returned a non-finite force");
-  Matrix3X area = areaElements(su, sv).asDiagonal() * forces;
+  MatrixX3 area = areaElements(su, sv).asDiagonal() * forces;
   if (pressure) {
     const Eigen::VectorXd pressures = pressure->pressuresAt(positions);
     if (pressures.size() != positions.rows()) {
@@ -121,8 +121,8 @@ Matrix3X fieldForces(const SurfaceQuadrature& q, const Matrix3X& controlPoints, 
   return integrate(q, area);
 }
 
-SparseMatrix fieldStiffness(const SurfaceQuadrature& q, const Matrix3X& controlPoints, double slope) {
-  const Matrix3X su = applyOperator(q.Ju, controlPoints), sv = applyOperator(q.Jv, controlPoints);
+SparseMatrix fieldStiffness(const SurfaceQuadrature& q, const MatrixX3& controlPoints, double slope) {
+  const MatrixX3 su = applyOperator(q.Ju, controlPoints), sv = applyOperator(q.Jv, controlPoints);
   const Eigen::VectorXd weights = slope * q.weights.cwiseProduct(areaElements(su, sv));
   // NB: one element's quadrature points share its columns (J, J_u and J_v
   // have one pattern), so their rank-one terms are summed in a dense block

@@ -67,7 +67,7 @@ struct Integrator::Impl {
   // The right-hand side is forceWeight f + C p(t) + P p(t-dt).
   double forceWeight = 0.0;
   PairedProduct rightHandSide;
-  Matrix3X rhs;                              // the right-hand side, by vertex
+  MatrixX3 rhs;                              // the right-hand side, by vertex
   std::vector<int> freeIndex;                // free position of each vertex, or -1
   std::vector<int> freeVertices;
   SymmetricMatrix lhsFree, lhsCoupling;      // free x free, free x fixed
@@ -195,7 +195,7 @@ Integrator::~Integrator() = default;
 Integrator::Integrator(Integrator&&) noexcept = default;
 Integrator& Integrator::operator=(Integrator&&) noexcept = default;
 
-Matrix3X Integrator::step(const Matrix3X& previous, const Matrix3X& current, const Matrix3X& force) {
+MatrixX3 Integrator::step(const MatrixX3& previous, const MatrixX3& current, const MatrixX3& force) {
   Impl& s = *impl_;
   const int free = static_cast<int>(s.freeVertices.size());
   const int vertices = static_cast<int>(s.freeIndex.size());
@@ -205,7 +205,7 @@ Matrix3X Integrator::step(const Matrix3X& previous, const Matrix3X& current, con
   }
   s.iterations = 0;
   s.rightHandSide.apply(s.forceWeight, force, current, previous, s.rhs);
-  Matrix3X next = current;
+  MatrixX3 next = current;
   Eigen::MatrixXd rhsFree(free, 3);
   for (int i = 0; i < free; ++i) rhsFree.row(i) = s.rhs.row(s.freeVertices[i]);
   if (pinned.rows() > 0) rhsFree -= s.lhsCoupling * pinned;

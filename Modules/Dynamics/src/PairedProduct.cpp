@@ -97,7 +97,7 @@ DYNSUB_AVX2 void productAvx2(int n, int begin, int end, const int* start, const 
 
 }  // namespace
 
-void PairedProduct::sum(const Matrix3X& p, const Matrix3X& q) {
+void PairedProduct::sum(const MatrixX3& p, const MatrixX3& q) {
   const int n = static_cast<int>(p_.size() / 4);
   if (p.rows() != n || q.rows() != n) throw Error("internal: paired product of unequal sizes");
   for (int i = 0; i < n; ++i) {
@@ -123,7 +123,7 @@ void PairedProduct::sum(const Matrix3X& p, const Matrix3X& q) {
   for (size_t i = 0; i < sums_.size(); ++i) sums_[i] += secondSums_[i];
 }
 
-void PairedProduct::apply(double w, const Matrix3X& f, const Matrix3X& p, const Matrix3X& q, Matrix3X& rhs) {
+void PairedProduct::apply(double w, const MatrixX3& f, const MatrixX3& p, const MatrixX3& q, MatrixX3& rhs) {
   const int n = static_cast<int>(p_.size() / 4);
   if (f.rows() != n) throw Error("internal: paired product of unequal sizes");
   sum(p, q);

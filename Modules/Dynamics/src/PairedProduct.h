@@ -23,7 +23,7 @@ class PairedProduct {
 
   // rhs = w f + C p + P q, all #vertices x 3. Not for two threads at once
   // (it keeps its scratch).
-  void apply(double w, const Matrix3X& f, const Matrix3X& p, const Matrix3X& q, Matrix3X& rhs);
+  void apply(double w, const MatrixX3& f, const MatrixX3& p, const MatrixX3& q, MatrixX3& rhs);
 
  private:
   std::vector<int> start_;       // column j's entries: [start_[j], start_[j + 1]), the diagonal first
@@ -33,7 +33,7 @@ class PairedProduct {
   static constexpr long kThreadShare = 50000;
   int split_ = 0;                     // columns from split_ on go to a second thread; 0: none
   // sums_ (+ secondSums_) = C p + P q, points packed as [x y z 0].
-  void sum(const Matrix3X& p, const Matrix3X& q);
+  void sum(const MatrixX3& p, const MatrixX3& q);
   std::vector<double> p_, q_, sums_, secondSums_;  // four per vertex: x, y, z, 0
 };
 

@@ -48,13 +48,13 @@ bool PullForceModel::active() const {
   return active_;
 }
 
-void PullForceModel::beginLevel(const LimitSurface& surface, const SurfaceQuadrature&, const Matrix3X&) {
+void PullForceModel::beginLevel(const LimitSurface& surface, const SurfaceQuadrature&, const MatrixX3&) {
   std::lock_guard<std::mutex> lock(mutex_);
   surface_ = &surface;
   attached_ = false;  // element numbers changed; re-attach near anchor_
 }
 
-void PullForceModel::attachNearAnchor(const Matrix3X& controlPoints) {
+void PullForceModel::attachNearAnchor(const MatrixX3& controlPoints) {
   if (attached_) return;
   ClosestPointLocator locator(*surface_);
   locator.update(controlPoints);
@@ -62,19 +62,19 @@ void PullForceModel::attachNearAnchor(const Matrix3X& controlPoints) {
   attached_ = true;
 }
 
-Matrix3X PullForceModel::generalizedForce(const Matrix3X& controlPoints, double& potential) {
+MatrixX3 PullForceModel::generalizedForce(const MatrixX3& controlPoints, double& potential) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (!active_ || !surface_) return Matrix3X::Zero(controlPoints.rows(), 3);
+  if (!active_ || !surface_) return MatrixX3::Zero(controlPoints.rows(), 3);
   attachNearAnchor(controlPoints);
   double energy = 0.0;
-  const Matrix3X force = springForces(*surface_, controlPoints, {Spring{attachment_, target_, stiffness_}}, &energy);
+  const MatrixX3 force = springForces(*surface_, controlPoints, {Spring{attachment_, target_, stiffness_}}, &energy);
   potential += energy;
   // Where the spring holds the surface now: the place to re-attach after a refinement.
   anchor_ = (surface_->limitOperator({attachment_}) * controlPoints).row(0).transpose();
   return force;
 }
 
-SparseMatrix PullForceModel::stabilizingStiffness(const Matrix3X& controlPoints) {
+SparseMatrix PullForceModel::stabilizingStiffness(const MatrixX3& controlPoints) {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!active_ || !surface_) return SparseMatrix();
   attachNearAnchor(controlPoints);

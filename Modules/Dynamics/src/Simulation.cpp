@@ -21,12 +21,12 @@ namespace dynsub {
 
 namespace {
 
-double modelSize(const Matrix3X& points) {
+double modelSize(const MatrixX3& points) {
   return (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm();
 }
 
 // sum over x, y, z of a^T A a.
-double quadraticForm(const SymmetricMatrix& a, const Matrix3X& x) {
+double quadraticForm(const SymmetricMatrix& a, const MatrixX3& x) {
   return (x.array() * applyOperator(a, x).array()).sum();
 }
 
@@ -42,12 +42,12 @@ struct LevelModel {
   std::shared_ptr<const LimitSurface> surface;
   PhysicalMatrices matrices;
   SurfaceQuadrature quadrature;
-  Matrix3X start;
+  MatrixX3 start;
   double size = 0;  // bounding-box diagonal of the control points, mm
 };
 
 // Sets the model's start, its control points.
-void setStart(LevelModel& model, const Matrix3X& points) {
+void setStart(LevelModel& model, const MatrixX3& points) {
   model.start = points;
   model.size = modelSize(model.start);
   if (!(model.size > 0.0)) throw Error("the control mesh has no extent");
@@ -93,8 +93,8 @@ LevelModel buildLevel(const ControlMesh& mesh, int level, int& initialIsolation,
 }
 
 // f_p at `points`; adds the forces' potential energy to `potential`.
-Matrix3X totalForce(const std::vector<ForceModel*>& forces, const Matrix3X& points, double& potential) {
-  Matrix3X force = Matrix3X::Zero(points.rows(), 3);
+MatrixX3 totalForce(const std::vector<ForceModel*>& forces, const MatrixX3& points, double& potential) {
+  MatrixX3 force = MatrixX3::Zero(points.rows(), 3);
   for (ForceModel* f : forces) force += f->generalizedForce(points, potential);
   return force;
 }
@@ -130,12 +130,12 @@ class EquilibriumWindow {
 // The limit surface at the quadrature points of one state: positions and
 // unit normals (zero where the normal degenerates: a collapsed element).
 struct SurfaceFrame {
-  Matrix3X positions, normals;
+  MatrixX3 positions, normals;
 };
 
-SurfaceFrame surfaceFrame(const SurfaceQuadrature& quadrature, const Matrix3X& points) {
+SurfaceFrame surfaceFrame(const SurfaceQuadrature& quadrature, const MatrixX3& points) {
   SurfaceFrame frame;
-  Matrix3X su, sv;
+  MatrixX3 su, sv;
   applyOperators(quadrature.J, quadrature.Ju, quadrature.Jv, points, frame.positions, su, sv);  // one pass
   frame.normals.resize(su.rows(), 3);
   for (Eigen::Index i = 0; i < su.rows(); ++i) {
@@ -181,7 +181,7 @@ class StepShapeMotion {
  public:
   explicit StepShapeMotion(const LevelModel& model) : model_(model) {}
   // The step from `previous` to `current`, whose relative energy change is `change`.
-  double measure(const Matrix3X& previous, const Matrix3X& current, double change, double tolerance) {
+  double measure(const MatrixX3& previous, const MatrixX3& current, double change, double tolerance) {
     if (!(change <= tolerance)) return std::numeric_limits<double>::infinity();
     if (!previousFrame_) previousFrame_ = surfaceFrame(model_.quadrature, previous);
     if (!frame_) frame_ = surfaceFrame(model_.quadrature, current);
@@ -206,12 +206,12 @@ enum class LevelEnd { Equilibrium, Coarse, StepLimit, Diverged };
 // the last state reached.
 LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& forces, const std::vector<int>& fixed,
                       const SimulationOptions& options, const AcceptFit& coarseAccept, double& timeStep,
-                      double regrowCeiling, const ProgressCallback& progress, Matrix3X& points,
+                      double regrowCeiling, const ProgressCallback& progress, MatrixX3& points,
                       LevelSummary& summary) {
   IntegratorOptions integratorOptions = options.integrator;
   integratorOptions.timeStep = timeStep;
   // The stabilizing stiffness of the forces at `at` (Integrator.h).
-  auto stabilizingAt = [&](const Matrix3X& at) {
+  auto stabilizingAt = [&](const MatrixX3& at) {
     SymmetricMatrix stabilizing(at.rows(), at.rows());
     for (ForceModel* f : forces) {
       const SparseMatrix s = f->stabilizingStiffness(at);
@@ -226,7 +226,7 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
   const EquilibriumOptions loose = loosened(options.equilibrium);
   EquilibriumWindow looseWindow(loose, options.equilibrium.window);
   bool asked = !coarseAccept;
-  Matrix3X previous = model.start;
+  MatrixX3 previous = model.start;
   points = model.start;
   StepShapeMotion stepMotion(model);
   double lastEnergy = std::numeric_limits<double>::quiet_NaN();
@@ -236,9 +236,9 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
   double energyTwoBefore = std::numeric_limits<double>::quiet_NaN();
   for (int step = 1; step <= options.equilibrium.maxSteps; ++step) {
     double potential = 0.0;
-    const Matrix3X force = totalForce(forces, points, potential);
+    const MatrixX3 force = totalForce(forces, points, potential);
     acceptState(forces);
-    const Matrix3X velocity = (points - previous) / timeStep;
+    const MatrixX3 velocity = (points - previous) / timeStep;
     const double energy = 0.5 * quadraticForm(model.matrices.mass, velocity) +
                           0.5 * quadraticForm(model.matrices.stiffness, points) + potential;
     if (step == 1) firstEnergy = std::abs(energy);
@@ -294,7 +294,7 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
     lastEnergy = energy;
     summary.energy = energy;
 
-    Matrix3X next = integrator.step(previous, points, force);
+    MatrixX3 next = integrator.step(previous, points, force);
     summary.solverIterations += integrator.lastIterations();
     const double motion = (next - points).rowwise().norm().maxCoeff();
     if (!next.allFinite() || motion > model.size) return LevelEnd::Diverged;
@@ -318,7 +318,7 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
 // it ends there, and if so it goes on, unchanged, to the full rule.
 LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>& forces, const std::vector<int>& fixed,
                         const SimulationOptions& options, const AcceptFit& coarseAccept,
-                        const ProgressCallback& progress, Matrix3X& points, LevelSummary& summary) {
+                        const ProgressCallback& progress, MatrixX3& points, LevelSummary& summary) {
   bool lineSearch = true;
   for (const ForceModel* f : forces) lineSearch = lineSearch && f->hasPotential();
   StaticSolver solver(*model.surface, model.matrices.stiffness, fixed);
@@ -334,12 +334,12 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
   bool asked = !coarseAccept;
   points = model.start;
   double potential = 0.0;
-  Matrix3X force = totalForce(forces, points, potential);
+  MatrixX3 force = totalForce(forces, points, potential);
   acceptState(forces);
   double energy = 0.5 * quadraticForm(model.matrices.stiffness, points) + potential;
   summary.energy = energy;
   if (!std::isfinite(energy)) return LevelEnd::Diverged;
-  Matrix3X previous;
+  MatrixX3 previous;
   StepShapeMotion stepMotion(model);
   // The length the last Newton direction was accepted at.
   double lastLength = 1.0;
@@ -347,14 +347,14 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
   // the path of a level accepted at the looser rule must not depend on it.)
   bool lastStill = false;
   for (int step = 1; step <= options.equilibrium.maxSteps; ++step) {
-    const Matrix3X residual = force - model.matrices.stiffness * points;
-    Matrix3X trial, trialForce;
+    const MatrixX3 residual = force - model.matrices.stiffness * points;
+    MatrixX3 trial, trialForce;
     double trialEnergy = energy;
     bool accepted = false, evaluated = false;
     // The Newton direction first; where it lowers nothing, the isotropic one.
     for (const bool isotropic : {false, true}) {
       if (isotropic && !lineSearch) break;
-      const Matrix3X direction = solver.direction(forces, points, residual, isotropic);
+      const MatrixX3 direction = solver.direction(forces, points, residual, isotropic);
       if (!direction.allFinite()) return LevelEnd::Diverged;
       // The energy's slope along the direction: its gradient is K p - f_p.
       const double slope = -(residual.array() * direction.array()).sum();
@@ -425,11 +425,11 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
 
 // |f_p - K p| / max(|f_p|, |K p|) at `points` (Frobenius norms): 0 exactly at
 // the papers' equilibrium.
-double equilibriumResidual(const LevelModel& model, const std::vector<ForceModel*>& forces, const Matrix3X& points,
+double equilibriumResidual(const LevelModel& model, const std::vector<ForceModel*>& forces, const MatrixX3& points,
                            const std::vector<int>& fixed) {
   double potential = 0.0;
-  Matrix3X force = totalForce(forces, points, potential);
-  Matrix3X elastic = model.matrices.stiffness * points;
+  MatrixX3 force = totalForce(forces, points, potential);
+  MatrixX3 elastic = model.matrices.stiffness * points;
   for (int v : fixed) {  // fixed vertices are held by their supports
     force.row(v).setZero();
     elastic.row(v).setZero();
@@ -440,10 +440,10 @@ double equilibriumResidual(const LevelModel& model, const std::vector<ForceModel
 
 // One level from model.start to its equilibrium (or step limit); a divergence
 // restarts it with half the time step.
-Matrix3X runLevel(const LevelModel& model, const std::vector<ForceModel*>& forces, const std::vector<int>& fixed,
+MatrixX3 runLevel(const LevelModel& model, const std::vector<ForceModel*>& forces, const std::vector<int>& fixed,
                   const SimulationOptions& options, const AcceptFit& coarseAccept, double& timeStep,
                   const ProgressCallback& progress, LevelSummary& summary, LevelEnd& end) {
-  Matrix3X points;
+  MatrixX3 points;
   // The largest step a halved one may grow back to: the step asked for, then
   // half of any regrown step that diverged.
   double regrowCeiling = std::max(timeStep, options.integrator.timeStep);
@@ -557,7 +557,7 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
     // A level that will be refined may end at a looser rule.
     const bool coarse = accept && level < options.maxLevel && options.equilibrium.coarseLevelFactor > 1.0;
     LevelEnd end = LevelEnd::Equilibrium;
-    const Matrix3X points =
+    const MatrixX3 points =
         runLevel(model, forces, fixed, options, coarse ? accept : AcceptFit(), timeStep, progress, summary, end);
     summary.residual = equilibriumResidual(model, forces, points, fixed);
     mesh.setPoints(points);

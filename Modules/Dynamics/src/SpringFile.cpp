@@ -43,7 +43,7 @@ SpringFile readSpringFile(const std::string& path, double defaultStiffness) {
     rows.push_back(row);
   }
   if (rows.empty()) throw Error(path, "has no springs");
-  SpringFile result{Matrix3X(rows.size(), 3), Eigen::VectorXd(rows.size())};
+  SpringFile result{MatrixX3(rows.size(), 3), Eigen::VectorXd(rows.size())};
   for (size_t i = 0; i < rows.size(); ++i) {
     result.targets.row(i) = rows[i].head<3>().transpose();
     result.stiffness(i) = rows[i](3);

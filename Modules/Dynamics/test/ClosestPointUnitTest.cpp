@@ -20,11 +20,11 @@ namespace {
 
 // Points around the surface: tessellation points pushed along random
 // directions by up to `spread` mm, plus a few far away.
-Matrix3X queriesAround(const LimitSurface& surface, const Matrix3X& controlPoints, double spread, unsigned seed) {
-  const Matrix3X near = tessellate(surface, controlPoints, 2).points;
+MatrixX3 queriesAround(const LimitSurface& surface, const MatrixX3& controlPoints, double spread, unsigned seed) {
+  const MatrixX3 near = tessellate(surface, controlPoints, 2).points;
   std::mt19937_64 random(seed);
   std::uniform_real_distribution<double> offset(-spread, spread);
-  Matrix3X queries(near.rows() + 4, 3);
+  MatrixX3 queries(near.rows() + 4, 3);
   for (Eigen::Index i = 0; i < near.rows(); ++i)
     queries.row(i) = near.row(i) + Eigen::RowVector3d(offset(random), offset(random), offset(random));
   for (int i = 0; i < 4; ++i) queries.row(near.rows() + i) = Eigen::RowVector3d(10.0 * (i + 1), -7.0, 3.0 * i);
@@ -37,9 +37,9 @@ TEST(ClosestPointLocator, IsAtLeastAsNearAsADenseTessellation) {
     const LimitSurface surface(mesh);
     ClosestPointLocator locator(surface);
     locator.update(mesh.points());
-    const Matrix3X queries = queriesAround(surface, mesh.points(), 0.3, 5);
+    const MatrixX3 queries = queriesAround(surface, mesh.points(), 0.3, 5);
     // 32 x 32 segments per element: a far finer net than the locator's 6 x 6 samples.
-    const Matrix3X dense = tessellate(surface, mesh.points(), 32).points;
+    const MatrixX3 dense = tessellate(surface, mesh.points(), 32).points;
     const std::vector<ClosestPoint> found = locator.findAll(queries);
     for (Eigen::Index i = 0; i < queries.rows(); ++i) {
       const double net = (dense.rowwise() - queries.row(i)).rowwise().norm().minCoeff();
@@ -63,13 +63,13 @@ TEST(ClosestPointLocator, TrackingDecidesAsARebuiltTreeDoes) {
     for (const char* name : {"cube", "torus"}) {
       const ControlMesh mesh = makeStandardMesh(name);
       const LimitSurface surface(mesh);
-      const Matrix3X queries = queriesAround(surface, mesh.points(), 0.2, 9);
+      const MatrixX3 queries = queriesAround(surface, mesh.points(), 0.2, 9);
       ClosestPointLocator tracking(surface, samples);
       tracking.update(mesh.points());
       std::vector<ClosestPoint> last = tracking.findAll(queries);
       std::mt19937_64 random(3);
       std::normal_distribution<double> jitter(0.0, 0.002);
-      Matrix3X points = mesh.points();
+      MatrixX3 points = mesh.points();
       int moved = 0;
       for (int state = 1; state <= 40; ++state) {
         // Small moves per state (as in a fit's steps), with now and then a jump.

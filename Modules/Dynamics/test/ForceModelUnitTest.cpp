@@ -28,16 +28,16 @@ namespace {
 TEST(SpringForceModel, ADeadZonePullsOnlyBeyondIt) {
   const ControlMesh cube = makeCube98();
   const LimitSurface surface(cube);
-  const Matrix3X onSurface = tessellate(surface, cube.points(), 1).points;
+  const MatrixX3 onSurface = tessellate(surface, cube.points(), 1).points;
   ClosestPointLocator locator(surface);
   locator.update(cube.points());
-  Matrix3X normals(onSurface.rows(), 3);
+  MatrixX3 normals(onSurface.rows(), 3);
   const std::vector<ClosestPoint> nearest = locator.findAll(onSurface);
   for (Eigen::Index i = 0; i < onSurface.rows(); ++i) normals.row(i) = nearest[i].normal.transpose();
   const double zone = 0.02;
   const SurfaceQuadrature quadrature = makeSurfaceQuadrature(surface);
   const Eigen::VectorXd k = Eigen::VectorXd::Constant(onSurface.rows(), 3.0);
-  auto forceOf = [&](const Matrix3X& targets, double deadZone, double& potential) {
+  auto forceOf = [&](const MatrixX3& targets, double deadZone, double& potential) {
     SpringForceModel springs(targets, k, SpringForceModel::Attach::NearestEachStep);
     springs.setDeadZone(deadZone);
     springs.beginLevel(surface, quadrature, cube.points());
@@ -45,12 +45,12 @@ TEST(SpringForceModel, ADeadZonePullsOnlyBeyondIt) {
     return springs.generalizedForce(cube.points(), potential);
   };
   double potential = 0.0;
-  const Matrix3X inside = forceOf(onSurface + 0.01 * normals, zone, potential);
+  const MatrixX3 inside = forceOf(onSurface + 0.01 * normals, zone, potential);
   EXPECT_EQ(inside.cwiseAbs().maxCoeff(), 0.0);
   EXPECT_EQ(potential, 0.0);
   double beyondPotential = 0.0, plainPotential = 0.0;
-  const Matrix3X beyond = forceOf(onSurface + 0.05 * normals, zone, beyondPotential);
-  const Matrix3X plain = forceOf(onSurface + 0.03 * normals, 0.0, plainPotential);
+  const MatrixX3 beyond = forceOf(onSurface + 0.05 * normals, zone, beyondPotential);
+  const MatrixX3 plain = forceOf(onSurface + 0.03 * normals, 0.0, plainPotential);
   // The attachments agree to the closest-point search's tolerance (1e-9 of the size).
   EXPECT_LT((beyond - plain).cwiseAbs().maxCoeff(), 1e-7 * plain.cwiseAbs().maxCoeff());
   EXPECT_NEAR(beyondPotential, plainPotential, 1e-7 * plainPotential);
@@ -66,8 +66,8 @@ TEST(SpringForceModel, ADeadZonePullsOnlyBeyondIt) {
 class RadialWell final : public ForceField {
  public:
   RadialWell(double radius, double strength, double width) : radius_(radius), strength_(strength), width_(width) {}
-  Matrix3X forcesAt(const Matrix3X& points) const override {
-    Matrix3X forces(points.rows(), 3);
+  MatrixX3 forcesAt(const MatrixX3& points) const override {
+    MatrixX3 forces(points.rows(), 3);
     for (Eigen::Index i = 0; i < points.rows(); ++i) {
       const double r = points.row(i).norm();
       const double towards = std::clamp((radius_ - r) / width_, -1.0, 1.0);
@@ -87,7 +87,7 @@ TEST(FieldForces, StiffnessIntegratesTheSlopeOverTheArea) {
   const LimitSurface surface(cube);
   const SurfaceQuadrature quadrature = makeSurfaceQuadrature(surface, 4);
   const SparseMatrix stiffness = fieldStiffness(quadrature, cube.points(), 3.0);
-  const Matrix3X su = quadrature.Ju * cube.points(), sv = quadrature.Jv * cube.points();
+  const MatrixX3 su = quadrature.Ju * cube.points(), sv = quadrature.Jv * cube.points();
   double area = 0.0;
   for (Eigen::Index i = 0; i < su.rows(); ++i) area += quadrature.weights(i) * su.row(i).cross(sv.row(i)).norm();
   const Eigen::VectorXd ones = Eigen::VectorXd::Ones(cube.vertexCount());
@@ -102,9 +102,9 @@ TEST(FieldForces, StiffnessEqualsTheProductOverTheQuadrature) {
   const ControlMesh cube = makeCube98();
   const LimitSurface surface(cube);
   const SurfaceQuadrature quadrature = makeSurfaceQuadrature(surface, 3);
-  const Matrix3X points = cube.points() * 1.7;
+  const MatrixX3 points = cube.points() * 1.7;
   const SparseMatrix stiffness = fieldStiffness(quadrature, points, 0.6);
-  const Matrix3X su = quadrature.Ju * points, sv = quadrature.Jv * points;
+  const MatrixX3 su = quadrature.Ju * points, sv = quadrature.Jv * points;
   Eigen::VectorXd weights(su.rows());
   for (Eigen::Index i = 0; i < su.rows(); ++i) weights(i) = 0.6 * quadrature.weights(i) * su.row(i).cross(sv.row(i)).norm();
   const Eigen::MatrixXd expected = Eigen::MatrixXd(SparseMatrix(quadrature.J.transpose() * weights.asDiagonal() * quadrature.J));
@@ -130,7 +130,7 @@ TEST(FieldForces, AReversingFieldSettlesOnItsEdge) {
   ASSERT_EQ(result.levels.size(), 1u);
   EXPECT_TRUE(result.levels[0].converged);
   const LimitSurface surface(result.mesh);
-  const Matrix3X points = tessellate(surface, result.mesh.points(), 4).points;
+  const MatrixX3 points = tessellate(surface, result.mesh.points(), 4).points;
   const Eigen::VectorXd radii = points.rowwise().norm();
   EXPECT_GT(radii.minCoeff(), 4.0 - 0.35);
   EXPECT_LT(radii.maxCoeff(), 4.0 + 0.2);
@@ -141,7 +141,7 @@ TEST(FieldForces, AReversingFieldSettlesOnItsEdge) {
 class HalfSpacePressure final : public PressureField {
  public:
   explicit HalfSpacePressure(double pressure) : pressure_(pressure) {}
-  Eigen::VectorXd pressuresAt(const Matrix3X& points) const override {
+  Eigen::VectorXd pressuresAt(const MatrixX3& points) const override {
     return points.col(2).unaryExpr([this](double z) { return z > 0 ? pressure_ : -pressure_; });
   }
   double slopeBound() const override { return 2.0; }
@@ -159,10 +159,10 @@ TEST(FieldForces, APressureFieldActsWithTheForceFieldInOnePass) {
   const SurfaceQuadrature quadrature = makeSurfaceQuadrature(surface);
   const RadialWell well(0.8, 0.3, 0.2);
   const HalfSpacePressure halves(0.05);
-  const Matrix3X positions = quadrature.J * cube.points();
-  const Matrix3X apart = fieldForces(quadrature, cube.points(), well) +
+  const MatrixX3 positions = quadrature.J * cube.points();
+  const MatrixX3 apart = fieldForces(quadrature, cube.points(), well) +
                          pressureForces(quadrature, cube.points(), halves.pressuresAt(positions));
-  const Matrix3X together = fieldForces(quadrature, cube.points(), well, &halves);
+  const MatrixX3 together = fieldForces(quadrature, cube.points(), well, &halves);
   EXPECT_LT((together - apart).cwiseAbs().maxCoeff(), 1e-12 * apart.cwiseAbs().maxCoeff());
   EXPECT_GT((together - fieldForces(quadrature, cube.points(), well)).cwiseAbs().maxCoeff(), 0.0);
   const HalfSpacePressure uniform(0.0);

@@ -30,18 +30,18 @@ TEST_P(FactoredStep, SolvesTheSchemesEquation) {
   assembly.elementSize = std::ldexp(1.0, -levels);
   const PhysicalMatrices m = assemblePhysicalMatrices(surface, Material{}, assembly);
   const SymmetricMatrix stabilizing = 0.3 * m.mass;  // any symmetric S on the elements' pattern
-  const Matrix3X p = mesh.points();
-  const Matrix3X previous = 0.99 * p + Matrix3X::Constant(p.rows(), 3, 0.001);
-  const Matrix3X force = (Matrix3X::Random(p.rows(), 3) * 0.1).eval();
+  const MatrixX3 p = mesh.points();
+  const MatrixX3 previous = 0.99 * p + MatrixX3::Constant(p.rows(), 3, 0.001);
+  const MatrixX3 force = (MatrixX3::Random(p.rows(), 3) * 0.1).eval();
   const std::vector<int> fixed = {3, 17, 400};
   for (IntegrationScheme scheme : {IntegrationScheme::FirstOrder, IntegrationScheme::SecondOrder}) {
     IntegratorOptions options;
     options.scheme = scheme;
     options.timeStep = 0.3;
     const double dt = options.timeStep;
-    const Matrix3X next = Integrator(m, stabilizing, fixed, options).step(previous, p, force);
+    const MatrixX3 next = Integrator(m, stabilizing, fixed, options).step(previous, p, force);
     const SymmetricMatrix k = m.stiffness + stabilizing;
-    Matrix3X lhs, rhs;
+    MatrixX3 lhs, rhs;
     if (scheme == IntegrationScheme::FirstOrder) {
       lhs = m.damping * next + 2.0 * dt * (k * next);
       rhs = 2.0 * dt * (force + stabilizing * p) + m.damping * previous;
@@ -70,7 +70,7 @@ INSTANTIATE_TEST_SUITE_P(Integrator, FactoredStep, testing::Values(2, 3),
 // The cube's matrices and one state of it, for the steps compared below.
 struct CubeStep {
   PhysicalMatrices m;
-  Matrix3X p, previous, force;
+  MatrixX3 p, previous, force;
 };
 CubeStep cubeStep() {
   const ControlMesh cube = makeCube98();
@@ -88,7 +88,7 @@ TEST(Integrator, SolversTakeTheSameStep) {
     IntegratorOptions options;
     options.scheme = scheme;
     options.solver = LinearSolver::Cholesky;
-    const Matrix3X reference = Integrator(m, SymmetricMatrix(), {0, 5}, options).step(previous, p, force);
+    const MatrixX3 reference = Integrator(m, SymmetricMatrix(), {0, 5}, options).step(previous, p, force);
     EXPECT_EQ(reference.row(0), p.row(0));  // fixed vertices stay
     EXPECT_EQ(reference.row(5), p.row(5));
     for (LinearSolver solver : {LinearSolver::ConjugateGradient, LinearSolver::PreconditionedConjugateGradient}) {
@@ -119,9 +119,9 @@ TEST(Integrator, RestabilizedTakesTheStepOfANewIntegrator) {
     IntegratorOptions options;
     options.scheme = scheme;
     Integrator integrator(m, SymmetricMatrix(0.3 * m.mass), fixed, options);
-    const Matrix3X first = integrator.step(previous, p, force);
+    const MatrixX3 first = integrator.step(previous, p, force);
     integrator.restabilize(m, SymmetricMatrix(2.5 * m.mass));
-    const Matrix3X second = integrator.step(previous, p, force);
+    const MatrixX3 second = integrator.step(previous, p, force);
     EXPECT_EQ(second, Integrator(m, SymmetricMatrix(2.5 * m.mass), fixed, options).step(previous, p, force));
     EXPECT_GT((second - first).cwiseAbs().maxCoeff(), 1e-6);  // the new stiffness took effect
     EXPECT_EQ(second.row(2), p.row(2));

@@ -38,7 +38,7 @@ TEST_P(PureSpringTest, EquilibriumIsTheDirectLeastSquaresSolution) {
   std::mt19937_64 random(7);
   std::uniform_real_distribution<double> jitter(-0.2, 0.2);
   const TriangleSurface samples = tessellate(surface, cube.points(), 2);
-  Matrix3X targets = samples.points;
+  MatrixX3 targets = samples.points;
   for (Eigen::Index i = 0; i < targets.rows(); ++i) targets.row(i) += Vector3(jitter(random), jitter(random), jitter(random)).transpose() + 0.3 * samples.normals.row(i);
   const Eigen::VectorXd stiffness = Eigen::VectorXd::Constant(targets.rows(), 5.0);
   SpringForceModel springs(targets, stiffness, SpringForceModel::Attach::NearestAtLevelStart);
@@ -63,9 +63,9 @@ TEST_P(PureSpringTest, EquilibriumIsTheDirectLeastSquaresSolution) {
   const SymmetricMatrix lhs = m.stiffness + SymmetricMatrix(springStiffness(surface, attached));
   Eigen::SimplicialLDLT<SymmetricMatrix> direct(lhs);
   ASSERT_EQ(direct.info(), Eigen::Success);
-  const Matrix3X zeros = Matrix3X::Zero(cube.vertexCount(), 3);
-  const Matrix3X rhs = springForces(surface, zeros, attached);  // J^T k d
-  const Matrix3X expected = direct.solve(Eigen::MatrixXd(rhs));
+  const MatrixX3 zeros = MatrixX3::Zero(cube.vertexCount(), 3);
+  const MatrixX3 rhs = springForces(surface, zeros, attached);  // J^T k d
+  const MatrixX3 expected = direct.solve(Eigen::MatrixXd(rhs));
   // The dynamics stop when steps move points by < 1e-11 of the size (~3.5);
   // the remaining distance to equilibrium is of that order.
   EXPECT_LT((result.mesh.points() - expected).cwiseAbs().maxCoeff(), 1e-7);
@@ -90,7 +90,7 @@ INSTANTIATE_TEST_SUITE_P(StaticScheme, PureSpringTest,
 TEST(StaticScheme, FixedVerticesStay) {
   const ControlMesh cube = makeCube98();
   const LimitSurface surface(cube);
-  Matrix3X targets = tessellate(surface, cube.points(), 1).points * 1.2;
+  MatrixX3 targets = tessellate(surface, cube.points(), 1).points * 1.2;
   SpringForceModel springs(targets, Eigen::VectorXd::Constant(targets.rows(), 1.0),
                            SpringForceModel::Attach::NearestEachStep);
   SimulationOptions options;
@@ -109,26 +109,26 @@ TEST(StaticScheme, FixedVerticesStay) {
 // evaluations of a level.
 class PullToTargets final : public ForceModel {
  public:
-  PullToTargets(Matrix3X targets, double stiffness, int jumpAfter = 0)
+  PullToTargets(MatrixX3 targets, double stiffness, int jumpAfter = 0)
       : targets_(std::move(targets)), k_(stiffness), jumpAfter_(jumpAfter) {}
-  void beginLevel(const LimitSurface&, const SurfaceQuadrature&, const Matrix3X&) override {
+  void beginLevel(const LimitSurface&, const SurfaceQuadrature&, const MatrixX3&) override {
     // A level restarted this often is a simulation that no longer ends.
     if (++levels_ > 50) throw std::runtime_error("the level was restarted over 50 times");
     evaluations_ = 0;
   }
-  Matrix3X generalizedForce(const Matrix3X& controlPoints, double&) override {
+  MatrixX3 generalizedForce(const MatrixX3& controlPoints, double&) override {
     const bool jumped = jumpAfter_ > 0 && ++evaluations_ > jumpAfter_;
-    return k_ * ((jumped ? Matrix3X(targets_.rowwise() + kJump) : targets_) - controlPoints);
+    return k_ * ((jumped ? MatrixX3(targets_.rowwise() + kJump) : targets_) - controlPoints);
   }
   inline static const Eigen::RowVector3d kJump{10.0, 0.0, 0.0};
-  SparseMatrix stabilizingStiffness(const Matrix3X& controlPoints) override {
+  SparseMatrix stabilizingStiffness(const MatrixX3& controlPoints) override {
     SparseMatrix s(controlPoints.rows(), controlPoints.rows());
     s.setIdentity();
     return k_ * s;
   }
 
  private:
-  Matrix3X targets_;
+  MatrixX3 targets_;
   double k_;
   int jumpAfter_, evaluations_ = 0, levels_ = 0;
 };
@@ -139,7 +139,7 @@ class PullToTargets final : public ForceModel {
 TEST(TimeSteps, AHalvedStepGrowsBackOnceTheEnergyFalls) {
   const ControlMesh cube = makeCube98();
   // Targets 3 model sizes away: the first steps at 4 s jump there at once.
-  const Matrix3X targets = cube.points().rowwise() + PullToTargets::kJump;
+  const MatrixX3 targets = cube.points().rowwise() + PullToTargets::kJump;
   auto run = [&](int regrowth, int jumpAfter = 0) {
     PullToTargets pull(targets, 1.0, jumpAfter);
     SimulationOptions options;

@@ -64,7 +64,7 @@ Sphere through(const Vector3& a, const Vector3& b, const Vector3& c, const Vecto
 }
 
 struct Welzl {
-  const Matrix3X& points;
+  const MatrixX3& points;
   const std::vector<int>& order;
   Vector3 at(int i) const { return points.row(order[i]).transpose(); }
 
@@ -91,7 +91,7 @@ struct Welzl {
 
 }  // namespace
 
-Sphere smallestEnclosingSphere(const Matrix3X& points) {
+Sphere smallestEnclosingSphere(const MatrixX3& points) {
   if (points.rows() == 0) throw Error("cannot enclose an empty point set");
   if (!points.allFinite()) throw Error("cannot enclose points with non-finite coordinates");
   std::vector<int> order(points.rows());

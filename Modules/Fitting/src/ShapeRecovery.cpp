@@ -33,7 +33,7 @@ SimulationOptions FitOptions::defaultSimulation() {
   return o;
 }
 
-FitError measureFitError(const LimitSurface& surface, const Matrix3X& controlPoints, const Matrix3X& data,
+FitError measureFitError(const LimitSurface& surface, const MatrixX3& controlPoints, const MatrixX3& data,
                          double diameter) {
   // NB: 8 x 8 samples per control face, as the outputs (Tessellation.h):
   // isolation's elements are a half or a quarter of a face on a side, and
@@ -50,7 +50,7 @@ FitError measureFitError(const LimitSurface& surface, const Matrix3X& controlPoi
   return FitError{100.0 * worst / diameter, 100.0 * std::sqrt(squares / nearest.size()) / diameter};
 }
 
-FitResult fitPointCloud(const Matrix3X& data, const ControlMesh& initial, const FitOptions& options,
+FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const FitOptions& options,
                         const ProgressCallback& progress) {
   const auto started = std::chrono::steady_clock::now();
   checkPointCloud(data, "point cloud");
@@ -67,7 +67,7 @@ FitResult fitPointCloud(const Matrix3X& data, const ControlMesh& initial, const 
       Eigen::VectorXd::Constant(data.rows(), options.dataStiffness * area / static_cast<double>(data.rows()));
   SpringForceModel springs(data, stiffness, SpringForceModel::Attach::NearestEachStep);
 
-  AcceptFit accept = [&](const LimitSurface& surface, const Matrix3X& points, bool settled) {
+  AcceptFit accept = [&](const LimitSurface& surface, const MatrixX3& points, bool settled) {
     // NB: mid-level (the static scheme's looser rule) the springs' lengths are
     // the data's distances at `points`, measured by their last evaluation
     // (tracked, so never shorter than a new search's). When they accept, a

@@ -15,7 +15,7 @@ TEST(EnclosingSphere, MatchesBruteForce) {
   std::uniform_real_distribution<double> coordinate(-1.0, 1.0);
   for (int trial = 0; trial < 5; ++trial) {
     const int n = 14;
-    Matrix3X points(n, 3);
+    MatrixX3 points(n, 3);
     for (int i = 0; i < n; ++i) points.row(i) << coordinate(random), 2.0 * coordinate(random), coordinate(random);
     const Sphere s = smallestEnclosingSphere(points);
     for (int i = 0; i < n; ++i) EXPECT_LE((points.row(i).transpose() - s.center).norm(), s.radius * (1 + 1e-9));
@@ -30,7 +30,7 @@ TEST(EnclosingSphere, MatchesBruteForce) {
       for (int b = a + 1; b < n; ++b) {
         consider(0.5 * (points.row(a) + points.row(b)).transpose());
         for (int c = b + 1; c < n; ++c) {
-          Matrix3X three(3, 3);
+          MatrixX3 three(3, 3);
           three << points.row(a), points.row(b), points.row(c);
           // The smallest sphere of 3 points, computed by the same routine, is their circle or a pair.
           consider(smallestEnclosingSphere(three).center);
@@ -50,7 +50,7 @@ TEST(EnclosingSphere, MatchesBruteForce) {
 }
 
 TEST(EnclosingSphere, OfPointsOnASphere) {
-  const Matrix3X points = ellipsoidPoints(5000, Vector3(3.0, 3.0, 3.0), 3);
+  const MatrixX3 points = ellipsoidPoints(5000, Vector3(3.0, 3.0, 3.0), 3);
   const Sphere s = smallestEnclosingSphere(points);
   EXPECT_NEAR(s.radius, 3.0, 1e-3);  // 5000 random points leave no cap wider than ~0.05 rad uncovered
   EXPECT_LT(s.center.norm(), 2e-3);

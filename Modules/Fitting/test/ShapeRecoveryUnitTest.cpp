@@ -18,12 +18,12 @@ namespace dynsub {
 namespace {
 
 TEST(PointCloudChecks, RefuseDegenerateData) {
-  EXPECT_THROW(checkPointCloud(Matrix3X::Random(3, 3), "three.xyz"), Error);
-  Matrix3X nan = Matrix3X::Random(10, 3);
+  EXPECT_THROW(checkPointCloud(MatrixX3::Random(3, 3), "three.xyz"), Error);
+  MatrixX3 nan = MatrixX3::Random(10, 3);
   nan(4, 1) = std::nan("");
   EXPECT_THROW(checkPointCloud(nan, "nan.xyz"), Error);
-  EXPECT_THROW(checkPointCloud(Matrix3X::Ones(10, 3), "same.xyz"), Error);
-  Matrix3X flat = Matrix3X::Random(10, 3);
+  EXPECT_THROW(checkPointCloud(MatrixX3::Ones(10, 3), "same.xyz"), Error);
+  MatrixX3 flat = MatrixX3::Random(10, 3);
   flat.col(2).setConstant(4.0);
   try {
     checkPointCloud(flat, "flat.xyz");
@@ -31,20 +31,20 @@ TEST(PointCloudChecks, RefuseDegenerateData) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("flat.xyz: all points lie on a plane"), std::string::npos) << e.what();
   }
-  Matrix3X line(10, 3);
+  MatrixX3 line(10, 3);
   for (int i = 0; i < 10; ++i) line.row(i) << i, 2 * i, -i;
   EXPECT_THROW(checkPointCloud(line, "line.xyz"), Error);
-  EXPECT_NO_THROW(checkPointCloud(Matrix3X::Random(10, 3), "fine.xyz"));
+  EXPECT_NO_THROW(checkPointCloud(MatrixX3::Random(10, 3), "fine.xyz"));
 }
 
 TEST(ShapeRecovery, RefusesAnOpenInitialModel) {
-  const Matrix3X points = ellipsoidPoints(200, Vector3(2, 2, 2), 5);
+  const MatrixX3 points = ellipsoidPoints(200, Vector3(2, 2, 2), 5);
   EXPECT_THROW(fitPointCloud(points, makeSheet81(), FitOptions{}), Error);
 }
 
 struct RecoveryCase {
   std::string name;
-  Matrix3X points;
+  MatrixX3 points;
   InitialShape init;
   int maxControlVertices;
 };
@@ -75,7 +75,7 @@ INSTANTIATE_TEST_SUITE_P(Analytic, ShapeRecoveryTest, ::testing::Values(0, 1, 2)
                          [](const auto& info) { return recoveryCase(info.param).name; });
 
 TEST(ShapeRecovery, SameInputGivesIdenticalOutput) {
-  const Matrix3X points = torusPoints(800, 30, 10, 9);
+  const MatrixX3 points = torusPoints(800, 30, 10, 9);
   const ControlMesh initial = initialModel(points, InitialShape::Torus);
   const FitResult a = fitPointCloud(points, initial, FitOptions{});
   const FitResult b = fitPointCloud(points, initial, FitOptions{});
@@ -92,7 +92,7 @@ TEST(ShapeRecovery, SameInputGivesIdenticalOutput) {
 // stops at must be the equilibrium's: the same fit run on to a rule 10 000
 // times tighter ends on the same surface and the same fit error.
 TEST(StaticScheme, EnergyFallsAtEveryStepToTheEquilibrium) {
-  const Matrix3X points = ellipsoidPoints(1500, Vector3(30, 20, 10), 11);
+  const MatrixX3 points = ellipsoidPoints(1500, Vector3(30, 20, 10), 11);
   FitOptions options;
   ASSERT_EQ(options.simulation.integrator.scheme, IntegrationScheme::Static);
   std::vector<std::pair<int, double>> energies;
@@ -136,7 +136,7 @@ TEST(StaticScheme, EnergyFallsAtEveryStepToTheEquilibrium) {
 // at all; asked for 0.01 % (beyond reach), it is refined once, and the first
 // level then ends sooner.
 TEST(StaticScheme, OnlyRefinedLevelsEndAtTheLooserRule) {
-  const Matrix3X points = ellipsoidPoints(1500, Vector3(30, 20, 10), 11);
+  const MatrixX3 points = ellipsoidPoints(1500, Vector3(30, 20, 10), 11);
   const ControlMesh initial = initialModel(points, InitialShape::Sphere);
   FitOptions full;
   full.simulation.equilibrium.coarseLevelFactor = 1.0;

@@ -100,7 +100,7 @@ Mask cropMask(const Mask& mask, const std::array<int, 3>& first, const std::arra
 }
 
 std::pair<std::array<int, 3>, std::array<int, 3>> boundingRegion(const ImageGeometry& geometry,
-                                                                 const Matrix3X& points, double margin) {
+                                                                 const MatrixX3& points, double margin) {
   Vector3 low = Vector3::Constant(1e300), high = Vector3::Constant(-1e300);
   // The margin is in mm along every axis: grow the physical box's corners.
   Vector3 lowPoint = points.colwise().minCoeff().transpose() - Vector3::Constant(margin);

@@ -8,7 +8,7 @@
 
 namespace dynsub {
 
-Mask voxelizeSurface(const Matrix3X& points, const std::vector<std::array<int, 3>>& triangles,
+Mask voxelizeSurface(const MatrixX3& points, const std::vector<std::array<int, 3>>& triangles,
                      const ImageGeometry& grid) {
   // Every edge must be shared by two triangles. The edges bucketed by their
   // lower point (a counting sort), each bucket's higher points sorted and
@@ -50,7 +50,7 @@ Mask voxelizeSurface(const Matrix3X& points, const std::vector<std::array<int, 3
   // The row through voxel centres (j, k) is shifted by this much, see the header.
   const double shiftJ = 1.0e-6, shiftK = 1.7e-6;
 
-  const Matrix3X index = (points.rowwise() - grid.origin.transpose()) * grid.indexFromPhysical().transpose();
+  const MatrixX3 index = (points.rowwise() - grid.origin.transpose()) * grid.indexFromPhysical().transpose();
 
   for (const auto& t : triangles) {
     const Vector3 a = index.row(t[0]), b = index.row(t[1]), c = index.row(t[2]);

@@ -16,7 +16,7 @@ namespace dynsub {
 namespace {
 
 // A closed UV sphere (triangles oriented outward).
-void uvSphere(const Vector3& centre, double radius, Matrix3X& points, std::vector<std::array<int, 3>>& triangles) {
+void uvSphere(const Vector3& centre, double radius, MatrixX3& points, std::vector<std::array<int, 3>>& triangles) {
   const int rings = 60, sectors = 120;
   points.resize(2 + (rings - 1) * sectors, 3);
   points.row(0) = (centre + Vector3(0, 0, radius)).transpose();
@@ -45,7 +45,7 @@ TEST(Voxelize, SphereOnAnAnisotropicRotatedGrid) {
   const ImageGeometry g = grid({48, 40, 24}, Vector3(0.6, 0.8, 1.5), Vector3(-14, -15, -16), skewDirection());
   const Vector3 centre = g.toPhysical(Vector3(23.5, 19.5, 11.5));
   const double radius = 10.0;
-  Matrix3X points;
+  MatrixX3 points;
   std::vector<std::array<int, 3>> triangles;
   uvSphere(centre, radius, points, triangles);
   const Mask mask = voxelizeSurface(points, triangles, g);
@@ -71,7 +71,7 @@ TEST(Voxelize, SphereOnAnAnisotropicRotatedGrid) {
 
 TEST(Voxelize, OpenSurfaceIsRefused) {
   const ImageGeometry g = grid({20, 20, 20}, Vector3::Ones(), Vector3::Zero(), Matrix3::Identity());
-  Matrix3X points;
+  MatrixX3 points;
   std::vector<std::array<int, 3>> triangles;
   uvSphere(Vector3(10, 10, 10), 5, points, triangles);
   // The last triangle twice (its edges used 3 times), or not at all (once):

@@ -183,7 +183,7 @@ struct Sculptor::Impl {
   // The control point drawn within kPickPixels of a display position, or -1.
   int controlPointAt(int x, int y) {
     vtkRenderer* r = view.renderer();
-    const Matrix3X& p = sculpture.model().controlPoints();
+    const MatrixX3& p = sculpture.model().controlPoints();
     int best = -1;
     double nearest = kPickPixels;
     for (int i = 0; i < p.rows(); ++i) {

@@ -113,7 +113,7 @@ struct Viewer::Impl {
   }
 
   void showLandmarks() {
-    const Matrix3X points = landmarkPositions(edits.landmarks);
+    const MatrixX3 points = landmarkPositions(edits.landmarks);
     for (auto& v : views) v->setLandmarks(points, edits.selected);
     surface3d.setLandmarks(points, edits.selected);
   }
@@ -478,7 +478,7 @@ Viewer::Impl::Impl(ViewerInput in)
   showLandmarks();
   if (edits.landmarks.size() >= 2) {
     // The structure the landmarks outline, with room around it.
-    const Matrix3X points = landmarkPositions(edits.landmarks);
+    const MatrixX3 points = landmarkPositions(edits.landmarks);
     const Vector3 low = points.colwise().minCoeff().transpose(), high = points.colwise().maxCoeff().transpose();
     const Vector3 room = 0.25 * (high - low) + Vector3::Constant(5.0);
     surface3d.frame(low - room, high + room);

@@ -236,8 +236,8 @@ void writeLandmarks(const std::vector<Landmark>& landmarks, const std::string& p
   output.commit();
 }
 
-Matrix3X landmarkPositions(const std::vector<Landmark>& landmarks) {
-  Matrix3X points(landmarks.size(), 3);
+MatrixX3 landmarkPositions(const std::vector<Landmark>& landmarks) {
+  MatrixX3 points(landmarks.size(), 3);
   for (std::size_t i = 0; i < landmarks.size(); ++i) points.row(i) = landmarks[i].position.transpose();
   return points;
 }

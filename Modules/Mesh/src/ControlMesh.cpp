@@ -9,7 +9,7 @@ namespace dynsub {
 
 ControlMesh::ControlMesh() : topology_(std::make_shared<const Topology>()) {}
 
-ControlMesh ControlMesh::fromPolygons(const Matrix3X& points, const std::vector<Polygon>& faces,
+ControlMesh ControlMesh::fromPolygons(const MatrixX3& points, const std::vector<Polygon>& faces,
                                       const std::string& source) {
   checkPolygonMesh(points, faces, source);
   ControlMesh mesh;
@@ -18,7 +18,7 @@ ControlMesh ControlMesh::fromPolygons(const Matrix3X& points, const std::vector<
   return mesh;
 }
 
-ControlMesh ControlMesh::fromTopology(const Matrix3X& points, Topology topology, const std::string& source) {
+ControlMesh ControlMesh::fromTopology(const MatrixX3& points, Topology topology, const std::string& source) {
   if (points.rows() != topology.vertexCount())
     throw Error(source, std::to_string(points.rows()) + " points for " + std::to_string(topology.vertexCount()) +
                             " vertices");
@@ -60,7 +60,7 @@ int ControlMesh::genus() const {
   return (2 - eulerCharacteristic() - boundaryLoopCount()) / 2;
 }
 
-void ControlMesh::setPoints(const Matrix3X& points) {
+void ControlMesh::setPoints(const MatrixX3& points) {
   if (points.rows() != vertexCount()) {
     throw Error("ControlMesh::setPoints: got " + std::to_string(points.rows()) +
                 " points for a mesh of " + std::to_string(vertexCount()) + " vertices");

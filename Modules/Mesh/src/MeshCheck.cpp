@@ -45,7 +45,7 @@ int fanCount(int vertex, const std::vector<int>& incidentFaces,
 
 }  // namespace
 
-void checkPolygonMesh(const Matrix3X& points, const std::vector<std::vector<int>>& faces,
+void checkPolygonMesh(const MatrixX3& points, const std::vector<std::vector<int>>& faces,
                       const std::string& source) {
   const int vertexCount = static_cast<int>(points.rows());
   if (vertexCount == 0) throw Error(source, "the mesh has no vertices");

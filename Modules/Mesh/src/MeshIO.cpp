@@ -27,8 +27,8 @@ std::ifstream openForReading(const std::string& path) {
   return in;
 }
 
-Matrix3X toMatrix(const std::vector<Vector3>& points) {
-  Matrix3X result(points.size(), 3);
+MatrixX3 toMatrix(const std::vector<Vector3>& points) {
+  MatrixX3 result(points.size(), 3);
   for (size_t i = 0; i < points.size(); ++i) result.row(i) = points[i].transpose();
   return result;
 }
@@ -357,7 +357,7 @@ void writeObj(const ControlMesh& mesh, const std::string& path) {
     out.precision(17);  // round-trips every double
     out << "# DynSub control mesh: " << mesh.vertexCount() << " vertices, " << mesh.faceCount()
         << " faces\n";
-    const Matrix3X points = mesh.points();
+    const MatrixX3 points = mesh.points();
     for (Eigen::Index v = 0; v < points.rows(); ++v) {
       out << "v " << points(v, 0) << ' ' << points(v, 1) << ' ' << points(v, 2) << '\n';
     }

@@ -42,7 +42,7 @@ ControlMesh makeCube98() {
       }
     }
   }
-  Matrix3X matrix(points.size(), 3);
+  MatrixX3 matrix(points.size(), 3);
   for (size_t i = 0; i < points.size(); ++i) matrix.row(i) = points[i].transpose();
   return ControlMesh::fromPolygons(matrix, faces, "cube (98 vertices)");
 }
@@ -52,7 +52,7 @@ ControlMesh makeTorus32() {
   constexpr int section = 4;  // along the minor circle
   constexpr double majorRadius = 1.0;
   constexpr double minorRadius = 0.5;
-  Matrix3X points(around * section, 3);
+  MatrixX3 points(around * section, 3);
   std::vector<Polygon> faces;
   auto id = [](int i, int j) { return (i % around) * section + (j % section); };
   for (int i = 0; i < around; ++i) {
@@ -70,7 +70,7 @@ ControlMesh makeTorus32() {
 
 ControlMesh makeSheet81() {
   constexpr int n = 8;
-  Matrix3X points((n + 1) * (n + 1), 3);
+  MatrixX3 points((n + 1) * (n + 1), 3);
   std::vector<Polygon> faces;
   auto id = [](int i, int j) { return j * (n + 1) + i; };
   for (int j = 0; j <= n; ++j) {

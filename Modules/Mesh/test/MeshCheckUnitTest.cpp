@@ -7,11 +7,11 @@
 namespace {
 
 using dynsub::ControlMesh;
-using dynsub::Matrix3X;
+using dynsub::MatrixX3;
 using dynsub::Polygon;
 
 // Expects fromPolygons to throw an error whose message contains `fragment`.
-void expectRejected(const Matrix3X& points, const std::vector<Polygon>& faces, const std::string& fragment) {
+void expectRejected(const MatrixX3& points, const std::vector<Polygon>& faces, const std::string& fragment) {
   try {
     ControlMesh::fromPolygons(points, faces, "test.obj");
     FAIL() << "accepted a mesh that should fail with: " << fragment;
@@ -22,8 +22,8 @@ void expectRejected(const Matrix3X& points, const std::vector<Polygon>& faces, c
   }
 }
 
-Matrix3X gridPoints(int columns, int rows) {
-  Matrix3X points(columns * rows, 3);
+MatrixX3 gridPoints(int columns, int rows) {
+  MatrixX3 points(columns * rows, 3);
   for (int j = 0; j < rows; ++j)
     for (int i = 0; i < columns; ++i) points.row(j * columns + i) << i, j, 0;
   return points;
@@ -44,7 +44,7 @@ TEST(MeshCheck, FacesKeepTheirVertexOrder) {
 }
 
 TEST(MeshCheck, RejectsEmptyMeshes) {
-  expectRejected(Matrix3X(0, 3), {}, "no vertices");
+  expectRejected(MatrixX3(0, 3), {}, "no vertices");
   expectRejected(gridPoints(2, 2), {}, "no faces");
 }
 
@@ -56,7 +56,7 @@ TEST(MeshCheck, RejectsBadFaces) {
 }
 
 TEST(MeshCheck, RejectsNonFiniteCoordinates) {
-  Matrix3X points = gridPoints(2, 2);
+  MatrixX3 points = gridPoints(2, 2);
   points(2, 1) = std::numeric_limits<double>::quiet_NaN();
   expectRejected(points, {{0, 1, 3, 2}}, "NaN");
 }
@@ -66,14 +66,14 @@ TEST(MeshCheck, RejectsIsolatedVertices) {
 }
 
 TEST(MeshCheck, RejectsNonManifoldEdges) {
-  Matrix3X points(5, 3);
+  MatrixX3 points(5, 3);
   points << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1;
   expectRejected(points, {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}}, "shared by 3 faces");
 }
 
 TEST(MeshCheck, RejectsNonManifoldVertices) {
   // Two triangles touching at vertex 0 only (a bowtie).
-  Matrix3X points(5, 3);
+  MatrixX3 points(5, 3);
   points << 0, 0, 0, 1, 0, 0, 1, 1, 0, -1, 0, 0, -1, -1, 0;
   expectRejected(points, {{0, 1, 2}, {0, 3, 4}}, "separate fans");
 }

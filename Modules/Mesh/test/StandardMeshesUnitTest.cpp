@@ -17,7 +17,7 @@ int countValence(const dynsub::ControlMesh& mesh, int valence) {
 // Signed volume by the divergence theorem (fan triangulation of each face):
 // positive when faces are oriented outward.
 double signedVolume(const dynsub::ControlMesh& mesh) {
-  const dynsub::Matrix3X p = mesh.points();
+  const dynsub::MatrixX3 p = mesh.points();
   double volume = 0;
   for (const dynsub::Polygon& face : mesh.faces()) {
     for (size_t k = 1; k + 1 < face.size(); ++k) {

@@ -57,7 +57,7 @@ double strongestNear(const Volume& magnitude, const Vector3& point, double radiu
 }
 
 // The reference magnitude and fractions of step 3 (see the header).
-EdgeScale edgeScale(const Volume& magnitude, const EdgeOptions& options, const Matrix3X& landmarks) {
+EdgeScale edgeScale(const Volume& magnitude, const EdgeOptions& options, const MatrixX3& landmarks) {
   const double strongEdges = percentile(magnitude.voxels, 0.99);
   if (options.reference == EdgeReference::Image || landmarks.rows() == 0)
     return {EdgeReference::Image, strongEdges, options.ofImage};
@@ -190,7 +190,7 @@ void checkEdgeOptions(const EdgeOptions& options) {
     throw Error("capture range must be a positive number of mm (got " + std::to_string(options.captureRange) + ")");
 }
 
-EdgeField::EdgeField(const Volume& image, const EdgeOptions& options, const Matrix3X& landmarks)
+EdgeField::EdgeField(const Volume& image, const EdgeOptions& options, const MatrixX3& landmarks)
     : geometry_(image.geometry) {
   checkEdgeOptions(options);
   const std::vector<Vector3> gradient = smoothedGradient(image, options.sigma);
@@ -221,8 +221,8 @@ double EdgeField::edgeDistance(const Vector3& point) const {
   return geometry_.spans(index) ? edgeDistance_.interpolate(index) : std::numeric_limits<double>::infinity();
 }
 
-Matrix3X EdgeField::sample(const Matrix3X& points) const {
-  Matrix3X result = Matrix3X::Zero(points.rows(), 3);
+MatrixX3 EdgeField::sample(const MatrixX3& points) const {
+  MatrixX3 result = MatrixX3::Zero(points.rows(), 3);
   const Matrix3 toIndex = geometry_.indexFromPhysical();
   const float* vectors = vectors_.data();
   for (Eigen::Index p = 0; p < points.rows(); ++p) {

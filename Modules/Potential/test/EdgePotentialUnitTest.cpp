@@ -35,7 +35,7 @@ TEST(EdgePotential, ForcesPointToTheBallsSurface) {
         }
   EXPECT_GT(edgeCount, 500);
   // Forces 3 mm inside point outward, 3 mm outside point inward (within 30 degrees).
-  Matrix3X probes(2 * 26, 3);
+  MatrixX3 probes(2 * 26, 3);
   std::vector<Vector3> radial;
   int row = 0;
   for (int x = -1; x <= 1; ++x)
@@ -48,13 +48,13 @@ TEST(EdgePotential, ForcesPointToTheBallsSurface) {
         radial.push_back(u);
         radial.push_back(-u);
       }
-  const Matrix3X forces = field.sample(probes);
+  const MatrixX3 forces = field.sample(probes);
   for (int p = 0; p < probes.rows(); ++p) {
     EXPECT_NEAR(forces.row(p).norm(), 1.0, 0.05) << p;
     EXPECT_GT(forces.row(p).dot(radial[p].transpose()), std::cos(M_PI / 6)) << p;
   }
   // Beyond the capture range, and outside the image, no force.
-  Matrix3X far(2, 3);
+  MatrixX3 far(2, 3);
   far.row(0) = centre.transpose();  // 8 mm from every edge > 6 mm
   far.row(1) = (centre + Vector3(500, 0, 0)).transpose();
   EXPECT_LT(field.sample(far).norm(), 1e-12);
@@ -74,8 +74,8 @@ Volume shellPhantom(const ImageGeometry& g, const Vector3& centre) {
 }
 
 // Points on a sphere in the 26 grid-free directions.
-Matrix3X pointsOnSphere(const Vector3& centre, double radius) {
-  Matrix3X points(26, 3);
+MatrixX3 pointsOnSphere(const Vector3& centre, double radius) {
+  MatrixX3 points(26, 3);
   int row = 0;
   for (int x = -1; x <= 1; ++x)
     for (int y = -1; y <= 1; ++y)
@@ -149,7 +149,7 @@ TEST(EdgePotential, LandmarksSetTheEdgeThresholds) {
   // grid, and in the flat middle of the core (0.5 mm from the centre, 3 mm
   // and more from its boundary: the blurred step has fallen to a few % of
   // its peak there). Both are refused rather than used.
-  const Matrix3X offGrid = pointsOnSphere(centre + Vector3(500, 0, 0), 9.0), flat = pointsOnSphere(centre, 0.5);
+  const MatrixX3 offGrid = pointsOnSphere(centre + Vector3(500, 0, 0), 9.0), flat = pointsOnSphere(centre, 0.5);
   const EdgeOptions byLandmarks;
   EXPECT_THROW(EdgeField(image, byLandmarks, offGrid), LandmarksOffEdges);
   EXPECT_THROW(EdgeField(image, byLandmarks, flat), LandmarksOffEdges);

@@ -38,8 +38,8 @@ void requireSurface(const FigureScene& scene) {
   if (!scene.surface || scene.surface->GetNumberOfPoints() == 0) throw Error("the figure has no surface to show");
 }
 
-Matrix3X surfacePoints(vtkPolyData* surface) {
-  Matrix3X p(surface->GetNumberOfPoints(), 3);
+MatrixX3 surfacePoints(vtkPolyData* surface) {
+  MatrixX3 p(surface->GetNumberOfPoints(), 3);
   for (vtkIdType i = 0; i < surface->GetNumberOfPoints(); ++i) {
     double x[3];
     surface->GetPoint(i, x);
@@ -56,7 +56,7 @@ namespace {
 // are the caller's to have removed).
 void drawSlices(const FigureScene& scene, vtkRenderWindow* window) {
   requireSurface(scene);
-  const Matrix3X points = surfacePoints(scene.surface);
+  const MatrixX3 points = surfacePoints(scene.surface);
   const Vector3 low = points.colwise().minCoeff().transpose(), high = points.colwise().maxCoeff().transpose();
   const Vector3 centre = 0.5 * (low + high);
   const ImageSlices* image = scene.image;

@@ -96,7 +96,7 @@ void pointsAsDots(vtkActor* actor, double pixels) {
   actor->GetProperty()->LightingOff();
 }
 
-vtkSmartPointer<vtkPolyData> dots(const Matrix3X& points, const std::vector<int>& rows, int selected) {
+vtkSmartPointer<vtkPolyData> dots(const MatrixX3& points, const std::vector<int>& rows, int selected) {
   vtkNew<vtkPoints> positions;
   vtkNew<vtkCellArray> vertices;
   vtkNew<vtkUnsignedCharArray> colours;
@@ -113,7 +113,7 @@ vtkSmartPointer<vtkPolyData> dots(const Matrix3X& points, const std::vector<int>
   return data;
 }
 
-std::vector<int> allRows(const Matrix3X& points) {
+std::vector<int> allRows(const MatrixX3& points) {
   std::vector<int> rows(points.rows());
   for (int r = 0; r < static_cast<int>(rows.size()); ++r) rows[r] = r;
   return rows;

@@ -99,9 +99,9 @@ struct SliceView::Impl {
   const ImageSlices* image = nullptr;
   SlicePlane plane;
   int index = -1;
-  Matrix3X landmarks;
+  MatrixX3 landmarks;
   int selected = -1;
-  Matrix3X dataPoints;
+  MatrixX3 dataPoints;
 
   vtkNew<vtkRenderer> renderer;
   vtkNew<vtkImageSliceMapper> imageMapper;
@@ -165,7 +165,7 @@ struct SliceView::Impl {
   Vector3 overlayShift() const { return 0.05 * plane.thickness * plane.normal; }
 
   // Rows of `points` within half a slice thickness of the plane.
-  std::vector<int> onSlice(const Matrix3X& points) const {
+  std::vector<int> onSlice(const MatrixX3& points) const {
     std::vector<int> rows;
     for (int r = 0; r < static_cast<int>(points.rows()); ++r)
       if (std::abs(plane.distance(points.row(r).transpose())) <= 0.5 * plane.thickness) rows.push_back(r);
@@ -249,13 +249,13 @@ void SliceView::colourByEdgeDistance(bool on) {
   }
 }
 
-void SliceView::setLandmarks(const Matrix3X& landmarks, int selected) {
+void SliceView::setLandmarks(const MatrixX3& landmarks, int selected) {
   impl_->landmarks = landmarks;
   impl_->selected = selected;
   impl_->update();
 }
 
-void SliceView::setDataPoints(const Matrix3X& points) {
+void SliceView::setDataPoints(const MatrixX3& points) {
   impl_->dataPoints = points;
   impl_->update();
 }

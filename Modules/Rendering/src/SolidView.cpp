@@ -32,7 +32,7 @@ constexpr std::array<unsigned char, 3> kFreePoint{235, 235, 235};
 constexpr std::array<unsigned char, 3> kFixedPoint{230, 40, 40};
 constexpr double kControlPointPixels = 8.0;
 
-vtkSmartPointer<vtkPoints> pointsOf(const Matrix3X& p) {
+vtkSmartPointer<vtkPoints> pointsOf(const MatrixX3& p) {
   auto points = vtkSmartPointer<vtkPoints>::New();
   points->SetDataTypeToDouble();
   points->SetNumberOfPoints(p.rows());
@@ -109,7 +109,7 @@ struct SolidView::Impl {
   void show(const Sculpture& s, int selectedFace) {
     const SolidModel& model = s.model();
     const SolidRefinement& refined = model.refinement();
-    const Matrix3X d = model.dataPoints();
+    const MatrixX3 d = model.dataPoints();
 
     vtkNew<vtkCellArray> faces;
     auto colours = colourArray();
@@ -132,7 +132,7 @@ struct SolidView::Impl {
     surface->GetCellData()->SetScalars(colours);
     surface->Modified();
 
-    const Matrix3X& p = model.controlPoints();
+    const MatrixX3& p = model.controlPoints();
     const Lattice& control = model.control();
     vtkNew<vtkCellArray> edges;
     for (const auto& [a, b] : control.edges()) {
@@ -158,7 +158,7 @@ struct SolidView::Impl {
 
     rope->Initialize();
     if (model.ropePoint() >= 0) {
-      Matrix3X ends(2, 3);
+      MatrixX3 ends(2, 3);
       ends.row(0) = d.row(model.ropePoint());
       ends.row(1) = model.ropeTarget().transpose();
       vtkNew<vtkCellArray> line, end;

@@ -27,7 +27,7 @@ namespace dynsub {
 vtkSmartPointer<vtkPolyData> controlMeshWireframe(const ControlMesh& mesh) {
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
-  const Matrix3X p = mesh.points();
+  const MatrixX3 p = mesh.points();
   for (Eigen::Index i = 0; i < p.rows(); ++i) points->InsertNextPoint(p(i, 0), p(i, 1), p(i, 2));
   vtkNew<vtkCellArray> lines;
   std::set<std::pair<int, int>> edges;
@@ -117,11 +117,11 @@ void SurfaceView::setControlMesh(vtkPolyData* wireframe) {
   impl_->wireActor->SetVisibility(wireframe != nullptr);
 }
 
-void SurfaceView::setLandmarks(const Matrix3X& landmarks, int selected) {
+void SurfaceView::setLandmarks(const MatrixX3& landmarks, int selected) {
   impl_->landmarkPoints->ShallowCopy(style::dots(landmarks, style::allRows(landmarks), selected));
 }
 
-void SurfaceView::setDataPoints(const Matrix3X& points) {
+void SurfaceView::setDataPoints(const MatrixX3& points) {
   impl_->dataPoints->ShallowCopy(style::dots(points, style::allRows(points)));
 }
 

@@ -148,7 +148,7 @@ TEST_F(Rendering, SliceViewPutsImageContourAndLandmarksInOneFrame) {
     const double circleRadius = std::sqrt(std::pow(phantom.radius, 2) - std::pow(plane.distance(phantom.centre), 2));
     const Vector3 onSlice = circleCentre + 0.5 * circleRadius * plane.right;
     const Vector3 offSlice = circleCentre - 0.5 * circleRadius * plane.right + 2.0 * plane.thickness * plane.normal;
-    Matrix3X landmarks(2, 3);
+    MatrixX3 landmarks(2, 3);
     landmarks << onSlice.transpose(), offSlice.transpose();
     view.setLandmarks(landmarks);
     view.frame(circleCentre, 20.0);

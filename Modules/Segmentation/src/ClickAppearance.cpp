@@ -117,7 +117,7 @@ EndPressure::EndPressure(const Volume& region, ClickAppearance appearance, const
   slopeBound_ = strength_ * appearance_.largestSlope() * steepGradient(region);
 }
 
-Eigen::VectorXd EndPressure::pressuresAt(const Matrix3X& points) const {
+Eigen::VectorXd EndPressure::pressuresAt(const MatrixX3& points) const {
   const ImageGeometry& g = region_.geometry;
   Eigen::VectorXd pressures = Eigen::VectorXd::Zero(points.rows());
   for (Eigen::Index i = 0; i < points.rows(); ++i) {

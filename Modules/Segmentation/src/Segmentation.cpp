@@ -14,7 +14,7 @@
 #include "dynsub/ApplyOperator.h"
 #include "dynsub/ClickAppearance.h"
 #include "dynsub/ClosestPoint.h"
-#include "dynsub/EdgeForce.h"
+#include "EdgeForce.h"
 #include "dynsub/Error.h"
 #include "dynsub/Forces.h"
 #include "dynsub/InitialModels.h"
@@ -37,11 +37,11 @@ class RegionPressureForceModel final : public ForceModel {
       : image_(image), toIndex_(image.geometry.indexFromPhysical()), median_(median),
         width_(window * std::max(spread, 1e-6)), strength_(strength),
         slope_(std::abs(strength) / width_ * steepGradient(image)) {}
-  void beginLevel(const LimitSurface&, const SurfaceQuadrature& quadrature, const Matrix3X&) override {
+  void beginLevel(const LimitSurface&, const SurfaceQuadrature& quadrature, const MatrixX3&) override {
     quadrature_ = &quadrature;
   }
-  Matrix3X generalizedForce(const Matrix3X& controlPoints, double&) override {
-    const Matrix3X positions = applyOperator(quadrature_->J, controlPoints);
+  MatrixX3 generalizedForce(const MatrixX3& controlPoints, double&) override {
+    const MatrixX3 positions = applyOperator(quadrature_->J, controlPoints);
     Eigen::VectorXd pressures(positions.rows());
     for (Eigen::Index i = 0; i < positions.rows(); ++i) {
       const Vector3 index = toIndex_ * (positions.row(i).transpose() - image_.geometry.origin);
@@ -56,7 +56,7 @@ class RegionPressureForceModel final : public ForceModel {
   // at most by about the steep gradient per mm: without this slope in the
   // stabilizer, the pressure overshoots at long time steps (the ball that
   // SegmentationUnitTest grows from a 3 mm seed would collapse at 4 s).
-  SparseMatrix stabilizingStiffness(const Matrix3X& controlPoints) override {
+  SparseMatrix stabilizingStiffness(const MatrixX3& controlPoints) override {
     return fieldStiffness(*quadrature_, controlPoints, slope_);
   }
 
@@ -67,7 +67,7 @@ class RegionPressureForceModel final : public ForceModel {
   const SurfaceQuadrature* quadrature_ = nullptr;
 };
 
-Matrix3X limitPoints(const ControlMesh& mesh, int segments) {
+MatrixX3 limitPoints(const ControlMesh& mesh, int segments) {
   const LimitSurface surface(mesh);
   return tessellate(surface, mesh.points(), segments).points;
 }
@@ -138,7 +138,7 @@ void checkSegmentOptions(const SegmentOptions& options) {
 }
 
 ControlMesh initialFromLandmarks(const std::vector<Landmark>& landmarks, double fraction) {
-  const Matrix3X points = landmarkPositions(landmarks);
+  const MatrixX3 points = landmarkPositions(landmarks);
   // Clicks on one slice are the flat set users give; say what would do.
   // (Points on a line, or at one point, get checkPointCloud's own words.)
   // NB: one slice of clicks says nothing of the structure across the slice:
@@ -153,8 +153,8 @@ ControlMesh initialFromLandmarks(const std::vector<Landmark>& landmarks, double 
   return initialModel(points, InitialShape::Sphere, fraction);
 }
 
-std::vector<double> distancesToSurface(const LimitSurface& surface, const Matrix3X& controlPoints,
-                                       const Matrix3X& landmarkPoints) {
+std::vector<double> distancesToSurface(const LimitSurface& surface, const MatrixX3& controlPoints,
+                                       const MatrixX3& landmarkPoints) {
   ClosestPointLocator locator(surface);
   locator.update(controlPoints);
   std::vector<double> distances;
@@ -177,14 +177,14 @@ SegmentationRegion::SegmentationRegion(const Volume& image, const std::vector<La
               << p.y() << ", " << p.z() << ") mm LPS lies outside the image";
       throw LandmarkError(message.str());
     }
-  const Matrix3X start = limitPoints(initial, 2);
+  const MatrixX3 start = limitPoints(initial, 2);
   for (Eigen::Index p = 0; p < start.rows(); ++p)
     if (!grid.covers(start.row(p).transpose())) throw Error("the initial model reaches outside the image");
 
   auto clock = Clock::now();
-  const Matrix3X landmarkPoints = landmarkPositions(landmarks);
-  const Matrix3X coverPoints = landmarkPositions(alsoCover);
-  Matrix3X extent(start.rows() + landmarkPoints.rows() + coverPoints.rows(), 3);
+  const MatrixX3 landmarkPoints = landmarkPositions(landmarks);
+  const MatrixX3 coverPoints = landmarkPositions(alsoCover);
+  MatrixX3 extent(start.rows() + landmarkPoints.rows() + coverPoints.rows(), 3);
   extent << start, landmarkPoints, coverPoints;
   std::tie(first_, size_) = boundingRegion(grid, extent, options.margin);
   image_ = cropVolume(image, first_, size_);
@@ -200,7 +200,7 @@ SegmentationRegion::SegmentationRegion(const Volume& image, const std::vector<La
   potentialSeconds_ = secondsSince(clock);
 }
 
-bool SegmentationRegion::covers(const Matrix3X& points) const {
+bool SegmentationRegion::covers(const MatrixX3& points) const {
   for (Eigen::Index p = 0; p < points.rows(); ++p)
     if (!covers(Vector3(points.row(p).transpose()))) return false;
   return true;
@@ -215,7 +215,7 @@ SegmentResult evolveInRegion(const SegmentationRegion& region, const std::vector
   checkSegmentOptions(options);
   if (!initial.isClosed()) throw Error("the initial model must be a closed control mesh");
   const auto clock = Clock::now();
-  const Matrix3X landmarkPoints = landmarkPositions(landmarks);
+  const MatrixX3 landmarkPoints = landmarkPositions(landmarks);
   if (!region.covers(landmarkPoints) || !region.covers(initial.points()))
     throw Error("the landmarks or the initial model reach outside the region of interest: build a new region");
   const EdgeForce field(region.edgeField(), options.imageForce);
@@ -239,7 +239,7 @@ SegmentResult evolveInRegion(const SegmentationRegion& region, const std::vector
   // Refine while a landmark is farther than the tolerance (see the header).
   // The last level's distances are the result's.
   std::vector<double> distances;
-  auto landmarksFit = [&](const LimitSurface& surface, const Matrix3X& controlPoints, bool) {
+  auto landmarksFit = [&](const LimitSurface& surface, const MatrixX3& controlPoints, bool) {
     if (landmarkPoints.rows() == 0) return false;
     distances = distancesToSurface(surface, controlPoints, landmarkPoints);
     for (double distance : distances)
@@ -273,7 +273,7 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
   SliceEnds ends;
   if (options.sliceEnds.enabled) ends = findSliceEnds(image, landmarks, initial, options.sliceEnds);
   const SegmentationRegion region(image, landmarks, initial, options, ends.springs);
-  const Matrix3X endPoints = landmarkPositions(ends.springs);
+  const MatrixX3 endPoints = landmarkPositions(ends.springs);
   SpringForceModel endSprings(endPoints, Eigen::VectorXd::Constant(endPoints.rows(), options.sliceEnds.stiffness),
                               SpringForceModel::Attach::NearestEachStep);
   std::vector<ForceModel*> forces = extraForces;

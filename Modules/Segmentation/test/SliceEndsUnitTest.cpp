@@ -172,7 +172,7 @@ TEST(ClickAppearance, ThePressureActsOnlyBeyondTheClickedSpan) {
     };
     const EndPressure pressure(image, *ClickAppearance::learn(image, landmarks, 1), landmarks, 1, 0.2,
                                end(-12, before), end(12, after));
-    Matrix3X points(6, 3);
+    MatrixX3 points(6, 3);
     points.row(0) = (shape.centre + Vector3(0, 0, 0)).transpose();    // inside, within the span
     points.row(1) = (shape.centre + Vector3(0, 16, 0)).transpose();   // inside, beyond the last slice
     points.row(2) = (shape.centre + Vector3(0, -16, 0)).transpose();  // inside, before the first

@@ -18,7 +18,7 @@ std::vector<int> sortedUnique(std::vector<int> v) {
 
 // Newell's normal of a loop: its length is twice the area of a planar loop;
 // it points the way the loop runs counter-clockwise around.
-Vector3 newellNormal(const Matrix3X& points, const std::vector<int>& loop) {
+Vector3 newellNormal(const MatrixX3& points, const std::vector<int>& loop) {
   Vector3 normal = Vector3::Zero();
   for (std::size_t i = 0; i < loop.size(); ++i)
     normal += Vector3(points.row(loop[i]).transpose()).cross(points.row(loop[(i + 1) % loop.size()]).transpose());
@@ -27,13 +27,13 @@ Vector3 newellNormal(const Matrix3X& points, const std::vector<int>& loop) {
 
 }  // namespace
 
-Vector3 centroidOf(const Matrix3X& points, const std::vector<int>& indices) {
+Vector3 centroidOf(const MatrixX3& points, const std::vector<int>& indices) {
   Vector3 sum = Vector3::Zero();
   for (int p : indices) sum += points.row(p).transpose();
   return sum / static_cast<double>(indices.size());
 }
 
-Lattice Lattice::fromCells(Matrix3X points, std::vector<std::vector<int>> faces, std::vector<std::vector<int>> cells,
+Lattice Lattice::fromCells(MatrixX3 points, std::vector<std::vector<int>> faces, std::vector<std::vector<int>> cells,
                            const std::string& source) {
   if (points.rows() == 0 || cells.empty()) throw Error(source, "the lattice has no points or no cells");
   if (!points.allFinite()) throw Error(source, "a point has a non-finite coordinate");
@@ -115,7 +115,7 @@ Lattice Lattice::fromCells(Matrix3X points, std::vector<std::vector<int>> faces,
   return l;
 }
 
-void Lattice::setPoints(const Matrix3X& points) {
+void Lattice::setPoints(const MatrixX3& points) {
   if (points.rows() != points_.rows() || !points.allFinite())
     throw Error("the lattice's new points must be " + std::to_string(points_.rows()) + " finite points");
   points_ = points;
@@ -144,7 +144,7 @@ Lattice extrudeFace(const Lattice& l, int face) {
   const double height = 2.0 * std::abs(normal.dot(centroid - cellCentroid));
 
   const int n = l.pointCount(), k = static_cast<int>(loop.size());
-  Matrix3X points(n + k, 3);
+  MatrixX3 points(n + k, 3);
   points.topRows(n) = l.points();
   for (int i = 0; i < k; ++i) points.row(n + i) = l.points().row(loop[i]) + height * normal.transpose();
   std::vector<std::vector<int>> faces = l.faces(), cells = l.cells();
@@ -189,7 +189,7 @@ Lattice deleteCell(const Lattice& l, int cell, std::vector<int>* kept) {
   int points = 0;
   for (int& p : pointNumber)
     if (p == 0) p = points++;
-  Matrix3X newPoints(points, 3);
+  MatrixX3 newPoints(points, 3);
   for (int p = 0; p < l.pointCount(); ++p)
     if (pointNumber[p] >= 0) newPoints.row(pointNumber[p]) = l.points().row(p);
   for (int f = 0; f < l.faceCount(); ++f) {
@@ -217,7 +217,7 @@ Lattice regularLattice(int nx, int ny, int nz, double size, const std::vector<in
   if (nx < 1 || ny < 1 || nz < 1) throw Error("a regular lattice needs at least one cell along each axis");
   const int px = nx + 1, py = ny + 1, pz = nz + 1;
   auto point = [&](int i, int j, int k) { return i + px * (j + py * k); };
-  Matrix3X points(px * py * pz, 3);
+  MatrixX3 points(px * py * pz, 3);
   for (int k = 0; k < pz; ++k)
     for (int j = 0; j < py; ++j)
       for (int i = 0; i < px; ++i) points.row(point(i, j, k)) << i * size, j * size, k * size;
@@ -251,7 +251,7 @@ Lattice regularLattice(int nx, int ny, int nz, double size, const std::vector<in
   int used = 0;
   for (int& r : renumber)
     if (r == 0) r = used++;
-  Matrix3X kept(used, 3);
+  MatrixX3 kept(used, 3);
   for (int p = 0; p < points.rows(); ++p)
     if (renumber[p] >= 0) kept.row(renumber[p]) = points.row(p);
   for (auto& loop : faces)

@@ -93,7 +93,7 @@ Lattice readLattice(const std::string& path) {
       reader.fail("expected the header \"dynsub-lattice 1\"");
   }
   const int n = reader.count("points");
-  Matrix3X points(n, 3);
+  MatrixX3 points(n, 3);
   for (int i = 0; i < n; ++i) {
     std::istringstream line = reader.next("a point");
     if (!(line >> points(i, 0) >> points(i, 1) >> points(i, 2))) reader.fail("expected a point \"x y z\"");

@@ -11,7 +11,7 @@ namespace {
 
 // Of the point sets `use` accepts, the one whose centroid is nearest `point`.
 template <typename Use>
-int nearestCentroid(const Matrix3X& points, const std::vector<std::vector<int>>& sets, const Vector3& point, Use use) {
+int nearestCentroid(const MatrixX3& points, const std::vector<std::vector<int>>& sets, const Vector3& point, Use use) {
   int best = -1;
   double nearest = std::numeric_limits<double>::infinity();
   for (int i = 0; i < static_cast<int>(sets.size()); ++i) {
@@ -43,7 +43,7 @@ Lattice Sculpture::control() const {
   return lattice;
 }
 
-void Sculpture::rebuild(const Lattice& rest, const Matrix3X& current, const std::vector<int>& fixed) {
+void Sculpture::rebuild(const Lattice& rest, const MatrixX3& current, const std::vector<int>& fixed) {
   auto model = std::make_unique<SolidModel>(rest, settings_.levels, settings_.material);
   model->setControlPoints(current);
   if (!fixed.empty()) model->fix(fixed);

@@ -22,7 +22,7 @@ struct SolidModel::Solver {
 };
 
 SolidModel::SolidModel(const Lattice& control, int levels, const SolidMaterial& material)
-    : control_(control), p_(control.points()), v_(Matrix3X::Zero(control.pointCount(), 3)),
+    : control_(control), p_(control.points()), v_(MatrixX3::Zero(control.pointCount(), 3)),
       fixed_(control.pointCount(), false), springs_(std::make_unique<Springs>()) {
   if (levels < 0 || levels > 4) throw Error("the solid's subdivision level must be 0 to 4 (got " + std::to_string(levels) + ")");
   refined_ = subdivideSolid(control, levels);
@@ -37,11 +37,11 @@ SolidModel::SolidModel(const Lattice& control, int levels, const SolidMaterial& 
 
 SolidModel::~SolidModel() = default;
 
-Matrix3X SolidModel::dataPoints() const { return refined_.A * p_; }
+MatrixX3 SolidModel::dataPoints() const { return refined_.A * p_; }
 int SolidModel::springCount() const { return static_cast<int>(springs_->normal.size()); }
 int SolidModel::virtualSpringCount() const { return static_cast<int>(springs_->virtuals.size()); }
 
-void SolidModel::setControlPoints(const Matrix3X& points) {
+void SolidModel::setControlPoints(const MatrixX3& points) {
   if (points.rows() != p_.rows() || !points.allFinite())
     throw Error("the solid needs " + std::to_string(p_.rows()) + " finite control points (got " +
                 std::to_string(points.rows()) + ")");
@@ -114,14 +114,14 @@ void SolidModel::rope(int dataPoint, const Vector3& target, double stiffness) {
 void SolidModel::releaseRope() { ropePoint_ = -1; }
 
 int SolidModel::nearestDataPoint(const Vector3& point) const {
-  const Matrix3X d = dataPoints();
+  const MatrixX3 d = dataPoints();
   Eigen::Index best = 0;
   (d.rowwise() - point.transpose()).rowwise().squaredNorm().minCoeff(&best);
   return static_cast<int>(best);
 }
 
 void SolidModel::resetRestLengths() {
-  const Matrix3X d = dataPoints();
+  const MatrixX3 d = dataPoints();
   springs_->normalRest.clear();
   for (const auto& [a, b] : springs_->normal) springs_->normalRest.push_back((d.row(a) - d.row(b)).norm());
   springs_->virtualRest.clear();
@@ -129,8 +129,8 @@ void SolidModel::resetRestLengths() {
     springs_->virtualRest.push_back((0.5 * (d.row(a) + d.row(b)) - d.row(m)).norm());
 }
 
-Matrix3X SolidModel::springForces(const Matrix3X& d, double* energy) const {
-  Matrix3X f = Matrix3X::Zero(d.rows(), 3);
+MatrixX3 SolidModel::springForces(const MatrixX3& d, double* energy) const {
+  MatrixX3 f = MatrixX3::Zero(d.rows(), 3);
   double stored = 0;
   for (std::size_t s = 0; s < springs_->normal.size(); ++s) {
     const auto [a, b] = springs_->normal[s];
@@ -161,11 +161,11 @@ void SolidModel::step(double dt, SolidScheme scheme) {
   if (!(std::isfinite(dt) && dt > 0)) throw Error("the time step must be finite and > 0");
   const Solver& s = *solver_;
   if (s.A1.cols() == 0) return;  // everything fixed
-  const Matrix3X d = dataPoints();
-  Matrix3X f = springForces(d) - material_.damping * (refined_.A * v_);
+  const MatrixX3 d = dataPoints();
+  MatrixX3 f = springForces(d) - material_.damping * (refined_.A * v_);
   if (ropePoint_ >= 0) f.row(ropePoint_) += ropeStiffness_ * (ropeTarget_.transpose() - d.row(ropePoint_));
-  const Matrix3X acceleration = s.ldlt.solve(Matrix3X(s.A1.transpose() * f));
-  Matrix3X p = p_, v = v_;
+  const MatrixX3 acceleration = s.ldlt.solve(MatrixX3(s.A1.transpose() * f));
+  MatrixX3 p = p_, v = v_;
   for (int i = 0; i < control_.pointCount(); ++i) {
     const int r = s.freeIndex[i];
     if (r < 0) continue;

@@ -212,7 +212,7 @@ SolidRefinement subdivideSolid(const Lattice& l) {
   for (int c = 0; c < l.cellCount(); ++c)
     refined.cellOrigin.insert(refined.cellOrigin.end(), l.cellPoints()[c].size(), c);
   refined.A = rows.matrix(l.pointCount());
-  const Matrix3X points = refined.A * l.points();
+  const MatrixX3 points = refined.A * l.points();
   refined.lattice =
       Lattice::fromCells(points, std::move(topology.faces), std::move(topology.cells), "subdivided lattice");
   return refined;

@@ -32,7 +32,7 @@ void holdAndPull(Sculpture& s, const Vector3& target, int steps) {
   s.run(steps);
 }
 
-double largestMove(const Matrix3X& a, const Matrix3X& b) { return (a - b).rowwise().norm().maxCoeff(); }
+double largestMove(const MatrixX3& a, const MatrixX3& b) { return (a - b).rowwise().norm().maxCoeff(); }
 
 // 80 s of motion: the default material brings the held cube back to within
 // 1e-7 mm of rest, and the taller extruded one (slower) within 1e-4 mm
@@ -99,7 +99,7 @@ TEST(Sculpting, PlasticityKeepsTheSculptedShape) {
   Sculpture s(cube3);
   holdAndPull(s, Vector3(2.5, 2.5, 3.0), 1000);
   s.plasticity();
-  const Matrix3X sculpted = s.model().controlPoints();
+  const MatrixX3 sculpted = s.model().controlPoints();
   EXPECT_EQ(s.rest().points(), sculpted);
   s.release();
   settle(s);
@@ -117,7 +117,7 @@ TEST(Sculpting, ExtrudeAndDeleteKeepTheRestShapeAndTheFixedPoints) {
   // extruded rest shape, with the base still where it was.
   holdAndPull(s, Vector3(2.6, 2.4, 2.8), 500);
   const int top = s.boundaryFaceNear(Vector3(1.5, 1.5, 2.0));
-  const Matrix3X heldBefore = s.model().controlPoints();
+  const MatrixX3 heldBefore = s.model().controlPoints();
   const int outer = s.extrude(top);
   EXPECT_FALSE(s.roped()) << "a topology change releases the rope";
   EXPECT_EQ(s.control().cellCount(), 9);

@@ -15,7 +15,7 @@ constexpr double kStep = 0.01;  // s; the semi-implicit scheme is stable here fo
 
 TEST(SolidDynamics, AFreeSolidUnderNoForceKeepsItsShape) {
   SolidModel model(regularLattice(2, 2, 2), 2);
-  const Matrix3X start = model.controlPoints();
+  const MatrixX3 start = model.controlPoints();
   for (int i = 0; i < 500; ++i) model.step(kStep);
   EXPECT_LT((model.controlPoints() - start).cwiseAbs().maxCoeff(), 1e-12);
   EXPECT_LT(model.kineticEnergy(), 1e-20);  // rest lengths are lengths to rounding
@@ -88,7 +88,7 @@ TEST(SolidDynamics, FixedControlPointsStayAndPlasticityKeepsTheShape) {
     if (model.control().points()(i, 2) == 0.0) bottom.push_back(i);
   ASSERT_EQ(bottom.size(), 9u);
   model.fix(bottom);
-  const Matrix3X start = model.controlPoints();
+  const MatrixX3 start = model.controlPoints();
   model.rope(model.nearestDataPoint(Vector3(2, 2, 2)), Vector3(2.5, 2.5, 3.0), 40.0);
   for (int i = 0; i < 600; ++i) model.step(kStep);
   for (int i : bottom) EXPECT_EQ((model.controlPoints().row(i) - start.row(i)).norm(), 0.0);
@@ -96,7 +96,7 @@ TEST(SolidDynamics, FixedControlPointsStayAndPlasticityKeepsTheShape) {
   // Plasticity: the pulled shape becomes the rest shape and stays after release.
   model.resetRestLengths();
   model.releaseRope();
-  const Matrix3X pulled = model.controlPoints();
+  const MatrixX3 pulled = model.controlPoints();
   for (int i = 0; i < 600; ++i) model.step(kStep);
   EXPECT_LT((model.controlPoints() - pulled).cwiseAbs().maxCoeff(), 0.02);
   // Stiffness and damping change while running; the state stays finite.
@@ -113,7 +113,7 @@ TEST(SolidDynamics, FixedControlPointsStayAndPlasticityKeepsTheShape) {
 TEST(SolidDynamics, ADivergingStepIsReportedAndTheStateKept) {
   SolidModel model(regularLattice(2, 2, 2), 1);
   model.rope(0, Vector3(-5, -5, -5), 1e6);
-  const Matrix3X before = model.controlPoints();
+  const MatrixX3 before = model.controlPoints();
   bool thrown = false;
   for (int i = 0; i < 2000 && !thrown; ++i) {
     try {

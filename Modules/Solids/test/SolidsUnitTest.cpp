@@ -64,7 +64,7 @@ TEST(SolidSubdivision, RegularInteriorIsTheTriCubicBSplineSolid) {
   Lattice lattice = regularLattice(cells, cells, cells);
   std::mt19937 random(7);
   std::uniform_real_distribution<double> jitter(-0.3, 0.3);
-  Matrix3X points = lattice.points();
+  MatrixX3 points = lattice.points();
   for (Eigen::Index i = 0; i < points.rows(); ++i)
     for (int a = 0; a < 3; ++a) points(i, a) += jitter(random);
   lattice.setPoints(points);
@@ -109,10 +109,10 @@ TEST(SolidSubdivision, EveryRefinedPointIsAnAffineBlendAndLevelsCompose) {
   EXPECT_LT((two.A * holes.points() - two.lattice.points()).cwiseAbs().maxCoeff(), 1e-12);
   // Translating the lattice translates the solid.
   Lattice moved = holes;
-  Matrix3X shifted = holes.points();
+  MatrixX3 shifted = holes.points();
   shifted.rowwise() += Eigen::RowVector3d(3, -1, 2);
   moved.setPoints(shifted);
-  Matrix3X expected = two.lattice.points();
+  MatrixX3 expected = two.lattice.points();
   expected.rowwise() += Eigen::RowVector3d(3, -1, 2);
   EXPECT_LT((subdivideSolid(moved, 2).lattice.points() - expected).cwiseAbs().maxCoeff(), 1e-12);
   // The refined lattice stays valid: each cell closed, each face in 1 or 2 cells.

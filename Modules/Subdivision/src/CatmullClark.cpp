@@ -92,7 +92,7 @@ Refinement refine(const Topology& topology) {
 
 SubdividedMesh subdivide(const ControlMesh& mesh) {
   Refinement refinement = refine(mesh.topology());
-  const Matrix3X points = refinement.subdivisionMatrix * mesh.points();
+  const MatrixX3 points = refinement.subdivisionMatrix * mesh.points();
   SubdividedMesh result{ControlMesh::fromTopology(points, std::move(refinement.topology), "refined mesh"), {}};
   result.subdivisionMatrix.swap(refinement.subdivisionMatrix);  // Eigen 3.4's sparse matrices have no move
   return result;

@@ -18,10 +18,10 @@ struct Principal {
   Vector3 variances;       // decreasing
 };
 
-Principal principalAxes(const Matrix3X& points) {
+Principal principalAxes(const MatrixX3& points) {
   Principal p;
   p.mean = points.colwise().mean().transpose();
-  const Matrix3X centred = points.rowwise() - p.mean.transpose();
+  const MatrixX3 centred = points.rowwise() - p.mean.transpose();
   const Eigen::Matrix3d covariance = centred.transpose() * centred / static_cast<double>(points.rows());
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
   for (int i = 0; i < 3; ++i) {
@@ -33,7 +33,7 @@ Principal principalAxes(const Matrix3X& points) {
 }
 
 // The limit positions of the control vertices.
-Matrix3X limitPositions(const ControlMesh& mesh) {
+MatrixX3 limitPositions(const ControlMesh& mesh) {
   const LimitSurface surface(mesh);
   return surface.controlVertexLimitOperator() * mesh.points();
 }
@@ -47,7 +47,7 @@ ControlMesh placeCube(ControlMesh cube, const Vector3& scale, const Matrix3& axe
 
 }  // namespace
 
-void checkPointCloud(const Matrix3X& points, const std::string& source) {
+void checkPointCloud(const MatrixX3& points, const std::string& source) {
   if (points.rows() < 4) {
     throw Error(source, "has " + std::to_string(points.rows()) + " points; a surface needs at least 4");
   }
@@ -62,7 +62,7 @@ void checkPointCloud(const Matrix3X& points, const std::string& source) {
   }
 }
 
-int spannedDimensions(const Matrix3X& points) {
+int spannedDimensions(const MatrixX3& points) {
   const Principal p = principalAxes(points);
   if (!(p.variances(0) > 0.0)) return 0;
   // Relative to the largest spread; 1e-12 of the variance is 1e-6 of the size.
@@ -78,7 +78,7 @@ ControlMesh cubeInEllipsoid(const Vector3& centre, const Matrix3& axes, const Ve
   return placeCube(cube, semiAxes / h, axes, centre);
 }
 
-ControlMesh initialModel(const Matrix3X& points, InitialShape shape, double fraction) {
+ControlMesh initialModel(const MatrixX3& points, InitialShape shape, double fraction) {
   if (!(fraction > 0 && fraction <= 1)) throw Error("the initial model's fraction of the data's extent must be in (0, 1]");
   const Principal p = principalAxes(points);
   if (shape == InitialShape::Sphere) {
@@ -87,17 +87,17 @@ ControlMesh initialModel(const Matrix3X& points, InitialShape shape, double frac
     return cubeInEllipsoid(p.mean, p.axes, semiAxes);
   }
   // Torus: axis along the least-variance direction (third axis).
-  const Matrix3X local = (points.rowwise() - p.mean.transpose()) * p.axes;
+  const MatrixX3 local = (points.rowwise() - p.mean.transpose()) * p.axes;
   const Eigen::VectorXd rho = local.leftCols(2).rowwise().norm();
   const double ring = rho.mean();
   const double tube = std::sqrt(((rho.array() - ring).square() + local.col(2).array().square()).mean());
   ControlMesh torus = makeTorus32();
   // The standard torus: ring radius 1, tube 0.5 (control mesh); measure its limit.
-  const Matrix3X limit = limitPositions(torus);
+  const MatrixX3 limit = limitPositions(torus);
   const Eigen::VectorXd limitRho = limit.leftCols(2).rowwise().norm();
   const double limitRing = limitRho.mean();
   const double limitTube = std::sqrt(((limitRho.array() - limitRing).square() + limit.col(2).array().square()).mean());
-  Matrix3X control = torus.points();
+  MatrixX3 control = torus.points();
   for (Eigen::Index i = 0; i < control.rows(); ++i) {
     const double r = control.row(i).head<2>().norm();
     const double radial = ring + (r - limitRing) * 0.5 * tube / limitTube;

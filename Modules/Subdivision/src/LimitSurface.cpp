@@ -566,14 +566,14 @@ struct LimitSurface::Impl {
   // searches' inner loop).
   // weights (rows over `columns`) applied to the control points, into out.
   template <class Weights, class Out>
-  static void blend(const Weights& weights, const std::vector<int>& columns, const Matrix3X& controlPoints, Out& out) {
+  static void blend(const Weights& weights, const std::vector<int>& columns, const MatrixX3& controlPoints, Out& out) {
     out.setZero();
     for (size_t c = 0; c < columns.size(); ++c) {
       out.noalias() += weights.col(static_cast<Eigen::Index>(c)) * controlPoints.row(columns[c]);
     }
   }
 
-  Eigen::Matrix<double, 6, 3> values(const ElementPoint& point, const Matrix3X& controlPoints) const {
+  Eigen::Matrix<double, 6, 3> values(const ElementPoint& point, const MatrixX3& controlPoints) const {
     checkPoint(point);
     const Element& element = elements[point.element];
     // The 16 grid points (or displacements) of the piece the point lies on.
@@ -736,7 +736,7 @@ SurfacePoint LimitSurface::toSurfacePoint(const ElementPoint& point) const {
 
 namespace {
 
-void checkPoints(const Matrix3X& controlPoints, int expected) {
+void checkPoints(const MatrixX3& controlPoints, int expected) {
   if (controlPoints.rows() != expected) {
     throw Error("got " + std::to_string(controlPoints.rows()) + " control points for a surface of " +
                 std::to_string(expected) + " control vertices");
@@ -745,12 +745,12 @@ void checkPoints(const Matrix3X& controlPoints, int expected) {
 
 }  // namespace
 
-LimitSample LimitSurface::evaluate(const ElementPoint& point, const Matrix3X& controlPoints) const {
+LimitSample LimitSurface::evaluate(const ElementPoint& point, const MatrixX3& controlPoints) const {
   checkPoints(controlPoints, impl_->controlVertexCount);
   return limitSampleOf(impl_->values(point, controlPoints));
 }
 
-LimitSample LimitSurface::evaluate(const SurfacePoint& point, const Matrix3X& controlPoints) const {
+LimitSample LimitSurface::evaluate(const SurfacePoint& point, const MatrixX3& controlPoints) const {
   checkPoints(controlPoints, impl_->controlVertexCount);
   Eigen::Matrix2d jacobian;
   const ElementPoint elementPoint = impl_->locate(point, jacobian);
@@ -904,9 +904,9 @@ Eigen::RowVectorXd LimitSurface::positionStencil(const ElementPoint& point) cons
 struct SurfaceState::Impl {
   static constexpr int kCachedLevels = 12;
   const LimitSurface* surface = nullptr;
-  Matrix3X controlPoints;
+  MatrixX3 controlPoints;
   SparseMatrix patchOperator;
-  Matrix3X grids;  // patchOperator * controlPoints
+  MatrixX3 grids;  // patchOperator * controlPoints
   // Per special element: the grid points of each subpatch a point has needed
   // at this state (slot 3 (level - 1) + child - 1; slot kSlots: the vertex
   // masks and the structure's vertices), each filled once under `mutex`. grids is sized once, on the
@@ -934,7 +934,7 @@ SurfaceState::SurfaceState(const LimitSurface& surface) : impl_(std::make_unique
 
 SurfaceState::~SurfaceState() = default;
 
-void SurfaceState::reset(const Matrix3X& controlPoints) {
+void SurfaceState::reset(const MatrixX3& controlPoints) {
   checkPoints(controlPoints, impl_->surface->controlVertexCount());
   impl_->controlPoints = controlPoints;
   impl_->grids = applyOperator(impl_->patchOperator, controlPoints);
@@ -945,11 +945,11 @@ void SurfaceState::reset(const Matrix3X& controlPoints) {
 
 const SparseMatrix& SurfaceState::patchOperator() const { return impl_->patchOperator; }
 
-const Matrix3X& SurfaceState::grids() const { return impl_->grids; }
+const MatrixX3& SurfaceState::grids() const { return impl_->grids; }
 
 LimitSample SurfaceState::evaluate(const ElementPoint& point) const {
   const LimitSurface::Impl& s = *impl_->surface->impl_;
-  const Matrix3X& p = impl_->controlPoints;
+  const MatrixX3& p = impl_->controlPoints;
   if (p.rows() != s.controlVertexCount) throw Error("internal: surface state used before reset()");
   s.checkPoint(point);
   const LimitSurface::Impl::Element& element = s.elements[point.element];

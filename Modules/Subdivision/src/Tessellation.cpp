@@ -11,7 +11,7 @@ int outputSegments(const LimitSurface& surface) {
   return std::max(2, kOutputSegments >> surface.isolationLevels());
 }
 
-TriangleSurface tessellate(const LimitSurface& surface, const Matrix3X& controlPoints, int segmentsPerElement) {
+TriangleSurface tessellate(const LimitSurface& surface, const MatrixX3& controlPoints, int segmentsPerElement) {
   const int n = segmentsPerElement;
   if (n < 1 || n > 1024) {
     throw Error("samples per face must be between 1 and 1024, got " + std::to_string(n));

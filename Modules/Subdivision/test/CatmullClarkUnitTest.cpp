@@ -26,8 +26,8 @@ TEST(CatmullClark, RowsOfASumToOne) {
 TEST(CatmullClark, InteriorRulesOnTheCube) {
   const dynsub::ControlMesh cube = dynsub::makeCube98();
   const dynsub::SubdividedMesh refined = dynsub::subdivide(cube);
-  const dynsub::Matrix3X before = cube.points();
-  const dynsub::Matrix3X after = refined.mesh.points();
+  const dynsub::MatrixX3 before = cube.points();
+  const dynsub::MatrixX3 after = refined.mesh.points();
   // Old vertices keep their numbers; a valence-3 corner (F + 2R + 0 V)/3 with
   // its three neighbours at distance 0.5 along the axes and faces around it.
   for (int v = 0; v < cube.vertexCount(); ++v) {
@@ -51,12 +51,12 @@ TEST(CatmullClark, InteriorRulesOnTheCube) {
 
 TEST(CatmullClark, BoundaryRulesOnTheSheet) {
   dynsub::ControlMesh sheet = dynsub::makeSheet81();
-  dynsub::Matrix3X points = sheet.points();
+  dynsub::MatrixX3 points = sheet.points();
   // Give the boundary a shape so the rules are visible in z.
   for (int v = 0; v < points.rows(); ++v) points(v, 2) = points(v, 0) * points(v, 0) + 0.5 * points(v, 1);
   sheet.setPoints(points);
   const dynsub::SubdividedMesh refined = dynsub::subdivide(sheet);
-  const dynsub::Matrix3X after = refined.mesh.points();
+  const dynsub::MatrixX3 after = refined.mesh.points();
   auto id = [](int i, int j) { return j * 9 + i; };
   // Corner (valence 2) fixed.
   EXPECT_LE((after.row(id(0, 0)) - points.row(id(0, 0))).norm(), 1e-15);
@@ -73,7 +73,7 @@ TEST(CatmullClark, BoundaryRulesOnTheSheet) {
 }
 
 TEST(CatmullClark, NgonsBecomeQuadsAroundTheirCentre) {
-  dynsub::Matrix3X points(5, 3);
+  dynsub::MatrixX3 points(5, 3);
   points << 1, 0, 0, 0.3, 0.95, 0, -0.8, 0.6, 0, -0.8, -0.6, 0, 0.3, -0.95, 0;
   const dynsub::ControlMesh pentagon = dynsub::ControlMesh::fromPolygons(points, {{0, 1, 2, 3, 4}});
   const dynsub::Refinement refinement = dynsub::refine(pentagon.topology());

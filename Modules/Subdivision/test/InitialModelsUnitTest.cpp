@@ -12,7 +12,7 @@
 namespace dynsub {
 namespace {
 
-Matrix3X limitPoints(const ControlMesh& mesh) {
+MatrixX3 limitPoints(const ControlMesh& mesh) {
   return tessellate(LimitSurface(mesh), mesh.points(), 8).points;
 }
 
@@ -25,9 +25,9 @@ TEST(InitialModels, TheCubeSpansTheEllipsoidsSemiAxes) {
   const Matrix3 axes = Eigen::AngleAxisd(0.7, Vector3(1, -2, 0.5).normalized()).toRotationMatrix();
   const ControlMesh cube = cubeInEllipsoid(centre, axes, semiAxes);
   const LimitSurface surface(cube);
-  const Matrix3X vertices = surface.controlVertexLimitOperator() * cube.points();
-  const Matrix3X local = (vertices.rowwise() - centre.transpose()) * axes;
-  const Matrix3X tessellation = (limitPoints(cube).rowwise() - centre.transpose()) * axes;
+  const MatrixX3 vertices = surface.controlVertexLimitOperator() * cube.points();
+  const MatrixX3 local = (vertices.rowwise() - centre.transpose()) * axes;
+  const MatrixX3 tessellation = (limitPoints(cube).rowwise() - centre.transpose()) * axes;
   for (int a = 0; a < 3; ++a) {
     EXPECT_NEAR(local.col(a).cwiseAbs().maxCoeff(), semiAxes(a), 1e-12) << "axis " << a;
     EXPECT_LE(tessellation.col(a).cwiseAbs().maxCoeff(), semiAxes(a) + 1e-12) << "axis " << a;
@@ -39,7 +39,7 @@ TEST(InitialModels, TheCubeSpansTheEllipsoidsSemiAxes) {
 TEST(InitialModels, TheSphereHasItsMeanRadius) {
   const Vector3 centre(1, -1, 0.5);
   const ControlMesh sphere = initialSphere(centre, 3.0);
-  const Matrix3X points = tessellate(LimitSurface(sphere), sphere.points(), 4).points;
+  const MatrixX3 points = tessellate(LimitSurface(sphere), sphere.points(), 4).points;
   EXPECT_NEAR((points.rowwise() - centre.transpose()).rowwise().norm().mean(), 3.0, 1e-12);
   EXPECT_THROW(initialSphere(centre, 0.0), Error);
   EXPECT_THROW(initialSphere(Vector3(NAN, 0, 0), 1.0), Error);

@@ -26,7 +26,7 @@ using dynsub::SurfacePoint;
 // beyond the 24 tabulated ones) as well as ordinary ones.
 const std::vector<double> kParameters = {0.0, 1e-9, 1e-6, 1e-3, 0.1, 0.25, 0.5, 0.6180339887, 0.9, 1.0};
 
-double diagonalOf(const dynsub::Matrix3X& points) {
+double diagonalOf(const dynsub::MatrixX3& points) {
   return (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm();
 }
 
@@ -52,7 +52,7 @@ TEST(LimitSurface, RegularGridReproducesTheBicubicBSpline) {
   std::mt19937 random(7);
   std::uniform_real_distribution<double> height(-1.0, 1.0);
   constexpr int n = 7;
-  dynsub::Matrix3X points(n * n, 3);
+  dynsub::MatrixX3 points(n * n, 3);
   std::vector<dynsub::Polygon> faces;
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i) points.row(j * n + i) << i + 0.1 * height(random), j, height(random);
@@ -114,8 +114,8 @@ TEST_P(LimitSurfaceProperties, OperatorRowsArePartitionsOfUnity) {
     }
   }
   // The operators and direct evaluation agree.
-  const dynsub::Matrix3X control = mesh.points();
-  const dynsub::Matrix3X positions = ops.J * control;
+  const dynsub::MatrixX3 control = mesh.points();
+  const dynsub::MatrixX3 positions = ops.J * control;
   for (size_t k = 0; k < points.size(); k += 7) {
     EXPECT_LE((positions.row(k).transpose() - surface.evaluate(points[k], control).position).norm(), 1e-12);
   }
@@ -148,8 +148,8 @@ TEST_P(LimitSurfaceProperties, RefinementPreservesTheLimitSurface) {
   const dynsub::SubdividedMesh refined = dynsub::subdivide(mesh);
   const LimitSurface coarse(mesh);
   const LimitSurface fine(refined.mesh);
-  const dynsub::Matrix3X coarsePoints = mesh.points();
-  const dynsub::Matrix3X finePoints = refined.mesh.points();
+  const dynsub::MatrixX3 coarsePoints = mesh.points();
+  const dynsub::MatrixX3 finePoints = refined.mesh.points();
   const double tolerance = 1e-10 * diagonalOf(coarsePoints);
   const dynsub::Topology topology = mesh.topology();
   int parametricFace = 0;
@@ -184,7 +184,7 @@ TEST_P(LimitSurfaceProperties, PositionsAndNormalsAgreeAcrossSharedEdges) {
   const dynsub::ControlMesh& mesh = GetParam().mesh;
   const LimitSurface surface(mesh);
   const dynsub::Topology& base = surface.baseTopology();
-  const dynsub::Matrix3X control = mesh.points();
+  const dynsub::MatrixX3 control = mesh.points();
   const double tolerance = 1e-12 * diagonalOf(control);
   // Point at parameter t along side k of an element, from corner k to k+1.
   auto along = [](int element, int side, double t) {
@@ -225,8 +225,8 @@ TEST_P(LimitSurfaceProperties, ParametricFacesMapToElementsAndBack) {
 TEST_P(LimitSurfaceProperties, ControlVertexLimitsLieOnTheSurface) {
   const dynsub::ControlMesh& mesh = GetParam().mesh;
   const LimitSurface surface(mesh);
-  const dynsub::Matrix3X control = mesh.points();
-  const dynsub::Matrix3X limits = surface.controlVertexLimitOperator() * control;
+  const dynsub::MatrixX3 control = mesh.points();
+  const dynsub::MatrixX3 limits = surface.controlVertexLimitOperator() * control;
   const dynsub::Topology& base = surface.baseTopology();
   // Control vertex i is base vertex i, a corner of its elements.
   for (int v = 0; v < mesh.vertexCount(); ++v) {
@@ -277,7 +277,7 @@ TEST(LimitSurface, EqualNeighbourhoodsShareOneLocalTopology) {
   std::vector<int> renumber(cube.vertexCount());
   std::iota(renumber.begin(), renumber.end(), 0);
   std::shuffle(renumber.begin(), renumber.end(), random);
-  dynsub::Matrix3X points(cube.vertexCount(), 3);
+  dynsub::MatrixX3 points(cube.vertexCount(), 3);
   for (int v = 0; v < cube.vertexCount(); ++v) points.row(renumber[v]) = cube.points().row(v);
   std::vector<dynsub::Polygon> faces = cube.faces();
   for (dynsub::Polygon& face : faces) {
@@ -414,7 +414,7 @@ TEST(SurfaceState, EvaluatesAsTheSurfaceDoesAtEveryDepthAndState) {
       }
     }
   }
-  dynsub::Matrix3X controlPoints = mesh.points();
+  dynsub::MatrixX3 controlPoints = mesh.points();
   for (int round = 0; round < 2; ++round) {
     state.reset(controlPoints);
     std::vector<dynsub::LimitSample> fromThreads(points.size());

@@ -36,7 +36,7 @@ bool parseXyz(std::string line, const std::string& separators, Vector3& point) {
   return true;
 }
 
-Matrix3X readText(const std::string& path, bool csv) {
+MatrixX3 readText(const std::string& path, bool csv) {
   std::ifstream in(path);
   if (!in) throw Error(path, "cannot be opened");
   std::vector<Vector3> points;
@@ -60,7 +60,7 @@ Matrix3X readText(const std::string& path, bool csv) {
     points.push_back(p);
   }
   if (points.empty()) throw Error(path, "has no points");
-  Matrix3X result(points.size(), 3);
+  MatrixX3 result(points.size(), 3);
   for (size_t i = 0; i < points.size(); ++i) result.row(i) = points[i].transpose();
   return result;
 }
@@ -87,7 +87,7 @@ void checkVtpCounts(const std::string& path) {
   }
 }
 
-Matrix3X readVtp(const std::string& path) {
+MatrixX3 readVtp(const std::string& path) {
   checkVtpCounts(path);
   vtkNew<vtkXMLPolyDataReader> reader;
   if (!reader->CanReadFile(path.c_str())) throw Error(path, "is not a VTK XML polydata file");
@@ -96,7 +96,7 @@ Matrix3X readVtp(const std::string& path) {
   if (reader->GetErrorCode() != 0) throw Error(path, "could not be read (truncated or corrupt?)");
   vtkPolyData* data = reader->GetOutput();
   if (!data || !data->GetPoints() || data->GetNumberOfPoints() == 0) throw Error(path, "has no points");
-  Matrix3X result(static_cast<Eigen::Index>(data->GetNumberOfPoints()), 3);
+  MatrixX3 result(static_cast<Eigen::Index>(data->GetNumberOfPoints()), 3);
   for (vtkIdType i = 0; i < data->GetNumberOfPoints(); ++i) {
     double p[3];
     data->GetPoint(i, p);
@@ -107,14 +107,14 @@ Matrix3X readVtp(const std::string& path) {
 
 }  // namespace
 
-Matrix3X readPointCloud(const std::string& path) {
+MatrixX3 readPointCloud(const std::string& path) {
   if (!std::filesystem::exists(path)) throw Error(path, "no such file");
   const std::string extension = lowerCaseExtension(path);
   if (extension == ".xyz" || extension == ".txt") return readText(path, false);
   if (extension == ".csv") return readText(path, true);
   if (extension == ".vtp") return readVtp(path);
   if (extension == ".ply" || extension == ".off" || extension == ".obj") {
-    Matrix3X points = readPolygonData(path).points;
+    MatrixX3 points = readPolygonData(path).points;
     if (points.rows() == 0) throw Error(path, "has no points");
     return points;
   }

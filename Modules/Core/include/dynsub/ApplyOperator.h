@@ -13,7 +13,7 @@ namespace dynsub {
 // (2.2 ms against 6.9 ms for 98 304 rows of 16), with the same sums in the
 // same order, so the same results to the bit.
 // Into `result`, resized only if its size differs (a loop can reuse it).
-inline void applyOperator(const SparseMatrix& op, const Matrix3X& points, Matrix3X& result) {
+inline void applyOperator(const SparseMatrix& op, const MatrixX3& points, MatrixX3& result) {
   eigen_assert(op.cols() == points.rows());
   result.resize(op.rows(), 3);
   const int* outer = op.outerIndexPtr();
@@ -45,7 +45,7 @@ inline void applyOperator(const SparseMatrix& op, const Matrix3X& points, Matrix
 // their columns agree too is checked in debug builds only (reading the
 // pattern three times to check it would cost what sharing it saves).
 inline void applyOperators(const SparseMatrix& a, const SparseMatrix& b, const SparseMatrix& c,
-                           const Matrix3X& points, Matrix3X& ra, Matrix3X& rb, Matrix3X& rc) {
+                           const MatrixX3& points, MatrixX3& ra, MatrixX3& rb, MatrixX3& rc) {
   const Eigen::Index rows = a.rows();
   for (const SparseMatrix* op : {&a, &b, &c}) {
     if (!op->isCompressed() || op->rows() != rows || op->cols() != points.rows() ||
@@ -90,7 +90,7 @@ namespace detail {
 // index i, weight w) adds w * input.row(o) to result.row(i), x, y and z in
 // one pass. Column-major, this is op * input; row-major, op^T * input.
 template <int Options>
-void scatterAdd(const Eigen::SparseMatrix<double, Options>& op, const Matrix3X& input, Matrix3X& result) {
+void scatterAdd(const Eigen::SparseMatrix<double, Options>& op, const MatrixX3& input, MatrixX3& result) {
   const int* outer = op.outerIndexPtr();
   const int* counts = op.innerNonZeroPtr();  // null when compressed
   const int* inner = op.innerIndexPtr();
@@ -116,9 +116,9 @@ void scatterAdd(const Eigen::SparseMatrix<double, Options>& op, const Matrix3X& 
 // order as Eigen's op * points, which makes three passes, one per column.
 // NB: the energy's x^T K x and v^T M v at every time step were a twentieth
 // of a segmentation, most of it Eigen's three scattering passes.
-inline Matrix3X applyOperator(const Eigen::SparseMatrix<double, Eigen::ColMajor>& op, const Matrix3X& points) {
+inline MatrixX3 applyOperator(const Eigen::SparseMatrix<double, Eigen::ColMajor>& op, const MatrixX3& points) {
   eigen_assert(op.cols() == points.rows());
-  Matrix3X result = Matrix3X::Zero(op.rows(), 3);
+  MatrixX3 result = MatrixX3::Zero(op.rows(), 3);
   detail::scatterAdd(op, points, result);
   return result;
 }
@@ -128,15 +128,15 @@ inline Matrix3X applyOperator(const Eigen::SparseMatrix<double, Eigen::ColMajor>
 // points, J^T f. The same sums in the same order as Eigen's
 // op.transpose() * values (each result row summed over op's rows in order),
 // which makes three passes, one per column.
-inline Matrix3X applyTransposed(const SparseMatrix& op, const Matrix3X& values) {
+inline MatrixX3 applyTransposed(const SparseMatrix& op, const MatrixX3& values) {
   if (op.rows() != values.rows()) throw std::invalid_argument("applyTransposed: one row of values per row expected");
-  Matrix3X result = Matrix3X::Zero(op.cols(), 3);
+  MatrixX3 result = MatrixX3::Zero(op.cols(), 3);
   detail::scatterAdd(op, values, result);
   return result;
 }
 
-inline Matrix3X applyOperator(const SparseMatrix& op, const Matrix3X& points) {
-  Matrix3X result;
+inline MatrixX3 applyOperator(const SparseMatrix& op, const MatrixX3& points) {
+  MatrixX3 result;
   applyOperator(op, points, result);
   return result;
 }

@@ -37,7 +37,7 @@ class ClosestPointLocator {
 
   // New control points (#control vertices x 3). The sample tree is rebuilt
   // lazily, by the first search that needs the samples where they are now.
-  void update(const Matrix3X& controlPoints);
+  void update(const MatrixX3& controlPoints);
   ClosestPoint find(const Vector3& query) const;
   // With a hint (e.g. last step's closest point): Newton's method from the hint
   // first, kept if it is at least as near as the nearest tessellation sample
@@ -49,8 +49,8 @@ class ClosestPointLocator {
   ClosestPoint find(const Vector3& query, const ElementPoint& hint) const;
   // One result per row of `queries`, in order (in parallel; deterministic).
   // Searches may rebuild the tree: calls on one locator must not overlap.
-  std::vector<ClosestPoint> findAll(const Matrix3X& queries) const;
-  std::vector<ClosestPoint> findAll(const Matrix3X& queries, const std::vector<ElementPoint>& hints) const;
+  std::vector<ClosestPoint> findAll(const MatrixX3& queries) const;
+  std::vector<ClosestPoint> findAll(const MatrixX3& queries, const std::vector<ElementPoint>& hints) const;
   // The surface's patchOperator(), which update() applies to find points on
   // normal elements without going through the surface's general path.
   const SparseMatrix& patchOperator() const;
@@ -68,15 +68,15 @@ class ClosestPointLocator {
 // search per point instead of a new tessellation and a full search.
 class TrackedDistances {
  public:
-  explicit TrackedDistances(Matrix3X points);
+  explicit TrackedDistances(MatrixX3 points);
   ~TrackedDistances();
   // `level` tells surfaces apart: a level other than the last call's (or a
   // surface of another size) builds a new locator. The surface must live
   // until the next call.
-  Eigen::VectorXd measure(const LimitSurface& surface, int level, const Matrix3X& controlPoints);
+  Eigen::VectorXd measure(const LimitSurface& surface, int level, const MatrixX3& controlPoints);
 
  private:
-  Matrix3X points_;
+  MatrixX3 points_;
   const LimitSurface* surface_ = nullptr;
   int level_ = -1;
   std::unique_ptr<ClosestPointLocator> locator_;

@@ -17,10 +17,10 @@ class ForceModel {
   // A level starts: the control mesh (and so the surface and its quadrature)
   // changed. The references stay valid until the next beginLevel.
   virtual void beginLevel(const LimitSurface& surface, const SurfaceQuadrature& quadrature,
-                          const Matrix3X& controlPoints) = 0;
+                          const MatrixX3& controlPoints) = 0;
   // f_p at the control points (#control x 3); adds the force's potential
   // energy (N mm) to `potential` where it has one.
-  virtual Matrix3X generalizedForce(const Matrix3X& controlPoints, double& potential) = 0;
+  virtual MatrixX3 generalizedForce(const MatrixX3& controlPoints, double& potential) = 0;
   // The state of the last generalizedForce call is the one the simulation
   // goes on from. The static scheme also evaluates trial states it may
   // reject; forces that track the surface (springs re-attaching to the
@@ -29,11 +29,11 @@ class ForceModel {
   virtual void acceptState() {}
   // A stiffness S >= 0 of the force near the current state, used only to
   // stabilize time integration (Integrator.h); empty (0 x 0) if none.
-  virtual SparseMatrix stabilizingStiffness(const Matrix3X& controlPoints);
+  virtual SparseMatrix stabilizingStiffness(const MatrixX3& controlPoints);
   // Adds an approximation of -d f_p / d p at the state of the last
   // generalizedForce call, for the static scheme's Newton steps
   // (StaticSolver.h). By default the stabilizing stiffness on x, y and z alike.
-  virtual void addTangentStiffness(const Matrix3X& controlPoints, TangentStiffness& into);
+  virtual void addTangentStiffness(const MatrixX3& controlPoints, TangentStiffness& into);
   // True when generalizedForce adds the force's whole potential energy, so
   // that the total energy is what the static scheme's steps must lower.
   virtual bool hasPotential() const { return false; }
@@ -48,18 +48,18 @@ class SpringForceModel final : public ForceModel {
  public:
   enum class Attach { NearestEachStep, NearestAtLevelStart };
   // targets: #springs x 3 (mm); stiffness: one per spring (N/mm), > 0.
-  SpringForceModel(Matrix3X targets, Eigen::VectorXd stiffness, Attach attach);
+  SpringForceModel(MatrixX3 targets, Eigen::VectorXd stiffness, Attach attach);
   ~SpringForceModel() override;
 
   void beginLevel(const LimitSurface& surface, const SurfaceQuadrature& quadrature,
-                  const Matrix3X& controlPoints) override;
-  Matrix3X generalizedForce(const Matrix3X& controlPoints, double& potential) override;
+                  const MatrixX3& controlPoints) override;
+  MatrixX3 generalizedForce(const MatrixX3& controlPoints, double& potential) override;
   void acceptState() override;
-  SparseMatrix stabilizingStiffness(const Matrix3X& controlPoints) override;
+  SparseMatrix stabilizingStiffness(const MatrixX3& controlPoints) override;
   // NearestEachStep: k (n n^T + kTangentialShare (I - n n^T)) at each
   // attachment, n the limit normal there (the tangent-plane stiffness of
   // StaticSolver.h); NearestAtLevelStart: k J^T J, the exact derivative.
-  void addTangentStiffness(const Matrix3X& controlPoints, TangentStiffness& into) override;
+  void addTangentStiffness(const MatrixX3& controlPoints, TangentStiffness& into) override;
   bool hasPotential() const override { return true; }
 
   // The share of a spring's stiffness kept tangentially in the static
@@ -79,17 +79,17 @@ class SpringForceModel final : public ForceModel {
   void setDeadZone(double zone);
 
  private:
-  void attach(const Matrix3X& controlPoints);
+  void attach(const MatrixX3& controlPoints);
 
-  Matrix3X targets_;
+  MatrixX3 targets_;
   Eigen::VectorXd stiffness_;
   Attach attach_;
   const LimitSurface* surface_ = nullptr;
   std::unique_ptr<ClosestPointLocator> locator_;
   std::vector<Spring> springs_;       // at the last evaluation
   std::vector<ElementPoint> tracked_;  // attachments at the last accepted state
-  Matrix3X positions_;                 // the surface at the attachments (NearestEachStep)
-  Matrix3X normals_;                   // and its unit normals there
+  MatrixX3 positions_;                 // the surface at the attachments (NearestEachStep)
+  MatrixX3 normals_;                   // and its unit normals there
   Eigen::VectorXd lengths_;
   // Per spring at the last evaluation: its attachment's position stencil on
   // a special element, empty on a normal one (NearestEachStep).
@@ -102,8 +102,8 @@ class InflationForceModel final : public ForceModel {
  public:
   explicit InflationForceModel(double pressure);
   void beginLevel(const LimitSurface& surface, const SurfaceQuadrature& quadrature,
-                  const Matrix3X& controlPoints) override;
-  Matrix3X generalizedForce(const Matrix3X& controlPoints, double& potential) override;
+                  const MatrixX3& controlPoints) override;
+  MatrixX3 generalizedForce(const MatrixX3& controlPoints, double& potential) override;
 
  private:
   double pressure_;
@@ -118,12 +118,12 @@ class FieldForceModel final : public ForceModel {
   explicit FieldForceModel(const ForceField& field, const PressureField* pressure = nullptr)
       : field_(field), pressure_(pressure) {}
   void beginLevel(const LimitSurface& surface, const SurfaceQuadrature& quadrature,
-                  const Matrix3X& controlPoints) override;
-  Matrix3X generalizedForce(const Matrix3X& controlPoints, double& potential) override;
+                  const MatrixX3& controlPoints) override;
+  MatrixX3 generalizedForce(const MatrixX3& controlPoints, double& potential) override;
   // fieldStiffness with the field's slopeBound (plus the pressure's): a
   // field that reverses across an edge is a stiff explicit force, which the
   // papers' schemes would let oscillate about the edge instead of settling on it.
-  SparseMatrix stabilizingStiffness(const Matrix3X& controlPoints) override;
+  SparseMatrix stabilizingStiffness(const MatrixX3& controlPoints) override;
 
  private:
   const ForceField& field_;

@@ -38,22 +38,22 @@ SurfaceQuadrature makeSurfaceQuadrature(const LimitSurface& surface, int pointsP
 class ForceField {
  public:
   virtual ~ForceField() = default;
-  virtual Matrix3X forcesAt(const Matrix3X& points) const = 0;
+  virtual MatrixX3 forcesAt(const MatrixX3& points) const = 0;
   // An upper bound of |df/dx| (N/mm^3) wherever the field changes fastest, or
   // 0 if unknown; it only serves to stabilize time integration (Integrator.h).
   virtual double slopeBound() const { return 0.0; }
 };
 
 // Generalized spring forces; `energy` (if given) receives sum k |d - s|^2 / 2 (N mm).
-Matrix3X springForces(const LimitSurface& surface, const Matrix3X& controlPoints, const std::vector<Spring>& springs,
+MatrixX3 springForces(const LimitSurface& surface, const MatrixX3& controlPoints, const std::vector<Spring>& springs,
                       double* energy = nullptr);
 // sum k J_s^T J_s over the springs (#control by #control): minus the
 // derivative of the spring forces with the attachments held fixed.
 SparseMatrix springStiffness(const LimitSurface& surface, const std::vector<Spring>& springs);
 
-Matrix3X inflationForces(const SurfaceQuadrature& quadrature, const Matrix3X& controlPoints, double pressure);
+MatrixX3 inflationForces(const SurfaceQuadrature& quadrature, const MatrixX3& controlPoints, double pressure);
 // A pressure that varies over the surface: one value (N/mm^2) per quadrature point.
-Matrix3X pressureForces(const SurfaceQuadrature& quadrature, const Matrix3X& controlPoints,
+MatrixX3 pressureForces(const SurfaceQuadrature& quadrature, const MatrixX3& controlPoints,
                         const Eigen::VectorXd& pressures);
 // A pressure along the surface's normal s_u x s_v that depends on where the
 // surface is: N points in mm -> N pressures (N/mm^2; > 0 pushes outward, as
@@ -61,7 +61,7 @@ Matrix3X pressureForces(const SurfaceQuadrature& quadrature, const Matrix3X& con
 class PressureField {
  public:
   virtual ~PressureField() = default;
-  virtual Eigen::VectorXd pressuresAt(const Matrix3X& points) const = 0;
+  virtual Eigen::VectorXd pressuresAt(const MatrixX3& points) const = 0;
   // How fast the pressure changes with position (N/mm^3): an upper bound of
   // |dp/dx| or an estimate of one, 0 if unknown. As ForceField's, it only
   // serves to stabilize time integration.
@@ -70,11 +70,11 @@ class PressureField {
 
 // The field's forces, and the pressure's (if given) from the same evaluation
 // of the surface at the quadrature points.
-Matrix3X fieldForces(const SurfaceQuadrature& quadrature, const Matrix3X& controlPoints, const ForceField& field,
+MatrixX3 fieldForces(const SurfaceQuadrature& quadrature, const MatrixX3& controlPoints, const ForceField& field,
                      const PressureField* pressure = nullptr);
 // slope * sum_q w_q |s_u x s_v|_q J_q^T J_q (#control by #control): the
 // stiffness of a field whose force changes by `slope` N/mm^3 in every
 // direction, integrated over the surface at `controlPoints`.
-SparseMatrix fieldStiffness(const SurfaceQuadrature& quadrature, const Matrix3X& controlPoints, double slope);
+SparseMatrix fieldStiffness(const SurfaceQuadrature& quadrature, const MatrixX3& controlPoints, double slope);
 
 }  // namespace dynsub

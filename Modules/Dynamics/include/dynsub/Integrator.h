@@ -66,7 +66,7 @@ class Integrator {
   void restabilize(const PhysicalMatrices& matrices, const SymmetricMatrix& forceStiffness);
   // p(t + dt) from p(t - dt), p(t) and the generalized force at p(t) (all
   // #control x 3). Throws dynsub::Error when an iterative solver fails.
-  Matrix3X step(const Matrix3X& previous, const Matrix3X& current, const Matrix3X& force);
+  MatrixX3 step(const MatrixX3& previous, const MatrixX3& current, const MatrixX3& force);
   // Iterations of the last iterative solve (summed over x, y, z); 0 for Cholesky.
   int lastIterations() const;
   const IntegratorOptions& options() const;

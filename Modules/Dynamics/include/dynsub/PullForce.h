@@ -27,16 +27,16 @@ class PullForceModel final : public ForceModel {
   unsigned moves() const;
 
   void beginLevel(const LimitSurface& surface, const SurfaceQuadrature& quadrature,
-                  const Matrix3X& controlPoints) override;
-  Matrix3X generalizedForce(const Matrix3X& controlPoints, double& potential) override;
+                  const MatrixX3& controlPoints) override;
+  MatrixX3 generalizedForce(const MatrixX3& controlPoints, double& potential) override;
   // The spring's stiffness while a pull is on (a stiff explicit spring would
   // make the surface oscillate about the target instead of settling).
-  SparseMatrix stabilizingStiffness(const Matrix3X& controlPoints) override;
+  SparseMatrix stabilizingStiffness(const MatrixX3& controlPoints) override;
   bool hasPotential() const override { return true; }
 
  private:
   // With the mutex held: attach to the surface point nearest anchor_ unless attached.
-  void attachNearAnchor(const Matrix3X& controlPoints);
+  void attachNearAnchor(const MatrixX3& controlPoints);
 
   double stiffness_;
   mutable std::mutex mutex_;

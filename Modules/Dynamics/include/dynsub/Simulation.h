@@ -151,7 +151,7 @@ struct Progress {
   // surface. Valid only during the callback; the callback may throw to stop
   // the simulation (the exception propagates out of simulate).
   const LimitSurface* surface = nullptr;
-  const Matrix3X* controlPoints = nullptr;
+  const MatrixX3* controlPoints = nullptr;
   // Shape recovery in the static scheme (fitPointCloud): each data point's
   // distance (mm) to the surface at this state, which the data springs
   // measured for the step's last force evaluation. Null otherwise (the time
@@ -165,7 +165,7 @@ struct Progress {
 // EquilibriumOptions::coarseLevelFactor (not `settled`; the forces were last
 // evaluated at `controlPoints`). After an acceptance there, the same level
 // is asked again at its end.
-using AcceptFit = std::function<bool(const LimitSurface& surface, const Matrix3X& controlPoints, bool settled)>;
+using AcceptFit = std::function<bool(const LimitSurface& surface, const MatrixX3& controlPoints, bool settled)>;
 using ProgressCallback = std::function<void(const Progress&)>;
 
 // forces are not owned. fixed: control vertices of the initial mesh that do not

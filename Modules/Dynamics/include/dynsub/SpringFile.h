@@ -9,7 +9,7 @@
 namespace dynsub {
 
 struct SpringFile {
-  Matrix3X targets;           // one row per spring: the point in space it pulls towards
+  MatrixX3 targets;           // one row per spring: the point in space it pulls towards
   Eigen::VectorXd stiffness;  // N/mm, > 0
 };
 

@@ -29,41 +29,11 @@
 
 #include "dynsub/LimitSurface.h"
 #include "dynsub/PhysicalMatrices.h"
+#include "dynsub/TangentStiffness.h"
 
 namespace dynsub {
 
 class ForceModel;
-
-// A 3N by 3N symmetric stiffness on the pattern of a surface's elements,
-// filled in place: K on x, y and z, then per-point blocks (J_q^T J_q) (x) B.
-class TangentStiffness {
- public:
-  // The surface must outlive this.
-  explicit TangentStiffness(const LimitSurface& surface);
-  ~TangentStiffness();
-
-  // Starts anew with `scalar` (N by N) on x, y and z alike.
-  void reset(const SymmetricMatrix& scalar);
-  // Starts anew with the last reset()'s `scalar`, from a copy of the values
-  // it gave (the Newton steps of one level all start from K).
-  void resetToLast();
-  // Adds S (x) I_3 for a symmetric N by N S joining only control vertices
-  // that share an element (springs' and fields' J^T W J are such).
-  void addScalar(const SparseMatrix& scalar);
-  // Adds (J_q^T J_q) (x) B: a stiffness B (symmetric 3 x 3, N/mm) acting on
-  // the limit position at q. `weights`, when given, is q's
-  // LimitSurface::positionStencil, taken already by the caller; it must live
-  // until the next matrix().
-  void addPoint(const ElementPoint& q, const Eigen::Matrix3d& block, const Eigen::RowVectorXd* weights = nullptr);
-  // The matrix with every addition made, its lower triangle alone stored
-  // (the solvers read no other); the caller may change values in place
-  // until the next reset.
-  SymmetricMatrix& matrix();
-
- private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
-};
 
 class StaticSolver {
  public:
@@ -79,8 +49,8 @@ class StaticSolver {
   // A matrix that will not factor as positive definite is regularized (a
   // diagonal shift growing 1000-fold, up to 1e-2 of the mean diagonal); if it
   // still fails, throws dynsub::Error.
-  Matrix3X direction(const std::vector<ForceModel*>& forces, const Matrix3X& controlPoints,
-                     const Matrix3X& residual, bool isotropic = false);
+  MatrixX3 direction(const std::vector<ForceModel*>& forces, const MatrixX3& controlPoints,
+                     const MatrixX3& residual, bool isotropic = false);
   // Diagonal shifts applied over all factorizations (0 when none was needed).
   int regularizations() const;
 

@@ -17,6 +17,6 @@ struct Sphere {
 };
 
 // Throws dynsub::Error for an empty or non-finite point set.
-Sphere smallestEnclosingSphere(const Matrix3X& points);
+Sphere smallestEnclosingSphere(const MatrixX3& points);
 
 }  // namespace dynsub

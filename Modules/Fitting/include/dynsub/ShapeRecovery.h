@@ -48,11 +48,11 @@ struct FitResult {
   double seconds = 0;
 };
 
-FitError measureFitError(const LimitSurface& surface, const Matrix3X& controlPoints, const Matrix3X& data,
+FitError measureFitError(const LimitSurface& surface, const MatrixX3& controlPoints, const MatrixX3& data,
                          double diameter);
 
 // `initial` must be closed. Throws dynsub::Error on bad input or divergence.
-FitResult fitPointCloud(const Matrix3X& data, const ControlMesh& initial, const FitOptions& options,
+FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const FitOptions& options,
                         const ProgressCallback& progress = nullptr);
 
 }  // namespace dynsub

@@ -117,7 +117,7 @@ Mask cropMask(const Mask& mask, const std::array<int, 3>& first, const std::arra
 // The smallest index box, grown by `margin` mm on every side and clamped to the
 // image, that contains the given physical points. Returns {first, size}.
 std::pair<std::array<int, 3>, std::array<int, 3>> boundingRegion(const ImageGeometry& geometry,
-                                                                 const Matrix3X& points, double margin);
+                                                                 const MatrixX3& points, double margin);
 
 // The smallest index box holding every non-zero voxel of `voxels` (on
 // `geometry`'s grid, in its order), grown by `margin` voxels on every side and

@@ -16,7 +16,7 @@ namespace dynsub {
 
 // Throws dynsub::Error if the surface is not closed (an edge not shared by
 // exactly two triangles) or a triangle names a missing point.
-Mask voxelizeSurface(const Matrix3X& points, const std::vector<std::array<int, 3>>& triangles,
+Mask voxelizeSurface(const MatrixX3& points, const std::vector<std::array<int, 3>>& triangles,
                      const ImageGeometry& grid);
 
 }  // namespace dynsub

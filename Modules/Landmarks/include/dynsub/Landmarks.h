@@ -33,6 +33,6 @@ void writeLandmarks(const std::vector<Landmark>& landmarks, const std::string& p
                     CoordinateSystem system = CoordinateSystem::LPS);
 
 // Positions as an N x 3 matrix.
-Matrix3X landmarkPositions(const std::vector<Landmark>& landmarks);
+MatrixX3 landmarkPositions(const std::vector<Landmark>& landmarks);
 
 }  // namespace dynsub

@@ -23,12 +23,12 @@ class ControlMesh {
   // Checks the polygons (throws dynsub::Error naming `source` and the problem)
   // and builds the mesh. Vertex i of the mesh is row i of `points`; face f is
   // faces[f] with the same vertex order.
-  static ControlMesh fromPolygons(const Matrix3X& points, const std::vector<Polygon>& faces,
+  static ControlMesh fromPolygons(const MatrixX3& points, const std::vector<Polygon>& faces,
                                   const std::string& source = "mesh");
   // A mesh whose topology is already known to be valid: a refinement of a
   // checked mesh (CatmullClark.h) is manifold and consistently oriented by
   // construction, so only the points are checked (finite, one per vertex).
-  static ControlMesh fromTopology(const Matrix3X& points, Topology topology, const std::string& source = "mesh");
+  static ControlMesh fromTopology(const MatrixX3& points, Topology topology, const std::string& source = "mesh");
 
   int vertexCount() const { return topology_->vertexCount(); }
   int faceCount() const { return topology_->faceCount(); }
@@ -40,14 +40,14 @@ class ControlMesh {
   // Genus of the surface, from the Euler characteristic, assuming it is connected.
   int genus() const;
 
-  const Matrix3X& points() const { return points_; }
+  const MatrixX3& points() const { return points_; }
   // Replaces the vertex positions; `points` must have vertexCount() rows.
-  void setPoints(const Matrix3X& points);
+  void setPoints(const MatrixX3& points);
   const std::vector<Polygon>& faces() const { return topology_->faces(); }
   const Topology& topology() const { return *topology_; }
 
  private:
-  Matrix3X points_;
+  MatrixX3 points_;
   // Shared: copies of a mesh (one per level, per result) differ only in their points.
   std::shared_ptr<const Topology> topology_;
 };

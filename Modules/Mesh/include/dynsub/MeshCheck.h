@@ -15,7 +15,7 @@ namespace dynsub {
 // isolated vertex; an edge with more than two faces (non-manifold edge); a
 // vertex whose faces form more than one fan (non-manifold vertex); two faces
 // traversing an edge in the same direction (inconsistent orientation).
-void checkPolygonMesh(const Matrix3X& points, const std::vector<std::vector<int>>& faces,
+void checkPolygonMesh(const MatrixX3& points, const std::vector<std::vector<int>>& faces,
                       const std::string& source);
 
 }  // namespace dynsub

@@ -11,7 +11,7 @@
 namespace dynsub {
 
 struct PolygonData {
-  Matrix3X points;
+  MatrixX3 points;
   std::vector<Polygon> faces;
 };
 

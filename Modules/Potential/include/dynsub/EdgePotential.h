@@ -91,10 +91,10 @@ class EdgeField {
   // `landmarks` (N x 3, mm) are points on the wanted boundary; they set the
   // edge thresholds when options.reference is Landmarks (see above); throws
   // LandmarksOffEdges when they are not on an edge.
-  EdgeField(const Volume& image, const EdgeOptions& options, const Matrix3X& landmarks = Matrix3X());
+  EdgeField(const Volume& image, const EdgeOptions& options, const MatrixX3& landmarks = MatrixX3());
 
   // N points in mm -> N unit (or zero) vectors, trilinearly interpolated.
-  Matrix3X sample(const Matrix3X& points) const;
+  MatrixX3 sample(const MatrixX3& points) const;
   // How fast the sampled unit vectors can change, per mm: they can reverse
   // (+1 to -1) between neighbouring voxels (across an edge two voxels thick,
   // or the ridge midway between two edges), so 2 / (smallest spacing).

@@ -20,8 +20,8 @@ struct FigureInputs {
   std::string surfaceFile;                   // any file SurfacePolyData.h reads
   const Volume* image = nullptr;             // optional
   const ControlMesh* controlMesh = nullptr;  // optional wireframe, 3D figure only
-  Matrix3X landmarks;                        // #landmarks x 3, LPS mm
-  Matrix3X dataPoints;                       // range data, mm
+  MatrixX3 landmarks;                        // #landmarks x 3, LPS mm
+  MatrixX3 dataPoints;                       // range data, mm
   const ConvergenceHistory* history = nullptr;  // needed for the convergence figure
   // Per point of `surface`: its distance to the nearest edge (mm, -1
   // unknown), to colour it by (FigureScene::edgeDistances); empty: none. A

@@ -36,8 +36,8 @@ struct FigureScene {
   const ImageSlices* image = nullptr; // optional (SlicePlanes.h)
   vtkPolyData* surface = nullptr;     // the limit surface, required (SurfacePolyData.h)
   vtkPolyData* controlMesh = nullptr; // optional wireframe (SurfaceView.h), 3D figure only
-  Matrix3X landmarks;                 // #landmarks x 3, LPS mm
-  Matrix3X dataPoints;                // range data, mm
+  MatrixX3 landmarks;                 // #landmarks x 3, LPS mm
+  MatrixX3 dataPoints;                // range data, mm
   // The surface and its contours coloured by its point array
   // kEdgeDistanceScalars (SurfaceWriter.h), with a colour bar in the 3D
   // figure, instead of by element type: where a segmentation is held by the

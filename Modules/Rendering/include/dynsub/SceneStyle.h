@@ -47,9 +47,9 @@ void pointsAsDots(vtkActor* actor, double pixels);
 
 // The rows `rows` of `points` as vertices; with `selected` >= -1 they carry
 // landmark colours (kLandmark, and kSelectedLandmark for row `selected`).
-vtkSmartPointer<vtkPolyData> dots(const Matrix3X& points, const std::vector<int>& rows, int selected = -2);
+vtkSmartPointer<vtkPolyData> dots(const MatrixX3& points, const std::vector<int>& rows, int selected = -2);
 // Every row of `points`.
-std::vector<int> allRows(const Matrix3X& points);
+std::vector<int> allRows(const MatrixX3& points);
 
 // Adds `actor` drawing `points` to `renderer`: landmarks as dots coloured by
 // their per-point colours (kLandmark, kSelectedLandmark); range data as small

@@ -37,9 +37,9 @@ class SliceView {
   // the nearest edge (style::colourByEdgeDistance; the surface must carry it).
   void colourByEdgeDistance(bool on);
   // Landmarks (#landmarks x 3, LPS mm); those within half a slice of the plane are drawn.
-  void setLandmarks(const Matrix3X& landmarks, int selected = -1);
+  void setLandmarks(const MatrixX3& landmarks, int selected = -1);
   // Range data drawn as small white dots where within half a slice.
-  void setDataPoints(const Matrix3X& points);
+  void setDataPoints(const MatrixX3& points);
 
   // Show the image's slice `index` (clamped), or any plane.
   void showSlice(int index);

@@ -35,8 +35,8 @@ class SurfaceView {
   // with its colour bar.
   void colourByEdgeDistance(bool on);
   void setControlMesh(vtkPolyData* wireframe);  // nullptr hides it
-  void setLandmarks(const Matrix3X& landmarks, int selected = -1);  // #landmarks x 3, LPS mm
-  void setDataPoints(const Matrix3X& points);
+  void setLandmarks(const MatrixX3& landmarks, int selected = -1);  // #landmarks x 3, LPS mm
+  void setDataPoints(const MatrixX3& points);
   // The three slice planes of `image` (not owned) at the given slice indices
   // (axial, coronal, sagittal); nullptr hides them.
   void setImage(const ImageSlices* image);

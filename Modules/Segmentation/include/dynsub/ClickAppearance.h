@@ -73,7 +73,7 @@ class EndPressure final : public PressureField {
   // (none: no pressure beyond it).
   EndPressure(const Volume& region, ClickAppearance appearance, const std::vector<Landmark>& landmarks, int axis,
               double strength, std::optional<End> before, std::optional<End> after);
-  Eigen::VectorXd pressuresAt(const Matrix3X& points) const override;
+  Eigen::VectorXd pressuresAt(const MatrixX3& points) const override;
   double slopeBound() const override { return slopeBound_; }
 
  private:

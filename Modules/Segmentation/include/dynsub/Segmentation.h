@@ -117,7 +117,7 @@ class SegmentationRegion {
 
   // Whether every point lies inside the region's grid (a refit beyond it
   // needs a new region: the edge directions are zero outside).
-  bool covers(const Matrix3X& points) const;
+  bool covers(const MatrixX3& points) const;
   bool covers(const Vector3& point) const;
 
   const EdgeField& edgeField() const { return *edgeField_; }
@@ -165,7 +165,7 @@ void checkSegmentOptions(const SegmentOptions& options);
 
 // Distance (mm) from each landmark (row of `landmarkPoints`) to the exact limit
 // surface at `controlPoints`: the misfit the refinement rule and the report use.
-std::vector<double> distancesToSurface(const LimitSurface& surface, const Matrix3X& controlPoints,
-                                       const Matrix3X& landmarkPoints);
+std::vector<double> distancesToSurface(const LimitSurface& surface, const MatrixX3& controlPoints,
+                                       const MatrixX3& landmarkPoints);
 
 }  // namespace dynsub

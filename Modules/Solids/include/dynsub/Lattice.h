@@ -26,7 +26,7 @@ class Lattice {
  public:
   Lattice() = default;
 
-  static Lattice fromCells(Matrix3X points, std::vector<std::vector<int>> faces, std::vector<std::vector<int>> cells,
+  static Lattice fromCells(MatrixX3 points, std::vector<std::vector<int>> faces, std::vector<std::vector<int>> cells,
                            const std::string& source = "lattice");
 
   int pointCount() const { return static_cast<int>(points_.rows()); }
@@ -34,9 +34,9 @@ class Lattice {
   int faceCount() const { return static_cast<int>(faces_.size()); }
   int cellCount() const { return static_cast<int>(cells_.size()); }
 
-  const Matrix3X& points() const { return points_; }  // #points x 3, mm
+  const MatrixX3& points() const { return points_; }  // #points x 3, mm
   // Replaces the positions; same number of rows, finite.
-  void setPoints(const Matrix3X& points);
+  void setPoints(const MatrixX3& points);
 
   // What elements are made of.
   const std::vector<std::array<int, 2>>& edges() const { return edges_; }  // (a, b), a < b
@@ -60,7 +60,7 @@ class Lattice {
   int edgeBetween(int a, int b) const;
 
  private:
-  Matrix3X points_;
+  MatrixX3 points_;
   std::vector<std::array<int, 2>> edges_;
   std::vector<std::vector<int>> faces_, cells_, faceEdges_, cellEdges_, cellPoints_;
   std::vector<std::vector<int>> faceCells_, edgeFaces_, edgeCells_, pointEdges_, pointFaces_, pointCells_;
@@ -80,7 +80,7 @@ class Lattice {
 //    surface turned counter-clockwise seen from outside.
 Lattice extrudeFace(const Lattice& lattice, int face);
 // The average of the rows `indices` of `points` (a face's or a cell's centre).
-Vector3 centroidOf(const Matrix3X& points, const std::vector<int>& indices);
+Vector3 centroidOf(const MatrixX3& points, const std::vector<int>& indices);
 
 // Whether `face` runs counter-clockwise seen from outside `cell` (its Newell
 // normal points away from the cell's centroid): how a boundary face should run

@@ -79,7 +79,7 @@ class Sculpture {
 
  private:
   // A new model on `rest`, at `current`, with `fixed` carried over.
-  void rebuild(const Lattice& rest, const Matrix3X& current, const std::vector<int>& fixed);
+  void rebuild(const Lattice& rest, const MatrixX3& current, const std::vector<int>& fixed);
 
   SculptSettings settings_;
   Lattice rest_;

@@ -45,12 +45,12 @@ class SolidModel {
   const Lattice& control() const { return control_; }
   const Lattice& dataLattice() const { return refined_.lattice; }  // topology of the mass points
   const SolidRefinement& refinement() const { return refined_; }
-  const Matrix3X& controlPoints() const { return p_; }
+  const MatrixX3& controlPoints() const { return p_; }
   // Moves the control points (fixed ones too) and stops all motion; the
   // springs keep their rest lengths. Throws dynsub::Error for a wrong size or
   // non-finite points.
-  void setControlPoints(const Matrix3X& points);
-  Matrix3X dataPoints() const;  // A p
+  void setControlPoints(const MatrixX3& points);
+  MatrixX3 dataPoints() const;  // A p
   int springCount() const;
   int virtualSpringCount() const;
 
@@ -83,13 +83,13 @@ class SolidModel {
   struct Springs;
   // Forces of the normal and virtual springs on the mass points `d`;
   // `energy` (if given) receives their stored energy, N mm.
-  Matrix3X springForces(const Matrix3X& d, double* energy = nullptr) const;
+  MatrixX3 springForces(const MatrixX3& d, double* energy = nullptr) const;
   void factor();
 
   Lattice control_;
   SolidRefinement refined_;
   SolidMaterial material_;
-  Matrix3X p_, v_;  // control points and their velocities
+  MatrixX3 p_, v_;  // control points and their velocities
   std::vector<bool> fixed_;
   std::unique_ptr<Springs> springs_;
   int ropePoint_ = -1;

@@ -12,11 +12,11 @@ namespace dynsub {
 // Checks a point cloud read from `source`: at least 4 points, finite
 // coordinates, not all coincident, not all on a plane or a line. Throws
 // dynsub::Error naming the source.
-void checkPointCloud(const Matrix3X& points, const std::string& source);
+void checkPointCloud(const MatrixX3& points, const std::string& source);
 
 // The dimensions finite points span, by checkPointCloud's test: 0 when they
 // all coincide, 1 on a line, 2 on a plane, 3 when they enclose a volume.
-int spannedDimensions(const Matrix3X& points);
+int spannedDimensions(const MatrixX3& points);
 
 // The 98-vertex cube whose limit surface spans `semiAxes` (mm) along the
 // columns of `axes` (orthonormal, right-handed) around `centre`: its
@@ -31,7 +31,7 @@ enum class InitialShape { Sphere, Torus };
 // (sqrt(3 lambda_i): exact for points spread over an ellipsoid's surface).
 // Torus: the 32-vertex torus around the axis of least variance, with the
 // data's mean ring radius and half its mean tube radius.
-ControlMesh initialModel(const Matrix3X& points, InitialShape shape, double fraction = 0.5);
+ControlMesh initialModel(const MatrixX3& points, InitialShape shape, double fraction = 0.5);
 
 // The cube as a sphere of `radius` mm around `centre`: scaled equally along
 // every axis so that its limit surface's mean distance from the centre (on

@@ -148,8 +148,8 @@ class LimitSurface {
   // The inverse: where an element point lies on the control mesh's parametric faces.
   SurfacePoint toSurfacePoint(const ElementPoint& point) const;
 
-  LimitSample evaluate(const ElementPoint& point, const Matrix3X& controlPoints) const;
-  LimitSample evaluate(const SurfacePoint& point, const Matrix3X& controlPoints) const;
+  LimitSample evaluate(const ElementPoint& point, const MatrixX3& controlPoints) const;
+  LimitSample evaluate(const SurfacePoint& point, const MatrixX3& controlPoints) const;
   // Derivatives up to `order` (0, 1 or 2); the operators of higher ones are
   // left empty (0 x 0).
   LimitOperators operators(const std::vector<ElementPoint>& points, int order = 2) const;
@@ -210,13 +210,13 @@ class SurfaceState {
  public:
   explicit SurfaceState(const LimitSurface& surface);  // the surface must outlive this
   ~SurfaceState();
-  void reset(const Matrix3X& controlPoints);
+  void reset(const MatrixX3& controlPoints);
   LimitSample evaluate(const ElementPoint& point) const;
   // The surface's patchOperator(), built once, and patchOperator() times the
   // control points of the last reset(): rows 16 e .. 16 e + 15 are normal
   // element e's grid points.
   const SparseMatrix& patchOperator() const;
-  const Matrix3X& grids() const;
+  const MatrixX3& grids() const;
 
  private:
   struct Impl;

@@ -12,8 +12,8 @@
 namespace dynsub {
 
 struct TriangleSurface {
-  Matrix3X points;   // mm
-  Matrix3X normals;  // unit limit normals at the points
+  MatrixX3 points;   // mm
+  MatrixX3 normals;  // unit limit normals at the points
   std::vector<std::array<int, 3>> triangles;
   std::vector<int> triangleElement;           // the element each triangle lies in
   std::vector<ElementType> triangleType;      // that element's type
@@ -30,6 +30,6 @@ constexpr int kOutputSegments = 8;
 int outputSegments(const LimitSurface& surface);
 
 // N = segmentsPerElement >= 1. Throws dynsub::Error for N < 1 or N > 1024.
-TriangleSurface tessellate(const LimitSurface& surface, const Matrix3X& controlPoints, int segmentsPerElement);
+TriangleSurface tessellate(const LimitSurface& surface, const MatrixX3& controlPoints, int segmentsPerElement);
 
 }  // namespace dynsub

@@ -15,6 +15,6 @@ namespace dynsub {
 // Throws dynsub::Error naming the file (and line) for a missing, empty,
 // truncated or malformed file or an unknown extension. Coordinates are not
 // checked for finiteness here (see checkPointCloud in InitialModels.h).
-Matrix3X readPointCloud(const std::string& path);
+MatrixX3 readPointCloud(const std::string& path);
 
 }  // namespace dynsub

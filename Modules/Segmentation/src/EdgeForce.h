@@ -10,7 +10,7 @@ class EdgeForce final : public ForceField {
  public:
   // `field` is not owned and must outlive this; `strength` is k.
   EdgeForce(const EdgeField& field, double strength) : field_(field), strength_(strength) {}
-  Matrix3X forcesAt(const Matrix3X& points) const override { return strength_ * field_.sample(points); }
+  MatrixX3 forcesAt(const MatrixX3& points) const override { return strength_ * field_.sample(points); }
   // The field's directions can reverse between neighbouring voxels (EdgeField::slopeBound).
   double slopeBound() const override { return strength_ * field_.slopeBound(); }
 
