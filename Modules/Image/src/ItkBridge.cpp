@@ -24,14 +24,6 @@ namespace {
 
 using GradientImage = itk::Image<itk::CovariantVector<float, 3>, 3>;
 
-// A clear message for a file ITK has no reader for; its size checked
-// (inspectHeader).
-void inspectFile(const std::string& path) {
-  auto io = itk::ImageIOFactory::CreateImageIO(path.c_str(), itk::ImageIOFactory::FileModeEnum::ReadMode);
-  if (!io) throw Error(path, "unknown or unreadable image format");
-  inspectHeader(path, *io);
-}
-
 // The formats ITK reads and writes here, registered explicitly once (GDCM's
 // reader is made by readDicom itself).
 void registerFormats() {
@@ -44,13 +36,66 @@ void registerFormats() {
   (void)registered;
 }
 
+// The voxels of `io`'s file, of component type T, as float.
+template <typename T>
+void readConverted(itk::ImageIOBase& io, std::size_t count, std::vector<float>& voxels) {
+  std::vector<T> raw(count);
+  io.Read(raw.data());
+  voxels.resize(count);
+  std::transform(raw.begin(), raw.end(), voxels.begin(), [](T v) { return static_cast<float>(v); });
+}
+
+// Reads a 3D scalar image whose header `io` has read; false for a component
+// type it does not know (left to ImageFileReader).
+bool readScalarVolume(itk::ImageIOBase& io, Geometry& geometry, std::vector<float>& voxels) {
+  using Component = itk::IOComponentEnum;
+  for (unsigned a = 0; a < 3; ++a) {
+    geometry.size[a] = static_cast<int>(io.GetDimensions(a));
+    geometry.spacing[a] = io.GetSpacing(a);
+    geometry.origin[a] = io.GetOrigin(a);
+    const std::vector<double> axis = io.GetDirection(a);  // index axis a in physical space
+    for (unsigned b = 0; b < 3; ++b) geometry.direction[3 * b + a] = axis[b];
+  }
+  const std::size_t count = static_cast<std::size_t>(countOf(geometry));
+  itk::ImageIORegion whole(3);
+  for (unsigned a = 0; a < 3; ++a) {
+    whole.SetIndex(a, 0);
+    whole.SetSize(a, io.GetDimensions(a));
+  }
+  io.SetIORegion(whole);
+  switch (io.GetComponentType()) {
+    case Component::FLOAT:
+      voxels.resize(count);
+      io.Read(voxels.data());
+      return true;
+    case Component::UCHAR: readConverted<unsigned char>(io, count, voxels); return true;
+    case Component::CHAR: readConverted<signed char>(io, count, voxels); return true;
+    case Component::USHORT: readConverted<unsigned short>(io, count, voxels); return true;
+    case Component::SHORT: readConverted<short>(io, count, voxels); return true;
+    case Component::UINT: readConverted<unsigned int>(io, count, voxels); return true;
+    case Component::INT: readConverted<int>(io, count, voxels); return true;
+    case Component::DOUBLE: readConverted<double>(io, count, voxels); return true;
+    default: return false;
+  }
+}
+
 }  // namespace
 
 void readImage(const std::string& path, Geometry& geometry, std::vector<float>& voxels) {
   registerFormats();
   try {
-    inspectFile(path);
+    auto io = itk::ImageIOFactory::CreateImageIO(path.c_str(), itk::ImageIOFactory::FileModeEnum::ReadMode);
+    if (!io) throw Error(path, "unknown or unreadable image format");
+    inspectHeader(path, *io);
+    // A 3D scalar image is read by its ImageIO straight into `voxels` (a
+    // float file) or through one buffer of its own type: ImageFileReader
+    // would add an image of its own and a copy of it into `voxels`, a third
+    // of the segment command's page faults. Other files (2D, 4D, vectors)
+    // go through ImageFileReader, which makes a 3D float image of them.
+    if (io->GetNumberOfDimensions() == 3 && io->GetNumberOfComponents() == 1 && readScalarVolume(*io, geometry, voxels))
+      return;
     auto reader = itk::ImageFileReader<FloatImage>::New();
+    reader->SetImageIO(io);
     reader->SetFileName(path);
     reader->Update();
     const FloatImage* image = reader->GetOutput();
