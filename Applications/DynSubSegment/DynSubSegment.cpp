@@ -15,7 +15,6 @@
 #include <iostream>
 #include <list>
 #include <memory>
-#include <sstream>
 
 #include <CLI/CLI.hpp>
 
@@ -55,30 +54,29 @@ std::vector<slicer::ParameterGroup> parameterGroups(Arguments& a) {
       if (row.group != g.name) continue;
       const std::string label = row.label + (row.unit.empty() ? "" : " (" + row.unit + ")");
       slicer::Parameter p{"", "", row.camelName(), row.camelName(), label, row.help + ".", {}, "", "", "", "", {}, -1};
-      const auto number = [](double v) {
-        std::ostringstream out;
-        out << std::setprecision(12) << v;
-        return std::isfinite(v) ? out.str() : std::string();
+      // A number's range and slider step; an unbounded end is left out.
+      const auto constrain = [&] {
+        const auto bound = [](double v) { return std::isfinite(v) ? slicer::number(v) : std::string(); };
+        p.minimum = bound(row.low);
+        p.maximum = bound(row.high);
+        p.step = row.step > 0 ? slicer::number(row.step) : "";
       };
-      p.minimum = number(row.low);
-      p.maximum = number(row.high);
-      p.step = row.step > 0 ? number(row.step) : "";
       if (const auto* real = std::get_if<dynsub::Parameter::Real>(&row.value)) {
         p.element = "double";
         p.target = &(*real)(a.parameters);
+        constrain();
       } else if (const auto* whole = std::get_if<dynsub::Parameter::Whole>(&row.value)) {
         p.element = "integer";
         p.target = &(*whole)(a.parameters);
+        constrain();
       } else if (const auto* choice = std::get_if<dynsub::Parameter::Choice>(&row.value)) {
         p.element = "string-enumeration";
         p.choices = choice->names;
-        p.minimum = p.maximum = p.step = "";
         std::string& value = a.choices.emplace_back(choice->get(a.parameters));
         p.target = &value;
         a.afterParsing.push_back([set = choice->set, &value](Arguments& arguments) { set(arguments.parameters, value); });
       } else if (const auto* on = std::get_if<dynsub::Parameter::Switch>(&row.value)) {
         p.element = "boolean";
-        p.minimum = p.maximum = p.step = "";
         if (!(*on)(a.parameters)) {
           p.target = &(*on)(a.parameters);
         } else {
@@ -150,17 +148,6 @@ slicer::Module describe(Arguments& a) {
   return m;
 }
 
-// "x,y,z" as Slicer writes a point: three finite numbers.
-Vector3 parsePoint(const std::string& text, const std::string& flag) {
-  std::stringstream in(text);
-  Vector3 p;
-  char comma1 = 0, comma2 = 0;
-  if (!(in >> p.x() >> comma1 >> p.y() >> comma2 >> p.z()) || comma1 != ',' || comma2 != ',' || !p.allFinite() ||
-      (in >> std::ws, !in.eof()))
-    throw Error("--" + flag + " " + text + ": expected x,y,z (three finite numbers, LPS mm)");
-  return p;
-}
-
 // Slicer's progress bar: <filter-progress> from 0 to 1, each level of the
 // evolution an equal share (a level's steps approach its end).
 class SlicerProgress {
@@ -214,7 +201,7 @@ void run(Arguments& a) {
   in.image = a.image;
   const Volume image = readVolume(a.image);
   for (std::size_t i = 0; i < a.seeds.size(); ++i)
-    in.landmarks.push_back({"seed-" + std::to_string(i + 1), parsePoint(a.seeds[i], "seed")});
+    in.landmarks.push_back({"seed-" + std::to_string(i + 1), parsePoint(a.seeds[i], "--seed")});
   in.landmarkSource = "--seed";
   if (!a.landmarks.empty()) {
     const std::vector<Landmark> fromFile = readLandmarks(a.landmarks);
@@ -223,7 +210,7 @@ void run(Arguments& a) {
   }
   if (!a.inside.empty()) {
     in.start.kind = SegmentStart::Kind::Seed;
-    in.start.center = parsePoint(a.inside, "inside");
+    in.start.center = parsePoint(a.inside, "--inside");
     in.start.text = "inside:" + a.inside;
   } else if (in.landmarks.size() == 1) {
     // One point cannot outline a structure: it is read as a click inside it.

@@ -23,12 +23,6 @@ std::string escaped(const std::string& text) {
   return out;
 }
 
-std::string number(double value) {
-  std::ostringstream out;
-  out << std::setprecision(12) << value;
-  return out.str();
-}
-
 // The default a plain value shows in Slicer's panel: the target's value now.
 std::string defaultOf(const Parameter& p) {
   if (!p.channel.empty() || p.index >= 0) return "";
@@ -44,6 +38,12 @@ void tag(std::ostringstream& out, const char* indent, const std::string& name, c
 }
 
 }  // namespace
+
+std::string number(double value) {
+  std::ostringstream out;
+  out << std::setprecision(12) << value;
+  return out.str();
+}
 
 std::string descriptor(const Module& module) {
   std::ostringstream out;

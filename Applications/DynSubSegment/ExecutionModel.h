@@ -41,6 +41,9 @@ struct Module {
   std::vector<ParameterGroup> groups;
 };
 
+// A number as the descriptor writes it: to 12 significant digits.
+std::string number(double value);
+
 // The descriptor, starting with "<?xml". Each plain value's default is the
 // target's current value.
 std::string descriptor(const Module& module);

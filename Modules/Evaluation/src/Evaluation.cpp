@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -16,7 +15,6 @@
 
 #include "dynsub/Error.h"
 #include "dynsub/ImageIO.h"
-#include "dynsub/Labelmap.h"
 #include "dynsub/Metrics.h"
 #include "dynsub/SegmentImage.h"
 

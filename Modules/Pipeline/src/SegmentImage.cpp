@@ -184,6 +184,11 @@ void checkStart(const SegmentInputs& in) {
 
 }  // namespace
 
+Vector3 parsePoint(const std::string& text, const std::string& option) {
+  const std::vector<double> v = numbersAfter(text, 0, 3, "x,y,z", option);
+  return Vector3(v[0], v[1], v[2]);
+}
+
 void checkSegmentInputs(const SegmentInputs& in, const SegmentParameters& parameters) {
   optionsFor(in, parameters);
   checkStart(in);

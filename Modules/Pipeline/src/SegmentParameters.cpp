@@ -217,6 +217,16 @@ std::vector<Parameter> table() {
 
 bool isWhole(double v) { return std::isfinite(v) && v == std::floor(v); }
 
+// "sigma_mm (--sigma)": how errors name a row, for plans and the command line alike.
+std::string nameOf(const Parameter& row) { return row.key() + " (" + row.flag() + ")"; }
+
+// `x` (given as `value`) within the row's range, or an error naming the row.
+double requireInRange(const Parameter& row, double x, const ParameterValue& value) {
+  if (!(x >= row.low && x <= row.high))
+    throw Error(nameOf(row) + " must be in " + number(row.low) + ".." + number(row.high) + ", got " + toText(value));
+  return x;
+}
+
 }  // namespace
 
 std::string Parameter::key() const { return unit == "mm" ? name + "_mm" : name; }
@@ -280,13 +290,8 @@ ParameterValue parameterValue(const SegmentParameters& parameters, const Paramet
 }
 
 void setParameter(SegmentParameters& p, const Parameter& parameter, const ParameterValue& value) {
-  const std::string what = parameter.key() + " (" + parameter.flag() + ")";
-  const auto inRange = [&](double v) {
-    if (!(v >= parameter.low && v <= parameter.high))
-      throw Error(what + " must be in " + number(parameter.low) + ".." + number(parameter.high) + ", got " +
-                  toText(value));
-    return v;
-  };
+  const std::string what = nameOf(parameter);
+  const auto inRange = [&](double v) { return requireInRange(parameter, v, value); };
   const auto real = [&]() -> double {
     if (const double* d = std::get_if<double>(&value)) return inRange(*d);
     if (const int* i = std::get_if<int>(&value)) return inRange(*i);
@@ -348,10 +353,7 @@ void checkRanges(const SegmentParameters& parameters) {
     const double* real = std::get_if<double>(&v);
     const int* whole = std::get_if<int>(&v);
     if (!real && !whole) continue;
-    const double x = real ? *real : *whole;
-    if (!(x >= row.low && x <= row.high))
-      throw Error(row.key() + " (" + row.flag() + ") must be in " + number(row.low) + ".." + number(row.high) +
-                  ", got " + toText(v));
+    requireInRange(row, real ? *real : *whole, v);
   }
 }
 

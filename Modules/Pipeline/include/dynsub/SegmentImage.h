@@ -37,6 +37,9 @@ struct SegmentStart {
 // "auto", "sphere:x,y,z,r", "seed:x,y,z" or a mesh path; `option` names the
 // flag in errors. Throws dynsub::Error on malformed or non-finite numbers.
 SegmentStart parseSegmentStart(const std::string& value, const std::string& option);
+// "x,y,z": a point in LPS mm, as a click is given on a command line; throws
+// dynsub::Error naming `option` on malformed or non-finite numbers.
+Vector3 parsePoint(const std::string& text, const std::string& option);
 
 struct SegmentInputs {
   std::string image;                // the file, for the report
