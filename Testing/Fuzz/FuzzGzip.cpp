@@ -1,4 +1,4 @@
-// The gzip check made before ITK reads a .nii.gz (FileChecks.h: inflatedSize).
+// The gzip check made before ITK reads a .nii.gz (FileChecks.h: inflateGzipFile).
 #include "FileChecks.h"
 #include "FuzzInput.h"
 #include "dynsub/Error.h"
@@ -7,7 +7,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   using namespace dynsub::fuzz;
   const InputFile input(data, size, ".nii.gz");
   try {
-    dynsub::filechecks::inflatedSize(input.path());
+    dynsub::filechecks::inflateGzipFile(input.path(), 1 << 20);
   } catch (const dynsub::Error& e) {
     refused(e);
   }

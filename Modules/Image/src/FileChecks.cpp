@@ -1,10 +1,15 @@
-// What the checks of every format share: the inflated size of gzip data, the
+// What the checks of every format share: inflating gzip data, the
 // memory an image needs, and the choice of checks by file name (FileChecks.h).
 #include "FileChecks.h"
 
+#include <libdeflate.h>
 #include <unistd.h>
-#include <zlib.h>
 
+#include <algorithm>
+#include <fstream>
+#include <iterator>
+#include <memory>
+#include <new>
 #include <vector>
 
 #include "dynsub/Error.h"
@@ -12,23 +17,50 @@
 
 namespace dynsub::filechecks {
 
-std::uintmax_t inflatedSize(const std::string& path, std::uintmax_t enough) {
-  gzFile file = gzopen(path.c_str(), "rb");
-  if (!file) throw Error(path, "cannot be opened");
-  std::vector<char> buffer(1 << 16);
-  std::uintmax_t total = 0;
-  int read = 0;
-  while (total < enough && (read = gzread(file, buffer.data(), static_cast<unsigned>(buffer.size()))) > 0)
-    total += read;
-  int code = Z_OK;
-  std::string message = gzerror(file, &code);
-  gzclose(file);
-  // zlib's message starts with the path, which the error names already.
-  if (message.rfind(path + ": ", 0) == 0) message.erase(0, path.size() + 2);
-  if (read < 0 || (code != Z_OK && code != Z_STREAM_END))
-    throw Error(path, "truncated or corrupt compressed data (" + message + ") after " + std::to_string(total) +
-                          " bytes");
-  return total;
+std::vector<unsigned char> inflateGzipFile(const std::string& path, std::uintmax_t expected) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path, "cannot be opened");
+  const std::vector<unsigned char> packed{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  if (in.bad()) throw Error(path, "cannot be read");
+  auto corrupt = [&](const std::string& why) {
+    return Error(path, "truncated or corrupt compressed data (" + why + ")");
+  };
+  // A gzip member ends with its inflated size modulo 2^32: the usual file,
+  // one member under 4 GiB, is inflated in one call into a buffer of that size.
+  std::size_t capacity = static_cast<std::size_t>(expected);
+  if (packed.size() >= 18) {
+    std::uint32_t trailer = 0;
+    for (int b = 3; b >= 0; --b) trailer = trailer << 8 | packed[packed.size() - 4 + b];
+    capacity = std::max<std::size_t>(capacity, trailer);
+  }
+  const std::size_t largest = static_cast<std::size_t>(expected) * 4 + (1 << 16);
+  capacity = std::min(std::max<std::size_t>(capacity, 1), largest);
+  const std::unique_ptr<libdeflate_decompressor, void (*)(libdeflate_decompressor*)> decompressor(
+      libdeflate_alloc_decompressor(), &libdeflate_free_decompressor);
+  if (!decompressor) throw std::bad_alloc();
+  std::vector<unsigned char> inflated(capacity);
+  std::size_t read = 0, written = 0;
+  if (packed.empty()) throw corrupt("an empty file");
+  while (read < packed.size()) {  // one member after another, as gzip does
+    std::size_t memberIn = 0, memberOut = 0;
+    const auto result = libdeflate_gzip_decompress_ex(decompressor.get(), packed.data() + read, packed.size() - read,
+                                                      inflated.data() + written, inflated.size() - written,
+                                                      &memberIn, &memberOut);
+    if (result == LIBDEFLATE_INSUFFICIENT_SPACE) {
+      // More data than the trailer said (several members, or over 4 GiB):
+      // the member is inflated again into a buffer twice as large.
+      if (inflated.size() >= largest)
+        throw Error(path, "inflates to more than " + std::to_string(largest) + " bytes, far beyond the " +
+                              std::to_string(expected) + " its header announces");
+      inflated.resize(std::min(inflated.size() * 2, largest));
+      continue;
+    }
+    if (result != LIBDEFLATE_SUCCESS) throw corrupt("not a complete gzip stream");
+    read += memberIn;
+    written += memberOut;
+  }
+  inflated.resize(written);
+  return inflated;
 }
 
 void requireMemoryFor(const std::string& path, std::uintmax_t voxels) {

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace dynsub::filechecks {
 
@@ -18,10 +19,11 @@ inline std::optional<std::uintmax_t> checkedProduct(std::uintmax_t a, std::uintm
   return result;
 }
 
-// The number of bytes a gzip file inflates to, or at least `enough` when it
-// inflates to that many or more (inflating stops there). Throws
-// dynsub::Error when its stream is cut short or corrupt before that.
-std::uintmax_t inflatedSize(const std::string& path, std::uintmax_t enough = UINTMAX_MAX);
+// The bytes a gzip file inflates to, in one piece (libdeflate). `expected`
+// is the size its contents announce; more than four times as much is refused
+// rather than allocated. Throws dynsub::Error naming the file when its
+// stream is cut short or corrupt.
+std::vector<unsigned char> inflateGzipFile(const std::string& path, std::uintmax_t expected);
 
 // Throws dynsub::Error when an image of `voxels` voxels would not fit in this
 // machine's memory as float (a corrupt or hostile header), before anything

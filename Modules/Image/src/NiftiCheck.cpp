@@ -46,37 +46,37 @@ Error truncatedData(const std::string& path, std::uintmax_t actual, bool gzipped
                          ", the header announces " + std::to_string(needed));
 }
 
-// Scans `voxels` float (4-byte) or double (8-byte) values from byte `offset`
-// of a file (inflated when gzipped); throws naming the count of NaN or
-// infinite ones and the voxel index (i, j, k) of the first.
-void requireFiniteVoxels(const std::string& path, bool gzipped, std::uintmax_t offset, std::uintmax_t voxels,
-                         int bytes, bool swap, const std::array<std::int64_t, 3>& size) {
-  gzFile file = gzopen(path.c_str(), "rb");  // reads plain files too
-  if (!file) throw Error(path, "cannot be opened");
-  std::vector<unsigned char> buffer(static_cast<std::size_t>(bytes) << 14);
-  std::uintmax_t done = 0, bad = 0, first = 0;
-  bool ok = gzseek(file, static_cast<z_off_t>(offset), SEEK_SET) >= 0;
-  while (ok && done < voxels) {
-    const auto want = static_cast<unsigned>(std::min<std::uintmax_t>(voxels - done, buffer.size() / bytes) * bytes);
-    ok = gzread(file, buffer.data(), want) == static_cast<int>(want);
-    for (unsigned at = 0; ok && at < want; at += bytes) {
-      unsigned char* value = &buffer[at];
-      if (swap) std::reverse(value, value + bytes);
-      double number = 0;
-      if (bytes == 4) {
-        float f = 0;
-        std::memcpy(&f, value, 4);
-        number = f;
-      } else {
-        std::memcpy(&number, value, 8);
-      }
-      if (!std::isfinite(number) && bad++ == 0) first = done + at / bytes;
+// Scans `voxels` float (4-byte) or double (8-byte) values from `data`;
+// throws naming the count of NaN or infinite ones and the voxel index
+// (i, j, k) of the first.
+void requireFiniteVoxels(const std::string& path, const unsigned char* data, std::uintmax_t voxels, int bytes,
+                         bool swap, const std::array<std::int64_t, 3>& size) {
+  std::uintmax_t bad = 0, first = 0;
+  for (std::uintmax_t v = 0; v < voxels; ++v) {
+    unsigned char value[8];
+    std::memcpy(value, data + v * bytes, bytes);
+    if (swap) std::reverse(value, value + bytes);
+    double number = 0;
+    if (bytes == 4) {
+      float f = 0;
+      std::memcpy(&f, value, 4);
+      number = f;
+    } else {
+      std::memcpy(&number, value, 8);
     }
-    done += want / bytes;
+    if (!std::isfinite(number) && bad++ == 0) first = v;
   }
-  gzclose(file);
-  if (!ok) throw Error(path, std::string("cannot read its ") + (gzipped ? "compressed " : "") + "voxels");
   if (bad) throw Error(path, nonFiniteMessage(bad, first, size));
+}
+
+// The `count` bytes of a plain file from byte `offset`.
+std::vector<unsigned char> readBytes(const std::string& path, std::uintmax_t offset, std::uintmax_t count) {
+  std::ifstream in(path, std::ios::binary);
+  std::vector<unsigned char> bytes(static_cast<std::size_t>(count));
+  in.seekg(static_cast<std::streamoff>(offset));
+  in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(count));
+  if (!in) throw Error(path, "cannot read its voxels");
+  return bytes;
 }
 
 }  // namespace
@@ -154,12 +154,19 @@ void checkNiftiFile(const std::string& path) {
   const auto needed = static_cast<std::uintmax_t>(offset) + count * bytesPerVoxel;
   std::array<std::int64_t, 3> size{1, 1, 1};
   for (int a = 0; a < 3 && a < dimensions; ++a) size[a] = dim(a + 1);
-  const auto actual = gzipped ? inflatedSize(path, needed) : fs::file_size(path);
+  // The whole stream is inflated: a gzip stream cut short or corrupt after
+  // the image's bytes is refused too.
+  const std::vector<unsigned char> inflated = gzipped ? inflateGzipFile(path, needed) : std::vector<unsigned char>();
+  const auto actual = gzipped ? inflated.size() : fs::file_size(path);
   if (actual < needed) throw truncatedData(path, actual, gzipped, needed);
   // ITK's NIfTI reader turns NaN and infinite voxels into 0 without a word
   // (ITK 5.2): float data is scanned for them here.
-  if (datatype == 16 || datatype == 64)
-    requireFiniteVoxels(path, gzipped, static_cast<std::uintmax_t>(offset), count, datatype == 16 ? 4 : 8, swap, size);
+  if (datatype == 16 || datatype == 64) {
+    const int bytes = datatype == 16 ? 4 : 8;
+    const auto start = static_cast<std::uintmax_t>(offset);
+    const std::vector<unsigned char> plain = gzipped ? std::vector<unsigned char>() : readBytes(path, start, count * bytes);
+    requireFiniteVoxels(path, gzipped ? inflated.data() + start : plain.data(), count, bytes, swap, size);
+  }
 }
 
 bool isNiftiName(const std::string& path) {

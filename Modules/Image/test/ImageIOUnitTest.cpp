@@ -6,6 +6,8 @@
 #include <fstream>
 #include <limits>
 
+#include <zlib.h>
+
 #include "ScratchFiles.h"
 #include "TestGrids.h"
 #include "dynsub/Error.h"
@@ -152,17 +154,50 @@ std::string readError(const fs::path& path) {
   }
 }
 
+// Writes `from` gzipped to `to`, as `members` gzip members one after another
+// (as bgzip and concatenated .gz files have them).
+void gzipFile(const fs::path& from, const fs::path& to, int members = 1) {
+  std::ifstream in(from, std::ios::binary);
+  const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  fs::remove(to);
+  const std::size_t piece = bytes.size() / members + 1;
+  for (std::size_t at = 0; at < bytes.size(); at += piece) {
+    gzFile out = gzopen(to.c_str(), "ab");
+    ASSERT_NE(out, nullptr);
+    const auto size = static_cast<unsigned>(std::min(piece, bytes.size() - at));
+    ASSERT_EQ(gzwrite(out, bytes.data() + at, size), static_cast<int>(size));
+    ASSERT_EQ(gzclose(out), Z_OK);
+  }
+}
+
 TEST(HostileImages, NanAndInfiniteVoxelsAreRefusedWithTheFirstIndex) {
   for (const float bad : {std::numeric_limits<float>::quiet_NaN(), -std::numeric_limits<float>::infinity()}) {
     std::vector<float> voxels = ramp(6 * 5 * 4, 1.0f);
     voxels[2 + 6 * (3 + 5 * 1)] = bad;
     voxels[100] = bad;
     writeNifti(scratch("bad_voxels.nii"), {6, 5, 4}, Vector3(1, 1, 1), voxels);
-    const std::string error = readError(scratch("bad_voxels.nii"));
-    EXPECT_NE(error.find("bad_voxels.nii: 2 voxel(s) are NaN or infinite, the first at index (2, 3, 1)"),
-              std::string::npos)
-        << error;
+    gzipFile(scratch("bad_voxels.nii"), scratch("bad_voxels.nii.gz"));
+    for (const std::string name : {"bad_voxels.nii", "bad_voxels.nii.gz"}) {
+      const std::string error = readError(scratch(name));
+      EXPECT_NE(error.find(name + ": 2 voxel(s) are NaN or infinite, the first at index (2, 3, 1)"), std::string::npos)
+          << error;
+    }
   }
+}
+
+// A .nii.gz of several gzip members reads as the plain file; one cut short
+// inside its last member is refused, naming the file.
+TEST(HostileImages, GzipMembersAreReadOneAfterAnotherAndACutStreamIsRefused) {
+  const std::vector<float> voxels = ramp(9 * 8 * 7, 0.5f);
+  writeNifti(scratch("members.nii"), {9, 8, 7}, Vector3(1, 1, 1), voxels);
+  gzipFile(scratch("members.nii"), scratch("members.nii.gz"), 3);
+  const Volume plain = readVolume(scratch("members.nii").string());
+  const Volume members = readVolume(scratch("members.nii.gz").string());
+  EXPECT_EQ(members.voxels, plain.voxels);
+  const auto size = fs::file_size(scratch("members.nii.gz"));
+  fs::resize_file(scratch("members.nii.gz"), size - 10);
+  EXPECT_NE(readError(scratch("members.nii.gz")).find("members.nii.gz: truncated or corrupt compressed data"),
+            std::string::npos);
 }
 
 // ITK keeps NaN in MetaImage and NRRD files; readVolume refuses them there too.
