@@ -3,6 +3,13 @@
 // negative indices accepted, other records ignored), OFF, and PLY (ascii and
 // binary, either byte order; element "vertex" with x, y, z and element "face"
 // with a "vertex_indices" list). Writing: OBJ with round-trip precision.
+//
+// The readers are DynSub's own rather than OpenMesh::IO because a control
+// mesh must survive a round trip exactly and a bad record must be refused:
+// OpenMesh 9's OBJ reader keeps coordinates as float (0.12345678901234567
+// comes back as 0.12345679104328156), drops a vertex it cannot parse and the
+// faces that use it with only a line on its log, and splits the faces of a
+// non-manifold edge onto copies of their vertices.
 #include <string>
 #include <vector>
 
