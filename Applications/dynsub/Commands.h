@@ -13,6 +13,7 @@ void addFitCommand(CLI::App& app);
 void addDeformCommand(CLI::App& app);
 void addSegmentCommand(CLI::App& app);
 void addEvaluateCommand(CLI::App& app);
+void addSubjectCommand(CLI::App& app);
 void addRenderCommand(CLI::App& app);
 void addViewCommand(CLI::App& app);
 void addSolidCommand(CLI::App& app);

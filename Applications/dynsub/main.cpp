@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   dynsub::app::addDeformCommand(app);
   dynsub::app::addSegmentCommand(app);
   dynsub::app::addEvaluateCommand(app);
+  dynsub::app::addSubjectCommand(app);
   dynsub::app::addRenderCommand(app);
   dynsub::app::addViewCommand(app);
   dynsub::app::addSolidCommand(app);

@@ -335,5 +335,18 @@ env -u DISPLAY "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" --script "$DA
   --out "$work/arm4" >/dev/null 2>&1
 check "solid sculpt --script without a display draws on a private Xvfb" test -s "$work/arm4/sculpted.png"
 
+# A generated subject: Colin27 moved and acquired again, with its AAL labels.
+mri=/usr/share/mricron/templates
+"$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --seed 4 --set snr=20,20 --out "$work/subject" >/dev/null
+check "subject writes the image, the labels and the record" \
+  test -s "$work/subject/image.nii.gz" -a -s "$work/subject/labels.nii.gz" -a -s "$work/subject/subject.json"
+check "subject records the drawn SNR" grep -q '"snr": 20,' "$work/subject/subject.json"
+expect_error "subject: an unknown setting" 1 "unknown setting 'noise'" "$work/s40" \
+  "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --set noise=3 --out "$work/s40"
+expect_error "subject: a warp that could fold" 1 "warp_mm must be" "$work/s41" \
+  "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --set warp_mm=20 --out "$work/s41"
+expect_error "subject: missing labels" 1 "nolabels.nii.gz" "$work/s42" \
+  "$DYNSUB" subject "$mri/ch2.nii.gz" "$work/nolabels.nii.gz" --out "$work/s42"
+
 if [ "$failures" -gt 0 ]; then echo "$failures check(s) failed"; exit 1; fi
 echo "all command-line checks passed"

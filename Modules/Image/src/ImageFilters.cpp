@@ -17,6 +17,10 @@ std::vector<Vector3> smoothedGradient(const Volume& image, double sigma) {
   return gradient;
 }
 
+Volume gaussianSmoothed(const Volume& image, double sigma) {
+  return {image.geometry, itkbridge::recursiveGaussian(toBridge(image.geometry), image.voxels, sigma)};
+}
+
 namespace {
 
 constexpr double kNone = std::numeric_limits<double>::infinity();  // no feature on the line

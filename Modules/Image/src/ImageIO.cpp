@@ -83,4 +83,18 @@ void writeMask(const Mask& mask, const std::string& path, std::uint8_t label) {
   output.commit();
 }
 
+void writeVolume(const Volume& volume, const std::string& path, VoxelType type) {
+  const std::string extension = lowerCaseExtension(path);
+  if (extension == ".mhd" || extension == ".nhdr" || extension == ".hdr")
+    throw Error(path, "a header with a separate data file is not written; use .nii.gz, .nii, .nrrd or .mha");
+  if (type == VoxelType::Label16) {
+    for (const float v : volume.voxels)
+      if (!(v >= -32768.0f && v <= 32767.0f)) throw Error(path, "a label value outside -32768..32767: " + std::to_string(v));
+  }
+  requireWritableDirectoryFor(path);
+  AtomicOutput output(path);
+  itkbridge::writeImage(toBridge(volume.geometry), volume.voxels, type == VoxelType::Label16, output.temporaryPath());
+  output.commit();
+}
+
 }  // namespace dynsub

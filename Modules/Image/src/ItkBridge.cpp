@@ -3,6 +3,7 @@
 #include "ItkImages.h"
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include <itkGradientRecursiveGaussianImageFilter.h>
@@ -15,6 +16,7 @@
 #include <itkNiftiImageIOFactory.h>
 #include <itkNrrdImageIOFactory.h>
 #include <itkSignedMaurerDistanceMapImageFilter.h>
+#include <itkSmoothingRecursiveGaussianImageFilter.h>
 
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
@@ -118,6 +120,39 @@ void writeLabels(const Geometry& geometry, const std::vector<std::uint8_t>& voxe
   } catch (const itk::ExceptionObject& e) {
     throw Error(path, std::string("cannot write labelmap: ") + e.GetDescription());
   }
+}
+
+void writeImage(const Geometry& geometry, const std::vector<float>& voxels, bool labels, const std::string& path) {
+  registerFormats();
+  try {
+    if (labels) {
+      using LabelImage = itk::Image<std::int16_t, 3>;
+      std::vector<std::int16_t> values(voxels.size());
+      for (std::size_t v = 0; v < voxels.size(); ++v) values[v] = static_cast<std::int16_t>(std::lround(voxels[v]));
+      auto writer = itk::ImageFileWriter<LabelImage>::New();
+      writer->SetFileName(path);
+      writer->SetInput(makeImage<LabelImage>(geometry, values));
+      writer->UseCompressionOn();
+      writer->Update();
+    } else {
+      auto writer = itk::ImageFileWriter<FloatImage>::New();
+      writer->SetFileName(path);
+      writer->SetInput(makeImage<FloatImage>(geometry, voxels));
+      writer->UseCompressionOn();
+      writer->Update();
+    }
+  } catch (const itk::ExceptionObject& e) {
+    throw Error(path, std::string("cannot write image: ") + e.GetDescription());
+  }
+}
+
+std::vector<float> recursiveGaussian(const Geometry& geometry, const std::vector<float>& voxels, double sigma) {
+  auto filter = itk::SmoothingRecursiveGaussianImageFilter<FloatImage, FloatImage>::New();
+  filter->SetInput(makeImage<FloatImage>(geometry, voxels));
+  filter->SetSigma(sigma);
+  filter->Update();
+  const float* buffer = filter->GetOutput()->GetBufferPointer();
+  return std::vector<float>(buffer, buffer + voxels.size());
 }
 
 std::vector<float> recursiveGaussianGradient(const Geometry& geometry, const std::vector<float>& voxels,

@@ -35,6 +35,16 @@ DYNSUB_ITK_BRIDGE_API void readDicom(const std::string& path, Geometry& geometry
 DYNSUB_ITK_BRIDGE_API void writeLabels(const Geometry& geometry, const std::vector<std::uint8_t>& voxels,
                                        const std::string& path);
 
+// A float image (`labels` false) or a label image of 16-bit signed integers
+// (`labels` true, values rounded), compressed when the format allows;
+// throws dynsub::Error.
+DYNSUB_ITK_BRIDGE_API void writeImage(const Geometry& geometry, const std::vector<float>& voxels, bool labels,
+                                      const std::string& path);
+
+// The image smoothed by a Gaussian of sigma mm (Deriche's recursive filters).
+DYNSUB_ITK_BRIDGE_API std::vector<float> recursiveGaussian(const Geometry& geometry, const std::vector<float>& voxels,
+                                                           double sigma);
+
 // Gradient (physical LPS axes, per mm) of the image smoothed by a Gaussian of
 // sigma mm, with Deriche's recursive filters; three components per voxel.
 DYNSUB_ITK_BRIDGE_API std::vector<float> recursiveGaussianGradient(const Geometry& geometry,

@@ -14,13 +14,16 @@ namespace dynsub {
 // voxels' order.
 std::vector<Vector3> smoothedGradient(const Volume& image, double sigma);
 
+// The image smoothed by a Gaussian of sigma mm (Deriche's recursive filters).
+Volume gaussianSmoothed(const Volume& image, double sigma);
+
 // The Euclidean distance (mm, by the grid's spacing) from every voxel centre
 // to the nearest voxel of `mask`, 0 on it, in the voxels' order; exact (the
 // separable transform of Felzenszwalb and Huttenlocher, one pass per axis);
 // infinity everywhere for an empty mask. It equals ITK's Maurer transform to
 // the bit on grids whose squared distances floats hold exactly (1 mm, 0.5
-// mm: DistanceUnitTests), elsewhere within a float's rounding; ITK's took a
-// third of a seed's command (Documentation/Performance.md, twentieth session).
+// mm: DistanceUnitTests), elsewhere within a float's rounding. It is
+// DynSub's own because ITK's took a third of a seed click's command.
 std::vector<float> distanceTo(const Mask& mask);
 
 }  // namespace dynsub

@@ -35,4 +35,13 @@ Volume readVolume(const std::string& path);
 // The file appears complete or not at all.
 void writeMask(const Mask& mask, const std::string& path, std::uint8_t label = 1);
 
+// How writeVolume stores voxels: as 32-bit floats (an image), or rounded to
+// 16-bit signed integers (a label map).
+enum class VoxelType { Float32, Label16 };
+
+// Writes a volume on its grid, by ITK, in a single-file format chosen by
+// extension (.nii.gz, .nii, .nrrd, .mha). Label values must lie in
+// -32768..32767. The file appears complete or not at all.
+void writeVolume(const Volume& volume, const std::string& path, VoxelType type);
+
 }  // namespace dynsub

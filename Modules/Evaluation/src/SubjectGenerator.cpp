@@ -1,0 +1,333 @@
+#include "dynsub/SubjectGenerator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <sstream>
+#include <vector>
+
+#include "dynsub/Error.h"
+#include "dynsub/ImageFilters.h"
+#include "dynsub/ParallelFor.h"
+
+namespace dynsub {
+namespace {
+
+// Draws from the standard's 64-bit Mersenne Twister, whose output the
+// standard fixes, through transforms of its own: the library's distributions
+// may differ between implementations.
+class Draw {
+ public:
+  explicit Draw(std::uint64_t seed) : engine_(seed) {}
+  double uniform() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }  // [0, 1)
+  double uniform(double low, double high) { return low + (high - low) * uniform(); }
+  double normal() {  // Box and Muller's transform, one of the pair
+    const double radius = std::sqrt(-2.0 * std::log(1.0 - uniform()));
+    return radius * std::cos(2.0 * M_PI * uniform());
+  }
+  Vector3 inBall(double radius) {
+    for (;;) {
+      const Vector3 v(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1));
+      if (v.squaredNorm() <= 1) return radius * v;
+    }
+  }
+
+ private:
+  std::mt19937_64 engine_;
+};
+
+// Cubic B-spline weights of the four nodes around t (node floor(t) - 1 first).
+std::array<double, 4> cubicWeights(double t, int& first) {
+  const double f = std::floor(t), u = t - f;
+  first = static_cast<int>(f) - 1;
+  const double v = 1 - u;
+  return {v * v * v / 6, (3 * u * u * u - 6 * u * u + 4) / 6, (-3 * u * u * u + 3 * u * u + 3 * u + 1) / 6,
+          u * u * u / 6};
+}
+
+// A vector field on a grid's continuous index, a cubic B-spline over nodes
+// `spacingMm` apart along the grid's axes, covering the grid.
+class BSplineField {
+ public:
+  BSplineField(const ImageGeometry& grid, double spacingMm) {
+    for (int a = 0; a < 3; ++a) {
+      step_[a] = spacingMm / grid.spacing[a];  // voxels between nodes
+      nodes_[a] = static_cast<int>(std::floor((grid.size[a] - 1) / step_[a])) + 4;
+    }
+    values_.assign(static_cast<std::size_t>(nodes_[0]) * nodes_[1] * nodes_[2], Vector3::Zero());
+  }
+  std::size_t nodeCount() const { return values_.size(); }
+  Vector3& node(std::size_t n) { return values_[n]; }
+
+  Vector3 at(const Vector3& index) const {
+    std::array<std::array<double, 4>, 3> w;
+    std::array<int, 3> first;
+    for (int a = 0; a < 3; ++a) w[a] = cubicWeights(index[a] / step_[a], first[a]);
+    Vector3 sum = Vector3::Zero();
+    for (int c = 0; c < 4; ++c) {
+      const int nk = std::clamp(first[2] + c + 1, 0, nodes_[2] - 1);
+      for (int b = 0; b < 4; ++b) {
+        const int nj = std::clamp(first[1] + b + 1, 0, nodes_[1] - 1);
+        const double wjk = w[1][b] * w[2][c];
+        for (int a = 0; a < 4; ++a) {
+          const int ni = std::clamp(first[0] + a + 1, 0, nodes_[0] - 1);
+          sum += (w[0][a] * wjk) * values_[ni + static_cast<std::size_t>(nodes_[0]) * (nj + nodes_[1] * nk)];
+        }
+      }
+    }
+    return sum;
+  }
+
+ private:
+  std::array<double, 3> step_{};
+  std::array<int, 3> nodes_{};
+  std::vector<Vector3> values_;
+};
+
+// The map from the subject's grid to the source's physical space:
+// p -> centre + linear (p + warp(p) - centre) + translation.
+struct SubjectMap {
+  Matrix3 linear = Matrix3::Identity();
+  Vector3 centre = Vector3::Zero(), translation = Vector3::Zero();
+  BSplineField warp;
+  const ImageGeometry& grid;
+
+  Vector3 sourcePoint(const Vector3& index) const {
+    const Vector3 p = grid.toPhysical(index) + warp.at(index);
+    return centre + linear * (p - centre) + translation;
+  }
+};
+
+Matrix3 rotation(const Vector3& radians) {
+  return (Eigen::AngleAxisd(radians.z(), Vector3::UnitZ()) * Eigen::AngleAxisd(radians.y(), Vector3::UnitY()) *
+          Eigen::AngleAxisd(radians.x(), Vector3::UnitX()))
+      .toRotationMatrix();
+}
+
+// The smallest Jacobian determinant of the map, by differences over one
+// voxel at every fourth voxel along each axis.
+double smallestJacobian(const SubjectMap& map, const ImageGeometry& grid) {
+  const double gridVolume = (grid.direction * grid.spacing.asDiagonal()).determinant();
+  std::vector<double> smallest(static_cast<std::size_t>(grid.size[2]), 1e300);
+  parallelFor(grid.size[2], 2, [&](Eigen::Index index) {
+    const int k = static_cast<int>(index);
+    if (k % 4 || k + 1 >= grid.size[2]) return;
+    for (int j = 0; j + 1 < grid.size[1]; j += 4) {
+      for (int i = 0; i + 1 < grid.size[0]; i += 4) {
+        const Vector3 x(i, j, k);
+        const Vector3 p = map.sourcePoint(x);
+        Matrix3 d;
+        for (int a = 0; a < 3; ++a) d.col(a) = map.sourcePoint(x + Vector3::Unit(a)) - p;
+        smallest[k] = std::min(smallest[k], d.determinant() / gridVolume);
+      }
+    }
+  });
+  return *std::min_element(smallest.begin(), smallest.end());
+}
+
+// The intensity below which `fraction` of `values` lie.
+float quantile(std::vector<float> values, double fraction) {
+  if (values.empty()) return 0;
+  const auto at = static_cast<std::size_t>(fraction * static_cast<double>(values.size() - 1));
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(at), values.end());
+  return values[at];
+}
+
+// The image averaged over `factor` voxels along `axis` (thick slices: each
+// slice's signal is the mean over its thickness).
+Volume thickSlices(const Volume& image, int axis, int factor) {
+  Volume thick;
+  thick.geometry = image.geometry;
+  thick.geometry.size[axis] = image.geometry.size[axis] / factor;
+  thick.geometry.spacing[axis] *= factor;
+  thick.geometry.origin += image.geometry.direction.col(axis) * image.geometry.spacing[axis] * (factor - 1) / 2.0;
+  thick.voxels.assign(static_cast<std::size_t>(thick.geometry.voxelCount()), 0.0f);
+  const ImageGeometry& g = thick.geometry;
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i) {
+        double sum = 0;
+        for (int s = 0; s < factor; ++s) {
+          std::array<int, 3> at{i, j, k};
+          at[axis] = at[axis] * factor + s;
+          sum += image.at(at[0], at[1], at[2]);
+        }
+        thick.voxels[g.offset(i, j, k)] = static_cast<float>(sum / factor);
+      }
+  return thick;
+}
+
+}  // namespace
+
+void setSubjectSetting(SubjectSettings& s, const std::string& key, const std::string& value) {
+  auto number = [&](const std::string& text) {
+    std::size_t used = 0;
+    double v = 0;
+    try {
+      v = std::stod(text, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != text.size() || !std::isfinite(v))
+      throw Error("subject settings", key + " must be a number, got '" + value + "'");
+    return v;
+  };
+  auto range = [&](std::array<double, 2>& r) {
+    const auto comma = value.find(',');
+    r[0] = number(value.substr(0, comma));
+    r[1] = comma == std::string::npos ? r[0] : number(value.substr(comma + 1));
+  };
+  const std::pair<const char*, double SubjectSettings::*> scalars[] = {
+      {"rotation_degrees", &SubjectSettings::rotationDegrees}, {"scale_spread", &SubjectSettings::scaleSpread},
+      {"shear_spread", &SubjectSettings::shearSpread},         {"translation_mm", &SubjectSettings::translationMm},
+      {"warp_spacing_mm", &SubjectSettings::warpSpacingMm},    {"warp_mm", &SubjectSettings::warpMm},
+      {"gamma_spread", &SubjectSettings::gammaSpread},         {"bias_spread", &SubjectSettings::biasSpread},
+      {"source_snr", &SubjectSettings::sourceSnr},             {"thick_fraction", &SubjectSettings::thickFraction},
+      {"thick_mm", &SubjectSettings::thickMm}};
+  for (const auto& [name, member] : scalars) {
+    if (key == name) {
+      s.*member = number(value);
+      return;
+    }
+  }
+  if (key == "blur_mm") return range(s.blurMm);
+  if (key == "snr") return range(s.snr);
+  throw Error("subject settings", "unknown setting '" + key + "'");
+}
+
+void checkSubjectSettings(const SubjectSettings& s) {
+  auto require = [](bool ok, const std::string& what) {
+    if (!ok) throw Error("subject settings", what);
+  };
+  require(s.rotationDegrees >= 0 && s.rotationDegrees <= 45, "rotation_degrees must be in 0..45");
+  require(s.scaleSpread >= 0 && s.scaleSpread <= 0.3, "scale_spread must be in 0..0.3");
+  require(s.shearSpread >= 0 && s.shearSpread <= 0.2, "shear_spread must be in 0..0.2");
+  require(s.translationMm >= 0 && s.translationMm <= 50, "translation_mm must be in 0..50");
+  require(s.warpSpacingMm >= 5 && s.warpSpacingMm <= 200, "warp_spacing_mm must be in 5..200");
+  require(s.warpMm >= 0 && s.warpMm < 0.4 * s.warpSpacingMm,
+          "warp_mm must be at least 0 and under 0.4 x warp_spacing_mm, or the deformation may fold");
+  require(s.gammaSpread >= 0 && s.gammaSpread <= 1, "gamma_spread must be in 0..1");
+  require(s.biasSpread >= 0 && s.biasSpread < 1, "bias_spread must be in 0..1 (below 1)");
+  require(s.blurMm[0] >= 0 && s.blurMm[0] <= s.blurMm[1] && s.blurMm[1] <= 5, "blur_mm must be a range within 0..5");
+  require(s.snr[0] > 0 && s.snr[0] <= s.snr[1] && s.snr[1] <= 1000, "snr must be a range within 0..1000");
+  require(s.sourceSnr > 0, "source_snr must be positive");
+  require(s.thickFraction >= 0 && s.thickFraction <= 1, "thick_fraction must be in 0..1");
+  require(s.thickMm > 0 && s.thickMm <= 10, "thick_mm must be in 0..10");
+}
+
+Subject makeSubject(const Volume& image, const Volume& labels, const SubjectSettings& settings, std::uint64_t seed) {
+  checkSubjectSettings(settings);
+  const ImageGeometry& grid = image.geometry;
+  Draw draw(seed);
+  Subject subject;
+  subject.draw.seed = seed;
+
+  // The anatomy's map: affine about the image's centre, then the warp.
+  SubjectMap map{Matrix3::Identity(), grid.toPhysical(0.5 * Vector3(grid.size[0] - 1, grid.size[1] - 1,
+                                                                     grid.size[2] - 1)),
+                 Vector3::Zero(), BSplineField(grid, settings.warpSpacingMm), grid};
+  const double maxAngle = settings.rotationDegrees * M_PI / 180;
+  const Vector3 angles(draw.uniform(-maxAngle, maxAngle), draw.uniform(-maxAngle, maxAngle),
+                       draw.uniform(-maxAngle, maxAngle));
+  Matrix3 scaleShear = Matrix3::Identity();
+  for (int a = 0; a < 3; ++a) scaleShear(a, a) = 1 + draw.uniform(-settings.scaleSpread, settings.scaleSpread);
+  for (int a = 0; a < 3; ++a)
+    for (int b = a + 1; b < 3; ++b) scaleShear(a, b) = draw.uniform(-settings.shearSpread, settings.shearSpread);
+  map.linear = rotation(angles) * scaleShear;
+  for (int a = 0; a < 3; ++a) map.translation[a] = draw.uniform(-settings.translationMm, settings.translationMm);
+  for (std::size_t n = 0; n < map.warp.nodeCount(); ++n) map.warp.node(n) = draw.inBall(settings.warpMm);
+  subject.draw.smallestJacobian = smallestJacobian(map, grid);
+
+  // The anatomy moved: the image by trilinear interpolation (0 outside the
+  // source), the labels by the nearest label.
+  Volume anatomy{grid, std::vector<float>(image.voxels.size(), 0.0f)};
+  subject.labels = {grid, std::vector<float>(image.voxels.size(), 0.0f)};
+  const Matrix3 toSourceIndex = image.geometry.indexFromPhysical();
+  const Matrix3 toLabelIndex = labels.geometry.indexFromPhysical();
+  parallelFor(grid.size[2], 2, [&](Eigen::Index index) {
+    const int k = static_cast<int>(index);
+    for (int j = 0; j < grid.size[1]; ++j) {
+      for (int i = 0; i < grid.size[0]; ++i) {
+        const Vector3 p = map.sourcePoint(Vector3(i, j, k));
+        const long long at = grid.offset(i, j, k);
+        const Vector3 sourceIndex = toSourceIndex * (p - image.geometry.origin);
+        if (image.geometry.spans(sourceIndex)) anatomy.voxels[at] = static_cast<float>(image.interpolate(sourceIndex));
+        const Vector3 labelIndex = toLabelIndex * (p - labels.geometry.origin);
+        const int li = static_cast<int>(std::lround(labelIndex.x())), lj = static_cast<int>(std::lround(labelIndex.y())),
+                  lk = static_cast<int>(std::lround(labelIndex.z()));
+        if (labels.geometry.contains(li, lj, lk)) subject.labels.voxels[at] = labels.at(li, lj, lk);
+      }
+    }
+  });
+
+  // Contrast: the head's intensities (above a tenth of its bright end) scaled
+  // to 0..1 by that bright end, raised to gamma, and scaled back.
+  std::vector<float> positive;
+  positive.reserve(anatomy.voxels.size());
+  for (const float v : anatomy.voxels)
+    if (v > 0) positive.push_back(v);
+  const float bright = quantile(positive, 0.995);
+  if (!(bright > 0)) throw Error("subject", "the source image has no positive intensities");
+  subject.draw.gamma = std::exp(draw.uniform(-settings.gammaSpread, settings.gammaSpread));
+  for (float& v : anatomy.voxels)
+    v = v > 0 ? static_cast<float>(bright * std::pow(v / bright, subject.draw.gamma)) : 0.0f;
+
+  // A bias field: smooth, within 1 +- biasSpread (a B-spline over nodes 80
+  // mm apart never leaves its nodes' range).
+  BSplineField bias(grid, 80);
+  const double logBias = std::log1p(settings.biasSpread);
+  for (std::size_t n = 0; n < bias.nodeCount(); ++n) bias.node(n) = Vector3(draw.uniform(-logBias, logBias), 0, 0);
+  parallelFor(grid.size[2], 2, [&](Eigen::Index index) {
+    const int k = static_cast<int>(index);
+    for (int j = 0; j < grid.size[1]; ++j)
+      for (int i = 0; i < grid.size[0]; ++i)
+        anatomy.voxels[grid.offset(i, j, k)] *= static_cast<float>(std::exp(bias.at(Vector3(i, j, k)).x()));
+  });
+
+  // The scanner's blur, then thick slices for some subjects.
+  subject.draw.blurMm = draw.uniform(settings.blurMm[0], settings.blurMm[1]);
+  Volume acquired = subject.draw.blurMm > 0 ? gaussianSmoothed(anatomy, subject.draw.blurMm) : anatomy;
+  anatomy = Volume();
+  if (draw.uniform() < settings.thickFraction) {
+    const int axis = std::min(2, static_cast<int>(draw.uniform() * 3));
+    const int factor = static_cast<int>(std::lround(settings.thickMm / grid.spacing[axis]));
+    if (factor >= 2 && grid.size[axis] >= 2 * factor) {
+      subject.draw.thickAxis = axis;
+      acquired = thickSlices(acquired, axis, factor);
+    }
+  }
+
+  // Rician noise at the drawn SNR of white matter, whose intensity is taken
+  // as the median of the head's brightest quarter (above a tenth of its
+  // bright end), where T1 images have their white matter.
+  std::vector<float> head;
+  for (const float v : acquired.voxels)
+    if (v > 0.1f * bright) head.push_back(v);
+  const float upper = quantile(head, 0.75);
+  std::vector<float> brightest;
+  for (const float v : head)
+    if (v >= upper) brightest.push_back(v);
+  subject.draw.whiteMatter = quantile(brightest, 0.5);
+  subject.draw.snr = draw.uniform(settings.snr[0], settings.snr[1]);
+  const double total = subject.draw.whiteMatter / subject.draw.snr;
+  const double own = subject.draw.whiteMatter / settings.sourceSnr;
+  subject.draw.noiseSigma = std::sqrt(std::max(0.0, total * total - own * own));
+  for (float& v : acquired.voxels) {
+    const double real = v + subject.draw.noiseSigma * draw.normal(), imaginary = subject.draw.noiseSigma * draw.normal();
+    v = static_cast<float>(std::hypot(real, imaginary));
+  }
+  subject.image = std::move(acquired);
+  return subject;
+}
+
+std::string subjectRecord(const SubjectDraw& d) {
+  std::ostringstream out;
+  out.precision(6);
+  out << "{\"seed\": " << d.seed << ", \"gamma\": " << d.gamma << ", \"blur_mm\": " << d.blurMm
+      << ", \"snr\": " << d.snr << ", \"noise_sigma\": " << d.noiseSigma << ", \"white_matter\": " << d.whiteMatter
+      << ", \"thick_axis\": " << (d.thickAxis ? std::to_string(*d.thickAxis) : std::string("null"))
+      << ", \"smallest_jacobian\": " << d.smallestJacobian << "}";
+  return out.str();
+}
+
+}  // namespace dynsub

@@ -1,0 +1,157 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "dynsub/Error.h"
+#include "dynsub/SubjectGenerator.h"
+
+namespace dynsub {
+namespace {
+
+// A 56 mm cube at 1 mm: an ellipsoid of intensity 200 (label 1) inside a
+// shell of 100 (label 2), air (0) around both.
+struct Phantom {
+  Volume image, labels;
+};
+
+Phantom phantom() {
+  Phantom p;
+  p.image.geometry.size = {56, 56, 56};
+  p.image.geometry.origin = Vector3(-27.5, -27.5, -27.5);
+  p.image.voxels.assign(56 * 56 * 56, 0.0f);
+  p.labels = p.image;
+  for (int k = 0; k < 56; ++k)
+    for (int j = 0; j < 56; ++j)
+      for (int i = 0; i < 56; ++i) {
+        const Vector3 x = p.image.geometry.toPhysical(Vector3(i, j, k));
+        const double inner = std::pow(x.x() / 14, 2) + std::pow(x.y() / 10, 2) + std::pow(x.z() / 8, 2);
+        const double outer = x.squaredNorm() / (22.0 * 22.0);
+        const long long at = p.image.geometry.offset(i, j, k);
+        if (inner <= 1) {
+          p.image.voxels[at] = 200;
+          p.labels.voxels[at] = 1;
+        } else if (outer <= 1) {
+          p.image.voxels[at] = 100;
+          p.labels.voxels[at] = 2;
+        }
+      }
+  return p;
+}
+
+// Only the anatomy's map: no contrast change, bias, blur or noise to speak of.
+SubjectSettings moveOnly() {
+  SubjectSettings s;
+  s.gammaSpread = 0;
+  s.biasSpread = 0;
+  s.blurMm = {0, 0};
+  s.snr = {1000, 1000};
+  s.sourceSnr = 1000;
+  s.warpSpacingMm = 15;
+  s.warpMm = 3;
+  return s;
+}
+
+TEST(SubjectGenerator, TheSameSeedGivesTheSameSubjectAndAnotherSeedAnother) {
+  const Phantom p = phantom();
+  const SubjectSettings settings;
+  const Subject a = makeSubject(p.image, p.labels, settings, 7);
+  const Subject b = makeSubject(p.image, p.labels, settings, 7);
+  const Subject c = makeSubject(p.image, p.labels, settings, 8);
+  EXPECT_EQ(a.image.voxels, b.image.voxels);
+  EXPECT_EQ(a.labels.voxels, b.labels.voxels);
+  EXPECT_NE(a.labels.voxels, c.labels.voxels);
+  EXPECT_NE(a.draw.snr, c.draw.snr);
+}
+
+// The labels move with the anatomy: with the acquisition's changes switched
+// off, label 1 lies on the bright ellipsoid and label 0 on air. Voxels whose
+// trilinear sample straddles a boundary are the only disagreement, so 97 %
+// agreement is asked of each (the ellipsoid has about 4700 voxels, a third
+// of them on its boundary layer; a misplaced label would fall far below).
+TEST(SubjectGenerator, LabelsAgreeWithTheMovedImage) {
+  const Phantom p = phantom();
+  for (const std::uint64_t seed : {1u, 2u, 3u}) {
+    const Subject s = makeSubject(p.image, p.labels, moveOnly(), seed);
+    ASSERT_TRUE(s.image.geometry.sameGridAs(s.labels.geometry));
+    long long inner = 0, innerBright = 0, air = 0, airDark = 0;
+    for (std::size_t v = 0; v < s.labels.voxels.size(); ++v) {
+      if (s.labels.voxels[v] == 1) {
+        ++inner;
+        innerBright += s.image.voxels[v] > 150;
+      } else if (s.labels.voxels[v] == 0) {
+        ++air;
+        airDark += s.image.voxels[v] < 50;
+      }
+    }
+    EXPECT_GT(inner, 3000) << seed;
+    EXPECT_GE(static_cast<double>(innerBright) / inner, 0.97) << seed;
+    EXPECT_GE(static_cast<double>(airDark) / air, 0.97) << seed;
+    // The map moved the anatomy: the labels are not the source's.
+    EXPECT_NE(s.labels.voxels, p.labels.voxels) << seed;
+  }
+}
+
+// The deformation never folds, even with control points moved close to the
+// bound (0.39 of their spacing); past the bound the settings are refused.
+TEST(SubjectGenerator, TheMapDoesNotFoldAndUnsafeWarpsAreRefused) {
+  const Phantom p = phantom();
+  SubjectSettings settings = moveOnly();
+  settings.warpSpacingMm = 12;
+  settings.warpMm = 0.39 * 12;
+  for (const std::uint64_t seed : {11u, 12u, 13u, 14u}) {
+    const Subject s = makeSubject(p.image, p.labels, settings, seed);
+    EXPECT_GT(s.draw.smallestJacobian, 0.0) << seed;
+    // The label volumes follow the map's overall volume change rather than
+    // vanishing or doubling.
+    long long inner = 0, source = 0;
+    for (const float l : s.labels.voxels) inner += l == 1;
+    for (const float l : p.labels.voxels) source += l == 1;
+    EXPECT_GT(inner, 0.6 * source) << seed;
+    EXPECT_LT(inner, 1.6 * source) << seed;
+  }
+  settings.warpMm = 0.41 * 12;
+  EXPECT_THROW(makeSubject(p.image, p.labels, settings, 1), Error);
+}
+
+// Air carries Rician noise: its magnitude is Rayleigh, of mean sigma
+// sqrt(pi / 2), so the drawn sigma is recovered from air far from the head
+// within 5 % (about 9000 such voxels).
+TEST(SubjectGenerator, NoiseHasTheDrawnSignalToNoiseRatio) {
+  const Phantom p = phantom();
+  SubjectSettings settings;
+  settings.snr = {25, 25};
+  const Subject s = makeSubject(p.image, p.labels, settings, 5);
+  EXPECT_DOUBLE_EQ(s.draw.snr, 25);
+  EXPECT_NEAR(s.draw.noiseSigma, s.draw.whiteMatter * std::sqrt(1.0 / 625 - 1.0 / (70.0 * 70.0)), 1e-9);
+  double sum = 0;
+  long long count = 0;
+  const ImageGeometry& g = s.image.geometry;
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i)
+        if (g.toPhysical(Vector3(i, j, k)).norm() > 33) {
+          sum += s.image.at(i, j, k);
+          ++count;
+        }
+  ASSERT_GT(count, 5000);
+  EXPECT_NEAR(sum / count / std::sqrt(M_PI / 2), s.draw.noiseSigma, 0.05 * s.draw.noiseSigma);
+}
+
+// A thick-slice subject: 3 mm along one axis, the same physical extent, and
+// its labels on the fine grid.
+TEST(SubjectGenerator, ThickSlicesKeepTheExtentAndTheFineLabels) {
+  const Phantom p = phantom();
+  SubjectSettings settings = moveOnly();
+  settings.thickFraction = 1;
+  const Subject s = makeSubject(p.image, p.labels, settings, 21);
+  ASSERT_TRUE(s.draw.thickAxis.has_value());
+  const int axis = *s.draw.thickAxis;
+  EXPECT_DOUBLE_EQ(s.image.geometry.spacing[axis], 3.0);
+  EXPECT_EQ(s.image.geometry.size[axis], 56 / 3);
+  EXPECT_TRUE(s.labels.geometry.sameGridAs(p.labels.geometry));
+  // The first thick slice's centre is the centre of the three fine ones.
+  EXPECT_NEAR(s.image.geometry.origin[axis], p.image.geometry.origin[axis] + 1.0, 1e-12);
+}
+
+}  // namespace
+}  // namespace dynsub
