@@ -39,6 +39,7 @@ struct Group {
   std::string split, image, structure, protocol;
   int runs = 0, failures = 0, collapses = 0;
   double meanDice = 0, worstDice = 1, meanLeakPercent = 0, meanMissPercent = 0, meanSeconds = 0;
+  std::string worstRun;  // the subject (for a cohort) and the click seed of the worst Dice
 };
 
 std::vector<Group> summarize(const std::vector<EvaluationRun>& runs) {
@@ -55,6 +56,8 @@ std::vector<Group> summarize(const std::vector<EvaluationRun>& runs) {
     g.failures += !r.error.empty();
     g.collapses += r.error.empty() && r.collapsed;
     g.meanDice += dice;
+    if (g.worstRun.empty() || dice < g.worstDice)
+      g.worstRun = (r.subject.empty() ? "" : "subject " + r.subject.substr(1) + ", ") + "seed " + std::to_string(r.seed);
     g.worstDice = std::min(g.worstDice, dice);
     if (r.error.empty() && r.referenceVolume > 0) {
       g.meanLeakPercent += 100 * r.leak / r.referenceVolume;
@@ -84,11 +87,12 @@ std::string csvField(const std::string& text) {
 
 void writeRunsCsv(const std::vector<EvaluationRun>& runs, const std::string& path) {
   std::ofstream out(path);
-  out << "split,image,structure,protocol,seed,format,landmarks,dice,jaccard,mean_surface_distance_mm,hd95_mm,"
+  out << "split,image,subject,subject_snr,thick_axis,structure,protocol,seed,format,landmarks,dice,jaccard,mean_surface_distance_mm,hd95_mm,"
          "volume_mm3,reference_volume_mm3,leak_mm3,miss_mm3,collapsed,surface_on_edges,seconds,steps,control_vertices,warnings,error\n";
   out << std::setprecision(6);
   for (const EvaluationRun& r : runs)
-    out << csvField(r.split) << ',' << csvField(r.image) << ',' << csvField(r.structure) << ','
+    out << csvField(r.split) << ',' << csvField(r.image) << ',' << csvField(r.subject) << ',' << r.subjectSnr << ','
+        << r.subjectThickAxis << ',' << csvField(r.structure) << ','
         << csvField(r.protocol) << ',' << r.seed << ',' << r.format
         << ',' << r.landmarks << ',' << r.dice << ',' << r.jaccard << ',' << r.meanSurfaceDistance << ',' << r.hd95
         << ',' << r.volume << ',' << r.referenceVolume << ',' << r.leak << ',' << r.miss << ','
@@ -100,13 +104,13 @@ void writeRunsCsv(const std::vector<EvaluationRun>& runs, const std::string& pat
 
 void writeSummaryCsv(const std::vector<Group>& groups, const std::string& path) {
   std::ofstream out(path);
-  out << "split,image,structure,protocol,runs,mean_dice,worst_dice,mean_leak_percent,mean_miss_percent,collapses,"
-         "failures,mean_seconds\n";
+  out << "split,image,structure,protocol,runs,mean_dice,worst_dice,worst_run,mean_leak_percent,mean_miss_percent,"
+         "collapses,failures,mean_seconds\n";
   out << std::setprecision(4);
   for (const Group& g : groups)
     out << csvField(g.split) << ',' << csvField(g.image) << ',' << csvField(g.structure) << ','
         << csvField(g.protocol) << ',' << g.runs << ','
-        << g.meanDice << ',' << g.worstDice << ',' << g.meanLeakPercent << ',' << g.meanMissPercent << ','
+        << g.meanDice << ',' << g.worstDice << ',' << csvField(g.worstRun) << ',' << g.meanLeakPercent << ',' << g.meanMissPercent << ','
         << g.collapses << ',' << g.failures << ',' << g.meanSeconds << '\n';
   out.close();
   if (!out) throw writeFailure(path);
@@ -128,6 +132,7 @@ Report summaryReport(const std::vector<Group>& groups, const std::vector<Evaluat
     r.set("runs", g.runs);
     r.set("mean_dice", g.meanDice);
     r.set("worst_dice", g.worstDice);
+    r.set("worst_run", g.worstRun);
     r.set("mean_leak_percent", g.meanLeakPercent);
     r.set("mean_miss_percent", g.meanMissPercent);
     r.set("collapses", g.collapses);
@@ -223,7 +228,7 @@ void runEvaluate(const EvaluateCommandOptions& o) {
   options.landmarkDirectory = o.keepLandmarks.empty() ? scratch.string() : o.keepLandmarks;
   const auto started = std::chrono::steady_clock::now();
   const std::vector<EvaluationRun> runs = runEvaluation(plan, options, [](const EvaluationRun& r, int n, int total) {
-    std::cerr << '[' << n << '/' << total << "] " << r.split << ' ' << r.image << ' ' << r.structure << ' '
+    std::cerr << '[' << n << '/' << total << "] " << r.split << ' ' << r.image << (r.subject.empty() ? "" : " " + r.subject) << ' ' << r.structure << ' '
               << r.protocol << " seed " << r.seed << ": ";
     if (r.error.empty()) {
       std::cerr << "Dice " << std::fixed << std::setprecision(3) << r.dice << (r.collapsed ? " (collapsed)" : "")

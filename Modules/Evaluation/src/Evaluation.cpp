@@ -17,6 +17,7 @@
 #include "dynsub/ImageIO.h"
 #include "dynsub/Metrics.h"
 #include "dynsub/SegmentImage.h"
+#include "dynsub/SubjectGenerator.h"
 
 namespace dynsub {
 
@@ -68,7 +69,7 @@ EvaluationRun runOne(const EvaluationPlan& plan, const Volume& image, const Mask
   inputs.landmarkSource = run.protocol;
   if (!landmarks.empty()) {
     const std::string path = (std::filesystem::path(landmarkDirectory) /
-                              (run.split + "_" + run.image + "_" + run.structure + "_" + run.protocol + "_" +
+                              (run.split + "_" + run.image + (run.subject.empty() ? "" : "_" + run.subject) + "_" + run.structure + "_" + run.protocol + "_" +
                                std::to_string(run.seed) + "." + run.format)).string();
     writeLandmarks(landmarks, path);
     landmarks = readLandmarks(path);
@@ -124,8 +125,38 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
   const std::filesystem::path base = std::filesystem::absolute(path).parent_path();
   EvaluationPlan plan;
   try {
-    plan.reference = resolve(j.at("reference").get<std::string>(), base);
-    for (const auto& i : j.at("images")) plan.images.push_back({i.at("name"), resolve(i.at("path"), base)});
+    if (j.contains("images")) {
+      plan.reference = resolve(j.at("reference").get<std::string>(), base);
+      for (const auto& i : j.at("images")) plan.images.push_back({i.at("name"), resolve(i.at("path"), base)});
+    }
+    const nlohmann::json cohorts = j.value("cohorts", nlohmann::json::array());
+    for (const auto& c : cohorts) {
+      EvaluationCohort cohort{c.at("name"), resolve(c.at("image"), base), resolve(c.at("labels"), base), {}, {}};
+      const std::string where = "cohort '" + cohort.name + "'";
+      const nlohmann::json settings = c.value("settings", nlohmann::json::object());
+      for (const auto& [key, value] : settings.items()) {
+        std::string text;
+        if (value.is_array()) {
+          for (const auto& v : value) text += (text.empty() ? "" : ",") + v.dump();
+        } else {
+          text = value.dump();
+        }
+        setSubjectSetting(cohort.settings, key, text);
+      }
+      checkSubjectSettings(cohort.settings);
+      std::set<std::uint64_t> seen;
+      for (const auto& [split, seeds] : c.at("subjects").items()) {
+        std::vector<std::uint64_t> list;
+        for (const auto& seed : seeds) {
+          list.push_back(static_cast<std::uint64_t>(wholeNumber(seed, where + ": a subject", 0, kLargestSetting)));
+          if (!seen.insert(list.back()).second)
+            throw Error(path, where + ": subject " + std::to_string(list.back()) +
+                                  " is in two splits (tuning and test subjects must be disjoint)");
+        }
+        cohort.subjects.emplace_back(split, list);
+      }
+      plan.cohorts.push_back(cohort);
+    }
     for (const auto& s : j.at("structures")) {
       const std::string name = s.at("name");
       std::vector<int> labels;
@@ -200,8 +231,15 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
     const std::string message = e.what();
     throw Error(message.rfind(path, 0) == 0 ? message : path + ": " + message);
   }
-  if (plan.images.empty() || plan.structures.empty() || plan.protocols.empty() || plan.splits.empty())
-    throw Error(path, "an evaluation plan needs images, structures, protocols and splits");
+  if ((plan.images.empty() && plan.cohorts.empty()) || plan.structures.empty() || plan.protocols.empty() ||
+      plan.splits.empty())
+    throw Error(path, "an evaluation plan needs images or cohorts, structures, protocols and splits");
+  for (const EvaluationCohort& cohort : plan.cohorts)
+    for (const auto& [split, seeds] : cohort.subjects) {
+      bool known = false;
+      for (const EvaluationSplit& s : plan.splits) known = known || s.name == split;
+      if (!known) throw Error(path, "cohort '" + cohort.name + "' names unknown split '" + split + "'");
+    }
   // Names make the runs' file names and the summary's groups: each once.
   auto unique = [&](const auto& entries, const auto& nameOf, const char* what) {
     std::set<std::string> seen;
@@ -211,6 +249,10 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
   };
   const auto name = [](const auto& entry) { return entry.name; };
   unique(plan.images, name, "images");
+  unique(plan.cohorts, name, "cohorts");
+  for (const EvaluationCohort& cohort : plan.cohorts)
+    for (const EvaluationImage& image : plan.images)
+      if (image.name == cohort.name) throw Error(path, "an image and a cohort are both named '" + image.name + "'");
   unique(plan.structures, name, "structures");
   unique(plan.protocols, [](const EvaluationProtocol& p) { return p.clicks.name; }, "protocols");
   unique(plan.splits, name, "splits");
@@ -231,27 +273,62 @@ std::vector<EvaluationRun> runEvaluation(const EvaluationPlan& plan, const Evalu
     if (!known) throw Error("the plan has no split '" + name + "'");
   }
 
-  // Every input is read once, before any run.
-  const Volume labels = readVolume(plan.reference);
-  std::map<std::string, Mask> references;
-  for (const EvaluationStructure& s : plan.structures) {
-    references[s.name] = selectLabels(labels, s.labels);
-    if (references[s.name].count() == 0)
-      throw Error(plan.reference, "structure '" + s.name + "' has no voxel with its labels");
+  // Every input is read or generated once, before any run: an image, its
+  // references (one mask per structure) and what its runs record of it.
+  struct Input {
+    std::string image, subject, split;  // split: empty for a plan's image (every split)
+    Volume volume;
+    std::map<std::string, Mask> references;
+    double snr = 0;
+    int thickAxis = -1;
+  };
+  std::vector<Input> inputs;
+  auto addReferences = [&](Input& input, const Volume& labels, const std::string& source) {
+    for (const EvaluationStructure& s : plan.structures) {
+      Mask& mask = input.references[s.name] = selectLabels(labels, s.labels);
+      if (mask.count() == 0) throw Error(source, "structure '" + s.name + "' has no voxel with its labels");
+    }
+  };
+  if (!plan.images.empty()) {
+    const Volume labels = readVolume(plan.reference);
+    for (const EvaluationImage& i : plan.images) {
+      Input& input = inputs.emplace_back();
+      input.image = i.name;
+      input.volume = readVolume(i.path);
+      addReferences(input, labels, plan.reference);
+    }
   }
-  std::vector<Volume> images;
-  for (const EvaluationImage& i : plan.images) images.push_back(readVolume(i.path));
+  for (const EvaluationCohort& cohort : plan.cohorts) {
+    const Volume image = readVolume(cohort.image), labels = readVolume(cohort.labels);
+    for (const auto& [split, seeds] : cohort.subjects) {
+      bool wanted = false;
+      for (const EvaluationSplit* s : splits) wanted = wanted || s->name == split;
+      if (!wanted) continue;
+      for (const std::uint64_t seed : seeds) {
+        Subject subject = makeSubject(image, labels, cohort.settings, seed);
+        Input& input = inputs.emplace_back();
+        input.image = cohort.name;
+        input.subject = "s" + std::to_string(seed);
+        input.split = split;
+        input.snr = subject.draw.snr;
+        input.thickAxis = subject.draw.thickAxis.value_or(-1);
+        addReferences(input, subject.labels, cohort.name + " subject " + std::to_string(seed));
+        input.volume = std::move(subject.image);
+      }
+    }
+  }
   std::filesystem::create_directories(options.landmarkDirectory);
 
   struct Job {
-    const Volume* image;
+    const Input* input;
     const EvaluationStructure* structure;
     const EvaluationProtocol* protocol;
     EvaluationRun run;
   };
   std::vector<Job> jobs;
   for (const EvaluationSplit* split : splits)
-    for (size_t i = 0; i < plan.images.size(); ++i)
+    for (const Input& input : inputs) {
+      if (!input.split.empty() && input.split != split->name) continue;
       for (const EvaluationStructure& structure : plan.structures) {
         if (!split->structures.empty() && std::find(split->structures.begin(), split->structures.end(),
                                                     structure.name) == split->structures.end())
@@ -260,15 +337,19 @@ std::vector<EvaluationRun> runEvaluation(const EvaluationPlan& plan, const Evalu
           for (unsigned seed : split->seeds) {
             EvaluationRun run;
             run.split = split->name;
-            run.image = plan.images[i].name;
+            run.image = input.image;
+            run.subject = input.subject;
+            run.subjectSnr = input.snr;
+            run.subjectThickAxis = input.thickAxis;
             run.structure = structure.name;
             run.protocol = protocol.clicks.name;
             run.seed = seed;
             static const char* const kFormats[] = {"mrk.json", "fcsv", "csv"};
             run.format = protocol.format == "rotate" ? kFormats[seed % 3] : protocol.format;
-            jobs.push_back({&images[i], &structure, &protocol, run});
+            jobs.push_back({&input, &structure, &protocol, run});
           }
       }
+    }
 
   std::vector<EvaluationRun> runs(jobs.size());
   std::atomic<size_t> next{0};
@@ -279,7 +360,8 @@ std::vector<EvaluationRun> runEvaluation(const EvaluationPlan& plan, const Evalu
       const Job& job = jobs[k];
       EvaluationRun run = job.run;
       try {
-        run = runOne(plan, *job.image, references.at(job.structure->name), *job.protocol, job.structure->axis, run,
+        run = runOne(plan, job.input->volume, job.input->references.at(job.structure->name), *job.protocol,
+                     job.structure->axis, run,
                      options.landmarkDirectory);
       } catch (const std::exception& e) {
         run.error = e.what();

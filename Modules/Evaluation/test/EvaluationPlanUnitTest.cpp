@@ -1,5 +1,6 @@
-// Reading an evaluation plan (Evaluation.h): its whole numbers. The plan's
-// other errors are checked through the command (TestEvaluation.sh).
+// Reading an evaluation plan (Evaluation.h): its whole numbers and its
+// cohorts. The plan's other errors are checked through the command
+// (TestEvaluation.sh).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -63,6 +64,52 @@ TEST(EvaluationPlan, FractionsAndNumbersOutOfRangeAreRefused) {
   EXPECT_NE(errorOf(R"({"name": "six"})", "[-1]").find("a seed must be in 0..4294967295, got -1"),
             std::string::npos);
   EXPECT_NE(errorOf(R"({"name": "six", "points_per_slice": 1e12})", "[1]").find("points_per_slice must be in"),
+            std::string::npos);
+}
+
+// A plan of cohorts only, with `cohort` as JSON text (tuning and test splits).
+std::string cohortError(const std::string& cohort, EvaluationPlan* plan = nullptr) {
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("dynsub_cohort_" + std::to_string(::getpid()) + "_" +
+                             ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".json"))
+                               .string();
+  std::ofstream(path) << R"({"cohorts": [)" << cohort << R"(],
+    "structures": [{"name": "caudate_left", "labels": [71], "orientation": "coronal"}],
+    "protocols": [{"name": "six"}], "splits": [{"name": "tuning", "seeds": [1]}, {"name": "test", "seeds": [101]}]})";
+  std::string error;
+  try {
+    const EvaluationPlan read = readEvaluationPlan(path);
+    if (plan) *plan = read;
+  } catch (const Error& e) {
+    error = e.what();
+  }
+  std::remove(path.c_str());
+  return error;
+}
+
+TEST(EvaluationPlan, CohortsTakeSettingsAndSubjectsPerSplit) {
+  EvaluationPlan plan;
+  ASSERT_EQ(cohortError(R"({"name": "noisy", "image": "ch2.nii.gz", "labels": "aal.nii.gz",
+      "settings": {"snr": [15, 20], "thick_fraction": 0.5}, "subjects": {"tuning": [1, 2], "test": [101]}})", &plan),
+            "");
+  const EvaluationCohort& cohort = plan.cohorts.at(0);
+  EXPECT_EQ(cohort.settings.snr[0], 15);
+  EXPECT_EQ(cohort.settings.snr[1], 20);
+  EXPECT_EQ(cohort.settings.thickFraction, 0.5);
+  ASSERT_EQ(cohort.subjects.size(), 2u);
+  for (const auto& [split, seeds] : cohort.subjects)
+    EXPECT_EQ(seeds, (split == "tuning" ? std::vector<std::uint64_t>{1, 2} : std::vector<std::uint64_t>{101})) << split;
+}
+
+TEST(EvaluationPlan, CohortsWithSharedSubjectsUnknownSplitsOrBadSettingsAreRefused) {
+  const std::string start = R"({"name": "noisy", "image": "ch2.nii.gz", "labels": "aal.nii.gz", )";
+  EXPECT_NE(cohortError(start + R"("subjects": {"tuning": [1, 2], "test": [2]}})").find("subject 2 is in two splits"),
+            std::string::npos);
+  EXPECT_NE(cohortError(start + R"("subjects": {"training": [1]}})").find("unknown split 'training'"),
+            std::string::npos);
+  EXPECT_NE(cohortError(start + R"("settings": {"noise": 2}, "subjects": {"test": [1]}})").find("unknown setting"),
+            std::string::npos);
+  EXPECT_NE(cohortError(start + R"("settings": {"warp_mm": 40}, "subjects": {"test": [1]}})").find("fold"),
             std::string::npos);
 }
 

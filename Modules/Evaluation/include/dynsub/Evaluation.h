@@ -22,12 +22,23 @@
 
 #include "dynsub/ClickProtocol.h"
 #include "dynsub/SegmentParameters.h"
+#include "dynsub/SubjectGenerator.h"
 
 namespace dynsub {
 
 struct EvaluationImage {
   std::string name;
   std::string path;
+};
+
+// Generated subjects (SubjectGenerator.h) made from one image and its label
+// map, each its own ground truth: a cohort's subjects run in their split only,
+// so tuning and test subjects never meet.
+struct EvaluationCohort {
+  std::string name;
+  std::string image, labels;  // paths
+  SubjectSettings settings;
+  std::vector<std::pair<std::string, std::vector<std::uint64_t>>> subjects;  // split -> subject seeds
 };
 
 struct EvaluationStructure {
@@ -54,6 +65,7 @@ struct EvaluationPlan {
   SegmentParameters parameters;
   std::string reference;  // labelmap path
   std::vector<EvaluationImage> images;
+  std::vector<EvaluationCohort> cohorts;
   std::vector<EvaluationStructure> structures;
   std::vector<EvaluationProtocol> protocols;
   std::vector<EvaluationSplit> splits;
@@ -64,6 +76,9 @@ EvaluationPlan readEvaluationPlan(const std::string& path);
 
 struct EvaluationRun {
   std::string split, image, structure, protocol, format;
+  std::string subject;  // a cohort's subject ("s" and its seed), empty for a plan's image
+  double subjectSnr = 0;  // what the subject was drawn with (0 for a plan's image)
+  int subjectThickAxis = -1;
   unsigned seed = 0;
   int landmarks = 0;
   std::string error;  // empty when the run succeeded
@@ -86,8 +101,8 @@ struct EvaluationOptions {
   std::string landmarkDirectory;    // where each run's landmark file is written
 };
 
-// The runs of the plan's splits, in a fixed order (split, image, structure,
-// protocol, seed) whatever `jobs` is. `done` (may be null) is called after
+// The runs of the plan's splits, in a fixed order (split, image or cohort and
+// its subjects, structure, protocol, seed) whatever `jobs` is. `done` (may be null) is called after
 // each run, from the worker that ran it, serialized.
 std::vector<EvaluationRun> runEvaluation(const EvaluationPlan& plan, const EvaluationOptions& options,
                                          const std::function<void(const EvaluationRun&, int finished, int total)>& done);
