@@ -54,6 +54,34 @@ PY
 check "the SVG plot is well-formed XML" python3 -c "import sys, xml.dom.minidom; xml.dom.minidom.parse(sys.argv[1])" \
   "$work/eval/dice_test.svg"
 
+# A cohort of generated subjects (SubjectGenerator.h): one single-scan test
+# subject (SNR 20-30) made from Colin27 and AAL, two structures, six slices
+# of clicks. Each run is scored against the subject's own moved labels.
+cat >"$work/cohort.json" <<'JSON'
+{"cohorts": [{"name": "single_scan", "image": "/usr/share/mricron/templates/ch2.nii.gz",
+  "labels": "/usr/share/mricron/templates/aal.nii.gz", "settings": {"snr": [20, 30]},
+  "subjects": {"tuning": [1], "test": [101]}}],
+ "structures": [{"name": "putamen_right", "labels": [74], "orientation": "coronal"},
+                {"name": "thalamus_left", "labels": [77], "orientation": "coronal"}],
+ "protocols": [{"name": "six_slices", "slices": 6, "points_per_slice": 6, "coverage": [0.6, 0.8],
+                "scatter_mm": 0.4, "format": "rotate"}],
+ "splits": [{"name": "tuning", "seeds": [1]}, {"name": "test", "seeds": [101]}]}
+JSON
+"$DYNSUB" evaluate "$work/cohort.json" --split test --out "$work/cohort" >"$work/cohort.log" 2>&1
+check "evaluate runs a cohort" test $? -eq 0
+# Only the test subject runs in the test split; floors as above (today's
+# Dice less 0.06: 0.832 and 0.864).
+check "a cohort's test subject, scored against its own labels" python3 - "$work/cohort/runs.csv" <<'PY'
+import csv, sys
+runs = list(csv.DictReader(open(sys.argv[1])))
+assert len(runs) == 2, len(runs)
+assert all(r["subject"] == "s101" and r["image"] == "single_scan" and not r["error"] for r in runs), runs
+assert 20 <= float(runs[0]["subject_snr"]) <= 30, runs[0]["subject_snr"]
+floors = {"putamen_right": 0.77, "thalamus_left": 0.80}
+for r in runs:
+    assert float(r["dice"]) >= floors[r["structure"]], (r["structure"], r["dice"])
+PY
+
 # Bad plans: a clear error naming the file, a non-zero exit, no output.
 bad() {  # bad NAME PLAN-TEXT EXPECTED-MESSAGE
   local name=$1 text=$2 expected=$3
@@ -71,7 +99,7 @@ edited() {
 }
 bad not_json '{"reference": ' "not valid JSON"
 bad no_splits '{"reference": "x.nii.gz", "images": [], "structures": [], "protocols": [], "splits": []}' \
-  "needs images, structures, protocols and splits"
+  "needs images or cohorts, structures, protocols and splits"
 bad unknown_structure "$(edited "p['splits'][0]['structures'] = ['nucleus_x']")" "unknown structure 'nucleus_x'"
 bad bad_protocol "$(edited "p['protocols'][0]['coverage'] = [0.9, 0.2]")" "coverage"
 # Whole numbers are whole: 1.5 slices or a seed of -1 is refused, not read as 1 or 4294967295.
