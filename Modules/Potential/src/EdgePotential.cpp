@@ -39,20 +39,35 @@ double percentile(std::vector<float> values, double fraction) {
 }
 
 // The strongest gradient magnitude within `radius` mm of a point: the height
-// of the edge an expert meant when clicking next to it.
+// of the edge an expert meant when clicking next to it. Along an axis whose
+// voxels are longer than twice the radius (thick slices), a voxel is as near
+// as its slab: a click between two slices sees both.
 double strongestNear(const Volume& magnitude, const Vector3& point, double radius) {
   const ImageGeometry& g = magnitude.geometry;
   const Vector3 centre = g.toIndex(point);
   double strongest = 0;
   int reach[3];
-  for (int a = 0; a < 3; ++a) reach[a] = static_cast<int>(std::ceil(radius / g.spacing[a]));
+  Vector3 slab = Vector3::Zero();  // mm, half a voxel along thick axes
+  for (int a = 0; a < 3; ++a) {
+    if (0.5 * g.spacing[a] > radius) slab[a] = 0.5 * g.spacing[a];
+    reach[a] = static_cast<int>(std::ceil((radius + slab[a]) / g.spacing[a]));
+  }
+  const bool thick = slab.maxCoeff() > 0;
   const int ci = static_cast<int>(std::lround(centre[0])), cj = static_cast<int>(std::lround(centre[1])),
             ck = static_cast<int>(std::lround(centre[2]));
   for (int k = ck - reach[2]; k <= ck + reach[2]; ++k)
     for (int j = cj - reach[1]; j <= cj + reach[1]; ++j)
-      for (int i = ci - reach[0]; i <= ci + reach[0]; ++i)
-        if (g.contains(i, j, k) && (g.toPhysical(Vector3(i, j, k)) - point).norm() <= radius)
-          strongest = std::max(strongest, static_cast<double>(magnitude.at(i, j, k)));
+      for (int i = ci - reach[0]; i <= ci + reach[0]; ++i) {
+        if (!g.contains(i, j, k)) continue;
+        bool near = false;
+        if (thick) {  // offsets along the grid's axes (mm), less the slabs
+          const Vector3 offset = (Vector3(i, j, k) - centre).cwiseProduct(g.spacing).cwiseAbs() - slab;
+          near = offset.cwiseMax(0.0).norm() <= radius;
+        } else {
+          near = (g.toPhysical(Vector3(i, j, k)) - point).norm() <= radius;
+        }
+        if (near) strongest = std::max(strongest, static_cast<double>(magnitude.at(i, j, k)));
+      }
   return strongest;
 }
 

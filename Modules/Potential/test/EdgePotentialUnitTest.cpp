@@ -159,6 +159,26 @@ TEST(EdgePotential, LandmarksSetTheEdgeThresholds) {
   EXPECT_EQ(edgesNear(flatByImage, centre, 4.5), inner);
 }
 
+// On 3 mm slices, clicks midway between two slices are 1.5 mm from every
+// voxel centre, beyond the landmarks' 1 mm reach: the reach along the thick
+// axis is half a slice, so they still set the thresholds from the slices on
+// either side (the outer boundary's edge, as on the fine grid).
+TEST(EdgePotential, ClicksBetweenThickSlicesSetTheEdgeThresholds) {
+  const ImageGeometry g = grid({40, 36, 12}, Vector3(1, 1, 3), Vector3(0, 0, 0), Matrix3::Identity());
+  const Vector3 centre = g.toPhysical(Vector3(19.5, 17.5, 6));  // on slice 6
+  const Volume image = shellPhantom(g, centre);
+  MatrixX3 between(24, 3);
+  for (int p = 0; p < 24; ++p) {
+    const double angle = 2 * M_PI * p / 12, z = p < 12 ? 1.5 : -1.5, r = std::sqrt(81 - z * z);
+    between.row(p) = (centre + Vector3(r * std::cos(angle), r * std::sin(angle), z)).transpose();
+  }
+  const EdgeField field(image, EdgeOptions{}, between);
+  EXPECT_EQ(field.scale().reference, EdgeReference::Landmarks);
+  // Thick slices blur the step along z: the peak is lower than the fine
+  // grid's 80 / sqrt(2 pi), but far above the 1 % refusal line.
+  EXPECT_GT(field.scale().magnitude, 0.3 * 80 / std::sqrt(2 * M_PI));
+}
+
 TEST(EdgePotential, BadOptionsAreRefused) {
   EdgeOptions options;
   options.sigma = std::nan("");
