@@ -33,7 +33,11 @@ std::vector<unsigned char> inflateGzipFile(const std::string& path, std::uintmax
     for (int b = 3; b >= 0; --b) trailer = trailer << 8 | packed[packed.size() - 4 + b];
     capacity = std::max<std::size_t>(capacity, trailer);
   }
-  const std::size_t largest = static_cast<std::size_t>(expected) * 4 + (1 << 16);
+  // Deflate inflates at most 1032-fold: no buffer beyond what the file can
+  // hold is allocated, whatever a hostile header or trailer announces.
+  const std::size_t possible = packed.size() * 1032 + (1 << 16);
+  const std::size_t largest =
+      std::min(possible, static_cast<std::size_t>(std::min<std::uintmax_t>(expected, possible)) * 4 + (1 << 16));
   capacity = std::min(std::max<std::size_t>(capacity, 1), largest);
   const std::unique_ptr<libdeflate_decompressor, void (*)(libdeflate_decompressor*)> decompressor(
       libdeflate_alloc_decompressor(), &libdeflate_free_decompressor);
