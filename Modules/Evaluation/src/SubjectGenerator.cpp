@@ -9,6 +9,8 @@
 #include "dynsub/Error.h"
 #include "dynsub/ImageFilters.h"
 #include "dynsub/ParallelFor.h"
+#include "dynsub/Percentile.h"
+#include "dynsub/TextFields.h"
 
 namespace dynsub {
 namespace {
@@ -125,14 +127,6 @@ double smallestJacobian(const SubjectMap& map, const ImageGeometry& grid) {
   return *std::min_element(smallest.begin(), smallest.end());
 }
 
-// The intensity below which `fraction` of `values` lie.
-float quantile(std::vector<float> values, double fraction) {
-  if (values.empty()) return 0;
-  const auto at = static_cast<std::size_t>(fraction * static_cast<double>(values.size() - 1));
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(at), values.end());
-  return values[at];
-}
-
 // The image averaged over `factor` voxels along `axis` (thick slices: each
 // slice's signal is the mean over its thickness).
 Volume thickSlices(const Volume& image, int axis, int factor) {
@@ -161,14 +155,8 @@ Volume thickSlices(const Volume& image, int axis, int factor) {
 
 void setSubjectSetting(SubjectSettings& s, const std::string& key, const std::string& value) {
   auto number = [&](const std::string& text) {
-    std::size_t used = 0;
     double v = 0;
-    try {
-      v = std::stod(text, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != text.size() || !std::isfinite(v))
+    if (!parseNumber(text, v) || !std::isfinite(v))
       throw Error("subject settings", key + " must be a number, got '" + value + "'");
     return v;
   };
@@ -266,7 +254,7 @@ Subject makeSubject(const Volume& image, const Volume& labels, const SubjectSett
   positive.reserve(anatomy.voxels.size());
   for (const float v : anatomy.voxels)
     if (v > 0) positive.push_back(v);
-  const float bright = quantile(positive, 0.995);
+  const float bright = percentile(positive, 0.995);
   if (!(bright > 0)) throw Error("subject", "the source image has no positive intensities");
   subject.draw.gamma = std::exp(draw.uniform(-settings.gammaSpread, settings.gammaSpread));
   for (float& v : anatomy.voxels)
@@ -303,11 +291,11 @@ Subject makeSubject(const Volume& image, const Volume& labels, const SubjectSett
   std::vector<float> head;
   for (const float v : acquired.voxels)
     if (v > 0.1f * bright) head.push_back(v);
-  const float upper = quantile(head, 0.75);
+  const float upper = percentile(head, 0.75);
   std::vector<float> brightest;
   for (const float v : head)
     if (v >= upper) brightest.push_back(v);
-  subject.draw.whiteMatter = quantile(brightest, 0.5);
+  subject.draw.whiteMatter = percentile(brightest, 0.5);
   subject.draw.snr = draw.uniform(settings.snr[0], settings.snr[1]);
   const double total = subject.draw.whiteMatter / subject.draw.snr;
   const double own = subject.draw.whiteMatter / settings.sourceSnr;

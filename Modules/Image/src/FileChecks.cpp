@@ -25,6 +25,7 @@ std::vector<unsigned char> inflateGzipFile(const std::string& path, std::uintmax
   auto corrupt = [&](const std::string& why) {
     return Error(path, "truncated or corrupt compressed data (" + why + ")");
   };
+  if (packed.empty()) throw corrupt("an empty file");
   // A gzip member ends with its inflated size modulo 2^32: the usual file,
   // one member under 4 GiB, is inflated in one call into a buffer of that size.
   std::size_t capacity = static_cast<std::size_t>(expected);
@@ -44,7 +45,6 @@ std::vector<unsigned char> inflateGzipFile(const std::string& path, std::uintmax
   if (!decompressor) throw std::bad_alloc();
   std::vector<unsigned char> inflated(capacity);
   std::size_t read = 0, written = 0;
-  if (packed.empty()) throw corrupt("an empty file");
   while (read < packed.size()) {  // one member after another, as gzip does
     std::size_t memberIn = 0, memberOut = 0;
     const auto result = libdeflate_gzip_decompress_ex(decompressor.get(), packed.data() + read, packed.size() - read,

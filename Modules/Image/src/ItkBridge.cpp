@@ -109,40 +109,39 @@ void readImage(const std::string& path, Geometry& geometry, std::vector<float>& 
   }
 }
 
-void writeLabels(const Geometry& geometry, const std::vector<std::uint8_t>& voxels, const std::string& path) {
+namespace {
+
+// `voxels` on `geometry` written by ITK as an Image, compressed when the
+// format allows; `what` names it in the error.
+template <typename Image, typename Pixel>
+void writeCompressed(const Geometry& geometry, const std::vector<Pixel>& voxels, const std::string& path,
+                     const char* what) {
   registerFormats();
   try {
-    auto writer = itk::ImageFileWriter<MaskImage>::New();
+    auto writer = itk::ImageFileWriter<Image>::New();
     writer->SetFileName(path);
-    writer->SetInput(makeImage<MaskImage>(geometry, voxels));
+    writer->SetInput(makeImage<Image>(geometry, voxels));
     writer->UseCompressionOn();
     writer->Update();
   } catch (const itk::ExceptionObject& e) {
-    throw Error(path, std::string("cannot write labelmap: ") + e.GetDescription());
+    throw Error(path, std::string("cannot write ") + what + ": " + e.GetDescription());
   }
 }
 
+}  // namespace
+
+void writeLabels(const Geometry& geometry, const std::vector<std::uint8_t>& voxels, const std::string& path) {
+  writeCompressed<MaskImage>(geometry, voxels, path, "labelmap");
+}
+
 void writeImage(const Geometry& geometry, const std::vector<float>& voxels, bool labels, const std::string& path) {
-  registerFormats();
-  try {
-    if (labels) {
-      using LabelImage = itk::Image<std::int16_t, 3>;
-      std::vector<std::int16_t> values(voxels.size());
-      for (std::size_t v = 0; v < voxels.size(); ++v) values[v] = static_cast<std::int16_t>(std::lround(voxels[v]));
-      auto writer = itk::ImageFileWriter<LabelImage>::New();
-      writer->SetFileName(path);
-      writer->SetInput(makeImage<LabelImage>(geometry, values));
-      writer->UseCompressionOn();
-      writer->Update();
-    } else {
-      auto writer = itk::ImageFileWriter<FloatImage>::New();
-      writer->SetFileName(path);
-      writer->SetInput(makeImage<FloatImage>(geometry, voxels));
-      writer->UseCompressionOn();
-      writer->Update();
-    }
-  } catch (const itk::ExceptionObject& e) {
-    throw Error(path, std::string("cannot write image: ") + e.GetDescription());
+  if (labels) {
+    using LabelImage = itk::Image<std::int16_t, 3>;
+    std::vector<std::int16_t> values(voxels.size());
+    for (std::size_t v = 0; v < voxels.size(); ++v) values[v] = static_cast<std::int16_t>(std::lround(voxels[v]));
+    writeCompressed<LabelImage>(geometry, values, path, "image");
+  } else {
+    writeCompressed<FloatImage>(geometry, voxels, path, "image");
   }
 }
 

@@ -9,6 +9,7 @@
 #include "dynsub/Error.h"
 #include "dynsub/ImageFilters.h"
 #include "dynsub/ParallelFor.h"
+#include "dynsub/Percentile.h"
 
 namespace dynsub {
 namespace {
@@ -29,13 +30,6 @@ Volume magnitudeOf(const ImageGeometry& geometry, const std::vector<Vector3>& gr
     for (long long v = k * slice; v < (k + 1) * slice; ++v) magnitude.voxels[v] = static_cast<float>(gradient[v].norm());
   });
   return magnitude;
-}
-
-double percentile(std::vector<float> values, double fraction) {
-  if (values.empty()) return 0;
-  const auto at = values.begin() + static_cast<long>(fraction * (values.size() - 1));
-  std::nth_element(values.begin(), at, values.end());
-  return *at;
 }
 
 // The strongest gradient magnitude within `radius` mm of a point: the height

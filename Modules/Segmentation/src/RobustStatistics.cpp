@@ -1,9 +1,11 @@
 #include "RobustStatistics.h"
 
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "dynsub/LimitSurface.h"
+#include "dynsub/Percentile.h"
 #include "dynsub/Tessellation.h"
 #include "dynsub/Voxelize.h"
 
@@ -35,10 +37,7 @@ double steepGradient(const Volume& image) {
         const double dz = (image.voxels[g.offset(i, j, k + 1)] - image.voxels[g.offset(i, j, k - 1)]) / (2 * g.spacing(2));
         magnitudes.push_back(std::sqrt(dx * dx + dy * dy + dz * dz));
       }
-  if (magnitudes.empty()) return 0.0;
-  const auto at = magnitudes.begin() + static_cast<std::ptrdiff_t>(0.99 * (magnitudes.size() - 1));
-  std::nth_element(magnitudes.begin(), at, magnitudes.end());
-  return *at;
+  return percentile(std::move(magnitudes), 0.99);
 }
 
 }  // namespace dynsub
