@@ -66,7 +66,7 @@ void squaredDistanceAlong(float* f, long long stride, int n, double s, std::vect
 std::vector<float> distanceTo(const Mask& mask) {
   const ImageGeometry& g = mask.geometry;
   const long long count = g.voxelCount();
-  // NB: squared distances are kept in floats between the passes (each line is
+  // Squared distances are kept in floats between the passes (each line is
   // worked in doubles): on 1 mm and 0.5 mm grids floats hold them exactly,
   // elsewhere they round as ITK's did; half the memory of doubles, and the
   // distances are taken in place.
