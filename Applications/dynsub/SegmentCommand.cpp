@@ -33,6 +33,10 @@ struct Arguments {
   std::string init = "auto";
   std::string reference;
   std::vector<int> referenceLabels;
+  std::string atlas = kDefaultAtlasImage;
+  std::string atlasLabels = kDefaultAtlasLabels;
+  std::string atlasLabel;
+  std::string inside;
   SegmentParameters parameters;
   FigureOptions figures;
 };
@@ -108,6 +112,15 @@ void runSegment(const Arguments& o) {
   if (!o.landmarks.empty()) inputs.landmarks = readLandmarks(o.landmarks);
   inputs.image = o.image;
   inputs.landmarkSource = o.landmarks;
+  if (!o.inside.empty()) inputs.inside = parsePoint(o.inside, "--inside");
+  if (inputs.start.kind == SegmentStart::Kind::Atlas) {
+    if (o.atlasLabel.empty())
+      throw Error("--init atlas needs --atlas-label N[,M...] or a name from the atlas's table (e.g. Caudate_L)");
+    inputs.atlas = std::make_shared<const Atlas>(readAtlas(o.atlas, o.atlasLabels));
+    inputs.atlasLabels = atlasLabelValues(*inputs.atlas, o.atlasLabel);
+  } else if (!o.atlasLabel.empty()) {
+    throw Error("--atlas-label serves an atlas start: add --init atlas");
+  }
   checkSegmentInputs(inputs, o.parameters);
   // NB: the reference is needed only to score the result, and reading it
   // (a whole labelmap, inflated and converted) took a fifth of the caudate
@@ -152,8 +165,22 @@ void addSegmentCommand(CLI::App& app) {
                       "Initial model: auto (the 98-vertex cube inside the landmarks' PCA ellipsoid), "
                       "seed:x,y,z (one click inside the structure, LPS mm: grown through the tissue like the "
                       "click's, its boundary the springs when no --landmarks are given), "
-                      "sphere:x,y,z,r (LPS mm), or a closed control mesh file in LPS mm")
+                      "sphere:x,y,z,r (LPS mm), atlas (the atlas's structure --atlas-label registered to the image, "
+                      "which also holds the surface softly where clicks and edges say nothing), or a closed "
+                      "control mesh file in LPS mm")
       ->default_val("auto");
+  command->add_option("--atlas-label", o->atlasLabel,
+                      "With --init atlas: the structure's label value(s) in the atlas, or names from its table "
+                      "(Caudate_L; Caudate_L,Caudate_R)");
+  command->add_option("--atlas", o->atlas, "With --init atlas: the atlas's template image")
+      ->default_str(kDefaultAtlasImage);
+  command->add_option("--atlas-labels", o->atlasLabels,
+                      "With --init atlas: the atlas's label map, on its template's grid, with its names in "
+                      "LABELS.txt beside it (mricron's format: one 'VALUE NAME' per line)")
+      ->default_str(kDefaultAtlasLabels);
+  command->add_option("--inside", o->inside,
+                      "With --init atlas: x,y,z (LPS mm), a click inside the structure; it picks the carried "
+                      "label's part and moves a misplaced one there");
   command->add_option("--reference", o->reference, "Reference labelmap on the image's grid, for Dice and distances");
   command->add_option("--reference-label", o->referenceLabels, "Label value(s) of the structure in --reference")
       ->delimiter(',');

@@ -58,13 +58,22 @@ int optionalWholeNumber(const nlohmann::json& object, const char* key, int fallb
 // A result keeping less than this fraction of the reference's volume has collapsed.
 constexpr double kCollapsedBelowReference = 0.2;
 
+// An atlas protocol's start: the plan's atlas, the structure's labels in it
+// and the image's affine registration to it, made once per image.
+struct AtlasContext {
+  std::shared_ptr<const Atlas> atlas;
+  std::vector<int> labels;
+  std::shared_ptr<const AtlasAffine> affine;
+};
+
 EvaluationRun runOne(const EvaluationPlan& plan, const Volume& image, const Mask& reference,
                      const EvaluationProtocol& protocol, int axis, EvaluationRun run,
-                     const std::string& landmarkDirectory) {
+                     const std::string& landmarkDirectory, const AtlasContext& atlas) {
   ClickProtocol clicks = protocol.clicks;
   if (!protocol.ownAxis) clicks.axis = axis;
   // The clicks go through a file in the protocol's format, as a user's would.
-  std::vector<Landmark> landmarks = expertClicks(reference, clicks, run.seed);
+  std::vector<Landmark> landmarks =
+      protocol.noClicks || clicks.seedOnly ? std::vector<Landmark>{} : expertClicks(reference, clicks, run.seed);
   SegmentInputs inputs;
   inputs.landmarkSource = run.protocol;
   if (!landmarks.empty()) {
@@ -77,7 +86,13 @@ EvaluationRun runOne(const EvaluationPlan& plan, const Volume& image, const Mask
   }
   run.landmarks = static_cast<int>(landmarks.size());
   inputs.landmarks = landmarks;
-  if (clicks.seedOnly) {  // as segment --init seed: does without landmarks
+  if (protocol.atlas) {  // as segment --init atlas [--inside x,y,z]
+    inputs.start.kind = SegmentStart::Kind::Atlas;
+    inputs.atlas = atlas.atlas;
+    inputs.atlasLabels = atlas.labels;
+    inputs.atlasAffine = atlas.affine;
+    if (clicks.seedOnly) inputs.inside = seedClick(reference, clicks.seedDepth, run.seed);
+  } else if (clicks.seedOnly) {  // as segment --init seed: does without landmarks
     inputs.start.kind = SegmentStart::Kind::Seed;
     inputs.start.center = seedClick(reference, clicks.seedDepth, run.seed);
   }
@@ -128,6 +143,10 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
     if (j.contains("images")) {
       plan.reference = resolve(j.at("reference").get<std::string>(), base);
       for (const auto& i : j.at("images")) plan.images.push_back({i.at("name"), resolve(i.at("path"), base)});
+    }
+    if (j.contains("atlas")) {
+      plan.atlasImage = resolve(j.at("atlas").at("image").get<std::string>(), base);
+      plan.atlasLabels = resolve(j.at("atlas").at("labels").get<std::string>(), base);
     }
     const nlohmann::json cohorts = j.value("cohorts", nlohmann::json::array());
     for (const auto& c : cohorts) {
@@ -186,6 +205,10 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
         protocol.ownAxis = true;
         c.axis = axisOf(p.at("orientation"), "protocol '" + c.name + "'");
       }
+      protocol.atlas = p.value("atlas", false);
+      protocol.noClicks = !p.value("clicks", true);
+      if (protocol.noClicks && !protocol.atlas)
+        throw Error(path, "protocol '" + c.name + "': only an atlas protocol can do without clicks");
       protocol.format = p.value("format", protocol.format);
       if (protocol.format != "mrk.json" && protocol.format != "fcsv" && protocol.format != "csv" &&
           protocol.format != "rotate")
@@ -277,7 +300,9 @@ std::vector<EvaluationRun> runEvaluation(const EvaluationPlan& plan, const Evalu
   // references (one mask per structure) and what its runs record of it.
   struct Input {
     std::string image, subject, split;  // split: empty for a plan's image (every split)
+    std::string path;                   // a plan's image's file
     Volume volume;
+    std::shared_ptr<const AtlasAffine> atlasAffine;  // for atlas protocols
     std::map<std::string, Mask> references;
     double snr = 0;
     int thickAxis = -1;
@@ -294,6 +319,7 @@ std::vector<EvaluationRun> runEvaluation(const EvaluationPlan& plan, const Evalu
     for (const EvaluationImage& i : plan.images) {
       Input& input = inputs.emplace_back();
       input.image = i.name;
+      input.path = i.path;
       input.volume = readVolume(i.path);
       addReferences(input, labels, plan.reference);
     }
@@ -319,6 +345,20 @@ std::vector<EvaluationRun> runEvaluation(const EvaluationPlan& plan, const Evalu
   }
   std::filesystem::create_directories(options.landmarkDirectory);
 
+  // Atlas protocols: the atlas read once, each image registered to it once.
+  const auto isAtlasImage = [&](const Input& input) {
+    return !input.path.empty() &&
+           std::filesystem::weakly_canonical(input.path) == std::filesystem::weakly_canonical(plan.atlasImage);
+  };
+  std::shared_ptr<const Atlas> atlas;
+  if (std::any_of(plan.protocols.begin(), plan.protocols.end(), [](const auto& p) { return p.atlas; })) {
+    atlas = std::make_shared<const Atlas>(readAtlas(plan.atlasImage, plan.atlasLabels));
+    for (Input& input : inputs)
+      if (!isAtlasImage(input))
+        input.atlasAffine =
+            std::make_shared<const AtlasAffine>(registerAtlasAffine(input.volume, *atlas, plan.parameters.registration));
+  }
+
   struct Job {
     const Input* input;
     const EvaluationStructure* structure;
@@ -335,6 +375,7 @@ std::vector<EvaluationRun> runEvaluation(const EvaluationPlan& plan, const Evalu
           continue;
         for (const EvaluationProtocol& protocol : plan.protocols)
           for (unsigned seed : split->seeds) {
+            if (protocol.atlas && isAtlasImage(input)) continue;
             EvaluationRun run;
             run.split = split->name;
             run.image = input.image;
@@ -361,8 +402,8 @@ std::vector<EvaluationRun> runEvaluation(const EvaluationPlan& plan, const Evalu
       EvaluationRun run = job.run;
       try {
         run = runOne(plan, job.input->volume, job.input->references.at(job.structure->name), *job.protocol,
-                     job.structure->axis, run,
-                     options.landmarkDirectory);
+                     job.structure->axis, run, options.landmarkDirectory,
+                     {atlas, job.structure->labels, job.input->atlasAffine});
       } catch (const std::exception& e) {
         run.error = e.what();
       }

@@ -7,9 +7,11 @@
 
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/Error.h"
+#include "dynsub/ForceModel.h"
 #include "dynsub/Labelmap.h"
 #include "dynsub/MeshIO.h"
 #include "dynsub/ModelOutputs.h"
+#include "dynsub/ShapeRecovery.h"
 
 namespace dynsub {
 
@@ -111,9 +113,55 @@ Report sliceEndsReport(const SliceEnds& ends) {
   return r;
 }
 
+Report atlasReport(const SegmentInputs& in, const SegmentOutcome& outcome, bool reused) {
+  const AtlasAffine& affine = *outcome.atlasAffine;
+  const CarriedLabel& carried = *outcome.carried;
+  Report r;
+  r.set("template", in.atlas->imagePath);
+  r.set("labels", in.atlas->labelsPath);
+  r.set("label_values", in.atlasLabels);
+  Report registration;
+  registration.set("affine_metric", affine.metric);
+  registration.set("affine_iterations", affine.iterations);
+  registration.set("affine_seconds", reused ? 0.0 : affine.seconds);
+  registration.set("affine_reused", reused);
+  registration.set("deformable_metric", carried.metric);
+  registration.set("deformable_iterations", carried.iterations);
+  registration.set("deformable_seconds", carried.seconds);
+  registration.set("largest_warp_mm", carried.largestWarpMm);
+  r.set("registration", registration);
+  r.set("carried_volume_mm3", carriedVolume(carried));
+  if (in.inside) {
+    r.set("inside_lps_mm", *in.inside);
+    r.set("inside_shift_mm", carried.shift);
+  }
+  r.set("prior_points", outcome.prior.size());
+  return r;
+}
+
+// The atlas's start: its structure carried to the image, the prior's points
+// on its boundary, and a control mesh fitted to that boundary (the papers'
+// cube in its points' PCA ellipsoid, pulled onto 4 times as many points at
+// the initial level).
+ControlMesh atlasStart(const Volume& image, const SegmentInputs& in, const SegmentParameters& parameters,
+                       SegmentOutcome& outcome) {
+  outcome.atlasAffine = in.atlasAffine ? in.atlasAffine
+                                       : std::make_shared<const AtlasAffine>(
+                                             registerAtlasAffine(image, *in.atlas, parameters.registration));
+  outcome.carried = carryLabel(image, *in.atlas, in.atlasLabels, *outcome.atlasAffine, in.inside,
+                               parameters.registration);
+  outcome.prior = carriedBoundary(*outcome.carried, parameters.priorPoints);
+  const std::vector<Landmark> boundary = carriedBoundary(*outcome.carried, 4 * parameters.priorPoints);
+  FitOptions fit;
+  fit.simulation.maxLevel = 0;
+  return fitPointCloud(landmarkPositions(boundary), initialFromLandmarks(boundary, parameters.initialFraction), fit)
+      .mesh;
+}
+
 // The initial control mesh, and the springs: the user's landmarks, or for a
-// seed start without landmarks the seed region's boundary points, softer than
-// an expert's clicks.
+// seed start without landmarks the seed region's boundary points, and for an
+// atlas start without landmarks the prior's points, softer than an expert's
+// clicks.
 ControlMesh chooseStart(const Volume& image, const SegmentInputs& in, const SegmentParameters& parameters,
                         SegmentOptions& options, SegmentOutcome& outcome) {
   outcome.springs = in.landmarks;
@@ -133,6 +181,14 @@ ControlMesh chooseStart(const Volume& image, const SegmentInputs& in, const Segm
         options.landmarkStiffness = parameters.seed.stiffness;
       }
       return initialFromLandmarks(outcome.seed->boundary, parameters.initialFraction);
+    }
+    case SegmentStart::Kind::Atlas: {
+      ControlMesh mesh = atlasStart(image, in, parameters, outcome);
+      if (in.landmarks.empty()) {
+        outcome.springs = outcome.prior;
+        options.landmarkStiffness = parameters.priorStiffness;
+      }
+      return mesh;
     }
     case SegmentStart::Kind::Mesh: {
       ControlMesh mesh = readControlMesh(in.start.meshPath);
@@ -155,6 +211,8 @@ SegmentStart parseSegmentStart(const std::string& value, const std::string& opti
     start.kind = SegmentStart::Kind::Sphere;
     start.center = Vector3(v[0], v[1], v[2]);
     start.radius = v[3];
+  } else if (value == "atlas") {
+    start.kind = SegmentStart::Kind::Atlas;
   } else if (value.rfind("seed:", 0) == 0) {
     const std::vector<double> v = numbersAfter(value, 5, 3, "seed:x,y,z", option);
     start.kind = SegmentStart::Kind::Seed;
@@ -170,11 +228,17 @@ namespace {
 
 // The evolution's options for these inputs (segmentOptions()).
 SegmentOptions optionsFor(const SegmentInputs& in, const SegmentParameters& parameters) {
-  const bool pointsOnBoundary = !in.landmarks.empty() || in.start.kind == SegmentStart::Kind::Seed;
+  const bool pointsOnBoundary = !in.landmarks.empty() || in.start.kind == SegmentStart::Kind::Seed ||
+                                in.start.kind == SegmentStart::Kind::Atlas;
   return segmentOptions(parameters, pointsOnBoundary);
 }
 
 void checkStart(const SegmentInputs& in) {
+  if (in.inside && in.start.kind != SegmentStart::Kind::Atlas)
+    throw Error("--inside serves an atlas start (--init atlas); to start from one click alone, use --init "
+                "seed:x,y,z");
+  if (in.start.kind == SegmentStart::Kind::Atlas && (!in.atlas || in.atlasLabels.empty()))
+    throw Error("an atlas start needs the structure's labels in the atlas (--atlas-label)");
   if (in.start.kind != SegmentStart::Kind::FromLandmarks || in.landmarks.size() >= 4) return;
   const std::string alternatives = "give at least 4 on the structure's boundary, or start from one click inside it";
   if (in.landmarks.empty()) throw Error("no landmarks to build the initial model from: " + alternatives);
@@ -203,6 +267,16 @@ SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& in, const 
   const auto started = std::chrono::steady_clock::now();
   const ControlMesh initial = chooseStart(image, in, parameters, options, outcome);
   const std::vector<Landmark>& springs = outcome.springs;
+  // With landmarks, the atlas's prior pulls besides them, softly.
+  std::vector<ForceModel*> extraForces;
+  std::unique_ptr<SpringForceModel> priorSprings;
+  if (outcome.carried && !in.landmarks.empty() && parameters.priorStiffness > 0) {
+    const MatrixX3 points = landmarkPositions(outcome.prior);
+    priorSprings = std::make_unique<SpringForceModel>(
+        points, Eigen::VectorXd::Constant(points.rows(), parameters.priorStiffness),
+        SpringForceModel::Attach::NearestEachStep);
+    extraForces.push_back(priorSprings.get());
+  }
 
   // The rms landmark distance every 5 steps, the landmarks' nearest points
   // tracked from sample to sample (a new locator only when the level changes).
@@ -217,7 +291,7 @@ SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& in, const 
       5);
   outcome.result = [&] {
     try {
-      return segment(image, springs, initial, options, recorder.callback(progress));
+      return segment(image, springs, initial, options, recorder.callback(progress), extraForces);
     } catch (const LandmarksOffEdges& error) {
       // Name where the points came from, and the options that help.
       throw Error(in.landmarkSource, std::string(error.what()) + " (--edge-landmark-reach, --edge-reference image)");
@@ -244,6 +318,7 @@ SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& in, const 
   report.set("landmark_count", in.landmarks.size());
   report.set("init", in.start.text);
   if (outcome.seed) report.set("seed", seedReport(*outcome.seed, !in.landmarks.empty()));
+  if (outcome.carried) report.set("atlas", atlasReport(in, outcome, in.atlasAffine != nullptr));
   if (in.reference) {
     outcome.metrics = compareMasks(outcome.labelmap, in.reference());
     report.set("reference", in.referencePath);

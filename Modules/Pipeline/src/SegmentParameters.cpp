@@ -183,6 +183,22 @@ std::vector<Parameter> table() {
        "With a seed click and no landmarks: the stiffness of the springs to the region's boundary points",
        [](P& p) -> double& { return p.seed.stiffness; }, 0, 10000, 0.5));
 
+  // Atlas.
+  add(row("prior_points", "Prior points", "", "Atlas",
+       "With an atlas start: the points spread over the carried label's boundary that the prior's springs pull "
+       "toward",
+       [](P& p) -> int& { return p.priorPoints; }, 4, 100000, 1));
+  add(row("prior_stiffness", "Prior stiffness", "N/mm", "Atlas",
+       "With an atlas start: the stiffness of each prior spring (0: none; the atlas then only starts the "
+       "surface)",
+       [](P& p) -> double& { return p.priorStiffness; }, 0, 10000, 0.5));
+  add(row("registration_grid", "Registration grid", "mm", "Atlas",
+       "With an atlas start: the spacing of the deformable registration's B-spline control points",
+       [](P& p) -> double& { return p.registration.gridSpacingMm; }, 2, 500, 1));
+  add(row("registration_margin", "Registration margin", "mm", "Atlas",
+       "With an atlas start: the neighbourhood around the structure the deformable registration covers",
+       [](P& p) -> double& { return p.registration.marginMm; }, 0, 200, 1));
+
   // Solver.
   add(row("scheme", "Scheme", "", "Solver",
        "How the equilibrium is reached: static (Newton steps on K p = f_p), or time integration, first-order "
@@ -259,6 +275,7 @@ const std::vector<ParameterGroup>& segmentParameterGroups() {
       {"Refinement", "When the control mesh is refined.", false},
       {"Slice ends", "The structure's ends beyond the outermost clicked slices.", true},
       {"Start", "The initial model, from the landmarks or from a click inside.", true},
+      {"Atlas", "The start from an atlas registered to the image, and its prior.", true},
       {"Solver", "How the equilibrium is reached, and the surface's material.", true}};
   return groups;
 }
@@ -362,6 +379,7 @@ void checkRanges(const SegmentParameters& parameters) {
 SegmentOptions segmentOptions(const SegmentParameters& parameters, bool pointsOnBoundary) {
   checkRanges(parameters);
   checkSeedOptions(parameters.seed);
+  checkAtlasRegistrationOptions(parameters.registration);
   SegmentOptions o = parameters.segment;
   EdgeOptions& edges = o.edges;
   // Landmarks off every edge are an error, not a silent switch to the image's reference (EdgePotential.h).

@@ -1,4 +1,4 @@
-#include "RegionGrowing.h"
+#include "dynsub/RegionGrowing.h"
 
 #include <algorithm>
 #include <array>

@@ -6,7 +6,7 @@
 #include <limits>
 #include <sstream>
 
-#include "RegionGrowing.h"
+#include "dynsub/RegionGrowing.h"
 #include "RobustStatistics.h"
 #include "dynsub/Error.h"
 

@@ -184,8 +184,10 @@ SegmentationRegion::SegmentationRegion(const Volume& image, const std::vector<La
   auto clock = Clock::now();
   const MatrixX3 landmarkPoints = landmarkPositions(landmarks);
   const MatrixX3 coverPoints = landmarkPositions(alsoCover);
-  MatrixX3 extent(start.rows() + landmarkPoints.rows() + coverPoints.rows(), 3);
-  extent << start, landmarkPoints, coverPoints;
+  // The control points too: a refit checks that they stay inside (evolveInRegion),
+  // and a mesh fitted to a shape (an atlas start) has them outside its surface.
+  MatrixX3 extent(start.rows() + initial.points().rows() + landmarkPoints.rows() + coverPoints.rows(), 3);
+  extent << start, initial.points(), landmarkPoints, coverPoints;
   std::tie(first_, size_) = boundingRegion(grid, extent, options.margin);
   image_ = cropVolume(image, first_, size_);
   // readVolume refuses such images; a volume made in memory is checked here,

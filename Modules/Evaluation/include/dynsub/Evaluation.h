@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "dynsub/Atlas.h"
 #include "dynsub/ClickProtocol.h"
 #include "dynsub/SegmentParameters.h"
 #include "dynsub/SubjectGenerator.h"
@@ -51,6 +52,13 @@ struct EvaluationProtocol {
   ClickProtocol clicks;   // its axis is the structure's unless `ownAxis`
   bool ownAxis = false;
   std::string format = "mrk.json";  // mrk.json, fcsv or csv; "rotate": by seed
+  // An atlas start (segment --init atlas) with the structure's labels in the
+  // plan's atlas: with the clicks as landmarks, with a seed-only protocol's
+  // click as --inside, or with no click at all (`noClicks`). Never run on
+  // an image that is the atlas's own template: registering it to itself
+  // measures nothing.
+  bool atlas = false;
+  bool noClicks = false;
 };
 
 struct EvaluationSplit {
@@ -69,6 +77,10 @@ struct EvaluationPlan {
   std::vector<EvaluationStructure> structures;
   std::vector<EvaluationProtocol> protocols;
   std::vector<EvaluationSplit> splits;
+  // The atlas of atlas protocols: template and label map, whose label values
+  // are the structures' (a cohort generated from it, or an image labelled
+  // like it).
+  std::string atlasImage = kDefaultAtlasImage, atlasLabels = kDefaultAtlasLabels;
 };
 
 // Throws dynsub::Error naming the file and the problem.

@@ -1,6 +1,6 @@
 #pragma once
 // One segmentation from its inputs to its report: the start (from the
-// landmarks, a click inside, a sphere or a control mesh), the evolution
+// landmarks, a click inside, a sphere, a control mesh or an atlas), the evolution
 // (Segmentation.h) with its convergence record, the labelmap, the scores
 // against a reference, and report.json. `dynsub segment`, the 3D Slicer module
 // DynSubSegment and `dynsub evaluate` all run this, so all three segment and
@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "dynsub/Atlas.h"
 #include "dynsub/ConvergenceHistory.h"
 #include "dynsub/Landmarks.h"
 #include "dynsub/Metrics.h"
@@ -26,6 +27,7 @@ struct SegmentStart {
     Sphere,         // `center`, `radius`
     Seed,           // one click inside the structure at `center` (SeedGrowth.h)
     Mesh,           // a closed control mesh read from `meshPath`
+    Atlas,          // the atlas's structure carried to the image (Atlas.h), with its prior
   };
   Kind kind = Kind::FromLandmarks;
   Vector3 center = Vector3::Zero();  // LPS mm
@@ -34,7 +36,7 @@ struct SegmentStart {
   std::string text = "auto";  // as the user gave it, for report.json
 };
 
-// "auto", "sphere:x,y,z,r", "seed:x,y,z" or a mesh path; `option` names the
+// "auto", "sphere:x,y,z,r", "seed:x,y,z", "atlas" or a mesh path; `option` names the
 // flag in errors. Throws dynsub::Error on malformed or non-finite numbers.
 SegmentStart parseSegmentStart(const std::string& value, const std::string& option);
 // "x,y,z": a point in LPS mm, as a click is given on a command line; throws
@@ -55,12 +57,26 @@ struct SegmentInputs {
   // The labelmap's grid; the image's when not given (an evaluation scores
   // on its reference's own grid).
   std::optional<ImageGeometry> labelmapGrid;
+  // An atlas start: the atlas, its structure's label values, and the image's
+  // affine registration to it when one was made already (the structures of
+  // one image share it; segmentImage makes it otherwise).
+  std::shared_ptr<const Atlas> atlas;
+  std::vector<int> atlasLabels;
+  std::shared_ptr<const AtlasAffine> atlasAffine;
+  // With an atlas start: a click inside the structure (LPS mm), which picks
+  // the carried label's part and moves a misplaced one to it.
+  std::optional<Vector3> inside;
 };
 
 struct SegmentOutcome {
   SegmentResult result;
   Mask labelmap;                     // result.surface voxelized (Labelmap.h)
   std::unique_ptr<SeedRegion> seed;  // for a seed start
+  // For an atlas start: the registration (to reuse for the image's other
+  // structures), the label carried to the image and the prior's points.
+  std::shared_ptr<const AtlasAffine> atlasAffine;
+  std::optional<CarriedLabel> carried;
+  std::vector<Landmark> prior;
   std::vector<Landmark> springs;     // what the springs pulled to
   OverlapMetrics metrics;            // against the reference, when given
   ConvergenceHistory history;

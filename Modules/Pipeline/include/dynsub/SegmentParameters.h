@@ -13,6 +13,7 @@
 #include <variant>
 #include <vector>
 
+#include "dynsub/Atlas.h"
 #include "dynsub/SeedGrowth.h"
 #include "dynsub/Segmentation.h"
 
@@ -27,6 +28,12 @@ struct SegmentParameters {
   // Fractions of the edge reference in use (EdgeOptions::ofLandmarks or
   // ofImage, see segmentOptions()); unset, that reference's own default.
   std::optional<double> edgeLow, edgeHigh;
+  // An atlas start (Atlas.h): the registration, and the prior: soft springs
+  // from this many points on the carried label's boundary, which hold the
+  // surface where the image and the clicks say nothing.
+  AtlasRegistrationOptions registration;
+  int priorPoints = 100;
+  double priorStiffness = 2.0;  // N/mm per point (0: no prior)
 };
 
 // One row of the table.

@@ -1,7 +1,7 @@
 #pragma once
-// Private to the Segmentation module: the steps of growing a region from a
-// seed (SeedGrowth.h) on a voxel grid, with masks as one byte per voxel in
-// the grid's order.
+// Regions on a voxel grid, with masks as one byte per voxel in the grid's
+// order: the steps of growing a region from a seed (SeedGrowth.h), and the
+// boundary points an atlas's carried label gives (Atlas.h).
 #include <cstdint>
 #include <vector>
 

@@ -1,0 +1,119 @@
+#pragma once
+// An atlas's structure carried to a subject, to start a segmentation from
+// and to hold it where the image and the clicks say nothing (automatic
+// initialization, which the TVCG paper leaves as future work).
+//
+// The atlas is a template image and its label map on one grid. ITK registers
+// the template to the subject in two steps: an affine transform on the whole
+// head, maximizing Mattes mutual information (so a T1 template serves a
+// subject of another contrast or bias), then a cubic B-spline in the
+// structure's neighbourhood. The structure's labels are carried to the
+// subject's grid through both; its boundary gives segment() a start and a
+// prior (SegmentImage.h).
+//
+// One affine registration serves every structure of a subject (evaluations
+// and several structures reuse it); the B-spline is the structure's own.
+#include <array>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "dynsub/Landmarks.h"
+#include "dynsub/Volume.h"
+
+namespace dynsub {
+
+// Colin27 and the AAL labels, from Debian's mricron-data.
+inline const char* const kDefaultAtlasImage = "/usr/share/mricron/templates/ch2.nii.gz";
+inline const char* const kDefaultAtlasLabels = "/usr/share/mricron/templates/aal.nii.gz";
+
+struct Atlas {
+  std::string imagePath, labelsPath;
+  Volume image;
+  Volume labels;  // on the image's grid
+  // The label map's names (value, name), from the table beside it: for
+  // labels.nii.gz, labels.nii.txt or labels.txt, one "VALUE NAME ..." per line
+  // (mricron's format). Empty when there is none.
+  std::vector<std::pair<int, std::string>> names;
+};
+
+// Throws dynsub::Error naming the file when either cannot be read, or when
+// the label map is not on the template's grid.
+Atlas readAtlas(const std::string& imagePath, const std::string& labelsPath);
+
+// "71", "71,72", "Caudate_L" or "Caudate_L,Caudate_R": the label values.
+// Throws dynsub::Error for a name the table does not hold (naming the
+// nearest), or a value no voxel of the label map has.
+std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec);
+
+// y = linear x + translation: a subject point (LPS mm) to the template's.
+struct AffineMap {
+  Matrix3 linear = Matrix3::Identity();
+  Vector3 translation = Vector3::Zero();
+
+  Vector3 operator()(const Vector3& x) const { return linear * x + translation; }
+  AffineMap inverse() const;
+};
+
+struct AtlasRegistrationOptions {
+  // The affine step: the pyramid's voxel sizes (mm), coarse to fine, and
+  // its iterations per level.
+  std::vector<double> affineLevelsMm{4.0, 2.0};
+  int affineIterations = 200;
+  // The B-spline step: its control points' spacing, the largest shift of
+  // one, its pyramid and iterations, and the margin (mm) around the
+  // structure it is computed in.
+  double gridSpacingMm = 20.0;
+  double largestShiftMm = 10.0;
+  std::vector<double> deformableLevelsMm{2.0};
+  int deformableIterations = 60;
+  double marginMm = 10.0;
+  // Share of the voxels the metric samples, at random from a fixed seed.
+  double samplingFraction = 0.2;
+};
+
+void checkAtlasRegistrationOptions(const AtlasRegistrationOptions& options);
+
+struct AtlasAffine {
+  AffineMap map;  // subject -> template
+  double metric = 0;  // Mattes mutual information at the end (lower is better)
+  int iterations = 0;
+  double seconds = 0;
+};
+
+// Throws dynsub::Error when the registration fails or ends in a degenerate map.
+AtlasAffine registerAtlasAffine(const Volume& subject, const Atlas& atlas, const AtlasRegistrationOptions& options);
+
+struct CarriedLabel {
+  Mask mask;                   // on a sub-grid of the subject (ImageGeometry::region)
+  std::array<int, 3> first{};  // the sub-grid's first voxel in the subject
+  double metric = 0;           // the B-spline step's mutual information
+  int iterations = 0;
+  double seconds = 0;          // the B-spline step and the carrying
+  // The correction an inside click made (mm): how far the label was moved so
+  // that the click lies inside it; zero without a click or when it already did.
+  Vector3 shift = Vector3::Zero();
+  // The B-spline's largest displacement (mm, in the subject, before the
+  // affine map): how much the deformable step changed.
+  double largestWarpMm = 0;
+};
+
+// The structure's labels on the subject's grid, through the affine map and
+// a B-spline computed around the structure. With `inside` (a click inside
+// the structure, LPS mm): only the carried label's part that holds the
+// click, or, when the click lies outside it, the label moved so that the
+// click lies 2 mm deep. Throws dynsub::Error when the labels leave nothing on
+// the subject's grid, or the click lies outside the image.
+CarriedLabel carryLabel(const Volume& subject, const Atlas& atlas, const std::vector<int>& labels,
+                        const AtlasAffine& affine, const std::optional<Vector3>& inside,
+                        const AtlasRegistrationOptions& options);
+
+// At most `count` points on the carried label's boundary, spread evenly
+// (farthest-point sampling), as soft landmarks named "atlas N".
+std::vector<Landmark> carriedBoundary(const CarriedLabel& label, int count);
+
+// The carried label's volume (mm^3).
+double carriedVolume(const CarriedLabel& label);
+
+}  // namespace dynsub

@@ -1,0 +1,331 @@
+#include "dynsub/Atlas.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include "BridgeGeometry.h"
+#include "ItkRegistration.h"
+#include "dynsub/Error.h"
+#include "dynsub/ImageIO.h"
+#include "dynsub/RegionGrowing.h"
+
+namespace dynsub {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+bool endsWith(const std::string& text, const std::string& end) {
+  return text.size() >= end.size() && text.compare(text.size() - end.size(), end.size(), end) == 0;
+}
+
+// The name table beside a label map: labels.nii.gz -> labels.nii.txt, then labels.txt.
+std::vector<std::pair<int, std::string>> readNames(const std::string& labelsPath) {
+  std::string base = labelsPath;
+  if (endsWith(base, ".gz")) base.resize(base.size() - 3);
+  std::vector<std::string> candidates = {base + ".txt"};
+  if (const auto dot = base.rfind('.'); dot != std::string::npos && dot > base.find_last_of('/') + 1)
+    candidates.push_back(base.substr(0, dot) + ".txt");
+  for (const std::string& path : candidates) {
+    std::ifstream in(path);
+    if (!in) continue;
+    std::vector<std::pair<int, std::string>> names;
+    std::string line;
+    int number = 0;
+    while (std::getline(in, line)) {
+      ++number;
+      std::istringstream fields(line);
+      int value = 0;
+      std::string name;
+      if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+      if (!(fields >> value >> name))
+        throw Error(path, "line " + std::to_string(number) + ": expected a label value and its name");
+      names.emplace_back(value, name);
+    }
+    return names;
+  }
+  return {};
+}
+
+std::string lowered(std::string text) {
+  std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
+  return text;
+}
+
+// Levenshtein's distance, case-insensitive: for naming the nearest label.
+std::size_t editDistance(const std::string& a, const std::string& b) {
+  const std::string x = lowered(a), y = lowered(b);
+  std::vector<std::size_t> row(y.size() + 1);
+  for (std::size_t j = 0; j <= y.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= x.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= y.size(); ++j) {
+      const std::size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (x[i - 1] != y[j - 1])});
+      diagonal = above;
+    }
+  }
+  return row[y.size()];
+}
+
+itkbridge::AffineArray toArray(const AffineMap& map) {
+  itkbridge::AffineArray a{};
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) a[4 * r + c] = map.linear(r, c);
+    a[4 * r + 3] = map.translation[r];
+  }
+  return a;
+}
+
+}  // namespace
+
+AffineMap AffineMap::inverse() const {
+  AffineMap inverse;
+  inverse.linear = linear.inverse();
+  inverse.translation = -inverse.linear * translation;
+  return inverse;
+}
+
+Atlas readAtlas(const std::string& imagePath, const std::string& labelsPath) {
+  Atlas atlas;
+  atlas.imagePath = imagePath;
+  atlas.labelsPath = labelsPath;
+  atlas.image = readVolume(imagePath);
+  atlas.labels = readVolume(labelsPath);
+  if (!atlas.labels.geometry.sameGridAs(atlas.image.geometry))
+    throw Error(labelsPath, "the atlas's label map is not on its template's grid (" + imagePath + ")");
+  atlas.names = readNames(labelsPath);
+  return atlas;
+}
+
+std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec) {
+  std::vector<int> values;
+  std::stringstream items(spec);
+  std::string item;
+  while (std::getline(items, item, ',')) {
+    item.erase(0, item.find_first_not_of(" \t"));
+    item.erase(item.find_last_not_of(" \t") + 1);
+    if (item.empty()) throw Error("--atlas-label " + spec + ": an empty label");
+    double number = 0;
+    std::istringstream asNumber(item);
+    if (asNumber >> number && asNumber.eof()) {
+      if (number != std::floor(number) || std::abs(number) > 32767)
+        throw Error("--atlas-label " + spec + ": " + item + " is not a label value");
+      values.push_back(static_cast<int>(number));
+      continue;
+    }
+    const auto named = std::find_if(atlas.names.begin(), atlas.names.end(),
+                                    [&](const auto& entry) { return lowered(entry.second) == lowered(item); });
+    if (named != atlas.names.end()) {
+      values.push_back(named->first);
+      continue;
+    }
+    if (atlas.names.empty())
+      throw Error(atlas.labelsPath, "no table of label names beside it: give --atlas-label as numbers, not '" +
+                                        item + "'");
+    const auto nearest = std::min_element(atlas.names.begin(), atlas.names.end(), [&](const auto& a, const auto& b) {
+      return editDistance(a.second, item) < editDistance(b.second, item);
+    });
+    throw Error(atlas.labelsPath, "no label named '" + item + "' (did you mean '" + nearest->second + "'?)");
+  }
+  if (values.empty()) throw Error("--atlas-label: no label given");
+  for (int value : values)
+    if (selectLabels(atlas.labels, {value}).count() == 0)
+      throw Error(atlas.labelsPath, "no voxel has the label " + std::to_string(value));
+  return values;
+}
+
+void checkAtlasRegistrationOptions(const AtlasRegistrationOptions& o) {
+  auto positiveLevels = [](const std::vector<double>& levels, const char* name) {
+    if (levels.empty()) throw Error(std::string(name) + " must name at least one level");
+    for (double level : levels)
+      if (!std::isfinite(level) || level <= 0) throw Error(std::string(name) + " must be positive sizes in mm");
+  };
+  positiveLevels(o.affineLevelsMm, "the affine registration's levels");
+  positiveLevels(o.deformableLevelsMm, "the deformable registration's levels");
+  auto positive = [](double value, const char* name) {
+    if (!std::isfinite(value) || value <= 0) throw Error(std::string(name) + " must be a positive number");
+  };
+  positive(o.gridSpacingMm, "the B-spline's grid spacing");
+  positive(o.largestShiftMm, "the B-spline's largest shift");
+  requireFiniteNonNegative(o.marginMm, "the deformable registration's margin");
+  if (o.affineIterations < 1 || o.deformableIterations < 1)
+    throw Error("the registrations need at least one iteration per level");
+  if (!(o.samplingFraction > 0 && o.samplingFraction <= 1))
+    throw Error("the registration's sampling fraction must lie in (0, 1]");
+}
+
+AtlasAffine registerAtlasAffine(const Volume& subject, const Atlas& atlas, const AtlasRegistrationOptions& options) {
+  checkAtlasRegistrationOptions(options);
+  const auto started = Clock::now();
+  itkbridge::AffineSettings settings;
+  settings.levelsMm = options.affineLevelsMm;
+  settings.iterations = options.affineIterations;
+  settings.samplingFraction = options.samplingFraction;
+  const itkbridge::AffineOutcome outcome = itkbridge::registerAffine(
+      toBridge(subject.geometry), subject.voxels, toBridge(atlas.image.geometry), atlas.image.voxels, settings);
+  AtlasAffine affine;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) affine.map.linear(r, c) = outcome.transform[4 * r + c];
+    affine.map.translation[r] = outcome.transform[4 * r + 3];
+  }
+  affine.metric = outcome.metric;
+  affine.iterations = outcome.iterations;
+  affine.seconds = secondsSince(started);
+  // A head maps to a head: a scale beyond 1:3 either way is a failed registration.
+  const double determinant = affine.map.linear.determinant();
+  if (!affine.map.linear.allFinite() || !affine.map.translation.allFinite() || !(determinant > 1.0 / 27) ||
+      !(determinant < 27))
+    throw Error(atlas.imagePath, "the registration of the atlas to the image failed (a degenerate transform)");
+  return affine;
+}
+
+CarriedLabel carryLabel(const Volume& subject, const Atlas& atlas, const std::vector<int>& labels,
+                        const AtlasAffine& affine, const std::optional<Vector3>& inside,
+                        const AtlasRegistrationOptions& options) {
+  checkAtlasRegistrationOptions(options);
+  const auto started = Clock::now();
+  if (inside && (!inside->allFinite() || !subject.geometry.covers(*inside)))
+    throw LandmarkError("the click inside the structure lies outside the image");
+  const Mask structure = selectLabels(atlas.labels, labels);
+  const ImageGeometry& atlasGrid = atlas.labels.geometry;
+  const auto [atlasFirst, atlasSize] = occupiedRegion(atlasGrid, structure.voxels, 0);
+  if (atlasSize[0] == 0) throw Error(atlas.labelsPath, "the labels hold no voxel");
+
+  // The structure's box in the template, through the inverse map, grown by
+  // the margin: where the subject is registered and labelled.
+  const AffineMap toSubject = affine.map.inverse();
+  MatrixX3 corners(8, 3);
+  for (int c = 0; c < 8; ++c) {
+    Vector3 index;
+    for (int a = 0; a < 3; ++a) index[a] = atlasFirst[a] + (((c >> a) & 1) ? atlasSize[a] - 1 : 0);
+    corners.row(c) = toSubject(atlasGrid.toPhysical(index)).transpose();
+  }
+  if (inside) {
+    corners.conservativeResize(9, 3);
+    corners.row(8) = inside->transpose();
+  }
+  const auto [first, size] =
+      boundingRegion(subject.geometry, corners, options.marginMm);
+  if (std::min({size[0], size[1], size[2]}) < 4)
+    throw Error(atlas.imagePath, "the atlas's structure falls outside the image after registration");
+  const Volume region = cropVolume(subject, first, size);
+
+  itkbridge::BSplineSettings settings;
+  settings.gridSpacingMm = options.gridSpacingMm;
+  settings.largestShiftMm = options.largestShiftMm;
+  settings.levelsMm = options.deformableLevelsMm;
+  settings.iterations = options.deformableIterations;
+  settings.samplingFraction = options.samplingFraction;
+  const itkbridge::BSplineOutcome warp =
+      itkbridge::registerBSpline(toBridge(region.geometry), region.voxels, toBridge(atlas.image.geometry),
+                                 atlas.image.voxels, toArray(affine.map), settings);
+
+  // Each voxel takes the structure's share at its template point
+  // (trilinear in the template's mask), in when at least half.
+  CarriedLabel carried;
+  carried.first = first;
+  carried.metric = warp.metric;
+  carried.iterations = warp.iterations;
+  const ImageGeometry& grid = region.geometry;
+  std::vector<std::uint8_t> in(static_cast<std::size_t>(grid.voxelCount()), 0);
+  const Matrix3 toAtlasIndex = atlasGrid.indexFromPhysical();
+  long long o = 0;
+  const ImageGeometry field = fromBridge(warp.field);
+  const Matrix3 toFieldIndex = field.indexFromPhysical();
+  for (int k = 0; k < grid.size[2]; ++k)
+    for (int j = 0; j < grid.size[1]; ++j)
+      for (int i = 0; i < grid.size[0]; ++i, ++o) {
+        const Vector3 x = grid.toPhysical(Vector3(i, j, k));
+        const Trilinear at = trilinearAt(field, toFieldIndex * (x - field.origin));
+        Vector3 d = Vector3::Zero();
+        for (int c = 0; c < 8; ++c)
+          for (int a = 0; a < 3; ++a) d[a] += at.weight[c] * warp.displacement[3 * at.offset[c] + a];
+        const Vector3 y = affine.map(x + d);
+        carried.largestWarpMm = std::max(carried.largestWarpMm, d.norm());
+        const Vector3 index = toAtlasIndex * (y - atlasGrid.origin);
+        bool within = true;
+        for (int a = 0; a < 3; ++a) within = within && index[a] >= -0.5 && index[a] <= atlasGrid.size[a] - 0.5;
+        if (!within) continue;
+        const Trilinear corners = trilinearAt(atlasGrid, index);
+        double share = 0;
+        for (int c = 0; c < 8; ++c) share += corners.weight[c] * structure.voxels[corners.offset[c]];
+        in[o] = share >= 0.5;
+      }
+  if (std::none_of(in.begin(), in.end(), [](std::uint8_t v) { return v != 0; }))
+    throw Error(atlas.imagePath, "the atlas's structure falls outside the image after registration");
+
+  if (inside) {
+    // The click's voxel on the region's grid.
+    const Vector3 index = grid.toIndex(*inside);
+    std::array<int, 3> click{};
+    for (int a = 0; a < 3; ++a) click[a] = std::clamp(static_cast<int>(std::lround(index[a])), 0, grid.size[a] - 1);
+    long long at = grid.offset(click[0], click[1], click[2]);
+    if (!in[at]) {
+      // Move the label so that its voxel nearest the click among those 2 mm
+      // deep (or half its greatest depth, for a thin one) lands on the click.
+      const std::vector<float> depth = depthInside(in, grid);
+      const float deepest = *std::max_element(depth.begin(), depth.end());
+      const float wanted = std::min(2.0f, 0.5f * deepest);
+      long long best = -1;
+      double bestDistance = std::numeric_limits<double>::infinity();
+      for (long long v = 0; v < grid.voxelCount(); ++v) {
+        if (!in[v] || depth[v] < wanted) continue;
+        const int vi = static_cast<int>(v % grid.size[0]);
+        const int vj = static_cast<int>((v / grid.size[0]) % grid.size[1]);
+        const int vk = static_cast<int>(v / (static_cast<long long>(grid.size[0]) * grid.size[1]));
+        const double d = (grid.toPhysical(Vector3(vi, vj, vk)) - *inside).norm();
+        if (d < bestDistance) {
+          bestDistance = d;
+          best = v;
+        }
+      }
+      const std::array<int, 3> from = {static_cast<int>(best % grid.size[0]),
+                                       static_cast<int>((best / grid.size[0]) % grid.size[1]),
+                                       static_cast<int>(best / (static_cast<long long>(grid.size[0]) * grid.size[1]))};
+      std::vector<std::uint8_t> moved(in.size(), 0);
+      const std::array<int, 3> by = {click[0] - from[0], click[1] - from[1], click[2] - from[2]};
+      o = 0;
+      for (int k = 0; k < grid.size[2]; ++k)
+        for (int j = 0; j < grid.size[1]; ++j)
+          for (int i = 0; i < grid.size[0]; ++i, ++o)
+            if (in[o] && grid.contains(i + by[0], j + by[1], k + by[2]))
+              moved[grid.offset(i + by[0], j + by[1], k + by[2])] = 1;
+      in = std::move(moved);
+      carried.shift = grid.direction * grid.spacing.cwiseProduct(Vector3(by[0], by[1], by[2]));
+      at = grid.offset(click[0], click[1], click[2]);
+    }
+    in = connectedTo(in, grid, {at});
+  }
+  carried.mask = Mask{grid, fillHoles(in, grid)};
+  carried.seconds = secondsSince(started);
+  return carried;
+}
+
+std::vector<Landmark> carriedBoundary(const CarriedLabel& label, int count) {
+  bool touchesSide = false;
+  const std::vector<Vector3> faces = boundaryFaces(label.mask.voxels, label.mask.geometry, &touchesSide);
+  if (faces.size() < 4) throw Error("the atlas's structure carried to the image is too small to start a surface from");
+  Vector3 centre = Vector3::Zero();
+  for (const Vector3& face : faces) centre += face;
+  centre /= static_cast<double>(faces.size());
+  const std::vector<Vector3> spread = farthestPointSample(faces, centre, static_cast<std::size_t>(count));
+  std::vector<Landmark> points;
+  for (std::size_t p = 0; p < spread.size(); ++p) points.push_back({"atlas " + std::to_string(p + 1), spread[p]});
+  return points;
+}
+
+double carriedVolume(const CarriedLabel& label) {
+  return static_cast<double>(label.mask.count()) * label.mask.geometry.spacing.prod();
+}
+
+}  // namespace dynsub

@@ -1,0 +1,125 @@
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdio>
+
+#include "dynsub/Atlas.h"
+#include "dynsub/Error.h"
+#include "dynsub/SubjectGenerator.h"
+
+namespace dynsub {
+namespace {
+
+double dice(const Mask& a, const Mask& b) {
+  long long both = 0, sum = 0;
+  for (std::size_t v = 0; v < a.voxels.size(); ++v) {
+    both += a.voxels[v] && b.voxels[v];
+    sum += (a.voxels[v] != 0) + (b.voxels[v] != 0);
+  }
+  return sum ? 2.0 * static_cast<double>(both) / static_cast<double>(sum) : 0.0;
+}
+
+// The basal ganglia of Colin27 with AAL, cropped to an 80 x 90 x 60 mm box
+// so that a registration takes seconds: the atlas of these tests.
+const Atlas& croppedAtlas() {
+  static const Atlas atlas = [] {
+    Atlas full = readAtlas(kDefaultAtlasImage, kDefaultAtlasLabels);
+    const std::array<int, 3> first{50, 95, 55}, size{80, 90, 60};
+    Atlas crop;
+    crop.imagePath = full.imagePath;
+    crop.labelsPath = full.labelsPath;
+    crop.image = cropVolume(full.image, first, size);
+    crop.labels = cropVolume(full.labels, first, size);
+    crop.names = full.names;
+    return crop;
+  }();
+  return atlas;
+}
+
+TEST(Atlas, NamesAndValuesSelectLabels) {
+  const Atlas& atlas = croppedAtlas();
+  EXPECT_EQ(atlasLabelValues(atlas, "71"), std::vector<int>{71});
+  EXPECT_EQ(atlasLabelValues(atlas, "Caudate_L,caudate_r"), (std::vector<int>{71, 72}));
+  try {
+    atlasLabelValues(atlas, "Caudat_L");
+    FAIL() << "a misspelt name was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("did you mean 'Caudate_L'"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(atlasLabelValues(atlas, "71,,72"), Error);
+  EXPECT_THROW(atlasLabelValues(atlas, "7.5"), Error);
+  // The calcarine cortex lies outside the cropped box: no voxel has it.
+  EXPECT_THROW(atlasLabelValues(atlas, "Calcarine_L"), Error);
+}
+
+TEST(Atlas, MissingLabelMapIsNamed) {
+  try {
+    readAtlas(kDefaultAtlasImage, "/nonexistent/labels.nii.gz");
+    FAIL() << "a missing label map was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/labels.nii.gz"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Atlas, InverseUndoesTheMap) {
+  AffineMap map;
+  map.linear << 1.1, 0.1, 0, -0.05, 0.9, 0.2, 0, 0.1, 1.05;
+  map.translation = Vector3(3, -4, 5);
+  const Vector3 x(10, 20, -30);
+  EXPECT_LT((map.inverse()(map(x)) - x).norm(), 1e-9);
+}
+
+// A subject generated from the cropped atlas (an affine map, a smooth
+// warp of up to 5 mm, another contrast, a bias field and single-scan noise):
+// registration carries the left caudate onto its true place. The carried
+// label's Dice with the subject's own is at least 0.80 (it was 0.88 when
+// written: the B-spline's 20 mm grid cannot follow the generator's whole
+// warp, and the label's voxels are rounded twice); the untouched atlas
+// label scores well below.
+TEST(Atlas, RegistrationCarriesTheCaudateToAGeneratedSubject) {
+  const Atlas& atlas = croppedAtlas();
+  const Subject subject = makeSubject(atlas.image, atlas.labels, SubjectSettings{}, 7);
+  const auto started = std::chrono::steady_clock::now();
+  const AtlasAffine affine = registerAtlasAffine(subject.image, atlas, AtlasRegistrationOptions{});
+  const CarriedLabel carried = carryLabel(subject.image, atlas, {71}, affine, std::nullopt, AtlasRegistrationOptions{});
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  const Mask truth = selectLabels(subject.labels, {71});
+  const Mask mask = pasteMask(carried.mask, subject.labels.geometry, carried.first);
+  const double registered = dice(mask, truth);
+  const double untouched = dice(selectLabels(atlas.labels, {71}), truth);
+  std::printf("Dice %.3f registered, %.3f untouched; affine %.2f s (%d iterations), B-spline %.2f s, "
+              "largest warp %.1f mm, %.2f s in all\n",
+              registered, untouched, affine.seconds, affine.iterations, carried.seconds, carried.largestWarpMm,
+              seconds);
+  EXPECT_GE(registered, 0.80);
+  EXPECT_GT(registered, untouched + 0.1);
+}
+
+// A click outside the carried label moves it there; one inside keeps the
+// part that holds it.
+TEST(Atlas, InsideClickMovesAMisplacedLabel) {
+  const Atlas& atlas = croppedAtlas();
+  AtlasAffine shifted;
+  shifted.map.translation = Vector3(0, 0, 25);  // the template 25 mm off along z
+  const Mask truth = selectLabels(atlas.labels, {71});
+  Vector3 centre = Vector3::Zero();
+  long long n = 0;
+  for (int k = 0; k < truth.geometry.size[2]; ++k)
+    for (int j = 0; j < truth.geometry.size[1]; ++j)
+      for (int i = 0; i < truth.geometry.size[0]; ++i)
+        if (truth.voxels[truth.geometry.offset(i, j, k)]) {
+          centre += truth.geometry.toPhysical(Vector3(i, j, k));
+          ++n;
+        }
+  centre /= static_cast<double>(n);
+  AtlasRegistrationOptions options;
+  options.deformableIterations = 1;
+  const CarriedLabel carried = carryLabel(atlas.image, atlas, {71}, shifted, centre, options);
+  const Mask mask = pasteMask(carried.mask, truth.geometry, carried.first);
+  const Vector3 index = truth.geometry.toIndex(centre);
+  EXPECT_TRUE(mask.voxels[truth.geometry.offset(std::lround(index[0]), std::lround(index[1]), std::lround(index[2]))]);
+  EXPECT_THROW(carryLabel(atlas.image, atlas, {71}, shifted, Vector3(1e4, 0, 0), options), LandmarkError);
+}
+
+}  // namespace
+}  // namespace dynsub
