@@ -31,7 +31,7 @@ namespace {
 using namespace dynsub;
 
 struct Arguments {
-  std::string image, landmarks, inside, labelmap, model, report;
+  std::string image, landmarks, inside, atlasLabel, labelmap, model, report;
   std::vector<std::string> seeds;
   int labelValue = 1;
   SegmentParameters parameters;
@@ -107,8 +107,9 @@ slicer::Module describe(Arguments& a) {
   m.description =
       "Segments a structure with a dynamic Catmull-Clark subdivision surface: a smooth closed surface, defined by "
       "a small control mesh, moves toward the image's edges and toward points placed on the structure's boundary, "
-      "and is refined until it meets them. Give at least 4 boundary points, or one point inside the structure "
-      "(its tissue is grown from there and the surface starts on that region's boundary).";
+      "and is refined until it meets them. Give at least 4 boundary points, one point inside the structure "
+      "(its tissue is grown from there and the surface starts on that region's boundary), or the structure's "
+      "name in the AAL atlas.";
   m.version = DYNSUB_VERSION;
   m.license = "See the DynSub source tree";
   m.contributor = "DynSub developers";
@@ -130,6 +131,12 @@ slicer::Module describe(Arguments& a) {
                            "One click inside the structure: the surface starts from the region of like tissue "
                            "grown from it. Without boundary points that region's boundary guides the surface.",
                            &a.inside, "", "", "", "", {}, -1});
+  io.parameters.push_back({"string", "", "atlasLabel", "atlasLabel", "Atlas structure",
+                           "The structure's label value(s) or name(s) in Colin27's AAL atlas (Caudate_L; "
+                           "Putamen_L,Putamen_R): the atlas, registered to the volume, starts the surface and "
+                           "holds it softly where the points and the edges say nothing. The point inside, if "
+                           "given, says where the structure is.",
+                           &a.atlasLabel, "", "", "", "", {}, -1});
   io.parameters.push_back({"image", "type=\"label\" reference=\"inputVolume\"", "outputLabelmap", "labelmap",
                            "Output labelmap", "The structure as a label image on the input volume's grid.",
                            &a.labelmap, "output", "", "", "", {}, -1});
@@ -208,7 +215,12 @@ void run(Arguments& a) {
     in.landmarks.insert(in.landmarks.end(), fromFile.begin(), fromFile.end());
     in.landmarkSource = a.seeds.empty() ? a.landmarks : "--seed and " + a.landmarks;
   }
-  if (!a.inside.empty()) {
+  if (!a.atlasLabel.empty()) {
+    in.start = parseSegmentStart("atlas", "--init");
+    in.atlas = std::make_shared<const Atlas>(readAtlas(kDefaultAtlasImage, kDefaultAtlasLabels));
+    in.atlasLabels = atlasLabelValues(*in.atlas, a.atlasLabel);
+    if (!a.inside.empty()) in.inside = parsePoint(a.inside, "--inside");
+  } else if (!a.inside.empty()) {
     in.start.kind = SegmentStart::Kind::Seed;
     in.start.center = parsePoint(a.inside, "--inside");
     in.start.text = "inside:" + a.inside;

@@ -47,7 +47,12 @@ std::vector<Group> summarize(const std::vector<EvaluationRun>& runs) {
   std::vector<std::tuple<std::string, std::string, std::string, std::string>> order;
   for (const EvaluationRun& r : runs) {
     const auto key = std::make_tuple(r.split, r.image, r.structure, r.protocol);
-    auto [it, inserted] = groups.try_emplace(key, Group{r.split, r.image, r.structure, r.protocol});
+    Group fresh;
+    fresh.split = r.split;
+    fresh.image = r.image;
+    fresh.structure = r.structure;
+    fresh.protocol = r.protocol;
+    auto [it, inserted] = groups.try_emplace(key, fresh);
     if (inserted) order.push_back(key);
     Group& g = it->second;
     ++g.runs;

@@ -74,6 +74,13 @@ check "one point: read as a click inside" grep -q '"springs": "boundary points"'
 check "one point: a caudate-sized region (Dice >= 0.5)" \
   "$python" "$here/slicer_module_check.py" dice "$work/inside.nrrd" 1 "$templates/aal.nii.gz" 71 0.5
 
+# The atlas start by name, with the point inside: the run is checked, not
+# its accuracy (Colin27 is the atlas's own brain).
+"$MODULE" --atlasLabel Caudate_L --inside 15.4,-1.5,16.0 --labelmap "$work/atlas.nrrd" --report "$work/atlas.json" \
+  "$work/ch2.nrrd" >"$work/atlas.out" 2>&1
+check "atlas start: exit 0" test $? -eq 0
+check "atlas start: the report has the registration" grep -q '"affine_iterations"' "$work/atlas.json"
+
 # expect_failure NAME CODE PATTERN ARGS...: exit CODE, PATTERN on stderr, no output file.
 expect_failure() {
   local name=$1 code=$2 pattern=$3; shift 3

@@ -348,5 +348,28 @@ expect_error "subject: a warp that could fold" 1 "warp_mm must be" "$work/s41" \
 expect_error "subject: missing labels" 1 "nolabels.nii.gz" "$work/s42" \
   "$DYNSUB" subject "$mri/ch2.nii.gz" "$work/nolabels.nii.gz" --out "$work/s42"
 
+# The atlas start on that subject: Colin27 and AAL registered to it, the left
+# putamen carried there by name, with a click inside it.
+"$DYNSUB" segment "$work/subject/image.nii.gz" --init atlas --atlas-label Putamen_L --inside=22,-8,4 \
+  --reference "$work/subject/labels.nii.gz" --reference-label 73 --no-figures --out "$work/atlas" >/dev/null 2>&1
+check "segment --init atlas succeeds" test -s "$work/atlas/labelmap.nii.gz"
+check "segment --init atlas reports the registration and the click" python3 -c "
+import json
+r = json.load(open('$work/atlas/report.json'))
+a = r['atlas']
+assert a['label_values'] == [73] and a['registration']['affine_iterations'] > 0, a
+assert len(a['inside_lps_mm']) == 3 and a['prior_points'] == 100, a
+assert r['dice'] > 0.7, r['dice']
+"
+expect_error "segment --init atlas: a misspelt label" 1 "did you mean 'Putamen_L'" "$work/s43" \
+  "$DYNSUB" segment "$work/subject/image.nii.gz" --init atlas --atlas-label Putamn_L --out "$work/s43"
+expect_error "segment --init atlas: no label" 1 "needs --atlas-label" "$work/s44" \
+  "$DYNSUB" segment "$work/subject/image.nii.gz" --init atlas --out "$work/s44"
+expect_error "segment --inside without an atlas start" 1 "serves an atlas start" "$work/s45" \
+  "$DYNSUB" segment "$work/subject/image.nii.gz" --init sphere:22,-8,4,5 --inside=22,-8,4 --out "$work/s45"
+expect_error "segment --init atlas: a label map off the template's grid" 1 "not on its template's grid" "$work/s46" \
+  "$DYNSUB" segment "$work/subject/image.nii.gz" --init atlas --atlas-label 73 --atlas-labels "$mri/ch2better.nii.gz" \
+  --out "$work/s46"
+
 if [ "$failures" -gt 0 ]; then echo "$failures check(s) failed"; exit 1; fi
 echo "all command-line checks passed"

@@ -19,6 +19,8 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+constexpr double kFieldVoxels = 40000;
+
 double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -151,12 +153,13 @@ void checkAtlasRegistrationOptions(const AtlasRegistrationOptions& o) {
       if (!std::isfinite(level) || level <= 0) throw Error(std::string(name) + " must be positive sizes in mm");
   };
   positiveLevels(o.affineLevelsMm, "the affine registration's levels");
-  positiveLevels(o.deformableLevelsMm, "the deformable registration's levels");
+
   auto positive = [](double value, const char* name) {
     if (!std::isfinite(value) || value <= 0) throw Error(std::string(name) + " must be a positive number");
   };
-  positive(o.gridSpacingMm, "the B-spline's grid spacing");
-  positive(o.largestShiftMm, "the B-spline's largest shift");
+  positive(o.deformableLevelMm, "the deformable registration's voxel size");
+  positive(o.updateSigmaMm, "the deformable registration's update smoothing");
+  requireFiniteNonNegative(o.totalSigmaMm, "the deformable registration's field smoothing");
   requireFiniteNonNegative(o.marginMm, "the deformable registration's margin");
   if (o.affineIterations < 1 || o.deformableIterations < 1)
     throw Error("the registrations need at least one iteration per level");
@@ -220,15 +223,17 @@ CarriedLabel carryLabel(const Volume& subject, const Atlas& atlas, const std::ve
     throw Error(atlas.imagePath, "the atlas's structure falls outside the image after registration");
   const Volume region = cropVolume(subject, first, size);
 
-  itkbridge::BSplineSettings settings;
-  settings.gridSpacingMm = options.gridSpacingMm;
-  settings.largestShiftMm = options.largestShiftMm;
-  settings.levelsMm = options.deformableLevelsMm;
+  itkbridge::DeformableSettings settings;
+  // A large structure's field is coarser: at most kFieldVoxels voxels, so
+  // that the cerebellum's registration takes about as long as a caudate's.
+  const double regionVolume = region.geometry.spacing.prod() * static_cast<double>(region.geometry.voxelCount());
+  settings.levelMm = std::max(options.deformableLevelMm, std::cbrt(regionVolume / kFieldVoxels));
   settings.iterations = options.deformableIterations;
-  settings.samplingFraction = options.samplingFraction;
-  const itkbridge::BSplineOutcome warp =
-      itkbridge::registerBSpline(toBridge(region.geometry), region.voxels, toBridge(atlas.image.geometry),
-                                 atlas.image.voxels, toArray(affine.map), settings);
+  settings.updateSigmaMm = options.updateSigmaMm;
+  settings.totalSigmaMm = options.totalSigmaMm;
+  const itkbridge::DeformableOutcome warp =
+      itkbridge::registerDeformable(toBridge(region.geometry), region.voxels, toBridge(atlas.image.geometry),
+                                    atlas.image.voxels, toArray(affine.map), settings);
 
   // Each voxel takes the structure's share at its template point
   // (trilinear in the template's mask), in when at least half.

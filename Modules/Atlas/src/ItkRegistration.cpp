@@ -5,11 +5,12 @@
 #include <string>
 
 #include <itkAffineTransform.h>
-#include <itkBSplineTransform.h>
-#include <itkBSplineTransformInitializer.h>
 #include <itkCenteredTransformInitializer.h>
 #include <itkImageRegistrationMethodv4.h>
-#include <itkLBFGSBOptimizerv4.h>
+#include <itkGaussianSmoothingOnUpdateDisplacementFieldTransform.h>
+#include <itkGradientDescentOptimizerv4.h>
+#include <itkResampleImageFilter.h>
+#include <itkSmoothingRecursiveGaussianImageFilter.h>
 #include <itkMattesMutualInformationImageToImageMetricv4.h>
 #include <itkRegistrationParameterScalesFromPhysicalShift.h>
 #include <itkRegularStepGradientDescentOptimizerv4.h>
@@ -22,7 +23,6 @@ namespace dynsub::itkbridge {
 namespace {
 
 using Affine = itk::AffineTransform<double, 3>;
-using BSpline = itk::BSplineTransform<double, 3, 3>;
 using Metric = itk::MattesMutualInformationImageToImageMetricv4<FloatImage, FloatImage>;
 using Sampling = itk::ImageRegistrationMethodv4Enums::MetricSamplingStrategy;
 
@@ -125,10 +125,35 @@ AffineOutcome registerAffine(const Geometry& fixedGeometry, const std::vector<fl
   return outcome;
 }
 
-BSplineOutcome registerBSpline(const Geometry& fixedGeometry, const std::vector<float>& fixed,
-                               const Geometry& movingGeometry, const std::vector<float>& moving,
-                               const AffineArray& affine, const BSplineSettings& settings) {
-  const auto fixedImage = makeImage<FloatImage>(fixedGeometry, fixed);
+DeformableOutcome registerDeformable(const Geometry& fixedGeometry, const std::vector<float>& fixed,
+                                     const Geometry& movingGeometry, const std::vector<float>& moving,
+                                     const AffineArray& affine, const DeformableSettings& settings) {
+  // The fixed region smoothed and resampled to the field's grid: the
+  // registration runs on that grid alone.
+  Geometry grid = fixedGeometry;
+  for (int a = 0; a < 3; ++a) {
+    const double extent = fixedGeometry.spacing[a] * (fixedGeometry.size[a] - 1);
+    const double step = std::max(fixedGeometry.spacing[a], settings.levelMm);
+    grid.size[a] = 1 + static_cast<int>(std::ceil(extent / step));
+    grid.spacing[a] = grid.size[a] > 1 ? extent / (grid.size[a] - 1) : step;
+  }
+  auto fixedImage = makeImage<FloatImage>(fixedGeometry, fixed);
+  const double sigma = 0.5 * settings.levelMm;
+  FloatImage::Pointer smoothed = fixedImage;
+  if (sigma > fixedGeometry.spacing[0]) {
+    auto smoother = itk::SmoothingRecursiveGaussianImageFilter<FloatImage, FloatImage>::New();
+    smoother->SetInput(fixedImage);
+    smoother->SetSigma(sigma);
+    smoother->Update();
+    smoothed = smoother->GetOutput();
+  }
+  const auto gridImage = makeImage<FloatImage>(grid, std::vector<float>(countOf(grid), 0.0f));
+  auto resampler = itk::ResampleImageFilter<FloatImage, FloatImage>::New();
+  resampler->SetInput(smoothed);
+  resampler->UseReferenceImageOn();
+  resampler->SetReferenceImage(gridImage);
+  resampler->Update();
+  const FloatImage::Pointer fixedOnGrid = resampler->GetOutput();
   const auto movingImage = makeImage<FloatImage>(movingGeometry, moving);
 
   auto start = Affine::New();
@@ -141,90 +166,66 @@ BSplineOutcome registerBSpline(const Geometry& fixedGeometry, const std::vector<
   start->SetMatrix(matrix);
   start->SetOffset(offset);
 
-  // Control points about gridSpacingMm apart over the fixed image's extent.
-  auto transform = BSpline::New();
-  BSpline::MeshSizeType mesh;
-  for (int a = 0; a < 3; ++a) {
-    const double extent = fixedGeometry.spacing[a] * (fixedGeometry.size[a] - 1);
-    mesh[a] = std::max(1u, static_cast<unsigned>(std::lround(extent / settings.gridSpacingMm)));
-  }
-  auto initializer = itk::BSplineTransformInitializer<BSpline, FloatImage>::New();
-  initializer->SetTransform(transform);
-  initializer->SetImage(fixedImage);
-  initializer->SetTransformDomainMeshSize(mesh);
-  initializer->InitializeTransform();
-  transform->SetIdentity();
+  using FieldTransform = itk::GaussianSmoothingOnUpdateDisplacementFieldTransform<double, 3>;
+  using FieldImage = FieldTransform::DisplacementFieldType;
+  auto displacement = FieldImage::New();
+  displacement->CopyInformation(fixedOnGrid);
+  displacement->SetRegions(fixedOnGrid->GetLargestPossibleRegion());
+  displacement->Allocate();
+  displacement->FillBuffer(FieldImage::PixelType(0.0));
+  auto transform = FieldTransform::New();
+  transform->SetDisplacementField(displacement);
+  // The operator's variances are in voxels of the field's grid.
+  const double voxel = std::max({grid.spacing[0], grid.spacing[1], grid.spacing[2]});
+  transform->SetGaussianSmoothingVarianceForTheUpdateField(std::pow(settings.updateSigmaMm / voxel, 2));
+  transform->SetGaussianSmoothingVarianceForTheTotalField(std::pow(settings.totalSigmaMm / voxel, 2));
 
-  const unsigned count = transform->GetNumberOfParameters();
-  auto optimizer = itk::LBFGSBOptimizerv4::New();
-  itk::LBFGSBOptimizerv4::BoundSelectionType select(count);
-  itk::LBFGSBOptimizerv4::BoundValueType lower(count), upper(count);
-  select.Fill(2);  // both bounds: no control point moves farther than largestShiftMm
-  lower.Fill(-settings.largestShiftMm);
-  upper.Fill(settings.largestShiftMm);
-  optimizer->SetBoundSelection(select);
-  optimizer->SetLowerBound(lower);
-  optimizer->SetUpperBound(upper);
-  optimizer->SetCostFunctionConvergenceFactor(1e7);
-  optimizer->SetGradientConvergenceTolerance(1e-5);
+  auto metric = mattes(settings.histogramBins);
+  auto scales = itk::RegistrationParameterScalesFromPhysicalShift<Metric>::New();
+  scales->SetMetric(metric);
+  auto optimizer = itk::GradientDescentOptimizerv4::New();
+  optimizer->SetScalesEstimator(scales);
+  // Every step moves no voxel more than a quarter of a field voxel.
+  optimizer->SetLearningRate(1.0);
+  optimizer->SetMaximumStepSizeInPhysicalUnits(0.25 * voxel);
+  optimizer->SetDoEstimateLearningRateAtEachIteration(true);
+  optimizer->SetDoEstimateLearningRateOnce(false);
   optimizer->SetNumberOfIterations(settings.iterations);
-  optimizer->SetMaximumNumberOfFunctionEvaluations(2 * settings.iterations);
-  optimizer->SetMaximumNumberOfCorrections(5);
+  optimizer->SetConvergenceWindowSize(10);
+  optimizer->SetMinimumConvergenceValue(1e-6);
 
-  using Method = itk::ImageRegistrationMethodv4<FloatImage, FloatImage, BSpline>;
+  using Method = itk::ImageRegistrationMethodv4<FloatImage, FloatImage, FieldTransform>;
   auto method = Method::New();
-  method->SetFixedImage(fixedImage);
+  method->SetFixedImage(fixedOnGrid);
   method->SetMovingImage(movingImage);
-  method->SetMetric(mattes(settings.histogramBins));
+  method->SetMetric(metric);
   method->SetOptimizer(optimizer);
-  method->SetMovingInitialTransform(start);  // points pass the B-spline, then the affine
+  method->SetMovingInitialTransform(start);  // points pass the field, then the affine
   method->SetInitialTransform(transform);
   method->InPlaceOn();
-  setPyramid(*method, fixedImage.GetPointer(), settings.levelsMm);
-  method->SetMetricSamplingStrategy(Sampling::RANDOM);
-  method->SetMetricSamplingPercentage(settings.samplingFraction);
-  method->MetricSamplingReinitializeSeed(kSamplingSeed);
-  // L-BFGS-B warns on every run that it ignores the parameter scales the
-  // registration sets; the control points' shifts are all in mm, so scales
-  // of one are right.
-  const bool warnings = itk::Object::GetGlobalWarningDisplay();
-  itk::Object::GlobalWarningDisplayOff();
+  method->SetNumberOfLevels(1);
+  Method::ShrinkFactorsArrayType shrink(1);
+  shrink[0] = 1;
+  method->SetShrinkFactorsPerLevel(shrink);
+  Method::SmoothingSigmasArrayType sigmas(1);
+  sigmas[0] = 0;
+  method->SetSmoothingSigmasPerLevel(sigmas);
+  method->SetMetricSamplingStrategy(Sampling::NONE);
   try {
     method->Update();
   } catch (const itk::ExceptionObject& e) {
-    itk::Object::SetGlobalWarningDisplay(warnings);
     throw Error(std::string("the deformable registration failed: ") + e.GetDescription());
   }
-  itk::Object::SetGlobalWarningDisplay(warnings);
 
-  BSplineOutcome outcome;
+  DeformableOutcome outcome;
   outcome.metric = optimizer->GetValue();
   outcome.iterations = static_cast<int>(optimizer->GetCurrentIteration());
-  const BSpline* warp = method->GetTransform();
-  Geometry& field = outcome.field;
-  field.origin = fixedGeometry.origin;
-  field.direction = fixedGeometry.direction;
-  for (int a = 0; a < 3; ++a) {
-    const double extent = fixedGeometry.spacing[a] * (fixedGeometry.size[a] - 1);
-    const double step = std::max(fixedGeometry.spacing[a], settings.levelsMm.back());
-    field.size[a] = 1 + static_cast<int>(std::ceil(extent / step));
-    field.spacing[a] = field.size[a] > 1 ? extent / (field.size[a] - 1) : step;
-  }
-  const auto fieldImage = makeImage<FloatImage>(field, std::vector<float>(countOf(field), 0.0f));
-  outcome.displacement.resize(3 * static_cast<std::size_t>(countOf(field)));
-  std::size_t n = 0;
-  FloatImage::IndexType index;
-  for (int k = 0; k < field.size[2]; ++k)
-    for (int j = 0; j < field.size[1]; ++j)
-      for (int i = 0; i < field.size[0]; ++i) {
-        index[0] = i;
-        index[1] = j;
-        index[2] = k;
-        FloatImage::PointType x;
-        fieldImage->TransformIndexToPhysicalPoint(index, x);
-        const auto y = warp->TransformPoint(x);
-        for (int a = 0; a < 3; ++a) outcome.displacement[n++] = static_cast<float>(y[a] - x[a]);
-      }
+  outcome.field = grid;
+  const FieldImage* result = transform->GetDisplacementField();
+  outcome.displacement.resize(3 * static_cast<std::size_t>(countOf(grid)));
+  const auto* values = result->GetBufferPointer();
+  for (long long v = 0; v < countOf(grid); ++v)
+    for (int a = 0; a < 3; ++a) outcome.displacement[3 * v + a] = static_cast<float>(values[v][a]);
   return outcome;
 }
 

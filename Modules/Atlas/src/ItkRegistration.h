@@ -36,32 +36,37 @@ DYNSUB_ITK_BRIDGE_API AffineOutcome registerAffine(const Geometry& fixedGeometry
                                                    const Geometry& movingGeometry, const std::vector<float>& moving,
                                                    const AffineSettings& settings);
 
-struct BSplineSettings {
-  double gridSpacingMm = 20.0;   // between the control points of the cubic B-spline
-  double largestShiftMm = 10.0;  // bound of each control point's displacement (L-BFGS-B's box)
-  std::vector<double> levelsMm{2.0};
-  int iterations = 60;            // per level, at most
-  double samplingFraction = 0.2;
+struct DeformableSettings {
+  double levelMm = 2.0;        // the displacement field's voxel size
+  int iterations = 50;         // at most
+  // The Gaussian smoothing of each step's update and of the total field
+  // (sigma, mm): what keeps the field smooth and one to one.
+  double updateSigmaMm = 4.0;
+  double totalSigmaMm = 2.0;
   int histogramBins = 32;
 };
 
-struct BSplineOutcome {
-  // The B-spline's displacement d (x, y, z per voxel, i fastest) on `field`,
-  // a grid over the fixed image's extent as fine as the last level: a fixed
-  // point x maps to affine(x + d(x)) in the moving image. The B-spline is
-  // smooth on the scale of its control points, so d is interpolated from
-  // this grid to any finer one within a hundredth of a millimetre.
+struct DeformableOutcome {
+  // The displacement d (x, y, z per voxel, i fastest) on `field`, a grid
+  // over the fixed image's extent with levelMm voxels: a fixed point x maps
+  // to affine(x + d(x)) in the moving image, d interpolated trilinearly.
   Geometry field;
   std::vector<float> displacement;
   double metric = 0;
   int iterations = 0;
 };
 
-// A cubic B-spline refinement, in the fixed image's (usually a region's)
-// extent, of `affine` (applied after it). Throws dynsub::Error when the
-// optimizer fails.
-DYNSUB_ITK_BRIDGE_API BSplineOutcome registerBSpline(const Geometry& fixedGeometry, const std::vector<float>& fixed,
-                                                     const Geometry& movingGeometry, const std::vector<float>& moving,
-                                                     const AffineArray& affine, const BSplineSettings& settings);
+// A dense displacement field refining `affine` (applied after it) over the
+// fixed image (usually a region), by gradient descent on Mattes mutual
+// information with the field smoothed at every step, as ANTs' Gaussian
+// displacement field does: each voxel's displacement depends on its
+// neighbourhood only, so a step costs the same whatever the region's size.
+// Throws dynsub::Error when the optimizer fails.
+DYNSUB_ITK_BRIDGE_API DeformableOutcome registerDeformable(const Geometry& fixedGeometry,
+                                                           const std::vector<float>& fixed,
+                                                           const Geometry& movingGeometry,
+                                                           const std::vector<float>& moving,
+                                                           const AffineArray& affine,
+                                                           const DeformableSettings& settings);
 
 }  // namespace dynsub::itkbridge

@@ -1,5 +1,6 @@
 #include "dynsub/SegmentImage.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -154,8 +155,23 @@ ControlMesh atlasStart(const Volume& image, const SegmentInputs& in, const Segme
   const std::vector<Landmark> boundary = carriedBoundary(*outcome.carried, 4 * parameters.priorPoints);
   FitOptions fit;
   fit.simulation.maxLevel = 0;
-  return fitPointCloud(landmarkPositions(boundary), initialFromLandmarks(boundary, parameters.initialFraction), fit)
-      .mesh;
+  ControlMesh mesh =
+      fitPointCloud(landmarkPositions(boundary), initialFromLandmarks(boundary, parameters.initialFraction), fit)
+          .mesh;
+  // A structure the image's side cuts (the cerebellum at the foot of a
+  // scan) gives a fitted surface that bulges past the side: it is shrunk
+  // about its centre, 5 % at a time, until its limit surface lies inside.
+  const Eigen::RowVector3d centre = mesh.points().colwise().mean();
+  const MatrixX3 fitted = mesh.points();
+  for (double scale = 1.0; scale > 0.3; scale -= 0.05) {
+    mesh.setPoints((fitted.rowwise() - centre) * scale + centre.replicate(fitted.rows(), 1));
+    const MatrixX3 limit = tessellate(LimitSurface(mesh), mesh.points(), 2).points;
+    bool inside = true;
+    for (Eigen::Index p = 0; p < limit.rows() && inside; ++p)
+      inside = image.geometry.covers(Vector3(limit.row(p).transpose()));
+    if (inside) return mesh;
+  }
+  throw Error(in.atlas->labelsPath, "the atlas's structure carried to the image lies mostly outside it");
 }
 
 // The initial control mesh, and the springs: the user's landmarks, or for a
@@ -307,6 +323,23 @@ SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& in, const 
   outcome.history = recorder.history();
   const SegmentResult& result = outcome.result;
   outcome.warnings = result.warnings;
+  if (outcome.carried && in.landmarks.empty()) {
+    // The springs are the atlas's boundary points, not clicks: segment()'s
+    // warning of clicks far from edges says here where atlas and image disagree.
+    outcome.warnings.erase(std::remove_if(outcome.warnings.begin(), outcome.warnings.end(),
+                                          [](const std::string& w) { return w.rfind("landmark", 0) == 0; }),
+                           outcome.warnings.end());
+    const double range = options.edges.captureRange;
+    const auto far = std::count_if(result.landmarkEdgeDistances.begin(), result.landmarkEdgeDistances.end(),
+                                   [range](double d) { return d > range; });
+    if (far > 0) {
+      std::ostringstream warning;
+      warning << far << " of the atlas's " << springs.size() << " boundary points are more than " << range
+              << " mm from every edge the image shows: the atlas and the image disagree there (check the "
+                 "result, or add clicks)";
+      outcome.warnings.push_back(warning.str());
+    }
+  }
   if (outcome.seed) {
     const std::vector<std::string> seed = seedWarnings(*outcome.seed);
     outcome.warnings.insert(outcome.warnings.begin(), seed.begin(), seed.end());

@@ -192,9 +192,10 @@ std::vector<Parameter> table() {
        "With an atlas start: the stiffness of each prior spring (0: none; the atlas then only starts the "
        "surface)",
        [](P& p) -> double& { return p.priorStiffness; }, 0, 10000, 0.5));
-  add(row("registration_grid", "Registration grid", "mm", "Atlas",
-       "With an atlas start: the spacing of the deformable registration's B-spline control points",
-       [](P& p) -> double& { return p.registration.gridSpacingMm; }, 2, 500, 1));
+  add(row("registration_smoothing", "Registration smoothing", "mm", "Atlas",
+       "With an atlas start: the Gaussian (sigma) that smooths each step of the deformable registration; "
+       "larger keeps the atlas's shape, smaller follows the image closer",
+       [](P& p) -> double& { return p.registration.updateSigmaMm; }, 0.5, 50, 0.5));
   add(row("registration_margin", "Registration margin", "mm", "Atlas",
        "With an atlas start: the neighbourhood around the structure the deformable registration covers",
        [](P& p) -> double& { return p.registration.marginMm; }, 0, 200, 1));

@@ -184,10 +184,8 @@ SegmentationRegion::SegmentationRegion(const Volume& image, const std::vector<La
   auto clock = Clock::now();
   const MatrixX3 landmarkPoints = landmarkPositions(landmarks);
   const MatrixX3 coverPoints = landmarkPositions(alsoCover);
-  // The control points too: a refit checks that they stay inside (evolveInRegion),
-  // and a mesh fitted to a shape (an atlas start) has them outside its surface.
-  MatrixX3 extent(start.rows() + initial.points().rows() + landmarkPoints.rows() + coverPoints.rows(), 3);
-  extent << start, initial.points(), landmarkPoints, coverPoints;
+  MatrixX3 extent(start.rows() + landmarkPoints.rows() + coverPoints.rows(), 3);
+  extent << start, landmarkPoints, coverPoints;
   std::tie(first_, size_) = boundingRegion(grid, extent, options.margin);
   image_ = cropVolume(image, first_, size_);
   // readVolume refuses such images; a volume made in memory is checked here,
@@ -218,7 +216,9 @@ SegmentResult evolveInRegion(const SegmentationRegion& region, const std::vector
   if (!initial.isClosed()) throw Error("the initial model must be a closed control mesh");
   const auto clock = Clock::now();
   const MatrixX3 landmarkPoints = landmarkPositions(landmarks);
-  if (!region.covers(landmarkPoints) || !region.covers(initial.points()))
+  // The limit surface, not the control points: those of a mesh fitted to a
+  // shape (an atlas start) lie outside it, and may lie outside the image.
+  if (!region.covers(landmarkPoints) || !region.covers(limitPoints(initial, 2)))
     throw Error("the landmarks or the initial model reach outside the region of interest: build a new region");
   const EdgeForce field(region.edgeField(), options.imageForce);
   FieldForceModel imageForces(field, pressure);

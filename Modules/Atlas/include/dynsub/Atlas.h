@@ -6,13 +6,13 @@
 // The atlas is a template image and its label map on one grid. ITK registers
 // the template to the subject in two steps: an affine transform on the whole
 // head, maximizing Mattes mutual information (so a T1 template serves a
-// subject of another contrast or bias), then a cubic B-spline in the
-// structure's neighbourhood. The structure's labels are carried to the
+// subject of another contrast or bias), then a smooth displacement field in
+// the structure's neighbourhood. The structure's labels are carried to the
 // subject's grid through both; its boundary gives segment() a start and a
 // prior (SegmentImage.h).
 //
 // One affine registration serves every structure of a subject (evaluations
-// and several structures reuse it); the B-spline is the structure's own.
+// and several structures reuse it); the displacement field is the structure's own.
 #include <array>
 #include <optional>
 #include <string>
@@ -57,20 +57,22 @@ struct AffineMap {
 };
 
 struct AtlasRegistrationOptions {
-  // The affine step: the pyramid's voxel sizes (mm), coarse to fine, and
-  // its iterations per level.
+  // The affine step: the pyramid's voxel sizes (mm), coarse to fine, its
+  // iterations per level, and the share of the voxels its metric samples
+  // (at random, from a fixed seed).
   std::vector<double> affineLevelsMm{4.0, 2.0};
   int affineIterations = 200;
-  // The B-spline step: its control points' spacing, the largest shift of
-  // one, its pyramid and iterations, and the margin (mm) around the
-  // structure it is computed in.
-  double gridSpacingMm = 20.0;
-  double largestShiftMm = 10.0;
-  std::vector<double> deformableLevelsMm{2.0};
-  int deformableIterations = 60;
-  double marginMm = 10.0;
-  // Share of the voxels the metric samples, at random from a fixed seed.
   double samplingFraction = 0.2;
+  // The deformable step: a displacement field over the structure's
+  // neighbourhood (its box grown by marginMm) on a grid of this voxel size
+  // (coarser for a structure larger than a caudate or a thalamus, so that
+  // the field has at most 40,000 voxels), its iterations, and the Gaussian
+  // smoothing (sigma, mm) of each step's update and of the whole field.
+  double deformableLevelMm = 2.0;
+  int deformableIterations = 50;
+  double updateSigmaMm = 4.0;
+  double totalSigmaMm = 2.0;
+  double marginMm = 10.0;
 };
 
 void checkAtlasRegistrationOptions(const AtlasRegistrationOptions& options);
@@ -88,19 +90,19 @@ AtlasAffine registerAtlasAffine(const Volume& subject, const Atlas& atlas, const
 struct CarriedLabel {
   Mask mask;                   // on a sub-grid of the subject (ImageGeometry::region)
   std::array<int, 3> first{};  // the sub-grid's first voxel in the subject
-  double metric = 0;           // the B-spline step's mutual information
+  double metric = 0;           // the deformable step's mutual information
   int iterations = 0;
-  double seconds = 0;          // the B-spline step and the carrying
+  double seconds = 0;          // the deformable step and the carrying
   // The correction an inside click made (mm): how far the label was moved so
   // that the click lies inside it; zero without a click or when it already did.
   Vector3 shift = Vector3::Zero();
-  // The B-spline's largest displacement (mm, in the subject, before the
+  // The field's largest displacement (mm, in the subject, before the
   // affine map): how much the deformable step changed.
   double largestWarpMm = 0;
 };
 
 // The structure's labels on the subject's grid, through the affine map and
-// a B-spline computed around the structure. With `inside` (a click inside
+// a displacement field computed around the structure. With `inside` (a click inside
 // the structure, LPS mm): only the carried label's part that holds the
 // click, or, when the click lies outside it, the label moved so that the
 // click lies 2 mm deep. Throws dynsub::Error when the labels leave nothing on

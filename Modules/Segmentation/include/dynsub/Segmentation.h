@@ -108,9 +108,8 @@ constexpr double kLeakedAbove = 0.05;
 // while the model and the landmarks stay inside.
 class SegmentationRegion {
  public:
-  // The bounding box of the initial model (its limit surface and its
-  // control points) and the landmarks, grown by options.margin mm; the
-  // landmarks set the edge thresholds. The
+  // The bounding box of the initial model's limit surface and the landmarks,
+  // grown by options.margin mm; the landmarks set the edge thresholds. The
   // box also holds `alsoCover` (e.g. soft springs), which set nothing. Throws
   // as segment() does when a landmark or the model lies outside the image.
   SegmentationRegion(const Volume& image, const std::vector<Landmark>& landmarks, const ControlMesh& initial,
