@@ -217,8 +217,7 @@ CarriedLabel carryLabel(const Volume& subject, const Atlas& atlas, const std::ve
     corners.conservativeResize(9, 3);
     corners.row(8) = inside->transpose();
   }
-  const auto [first, size] =
-      boundingRegion(subject.geometry, corners, options.marginMm);
+  const auto [first, size] = boundingRegion(subject.geometry, corners, options.marginMm);
   if (std::min({size[0], size[1], size[2]}) < 4)
     throw Error(atlas.imagePath, "the atlas's structure falls outside the image after registration");
   const Volume region = cropVolume(subject, first, size);
