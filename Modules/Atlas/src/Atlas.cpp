@@ -88,6 +88,47 @@ itkbridge::AffineArray toArray(const AffineMap& map) {
   return a;
 }
 
+// `in` moved by whole voxels so that its voxel nearest the click (`point`,
+// in the voxel `click`) among those 2 mm deep (or half its greatest depth,
+// for a thin one) lands on the click's voxel; `shift` receives the move (mm).
+std::vector<std::uint8_t> movedToClick(const std::vector<std::uint8_t>& in, const ImageGeometry& grid,
+                                       const Vector3& point, const std::array<int, 3>& click, Vector3& shift) {
+  const std::vector<float> depth = depthInside(in, grid);
+  const float wanted = std::min(2.0f, 0.5f * *std::max_element(depth.begin(), depth.end()));
+  std::array<int, 3> from{};
+  double nearest = std::numeric_limits<double>::infinity();
+  long long o = 0;
+  for (int k = 0; k < grid.size[2]; ++k)
+    for (int j = 0; j < grid.size[1]; ++j)
+      for (int i = 0; i < grid.size[0]; ++i, ++o) {
+        if (!in[o] || depth[o] < wanted) continue;
+        const double d = (grid.toPhysical(Vector3(i, j, k)) - point).norm();
+        if (d < nearest) {
+          nearest = d;
+          from = {i, j, k};
+        }
+      }
+  const std::array<int, 3> by = {click[0] - from[0], click[1] - from[1], click[2] - from[2]};
+  std::vector<std::uint8_t> moved(in.size(), 0);
+  o = 0;
+  for (int k = 0; k < grid.size[2]; ++k)
+    for (int j = 0; j < grid.size[1]; ++j)
+      for (int i = 0; i < grid.size[0]; ++i, ++o)
+        if (in[o] && grid.contains(i + by[0], j + by[1], k + by[2]))
+          moved[grid.offset(i + by[0], j + by[1], k + by[2])] = 1;
+  shift = grid.direction * grid.spacing.cwiseProduct(Vector3(by[0], by[1], by[2]));
+  return moved;
+}
+
+AffineMap fromArray(const itkbridge::AffineArray& a) {
+  AffineMap map;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) map.linear(r, c) = a[4 * r + c];
+    map.translation[r] = a[4 * r + 3];
+  }
+  return map;
+}
+
 }  // namespace
 
 AffineMap AffineMap::inverse() const {
@@ -177,10 +218,7 @@ AtlasAffine registerAtlasAffine(const Volume& subject, const Atlas& atlas, const
   const itkbridge::AffineOutcome outcome = itkbridge::registerAffine(
       toBridge(subject.geometry), subject.voxels, toBridge(atlas.image.geometry), atlas.image.voxels, settings);
   AtlasAffine affine;
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) affine.map.linear(r, c) = outcome.transform[4 * r + c];
-    affine.map.translation[r] = outcome.transform[4 * r + 3];
-  }
+  affine.map = fromArray(outcome.transform);
   affine.metric = outcome.metric;
   affine.iterations = outcome.iterations;
   affine.seconds = secondsSince(started);
@@ -273,41 +311,8 @@ CarriedLabel carryLabel(const Volume& subject, const Atlas& atlas, const std::ve
     const Vector3 index = grid.toIndex(*inside);
     std::array<int, 3> click{};
     for (int a = 0; a < 3; ++a) click[a] = std::clamp(static_cast<int>(std::lround(index[a])), 0, grid.size[a] - 1);
-    long long at = grid.offset(click[0], click[1], click[2]);
-    if (!in[at]) {
-      // Move the label so that its voxel nearest the click among those 2 mm
-      // deep (or half its greatest depth, for a thin one) lands on the click.
-      const std::vector<float> depth = depthInside(in, grid);
-      const float deepest = *std::max_element(depth.begin(), depth.end());
-      const float wanted = std::min(2.0f, 0.5f * deepest);
-      long long best = -1;
-      double bestDistance = std::numeric_limits<double>::infinity();
-      for (long long v = 0; v < grid.voxelCount(); ++v) {
-        if (!in[v] || depth[v] < wanted) continue;
-        const int vi = static_cast<int>(v % grid.size[0]);
-        const int vj = static_cast<int>((v / grid.size[0]) % grid.size[1]);
-        const int vk = static_cast<int>(v / (static_cast<long long>(grid.size[0]) * grid.size[1]));
-        const double d = (grid.toPhysical(Vector3(vi, vj, vk)) - *inside).norm();
-        if (d < bestDistance) {
-          bestDistance = d;
-          best = v;
-        }
-      }
-      const std::array<int, 3> from = {static_cast<int>(best % grid.size[0]),
-                                       static_cast<int>((best / grid.size[0]) % grid.size[1]),
-                                       static_cast<int>(best / (static_cast<long long>(grid.size[0]) * grid.size[1]))};
-      std::vector<std::uint8_t> moved(in.size(), 0);
-      const std::array<int, 3> by = {click[0] - from[0], click[1] - from[1], click[2] - from[2]};
-      o = 0;
-      for (int k = 0; k < grid.size[2]; ++k)
-        for (int j = 0; j < grid.size[1]; ++j)
-          for (int i = 0; i < grid.size[0]; ++i, ++o)
-            if (in[o] && grid.contains(i + by[0], j + by[1], k + by[2]))
-              moved[grid.offset(i + by[0], j + by[1], k + by[2])] = 1;
-      in = std::move(moved);
-      carried.shift = grid.direction * grid.spacing.cwiseProduct(Vector3(by[0], by[1], by[2]));
-      at = grid.offset(click[0], click[1], click[2]);
-    }
+    const long long at = grid.offset(click[0], click[1], click[2]);
+    if (!in[at]) in = movedToClick(in, grid, *inside, click, carried.shift);
     in = connectedTo(in, grid, {at});
   }
   carried.mask = Mask{grid, fillHoles(in, grid)};

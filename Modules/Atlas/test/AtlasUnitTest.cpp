@@ -5,19 +5,27 @@
 
 #include "dynsub/Atlas.h"
 #include "dynsub/Error.h"
+#include "dynsub/Metrics.h"
 #include "dynsub/SegmentImage.h"
 #include "dynsub/SubjectGenerator.h"
 
 namespace dynsub {
 namespace {
 
-double dice(const Mask& a, const Mask& b) {
-  long long both = 0, sum = 0;
-  for (std::size_t v = 0; v < a.voxels.size(); ++v) {
-    both += a.voxels[v] && b.voxels[v];
-    sum += (a.voxels[v] != 0) + (b.voxels[v] != 0);
-  }
-  return sum ? 2.0 * static_cast<double>(both) / static_cast<double>(sum) : 0.0;
+double dice(const Mask& a, const Mask& b) { return compareMasks(a, b).dice; }
+
+// The mean of the mask's voxel centres (LPS mm): a click well inside a compact structure.
+Vector3 centreOf(const Mask& mask) {
+  Vector3 sum = Vector3::Zero();
+  long long n = 0;
+  for (int k = 0; k < mask.geometry.size[2]; ++k)
+    for (int j = 0; j < mask.geometry.size[1]; ++j)
+      for (int i = 0; i < mask.geometry.size[0]; ++i)
+        if (mask.voxels[mask.geometry.offset(i, j, k)]) {
+          sum += mask.geometry.toPhysical(Vector3(i, j, k));
+          ++n;
+        }
+  return sum / static_cast<double>(n);
 }
 
 // The basal ganglia of Colin27 with AAL, cropped to an 80 x 90 x 60 mm box
@@ -103,16 +111,7 @@ TEST(Atlas, InsideClickMovesAMisplacedLabel) {
   AtlasAffine shifted;
   shifted.map.translation = Vector3(0, 0, 25);  // the template 25 mm off along z
   const Mask truth = selectLabels(atlas.labels, {71});
-  Vector3 centre = Vector3::Zero();
-  long long n = 0;
-  for (int k = 0; k < truth.geometry.size[2]; ++k)
-    for (int j = 0; j < truth.geometry.size[1]; ++j)
-      for (int i = 0; i < truth.geometry.size[0]; ++i)
-        if (truth.voxels[truth.geometry.offset(i, j, k)]) {
-          centre += truth.geometry.toPhysical(Vector3(i, j, k));
-          ++n;
-        }
-  centre /= static_cast<double>(n);
+  const Vector3 centre = centreOf(truth);
   AtlasRegistrationOptions options;
   options.deformableIterations = 1;
   const CarriedLabel carried = carryLabel(atlas.image, atlas, {71}, shifted, centre, options);
@@ -145,16 +144,7 @@ TEST(Atlas, SegmentsFromTheAtlasEndToEnd) {
   ASSERT_TRUE(alone.atlasAffine);
 
   inputs.atlasAffine = alone.atlasAffine;
-  Vector3 centre = Vector3::Zero();
-  long long n = 0;
-  for (int k = 0; k < truth.geometry.size[2]; ++k)
-    for (int j = 0; j < truth.geometry.size[1]; ++j)
-      for (int i = 0; i < truth.geometry.size[0]; ++i)
-        if (truth.voxels[truth.geometry.offset(i, j, k)]) {
-          centre += truth.geometry.toPhysical(Vector3(i, j, k));
-          ++n;
-        }
-  inputs.inside = centre / static_cast<double>(n);
+  inputs.inside = centreOf(truth);
   const SegmentOutcome clicked = segmentImage(subject.image, inputs, parameters);
   EXPECT_GE(dice(clicked.labelmap, truth), 0.80);
   EXPECT_EQ(clicked.atlasAffine, alone.atlasAffine);

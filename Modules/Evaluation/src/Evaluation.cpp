@@ -345,16 +345,14 @@ std::vector<EvaluationRun> runEvaluation(const EvaluationPlan& plan, const Evalu
   }
   std::filesystem::create_directories(options.landmarkDirectory);
 
-  // Atlas protocols: the atlas read once, each image registered to it once.
-  const auto isAtlasImage = [&](const Input& input) {
-    return !input.path.empty() &&
-           std::filesystem::weakly_canonical(input.path) == std::filesystem::weakly_canonical(plan.atlasImage);
-  };
+  // Atlas protocols: the atlas read once, each image registered to it once;
+  // an image that is the atlas's template has no registration and runs none.
   std::shared_ptr<const Atlas> atlas;
   if (std::any_of(plan.protocols.begin(), plan.protocols.end(), [](const auto& p) { return p.atlas; })) {
     atlas = std::make_shared<const Atlas>(readAtlas(plan.atlasImage, plan.atlasLabels));
+    const std::filesystem::path atlasImage = std::filesystem::weakly_canonical(plan.atlasImage);
     for (Input& input : inputs)
-      if (!isAtlasImage(input))
+      if (input.path.empty() || std::filesystem::weakly_canonical(input.path) != atlasImage)
         input.atlasAffine =
             std::make_shared<const AtlasAffine>(registerAtlasAffine(input.volume, *atlas, plan.parameters.registration));
   }
@@ -375,7 +373,7 @@ std::vector<EvaluationRun> runEvaluation(const EvaluationPlan& plan, const Evalu
           continue;
         for (const EvaluationProtocol& protocol : plan.protocols)
           for (unsigned seed : split->seeds) {
-            if (protocol.atlas && isAtlasImage(input)) continue;
+            if (protocol.atlas && !input.atlasAffine) continue;
             EvaluationRun run;
             run.split = split->name;
             run.image = input.image;

@@ -151,8 +151,11 @@ ControlMesh atlasStart(const Volume& image, const SegmentInputs& in, const Segme
                                              registerAtlasAffine(image, *in.atlas, parameters.registration));
   outcome.carried = carryLabel(image, *in.atlas, in.atlasLabels, *outcome.atlasAffine, in.inside,
                                parameters.registration);
-  outcome.prior = carriedBoundary(*outcome.carried, parameters.priorPoints);
+  // Farthest-point sampling is greedy: the prior's points are the first of
+  // the fit's, spread as evenly as if sampled alone.
   const std::vector<Landmark> boundary = carriedBoundary(*outcome.carried, 4 * parameters.priorPoints);
+  const std::size_t priorCount = std::min<std::size_t>(boundary.size(), parameters.priorPoints);
+  outcome.prior.assign(boundary.begin(), boundary.begin() + static_cast<std::ptrdiff_t>(priorCount));
   FitOptions fit;
   fit.simulation.maxLevel = 0;
   ControlMesh mesh =
@@ -165,11 +168,7 @@ ControlMesh atlasStart(const Volume& image, const SegmentInputs& in, const Segme
   const MatrixX3 fitted = mesh.points();
   for (double scale = 1.0; scale > 0.3; scale -= 0.05) {
     mesh.setPoints((fitted.rowwise() - centre) * scale + centre.replicate(fitted.rows(), 1));
-    const MatrixX3 limit = tessellate(LimitSurface(mesh), mesh.points(), 2).points;
-    bool inside = true;
-    for (Eigen::Index p = 0; p < limit.rows() && inside; ++p)
-      inside = image.geometry.covers(Vector3(limit.row(p).transpose()));
-    if (inside) return mesh;
+    if (limitSurfaceInside(mesh, image.geometry)) return mesh;
   }
   throw Error(in.atlas->labelsPath, "the atlas's structure carried to the image lies mostly outside it");
 }

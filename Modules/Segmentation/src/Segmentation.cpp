@@ -162,6 +162,13 @@ std::vector<double> distancesToSurface(const LimitSurface& surface, const Matrix
   return distances;
 }
 
+bool limitSurfaceInside(const ControlMesh& mesh, const ImageGeometry& grid) {
+  const MatrixX3 points = limitPoints(mesh, 2);
+  for (Eigen::Index p = 0; p < points.rows(); ++p)
+    if (!grid.covers(points.row(p).transpose())) return false;
+  return true;
+}
+
 SegmentationRegion::SegmentationRegion(const Volume& image, const std::vector<Landmark>& landmarks,
                                        const ControlMesh& initial, const SegmentOptions& options,
                                        const std::vector<Landmark>& alsoCover) {
@@ -177,9 +184,8 @@ SegmentationRegion::SegmentationRegion(const Volume& image, const std::vector<La
               << p.y() << ", " << p.z() << ") mm LPS lies outside the image";
       throw LandmarkError(message.str());
     }
+  if (!limitSurfaceInside(initial, grid)) throw Error("the initial model reaches outside the image");
   const MatrixX3 start = limitPoints(initial, 2);
-  for (Eigen::Index p = 0; p < start.rows(); ++p)
-    if (!grid.covers(start.row(p).transpose())) throw Error("the initial model reaches outside the image");
 
   auto clock = Clock::now();
   const MatrixX3 landmarkPoints = landmarkPositions(landmarks);

@@ -135,6 +135,10 @@ class SegmentationRegion {
   std::unique_ptr<const EdgeField> edgeField_;
 };
 
+// Whether a model's limit surface (2 x 2 samples per face, as segment()
+// checks an initial model) lies within the grid's voxels.
+bool limitSurfaceInside(const ControlMesh& mesh, const ImageGeometry& grid);
+
 // The papers' cube placed inside the landmarks' PCA ellipsoid (`fraction`
 // of its semi-axes, by default half). Throws dynsub::Error for fewer than 4
 // landmarks or flat ones (LandmarkError for landmarks on one plane).
