@@ -64,7 +64,7 @@ void writeSegmentOutputs(const std::filesystem::path& dir, const SegmentOutcome&
           addFigureOutputs(outputs, figures, result.mesh, result.surface, outcome.history, &image,
                            landmarkPositions(outcome.springs), MatrixX3(), result.surfaceEdgeDistances);
         };
-        // NB: with figures, the labelmap is compressed on a thread of its own
+        // With figures, the labelmap is compressed on a thread of its own
         // while they render on this one (a tenth of them). Without, this
         // thread has only convergence.csv to write, and writes the labelmap
         // too: a thread of its own took fresh 4 kB pages for the labelmap's
@@ -122,7 +122,7 @@ void runSegment(const Arguments& o) {
     throw Error("--atlas-label serves an atlas start: add --init atlas");
   }
   checkSegmentInputs(inputs, o.parameters);
-  // NB: the reference is needed only to score the result, and reading it
+  // The reference is needed only to score the result, and reading it
   // (a whole labelmap, inflated and converted) took a fifth of the caudate
   // demo's command: it is read on a second thread while the segmentation
   // runs, and its errors (a missing file at once) still come before any

@@ -63,7 +63,7 @@ std::vector<float> depthInside(const std::vector<std::uint8_t>& grown, const Ima
   const long long n = g.voxelCount();
   std::vector<std::uint8_t> outside(n);
   for (long long o = 0; o < n; ++o) outside[o] = !grown[o];
-  // NB: the box around `grown` is ringed by outside voxels (or by the grid's
+  // The box around `grown` is ringed by outside voxels (or by the grid's
   // side, as the whole grid is): each grown voxel's nearest one is in it.
   return distanceInBox(outside, g, occupiedRegion(g, grown, 1));
 }

@@ -141,7 +141,7 @@ ControlMesh initialFromLandmarks(const std::vector<Landmark>& landmarks, double 
   const MatrixX3 points = landmarkPositions(landmarks);
   // Clicks on one slice are the flat set users give; say what would do.
   // (Points on a line, or at one point, get checkPointCloud's own words.)
-  // NB: one slice of clicks says nothing of the structure across the slice:
+  // One slice of clicks says nothing of the structure across the slice:
   // even with a seed click at their centre the surface collapses or leaks, so
   // such landmarks are refused rather than guessed at.
   if (points.rows() >= 4 && points.allFinite() && spannedDimensions(points) == 2)
@@ -287,7 +287,7 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
   std::vector<ForceModel*> forces = extraForces;
   if (endPoints.rows() > 0) forces.push_back(&endSprings);
   std::optional<EndPressure> pressure = endPressure(region, landmarks, options.sliceEnds, ends);
-  // NB: the initial model's volume (for the collapse check) is measured on
+  // The initial model's volume (for the collapse check) is measured on
   // the second core while the evolution runs on one.
   std::future<double> initialVolume = std::async(std::launch::async, [&initial] {
     const LimitSurface limit(initial);
