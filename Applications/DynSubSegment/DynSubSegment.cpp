@@ -7,6 +7,7 @@
 //
 // Exit codes: 0 success; 1 an error in the inputs or the run (stderr names the
 // file and the problem, and nothing is written); 2 a usage error.
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -111,6 +112,7 @@ slicer::Module describe(Arguments& a) {
       "(its tissue is grown from there and the surface starts on that region's boundary), or the structure's "
       "name in the AAL atlas.";
   m.version = DYNSUB_VERSION;
+  m.documentationUrl = DYNSUB_DOCUMENTATION_URL;
   m.license = "See the DynSub source tree";
   m.contributor = "DynSub developers";
   m.acknowledgements = "Built on ITK, VTK and Eigen.";
@@ -140,9 +142,12 @@ slicer::Module describe(Arguments& a) {
   io.parameters.push_back({"image", "type=\"label\" reference=\"inputVolume\"", "outputLabelmap", "labelmap",
                            "Output labelmap", "The structure as a label image on the input volume's grid.",
                            &a.labelmap, "output", "", "", "", {}, -1});
-  io.parameters.push_back({"geometry", "type=\"model\"", "outputModel", "model", "Output model",
-                           "The fitted limit surface as a triangle model (LPS mm).", &a.model, "output", "", "", "",
-                           {}, -1});
+  // nipype names an output it is asked for by the first extension declared.
+  std::string modelExtensions;
+  for (const std::string& e : triangleSurfaceExtensions()) modelExtensions += (modelExtensions.empty() ? "" : ",") + e;
+  io.parameters.push_back({"geometry", "type=\"model\" fileExtensions=\"" + modelExtensions + "\"", "outputModel",
+                           "model", "Output model", "The fitted limit surface as a triangle model (LPS mm).",
+                           &a.model, "output", "", "", "", {}, -1});
   io.parameters.push_back({"file", "fileExtensions=\".json\"", "report", "report", "Report",
                            "Optional: the run's numbers and warnings as JSON (the report.json of dynsub segment).",
                            &a.report, "output", "", "", "", {}, -1});
@@ -211,7 +216,7 @@ void run(Arguments& a) {
     in.landmarks.push_back({"seed-" + std::to_string(i + 1), parsePoint(a.seeds[i], "--seed")});
   in.landmarkSource = "--seed";
   if (!a.landmarks.empty()) {
-    const std::vector<Landmark> fromFile = readLandmarks(a.landmarks);
+    const std::vector<Landmark> fromFile = readLandmarks(a.landmarks, &in.landmarkSystem);
     in.landmarks.insert(in.landmarks.end(), fromFile.begin(), fromFile.end());
     in.landmarkSource = a.seeds.empty() ? a.landmarks : "--seed and " + a.landmarks;
   }
@@ -285,7 +290,9 @@ int main(int argc, char** argv) {
   slicer::addOptions(app, module);
   app.add_flag("--xml", "Print the Execution Model descriptor (alone)");
   try {
-    app.parse(argc, argv);
+    std::vector<std::string> words = slicer::withJoinedPoints(module, argc, argv);
+    std::reverse(words.begin(), words.end());  // CLI11 takes a vector last word first
+    app.parse(words);
     run(arguments);
   } catch (const CLI::ParseError& error) {
     const int code = app.exit(error);

@@ -1,11 +1,15 @@
 #include "ExecutionModel.h"
 
 #include <iomanip>
+#include <optional>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <type_traits>
 
 #include <CLI/CLI.hpp>
+
+#include "dynsub/TextFields.h"
 
 namespace dynsub::slicer {
 
@@ -33,6 +37,22 @@ std::string defaultOf(const Parameter& p) {
   return "";
 }
 
+// The numbers in a word of a point ("[-16.5," or "19.0," or "1,2,3"), or
+// nothing when a part of it is not a number.
+std::optional<std::vector<std::string>> pointNumbers(const std::string& word) {
+  std::string text = word;
+  for (char& c : text)
+    if (c == '[' || c == ']' || c == '(' || c == ')' || c == ',') c = ' ';
+  std::istringstream in(text);
+  std::vector<std::string> numbers;
+  for (std::string part; in >> part;) {
+    double value = 0;
+    if (!dynsub::parseNumber(part, value)) return std::nullopt;
+    numbers.push_back(part);
+  }
+  return numbers;
+}
+
 void tag(std::ostringstream& out, const char* indent, const std::string& name, const std::string& text) {
   out << indent << '<' << name << '>' << escaped(text) << "</" << name << ">\n";
 }
@@ -52,6 +72,7 @@ std::string descriptor(const Module& module) {
   tag(out, "  ", "title", module.title);
   tag(out, "  ", "description", module.description);
   tag(out, "  ", "version", module.version);
+  if (!module.documentationUrl.empty()) tag(out, "  ", "documentation-url", module.documentationUrl);
   tag(out, "  ", "license", module.license);
   tag(out, "  ", "contributor", module.contributor);
   tag(out, "  ", "acknowledgements", module.acknowledgements);
@@ -83,6 +104,30 @@ std::string descriptor(const Module& module) {
   }
   out << "</executable>\n";
   return out.str();
+}
+
+std::vector<std::string> withJoinedPoints(const Module& module, int argc, const char* const* argv) {
+  std::set<std::string> pointFlags;
+  for (const ParameterGroup& group : module.groups)
+    for (const Parameter& p : group.parameters)
+      if (p.element == "point" && p.index < 0) pointFlags.insert("--" + p.flag);
+  const std::vector<std::string> words(argv + 1, argv + argc);
+  std::vector<std::string> joined;
+  for (std::size_t i = 0; i < words.size(); ++i) {
+    joined.push_back(words[i]);
+    if (!pointFlags.count(words[i])) continue;
+    std::vector<std::string> numbers;
+    std::size_t next = i + 1;
+    for (; next < words.size() && numbers.size() < 3; ++next) {
+      const auto found = pointNumbers(words[next]);
+      if (!found || found->empty() || numbers.size() + found->size() > 3) break;
+      numbers.insert(numbers.end(), found->begin(), found->end());
+    }
+    if (numbers.size() != 3) continue;
+    joined.push_back(numbers[0] + "," + numbers[1] + "," + numbers[2]);
+    i = next - 1;
+  }
+  return joined;
 }
 
 void addOptions(CLI::App& app, const Module& module) {

@@ -37,7 +37,7 @@ struct ParameterGroup {
 };
 
 struct Module {
-  std::string category, title, description, version, license, contributor, acknowledgements;
+  std::string category, title, description, version, documentationUrl, license, contributor, acknowledgements;
   std::vector<ParameterGroup> groups;
 };
 
@@ -47,6 +47,14 @@ std::string number(double value);
 // The descriptor, starting with "<?xml". Each plain value's default is the
 // target's current value.
 std::string descriptor(const Module& module);
+
+// The program's arguments (without its name), with each point's value as
+// one "x,y,z". Slicer passes a point so; nipype's generated interface passes
+// "[x, y, z]" for each of several points and "x y z" for a single one, which
+// the shell splits into three words. After a point's flag, words are joined
+// while they hold numbers, up to three; anything else is left to the option's
+// own error.
+std::vector<std::string> withJoinedPoints(const Module& module, int argc, const char* const* argv);
 
 // One CLI11 option per parameter (positional for an index), with the
 // constraints as checks and the targets' current values as defaults.

@@ -93,16 +93,28 @@ std::string csvField(const std::string& text) {
 void writeRunsCsv(const std::vector<EvaluationRun>& runs, const std::string& path) {
   std::ofstream out(path);
   out << "split,image,subject,subject_snr,thick_axis,structure,protocol,seed,format,landmarks,dice,jaccard,mean_surface_distance_mm,hd95_mm,"
-         "volume_mm3,reference_volume_mm3,leak_mm3,miss_mm3,collapsed,surface_on_edges,seconds,steps,control_vertices,warnings,error\n";
+         "volume_mm3,reference_volume_mm3,leak_mm3,miss_mm3,collapsed,surface_on_edges,"
+         "edge_strength_as_read,edge_strength_flipped,edge_strength_mirrored,edge_alignment_as_read,"
+         "edge_alignment_flipped,edge_alignment_mirrored,seconds,steps,control_vertices,warnings,"
+         "error\n";
   out << std::setprecision(6);
-  for (const EvaluationRun& r : runs)
+  for (const EvaluationRun& r : runs) {
     out << csvField(r.split) << ',' << csvField(r.image) << ',' << csvField(r.subject) << ',' << r.subjectSnr << ','
         << r.subjectThickAxis << ',' << csvField(r.structure) << ','
         << csvField(r.protocol) << ',' << r.seed << ',' << r.format
         << ',' << r.landmarks << ',' << r.dice << ',' << r.jaccard << ',' << r.meanSurfaceDistance << ',' << r.hd95
         << ',' << r.volume << ',' << r.referenceVolume << ',' << r.leak << ',' << r.miss << ','
-        << (r.collapsed ? 1 : 0) << ',' << r.surfaceOnEdges << ',' << r.seconds << ',' << r.steps << ',' << r.controlVertices << ','
+        << (r.collapsed ? 1 : 0) << ',' << r.surfaceOnEdges << ',';
+    if (r.convention) {
+      const ConventionScores& c = *r.convention;
+      out << c.asRead.strength << ',' << c.flipped.strength << ',' << c.mirrored.strength << ',' << c.asRead.alignment
+          << ',' << c.flipped.alignment << ',' << c.mirrored.alignment << ',';
+    } else {
+      out << ",,,,,,";
+    }
+    out << r.seconds << ',' << r.steps << ',' << r.controlVertices << ','
         << csvField(r.warnings) << ',' << csvField(r.error) << '\n';
+  }
   out.close();
   if (!out) throw writeFailure(path);
 }

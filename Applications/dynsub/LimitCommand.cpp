@@ -47,7 +47,7 @@ void addLimitCommand(CLI::App& app) {
       "1 special element, and Element), .obj, .ply, .stl.");
   command->add_option("MESH", options->mesh, "Control mesh (.obj, .off or .ply), closed or with boundaries")
       ->required();
-  command->add_option("--out", options->out, "Output surface file (.vtp, .obj, .ply or .stl)")->required();
+  command->add_option("--out", options->out, "Output surface file (.vtp, .vtk, .obj, .ply or .stl)")->required();
   command->add_option("--samples-per-face", options->samplesPerFace,
                       "N: parameter squares along each side of an element (1 to 1024)")
       ->default_val(8)

@@ -109,7 +109,7 @@ void runSegment(const Arguments& o) {
   SegmentInputs inputs;
   inputs.start = parseSegmentStart(o.init, "--init");
   const Volume image = readVolume(o.image);
-  if (!o.landmarks.empty()) inputs.landmarks = readLandmarks(o.landmarks);
+  if (!o.landmarks.empty()) inputs.landmarks = readLandmarks(o.landmarks, &inputs.landmarkSystem);
   inputs.image = o.image;
   inputs.landmarkSource = o.landmarks;
   if (!o.inside.empty()) inputs.inside = parsePoint(o.inside, "--inside");

@@ -46,9 +46,11 @@ def check_descriptor(module):
     root = ElementTree.fromstring(run.stdout)
     if root.tag != "executable":
         fail("the root element is not <executable>")
-    for tag in ("category", "title", "description", "version"):
+    for tag in ("category", "title", "description", "version", "documentation-url", "license"):
         if not (root.findtext(tag) or "").strip():
             fail(f"<{tag}> is missing or empty")
+    if not re.match(r"(https?|file)://", root.findtext("documentation-url")):
+        fail(f"<documentation-url> {root.findtext('documentation-url')!r} is not a URL")
     names, flags, indices = set(), set(), []
     for group in root.findall("parameters"):
         if not (group.findtext("label") or "").strip():
@@ -84,6 +86,9 @@ def check_descriptor(module):
                 fail(f"{name}: a plain value has no channel")
             if p.tag in ("image", "geometry") and p.get("type") not in IMAGE_TYPES:
                 fail(f"{name}: type {p.get('type')!r}")
+            if p.tag == "geometry" and channel == "output" and ".vtk" not in (p.get("fileExtensions") or ".vtk"):
+                # nipype names an output model by the first extension declared, .vtk without one.
+                fail(f"{name}: an output model that declares extensions must accept .vtk")
             reference = p.get("reference")
             if reference is not None and reference not in names:
                 fail(f"{name}: reference {reference!r} names no earlier parameter")
@@ -145,21 +150,42 @@ def generated_interface(module):
 
 
 def nipype_run(module, image, landmarks, workdir):
+    """Runs the module twice through nipype's generated class, as a nipype user would: the boundary
+    points as a list of [x, y, z] (nipype writes each as "--seed [x, y, z]"), then one point inside
+    (written "--inside x y z"). nipype names the outputs it is asked for (True) itself."""
+    import json
     from nipype import logging
     logging.getLogger("nipype.interface").setLevel("WARNING")  # not every <filter-progress> line
     interface = generated_interface(module)
-    os.chdir(workdir)
-    node = interface()
-    node.inputs.inputVolume = image
-    node.inputs.landmarks = landmarks
-    node.inputs.labelmap = True  # nipype names the output itself (outputLabelmap.nii, by its rule)
-    node.inputs.model = "nipype_surface.vtp"
-    result = node.run()
-    outputs = result.outputs
-    for path in (outputs.labelmap, outputs.model):
-        if not os.path.getsize(path) > 0:
-            fail(f"nipype run: {path} is missing or empty")
-    print(f"nipype ran: {node.cmdline}\n  -> {outputs.labelmap}, {outputs.model}")
+    markups = json.load(open(landmarks))["markups"][0]
+    if markups.get("coordinateSystem", "LPS") != "LPS":
+        fail(f"{landmarks}: expected LPS points")
+    points = [[float(v) for v in p["position"]] for p in markups["controlPoints"]]
+    for name, inputs, expected in (
+            ("boundary points", {"seed": points}, "--seed [%s, %s, %s]" % tuple(points[0])),
+            ("a point inside", {"inside": numpy.mean(points, axis=0).tolist()}, "--inside ")):
+        run_dir = os.path.join(workdir, name.replace(" ", "_"))
+        os.makedirs(run_dir)
+        os.chdir(run_dir)
+        node = interface()
+        node.inputs.inputVolume = image
+        for key, value in inputs.items():
+            setattr(node.inputs, key, value)
+        node.inputs.labelmap = True
+        node.inputs.model = True
+        node.inputs.report = "report.json"
+        if expected not in node.cmdline:
+            fail(f"nipype's command line {node.cmdline!r} lacks {expected!r}")
+        outputs = node.run().outputs
+        for path in (outputs.labelmap, outputs.model, outputs.report):
+            if not os.path.getsize(path) > 0:
+                fail(f"nipype run with {name}: {path} is missing or empty")
+        report = json.load(open(outputs.report))
+        if name == "boundary points" and report["landmark_count"] != len(points):
+            fail(f"nipype run with {name}: {report['landmark_count']} points reached the module, not {len(points)}")
+        if name == "a point inside" and not report["init"].startswith("inside:"):
+            fail(f"nipype run with {name}: the module started from {report['init']!r}")
+        print(f"nipype ran with {name}: {node.cmdline[:160]}...\n  -> {outputs.labelmap}, {outputs.model}")
 
 
 NRRD_TYPES = {"unsigned char": numpy.uint8, "uchar": numpy.uint8, "uint8": numpy.uint8,

@@ -248,6 +248,41 @@ expect_error "truncated .nii.gz" 1 "cut.nii.gz: truncated or corrupt compressed 
 printf 'x,y,z\n75,-75,89\n70,-80,94\n65,-75,99\n75,-85,84\n70,-73,91\n65,-83,87\n' >"$work/air.csv"
 expect_error "landmarks off every edge" 1 "air.csv: the image has no edges: its intensity is constant" "$work/s11" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/air.csv" --no-figures --out "$work/s11"
+# The caudate's clicks read in the wrong convention (RAS values in a file
+# that says LPS, in a CSV, or LPS values in a file that says RAS) land on the
+# mirror region: refused, with the fix named. The right RAS file passes.
+python3 - "$DATA/Landmarks/caudate_left.mrk.json" "$work" <<'PY'
+import copy, json, sys
+lps = json.load(open(sys.argv[1]))
+ras = copy.deepcopy(lps)
+for point in ras["markups"][0]["controlPoints"]:
+    point["position"] = [-point["position"][0], -point["position"][1], point["position"][2]]
+json.dump(ras, open(sys.argv[2] + "/ras_says_lps.mrk.json", "w"))
+ras["markups"][0]["coordinateSystem"] = "RAS"
+json.dump(ras, open(sys.argv[2] + "/ras.mrk.json", "w"))
+lps["markups"][0]["coordinateSystem"] = "RAS"
+json.dump(lps, open(sys.argv[2] + "/lps_says_ras.mrk.json", "w"))
+with open(sys.argv[2] + "/ras.csv", "w") as out:
+    out.write("x,y,z\n")
+    for point in ras["markups"][0]["controlPoints"]:
+        out.write("%g,%g,%g\n" % tuple(point["position"]))
+PY
+expect_error "RAS values in a file that says LPS" 1 \
+  "ras_says_lps.mrk.json: these points look like RAS; they are read as LPS.*\"coordinateSystem\" to \"RAS\"" \
+  "$work/s15" "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/ras_says_lps.mrk.json" --no-figures \
+  --out "$work/s15"
+expect_error "RAS values in a CSV" 1 "ras.csv: these points look like RAS.*a CSV's points are LPS" "$work/s16" \
+  "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/ras.csv" --no-figures --out "$work/s16"
+expect_error "LPS values in a file that says RAS" 1 "these points look like LPS; they are read as RAS" "$work/s17" \
+  "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/lps_says_ras.mrk.json" --no-figures --out "$work/s17"
+"$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/ras.mrk.json" --reference "$mri/aal.nii.gz" \
+  --reference-label 71 --no-figures --out "$work/s18" >/dev/null 2>&1
+check "RAS values in a file that says RAS segment the caudate" python3 -c "
+import json, sys; r = json.load(open('$work/s18/report.json')); e = r['landmark_edges']
+sys.exit(not (r['dice'] > 0.8 and e['flipped_evidence'] < 0 and e['as_read']['strength'] > e['flipped']['strength']))"
+"$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/ras_says_lps.mrk.json" --check-convention false \
+  --max-level 0 --no-figures --out "$work/s19" >/dev/null 2>&1
+check "--check-convention false keeps points as read" test -s "$work/s19/report.json"
 expect_error "unknown edge reference" 2 "edge-reference" "$work/s10" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:-10,10,10,5 --edge-reference scanner --out "$work/s10"
 expect_error "missing image" 1 "no such file" "$work/s1" \

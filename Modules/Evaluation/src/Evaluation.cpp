@@ -105,6 +105,7 @@ EvaluationRun runOne(const EvaluationPlan& plan, const Volume& image, const Mask
   run.controlVertices = result.mesh.vertexCount();
   run.surfaceOnEdges = result.surfaceOnEdges;
   run.seconds = outcome.seconds;
+  run.convention = outcome.convention;
 
   const Mask& mask = outcome.labelmap;
   const double voxel = reference.geometry.spacing.prod();

@@ -55,7 +55,7 @@ double finiteNumber(const std::string& text, const std::string& path, int line) 
   return value;
 }
 
-std::vector<Landmark> readMarkupsJson(const std::string& path, std::ifstream& in) {
+std::vector<Landmark> readMarkupsJson(const std::string& path, std::ifstream& in, CoordinateSystem& stated) {
   nlohmann::json document;
   try {
     in >> document;
@@ -65,6 +65,7 @@ std::vector<Landmark> readMarkupsJson(const std::string& path, std::ifstream& in
   if (!document.contains("markups") || !document["markups"].is_array())
     throw Error(path, "no \"markups\" list (not a 3D Slicer markups file)");
   std::vector<Landmark> landmarks;
+  bool first = true;
   // A field of another JSON type than the format's (a number for a label, a
   // markup that is not an object) makes nlohmann::json throw: the file is
   // malformed, and the message names the file.
@@ -74,6 +75,8 @@ std::vector<Landmark> readMarkupsJson(const std::string& path, std::ifstream& in
       if (system != "LPS" && system != "RAS") throw Error(path, "unknown coordinateSystem \"" + system + "\"");
       if (markup.contains("coordinateUnits") && markup["coordinateUnits"] != "mm")
         throw Error(path, "coordinateUnits must be mm");
+      if (first) stated = system == "RAS" ? CoordinateSystem::RAS : CoordinateSystem::LPS;
+      first = false;
       if (!markup.contains("controlPoints")) continue;
       int index = 0;
       for (const auto& point : markup["controlPoints"]) {
@@ -94,8 +97,7 @@ std::vector<Landmark> readMarkupsJson(const std::string& path, std::ifstream& in
   return landmarks;
 }
 
-std::vector<Landmark> readFcsv(const std::string& path, std::ifstream& in) {
-  CoordinateSystem system = CoordinateSystem::LPS;
+std::vector<Landmark> readFcsv(const std::string& path, std::ifstream& in, CoordinateSystem& system) {
   std::vector<std::string> columns = {"id", "x", "y", "z", "ow", "ox", "oy", "oz", "vis", "sel", "lock", "label"};
   std::vector<Landmark> landmarks;
   std::string line;
@@ -172,16 +174,18 @@ std::string labelOf(const std::vector<Landmark>& landmarks, std::size_t i) {
 
 }  // namespace
 
-std::vector<Landmark> readLandmarks(const std::string& path) {
+std::vector<Landmark> readLandmarks(const std::string& path, CoordinateSystem* stated) {
   const Format format = formatOf(path);
   std::ifstream in(path);
   if (!in) throw Error(path, "no such file or not readable");
   std::vector<Landmark> landmarks;
+  CoordinateSystem system = CoordinateSystem::LPS;
   switch (format) {
-    case Format::MarkupsJson: landmarks = readMarkupsJson(path, in); break;
-    case Format::Fcsv: landmarks = readFcsv(path, in); break;
+    case Format::MarkupsJson: landmarks = readMarkupsJson(path, in, system); break;
+    case Format::Fcsv: landmarks = readFcsv(path, in, system); break;
     case Format::Csv: landmarks = readCsv(path, in); break;
   }
+  if (stated) *stated = system;
   return landmarks;
 }
 

@@ -8,6 +8,7 @@
 
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/Error.h"
+#include "dynsub/FileNames.h"
 #include "dynsub/ForceModel.h"
 #include "dynsub/Labelmap.h"
 #include "dynsub/MeshIO.h"
@@ -241,6 +242,48 @@ SegmentStart parseSegmentStart(const std::string& value, const std::string& opti
 
 namespace {
 
+// How to make the source say what its values are, for the refusal below.
+std::string conventionFix(const std::string& source, CoordinateSystem meant) {
+  const std::string system = meant == CoordinateSystem::RAS ? "RAS" : "LPS";
+  const std::string extension = lowerCaseExtension(source);
+  if (extension == ".json") return "set the markups' \"coordinateSystem\" to \"" + system + "\"";
+  if (extension == ".fcsv") return "set the file's header to '# CoordinateSystem = " + system + "'";
+  if (extension == ".csv")
+    return "negate x and y (a CSV's points are LPS), or save the points as a .mrk.json with \"coordinateSystem\": "
+           "\"RAS\"";
+  return "negate x and y (points given as numbers are LPS)";
+}
+
+// Refuses landmarks whose RAS/LPS flip or left-right mirror fits the
+// image's edges far better than they do (LandmarkConvention.h), naming the fix.
+void refuseMisread(const SegmentInputs& in, const ConventionScores& scores) {
+  const Misreading misreading = likelyMisreading(scores);
+  if (misreading == Misreading::None) return;
+  const ReadingEdges& other = misreading == Misreading::Flipped ? scores.flipped : scores.mirrored;
+  std::ostringstream asRead;
+  asRead << std::setprecision(3);
+  if (scores.asRead.strength > 0)
+    asRead << "fit the image's edges far better: median gradient " << other.strength << " against "
+           << scores.asRead.strength << " per mm as read, alignment with their shape " << other.alignment
+           << " against " << scores.asRead.alignment;
+  else
+    asRead << "lie on edges (median gradient " << other.strength << " per mm) while, as read, some lie outside the "
+           << "image or on none";
+  std::ostringstream message;
+  if (misreading == Misreading::Flipped) {
+    const bool saysRas = in.landmarkSystem == CoordinateSystem::RAS;
+    const CoordinateSystem meant = saysRas ? CoordinateSystem::LPS : CoordinateSystem::RAS;
+    message << "these points look like " << (saysRas ? "LPS" : "RAS") << "; they are read as "
+            << (saysRas ? "RAS" : "LPS") << ". With x and y negated they " << asRead.str() << ". To fix, "
+            << conventionFix(in.landmarkSource, meant);
+  } else {
+    message << "these points look mirrored left to right: with x negated they " << asRead.str()
+            << ". Check their x values, and that the image's left and right are stored right";
+  }
+  message << " (--check-convention false keeps them as read)";
+  throw Error(in.landmarkSource, message.str());
+}
+
 // The evolution's options for these inputs (segmentOptions()).
 SegmentOptions optionsFor(const SegmentInputs& in, const SegmentParameters& parameters) {
   const bool pointsOnBoundary = !in.landmarks.empty() || in.start.kind == SegmentStart::Kind::Seed ||
@@ -280,6 +323,11 @@ SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& in, const 
 
   SegmentOutcome outcome;
   const auto started = std::chrono::steady_clock::now();
+  if (in.landmarks.size() >= 4) {
+    outcome.convention = conventionScores(image, landmarkPositions(in.landmarks), parameters.segment.edges.sigma,
+                                          parameters.segment.edges.landmarkReach);
+    if (parameters.checkConvention) refuseMisread(in, *outcome.convention);
+  }
   const ControlMesh initial = chooseStart(image, in, parameters, options, outcome);
   const std::vector<Landmark>& springs = outcome.springs;
   // With landmarks, the atlas's prior pulls besides them, softly.
@@ -349,6 +397,21 @@ SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& in, const 
   report.set("landmarks", in.landmarkSource);
   report.set("landmark_count", in.landmarks.size());
   report.set("init", in.start.text);
+  if (outcome.convention) {
+    Report convention;
+    const auto reading = [](const ReadingEdges& edges) {
+      Report r;
+      r.set("strength", edges.strength);
+      r.set("alignment", edges.alignment);
+      return r;
+    };
+    convention.set("as_read", reading(outcome.convention->asRead));
+    convention.set("flipped", reading(outcome.convention->flipped));
+    convention.set("mirrored", reading(outcome.convention->mirrored));
+    convention.set("flipped_evidence", misreadingEvidence(*outcome.convention, Misreading::Flipped));
+    convention.set("mirrored_evidence", misreadingEvidence(*outcome.convention, Misreading::Mirrored));
+    report.set("landmark_edges", convention);
+  }
   if (outcome.seed) report.set("seed", seedReport(*outcome.seed, !in.landmarks.empty()));
   if (outcome.carried) report.set("atlas", atlasReport(in, outcome, in.atlasAffine != nullptr));
   if (in.reference) {

@@ -6,6 +6,7 @@
 
 #include "dynsub/Error.h"
 #include "dynsub/Integrator.h"
+#include "dynsub/LandmarkConvention.h"
 
 namespace dynsub {
 
@@ -164,6 +165,17 @@ std::vector<Parameter> table() {
        "The initial model inside the landmarks' (or a seed region's boundary points') PCA ellipsoid: this "
        "fraction of its semi-axes",
        [](P& p) -> double& { return p.initialFraction; }, 0.05, 1, 0.05));
+  Parameter convention = row(
+      "check_convention", "Convention check", "", "Start",
+      "With 4 or more boundary points: refuse them when, with x and y negated (RAS read as LPS, or the reverse) "
+      "or with x alone negated (left and right swapped), they lie on image edges much stronger than theirs or "
+      "much better facing their shape",
+      [](P& p) -> bool& { return p.checkConvention; });
+  convention.opposite = Parameter::Opposite{
+      "noConventionCheck", "Skip the convention check",
+      "Check to keep points that look mirrored: by default, points whose RAS/LPS flip or left-right mirror lies "
+      "on much stronger edges are refused as read in the wrong coordinate convention."};
+  add(convention);
   add(row("seed_window", "Seed window", "spreads", "Start",
        "With a seed click: the intensity window grown through, in robust spreads (1.4826 MAD) of the "
        "intensities near the click either side of their median",

@@ -32,14 +32,12 @@ Volume magnitudeOf(const ImageGeometry& geometry, const std::vector<Vector3>& gr
   return magnitude;
 }
 
-// The strongest gradient magnitude within `radius` mm of a point: the height
-// of the edge an expert meant when clicking next to it. Along an axis whose
-// voxels are longer than twice the radius (thick slices), a voxel is as near
-// as its slab: a click between two slices sees both.
-double strongestNear(const Volume& magnitude, const Vector3& point, double radius) {
+}  // namespace
+
+StrongestVoxel strongestVoxelNear(const Volume& magnitude, const Vector3& point, double radius) {
   const ImageGeometry& g = magnitude.geometry;
   const Vector3 centre = g.toIndex(point);
-  double strongest = 0;
+  StrongestVoxel strongest;
   int reach[3];
   Vector3 slab = Vector3::Zero();  // mm, half a voxel along thick axes
   for (int a = 0; a < 3; ++a) {
@@ -60,10 +58,20 @@ double strongestNear(const Volume& magnitude, const Vector3& point, double radiu
         } else {
           near = (g.toPhysical(Vector3(i, j, k)) - point).norm() <= radius;
         }
-        if (near) strongest = std::max(strongest, static_cast<double>(magnitude.at(i, j, k)));
+        const double m = magnitude.at(i, j, k);
+        if (near && (strongest.offset < 0 || m > strongest.magnitude)) {
+          strongest.magnitude = m;
+          strongest.offset = g.offset(i, j, k);
+        }
       }
   return strongest;
 }
+
+double strongestNear(const Volume& magnitude, const Vector3& point, double radius) {
+  return strongestVoxelNear(magnitude, point, radius).magnitude;
+}
+
+namespace {
 
 // The reference magnitude and fractions of step 3 (see the header).
 EdgeScale edgeScale(const Volume& magnitude, const EdgeOptions& options, const MatrixX3& landmarks) {

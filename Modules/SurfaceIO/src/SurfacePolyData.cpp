@@ -10,6 +10,7 @@
 #include <vtkNew.h>
 #include <vtkOBJReader.h>
 #include <vtkPLYReader.h>
+#include <vtkPolyDataReader.h>
 #include <vtkSTLReader.h>
 #include <vtkAbstractPolyDataReader.h>
 #include <vtkPointData.h>
@@ -97,6 +98,10 @@ vtkSmartPointer<vtkPolyData> readSurfacePolyData(const std::string& path) {
     vtkNew<vtkXMLPolyDataReader> reader;
     reader->SetFileName(path.c_str());
     polyData = readWith(reader.GetPointer(), path);
+  } else if (extension == ".vtk") {
+    vtkNew<vtkPolyDataReader> reader;
+    reader->SetFileName(path.c_str());
+    polyData = readWith(reader.GetPointer(), path);
   } else if (extension == ".obj" || extension == ".ply" || extension == ".stl") {
     vtkSmartPointer<vtkAbstractPolyDataReader> reader;
     if (extension == ".obj") reader = vtkSmartPointer<vtkOBJReader>::New();
@@ -105,7 +110,7 @@ vtkSmartPointer<vtkPolyData> readSurfacePolyData(const std::string& path) {
     reader->SetFileName(path.c_str());
     polyData = readWith(reader, path);
   } else {
-    throw Error(path, "unknown surface format '" + extension + "' (expected .vtp, .obj, .ply or .stl)");
+    throw Error(path, "unknown surface format '" + extension + "' (expected .vtp, .vtk, .obj, .ply or .stl)");
   }
   if (polyData->GetNumberOfPolys() == 0) throw Error(path, "the file holds no surface polygons");
   for (vtkIdType i = 0; i < polyData->GetNumberOfPoints(); ++i) {

@@ -123,16 +123,52 @@ std::string stlBytes(const TriangleSurface& surface, const std::string& path) {
   return bytes;
 }
 
+template <typename T>
+void appendBigEndian(std::string& bytes, T value) {
+  char raw[sizeof(T)];
+  std::memcpy(raw, &value, sizeof(T));
+  std::reverse(raw, raw + sizeof(T));
+  bytes.append(raw, sizeof(T));
+}
+
+// Legacy VTK polydata, binary (big-endian, as the format has it): float
+// positions, triangles, and the normals and point data as point arrays.
+// 3D Slicer reads the coordinate system from "SPACE=" in the title line.
+std::string legacyVtkBytes(const TriangleSurface& surface, const std::vector<PointScalars>& scalars,
+                           const std::string& space) {
+  static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "legacy VTK is written big-endian by swapping");
+  const auto n = surface.points.rows();
+  const std::size_t triangles = surface.triangles.size();
+  std::string bytes = "# vtk DataFile Version 4.2\nDynSub surface" + (space.empty() ? "" : " SPACE=" + space) +
+                      "\nBINARY\nDATASET POLYDATA\nPOINTS " + std::to_string(n) + " float\n";
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (int a = 0; a < 3; ++a) appendBigEndian(bytes, static_cast<float>(surface.points(i, a)));
+  bytes += "\nPOLYGONS " + std::to_string(triangles) + " " + std::to_string(4 * triangles) + "\n";
+  for (const auto& t : surface.triangles) {
+    appendBigEndian(bytes, static_cast<int32_t>(3));
+    for (int p : t) appendBigEndian(bytes, static_cast<int32_t>(p));
+  }
+  bytes += "\nPOINT_DATA " + std::to_string(n) + "\nNORMALS Normals float\n";
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (int a = 0; a < 3; ++a) appendBigEndian(bytes, static_cast<float>(surface.normals(i, a)));
+  for (const PointScalars& s : scalars) {
+    bytes += "\nSCALARS " + s.name + " float 1\nLOOKUP_TABLE default\n";
+    for (Eigen::Index i = 0; i < n; ++i) appendBigEndian(bytes, static_cast<float>(s.values[i]));
+  }
+  bytes += '\n';
+  return bytes;
+}
+
 }  // namespace
 
-std::vector<std::string> triangleSurfaceExtensions() { return {".vtp", ".obj", ".ply", ".stl"}; }
+std::vector<std::string> triangleSurfaceExtensions() { return {".vtp", ".vtk", ".obj", ".ply", ".stl"}; }
 
 void writeTriangleSurface(const TriangleSurface& surface, const std::string& path,
                           const std::vector<PointScalars>& scalars, const std::string& space) {
   const std::string extension = lowerCaseExtension(path);
   const std::vector<std::string> known = triangleSurfaceExtensions();
   if (std::find(known.begin(), known.end(), extension) == known.end()) {
-    throw Error(path, "unknown surface format '" + extension + "' (expected .vtp, .obj, .ply or .stl)");
+    throw Error(path, "unknown surface format '" + extension + "' (expected .vtp, .vtk, .obj, .ply or .stl)");
   }
   if (!surface.points.allFinite()) throw Error(path, "the surface has non-finite coordinates; nothing written");
   for (const PointScalars& s : scalars)
@@ -143,6 +179,8 @@ void writeTriangleSurface(const TriangleSurface& surface, const std::string& pat
   AtomicOutput output(path);
   if (extension == ".vtp") {
     writeVtp(surface, output.temporaryPath(), path, scalars, space);
+  } else if (extension == ".vtk") {
+    writeFile(output.temporaryPath(), path, legacyVtkBytes(surface, scalars, space));
   } else if (extension == ".obj") {
     writeFile(output.temporaryPath(), path, objText(surface));
   } else if (extension == ".ply") {

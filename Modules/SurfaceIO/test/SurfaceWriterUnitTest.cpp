@@ -17,6 +17,7 @@
 #include <vtkNew.h>
 #include <vtkOBJReader.h>
 #include <vtkPLYReader.h>
+#include <vtkPolyDataReader.h>
 #include <vtkPolyData.h>
 #include <vtkSTLReader.h>
 #include <vtkXMLPolyDataReader.h>
@@ -107,6 +108,43 @@ TEST(SurfaceWriter, VtpRecordsItsCoordinateSpaceForSlicer) {
   fs::remove(bad);
   EXPECT_THROW(dynsub::writeTriangleSurface(surface, bad, {}, "XYZ"), dynsub::Error);
   EXPECT_FALSE(fs::exists(bad));
+}
+
+TEST(SurfaceWriter, LegacyVtkReadsBackWithItsSpaceAndPointData) {
+  // The legacy format is what nipype's Slicer interfaces and older Slicer
+  // scenes name models by: VTK's legacy reader gets every point, triangle,
+  // normal and scalar back (floats), and the title line says the space.
+  const dynsub::TriangleSurface surface = cubeSurface();
+  Eigen::VectorXd distance(surface.points.rows());
+  for (Eigen::Index i = 0; i < distance.size(); ++i) distance[i] = 0.25 * static_cast<double>(i % 7);
+  const std::string path = scratch("cube.vtk");
+  dynsub::writeTriangleSurface(surface, path, {{"edge_distance_mm", distance}}, "LPS");
+  vtkNew<vtkPolyDataReader> reader;
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  EXPECT_NE(std::string(reader->GetHeader()).find("SPACE=LPS"), std::string::npos);
+  vtkPolyData* data = reader->GetOutput();
+  ASSERT_EQ(data->GetNumberOfPoints(), surface.points.rows());
+  ASSERT_EQ(data->GetNumberOfPolys(), static_cast<vtkIdType>(surface.triangles.size()));
+  vtkNew<vtkIdList> ids;
+  for (vtkIdType t = 0; t < data->GetNumberOfCells(); ++t) {
+    data->GetCellPoints(t, ids);
+    ASSERT_EQ(ids->GetNumberOfIds(), 3);
+    for (int k = 0; k < 3; ++k) ASSERT_EQ(ids->GetId(k), surface.triangles[t][k]);
+  }
+  vtkDataArray* normals = data->GetPointData()->GetNormals();
+  vtkDataArray* scalars = data->GetPointData()->GetArray("edge_distance_mm");
+  ASSERT_NE(normals, nullptr);
+  ASSERT_NE(scalars, nullptr);
+  for (vtkIdType i = 0; i < data->GetNumberOfPoints(); ++i) {
+    double p[3];
+    data->GetPoint(i, p);
+    for (int a = 0; a < 3; ++a) {
+      ASSERT_EQ(p[a], static_cast<double>(static_cast<float>(surface.points(i, a))));
+      ASSERT_EQ(normals->GetComponent(i, a), static_cast<double>(static_cast<float>(surface.normals(i, a))));
+    }
+    ASSERT_EQ(scalars->GetComponent(i, 0), distance[i]);
+  }
 }
 
 TEST(SurfaceWriter, ObjPlyStlReadBack) {

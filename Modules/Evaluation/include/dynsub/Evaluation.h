@@ -17,11 +17,14 @@
 // splits name which structures and seeds each split runs: the tuning split is
 // what parameters may be chosen on, the test split what is reported.
 #include <functional>
+#include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "dynsub/Atlas.h"
 #include "dynsub/ClickProtocol.h"
+#include "dynsub/LandmarkConvention.h"
 #include "dynsub/SegmentParameters.h"
 #include "dynsub/SubjectGenerator.h"
 
@@ -102,6 +105,9 @@ struct EvaluationRun {
   // report calls surface_on_edges), to see how far that trust measure
   // follows the accuracy the reference gives.
   double surfaceOnEdges = 0;
+  // The edges at the landmarks as read, flipped and mirrored
+  // (LandmarkConvention.h), with 4 or more landmarks.
+  std::optional<ConventionScores> convention;
   std::string warnings;  // segment()'s own (collapse, leak), joined by "; "
   double seconds = 0;  // segmentImage()'s own (the image is read once per plan, the clicks made before)
   int steps = 0, controlVertices = 0;

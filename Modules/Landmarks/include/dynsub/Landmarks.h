@@ -16,16 +16,19 @@
 
 namespace dynsub {
 
+enum class CoordinateSystem { LPS, RAS };
+
 struct Landmark {
   std::string label;
   Vector3 position;  // LPS mm
 };
 
-enum class CoordinateSystem { LPS, RAS };
-
 // Throws dynsub::Error naming the file for a missing file, an unknown format,
 // a malformed entry (with its line or index) or a non-finite coordinate.
-std::vector<Landmark> readLandmarks(const std::string& path);
+// `stated`, when given, receives the system the file says its values are in
+// (a CSV's are LPS; of several markups lists, the first's), for messages
+// about a file that says one and holds the other.
+std::vector<Landmark> readLandmarks(const std::string& path, CoordinateSystem* stated = nullptr);
 
 // Format by extension (.mrk.json, .fcsv, .csv); `system` applies to .mrk.json
 // and .fcsv (CSV is always LPS). The file appears complete or not at all.

@@ -13,6 +13,7 @@
 
 #include "dynsub/Atlas.h"
 #include "dynsub/ConvergenceHistory.h"
+#include "dynsub/LandmarkConvention.h"
 #include "dynsub/Landmarks.h"
 #include "dynsub/Metrics.h"
 #include "dynsub/Report.h"
@@ -47,6 +48,9 @@ struct SegmentInputs {
   std::string image;                // the file, for the report
   std::string landmarkSource;       // the file or flag the landmarks came from, for messages
   std::vector<Landmark> landmarks;  // may be empty with a seed, sphere or mesh start
+  // The system the landmarks' source says they are in (readLandmarks);
+  // points given as numbers are LPS. Named when they look misread.
+  CoordinateSystem landmarkSystem = CoordinateSystem::LPS;
   SegmentStart start;
   // Optional: the structure in an expert's labelmap on the labelmap's grid,
   // asked for once the segmentation is done (so that it can be read
@@ -80,6 +84,9 @@ struct SegmentOutcome {
   std::vector<Landmark> springs;     // what the springs pulled to
   OverlapMetrics metrics;            // against the reference, when given
   ConvergenceHistory history;
+  // The edges at the landmarks as read and misread (LandmarkConvention.h),
+  // with 4 or more landmarks.
+  std::optional<ConventionScores> convention;
   std::vector<std::string> warnings;  // the seed's and the segmentation's
   double seconds = 0;                 // the start, the evolution and the labelmap
   Report report;
@@ -92,7 +99,8 @@ struct SegmentOutcome {
 void checkSegmentInputs(const SegmentInputs& inputs, const SegmentParameters& parameters);
 
 // Throws dynsub::Error naming the landmark source when the landmarks cannot
-// be used, and for impossible parameters; `progress` (may be empty) sees
+// be used (among them, landmarks that look read in the wrong convention,
+// unless parameters.checkConvention is off), and for impossible parameters; `progress` (may be empty) sees
 // every step.
 SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& inputs, const SegmentParameters& parameters,
                             const ProgressCallback& progress = nullptr);

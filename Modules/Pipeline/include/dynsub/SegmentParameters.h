@@ -25,6 +25,10 @@ struct SegmentParameters {
   // The start built from the landmarks (or a seed region's boundary points):
   // this fraction of their PCA ellipsoid's semi-axes (initialFromLandmarks).
   double initialFraction = 0.5;
+  // Refuse 4 or more boundary points that look read in the wrong convention
+  // (LandmarkConvention.h): their RAS/LPS flip or their left-right mirror
+  // lies on much stronger, better aligned edges than they do.
+  bool checkConvention = true;
   // Fractions of the edge reference in use (EdgeOptions::ofLandmarks or
   // ofImage, see segmentOptions()); unset, that reference's own default.
   std::optional<double> edgeLow, edgeHigh;

@@ -80,6 +80,19 @@ class LandmarksOffEdges : public LandmarkError {
   using LandmarkError::LandmarkError;
 };
 
+// The strongest value of a gradient magnitude image within `radius` mm of a
+// point: the height of the edge an expert meant when clicking next to it.
+// Along an axis whose voxels are longer than twice the radius (thick
+// slices), a voxel is as near as its slab: a click between two slices sees
+// both.
+double strongestNear(const Volume& magnitude, const Vector3& point, double radius);
+// The same, with the voxel it is at (offset -1 when no voxel is that near).
+struct StrongestVoxel {
+  double magnitude = 0;
+  long long offset = -1;
+};
+StrongestVoxel strongestVoxelNear(const Volume& magnitude, const Vector3& point, double radius);
+
 // Throws dynsub::Error for non-finite or impossible options.
 void checkEdgeOptions(const EdgeOptions& options);
 

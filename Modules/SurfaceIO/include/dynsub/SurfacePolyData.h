@@ -19,7 +19,7 @@ vtkSmartPointer<vtkPolyData> toPolyData(const TriangleSurface& surface);
 // point-data array `name`, in doubles.
 void addPointData(vtkPolyData* polyData, const std::string& name, const Eigen::VectorXd& values);
 
-// Reads a triangle surface (.vtp, .obj, .ply or .stl, by extension). Throws
+// Reads a triangle surface (.vtp, .vtk, .obj, .ply or .stl, by extension). Throws
 // dynsub::Error naming the file when it is missing, unreadable, has no
 // triangles, or has non-finite coordinates.
 vtkSmartPointer<vtkPolyData> readSurfacePolyData(const std::string& path);

@@ -3,6 +3,7 @@
 // file extension, so that ParaView, 3D Slicer and other tools open it:
 //   .vtp  VTK XML polydata by VTK's writer (binary, LZ4 blocks): point data "Normals", cell data
 //         "ElementType" (0 normal element, 1 special element) and "Element";
+//   .vtk  legacy VTK polydata (binary): normals and point data, no cell data;
 //   .obj  Wavefront OBJ with vertex normals;  .ply  binary PLY (float
 //         positions and normals);  .stl  binary STL.
 // Coordinates are written as given (mm). The file appears complete or not at all.
@@ -26,8 +27,8 @@ struct PointScalars {
 constexpr char kEdgeDistanceScalars[] = "edge_distance_mm";
 
 // `space`, when not empty, names the coordinate system of a .vtp as the
-// field-data string array "SPACE" that 3D Slicer reads ("LPS" or "RAS";
-// Slicer assumes LPS without it). Throws dynsub::Error naming the file for an
+// field-data string array "SPACE" that 3D Slicer reads, and of a .vtk as
+// "SPACE=" in its title line ("LPS" or "RAS"; Slicer assumes LPS without it). Throws dynsub::Error naming the file for an
 // unknown extension or space, a missing or read-only directory, a failed
 // write, or scalars of the wrong size or not finite.
 void writeTriangleSurface(const TriangleSurface& surface, const std::string& path,
