@@ -19,6 +19,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "CommandLine.h"
 #include "ExecutionModel.h"
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
@@ -296,7 +297,10 @@ int main(int argc, char** argv) {
     run(arguments);
   } catch (const CLI::ParseError& error) {
     const int code = app.exit(error);
-    return code == 0 ? 0 : 2;
+    if (code == 0) return 0;
+    const std::string hint = dynsub::app::didYouMean(app, std::vector<std::string>(argv + 1, argv + argc));
+    if (!hint.empty()) std::cerr << "DynSubSegment: " << hint << '\n';
+    return 2;
   } catch (const dynsub::Error& error) {
     std::cerr << "DynSubSegment: error: " << dynsub::withoutTemporaryPrefix(error.what()) << '\n';
     return 1;

@@ -1,11 +1,15 @@
 #include "CommandLine.h"
 
+#include <algorithm>
+
 #include <unistd.h>
 
 #include <cstdio>
 #include <variant>
 
 #include <CLI/CLI.hpp>
+
+#include "dynsub/TextFields.h"
 
 namespace dynsub::app {
 
@@ -106,6 +110,35 @@ ProgressCallback ProgressLine::callback() {
 void ProgressLine::finish() {
   if (written_) std::fprintf(stderr, "\n");
   written_ = false;
+}
+
+std::string didYouMean(const CLI::App& app, const std::vector<std::string>& words) {
+  const CLI::App* command = &app;
+  const std::vector<const CLI::App*> subcommands = app.get_subcommands([](const CLI::App*) { return true; });
+  if (!subcommands.empty()) {
+    // The command is the first word that is not an option.
+    const auto named = std::find_if(words.begin(), words.end(), [](const std::string& w) { return w.rfind('-', 0) != 0; });
+    if (named == words.end()) return "";
+    std::vector<std::string> names;
+    for (const CLI::App* sub : subcommands) names.push_back(sub->get_name());
+    const auto known = std::find(names.begin(), names.end(), *named);
+    if (known == names.end()) {
+      const std::string nearest = nearestWord(*named, names);
+      return nearest.empty() ? "" : "did you mean '" + nearest + "'? ('" + *named + "' is not a command)";
+    }
+    command = subcommands[static_cast<std::size_t>(known - names.begin())];
+  }
+  std::vector<std::string> flags;
+  for (const CLI::Option* option : command->get_options())
+    for (const std::string& name : option->get_lnames()) flags.push_back("--" + name);
+  for (const std::string& word : words) {
+    if (word.rfind("--", 0) != 0 || word == "--") continue;
+    const std::string flag = word.substr(0, word.find('='));
+    if (std::find(flags.begin(), flags.end(), flag) != flags.end()) continue;
+    const std::string nearest = nearestWord(flag, flags);
+    if (!nearest.empty()) return "did you mean '" + nearest + "'? ('" + flag + "' is not an option here)";
+  }
+  return "";
 }
 
 }  // namespace dynsub::app

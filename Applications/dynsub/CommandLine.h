@@ -2,6 +2,7 @@
 // What the commands that run a simulation share on the command line: the
 // physics and solver options, and a progress line on a terminal.
 #include <string>
+#include <vector>
 
 #include "dynsub/SegmentParameters.h"
 #include "dynsub/Simulation.h"
@@ -26,6 +27,12 @@ struct SimulationArguments {
 // and the value in `parameters` now as its default; `parameters` must outlive
 // the parsing.
 void addSegmentParameterOptions(CLI::App& command, SegmentParameters& parameters);
+
+// For a usage error: "did you mean 'segment'?" for a command that is not one
+// of `app`'s subcommands, or "did you mean '--landmarks'?" for a long option
+// the command does not have, when a known one is near; empty otherwise.
+// `words` are the program's arguments without its name.
+std::string didYouMean(const CLI::App& app, const std::vector<std::string>& words);
 
 // "\rlevel L  step S  energy E" on stderr while stderr is a terminal; silent otherwise.
 class ProgressLine {

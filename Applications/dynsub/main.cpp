@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "CommandLine.h"
 #include "Commands.h"
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
@@ -33,7 +34,10 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& error) {
     const int code = app.exit(error);
-    return code == 0 ? 0 : 2;
+    if (code == 0) return 0;
+    const std::string hint = dynsub::app::didYouMean(app, std::vector<std::string>(argv + 1, argv + argc));
+    if (!hint.empty()) std::cerr << "dynsub: " << hint << '\n';
+    return 2;
   } catch (const dynsub::Error& error) {
     std::cerr << "dynsub: error: " << dynsub::withoutTemporaryPrefix(error.what()) << '\n';
     return 1;

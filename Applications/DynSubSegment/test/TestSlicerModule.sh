@@ -107,6 +107,7 @@ expect_failure "model in a missing directory" 1 "no-dir" "${seeds[@]}" --labelma
   --model "$work/no-dir/m.vtp" "$work/ch2.nrrd"
 expect_failure "sigma out of range" 2 "sigma" "${seeds[@]}" --sigma 50 --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
 expect_failure "unknown option" 2 "frobnicate" --frobnicate "$work/ch2.nrrd"
+expect_failure "a misspelt option" 2 "did you mean '--sigma'" --sigm 2 "$work/ch2.nrrd"
 
 mkdir "$work/nipype"
 check "nipype's generated interface runs the module" \

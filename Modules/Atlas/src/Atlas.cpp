@@ -10,6 +10,7 @@
 #include "BridgeGeometry.h"
 #include "ItkRegistration.h"
 #include "dynsub/Error.h"
+#include "dynsub/TextFields.h"
 #include "dynsub/ImageIO.h"
 #include "dynsub/RegionGrowing.h"
 
@@ -60,23 +61,6 @@ std::vector<std::pair<int, std::string>> readNames(const std::string& labelsPath
 std::string lowered(std::string text) {
   std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
   return text;
-}
-
-// Levenshtein's distance, case-insensitive: for naming the nearest label.
-std::size_t editDistance(const std::string& a, const std::string& b) {
-  const std::string x = lowered(a), y = lowered(b);
-  std::vector<std::size_t> row(y.size() + 1);
-  for (std::size_t j = 0; j <= y.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= x.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= y.size(); ++j) {
-      const std::size_t above = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (x[i - 1] != y[j - 1])});
-      diagonal = above;
-    }
-  }
-  return row[y.size()];
 }
 
 itkbridge::AffineArray toArray(const AffineMap& map) {

@@ -1,5 +1,7 @@
 #include "dynsub/TextFields.h"
 
+#include <algorithm>
+#include <cctype>
 #include <stdexcept>
 
 namespace dynsub {
@@ -12,6 +14,35 @@ bool parseNumber(const std::string& field, double& value) {
   } catch (const std::logic_error&) {  // invalid_argument, out_of_range
     return false;
   }
+}
+
+std::size_t editDistance(const std::string& a, const std::string& b) {
+  const auto lower = [](unsigned char c) { return static_cast<char>(std::tolower(c)); };
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (lower(a[i - 1]) != lower(b[j - 1]))});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+std::string nearestWord(const std::string& word, const std::vector<std::string>& known) {
+  std::string nearest;
+  std::size_t best = std::max<std::size_t>(1, word.size() / 3) + 1;
+  for (const std::string& k : known) {
+    const std::size_t d = editDistance(word, k);
+    if (d < best) {
+      best = d;
+      nearest = k;
+    }
+  }
+  return nearest;
 }
 
 }  // namespace dynsub
