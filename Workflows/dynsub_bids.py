@@ -5,7 +5,7 @@ and the group table.
 Naming (BIDS 1.9 derivatives, "imaging data types: segmentations"): one job
 is one structure of one T1w image, written beside the image's own path:
 
-    sub-<label>[/ses-<label>]/anat/sub-<label>[_ses-<label>]_space-orig_desc-<structure>_dseg.nii.gz
+    sub-<label>[/ses-<label>]/anat/sub-<label>[_ses-<label>][entities]_space-orig_desc-<structure>_dseg.nii.gz
     ..._dseg.tsv     the lookup table (index 1 = the structure)
     ..._dseg.json    sidecar: Sources, SpatialReference, the run's figures
     ..._surface.vtp  the fitted limit surface (LPS mm)
@@ -14,7 +14,11 @@ is one structure of one T1w image, written beside the image's own path:
     sub-<label>[/ses-<label>]/figures/sub-<label>[_ses-<label>]_desc-<structure>_{slices,surface3d,convergence}.png
 
 `space-orig` is the T1w's own grid; `desc-` carries the structure, so BIDS
-labels (letters and digits only) are required of structure names.
+labels (letters and digits only) are required of structure names. The T1w's
+own entities (acq-, ce-, rec-, run-, echo-, part-, chunk-) are carried
+through, so two runs of a session are two jobs; a landmark file or seed
+without them serves the session's one T1w. `.bidsignore` lists the files
+the derivatives specification has no rule for.
 """
 import csv
 import glob
@@ -24,12 +28,18 @@ import re
 import shlex
 import shutil
 import subprocess
+import sys
 import tempfile
 
 LABEL = r"[A-Za-z0-9]+"
-T1W = re.compile(rf"^sub-(?P<sub>{LABEL})(?:_ses-(?P<ses>{LABEL}))?_T1w\.nii(?:\.gz)?$")
-LANDMARKS = re.compile(rf"^sub-(?P<sub>{LABEL})(?:_ses-(?P<ses>{LABEL}))?_desc-(?P<structure>{LABEL})"
-                       r"_landmarks\.(?:mrk\.json|fcsv|csv)$")
+# The entities a raw T1w's name may carry between ses- and the suffix, in
+# BIDS order; they are carried into the derivatives' names, so that two runs
+# of one subject are two jobs.
+ENTITIES = ("acq", "ce", "rec", "run", "echo", "part", "chunk")
+ENTITY_PATTERN = "".join(rf"(?:_{e}-{LABEL})?" for e in ENTITIES)
+T1W = re.compile(rf"^sub-(?P<sub>{LABEL})(?:_ses-(?P<ses>{LABEL}))?(?P<entities>{ENTITY_PATTERN})_T1w\.nii(?:\.gz)?$")
+LANDMARKS = re.compile(rf"^sub-(?P<sub>{LABEL})(?:_ses-(?P<ses>{LABEL}))?(?P<entities>{ENTITY_PATTERN})"
+                       rf"_desc-(?P<structure>{LABEL})_landmarks\.(?:mrk\.json|fcsv|csv)$")
 FIGURES = ("slices", "surface3d", "convergence")
 
 
@@ -40,8 +50,9 @@ class CohortError(Exception):
 class Job:
     """One structure of one T1w image."""
 
-    def __init__(self, subject, session, structure, t1w):
-        self.subject, self.session, self.structure, self.t1w = subject, session, structure, t1w
+    def __init__(self, subject, session, entities, structure, t1w):
+        self.subject, self.session, self.entities = subject, session, entities  # entities: "" or "_run-1", ...
+        self.structure, self.t1w = structure, t1w
         self.landmarks = None          # a landmark file, or
         self.seed = None               # (x, y, z) LPS mm of one click inside
         self.reference = None          # an expert labelmap on the T1w's grid
@@ -52,8 +63,8 @@ class Job:
         return f"sub-{self.subject}" + (f"/ses-{self.session}" if self.session else "")
 
     @property
-    def stem(self):  # sub-01 or sub-01_ses-1
-        return f"sub-{self.subject}" + (f"_ses-{self.session}" if self.session else "")
+    def stem(self):  # sub-01, sub-01_ses-1, sub-01_ses-1_run-2, ...
+        return f"sub-{self.subject}" + (f"_ses-{self.session}" if self.session else "") + self.entities
 
     @property
     def key(self):
@@ -93,31 +104,60 @@ def _relative(path, root):
     return os.path.relpath(os.path.abspath(path), os.path.abspath(root))
 
 
-def find_jobs(bids, landmarks_dir, seeds_table, reference_dir):
-    """Every (image, structure) with landmarks or a seed, keyed by (stem, structure)."""
+def _warn(message):
+    print(f"DynSub: warning: {message}", file=sys.stderr)
+
+
+def _read_names(table):
+    """A dseg.tsv's structure names -> their index values."""
+    names = {}
+    with open(table, newline="") as f:
+        for row in csv.DictReader(f, delimiter="\t"):
+            names.setdefault(row["name"], []).append(int(row["index"]))
+    return names
+
+
+def find_jobs(bids, landmarks_dir, seeds_table, reference_dir, warn=_warn):
+    """Every (image, structure) with landmarks or a seed, keyed by (stem, structure).
+
+    A T1w whose name has entities other than ENTITIES is skipped with a
+    warning; so is a reference found for a job whose structure its table
+    does not name."""
     if not os.path.isdir(bids):
         raise CohortError(f"{bids}: no such BIDS directory")
-    images = {}
+    images = {}  # (subject, session, entities) -> path
     for path in sorted(glob.glob(f"{bids}/sub-*/anat/*_T1w.nii*") + glob.glob(f"{bids}/sub-*/ses-*/anat/*_T1w.nii*")):
         match = T1W.match(os.path.basename(path))
         if not match:
-            raise CohortError(f"{path}: not handled (expected sub-<label>[_ses-<label>]_T1w.nii[.gz], "
-                              "letters and digits in labels)")
+            warn(f"{path}: skipped (a T1w is named sub-<label>[_ses-<label>][_{'-<label>][_'.join(ENTITIES)}-<label>]"
+                 "_T1w.nii[.gz], in that order, letters and digits in labels)")
+            continue
         subject, session = match["sub"], match["ses"]
         expected = f"{bids}/sub-{subject}" + (f"/ses-{session}" if session else "") + "/anat"
         if os.path.dirname(path) != expected:
             raise CohortError(f"{path}: its name does not match its folder")
-        if (subject, session) in images:
-            raise CohortError(f"{path}: a second T1w for sub-{subject}" + (f" ses-{session}" if session else "") +
-                              f" (also {images[(subject, session)]})")
-        images[(subject, session)] = path
+        key = (subject, session, match["entities"])
+        if key in images:  # .nii beside .nii.gz
+            raise CohortError(f"{path}: a second file for the same T1w (also {images[key]})")
+        images[key] = path
 
     jobs = {}
 
-    def job_for(subject, session, structure, source):
-        if (subject, session) not in images:
-            raise CohortError(f"{source}: no T1w image for sub-{subject}" + (f" ses-{session}" if session else ""))
-        job = Job(subject, session, structure, images[(subject, session)])
+    def job_for(subject, session, entities, structure, source):
+        """The job of the T1w a landmark file or seed names; without entities, the one T1w of its session."""
+        where = f"sub-{subject}" + (f" ses-{session}" if session else "")
+        if (subject, session, entities) in images:
+            path = images[(subject, session, entities)]
+        else:
+            candidates = sorted(k for k in images if k[:2] == (subject, session) and not entities)
+            if not candidates:
+                raise CohortError(f"{source}: no T1w image for {where}" + (f" with {entities[1:]}" if entities else ""))
+            if len(candidates) > 1:
+                raise CohortError(f"{source}: {where} has {len(candidates)} T1w images ("
+                                  + ", ".join(os.path.basename(images[k]) for k in candidates)
+                                  + "); name the one meant (e.g. sub-<label>_run-<label>_desc-...)")
+            entities, path = candidates[0][2], images[candidates[0]]
+        job = Job(subject, session, entities, structure, path)
         return jobs.setdefault(job.key, job)
 
     if landmarks_dir and os.path.isdir(landmarks_dir):
@@ -125,9 +165,9 @@ def find_jobs(bids, landmarks_dir, seeds_table, reference_dir):
                            glob.glob(f"{landmarks_dir}/sub-*/ses-*/anat/*_landmarks.*")):
             match = LANDMARKS.match(os.path.basename(path))
             if not match:
-                raise CohortError(f"{path}: not handled (expected sub-<label>[_ses-<label>]_desc-<structure>"
+                raise CohortError(f"{path}: not handled (expected sub-<label>[_ses-<label>][entities]_desc-<structure>"
                                   "_landmarks.mrk.json|.fcsv|.csv, letters and digits in labels)")
-            job = job_for(match["sub"], match["ses"], match["structure"], path)
+            job = job_for(match["sub"], match["ses"], match["entities"], match["structure"], path)
             if job.landmarks:
                 raise CohortError(f"{path}: a second landmark file for {job.stem} {job.structure} "
                                   f"(also {job.landmarks})")
@@ -149,19 +189,28 @@ def find_jobs(bids, landmarks_dir, seeds_table, reference_dir):
                                   "(LPS mm)") from None
             if not re.fullmatch(LABEL, structure) or not all(abs(v) < float("inf") for v in seed):
                 raise CohortError(f"{where}: structure must be letters and digits, x y z finite numbers")
-            job_for(subject, session, structure, where).seed = seed
+            job_for(subject, session, "", structure, where).seed = seed
 
     if reference_dir and os.path.isdir(reference_dir):
-        table = f"{reference_dir}/dseg.tsv"
-        names = {}
-        if os.path.exists(table):
-            with open(table, newline="") as f:
-                for row in csv.DictReader(f, delimiter="\t"):
-                    names.setdefault(row["name"], []).append(int(row["index"]))
+        dataset_table = f"{reference_dir}/dseg.tsv"
         for job in jobs.values():
-            path = f"{reference_dir}/{job.dir}/anat/{job.stem}_dseg.nii.gz"
-            if os.path.exists(path) and job.structure in names:
+            # The image's own reference, else its session's; its own table, else the dataset's.
+            folder = f"{reference_dir}/{job.dir}/anat"
+            session_stem = job.stem[: len(job.stem) - len(job.entities)]
+            stems = [job.stem] + ([session_stem] if job.entities else [])
+            path = next((f"{folder}/{s}_dseg.nii.gz" for s in stems if os.path.exists(f"{folder}/{s}_dseg.nii.gz")),
+                        None)
+            if not path:
+                continue
+            tables = [f"{folder}/{s}_dseg.tsv" for s in stems] + [dataset_table]
+            table = next((t for t in tables if os.path.exists(t)), None)
+            names = _read_names(table) if table else {}
+            if job.structure in names:
                 job.reference, job.reference_labels = path, names[job.structure]
+            else:
+                warn(f"{path}: a reference for {job.stem}, not used for {job.structure}: "
+                     + (f"{table} names no '{job.structure}'" if table else
+                        f"no dseg.tsv names its labels (looked for {', '.join(tables)})"))
     return jobs
 
 
@@ -247,6 +296,7 @@ GROUP_COLUMNS = {
     "warnings": "dynsub's warnings (a collapse, a leak, landmarks off edges), separated by '; '.",
     "message": "Why a job failed.",
     "dseg": "The labelmap, relative to the dataset root.",
+    "t1w": "The T1w image segmented, relative to the raw dataset's root.",
 }
 
 
@@ -257,7 +307,7 @@ def group_rows(jobs, out):
         paths = output_paths(out, job.dir, job.stem, job.structure)
         row = {c: "n/a" for c in GROUP_COLUMNS}
         row.update(participant_id=f"sub-{job.subject}", session_id=f"ses-{job.session}" if job.session else "n/a",
-                   structure=job.structure)
+                   structure=job.structure, t1w=os.path.join(job.dir, "anat", os.path.basename(job.t1w)))
         log = log_path(out, job.dir, job.stem, job.structure)
         if all(os.path.exists(p) for p in paths.values()):
             report = json.load(open(paths["report"]))
@@ -292,6 +342,18 @@ def write_group_table(jobs, out, table):
         json.dump({c: {"Description": d} for c, d in GROUP_COLUMNS.items()}, f, indent=2)
         f.write("\n")
     return rows
+
+
+# What a BIDS validator run over the derivatives should not judge: the
+# workflow's own files and the outputs the derivatives specification has no
+# rule for.
+BIDSIGNORE = ["logs/", "report.html", "segmentations.tsv", "segmentations.json", "*_surface.vtp", "*_report.json",
+              "*_convergence.csv", "figures/"]
+
+
+def write_bidsignore(path):
+    with open(path, "w") as f:
+        f.write("\n".join(BIDSIGNORE) + "\n")
 
 
 def write_dataset_description(path, version, bids):

@@ -65,7 +65,7 @@ def main():
         for name in files:
             path = os.path.join(relative, name)
             if relative == "." and name in ("dataset_description.json", "segmentations.tsv", "segmentations.json",
-                                            "report.html"):
+                                            "report.html", ".bidsignore"):
                 continue
             parts = relative.split(os.sep)
             if parts[0] == "logs":
