@@ -280,7 +280,7 @@ void refuseMisread(const SegmentInputs& in, const ConventionScores& scores) {
     message << "these points look mirrored left to right: with x negated they " << asRead.str()
             << ". Check their x values, and that the image's left and right are stored right";
   }
-  message << " (--check-convention false keeps them as read)";
+  message << " (to keep them as read: --check-convention false, or in Slicer 'Skip the convention check')";
   throw Error(in.landmarkSource, message.str());
 }
 

@@ -17,7 +17,6 @@
 // splits name which structures and seeds each split runs: the tuning split is
 // what parameters may be chosen on, the test split what is reported.
 #include <functional>
-#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
