@@ -48,6 +48,21 @@ void setPyramid(Method& method, const FloatImage* image, const std::vector<doubl
   method.SetSmoothingSigmasAreSpecifiedInPhysicalUnits(true);
 }
 
+// A v4 registration method of `fixed` and `moving` by `metric`, whose
+// optimizer changes `transform` in place.
+template <typename Method, typename Optimizer, typename Transform>
+typename Method::Pointer registrationMethod(const FloatImage* fixed, const FloatImage* moving, Metric* metric,
+                                            Optimizer* optimizer, Transform* transform) {
+  auto method = Method::New();
+  method->SetFixedImage(fixed);
+  method->SetMovingImage(moving);
+  method->SetMetric(metric);
+  method->SetOptimizer(optimizer);
+  method->SetInitialTransform(transform);
+  method->InPlaceOn();
+  return method;
+}
+
 Metric::Pointer mattes(int bins) {
   auto metric = Metric::New();
   metric->SetNumberOfHistogramBins(bins);
@@ -86,13 +101,8 @@ AffineOutcome registerAffine(const Geometry& fixedGeometry, const std::vector<fl
   optimizer->SetNumberOfIterations(settings.iterations);
 
   using Method = itk::ImageRegistrationMethodv4<FloatImage, FloatImage, Affine>;
-  auto method = Method::New();
-  method->SetFixedImage(fixedImage);
-  method->SetMovingImage(movingImage);
-  method->SetMetric(metric);
-  method->SetOptimizer(optimizer);
-  method->SetInitialTransform(transform);
-  method->InPlaceOn();
+  auto method = registrationMethod<Method>(fixedImage.GetPointer(), movingImage.GetPointer(), metric.GetPointer(),
+                                           optimizer.GetPointer(), transform.GetPointer());
   setPyramid(*method, fixedImage.GetPointer(), settings.levelsMm);
   method->SetMetricSamplingStrategy(Sampling::RANDOM);
   method->SetMetricSamplingPercentage(settings.samplingFraction);
@@ -195,14 +205,9 @@ DeformableOutcome registerDeformable(const Geometry& fixedGeometry, const std::v
   optimizer->SetMinimumConvergenceValue(1e-6);
 
   using Method = itk::ImageRegistrationMethodv4<FloatImage, FloatImage, FieldTransform>;
-  auto method = Method::New();
-  method->SetFixedImage(fixedOnGrid);
-  method->SetMovingImage(movingImage);
-  method->SetMetric(metric);
-  method->SetOptimizer(optimizer);
+  auto method = registrationMethod<Method>(fixedOnGrid.GetPointer(), movingImage.GetPointer(), metric.GetPointer(),
+                                           optimizer.GetPointer(), transform.GetPointer());
   method->SetMovingInitialTransform(start);  // points pass the field, then the affine
-  method->SetInitialTransform(transform);
-  method->InPlaceOn();
   method->SetNumberOfLevels(1);
   Method::ShrinkFactorsArrayType shrink(1);
   shrink[0] = 1;

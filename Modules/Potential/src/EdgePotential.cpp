@@ -23,6 +23,9 @@ void forEachSlice(const ImageGeometry& g, const Body& body) {
   parallelFor(g.size[2], g.voxelCount() >= (1 << 15) ? 2 : 1, body);
 }
 
+
+}  // namespace
+
 Volume magnitudeOf(const ImageGeometry& geometry, const std::vector<Vector3>& gradient) {
   Volume magnitude{geometry, std::vector<float>(gradient.size())};
   const long long slice = static_cast<long long>(geometry.size[0]) * geometry.size[1];
@@ -31,8 +34,6 @@ Volume magnitudeOf(const ImageGeometry& geometry, const std::vector<Vector3>& gr
   });
   return magnitude;
 }
-
-}  // namespace
 
 StrongestVoxel strongestVoxelNear(const Volume& magnitude, const Vector3& point, double radius) {
   const ImageGeometry& g = magnitude.geometry;
@@ -67,10 +68,6 @@ StrongestVoxel strongestVoxelNear(const Volume& magnitude, const Vector3& point,
   return strongest;
 }
 
-double strongestNear(const Volume& magnitude, const Vector3& point, double radius) {
-  return strongestVoxelNear(magnitude, point, radius).magnitude;
-}
-
 namespace {
 
 // The reference magnitude and fractions of step 3 (see the header).
@@ -81,7 +78,7 @@ EdgeScale edgeScale(const Volume& magnitude, const EdgeOptions& options, const M
   std::vector<float> strengths;
   for (Eigen::Index p = 0; p < landmarks.rows(); ++p)
     strengths.push_back(
-        static_cast<float>(strongestNear(magnitude, landmarks.row(p).transpose(), options.landmarkReach)));
+        static_cast<float>(strongestVoxelNear(magnitude, landmarks.row(p).transpose(), options.landmarkReach).magnitude));
   const double median = percentile(strengths, 0.5);
   // The faintest boundary segmented here (the pallidum) is at 0.11 of the
   // 99th percentile; a hundredth of it is flat tissue or off the image, and

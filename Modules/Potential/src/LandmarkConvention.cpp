@@ -23,8 +23,7 @@ ReadingEdges edgesAt(const Volume& image, const MatrixX3& points, double sigma, 
   const auto [first, size] = boundingRegion(image.geometry, points, reach + 4 * sigma);
   const Volume box = cropVolume(image, first, size);
   const std::vector<Vector3> gradient = smoothedGradient(box, sigma);
-  Volume magnitude{box.geometry, std::vector<float>(gradient.size())};
-  for (std::size_t v = 0; v < gradient.size(); ++v) magnitude.voxels[v] = static_cast<float>(gradient[v].norm());
+  const Volume magnitude = magnitudeOf(box.geometry, gradient);
   // The outward normal of the points' PCA ellipsoid at each point, C^-1 (p - c):
   // where a boundary click's edge should face.
   const Eigen::RowVector3d centre = points.colwise().mean();

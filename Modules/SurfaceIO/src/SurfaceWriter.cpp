@@ -73,11 +73,15 @@ std::string objText(const TriangleSurface& surface) {
   return text;
 }
 
+enum class ByteOrder { Little, Big };
+
+// PLY and STL are little-endian, as memory is here; legacy VTK is big-endian.
 template <typename T>
-void appendBinary(std::string& bytes, T value) {
-  static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "PLY and STL are written little-endian as in memory");
+void appendBinary(std::string& bytes, T value, ByteOrder order = ByteOrder::Little) {
+  static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "values are written from memory, little-endian");
   char raw[sizeof(T)];
   std::memcpy(raw, &value, sizeof(T));
+  if (order == ByteOrder::Big) std::reverse(raw, raw + sizeof(T));
   bytes.append(raw, sizeof(T));
 }
 
@@ -123,37 +127,28 @@ std::string stlBytes(const TriangleSurface& surface, const std::string& path) {
   return bytes;
 }
 
-template <typename T>
-void appendBigEndian(std::string& bytes, T value) {
-  char raw[sizeof(T)];
-  std::memcpy(raw, &value, sizeof(T));
-  std::reverse(raw, raw + sizeof(T));
-  bytes.append(raw, sizeof(T));
-}
-
 // Legacy VTK polydata, binary (big-endian, as the format has it): float
 // positions, triangles, and the normals and point data as point arrays.
 // 3D Slicer reads the coordinate system from "SPACE=" in the title line.
 std::string legacyVtkBytes(const TriangleSurface& surface, const std::vector<PointScalars>& scalars,
                            const std::string& space) {
-  static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "legacy VTK is written big-endian by swapping");
   const auto n = surface.points.rows();
   const std::size_t triangles = surface.triangles.size();
   std::string bytes = "# vtk DataFile Version 4.2\nDynSub surface" + (space.empty() ? "" : " SPACE=" + space) +
                       "\nBINARY\nDATASET POLYDATA\nPOINTS " + std::to_string(n) + " float\n";
   for (Eigen::Index i = 0; i < n; ++i)
-    for (int a = 0; a < 3; ++a) appendBigEndian(bytes, static_cast<float>(surface.points(i, a)));
+    for (int a = 0; a < 3; ++a) appendBinary(bytes, static_cast<float>(surface.points(i, a)), ByteOrder::Big);
   bytes += "\nPOLYGONS " + std::to_string(triangles) + " " + std::to_string(4 * triangles) + "\n";
   for (const auto& t : surface.triangles) {
-    appendBigEndian(bytes, static_cast<int32_t>(3));
-    for (int p : t) appendBigEndian(bytes, static_cast<int32_t>(p));
+    appendBinary(bytes, static_cast<int32_t>(3), ByteOrder::Big);
+    for (int p : t) appendBinary(bytes, static_cast<int32_t>(p), ByteOrder::Big);
   }
   bytes += "\nPOINT_DATA " + std::to_string(n) + "\nNORMALS Normals float\n";
   for (Eigen::Index i = 0; i < n; ++i)
-    for (int a = 0; a < 3; ++a) appendBigEndian(bytes, static_cast<float>(surface.normals(i, a)));
+    for (int a = 0; a < 3; ++a) appendBinary(bytes, static_cast<float>(surface.normals(i, a)), ByteOrder::Big);
   for (const PointScalars& s : scalars) {
     bytes += "\nSCALARS " + s.name + " float 1\nLOOKUP_TABLE default\n";
-    for (Eigen::Index i = 0; i < n; ++i) appendBigEndian(bytes, static_cast<float>(s.values[i]));
+    for (Eigen::Index i = 0; i < n; ++i) appendBinary(bytes, static_cast<float>(s.values[i]), ByteOrder::Big);
   }
   bytes += '\n';
   return bytes;

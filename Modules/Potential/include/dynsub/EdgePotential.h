@@ -39,6 +39,7 @@
 // The field is sampled at any point in mm (trilinear interpolation of the
 // three components); outside the image it is zero.
 #include <string>
+#include <vector>
 
 #include "dynsub/Error.h"
 #include "dynsub/Volume.h"
@@ -80,13 +81,14 @@ class LandmarksOffEdges : public LandmarkError {
   using LandmarkError::LandmarkError;
 };
 
+// The gradient's magnitude per voxel, as an image on `geometry`.
+Volume magnitudeOf(const ImageGeometry& geometry, const std::vector<Vector3>& gradient);
+
 // The strongest value of a gradient magnitude image within `radius` mm of a
-// point: the height of the edge an expert meant when clicking next to it.
-// Along an axis whose voxels are longer than twice the radius (thick
-// slices), a voxel is as near as its slab: a click between two slices sees
-// both.
-double strongestNear(const Volume& magnitude, const Vector3& point, double radius);
-// The same, with the voxel it is at (offset -1 when no voxel is that near).
+// point, and the voxel it is at (offset -1 when no voxel is that near): the
+// height of the edge an expert meant when clicking next to it. Along an axis
+// whose voxels are longer than twice the radius (thick slices), a voxel is
+// as near as its slab: a click between two slices sees both.
 struct StrongestVoxel {
   double magnitude = 0;
   long long offset = -1;

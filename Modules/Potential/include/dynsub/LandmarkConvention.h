@@ -19,7 +19,7 @@
 namespace dynsub {
 
 // The edges at one reading of the points: the median over them of the
-// strongest gradient magnitude within `reach` mm (strongestNear, on the
+// strongest gradient magnitude within `reach` mm (strongestVoxelNear, on the
 // image smoothed by a Gaussian of `sigma` mm; intensity per mm), and the mean
 // alignment (|cos|, 0 to 1) of that gradient with the normal of the points'
 // PCA ellipsoid. Both zero for a reading that puts a point outside the image.
