@@ -1,4 +1,5 @@
 // dynsub fit: shape recovery from range data (ShapeRecovery.h).
+#include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -14,6 +15,7 @@
 #include "dynsub/MeshIO.h"
 #include "dynsub/ModelOutputs.h"
 #include "dynsub/PointCloudIO.h"
+#include "dynsub/ScanNoise.h"
 #include "dynsub/ShapeRecovery.h"
 
 namespace dynsub::app {
@@ -25,6 +27,9 @@ struct FitCommandOptions {
   std::string out;
   std::string init = "auto";
   int genus = -1;
+  std::string noise = "auto";
+  bool keepOutliers = false;
+  std::string reference;
   FitOptions fit;
   SimulationArguments simulation;
   FigureOptions figures;
@@ -53,9 +58,37 @@ ControlMesh chooseInitialModel(const FitCommandOptions& o, const MatrixX3& data)
   return mesh;
 }
 
+// --noise: "auto" or a number of mm >= 0.
+double statedNoise(const std::string& text) {
+  if (text == "auto") return -1.0;
+  double value = 0.0;
+  size_t used = 0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != text.size() || !std::isfinite(value) || value < 0.0) {
+    throw CLI::ValidationError("--noise", "expected auto or a number of mm >= 0, got '" + text + "'");
+  }
+  return value;
+}
+
 void runFit(FitCommandOptions o) {
-  const MatrixX3 data = readPointCloud(o.points);
-  checkPointCloud(data, o.points);
+  const double stated = statedNoise(o.noise);
+  const MatrixX3 scan = readPointCloud(o.points);
+  checkPointCloud(scan, o.points);
+  const MatrixX3 reference = o.reference.empty() ? MatrixX3() : readPointCloud(o.reference);
+  if (!o.reference.empty()) checkPointCloud(reference, o.reference);
+  // The scan's own noise and outliers (ScanNoise.h), unless both are stated.
+  ScanNoise noise;
+  const bool measured = scan.rows() > kNoiseNeighbours && (stated < 0.0 || !o.keepOutliers);
+  if (measured) noise = estimateScanNoise(scan);
+  if (stated >= 0.0) noise.sigma = stated;
+  if (o.keepOutliers) noise.outliers.clear();
+  const MatrixX3 data = withoutRows(scan, noise.outliers);
+  if (data.rows() < 4) throw Error(o.points, "fewer than 4 points are left once the outliers are set aside");
+  o.fit.noise = noise.sigma;
   const ControlMesh initial = chooseInitialModel(o, data);
   const std::filesystem::path dir(o.out);
   prepareOutputDirectory(dir);
@@ -86,7 +119,24 @@ void runFit(FitCommandOptions o) {
   report.set("max_error_percent", result.error.maxPercent);
   report.set("rms_error_percent", result.error.rmsPercent);
   report.set("tolerance_percent", o.fit.tolerancePercent);
-  report.set("converged", result.error.maxPercent <= o.fit.tolerancePercent);
+  report.set("converged", result.toleranceMet);
+  Report noiseReport;
+  noiseReport.set("sigma_mm", noise.sigma);
+  noiseReport.set("sigma_percent", 100.0 * noise.sigma / diameter);
+  noiseReport.set("reach_percent", 100.0 * noiseReach(data.rows()) * noise.sigma / diameter);
+  noiseReport.set("estimated", stated < 0.0);
+  noiseReport.set("outliers", static_cast<int>(noise.outliers.size()));
+  noiseReport.set("noise_limited", result.noiseLimited);
+  if (result.noiseLimited) noiseReport.set("bias_percent", result.error.biasPercent);
+  report.set("data_noise", noiseReport);
+  if (!o.reference.empty()) {
+    const FitError e = measureFitError(*result.surface, result.mesh.points(), reference, diameter);
+    Report against;
+    against.set("points", o.reference);
+    against.set("max_error_percent", e.maxPercent);
+    against.set("rms_error_percent", e.rmsPercent);
+    report.set("reference", against);
+  }
   Report sphere;
   sphere.set("center_mm", result.enclosingSphere.center);
   sphere.set("diameter_mm", 2.0 * result.enclosingSphere.radius);
@@ -99,12 +149,17 @@ void runFit(FitCommandOptions o) {
   report.set("iterations", result.steps);
   report.set("seconds", result.seconds);
   std::vector<Report> levels;
-  for (size_t i = 0; i < result.levels.size(); ++i)
-    levels.push_back(levelReport(result.levels[i], result.levelErrors[i].maxPercent, result.levelErrors[i].rmsPercent));
+  for (size_t i = 0; i < result.levels.size(); ++i) {
+    Report level = levelReport(result.levels[i], result.levelErrors[i].maxPercent, result.levelErrors[i].rmsPercent);
+    if (result.noiseLimited) level.set("bias_percent", result.levelErrors[i].biasPercent);
+    levels.push_back(level);
+  }
   report.set("per_level", levels);
   Report parameters = simulationReport(o.fit.simulation);
   parameters.set("init", o.init);
   parameters.set("data_stiffness", o.fit.dataStiffness);
+  parameters.set("noise", o.noise);
+  parameters.set("keep_outliers", o.keepOutliers);
   report.set("parameters", parameters);
 
   const TriangleSurface surface = outputSurface(result.mesh, *result.surface);
@@ -119,7 +174,14 @@ void runFit(FitCommandOptions o) {
             << std::setprecision(3) << "max error " << result.error.maxPercent << " %, rms error "
             << result.error.rmsPercent << " % of the enclosing sphere's diameter ("
             << 2.0 * result.enclosingSphere.radius << " mm)"
-            << (result.error.maxPercent <= o.fit.tolerancePercent ? "" : " -- above the tolerance") << '\n'
+            << (result.toleranceMet ? "" : " -- above the tolerance") << '\n';
+  if (result.noiseLimited) {
+    std::cout << "the data's noise (sigma " << 100.0 * noise.sigma / diameter
+              << " %) puts that tolerance out of reach of the max error; the surface's bias is "
+              << result.error.biasPercent << " %\n";
+  }
+  if (!noise.outliers.empty()) std::cout << "set aside " << noise.outliers.size() << " outlier(s)\n";
+  std::cout
             << "wrote " << (dir / "surface.vtp").string() << ", control_mesh.obj, report.json, convergence.csv"
             << (o.figures.figures ? " and the figures that could be rendered" : "") << '\n';
 }
@@ -152,6 +214,17 @@ void addFitCommand(CLI::App& app) {
                       "Spring stiffness of the data, N/mm per unit parametric area, shared by all points")
       ->default_val(o->fit.dataStiffness)
       ->check(CLI::PositiveNumber);
+  command->add_option("--noise", o->noise,
+                      "The scan's noise: auto (measured from the points' scatter about their neighbours' local "
+                      "surface) or its standard deviation in mm (0: clean data). When the noise puts the tolerance "
+                      "out of reach of the max error, the fit holds the surface's bias to it instead")
+      ->default_val("auto");
+  command->add_flag("--keep-outliers", o->keepOutliers,
+                    "Fit every point; by default points far off their neighbours' local surface are set aside");
+  command->add_option("--reference", o->reference,
+                      "Points the fitted surface is also measured against (say, the scan before noise was added); "
+                      "reported as reference in report.json")
+      ->check(CLI::ExistingFile);
   o->simulation.addOptions(*command, FitOptions::defaultSimulation());
   o->figures.addOptions(*command);
   command->callback([o] { runFit(*o); });

@@ -5,6 +5,10 @@
 # genus 1) and the figure eight (315 points, genus 2), the last two from the
 # control meshes in Data/Meshes. Each must reach the papers' tolerance,
 # max_error_percent <= 1, with several times fewer control vertices than points.
+# Then the kitten as a worse scanner would take it (Tools/corrupt_cloud.py:
+# 0.3 % noise of the bounding box's diagonal per coordinate, 3 % outliers in
+# its box): the fit must find most outliers, stop by the bias rule, and end
+# within 1 % of the clean kitten's points (ShapeRecovery.h).
 # Needs DYNSUB (the executable) and DATA.
 set -u
 archive=/usr/share/doc/libcgal-dev/data.tar.gz
@@ -39,6 +43,28 @@ fit_scan() {
 fit_scan bear "$work/data/meshes/bear.off" 0 1538
 fit_scan kitten "$work/data/points_3/kitten.xyz" 1 772 --init "$DATA/Meshes/kitten_genus1.obj"
 fit_scan eight "$work/data/meshes/eight.off" 2 48 --init "$DATA/Meshes/eight_genus2.obj"
+
+tools=$(cd "$(dirname "${BASH_SOURCE[0]}")/../../../Tools" && pwd)
+python3 "$tools/corrupt_cloud.py" "$work/data/points_3/kitten.xyz" "$work/noisy_kitten.xyz" --noise 0.3 --outliers 3 --seed 1
+"$DYNSUB" fit "$work/noisy_kitten.xyz" --init "$DATA/Meshes/kitten_genus1.obj" --reference "$work/data/points_3/kitten.xyz" \
+  --no-figures --out "$work/noisy_kitten" >"$work/noisy_kitten.log" 2>&1
+check "noisy kitten: fit succeeds" test $? -eq 0
+cat "$work/noisy_kitten.log"
+nested() {  # nested REPORT KEY.KEY
+  python3 -c 'import json, sys; r = json.load(open(sys.argv[1]))
+for k in sys.argv[2].split("."): r = r[k]
+print(r)' "$1" "$2"
+}
+report=$work/noisy_kitten/report.json
+if [ -f "$report" ]; then
+  reference=$(nested "$report" reference.max_error_percent)
+  outliers=$(nested "$report" data_noise.outliers)
+  check "noisy kitten: $reference % from the clean kitten <= 1" awk -v e="$reference" 'BEGIN { exit !(e <= 1.0) }'
+  check "noisy kitten: stopped by the bias rule" test "$(nested "$report" data_noise.noise_limited)" = True
+  check "noisy kitten: tolerance met" test "$(nested "$report" converged)" = True
+  # 156 added; those within a few sigma of the surface cannot stand out.
+  check "noisy kitten: $outliers outliers set aside >= 100" test "$outliers" -ge 100
+fi
 
 echo "$failures failure(s)"
 test "$failures" -eq 0

@@ -199,8 +199,16 @@ class StepShapeMotion {
 };
 
 // Coarse: a level below the maximum settled to the looser rule and its fit
-// was not accepted (EquilibriumOptions::coarseLevelFactor).
-enum class LevelEnd { Equilibrium, Coarse, StepLimit, Diverged };
+// was not accepted (EquilibriumOptions::coarseLevelFactor); Accepted: it was,
+// and the simulation stops there (FitVerdict::Stop).
+enum class LevelEnd { Equilibrium, Coarse, Accepted, StepLimit, Diverged };
+
+// A level asked at the looser rule: how it ends, if it does.
+std::optional<LevelEnd> coarseEnd(FitVerdict verdict) {
+  if (verdict == FitVerdict::Refine) return LevelEnd::Coarse;
+  if (verdict == FitVerdict::Stop) return LevelEnd::Accepted;
+  return std::nullopt;
+}
 
 // The papers' time stepping (Integrator.h) from model.start; `points` ends at
 // the last state reached.
@@ -267,9 +275,9 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
         return LevelEnd::Equilibrium;
       } else if (looselyStill) {
         asked = true;
-        if (!coarseAccept(*model.surface, points, false)) {
+        if (const std::optional<LevelEnd> end = coarseEnd(coarseAccept(*model.surface, points, false))) {
           summary.energy = energy;
-          return LevelEnd::Coarse;
+          return *end;
         }
       }
     }
@@ -417,7 +425,9 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
     lastStill = window.still(change, shape);
     if (!asked && looseWindow.settled(change, shape)) {
       asked = true;
-      if (!coarseAccept(*model.surface, points, false)) return finish(LevelEnd::Coarse);
+      if (const std::optional<LevelEnd> end = coarseEnd(coarseAccept(*model.surface, points, false))) {
+        return finish(*end);
+      }
     }
   }
   return finish(LevelEnd::StepLimit);
@@ -468,8 +478,8 @@ MatrixX3 runLevel(const LevelModel& model, const std::vector<ForceModel*>& force
                          summary);
     }
     if (end != LevelEnd::Diverged) {
-      summary.converged = end == LevelEnd::Equilibrium || end == LevelEnd::Coarse;
-      summary.coarse = end == LevelEnd::Coarse;
+      summary.converged = end == LevelEnd::Equilibrium || end == LevelEnd::Coarse || end == LevelEnd::Accepted;
+      summary.coarse = end == LevelEnd::Coarse || end == LevelEnd::Accepted;
       summary.timeStep = timeStep;
       return points;
     }
@@ -565,8 +575,11 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
     summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     result.levels.push_back(summary);
 
-    // A coarse end was asked already, and refused.
-    const bool good = end == LevelEnd::Coarse ? false : accept ? accept(*model.surface, points, true) : true;
+    // A coarse end was asked already: refused, or accepted for good.
+    const bool good = end == LevelEnd::Coarse    ? false
+                      : end == LevelEnd::Accepted ? true
+                      : accept                    ? accept(*model.surface, points, true) != FitVerdict::Refine
+                                                  : true;
     if (good || level >= options.maxLevel) {
       result.origin = {level, initialIsolation};
       result.surface = model.surface;

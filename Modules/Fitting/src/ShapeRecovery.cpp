@@ -9,6 +9,7 @@
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/Error.h"
 #include "dynsub/LimitSurface.h"
+#include "dynsub/ScanNoise.h"
 #include "dynsub/StandardMeshes.h"
 #include "dynsub/Tessellation.h"
 
@@ -33,8 +34,12 @@ SimulationOptions FitOptions::defaultSimulation() {
   return o;
 }
 
+double noiseReach(Eigen::Index points) {
+  return std::sqrt(2.0 * std::log(static_cast<double>(std::max<Eigen::Index>(points, 2))));
+}
+
 FitError measureFitError(const LimitSurface& surface, const MatrixX3& controlPoints, const MatrixX3& data,
-                         double diameter) {
+                         double diameter, const Eigen::MatrixXi* neighbours) {
   // NB: 8 x 8 samples per control face, as the outputs (Tessellation.h):
   // isolation's elements are a half or a quarter of a face on a side, and
   // 8 x 8 per element would make the locator's samples, and this
@@ -47,7 +52,23 @@ FitError measureFitError(const LimitSurface& surface, const MatrixX3& controlPoi
     worst = std::max(worst, c.distance);
     squares += c.distance * c.distance;
   }
-  return FitError{100.0 * worst / diameter, 100.0 * std::sqrt(squares / nearest.size()) / diameter};
+  FitError error{100.0 * worst / diameter, 100.0 * std::sqrt(squares / nearest.size()) / diameter, 0.0};
+  if (neighbours) {
+    // Signed along the surface's normal; where it is undefined, the distance.
+    Eigen::VectorXd signedDistance(data.rows());
+    for (Eigen::Index i = 0; i < data.rows(); ++i) {
+      const ClosestPoint& c = nearest[static_cast<size_t>(i)];
+      signedDistance(i) = c.normal.isZero(0.0) ? c.distance : c.normal.dot(data.row(i).transpose() - c.position);
+    }
+    double bias = 0.0;
+    for (Eigen::Index i = 0; i < data.rows(); ++i) {
+      double sum = signedDistance(i);
+      for (int j = 0; j < kBiasNeighbours; ++j) sum += signedDistance((*neighbours)(i, j));
+      bias = std::max(bias, std::abs(sum) / static_cast<double>(kBiasNeighbours + 1));
+    }
+    error.biasPercent = 100.0 * bias / diameter;
+  }
+  return error;
 }
 
 FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const FitOptions& options,
@@ -59,9 +80,18 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
   if (!(std::isfinite(options.dataStiffness) && options.dataStiffness > 0.0)) {
     throw Error("the data stiffness must be finite and > 0");
   }
+  if (!(std::isfinite(options.noise) && options.noise >= 0.0)) throw Error("the data's noise must be finite and >= 0 mm");
   FitResult result;
   result.enclosingSphere = smallestEnclosingSphere(data);
   const double diameter = 2.0 * result.enclosingSphere.radius;
+  result.noiseLimited = data.rows() > kBiasNeighbours &&
+                        100.0 * noiseReach(data.rows()) * options.noise / diameter >= 0.5 * options.tolerancePercent;
+  const Eigen::MatrixXi neighbours =
+      result.noiseLimited ? nearestNeighbours(data, kBiasNeighbours) : Eigen::MatrixXi();
+  const auto met = [&](const FitError& e) {
+    return e.maxPercent <= options.tolerancePercent ||
+           (result.noiseLimited && e.biasPercent <= options.tolerancePercent);
+  };
   const double area = LimitSurface::elementCountOf(initial);
   const Eigen::VectorXd stiffness =
       Eigen::VectorXd::Constant(data.rows(), options.dataStiffness * area / static_cast<double>(data.rows()));
@@ -77,12 +107,17 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
     const Eigen::VectorXd& lengths = springs.lengths();
     if (!settled && lengths.size() == data.rows() &&
         100.0 * lengths.maxCoeff() / diameter <= options.tolerancePercent) {
-      return true;  // the level goes on, and is asked again at its end
+      return FitVerdict::Settle;  // the level goes on, and is asked again at its end
     }
-    const FitError e = measureFitError(surface, points, data, diameter);
-    const bool good = e.maxPercent <= options.tolerancePercent;
-    if (settled || !good) result.levelErrors.push_back(e);  // one per level, where it ends
-    return good;
+    const FitError e = measureFitError(surface, points, data, diameter, result.noiseLimited ? &neighbours : nullptr);
+    if (e.maxPercent <= options.tolerancePercent) {
+      if (settled) result.levelErrors.push_back(e);  // one per level, where it ends
+      return FitVerdict::Settle;
+    }
+    result.levelErrors.push_back(e);
+    // Noisy data within the tolerance by the bias rule stop here: the steps
+    // on to this level's full equilibrium would fit the noise.
+    return result.noiseLimited && e.biasPercent <= options.tolerancePercent ? FitVerdict::Stop : FitVerdict::Refine;
   };
 
   // The static scheme's progress comes after the accepted trial, the springs'
@@ -101,6 +136,7 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
   result.levels = std::move(simulation.levels);
   result.steps = simulation.steps;
   result.error = result.levelErrors.back();
+  result.toleranceMet = met(result.error);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
 }

@@ -248,11 +248,11 @@ SegmentResult evolveInRegion(const SegmentationRegion& region, const std::vector
   // The last level's distances are the result's.
   std::vector<double> distances;
   auto landmarksFit = [&](const LimitSurface& surface, const MatrixX3& controlPoints, bool) {
-    if (landmarkPoints.rows() == 0) return false;
+    if (landmarkPoints.rows() == 0) return FitVerdict::Refine;
     distances = distancesToSurface(surface, controlPoints, landmarkPoints);
     for (double distance : distances)
-      if (distance > options.landmarkTolerance) return false;
-    return true;
+      if (distance > options.landmarkTolerance) return FitVerdict::Refine;
+    return FitVerdict::Settle;
   };
   SimulationOptions simulation = options.simulation;
   simulation.origin = origin;

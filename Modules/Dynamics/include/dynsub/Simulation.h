@@ -159,13 +159,16 @@ struct Progress {
   const Eigen::VectorXd* dataDistances = nullptr;
 };
 
-// Decides whether the fit is good enough (true: stop). Asked at the end of
-// every level, the last one included (`settled`), and also where a level
-// below the maximum first meets the looser rule of
-// EquilibriumOptions::coarseLevelFactor (not `settled`; the forces were last
-// evaluated at `controlPoints`). After an acceptance there, the same level
-// is asked again at its end.
-using AcceptFit = std::function<bool(const LimitSurface& surface, const MatrixX3& controlPoints, bool settled)>;
+// Whether the fit is good enough. Asked at the end of every level, the last
+// one included (`settled`), and also where a level below the maximum first
+// meets the looser rule of EquilibriumOptions::coarseLevelFactor (not
+// `settled`; the forces were last evaluated at `controlPoints`).
+//  - Refine: not yet; the level ends (there, if not settled) and is refined.
+//  - Settle: good so far; a level asked before its end goes on to the full
+//    rule and is asked again there. At a level's end, the same as Stop.
+//  - Stop: good; the simulation ends at this state.
+enum class FitVerdict { Refine, Settle, Stop };
+using AcceptFit = std::function<FitVerdict(const LimitSurface& surface, const MatrixX3& controlPoints, bool settled)>;
 using ProgressCallback = std::function<void(const Progress&)>;
 
 // forces are not owned. fixed: control vertices of the initial mesh that do not

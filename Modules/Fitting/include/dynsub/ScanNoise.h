@@ -1,0 +1,65 @@
+#pragma once
+// What a scan's points say about their own accuracy, before any fit.
+//
+// Each point is compared with the surface its nearest neighbours describe: a
+// quadric z = q(x, y) fitted by least squares in the frame of the
+// neighbours' principal axes (z the least), the point itself left out. Its
+// offset from that quadric, divided by the prediction's spread
+// sqrt(1 + leverage), is the point's standardized residual t.
+//  - The noise: sigma = 1.4826 median |t| over the points, the robust
+//    standard deviation of a point about the surface. A quadric follows the
+//    surface's curvature, so on a densely sampled smooth surface t is the
+//    noise alone.
+//  - Outliers: points whose |t| exceeds kOutlierFactor times both sigma and
+//    their neighbourhood's own scale (1.4826 median |r| of the neighbours'
+//    residuals from the same quadric), and half the points' usual spacing.
+//    The neighbourhood's own scale keeps points where the quadric cannot
+//    follow the surface (a crease, a sparse scan) from being called
+//    outliers; a point scattered off the surface stands out against
+//    neighbours that lie on it. Points too far off for their neighbours to
+//    be a patch of the surface are caught by isolation instead
+//    (kIsolationFactor).
+// The quadric is fitted twice: the second fit leaves out the neighbours the
+// first left farther than 3 of its scales, so that an outlier among the
+// neighbours neither tilts the frame nor bends the quadric.
+//
+// Outliers drop out of a fit's springs (ShapeRecovery.h), the way robust ICP
+// trims its worst pairs, but decided from the data alone: a coarse surface
+// far from a genuine detail (a tail, an ear) does not make the detail's
+// points look like outliers, which trimming by residual would.
+#include <vector>
+
+#include "dynsub/Types.h"
+
+namespace dynsub {
+
+struct ScanNoise {
+  double sigma = 0.0;         // mm
+  std::vector<int> outliers;  // indices into the points, ascending
+};
+
+// Neighbours per point for the quadrics: 6 coefficients, with room left to
+// measure the residuals' spread.
+constexpr int kNoiseNeighbours = 20;
+// |t| beyond this many scales is an outlier: a Gaussian point exceeds 4
+// standard deviations about once in 16 000.
+constexpr double kOutlierFactor = 4.0;
+// A point whose mean distance to its neighbours is this many times theirs
+// (the median over them), or the median over all points, is isolated: an
+// outlier too far off the surface for its neighbours to be a patch of it.
+// On the clean scans and clouds the project fits (the synthetic tuning
+// clouds, CGAL's bear, kitten and eight) no point reaches 1.8 times the
+// median over all points.
+constexpr double kIsolationFactor = 3.0;
+
+// Throws dynsub::Error when there are fewer than kNoiseNeighbours + 1 points.
+ScanNoise estimateScanNoise(const MatrixX3& points);
+
+// The `count` nearest other points of each point (#points x count indices,
+// nearest first). count < #points.
+Eigen::MatrixXi nearestNeighbours(const MatrixX3& points, int count);
+
+// `points` without the rows `drop` (ascending).
+MatrixX3 withoutRows(const MatrixX3& points, const std::vector<int>& drop);
+
+}  // namespace dynsub

@@ -1,0 +1,185 @@
+#include "dynsub/ScanNoise.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <Eigen/Eigenvalues>
+#include <nanoflann.hpp>
+
+#include "dynsub/Error.h"
+#include "dynsub/ParallelFor.h"
+#include "dynsub/Percentile.h"
+
+namespace dynsub {
+
+namespace {
+
+// nanoflann's view of the points, without a copy.
+struct PointRows {
+  const MatrixX3& points;
+  size_t kdtree_get_point_count() const { return static_cast<size_t>(points.rows()); }
+  double kdtree_get_pt(size_t i, size_t d) const { return points(static_cast<Eigen::Index>(i), d); }
+  template <class Box>
+  bool kdtree_get_bbox(Box&) const {
+    return false;
+  }
+};
+using PointTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointRows>, PointRows, 3>;
+
+// 1 / Phi^-1(3/4): turns a median absolute deviation into a Gaussian's sigma.
+constexpr double kMadToSigma = 1.4826;
+
+double medianAbs(const Eigen::VectorXd& values) {
+  std::vector<double> a(static_cast<size_t>(values.size()));
+  for (Eigen::Index i = 0; i < values.size(); ++i) a[static_cast<size_t>(i)] = std::abs(values(i));
+  return percentile(std::move(a), 0.5);
+}
+
+// The monomials of z = q(x, y).
+Eigen::Matrix<double, 1, 6> quadricTerms(double x, double y) {
+  Eigen::Matrix<double, 1, 6> row;
+  row << 1.0, x, y, x * x, x * y, y * y;
+  return row;
+}
+
+// A quadric fitted to some of a point's neighbours, and what it predicts at the point.
+struct LocalFit {
+  Eigen::VectorXd residuals;  // of the neighbours used, along the frame's z
+  double scale = 0.0;         // 1.4826 median |residual|
+  double standardized = 0.0;  // the point's offset / sqrt(1 + leverage)
+  bool valid = false;
+};
+
+LocalFit fitQuadric(const MatrixX3& neighbours, const Vector3& point) {
+  LocalFit fit;
+  const Eigen::RowVector3d centroid = neighbours.colwise().mean();
+  const MatrixX3 centred = neighbours.rowwise() - centroid;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> pca(centred.transpose() * centred);
+  const Eigen::Matrix3d axes = pca.eigenvectors();  // columns, by increasing eigenvalue: z, then the plane's two
+  const Eigen::MatrixX3d local = centred * axes;      // columns: z, y, x
+  const double extent = std::sqrt(std::max(pca.eigenvalues()(2), 1e-300) / static_cast<double>(neighbours.rows()));
+  // Coordinates in units of the neighbourhood's extent keep the normal
+  // equations well scaled.
+  Eigen::MatrixXd terms(neighbours.rows(), 6);
+  for (Eigen::Index j = 0; j < neighbours.rows(); ++j) terms.row(j) = quadricTerms(local(j, 2) / extent, local(j, 1) / extent);
+  const Eigen::Matrix<double, 6, 6> normal = terms.transpose() * terms;
+  const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> solver(normal);
+  if (solver.info() != Eigen::Success || !solver.isPositive() || solver.vectorD().minCoeff() <= 1e-12 * solver.vectorD().maxCoeff()) {
+    return fit;  // the neighbours are on a line or a point: no surface to compare with
+  }
+  const Eigen::Matrix<double, 6, 1> coefficients = solver.solve(terms.transpose() * local.col(0));
+  fit.residuals = local.col(0) - terms * coefficients;
+  fit.scale = kMadToSigma * medianAbs(fit.residuals);
+  const Eigen::RowVector3d p = (point.transpose() - centroid) * axes;
+  const Eigen::Matrix<double, 1, 6> at = quadricTerms(p(2) / extent, p(1) / extent);
+  const double leverage = at * solver.solve(at.transpose());
+  fit.standardized = (p(0) - at * coefficients) / std::sqrt(1.0 + leverage);
+  fit.valid = std::isfinite(fit.standardized);
+  return fit;
+}
+
+}  // namespace
+
+Eigen::MatrixXi nearestNeighbours(const MatrixX3& points, int count) {
+  if (count < 1 || count >= points.rows()) {
+    throw Error("asked for " + std::to_string(count) + " neighbours of each of " + std::to_string(points.rows()) +
+                " points");
+  }
+  const PointRows rows{points};
+  const PointTree tree(3, rows, nanoflann::KDTreeSingleIndexAdaptorParams(16));  // built here
+  Eigen::MatrixXi neighbours(points.rows(), count);
+  parallelFor(points.rows(), threadsWorth(points.rows()), [&](Eigen::Index i) {
+    // The point itself is among the count + 1 answers (at distance 0, tied
+    // with any duplicate of it): ask for one more, and drop it.
+    std::vector<unsigned> found(static_cast<size_t>(count) + 1);  // nanoflann's index type
+    std::vector<double> squared(static_cast<size_t>(count) + 1);
+    const Vector3 q = points.row(i).transpose();
+    const size_t got = tree.knnSearch(q.data(), found.size(), found.data(), squared.data());
+    int column = 0;
+    for (size_t f = 0; f < got && column < count; ++f) {
+      if (static_cast<Eigen::Index>(found[f]) != i) neighbours(i, column++) = static_cast<int>(found[f]);
+    }
+  });
+  return neighbours;
+}
+
+MatrixX3 withoutRows(const MatrixX3& points, const std::vector<int>& drop) {
+  MatrixX3 kept(points.rows() - static_cast<Eigen::Index>(drop.size()), 3);
+  Eigen::Index next = 0;
+  size_t d = 0;
+  for (Eigen::Index i = 0; i < points.rows(); ++i) {
+    if (d < drop.size() && drop[d] == i) {
+      ++d;
+      continue;
+    }
+    kept.row(next++) = points.row(i);
+  }
+  return kept;
+}
+
+ScanNoise estimateScanNoise(const MatrixX3& points) {
+  if (points.rows() <= kNoiseNeighbours) {
+    throw Error("the noise of a scan is measured on at least " + std::to_string(kNoiseNeighbours + 1) +
+                " points; it has " + std::to_string(points.rows()));
+  }
+  const Eigen::MatrixXi neighbours = nearestNeighbours(points, kNoiseNeighbours);
+  const Eigen::Index n = points.rows();
+  Eigen::VectorXd standardized = Eigen::VectorXd::Zero(n), localScale = Eigen::VectorXd::Zero(n);
+  Eigen::VectorXd reach(n), nearest(n);  // mean and least distance to the neighbours
+  std::vector<char> valid(static_cast<size_t>(n), 0);
+  parallelFor(n, threadsWorth(n), [&](Eigen::Index i) {
+    MatrixX3 around(kNoiseNeighbours, 3);
+    for (int j = 0; j < kNoiseNeighbours; ++j) around.row(j) = points.row(neighbours(i, j));
+    const Vector3 point = points.row(i).transpose();
+    const Eigen::VectorXd distances = (around.rowwise() - point.transpose()).rowwise().norm();
+    reach(i) = distances.mean();
+    nearest(i) = distances(0);
+    LocalFit fit = fitQuadric(around, point);
+    if (!fit.valid) return;
+    // Again without the neighbours the first fit left far off.
+    std::vector<int> kept;
+    for (int j = 0; j < kNoiseNeighbours; ++j) {
+      if (std::abs(fit.residuals(j)) <= 3.0 * fit.scale) kept.push_back(j);
+    }
+    if (kept.size() < static_cast<size_t>(kNoiseNeighbours) && kept.size() >= 10) {
+      MatrixX3 trimmed(static_cast<Eigen::Index>(kept.size()), 3);
+      for (size_t k = 0; k < kept.size(); ++k) trimmed.row(static_cast<Eigen::Index>(k)) = around.row(kept[k]);
+      const LocalFit refit = fitQuadric(trimmed, point);
+      if (refit.valid) fit = refit;
+    }
+    standardized(i) = fit.standardized;
+    localScale(i) = fit.scale;
+    valid[static_cast<size_t>(i)] = 1;
+  });
+  std::vector<double> magnitudes;
+  magnitudes.reserve(static_cast<size_t>(n));
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (valid[static_cast<size_t>(i)]) magnitudes.push_back(std::abs(standardized(i)));
+  }
+  ScanNoise noise;
+  if (!magnitudes.empty()) noise.sigma = kMadToSigma * percentile(std::move(magnitudes), 0.5);
+  const double spacing = percentile(std::vector<double>(nearest.data(), nearest.data() + n), 0.5);
+  const double usualReach = percentile(std::vector<double>(reach.data(), reach.data() + n), 0.5);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    // Isolated: the neighbours are much farther from the point than its
+    // neighbours' own are from theirs (the median of their reaches), or than
+    // points' neighbours usually are: outliers off a large empty interior
+    // have other outliers for neighbours. A point far off the surface has no
+    // patch of it as neighbours, only scattered points, which no quadric
+    // describes, so the offset test below cannot judge it.
+    std::vector<double> around(kNoiseNeighbours);
+    for (int j = 0; j < kNoiseNeighbours; ++j) around[static_cast<size_t>(j)] = reach(neighbours(i, j));
+    const bool isolated = reach(i) > kIsolationFactor * std::min(usualReach, percentile(std::move(around), 0.5));
+    // Off the neighbours' surface by many scales, and by more than half the
+    // usual spacing of the points: on clean data the scales are the quadrics'
+    // tiny misfit, and an offset within the spacing cannot pull a fit anywhere.
+    const bool off = valid[static_cast<size_t>(i)] &&
+                     std::abs(standardized(i)) > kOutlierFactor * std::max(noise.sigma, localScale(i)) &&
+                     std::abs(standardized(i)) > 0.5 * spacing;
+    if (isolated || off) noise.outliers.push_back(static_cast<int>(i));
+  }
+  return noise;
+}
+
+}  // namespace dynsub
