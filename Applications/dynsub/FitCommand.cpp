@@ -124,7 +124,7 @@ void runFit(FitCommandOptions o) {
   noiseReport.set("sigma_mm", noise.sigma);
   noiseReport.set("sigma_percent", 100.0 * noise.sigma / diameter);
   noiseReport.set("reach_percent", 100.0 * noiseReach(data.rows()) * noise.sigma / diameter);
-  noiseReport.set("estimated", stated < 0.0);
+  noiseReport.set("estimated", measured && stated < 0.0);
   noiseReport.set("outliers", static_cast<int>(noise.outliers.size()));
   noiseReport.set("noise_limited", result.noiseLimited);
   if (result.noiseLimited) noiseReport.set("bias_percent", result.error.biasPercent);

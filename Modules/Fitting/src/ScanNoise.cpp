@@ -62,10 +62,13 @@ LocalFit fitQuadric(const MatrixX3& neighbours, const Vector3& point) {
   // Coordinates in units of the neighbourhood's extent keep the normal
   // equations well scaled.
   Eigen::MatrixXd terms(neighbours.rows(), 6);
-  for (Eigen::Index j = 0; j < neighbours.rows(); ++j) terms.row(j) = quadricTerms(local(j, 2) / extent, local(j, 1) / extent);
+  for (Eigen::Index j = 0; j < neighbours.rows(); ++j) {
+    terms.row(j) = quadricTerms(local(j, 2) / extent, local(j, 1) / extent);
+  }
   const Eigen::Matrix<double, 6, 6> normal = terms.transpose() * terms;
   const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> solver(normal);
-  if (solver.info() != Eigen::Success || !solver.isPositive() || solver.vectorD().minCoeff() <= 1e-12 * solver.vectorD().maxCoeff()) {
+  if (solver.info() != Eigen::Success || !solver.isPositive() ||
+      solver.vectorD().minCoeff() <= 1e-12 * solver.vectorD().maxCoeff()) {
     return fit;  // the neighbours are on a line or a point: no surface to compare with
   }
   const Eigen::Matrix<double, 6, 1> coefficients = solver.solve(terms.transpose() * local.col(0));

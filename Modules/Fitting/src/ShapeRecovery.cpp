@@ -80,7 +80,9 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
   if (!(std::isfinite(options.dataStiffness) && options.dataStiffness > 0.0)) {
     throw Error("the data stiffness must be finite and > 0");
   }
-  if (!(std::isfinite(options.noise) && options.noise >= 0.0)) throw Error("the data's noise must be finite and >= 0 mm");
+  if (!(std::isfinite(options.noise) && options.noise >= 0.0)) {
+    throw Error("the data's noise must be finite and >= 0 mm");
+  }
   FitResult result;
   result.enclosingSphere = smallestEnclosingSphere(data);
   const double diameter = 2.0 * result.enclosingSphere.radius;
@@ -115,9 +117,9 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
       return FitVerdict::Settle;
     }
     result.levelErrors.push_back(e);
-    // Noisy data within the tolerance by the bias rule stop here: the steps
-    // on to this level's full equilibrium would fit the noise.
-    return result.noiseLimited && e.biasPercent <= options.tolerancePercent ? FitVerdict::Stop : FitVerdict::Refine;
+    // Met by the bias rule (noisy data): stop here, since the steps on to
+    // this level's full equilibrium would fit the noise.
+    return met(e) ? FitVerdict::Stop : FitVerdict::Refine;
   };
 
   // The static scheme's progress comes after the accepted trial, the springs'

@@ -42,7 +42,7 @@ Report levelReport(const LevelSummary& l, double maxErrorPercent, double rmsErro
   r.set("control_vertices", l.controlVertices);
   r.set("iterations", l.steps);
   r.set("equilibrium", l.converged);
-  r.set("equilibrium_rule", l.coarse ? "coarse" : "full");  // coarse: a refined level, ended at looser tolerances
+  r.set("equilibrium_rule", l.coarse ? "coarse" : "full");  // coarse: ended at looser tolerances (LevelSummary::coarse)
   r.set("time_step_s", l.timeStep);
   r.set("divergences", l.divergences);
   r.set("energy", l.energy);

@@ -113,8 +113,9 @@ struct LevelSummary {
   int controlVertices = 0;
   int steps = 0;
   bool converged = false;
-  // The level ended at the looser rule of EquilibriumOptions::coarseLevelFactor
-  // (its fit was not accepted there, and it was refined).
+  // The level ended at the looser rule of EquilibriumOptions::coarseLevelFactor:
+  // its fit was not accepted there, and it was refined, or it was accepted
+  // for good (FitVerdict::Stop).
   bool coarse = false;
   double timeStep = 0;  // the step the level ended with
   // Times the level diverged and started again (with half the step, or at its
