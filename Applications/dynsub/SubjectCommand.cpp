@@ -52,14 +52,19 @@ void addSubjectCommand(CLI::App& app) {
   CLI::App* command = app.add_subcommand(
       "subject",
       "Make a test subject with exact ground truth from an image and its label map: the anatomy moved by a "
-      "random affine map and a smooth deformation that does not fold, then acquired again with another gamma, "
-      "a bias field, blur, Rician noise and, for some subjects, thick slices. The same seed gives the same "
-      "subject. Writes image.nii.gz, labels.nii.gz (on the fine grid) and subject.json (what was drawn).");
+      "random affine map and a smooth deformation that does not fold, then acquired again with a bias field, "
+      "blur, Rician noise and, for some subjects, thick slices. Realistic subjects (the default) keep the "
+      "source's intensities under another gamma; synthesized ones (--set mode=synthesized) draw them from the "
+      "labels and the source's tissue classes, T1-like or T2-like, so that their edges are their labels' "
+      "boundaries. The same seed gives the same subject. Writes image.nii.gz, labels.nii.gz (on the fine grid) "
+      "and subject.json (what was drawn).");
   command->add_option("IMAGE", arguments->image, "The source image (NIfTI, NRRD, MetaImage or DICOM)")->required();
   command->add_option("LABELS", arguments->labels, "Its label map (integer labels, any grid)")->required();
   command->add_option("--seed", arguments->seed, "The subject's seed")->default_val(1);
   command->add_option("--set", arguments->settings,
-                      "KEY=VALUE, repeatable: rotation_degrees, scale_spread, shear_spread, translation_mm, "
+                      "KEY=VALUE, repeatable: mode (realistic or synthesized), t2_fraction, label_spread, "
+                      "structure_labels (L1,L2,...: the labels a synthesized subject draws as structures), "
+                      "rotation_degrees, scale_spread, shear_spread, translation_mm, "
                       "warp_spacing_mm, warp_mm, gamma_spread, bias_spread, blur_mm (LOW,HIGH), snr (LOW,HIGH), "
                       "source_snr, thick_fraction, thick_mm");
   command->add_option("--out", arguments->out, "Output directory")->required();

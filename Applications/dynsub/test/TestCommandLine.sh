@@ -379,6 +379,12 @@ mri=/usr/share/mricron/templates
 check "subject writes the image, the labels and the record" \
   test -s "$work/subject/image.nii.gz" -a -s "$work/subject/labels.nii.gz" -a -s "$work/subject/subject.json"
 check "subject records the drawn SNR" grep -q '"snr": 20,' "$work/subject/subject.json"
+"$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --seed 4 --set mode=synthesized --set t2_fraction=1 \
+  --out "$work/synthesized" >/dev/null
+check "a synthesized subject records its contrast" grep -q '"contrast": "t2"' "$work/synthesized/subject.json"
+check "a synthesized subject shares its seed's anatomy" cmp -s "$work/subject/labels.nii.gz" "$work/synthesized/labels.nii.gz"
+expect_error "subject: an unknown mode" 1 "mode must be 'realistic' or 'synthesized'" "$work/s43" \
+  "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --set mode=synthetic --out "$work/s43"
 expect_error "subject: an unknown setting" 1 "unknown setting 'noise'" "$work/s40" \
   "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --set noise=3 --out "$work/s40"
 expect_error "subject: a warp that could fold" 1 "warp_mm must be" "$work/s41" \

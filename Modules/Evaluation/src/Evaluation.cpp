@@ -159,7 +159,7 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
         if (value.is_array()) {
           for (const auto& v : value) text += (text.empty() ? "" : ",") + v.dump();
         } else {
-          text = value.dump();
+          text = value.is_string() ? value.get<std::string>() : value.dump();
         }
         setSubjectSetting(cohort.settings, key, text);
       }

@@ -151,6 +151,80 @@ Volume thickSlices(const Volume& image, int axis, int factor) {
   return thick;
 }
 
+// The two thresholds between a head's three tissue classes (dark, grey and
+// white in a T1 image): one-dimensional k-means over a 512-bin histogram of
+// `head`, started at its 10th, 50th and 90th percentiles.
+std::array<double, 2> tissueThresholds(const std::vector<float>& head) {
+  const auto [lowest, highest] = std::minmax_element(head.begin(), head.end());
+  const double low = *lowest, high = *highest;
+  std::array<double, 3> centre{percentile(head, 0.1), percentile(head, 0.5), percentile(head, 0.9)};
+  if (!(high > low)) throw Error("subject", "the source image's head has one intensity: no tissue classes");
+  constexpr int kBins = 512;
+  std::vector<double> count(kBins, 0);
+  const double width = (high - low) / kBins;
+  for (const float v : head) ++count[std::min(kBins - 1, static_cast<int>((v - low) / width))];
+  for (int iteration = 0; iteration < 200; ++iteration) {
+    std::array<double, 3> sum{}, weight{};
+    for (int b = 0; b < kBins; ++b) {
+      const double value = low + (b + 0.5) * width;
+      int nearest = 0;
+      for (int c = 1; c < 3; ++c)
+        if (std::abs(value - centre[c]) < std::abs(value - centre[nearest])) nearest = c;
+      sum[nearest] += count[b] * value;
+      weight[nearest] += count[b];
+    }
+    std::array<double, 3> next = centre;
+    for (int c = 0; c < 3; ++c)
+      if (weight[c] > 0) next[c] = sum[c] / weight[c];
+    if (next == centre) break;
+    centre = next;
+  }
+  return {0.5 * (centre[0] + centre[1]), 0.5 * (centre[1] + centre[2])};
+}
+
+// The labels of a label map in increasing order; synthesized subjects need
+// them to be whole numbers in 0..65535, as label maps are written.
+std::vector<int> labelValues(const Volume& labels) {
+  std::vector<char> seen(65536, 0);
+  for (const float l : labels.voxels) {
+    if (!(l >= 0 && l <= 65535 && l == std::floor(l)))
+      throw Error("subject",
+                  "a synthesized subject needs labels that are whole numbers in 0..65535, found " + std::to_string(l));
+    seen[static_cast<int>(l)] = 1;
+  }
+  std::vector<int> values;
+  for (int l = 1; l < 65536; ++l)
+    if (seen[l]) values.push_back(l);
+  return values;
+}
+
+// A synthesized subject's intensities, in units of the source's bright end:
+// a mean and a texture (the sigma of white noise before the blur) per
+// tissue class and per label.
+struct Contrast {
+  struct Tissue {
+    double mean = 0, texture = 0;
+  };
+  bool t2 = false;
+  Tissue dark, grey, white;
+  std::vector<Tissue> label;  // by label value
+};
+
+Contrast drawContrast(Draw& draw, const SubjectSettings& settings, const std::vector<int>& labels) {
+  Contrast c;
+  c.t2 = draw.uniform() < settings.t2Fraction;
+  // T1: CSF dark, white matter bright. T2: the order reversed, with white
+  // matter above air and CSF the brightest.
+  c.dark.mean = c.t2 ? draw.uniform(0.85, 1.0) : draw.uniform(0.08, 0.22);
+  c.grey.mean = c.t2 ? draw.uniform(0.5, 0.62) : draw.uniform(0.42, 0.55);
+  c.white.mean = c.t2 ? draw.uniform(0.25, 0.35) : draw.uniform(0.72, 0.88);
+  for (Contrast::Tissue* t : {&c.dark, &c.grey, &c.white}) t->texture = draw.uniform(0.01, 0.03);
+  c.label.resize(labels.empty() ? 0 : labels.back() + 1);
+  for (const int l : labels)
+    c.label[l] = {c.grey.mean + draw.uniform(-settings.labelSpread, settings.labelSpread), draw.uniform(0.01, 0.03)};
+  return c;
+}
+
 }  // namespace
 
 void setSubjectSetting(SubjectSettings& s, const std::string& key, const std::string& value) {
@@ -166,17 +240,41 @@ void setSubjectSetting(SubjectSettings& s, const std::string& key, const std::st
     r[1] = comma == std::string::npos ? r[0] : number(value.substr(comma + 1));
   };
   const std::pair<const char*, double SubjectSettings::*> scalars[] = {
-      {"rotation_degrees", &SubjectSettings::rotationDegrees}, {"scale_spread", &SubjectSettings::scaleSpread},
-      {"shear_spread", &SubjectSettings::shearSpread},         {"translation_mm", &SubjectSettings::translationMm},
-      {"warp_spacing_mm", &SubjectSettings::warpSpacingMm},    {"warp_mm", &SubjectSettings::warpMm},
-      {"gamma_spread", &SubjectSettings::gammaSpread},         {"bias_spread", &SubjectSettings::biasSpread},
-      {"source_snr", &SubjectSettings::sourceSnr},             {"thick_fraction", &SubjectSettings::thickFraction},
-      {"thick_mm", &SubjectSettings::thickMm}};
+      {"rotation_degrees", &SubjectSettings::rotationDegrees},
+      {"scale_spread", &SubjectSettings::scaleSpread},
+      {"shear_spread", &SubjectSettings::shearSpread},
+      {"translation_mm", &SubjectSettings::translationMm},
+      {"warp_spacing_mm", &SubjectSettings::warpSpacingMm},
+      {"warp_mm", &SubjectSettings::warpMm},
+      {"gamma_spread", &SubjectSettings::gammaSpread},
+      {"bias_spread", &SubjectSettings::biasSpread},
+      {"source_snr", &SubjectSettings::sourceSnr},
+      {"thick_fraction", &SubjectSettings::thickFraction},
+      {"thick_mm", &SubjectSettings::thickMm},
+      {"t2_fraction", &SubjectSettings::t2Fraction},
+      {"label_spread", &SubjectSettings::labelSpread}};
   for (const auto& [name, member] : scalars) {
     if (key == name) {
       s.*member = number(value);
       return;
     }
+  }
+  if (key == "mode") {
+    if (value != "realistic" && value != "synthesized")
+      throw Error("subject settings", "mode must be 'realistic' or 'synthesized', got '" + value + "'");
+    s.synthesized = value == "synthesized";
+    return;
+  }
+  if (key == "structure_labels") {
+    s.structureLabels.clear();
+    std::stringstream list(value);
+    for (std::string item; std::getline(list, item, ',');) {
+      const double label = number(item);
+      if (label < 1 || label > 65535 || label != std::floor(label))
+        throw Error("subject settings", "structure_labels must be whole numbers in 1..65535, got '" + item + "'");
+      s.structureLabels.push_back(static_cast<int>(label));
+    }
+    return;
   }
   if (key == "blur_mm") return range(s.blurMm);
   if (key == "snr") return range(s.snr);
@@ -201,6 +299,9 @@ void checkSubjectSettings(const SubjectSettings& s) {
   require(s.sourceSnr > 0, "source_snr must be positive");
   require(s.thickFraction >= 0 && s.thickFraction <= 1, "thick_fraction must be in 0..1");
   require(s.thickMm > 0 && s.thickMm <= 10, "thick_mm must be in 0..10");
+  require(s.t2Fraction >= 0 && s.t2Fraction <= 1, "t2_fraction must be in 0..1");
+  require(s.labelSpread >= 0 && s.labelSpread <= 0.1,
+          "label_spread must be in 0..0.1 (grey structures would reach white matter's intensities)");
 }
 
 Subject makeSubject(const Volume& image, const Volume& labels, const SubjectSettings& settings, std::uint64_t seed) {
@@ -211,9 +312,9 @@ Subject makeSubject(const Volume& image, const Volume& labels, const SubjectSett
   subject.draw.seed = seed;
 
   // The anatomy's map: affine about the image's centre, then the warp.
-  SubjectMap map{Matrix3::Identity(), grid.toPhysical(0.5 * Vector3(grid.size[0] - 1, grid.size[1] - 1,
-                                                                     grid.size[2] - 1)),
-                 Vector3::Zero(), BSplineField(grid, settings.warpSpacingMm), grid};
+  SubjectMap map{Matrix3::Identity(),
+                 grid.toPhysical(0.5 * Vector3(grid.size[0] - 1, grid.size[1] - 1, grid.size[2] - 1)), Vector3::Zero(),
+                 BSplineField(grid, settings.warpSpacingMm), grid};
   const double maxAngle = settings.rotationDegrees * M_PI / 180;
   const Vector3 angles(draw.uniform(-maxAngle, maxAngle), draw.uniform(-maxAngle, maxAngle),
                        draw.uniform(-maxAngle, maxAngle));
@@ -241,24 +342,52 @@ Subject makeSubject(const Volume& image, const Volume& labels, const SubjectSett
         const Vector3 sourceIndex = toSourceIndex * (p - image.geometry.origin);
         if (image.geometry.spans(sourceIndex)) anatomy.voxels[at] = static_cast<float>(image.interpolate(sourceIndex));
         const Vector3 labelIndex = toLabelIndex * (p - labels.geometry.origin);
-        const int li = static_cast<int>(std::lround(labelIndex.x())), lj = static_cast<int>(std::lround(labelIndex.y())),
+        const int li = static_cast<int>(std::lround(labelIndex.x())),
+                  lj = static_cast<int>(std::lround(labelIndex.y())),
                   lk = static_cast<int>(std::lround(labelIndex.z()));
         if (labels.geometry.contains(li, lj, lk)) subject.labels.voxels[at] = labels.at(li, lj, lk);
       }
     }
   });
 
-  // Contrast: the head's intensities (above a tenth of its bright end) scaled
-  // to 0..1 by that bright end, raised to gamma, and scaled back.
   std::vector<float> positive;
   positive.reserve(anatomy.voxels.size());
   for (const float v : anatomy.voxels)
     if (v > 0) positive.push_back(v);
   const float bright = percentile(positive, 0.995);
   if (!(bright > 0)) throw Error("subject", "the source image has no positive intensities");
-  subject.draw.gamma = std::exp(draw.uniform(-settings.gammaSpread, settings.gammaSpread));
-  for (float& v : anatomy.voxels)
-    v = v > 0 ? static_cast<float>(bright * std::pow(v / bright, subject.draw.gamma)) : 0.0f;
+  std::optional<double> whiteMatter;  // known exactly for synthesized subjects
+  if (!settings.synthesized) {
+    // Contrast: the head's intensities scaled to 0..1 by its bright end,
+    // raised to gamma, and scaled back.
+    subject.draw.gamma = std::exp(draw.uniform(-settings.gammaSpread, settings.gammaSpread));
+    for (float& v : anatomy.voxels)
+      v = v > 0 ? static_cast<float>(bright * std::pow(v / bright, subject.draw.gamma)) : 0.0f;
+  } else {
+    // Each voxel's class: its label if it has one; else air below a tenth
+    // of the bright end, or the tissue class of the moved source intensity.
+    std::vector<float> head;
+    for (const float v : positive)
+      if (v > 0.1f * bright) head.push_back(v);
+    const std::array<double, 2> threshold = tissueThresholds(head);
+    const Contrast contrast = drawContrast(draw, settings, labelValues(labels));
+    subject.draw.contrast = contrast.t2 ? "t2" : "t1";
+    std::vector<char> structure(contrast.label.size(), settings.structureLabels.empty());
+    for (const int l : settings.structureLabels)
+      if (l < static_cast<int>(structure.size())) structure[l] = 1;
+    for (std::size_t v = 0; v < anatomy.voxels.size(); ++v) {
+      const int label = static_cast<int>(subject.labels.voxels[v]);
+      const double source = anatomy.voxels[v];
+      const Contrast::Tissue* tissue = nullptr;
+      if (label > 0 && structure[label])
+        tissue = &contrast.label[label];
+      else if (source > 0.1 * bright)
+        tissue = source < threshold[0] ? &contrast.dark : source < threshold[1] ? &contrast.grey : &contrast.white;
+      anatomy.voxels[v] =
+          tissue ? static_cast<float>(bright * std::max(0.0, tissue->mean + tissue->texture * draw.normal())) : 0.0f;
+    }
+    whiteMatter = bright * contrast.white.mean;
+  }
 
   // A bias field: smooth, within 1 +- biasSpread (a B-spline over nodes 80
   // mm apart never leaves its nodes' range).
@@ -285,23 +414,30 @@ Subject makeSubject(const Volume& image, const Volume& labels, const SubjectSett
     }
   }
 
-  // Rician noise at the drawn SNR of white matter, whose intensity is taken
-  // as the median of the head's brightest quarter (above a tenth of its
-  // bright end), where T1 images have their white matter.
-  std::vector<float> head;
-  for (const float v : acquired.voxels)
-    if (v > 0.1f * bright) head.push_back(v);
-  const float upper = percentile(head, 0.75);
-  std::vector<float> brightest;
-  for (const float v : head)
-    if (v >= upper) brightest.push_back(v);
-  subject.draw.whiteMatter = percentile(brightest, 0.5);
+  // Rician noise at the drawn SNR of white matter. A realistic subject's
+  // white matter is taken as the median of the head's brightest quarter
+  // (above a tenth of its bright end), where T1 images have it, and its
+  // noise adds to the source's own; a synthesized subject's is its drawn
+  // mean, and it has no noise of its own.
+  if (whiteMatter) {
+    subject.draw.whiteMatter = *whiteMatter;
+  } else {
+    std::vector<float> head;
+    for (const float v : acquired.voxels)
+      if (v > 0.1f * bright) head.push_back(v);
+    const float upper = percentile(head, 0.75);
+    std::vector<float> brightest;
+    for (const float v : head)
+      if (v >= upper) brightest.push_back(v);
+    subject.draw.whiteMatter = percentile(brightest, 0.5);
+  }
   subject.draw.snr = draw.uniform(settings.snr[0], settings.snr[1]);
   const double total = subject.draw.whiteMatter / subject.draw.snr;
-  const double own = subject.draw.whiteMatter / settings.sourceSnr;
+  const double own = whiteMatter ? 0.0 : subject.draw.whiteMatter / settings.sourceSnr;
   subject.draw.noiseSigma = std::sqrt(std::max(0.0, total * total - own * own));
   for (float& v : acquired.voxels) {
-    const double real = v + subject.draw.noiseSigma * draw.normal(), imaginary = subject.draw.noiseSigma * draw.normal();
+    const double real = v + subject.draw.noiseSigma * draw.normal(),
+                 imaginary = subject.draw.noiseSigma * draw.normal();
     v = static_cast<float>(std::hypot(real, imaginary));
   }
   subject.image = std::move(acquired);
@@ -311,8 +447,9 @@ Subject makeSubject(const Volume& image, const Volume& labels, const SubjectSett
 std::string subjectRecord(const SubjectDraw& d) {
   std::ostringstream out;
   out.precision(6);
-  out << "{\"seed\": " << d.seed << ", \"gamma\": " << d.gamma << ", \"blur_mm\": " << d.blurMm
-      << ", \"snr\": " << d.snr << ", \"noise_sigma\": " << d.noiseSigma << ", \"white_matter\": " << d.whiteMatter
+  out << "{\"seed\": " << d.seed << ", \"contrast\": \"" << d.contrast << "\", \"gamma\": " << d.gamma
+      << ", \"blur_mm\": " << d.blurMm << ", \"snr\": " << d.snr << ", \"noise_sigma\": " << d.noiseSigma
+      << ", \"white_matter\": " << d.whiteMatter
       << ", \"thick_axis\": " << (d.thickAxis ? std::to_string(*d.thickAxis) : std::string("null"))
       << ", \"smallest_jacobian\": " << d.smallestJacobian << "}";
   return out.str();

@@ -90,9 +90,12 @@ std::string cohortError(const std::string& cohort, EvaluationPlan* plan = nullpt
 TEST(EvaluationPlan, CohortsTakeSettingsAndSubjectsPerSplit) {
   EvaluationPlan plan;
   ASSERT_EQ(cohortError(R"({"name": "noisy", "image": "ch2.nii.gz", "labels": "aal.nii.gz",
-      "settings": {"snr": [15, 20], "thick_fraction": 0.5}, "subjects": {"tuning": [1, 2], "test": [101]}})", &plan),
+      "settings": {"snr": [15, 20], "thick_fraction": 0.5, "mode": "synthesized"},
+      "subjects": {"tuning": [1, 2], "test": [101]}})",
+                        &plan),
             "");
   const EvaluationCohort& cohort = plan.cohorts.at(0);
+  EXPECT_TRUE(cohort.settings.synthesized);
   EXPECT_EQ(cohort.settings.snr[0], 15);
   EXPECT_EQ(cohort.settings.snr[1], 20);
   EXPECT_EQ(cohort.settings.thickFraction, 0.5);

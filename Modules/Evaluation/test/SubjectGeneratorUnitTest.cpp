@@ -153,5 +153,130 @@ TEST(SubjectGenerator, ThickSlicesKeepTheExtentAndTheFineLabels) {
   EXPECT_NEAR(s.image.geometry.origin[axis], p.image.geometry.origin[axis] + 1.0, 1e-12);
 }
 
+
+// Nested shells for synthesized subjects: a ball of label 1 (source
+// intensity 100) inside white (200), grey (100) and dark (30) shells with
+// no label, air (0) around them.
+Phantom shells() {
+  Phantom p;
+  p.image.geometry.size = {56, 56, 56};
+  p.image.geometry.origin = Vector3(-27.5, -27.5, -27.5);
+  p.image.voxels.assign(56 * 56 * 56, 0.0f);
+  p.labels = p.image;
+  for (int k = 0; k < 56; ++k)
+    for (int j = 0; j < 56; ++j)
+      for (int i = 0; i < 56; ++i) {
+        const double r = p.image.geometry.toPhysical(Vector3(i, j, k)).norm();
+        const long long at = p.image.geometry.offset(i, j, k);
+        p.labels.voxels[at] = r < 8 ? 1 : 0;
+        p.image.voxels[at] = r < 8 ? 100 : r < 14 ? 200 : r < 20 ? 100 : r < 24 ? 30 : 0;
+      }
+  return p;
+}
+
+// A synthesized subject's intensities come from its labels and the source's
+// tissue classes alone, in a T1-like or a T2-like order. With the blur, the
+// bias and the noise switched off, the realistic subject of the same seed
+// (same anatomy, the source's intensities) tells which class each voxel
+// came from. Tolerances: textures are drawn with sigma at most 0.03 of the
+// bright end (200 here), so 0.15 x 200 = 30 is five sigmas; class means are
+// drawn at least 0.15 of the bright end apart, and a voxel's class is read
+// from a trilinear sample, so voxels on a class's boundary (a third of each
+// shell) are left out by asking the realistic sample to be within 5 of the
+// class's source value.
+TEST(SubjectGenerator, SynthesizedSubjectsDrawTheirIntensitiesFromLabelsAndTissueClasses) {
+  const Phantom p = shells();
+  SubjectSettings realistic = moveOnly();
+  realistic.gammaSpread = 0;
+  for (const double t2 : {0.0, 1.0}) {
+    SubjectSettings settings = realistic;
+    settings.synthesized = true;
+    settings.t2Fraction = t2;
+    settings.snr = {1e3, 1e3};
+    const std::uint64_t seed = t2 > 0 ? 31 : 32;
+    const Subject synthesized = makeSubject(p.image, p.labels, settings, seed);
+    const Subject source = makeSubject(p.image, p.labels, realistic, seed);
+    EXPECT_EQ(synthesized.labels.voxels, source.labels.voxels) << "one seed, one anatomy";
+    EXPECT_EQ(synthesized.draw.contrast, t2 > 0 ? "t2" : "t1");
+    double sum[5] = {}, count[5] = {};  // label 1, white, grey, dark, air
+    double lowest[5], highest[5];
+    std::fill(lowest, lowest + 5, 1e9);
+    std::fill(highest, highest + 5, -1e9);
+    for (std::size_t v = 0; v < source.image.voxels.size(); ++v) {
+      const float s = source.image.voxels[v];
+      int c = -1;
+      if (synthesized.labels.voxels[v] == 1)
+        c = 0;
+      else if (std::abs(s - 200) < 5)
+        c = 1;
+      else if (std::abs(s - 100) < 5)
+        c = 2;
+      else if (std::abs(s - 30) < 5)
+        c = 3;
+      else if (s == 0)
+        c = 4;
+      if (c < 0) continue;
+      const float value = synthesized.image.voxels[v];
+      sum[c] += value;
+      ++count[c];
+      lowest[c] = std::min<double>(lowest[c], value);
+      highest[c] = std::max<double>(highest[c], value);
+    }
+    double mean[5];
+    for (int c = 0; c < 5; ++c) {
+      ASSERT_GT(count[c], 200) << c;
+      mean[c] = sum[c] / count[c];
+      if (c < 4) {
+        EXPECT_LT(highest[c] - mean[c], 30) << c;
+        EXPECT_LT(mean[c] - lowest[c], 30) << c;
+      }
+    }
+    EXPECT_LT(highest[4], 1.0) << "air stays dark (noise at SNR 1000 only)";
+    if (t2 > 0) {
+      EXPECT_GT(mean[3], mean[2] + 0.15 * 200 - 1);  // CSF over grey
+      EXPECT_GT(mean[2], mean[1] + 0.15 * 200 - 1);  // grey over white
+    } else {
+      EXPECT_GT(mean[1], mean[2] + 0.17 * 200 - 1);  // white over grey
+      EXPECT_GT(mean[2], mean[3] + 0.2 * 200 - 1);   // grey over CSF
+    }
+    // The labelled ball is a grey structure: within label_spread of grey.
+    EXPECT_LT(std::abs(mean[0] - mean[2]), 0.05 * 200 + 2);
+    // Its white matter is known, and sets the noise exactly.
+    EXPECT_NEAR(synthesized.draw.noiseSigma, synthesized.draw.whiteMatter / 1e3, 1e-9);
+  }
+  // A label left out of structure_labels takes its tissue class: the ball
+  // (source intensity 100) is then drawn exactly as the grey shell is.
+  SubjectSettings cortexLike = realistic;
+  cortexLike.synthesized = true;
+  cortexLike.blurMm = {0, 0};
+  setSubjectSetting(cortexLike, "structure_labels", "2,3");
+  EXPECT_EQ(cortexLike.structureLabels, (std::vector<int>{2, 3}));
+  const Subject asTissue = makeSubject(p.image, p.labels, cortexLike, 33);
+  const Subject source = makeSubject(p.image, p.labels, realistic, 33);
+  std::vector<double> ball, grey;
+  for (std::size_t v = 0; v < source.image.voxels.size(); ++v) {
+    if (std::abs(source.image.voxels[v] - 100) >= 5) continue;
+    (asTissue.labels.voxels[v] == 1 ? ball : grey).push_back(asTissue.image.voxels[v]);
+  }
+  ASSERT_GT(ball.size(), 500u);
+  ASSERT_GT(grey.size(), 500u);
+  const auto mean = [](const std::vector<double>& values) {
+    double sum = 0;
+    for (const double value : values) sum += value;
+    return sum / values.size();
+  };
+  // Two samples of one texture (sigma at most 6 here): their means agree
+  // to far better than the label spread's 10.
+  EXPECT_NEAR(mean(ball), mean(grey), 1.0);
+
+  SubjectSettings bad = realistic;
+  EXPECT_THROW(setSubjectSetting(bad, "structure_labels", "1,2.5"), Error);
+  EXPECT_THROW(setSubjectSetting(bad, "mode", "synthetic"), Error);
+  setSubjectSetting(bad, "mode", "synthesized");
+  EXPECT_TRUE(bad.synthesized);
+  bad.labelSpread = 0.2;
+  EXPECT_THROW(checkSubjectSettings(bad), Error);
+}
+
 }  // namespace
 }  // namespace dynsub
