@@ -92,7 +92,7 @@ std::string csvField(const std::string& text) {
 
 void writeRunsCsv(const std::vector<EvaluationRun>& runs, const std::string& path) {
   std::ofstream out(path);
-  out << "split,image,subject,subject_snr,thick_axis,structure,protocol,seed,format,landmarks,dice,jaccard,mean_surface_distance_mm,hd95_mm,"
+  out << "split,image,subject,subject_snr,thick_axis,contrast,structure,protocol,seed,format,landmarks,dice,jaccard,mean_surface_distance_mm,hd95_mm,"
          "volume_mm3,reference_volume_mm3,leak_mm3,miss_mm3,collapsed,surface_on_edges,"
          "edge_strength_as_read,edge_strength_flipped,edge_strength_mirrored,edge_alignment_as_read,"
          "edge_alignment_flipped,edge_alignment_mirrored,seconds,steps,control_vertices,warnings,"
@@ -100,7 +100,7 @@ void writeRunsCsv(const std::vector<EvaluationRun>& runs, const std::string& pat
   out << std::setprecision(6);
   for (const EvaluationRun& r : runs) {
     out << csvField(r.split) << ',' << csvField(r.image) << ',' << csvField(r.subject) << ',' << r.subjectSnr << ','
-        << r.subjectThickAxis << ',' << csvField(r.structure) << ','
+        << r.subjectThickAxis << ',' << csvField(r.subjectContrast) << ',' << csvField(r.structure) << ','
         << csvField(r.protocol) << ',' << r.seed << ',' << r.format
         << ',' << r.landmarks << ',' << r.dice << ',' << r.jaccard << ',' << r.meanSurfaceDistance << ',' << r.hd95
         << ',' << r.volume << ',' << r.referenceVolume << ',' << r.leak << ',' << r.miss << ','

@@ -307,6 +307,7 @@ std::vector<EvaluationRun> runEvaluation(const EvaluationPlan& plan, const Evalu
     std::map<std::string, Mask> references;
     double snr = 0;
     int thickAxis = -1;
+    std::string contrast;
   };
   std::vector<Input> inputs;
   auto addReferences = [&](Input& input, const Volume& labels, const std::string& source) {
@@ -339,6 +340,7 @@ std::vector<EvaluationRun> runEvaluation(const EvaluationPlan& plan, const Evalu
         input.split = split;
         input.snr = subject.draw.snr;
         input.thickAxis = subject.draw.thickAxis.value_or(-1);
+        input.contrast = subject.draw.contrast;
         addReferences(input, subject.labels, cohort.name + " subject " + std::to_string(seed));
         input.volume = std::move(subject.image);
       }
@@ -381,6 +383,7 @@ std::vector<EvaluationRun> runEvaluation(const EvaluationPlan& plan, const Evalu
             run.subject = input.subject;
             run.subjectSnr = input.snr;
             run.subjectThickAxis = input.thickAxis;
+            run.subjectContrast = input.contrast;
             run.structure = structure.name;
             run.protocol = protocol.clicks.name;
             run.seed = seed;

@@ -93,6 +93,7 @@ struct EvaluationRun {
   std::string subject;  // a cohort's subject ("s" and its seed), empty for a plan's image
   double subjectSnr = 0;  // what the subject was drawn with (0 for a plan's image)
   int subjectThickAxis = -1;
+  std::string subjectContrast;  // "source", "t1" or "t2" (empty for a plan's image)
   unsigned seed = 0;
   int landmarks = 0;
   std::string error;  // empty when the run succeeded
