@@ -370,11 +370,15 @@ Subject makeSubject(const Volume& image, const Volume& labels, const SubjectSett
     for (const float v : positive)
       if (v > 0.1f * bright) head.push_back(v);
     const std::array<double, 2> threshold = tissueThresholds(head);
-    const Contrast contrast = drawContrast(draw, settings, labelValues(labels));
+    const std::vector<int> present = labelValues(labels);
+    std::vector<char> structure(present.empty() ? 0 : present.back() + 1, settings.structureLabels.empty());
+    for (const int l : settings.structureLabels) {
+      if (!std::binary_search(present.begin(), present.end(), l))
+        throw Error("subject", "structure_labels names label " + std::to_string(l) + ", which the label map lacks");
+      structure[l] = 1;
+    }
+    const Contrast contrast = drawContrast(draw, settings, present);
     subject.draw.contrast = contrast.t2 ? "t2" : "t1";
-    std::vector<char> structure(contrast.label.size(), settings.structureLabels.empty());
-    for (const int l : settings.structureLabels)
-      if (l < static_cast<int>(structure.size())) structure[l] = 1;
     for (std::size_t v = 0; v < anatomy.voxels.size(); ++v) {
       const int label = static_cast<int>(subject.labels.voxels[v]);
       const double source = anatomy.voxels[v];

@@ -249,9 +249,11 @@ TEST(SubjectGenerator, SynthesizedSubjectsDrawTheirIntensitiesFromLabelsAndTissu
   SubjectSettings cortexLike = realistic;
   cortexLike.synthesized = true;
   cortexLike.blurMm = {0, 0};
-  setSubjectSetting(cortexLike, "structure_labels", "2,3");
-  EXPECT_EQ(cortexLike.structureLabels, (std::vector<int>{2, 3}));
-  const Subject asTissue = makeSubject(p.image, p.labels, cortexLike, 33);
+  Phantom twoLabels = p;  // a second label, in a corner of air
+  twoLabels.labels.voxels[twoLabels.labels.geometry.offset(1, 1, 1)] = 2;
+  setSubjectSetting(cortexLike, "structure_labels", "2");
+  EXPECT_EQ(cortexLike.structureLabels, (std::vector<int>{2}));
+  const Subject asTissue = makeSubject(twoLabels.image, twoLabels.labels, cortexLike, 33);
   const Subject source = makeSubject(p.image, p.labels, realistic, 33);
   std::vector<double> ball, grey;
   for (std::size_t v = 0; v < source.image.voxels.size(); ++v) {
@@ -269,6 +271,8 @@ TEST(SubjectGenerator, SynthesizedSubjectsDrawTheirIntensitiesFromLabelsAndTissu
   // to far better than the label spread's 10.
   EXPECT_NEAR(mean(ball), mean(grey), 1.0);
 
+  setSubjectSetting(cortexLike, "structure_labels", "1,4");  // the phantom has no label 4
+  EXPECT_THROW(makeSubject(twoLabels.image, twoLabels.labels, cortexLike, 33), Error);
   SubjectSettings bad = realistic;
   EXPECT_THROW(setSubjectSetting(bad, "structure_labels", "1,2.5"), Error);
   EXPECT_THROW(setSubjectSetting(bad, "mode", "synthetic"), Error);
