@@ -294,6 +294,8 @@ GROUP_COLUMNS = {
     "iterations": "Time steps of the evolution.",
     "seconds": "Wall-clock seconds of the segmentation.",
     "warnings": "dynsub's warnings (a collapse, a leak, landmarks off edges), separated by '; '.",
+    "trust_flags": "Why not to trust the result (report.json's trust flags: one_click, small, "
+                   "atlas_clicks_apart, moved_from_atlas, leaked), separated by spaces, or n/a.",
     "message": "Why a job failed.",
     "dseg": "The labelmap, relative to the dataset root.",
     "t1w": "The T1w image segmented, relative to the raw dataset's root.",
@@ -313,7 +315,8 @@ def group_rows(jobs, out):
             report = json.load(open(paths["report"]))
             row["report"] = report  # not a column: for the QC page (qc_report.py)
             row.update(status="ok", dseg=_relative(paths["dseg"], out),
-                       warnings="; ".join(report.get("warnings", [])) or "n/a")
+                       warnings="; ".join(report.get("warnings", [])) or "n/a",
+                       trust_flags=" ".join(f["name"] for f in report.get("trust", {}).get("flags", [])) or "n/a")
             for column in ("volume_mm3", "dice", "mean_surface_distance_mm", "hd95_mm", "control_vertices",
                            "iterations", "seconds"):
                 if column in report:

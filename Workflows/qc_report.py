@@ -6,6 +6,8 @@ the convergence plot and its numbers.
 Flags (the reasons a row is marked for a look):
   failed       the job did not complete;
   warnings     dynsub warned (a collapse, a leak, landmarks far from edges, a seed region that leaked);
+  untrusted    report.json's trust flags say not to trust the result (one click alone, a result
+               small against its clicks or atlas, atlas and clicks or result apart, a leak);
   volume       the volume is more than 3 robust standard deviations (1.4826 MAD) from the
                median of the same structure, judged only with at least 4 of that structure;
   residual     the rms distance of the landmarks to the surface exceeds 1 mm (twice the
@@ -57,6 +59,8 @@ def flagged_rows(jobs, out):
         row["rms_residual_mm"] = _rms_residual(report)
         if report.get("warnings"):
             row["flags"].append("warnings")
+        if report.get("trust", {}).get("flags"):
+            row["flags"].append("untrusted")
         if row["rms_residual_mm"] is not None and row["rms_residual_mm"] > RESIDUAL_LIMIT_MM:
             row["flags"].append("residual")
     by_structure = {}
@@ -156,6 +160,7 @@ def write_report(jobs, out, path):
         parts.append("</tr>")
     parts.append("</tbody></table>")
     parts.append("<p>Flags: <b>failed</b> the job did not complete; <b>warnings</b> dynsub warned; "
+                 "<b>untrusted</b> report.json's trust flags say not to trust the result; "
                  f"<b>volume</b> more than {ROBUST_Z_LIMIT:g} robust SD from the structure's median "
                  f"(with at least {MIN_FOR_VOLUME_FLAG} of it); <b>residual</b> landmarks more than "
                  f"{RESIDUAL_LIMIT_MM:g} mm rms from the surface.</p>")
@@ -179,6 +184,8 @@ def write_report(jobs, out, path):
                  ("start", report.get("init")), ("surface on edges", report.get("surface_on_edges", "n/a"))]
         shown = [(k, f"{v:.3g}" if isinstance(v, float) else v) for k, v in facts]
         parts.append("<dl>" + "".join(f"<dt>{html.escape(k)}</dt><dd>{html.escape(str(v))}</dd>" for k, v in shown))
+        for flag in report.get("trust", {}).get("flags", []):
+            parts.append(f"<dt>not to trust ({html.escape(flag['name'])})</dt><dd>{html.escape(flag['message'])}</dd>")
         for warning in report.get("warnings", []):
             parts.append(f"<dt>warning</dt><dd>{html.escape(warning)}</dd>")
         parts.append("</dl></section>")

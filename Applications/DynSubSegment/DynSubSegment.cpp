@@ -270,6 +270,8 @@ void run(Arguments& a) {
                  "pulled the surface there: "
               << carried << " (check Points reach both ends if your points already reach them)</filter-comment>\n";
   for (const std::string& warning : outcome.warnings) std::cerr << "warning: " << warning << '\n';
+  for (const dynsub::TrustFlag& flag : outcome.trustFlags)
+    std::cerr << "not to trust (" << flag.name << "): " << flag.message << '\n';
   progress.report(1.0);
   std::cout << "<filter-end><filter-name>DynSubSegment</filter-name></filter-end>" << std::endl;
 }

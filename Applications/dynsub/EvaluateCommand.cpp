@@ -95,8 +95,9 @@ void writeRunsCsv(const std::vector<EvaluationRun>& runs, const std::string& pat
   out << "split,image,subject,subject_snr,thick_axis,contrast,structure,protocol,seed,format,landmarks,dice,jaccard,mean_surface_distance_mm,hd95_mm,"
          "volume_mm3,reference_volume_mm3,leak_mm3,miss_mm3,collapsed,surface_on_edges,"
          "edge_strength_as_read,edge_strength_flipped,edge_strength_mirrored,edge_alignment_as_read,"
-         "edge_alignment_flipped,edge_alignment_mirrored,seconds,steps,control_vertices,warnings,"
-         "error\n";
+         "edge_alignment_flipped,edge_alignment_mirrored,seconds,steps,control_vertices,outside_region,"
+         "trust_volume_ratio,trust_atlas_outline_distance_mm,trust_clicks_to_atlas_mm,trust_farthest_mm,"
+         "trust_march_share,trust_flags,warnings,error\n";
   out << std::setprecision(6);
   for (const EvaluationRun& r : runs) {
     out << csvField(r.split) << ',' << csvField(r.image) << ',' << csvField(r.subject) << ',' << r.subjectSnr << ','
@@ -112,8 +113,10 @@ void writeRunsCsv(const std::vector<EvaluationRun>& runs, const std::string& pat
     } else {
       out << ",,,,,,";
     }
-    out << r.seconds << ',' << r.steps << ',' << r.controlVertices << ','
-        << csvField(r.warnings) << ',' << csvField(r.error) << '\n';
+    const TrustMeasures& t = r.trust;
+    out << r.seconds << ',' << r.steps << ',' << r.controlVertices << ',' << t.outsideRegion << ','
+        << t.volumeRatio << ',' << t.outlineDistance << ',' << t.clicksToAtlas << ',' << t.farthestFromEvidence
+        << ',' << t.marchShare << ',' << csvField(r.trustFlags) << ',' << csvField(r.warnings) << ',' << csvField(r.error) << '\n';
   }
   out.close();
   if (!out) throw writeFailure(path);

@@ -93,6 +93,8 @@ void printSummary(const Arguments& o, const SegmentOutcome& outcome, const Volum
     std::cout << "followed the structure's tissue past the outermost clicked slices and pulled the surface there: "
               << carried << " (--slice-ends false if your clicks already reach its ends)\n";
   for (const std::string& warning : outcome.warnings) std::cerr << "warning: " << warning << '\n';
+  for (const TrustFlag& flag : outcome.trustFlags)
+    std::cerr << "not to trust (" << flag.name << "): " << flag.message << '\n';
   if (!o.reference.empty())
     std::cout << std::setprecision(3) << "Dice " << outcome.metrics.dice << ", mean surface distance "
               << outcome.metrics.meanSurfaceDistance << " mm, HD95 " << outcome.metrics.hd95 << " mm against " << o.reference

@@ -104,6 +104,8 @@ EvaluationRun runOne(const EvaluationPlan& plan, const Volume& image, const Mask
   for (const std::string& w : outcome.warnings) run.warnings += (run.warnings.empty() ? "" : "; ") + w;
   run.controlVertices = result.mesh.vertexCount();
   run.surfaceOnEdges = result.surfaceOnEdges;
+  run.trust = outcome.trust;
+  for (const TrustFlag& f : outcome.trustFlags) run.trustFlags += (run.trustFlags.empty() ? "" : " ") + f.name;
   run.seconds = outcome.seconds;
   run.convention = outcome.convention;
 

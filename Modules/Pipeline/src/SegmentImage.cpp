@@ -9,11 +9,13 @@
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
+#include "dynsub/ImageFilters.h"
 #include "dynsub/ForceModel.h"
 #include "dynsub/Labelmap.h"
 #include "dynsub/MeshIO.h"
 #include "dynsub/ModelOutputs.h"
 #include "dynsub/ShapeRecovery.h"
+#include "dynsub/Trust.h"
 
 namespace dynsub {
 
@@ -215,6 +217,77 @@ ControlMesh chooseStart(const Volume& image, const SegmentInputs& in, const Segm
   throw Error("internal: unknown initial model");
 }
 
+// Each point's distance to the carried label's boundary (mm): to the
+// label from outside, to its complement from inside, at the nearest voxel of
+// the label's sub-grid (plus the way there from a point beyond it).
+std::vector<double> distancesToCarried(const CarriedLabel& label, const std::vector<Vector3>& points) {
+  const Mask& inside = label.mask;
+  Mask outside = inside;
+  for (std::uint8_t& v : outside.voxels) v = !v;
+  const std::vector<float> toInside = distanceTo(inside), toOutside = distanceTo(outside);
+  const ImageGeometry& g = inside.geometry;
+  std::vector<double> d;
+  for (const Vector3& p : points) {
+    const Vector3 index = g.toIndex(p);
+    std::array<int, 3> v{};
+    for (int a = 0; a < 3; ++a) v[a] = std::clamp(static_cast<int>(std::lround(index(a))), 0, g.size[a] - 1);
+    const Vector3 centre = g.toPhysical(Vector3(v[0], v[1], v[2]));
+    const auto i = static_cast<std::size_t>(g.offset(v[0], v[1], v[2]));
+    d.push_back((p - centre).norm() + (inside.voxels[i] ? toOutside[i] : toInside[i]));
+  }
+  return d;
+}
+
+// What the result rests on (Trust.h).
+TrustEvidence trustEvidence(const Volume& image, const SegmentInputs& in, const SegmentOutcome& outcome) {
+  TrustEvidence e;
+  for (const Landmark& l : in.landmarks) e.clicks.push_back(l.position);
+  if (outcome.carried) {
+    for (const Landmark& l : outcome.prior) e.outline.push_back(l.position);
+    e.volume = carriedVolume(*outcome.carried);
+    e.clicksToAtlas = distancesToCarried(*outcome.carried, e.clicks);
+  }
+  e.oneClick = outcome.seed && in.landmarks.empty();
+  const SliceEnds& ends = outcome.result.sliceEnds;
+  for (const SliceEnd& end : ends.ends)
+    if (end.sprung || end.pressed) e.march = std::max(e.march, end.length);
+  if (ends.axis >= 0 && !in.landmarks.empty()) {
+    const Vector3 along = image.geometry.direction.col(ends.axis).normalized();
+    double low = std::numeric_limits<double>::infinity(), high = -low;
+    for (const Landmark& l : in.landmarks) {
+      low = std::min(low, l.position.dot(along));
+      high = std::max(high, l.position.dot(along));
+    }
+    e.clickedSpan = high - low;
+    e.sliceNormal = along;
+    e.onSlice = kOnSliceVoxels * image.geometry.spacing(ends.axis);
+  }
+  e.outsideRegion = outcome.result.outsideRegion;
+  return e;
+}
+
+Report trustReport(const TrustMeasures& m, const std::vector<TrustFlag>& flags) {
+  Report r;
+  const auto set = [&r](const char* key, double value) {
+    if (std::isfinite(value)) r.set(key, value);
+  };
+  set("volume_ratio", m.volumeRatio);
+  set("atlas_outline_distance_mm", m.outlineDistance);
+  set("clicks_to_atlas_mm", m.clicksToAtlas);
+  set("farthest_from_evidence_mm", m.farthestFromEvidence);
+  set("march_share", m.marchShare);
+  std::vector<Report> listed;
+  for (const TrustFlag& flag : flags) {
+    Report f;
+    f.set("name", flag.name);
+    f.set("message", flag.message);
+    listed.push_back(f);
+  }
+  r.set("flags", listed);
+  r.set("trusted", flags.empty());
+  return r;
+}
+
 }  // namespace
 
 SegmentStart parseSegmentStart(const std::string& value, const std::string& option) {
@@ -391,6 +464,9 @@ SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& in, const 
     const std::vector<std::string> seed = seedWarnings(*outcome.seed);
     outcome.warnings.insert(outcome.warnings.begin(), seed.begin(), seed.end());
   }
+  const TrustEvidence evidence = trustEvidence(image, in, outcome);
+  outcome.trust = measureTrust(result.surface, result.volume, evidence);
+  outcome.trustFlags = trustFlags(outcome.trust, evidence);
 
   Report& report = outcome.report;
   report.set("image", in.image);
@@ -443,6 +519,7 @@ SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& in, const 
   report.set("surface_outside_region", result.outsideRegion);
   if (std::isfinite(result.surfaceOnEdges)) report.set("surface_on_edges", result.surfaceOnEdges);
   report.set("warnings", outcome.warnings);
+  report.set("trust", trustReport(outcome.trust, outcome.trustFlags));
   std::vector<Report> residuals;
   for (std::size_t i = 0; i < springs.size(); ++i) {
     Report r;

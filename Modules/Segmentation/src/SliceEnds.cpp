@@ -9,8 +9,6 @@
 namespace dynsub {
 namespace {
 
-constexpr double kOnSlice = 0.25;  // voxels: landmarks this close along the axis share a slice
-
 // Step 1: the axis whose landmark positions (continuous voxel index) fall on
 // the fewest distinct slices, or -1.
 int sliceAxis(const std::vector<Vector3>& index, int* slices) {
@@ -20,7 +18,7 @@ int sliceAxis(const std::vector<Vector3>& index, int* slices) {
     for (const Vector3& p : index) along.push_back(p(a));
     std::sort(along.begin(), along.end());
     int distinct = 1;
-    for (std::size_t i = 1; i < along.size(); ++i) distinct += along[i] - along[i - 1] > kOnSlice;
+    for (std::size_t i = 1; i < along.size(); ++i) distinct += along[i] - along[i - 1] > kOnSliceVoxels;
     if (distinct >= 2 && distinct < fewest) {
       fewest = distinct;
       best = a;
@@ -93,7 +91,7 @@ SliceEnds findSliceEnds(const Volume& image, const std::vector<Landmark>& landma
     // Step 3: the end slice's landmarks, their centroid and rms radius.
     std::vector<Vector3> onSlice;
     for (std::size_t i = 0; i < landmarks.size(); ++i)
-      if (std::abs(index[i](axis) - slice) <= kOnSlice) onSlice.push_back(landmarks[i].position);
+      if (std::abs(index[i](axis) - slice) <= kOnSliceVoxels) onSlice.push_back(landmarks[i].position);
     if (onSlice.size() < 3) continue;
     Vector3 centre = Vector3::Zero();
     for (const Vector3& p : onSlice) centre += p;

@@ -26,6 +26,7 @@
 #include "dynsub/LandmarkConvention.h"
 #include "dynsub/SegmentParameters.h"
 #include "dynsub/SubjectGenerator.h"
+#include "dynsub/Trust.h"
 
 namespace dynsub {
 
@@ -109,6 +110,8 @@ struct EvaluationRun {
   // (LandmarkConvention.h), with 4 or more landmarks.
   std::optional<ConventionScores> convention;
   std::string warnings;  // segment()'s own (collapse, leak), joined by "; "
+  TrustMeasures trust;     // the result against what it rests on (Trust.h)
+  std::string trustFlags;  // the flags' names, joined by " "
   double seconds = 0;  // segmentImage()'s own (the image is read once per plan, the clicks made before)
   int steps = 0, controlVertices = 0;
 };

@@ -18,6 +18,7 @@
 #include "dynsub/Metrics.h"
 #include "dynsub/Report.h"
 #include "dynsub/SegmentParameters.h"
+#include "dynsub/Trust.h"
 
 namespace dynsub {
 
@@ -88,6 +89,8 @@ struct SegmentOutcome {
   // with 4 or more landmarks.
   std::optional<ConventionScores> convention;
   std::vector<std::string> warnings;  // the seed's and the segmentation's
+  TrustMeasures trust;                // the result against what it rests on (Trust.h)
+  std::vector<TrustFlag> trustFlags;  // why not to trust it; empty when nothing says so
   double seconds = 0;                 // the start, the evolution and the labelmap
   Report report;
 };
