@@ -404,6 +404,10 @@ a = r['atlas']
 assert a['label_values'] == [73] and a['registration']['affine_iterations'] > 0, a
 assert len(a['inside_lps_mm']) == 3 and a['prior_points'] == 100, a
 assert r['dice'] > 0.7, r['dice']
+# The atlas's start, on a subject it registers to, is trusted; its outline
+# lies near the result (the flag's threshold is 4.5 mm).
+t = r['trust']
+assert t['trusted'] and t['atlas_outline_distance_mm'] < 4.5 and 0.7 < t['volume_ratio'] < 1.5, t
 "
 expect_error "segment --init atlas: a misspelt label" 1 "did you mean 'Putamen_L'" "$work/s43" \
   "$DYNSUB" segment "$work/subject/image.nii.gz" --init atlas --atlas-label Putamn_L --out "$work/s43"

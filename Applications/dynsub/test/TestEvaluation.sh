@@ -42,6 +42,11 @@ for r in rows:
         print("surface_on_edges out of range:", r); ok = False
     if r["protocol"] != "seed" and not (0 < float(r["dice"]) <= 1):
         print("Dice out of range:", r); ok = False
+    # One click alone is flagged; clicks on slices outline a volume to compare with.
+    if (r["protocol"] == "seed") != ("one_click" in r["trust_flags"].split()):
+        print("one_click flag wrong:", r); ok = False
+    if r["protocol"] != "seed" and not float(r["trust_volume_ratio"]) > 0:
+        print("no volume ratio for clicks on slices:", r); ok = False
 for protocol, floor in (("six_slices", 0.70), ("sparse", 0.68), ("seed", 0.35)):
     dice = [float(r["dice"]) for r in rows if r["protocol"] == protocol]
     mean = sum(dice) / len(dice)

@@ -72,6 +72,10 @@ import json, sys
 r = json.load(open(sys.argv[1] + "/report.json"))
 ok = 0 < r["surface_on_edges"] <= 1 and all("edge_distance_mm" in l for l in r["landmark_residuals"])
 ok = ok and isinstance(r["warnings"], list) and r["surface_volume_mm3"] > r["initial_volume_mm3"]
+# The demo's clicks reach the caudate's ends: the result holds 1.28 times
+# what their slices outline and is trusted (a result under 0.7 would be flagged).
+t = r["trust"]
+ok = ok and t["trusted"] and t["flags"] == [] and 1.0 < t["volume_ratio"] < 1.6
 head = open(sys.argv[1] + "/surface.vtp", "rb").read(4096)
 sys.exit(0 if ok and b'Name="edge_distance_mm"' in head else 1)
 PY
@@ -108,6 +112,8 @@ import json, sys
 r = json.load(open(sys.argv[1] + "/report.json"))
 print("Dice", r["dice"], "seed", r["seed"])
 ok = r["dice"] >= 0.58 and r["seed"]["springs"] == "boundary points" and not r["seed"]["leaked"]
+# One click and nothing else is never to be trusted on its own.
+ok = ok and not r["trust"]["trusted"] and [f["name"] for f in r["trust"]["flags"]] == ["one_click"]
 sys.exit(0 if ok and r["seed"]["region_volume_mm3"] > 1000 and r["landmark_count"] == 0 else 1)
 PY
 for bad in seed:15.4,-1.5 seed:15.4,-1.5,16,2 seed:a,b,c seed:1500,0,0; do

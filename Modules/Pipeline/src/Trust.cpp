@@ -37,7 +37,8 @@ double percentile(std::vector<double> values, double fraction) {
 // The area of the convex hull of points in a plane (Andrew's monotone chain).
 double hullArea(std::vector<Eigen::Vector2d> p) {
   if (p.size() < 3) return 0;
-  std::sort(p.begin(), p.end(), [](const auto& a, const auto& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
+  std::sort(p.begin(), p.end(),
+            [](const auto& a, const auto& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
   const auto cross = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
     return (a - o).x() * (b - o).y() - (a - o).y() * (b - o).x();
   };
@@ -119,16 +120,16 @@ std::vector<TrustFlag> trustFlags(const TrustMeasures& m, const TrustEvidence& e
                      "evaluation's subjects is wrong (Dice under 0.7) more often than not; add boundary clicks on "
                      "a few slices, or an atlas (--init atlas --inside)"});
   if (m.volumeRatio < kTrustSmallBelow)
-    flags.push_back({"small", "the result encloses " + fixed(100 * m.volumeRatio, 0) + " % of the volume of " +
-                                  (evidence.volume > 0 ? "the atlas's structure" : "the outlines the clicks' slices give") +
-                                  ": it has probably shrunk away from the boundary between the clicks"});
+    flags.push_back(
+        {"small", "the result encloses " + fixed(100 * m.volumeRatio, 0) + " % of the volume of " +
+                      (evidence.volume > 0 ? "the atlas's structure" : "the outlines the clicks' slices give") +
+                      ": it has probably shrunk away from the boundary between the clicks"});
   if (m.clicksToAtlas > kTrustAtlasClicksApart)
     flags.push_back({"atlas_clicks_apart", "a tenth of the clicks lie " + fixed(m.clicksToAtlas, 1) +
                                                " mm or more from the atlas's structure: the atlas or the clicks "
                                                "are off (check the registration, or the clicks' structure)"});
   if (m.outlineDistance > kTrustMovedFromAtlas)
-    flags.push_back({"moved_from_atlas", "a tenth of the atlas's boundary points lie " +
-                                             fixed(m.outlineDistance, 1) +
+    flags.push_back({"moved_from_atlas", "a tenth of the atlas's boundary points lie " + fixed(m.outlineDistance, 1) +
                                              " mm or more from the result: the image's edges pulled it away from "
                                              "the atlas (check it there, or add clicks)"});
   if (m.outsideRegion > kLeakedAbove)

@@ -15,18 +15,18 @@
 namespace dynsub {
 
 struct TrustEvidence {
-  std::vector<Vector3> clicks;   // the user's boundary clicks (may be empty)
+  std::vector<Vector3> clicks;  // the user's boundary clicks (may be empty)
   // The clicks' slices: their normal (zero when the clicks are not on
   // slices) and how near along it two clicks share a slice (mm).
   Vector3 sliceNormal = Vector3::Zero();
   double onSlice = 0;
-  std::vector<Vector3> outline;  // the atlas prior's points on the carried label's boundary (may be empty)
-  double volume = 0;  // mm^3: the carried label's (0 without an atlas)
+  std::vector<Vector3> outline;       // the atlas prior's points on the carried label's boundary (may be empty)
+  double volume = 0;                  // mm^3: the carried label's (0 without an atlas)
   std::vector<double> clicksToAtlas;  // mm: each click's distance to the carried label's boundary
-  bool oneClick = false;  // a start from one click inside with nothing else: no clicks, no atlas
-  double march = 0;        // mm: the longest the slice-end march carried past the clicked slices
-  double clickedSpan = 0;  // mm: between the outermost clicked slices (0 when not on slices)
-  double outsideRegion = 0;  // the share of the result outside the region of interest
+  bool oneClick = false;              // a start from one click inside with nothing else: no clicks, no atlas
+  double march = 0;                   // mm: the longest the slice-end march carried past the clicked slices
+  double clickedSpan = 0;             // mm: between the outermost clicked slices (0 when not on slices)
+  double outsideRegion = 0;           // the share of the result outside the region of interest
 };
 
 struct TrustMeasures {
