@@ -9,8 +9,8 @@
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
-#include "dynsub/ImageFilters.h"
 #include "dynsub/ForceModel.h"
+#include "dynsub/ImageFilters.h"
 #include "dynsub/Labelmap.h"
 #include "dynsub/MeshIO.h"
 #include "dynsub/ModelOutputs.h"
@@ -219,8 +219,10 @@ ControlMesh chooseStart(const Volume& image, const SegmentInputs& in, const Segm
 
 // Each point's distance to the carried label's boundary (mm): to the
 // label from outside, to its complement from inside, at the nearest voxel of
-// the label's sub-grid (plus the way there from a point beyond it).
+// the label's sub-grid (plus the way there from a point beyond it). A
+// label that fills its whole sub-grid has no boundary there: no distances.
 std::vector<double> distancesToCarried(const CarriedLabel& label, const std::vector<Vector3>& points) {
+  if (points.empty()) return {};
   const Mask& inside = label.mask;
   Mask outside = inside;
   for (std::uint8_t& v : outside.voxels) v = !v;
@@ -233,7 +235,9 @@ std::vector<double> distancesToCarried(const CarriedLabel& label, const std::vec
     for (int a = 0; a < 3; ++a) v[a] = std::clamp(static_cast<int>(std::lround(index(a))), 0, g.size[a] - 1);
     const Vector3 centre = g.toPhysical(Vector3(v[0], v[1], v[2]));
     const auto i = static_cast<std::size_t>(g.offset(v[0], v[1], v[2]));
-    d.push_back((p - centre).norm() + (inside.voxels[i] ? toOutside[i] : toInside[i]));
+    const double boundary = inside.voxels[i] ? toOutside[i] : toInside[i];
+    if (!std::isfinite(boundary)) return {};
+    d.push_back((p - centre).norm() + boundary);
   }
   return d;
 }
