@@ -116,7 +116,8 @@ void writeRunsCsv(const std::vector<EvaluationRun>& runs, const std::string& pat
     const TrustMeasures& t = r.trust;
     out << r.seconds << ',' << r.steps << ',' << r.controlVertices << ',' << t.outsideRegion << ','
         << t.volumeRatio << ',' << t.outlineDistance << ',' << t.clicksToAtlas << ',' << t.farthestFromEvidence
-        << ',' << t.marchShare << ',' << csvField(r.trustFlags) << ',' << csvField(r.warnings) << ',' << csvField(r.error) << '\n';
+        << ',' << t.marchShare << ',' << csvField(r.trustFlags) << ',' << csvField(r.warnings) << ','
+        << csvField(r.error) << '\n';
   }
   out.close();
   if (!out) throw writeFailure(path);

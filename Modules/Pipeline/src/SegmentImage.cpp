@@ -256,14 +256,7 @@ TrustEvidence trustEvidence(const Volume& image, const SegmentInputs& in, const 
   for (const SliceEnd& end : ends.ends)
     if (end.sprung || end.pressed) e.march = std::max(e.march, end.length);
   if (ends.axis >= 0 && !in.landmarks.empty()) {
-    const Vector3 along = image.geometry.direction.col(ends.axis).normalized();
-    double low = std::numeric_limits<double>::infinity(), high = -low;
-    for (const Landmark& l : in.landmarks) {
-      low = std::min(low, l.position.dot(along));
-      high = std::max(high, l.position.dot(along));
-    }
-    e.clickedSpan = high - low;
-    e.sliceNormal = along;
+    e.sliceNormal = image.geometry.direction.col(ends.axis).normalized();
     e.onSlice = kOnSliceVoxels * image.geometry.spacing(ends.axis);
   }
   e.outsideRegion = outcome.result.outsideRegion;

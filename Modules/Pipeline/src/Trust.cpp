@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "dynsub/ParallelFor.h"
+#include "dynsub/Percentile.h"
 #include "dynsub/Segmentation.h"
 
 namespace dynsub {
@@ -25,13 +26,6 @@ MatrixX3 rows(const std::vector<Vector3>& points) {
   MatrixX3 m(static_cast<Eigen::Index>(points.size()), 3);
   for (std::size_t i = 0; i < points.size(); ++i) m.row(static_cast<Eigen::Index>(i)) = points[i].transpose();
   return m;
-}
-
-double percentile(std::vector<double> values, double fraction) {
-  if (values.empty()) return TrustMeasures::kNone;
-  const auto k = static_cast<std::ptrdiff_t>(std::floor(fraction * static_cast<double>(values.size() - 1)));
-  std::nth_element(values.begin(), values.begin() + k, values.end());
-  return values[static_cast<std::size_t>(k)];
 }
 
 // The area of the convex hull of points in a plane (Andrew's monotone chain).
@@ -107,8 +101,13 @@ TrustMeasures measureTrust(const TriangleSurface& result, double resultVolume, c
   }
   if (outline.rows() > 0 && result.points.rows() > 0)
     m.outlineDistance = percentile(nearestDistances(outline, result.points), 0.9);
-  m.clicksToAtlas = percentile(evidence.clicksToAtlas, 0.9);
-  if (evidence.clickedSpan > 0) m.marchShare = evidence.march / evidence.clickedSpan;
+  if (!evidence.clicksToAtlas.empty()) m.clicksToAtlas = percentile(evidence.clicksToAtlas, 0.9);
+  if (!evidence.sliceNormal.isZero() && !evidence.clicks.empty()) {
+    const Vector3 n = evidence.sliceNormal.normalized();
+    const Eigen::VectorXd along = clicks * n;
+    const double span = along.maxCoeff() - along.minCoeff();
+    if (span > 0) m.marchShare = evidence.march / span;
+  }
   return m;
 }
 

@@ -57,8 +57,7 @@ TrustEvidence clicksOnSlices(double* outlined) {
 TEST(Trust, ClicksOnSlicesOutlineTheirVolume) {
   double outlined = 0;
   TrustEvidence e = clicksOnSlices(&outlined);
-  e.march = 6.0;
-  e.clickedSpan = 16.0;
+  e.march = 6.0;  // against the 16 mm between the outermost clicked slices
   const TriangleSurface result = surfaceOf(spherePoints(20000, 10.0));
   const TrustMeasures m = measureTrust(result, kBall, e);
   EXPECT_NEAR(m.volumeRatio, kBall / outlined, 1e-9);

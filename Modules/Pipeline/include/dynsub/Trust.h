@@ -25,7 +25,6 @@ struct TrustEvidence {
   std::vector<double> clicksToAtlas;  // mm: each click's distance to the carried label's boundary
   bool oneClick = false;              // a start from one click inside with nothing else: no clicks, no atlas
   double march = 0;                   // mm: the longest the slice-end march carried past the clicked slices
-  double clickedSpan = 0;             // mm: between the outermost clicked slices (0 when not on slices)
   double outsideRegion = 0;           // the share of the result outside the region of interest
 };
 
@@ -40,7 +39,7 @@ struct TrustMeasures {
   double outlineDistance = kNone;       // mm: 90th percentile of the prior's points' distance to the result
   double clicksToAtlas = kNone;         // mm: 90th percentile of evidence.clicksToAtlas
   double farthestFromEvidence = kNone;  // mm: the result's point farthest from every click and prior point
-  double marchShare = kNone;            // the march over the clicked span
+  double marchShare = kNone;            // the march over the span between the outermost clicked slices
   double outsideRegion = 0;
 };
 

@@ -45,11 +45,11 @@
 
 namespace dynsub {
 
-// The defaults were chosen on the evaluation plan's tuning split
-// (Documentation/Segmentation.md).
 // Landmarks this close along an axis (voxels) share a slice.
 constexpr double kOnSliceVoxels = 0.25;
 
+// The defaults were chosen on the evaluation plan's tuning split
+// (Documentation/Segmentation.md).
 struct SliceEndOptions {
   bool enabled = true;
   double window = 2.5;      // robust spreads either side of the median
