@@ -214,6 +214,51 @@ def find_jobs(bids, landmarks_dir, seeds_table, reference_dir, warn=_warn):
     return jobs
 
 
+def labels(value):
+    """A participant_label or session_label setting as a list of labels.
+
+    It comes as a list (the BIDS App passes one) or as "01,02"; a "sub-" or
+    "ses-" prefix is dropped, as BIDS Apps accept both spellings."""
+    if value is None or value == "":
+        return []
+    items = value if isinstance(value, (list, tuple)) else str(value).split(",")
+    result = []
+    for item in items:
+        label = str(item).strip().removeprefix("sub-").removeprefix("ses-")
+        if not re.fullmatch(LABEL, label):
+            raise CohortError(f"'{item}': a label is letters and digits (sub-<label>, ses-<label>)")
+        result.append(label)
+    return result
+
+
+def select_jobs(jobs, participants, sessions):
+    """The jobs of the given participants and sessions (all where a list is
+    empty). A label that selects nothing is an error: it is a typing slip more
+    often than an intended no-op."""
+    chosen = {key: job for key, job in jobs.items()
+              if (not participants or job.subject in participants) and (not sessions or job.session in sessions)}
+    for label in participants:
+        if not any(job.subject == label for job in chosen.values()):
+            raise CohortError(f"sub-{label}: no T1w image with landmarks or a seed"
+                              + (f" in sessions {', '.join(sessions)}" if sessions else ""))
+    for label in sessions:
+        if not any(job.session == label for job in chosen.values()):
+            raise CohortError(f"ses-{label}: no T1w image with landmarks or a seed")
+    return chosen
+
+
+def configured_jobs(config):
+    """The jobs a workflow configuration names: the Snakefile's --config and
+    the BIDS App's settings, with the same defaults."""
+    root = os.path.abspath(str(config["bids"]))
+    jobs = find_jobs(root, str(config.get("landmarks", f"{root}/derivatives/landmarks")),
+                     config.get("seeds", default_seeds(root)),
+                     str(config.get("reference", f"{root}/derivatives/reference")))
+    if not jobs:
+        raise CohortError(f"{root}: no landmarks or seeds found for any T1w image")
+    return select_jobs(jobs, labels(config.get("participant_label")), labels(config.get("session_label")))
+
+
 def _last_error(log):
     """The line of the log that says what went wrong."""
     try:
@@ -350,13 +395,27 @@ def write_group_table(jobs, out, table):
 # What a BIDS validator run over the derivatives should not judge: the
 # workflow's own files and the outputs the derivatives specification has no
 # rule for.
-BIDSIGNORE = ["logs/", "report.html", "segmentations.tsv", "segmentations.json", "*_surface.vtp", "*_report.json",
-              "*_convergence.csv", "figures/"]
+BIDSIGNORE = ["logs/", "work/", "report.html", "segmentations.tsv", "segmentations.json", "*_surface.vtp",
+              "*_report.json", "*_convergence.csv", "figures/"]
+
+
+def _write_if_changed(path, text):
+    """Writes text by a rename, and only when it differs from the file's, so
+    that runs of several participants at once can each write it and a rerun
+    leaves it untouched."""
+    try:
+        if open(path).read() == text:
+            return
+    except OSError:
+        pass
+    temporary = f"{path}.{os.getpid()}.tmp"
+    with open(temporary, "w") as f:
+        f.write(text)
+    os.replace(temporary, path)
 
 
 def write_bidsignore(path):
-    with open(path, "w") as f:
-        f.write("\n".join(BIDSIGNORE) + "\n")
+    _write_if_changed(path, "\n".join(BIDSIGNORE) + "\n")
 
 
 def write_dataset_description(path, version, bids):
@@ -368,6 +427,4 @@ def write_dataset_description(path, version, bids):
                          "Description": "dynamic Catmull-Clark subdivision surfaces (dynsub segment)"}],
         "DatasetLinks": {"raw": "file://" + os.path.abspath(bids)},
     }
-    with open(path, "w") as f:
-        json.dump(description, f, indent=2)
-        f.write("\n")
+    _write_if_changed(path, json.dumps(description, indent=2) + "\n")

@@ -7,7 +7,7 @@ RAW is the input dataset: every file the workflow read (T1w images) must be
 valid BIDS by the BIDS validator (Debian python3-bids-validator). In
 DERIVATIVES, every file must be one of: dataset_description.json (with
 DatasetType derivative and GeneratedBy), the group table and its sidecar,
-job logs, or per-subject files named
+job logs, the BIDS App's work/ folder, or per-subject files named
 sub-<label>[_ses-<label>]_space-orig_desc-<label>_<suffix> in sub-<label>/[ses-<label>/]anat
 (figures: ..._desc-<label>_<figure>.png in .../figures), with entities in
 BIDS order, labels of letters and digits, folders matching the entities,
@@ -68,6 +68,8 @@ def main():
                                             "report.html", ".bidsignore"):
                 continue
             parts = relative.split(os.sep)
+            if parts[0] == "work":  # the BIDS App's Snakemake bookkeeping and cluster logs
+                continue
             if parts[0] == "logs":
                 match, parts = LOG.match(name), parts[1:]
                 kind = None

@@ -1,0 +1,105 @@
+#!/usr/bin/env bash
+# dynsub-bids, the BIDS App, on the cohort of make_cohort.py (sub-01: the
+# caudate from landmarks and the thalamus from a seed; sub-02: a moved copy;
+# sub-03 ses-2: the 0.5 mm MRI), with its outputs in derivatives/dynsub as
+# most users keep them:
+#  - `participant --participant-label 01` segments sub-01 only and writes no
+#    group table; sub-02 and sub-03 then run at once, in two processes on one
+#    output folder, spelt the BIDS Apps way (--participant_label, sub- prefix,
+#    --session_label);
+#  - `group` writes the table and the QC page of the four, starting no
+#    segmentation; a rerun of a participant does nothing;
+#  - the derivatives keep the naming rules (check_derivatives.py), and the
+#    official BIDS validator (npm bids-validator 1.x) finds no error in the
+#    dataset with its derivatives in place, while it does find the outputs
+#    misplaced at the dataset's top level (so the check can fail);
+#  - mistakes are refused with a message and nothing written: a label that
+#    selects nothing, the group level before any participant, a missing
+#    dataset, an unknown level.
+# Needs DYNSUB_BIDS, DATA, WORKFLOWS, BIDS_VALIDATOR; snakemake, nibabel.
+set -u
+source "$DATA/../Applications/dynsub/test/Checks.sh"
+require_colin27
+here=$(dirname "${BASH_SOURCE[0]}")
+python=/usr/bin/python3
+if [ ! -x "$BIDS_VALIDATOR" ]; then
+  echo "FAILED: $BIDS_VALIDATOR is missing (./run test installs npm's bids-validator into build/bids-validator)"
+  exit 1
+fi
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cd "$work"
+bids="$work/bids"
+out="$bids/derivatives/dynsub"
+"$python" "$here/make_cohort.py" "$templates" "$DATA" "$bids"
+
+"$DYNSUB_BIDS" "$bids" "$out" participant --participant-label 01 --cores 2 >"$work/p1.log" 2>&1
+check "participant 01: exit 0" test $? -eq 0 || tail -30 "$work/p1.log"
+check "participant 01: its two segmentations" \
+  test "$(find "$out/sub-01/anat" -name '*_dseg.nii.gz' | wc -l)" -eq 2
+check "participant 01: no other subject" test ! -e "$out/sub-02" -a ! -e "$out/sub-03"
+check "participant 01: no group table" test ! -e "$out/segmentations.tsv"
+check "participant 01: dataset_description.json and .bidsignore" \
+  test -s "$out/dataset_description.json" -a -s "$out/.bidsignore"
+
+# Two participant runs at once on one output folder, as a cluster's array
+# job would start them.
+"$DYNSUB_BIDS" "$bids" "$out" participant --participant_label sub-02 --cores 1 >"$work/p2.log" 2>&1 &
+second=$!
+"$DYNSUB_BIDS" "$bids" "$out" participant --participant_label 03 --session_label 2 --cores 1 >"$work/p3.log" 2>&1
+third=$?
+wait $second
+check "participants 02 and 03 at once: both exit 0" test $? -eq 0 -a $third -eq 0 ||
+  tail -30 "$work/p2.log" "$work/p3.log"
+
+"$DYNSUB_BIDS" "$bids" "$out" group >"$work/group.log" 2>&1
+check "group: exit 0" test $? -eq 0 || tail -30 "$work/group.log"
+check "group: no segmentation run" test "$(grep -c '^rule segment:' "$work/group.log")" -eq 0
+check "group: table and QC page" test -s "$out/segmentations.tsv" -a -s "$out/report.html"
+check "group: the four segmentations, all ok" "$python" - "$out/segmentations.tsv" <<'PY'
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1]), delimiter="\t"))
+assert [(r["participant_id"], r["session_id"], r["structure"], r["status"]) for r in rows] == [
+    ("sub-01", "n/a", "caudateL", "ok"), ("sub-01", "n/a", "thalamusL", "ok"),
+    ("sub-02", "n/a", "caudateL", "ok"), ("sub-03", "ses-2", "caudateL", "ok")], rows
+assert float(rows[0]["dice"]) >= 0.84, rows[0]  # the workflow test's bar on the demo's caudate (0.850)
+PY
+check "derivatives: BIDS names, sidecars, grids" "$python" "$here/check_derivatives.py" "$bids" "$out" 4
+
+touch "$work/marker"
+"$DYNSUB_BIDS" "$bids" "$out" participant --participant-label 01 --cores 2 >"$work/rerun.log" 2>&1
+check "rerun of participant 01: exit 0, nothing to be done" grep -q "Nothing to be done" "$work/rerun.log"
+check "rerun of participant 01: no file rewritten" \
+  test -z "$(find "$out" -newer "$work/marker" -type f -not -path '*/work/*')"
+
+# The official validator, on the raw dataset with the derivatives in place.
+validate() {  # validate DIR: prints the validator's errors and warnings by code; exit 1 on an error
+  "$BIDS_VALIDATOR" --json "$1" 2>/dev/null | "$python" -c '
+import json, sys
+result = json.load(sys.stdin)
+errors, warnings = result["issues"]["errors"], result["issues"]["warnings"]
+print("subjects:", result["summary"]["subjects"], "errors:", [e["key"] for e in errors],
+      "warnings:", [w["key"] for w in warnings])
+sys.exit(1 if errors or result["summary"]["subjects"] != ["01", "02", "03"] else 0)'
+}
+check "bids-validator: no error with the outputs in derivatives/dynsub" validate "$bids"
+cp -r "$bids" "$work/misplaced" && cp -r "$out"/. "$work/misplaced/"
+invalid() { ! validate "$1"; }
+check "bids-validator: the same outputs at the dataset's top level are errors" invalid "$work/misplaced"
+
+"$DYNSUB_BIDS" "$bids" "$work/fresh" participant --participant-label 09 >"$work/bad.log" 2>&1
+check "an unknown participant: exit 1" test $? -eq 1
+check "an unknown participant: named" grep -q "sub-09: no T1w image with landmarks or a seed" "$work/bad.log"
+check "an unknown participant: nothing written" test ! -e "$work/fresh"
+"$DYNSUB_BIDS" "$bids" "$work/fresh" group >"$work/bad.log" 2>&1
+check "group before participant: exit 1, says so" grep -q "run the participant level first" "$work/bad.log"
+check "group before participant: nothing written" test ! -e "$work/fresh"
+"$DYNSUB_BIDS" "$work/nowhere" "$work/fresh" participant >"$work/bad.log" 2>&1
+check "a missing dataset: exit 2, named" test $? -eq 2 -a -n "$(grep "nowhere: no such BIDS directory" "$work/bad.log")"
+"$DYNSUB_BIDS" "$bids" "$work/fresh" subject >"$work/bad.log" 2>&1
+check "an unknown level: exit 2" test $? -eq 2
+"$DYNSUB_BIDS" "$bids" "$work/fresh" participant --participant-label 0_1 >"$work/bad.log" 2>&1
+check "a malformed label: exit 2" test $? -eq 2
+
+echo "$failures failure(s)"
+exit $((failures > 0))
