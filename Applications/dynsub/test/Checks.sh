@@ -1,8 +1,9 @@
 # Sourced by the command-line test scripts: one named check at a time, failures counted.
+# A failed check returns 1, so that `check ... || show-the-log` shows why.
 failures=0
 check() {  # check NAME CONDITION...
   local name=$1; shift
-  if "$@"; then echo "ok: $name"; else echo "FAILED: $name"; failures=$((failures + 1)); fi
+  if "$@"; then echo "ok: $name"; else echo "FAILED: $name"; failures=$((failures + 1)); return 1; fi
 }
 # require_colin27: the Colin27 MRI and its AAL atlas (Debian package
 # mricron-data) in $templates, or the script stops, saying what to install.
