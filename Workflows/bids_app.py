@@ -80,6 +80,8 @@ def main(argv, snakefile, dynsub):
         parser.error(f"{args.bids_dir}: no such BIDS directory")
     if not os.path.isfile(os.path.join(args.bids_dir, "dataset_description.json")):
         parser.error(f"{args.bids_dir}: not a BIDS dataset (no dataset_description.json)")
+    if args.profile and not os.path.isfile(os.path.join(args.profile, "config.yaml")):
+        parser.error(f"--profile {args.profile}: not a Snakemake profile (no config.yaml in it)")
     bids_dir, out = os.path.abspath(args.bids_dir), os.path.abspath(args.output_dir)
     if out == bids_dir:
         parser.error(f"{args.output_dir}: the output directory must not be the BIDS dataset itself")

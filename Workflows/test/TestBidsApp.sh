@@ -98,6 +98,8 @@ check "group before participant: nothing written" test ! -e "$work/fresh"
 check "a missing dataset: exit 2, named" test $? -eq 2 -a -n "$(grep "nowhere: no such BIDS directory" "$work/bad.log")"
 "$DYNSUB_BIDS" "$bids" "$work/fresh" subject >"$work/bad.log" 2>&1
 check "an unknown level: exit 2" test $? -eq 2
+"$DYNSUB_BIDS" "$bids" "$work/fresh" participant --profile "$work" >"$work/bad.log" 2>&1
+check "a folder that is not a profile: exit 2, named" test $? -eq 2 -a -n "$(grep "not a Snakemake profile" "$work/bad.log")"
 "$DYNSUB_BIDS" "$bids" "$work/fresh" participant --participant-label 0_1 >"$work/bad.log" 2>&1
 check "a malformed label: exit 2" test $? -eq 2
 
