@@ -1,7 +1,10 @@
-"""The cohort's QC report: one self-contained HTML page (figures embedded,
-no network, no external script) with a sortable group table that flags
-outliers, and per segmentation its slices with the contour, the 3D view,
-the convergence plot and its numbers.
+"""The cohort's QC report: one HTML page (no network, no external script)
+with a sortable group table that flags outliers and shows each row's
+warnings and trust flags, a filter for flagged rows, and per segmentation
+its slices with the contour, the 3D view, the convergence plot and its
+numbers. The figures stay separate files beside it, loaded as they scroll
+into view and enlarged on click, so that the page of a large cohort opens
+at once; a copy of the page needs its folder.
 
 Flags (the reasons a row is marked for a look):
   failed       the job did not complete;
@@ -13,7 +16,6 @@ Flags (the reasons a row is marked for a look):
   residual     the rms distance of the landmarks to the surface exceeds 1 mm (twice the
                default landmark tolerance: the surface did not come to the clicks).
 """
-import base64
 import html
 import math
 import os
@@ -33,11 +35,13 @@ def _number(value):
         return None
 
 
-def _image(path, alt):
+def _image(path, alt, page):
+    """The figure at path, by its path relative to the page; a link to it
+    when scripts are off."""
     if not os.path.exists(path):
         return f'<p class="missing">{html.escape(alt)}: not rendered</p>'
-    data = base64.b64encode(open(path, "rb").read()).decode("ascii")
-    return f'<img src="data:image/png;base64,{data}" alt="{html.escape(alt)}">'
+    source = html.escape(os.path.relpath(path, os.path.dirname(page)))
+    return f'<a class="figure" href="{source}"><img src="{source}" loading="lazy" alt="{html.escape(alt)}"></a>'
 
 
 def _rms_residual(report):
@@ -92,14 +96,45 @@ tr.flagged td { background: #fde2e2; }
 .flag { display: inline-block; background: #c0392b; color: white; border-radius: 3px; padding: 0 0.3em;
         margin-right: 0.2em; font-size: 0.85em; }
 section { border-top: 2px solid #ccc; margin-top: 2em; padding-top: 0.5em; }
-section img { max-width: 32%; margin-right: 1%; vertical-align: top; border: 1px solid #ddd; }
-.missing { color: #888; font-style: italic; display: inline-block; width: 30%; }
+div.figures { display: flex; gap: 1%; align-items: flex-start; }
+div.figures > * { flex: 1; }
+a.figure img { width: 100%; border: 1px solid #ddd; cursor: zoom-in; }
+dialog { padding: 0; border: none; max-width: 95vw; max-height: 95vh; }
+dialog img { max-width: 95vw; max-height: 95vh; display: block; cursor: zoom-out; }
+dialog::backdrop { background: rgba(0, 0, 0, 0.7); }
+td.notes { text-align: left; max-width: 30em; font-size: 0.85em; }
+.missing { color: #888; font-style: italic; }
 dl { display: grid; grid-template-columns: max-content auto; gap: 0.1em 1em; }
 dt { font-weight: bold; }
 """
 
-# Sorting by a column's text, or numerically when every cell is a number or n/a.
+# Sorting by a column's text, or numerically when every cell is a number or
+# n/a; the flagged-rows filter (also set by the address's #flagged); a figure
+# enlarged in a dialog on click.
 SCRIPT = """
+var filter = document.getElementById("only-flagged");
+function applyFilter() {
+  document.querySelectorAll("#group tbody tr").forEach(function (row) {
+    row.hidden = filter.checked && !row.classList.contains("flagged");
+  });
+}
+filter.addEventListener("change", applyFilter);
+function filterFromAddress() {
+  if (location.hash === "#flagged") { filter.checked = true; applyFilter(); }
+}
+window.addEventListener("hashchange", filterFromAddress);
+applyFilter();
+filterFromAddress();
+var viewer = document.getElementById("viewer"), large = viewer.querySelector("img");
+document.querySelectorAll("a.figure").forEach(function (link) {
+  link.addEventListener("click", function (event) {
+    event.preventDefault();
+    large.src = link.getAttribute("href");
+    large.alt = link.querySelector("img").alt;
+    viewer.showModal();
+  });
+});
+viewer.addEventListener("click", function () { viewer.close(); });
 document.querySelectorAll("table.sortable th").forEach(function (header, column) {
   header.addEventListener("click", function () {
     var table = header.closest("table"), body = table.tBodies[0];
@@ -126,11 +161,14 @@ COLUMNS = [("participant_id", "subject", True), ("session_id", "session", True),
            ("status", "status", True), ("volume_mm3", "volume (mm³)", False),
            ("volume_z", "volume robust z", False), ("dice", "Dice", False), ("hd95_mm", "HD95 (mm)", False),
            ("rms_residual_mm", "landmark rms (mm)", False), ("control_vertices", "control vertices", False),
-           ("seconds", "seconds", False), ("flags", "flags", True)]
+           ("seconds", "seconds", False), ("flags", "flags", True), ("notes", "warnings and trust", True)]
 
 
 def _cell(row, key, text):
     value = row.get(key)
+    if key == "notes":
+        notes = [n for n in (row.get("trust_flags"), row.get("warnings")) if n not in (None, "", "n/a")]
+        return f'<td class="notes">{html.escape("; ".join(notes))}</td>'
     if key == "flags":
         shown = "".join(f'<span class="flag">{html.escape(f)}</span>' for f in value) or "—"
         return f'<td class="text" data-value="{len(value)}">{shown}</td>'
@@ -150,7 +188,10 @@ def write_report(jobs, out, path):
              "<title>DynSub QC report</title>", f"<style>{STYLE}</style></head><body>",
              "<h1>DynSub QC report</h1>",
              f"<p>{len(rows)} segmentations, {sum(r['status'] == 'ok' for r in rows)} complete, "
-             f"{flagged} flagged. Click a column header to sort; click a structure for its figures.</p>",
+             f"{flagged} flagged. Click a column header to sort; click a structure for its figures, "
+             "a figure to enlarge it.</p>",
+             '<p><label><input type="checkbox" id="only-flagged"> flagged rows only</label> '
+             '(<a href="#flagged">link</a>)</p>',
              '<table class="sortable" id="group"><thead><tr>']
     parts += [f"<th>{html.escape(title)}</th>" for _, title, _ in COLUMNS]
     parts.append("</tr></thead><tbody>")
@@ -173,9 +214,11 @@ def write_report(jobs, out, path):
                          f'{html.escape(row["message"])}</p></section>')
             continue
         figures = bids.figure_paths(out, job.dir, job.stem, job.structure)
-        parts += [_image(figures["slices"], "slices with the contour (green on an image edge, magenta 3 mm or more from any)"),
-                  _image(figures["surface3d"], "3D view, coloured the same way"),
-                  _image(figures["convergence"], "convergence")]
+        parts += ['<div class="figures">',
+                  _image(figures["slices"], "slices with the contour (green on an image edge, magenta 3 mm or more "
+                         "from any)", path),
+                  _image(figures["surface3d"], "3D view, coloured the same way", path),
+                  _image(figures["convergence"], "convergence", path), "</div>"]
         report = row["report"]
         facts = [("flags", ", ".join(row["flags"]) or "none"), ("volume (mm³)", row["volume_mm3"]),
                  ("Dice", row["dice"]), ("mean surface distance (mm)", row["mean_surface_distance_mm"]),
@@ -189,6 +232,7 @@ def write_report(jobs, out, path):
         for warning in report.get("warnings", []):
             parts.append(f"<dt>warning</dt><dd>{html.escape(warning)}</dd>")
         parts.append("</dl></section>")
+    parts.append('<dialog id="viewer"><img alt=""></dialog>')
     parts.append(f"<script>{SCRIPT}</script></body></html>")
     temporary = path + ".tmp"
     with open(temporary, "w", encoding="utf-8") as f:

@@ -123,6 +123,49 @@ chromium --headless=new --no-sandbox --disable-gpu --dump-dom "file://$work/out/
   2>/dev/null
 check "QC page: the DOM holds the 5 rows" test "$(grep -o '<tr class=' "$work/dom.html" | wc -l)" -eq 5
 if [ -n "${KEEP_SCREENSHOT:-}" ]; then cp "$work/report.png" "$KEEP_SCREENSHOT"; fi
+check "QC page: figures are files beside it, each one there" "$python" - "$work/out/report.html" <<'PY'
+import os, re, sys
+page = open(sys.argv[1]).read()
+sources = re.findall(r'<img src="([^"]+)"', page)
+assert "data:" not in page and len(sources) == 3 * 4, sources  # 4 complete segmentations, 3 figures each
+missing = [s for s in sources if not os.path.exists(os.path.join(os.path.dirname(sys.argv[1]), s))]
+assert not missing, missing
+PY
+chromium --headless=new --no-sandbox --disable-gpu --dump-dom "file://$work/out/report.html#flagged" \
+  >"$work/flagged.html" 2>/dev/null
+check "QC page: #flagged shows the 3 flagged rows only" \
+  test "$(grep -c '<tr class="flagged">' "$work/flagged.html")" -eq 3 -a \
+  "$(grep -c '<tr class="" hidden="">' "$work/flagged.html")" -eq 2
+
+# A cohort's page: 500 segmentations (one job's files linked under 500
+# subjects), every row present and no script error. Its load time is printed,
+# not asserted (Ecosystem.md has the figure).
+"$python" - "$WORKFLOWS" "$work/out" "$work/qc500" <<'PY'
+import os, sys
+sys.path.insert(0, sys.argv[1])
+import dynsub_bids as bids, qc_report
+source, out = sys.argv[2], sys.argv[3]
+original = bids.Job("01", None, "", "caudateL", "sub-01_T1w.nii.gz")
+files = {**bids.output_paths(source, original.dir, original.stem, original.structure),
+         **bids.figure_paths(source, original.dir, original.stem, original.structure)}
+jobs = {}
+for n in range(1000, 1500):
+    job = bids.Job(str(n), None, "", "caudateL", f"sub-{n}_T1w.nii.gz")
+    targets = {**bids.output_paths(out, job.dir, job.stem, job.structure),
+               **bids.figure_paths(out, job.dir, job.stem, job.structure)}
+    for key, path in targets.items():
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        os.link(files[key], path)
+    jobs[job.key] = job
+qc_report.write_report(jobs, out, f"{out}/report.html")
+PY
+start=$EPOCHREALTIME
+chromium --headless=new --no-sandbox --disable-gpu --enable-logging=stderr --v=0 --dump-dom \
+  "file://$work/qc500/report.html" >"$work/dom500.html" 2>"$work/chromium500.log"
+echo "QC page of 500: $(du -k "$work/qc500/report.html" | cut -f1) kB; Chromium started, loaded it and wrote its" \
+  "DOM in $(awk "BEGIN { print $EPOCHREALTIME - $start }") s"
+check "QC page of 500: every row present" test "$(grep -o '<tr class=' "$work/dom500.html" | wc -l)" -eq 500
+check "QC page of 500: no console message" test -z "$(grep CONSOLE "$work/chromium500.log")"
 
 snakemake -s "$WORKFLOWS/Snakefile" --cores 1 --config out="$work/x" >"$work/bad.log" 2>&1
 check "no bids: exit non-zero" test $? -ne 0
