@@ -100,8 +100,7 @@ def main(argv, snakefile, dynsub):
     except (bids.CohortError, OSError) as error:
         print(f"dynsub-bids: error: {error}", file=sys.stderr)
         return 1
-    reports = [bids.output_paths(out, job.dir, job.stem, job.structure)["report"] for job in jobs.values()]
-    if args.analysis_level == "group" and not any(os.path.exists(path) for path in reports):
+    if args.analysis_level == "group" and not bids.written_reports(jobs, out):
         print(f"dynsub-bids: error: {out}: no segmentation written yet; run the participant level first",
               file=sys.stderr)
         return 1

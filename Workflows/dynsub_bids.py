@@ -259,6 +259,13 @@ def configured_jobs(config):
     return select_jobs(jobs, labels(config.get("participant_label")), labels(config.get("session_label")))
 
 
+def written_reports(jobs, out):
+    """The report.json files of the jobs already segmented in out: what the
+    group level summarizes."""
+    reports = (output_paths(out, job.dir, job.stem, job.structure)["report"] for job in jobs.values())
+    return [path for path in reports if os.path.exists(path)]
+
+
 def _last_error(log):
     """The line of the log that says what went wrong."""
     try:

@@ -19,8 +19,9 @@ def state(job):
         if field.startswith("JobState="):
             return field.split("=", 1)[1]
     result = subprocess.run(["sacct", "-j", job, "-X", "-n", "-P", "-o", "State"], capture_output=True, text=True)
-    lines = result.stdout.split()
-    return lines[0].split()[0] if result.returncode == 0 and lines else None
+    # One line per job, e.g. "CANCELLED by 0": the state is its first word.
+    words = result.stdout.split()
+    return words[0] if result.returncode == 0 and words else None
 
 
 job_state = state(sys.argv[1])

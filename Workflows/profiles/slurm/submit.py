@@ -1,6 +1,7 @@
 #!/usr/bin/python3
-"""(Debian's Python, where Snakemake is.) Submits one Snakemake job script (the last argument) with sbatch and prints
-its Slurm job id, as Snakemake's --cluster expects.
+# Debian's Python, the one Snakemake is installed for (read_job_properties).
+"""Submits one Snakemake job script (the last argument) with sbatch and
+prints its Slurm job id, as Snakemake's --cluster expects.
 
 The job's rule, threads and resources come from the job script: cpus, memory
 (mem_mb), time limit (runtime, minutes), and the site's partition and account
