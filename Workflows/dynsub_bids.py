@@ -12,6 +12,7 @@ is one structure of one T1w image, written beside the image's own path:
     ..._report.json  dynsub segment's report
     ..._convergence.csv
     sub-<label>[/ses-<label>]/figures/sub-<label>[_ses-<label>]_desc-<structure>_{slices,surface3d,convergence}.png
+    ..._view.js      the data of the QC page's interactive view (qc_view.py)
 
 `space-orig` is the T1w's own grid; `desc-` carries the structure, so BIDS
 labels (letters and digits only) are required of structure names. The T1w's
@@ -30,6 +31,8 @@ import shutil
 import subprocess
 import sys
 import tempfile
+
+import qc_view
 
 LABEL = r"[A-Za-z0-9]+"
 # The entities a raw T1w's name may carry between ses- and the suffix, in
@@ -98,6 +101,15 @@ def default_seeds(bids):
 
 def figure_paths(out, dir, stem, structure):
     return {name: f"{out}/{dir}/figures/{stem}_desc-{structure}_{name}.png" for name in FIGURES}
+
+
+def view_path(out, dir, stem, structure):
+    return f"{out}/{dir}/figures/{stem}_desc-{structure}_view.js"
+
+
+def view_key(stem, structure):
+    """The name of one segmentation on the QC page: its section's id and its view's."""
+    return f"{stem}-{structure}"
 
 
 def _relative(path, root):
@@ -276,7 +288,7 @@ def _last_error(log):
     return (errors or lines or ["empty log"])[-1]
 
 
-def run_segmentation(job, outputs, figures, log, dynsub, extra_args, bids, out):
+def run_segmentation(job, outputs, figures, view, log, dynsub, extra_args, bids, out):
     """Runs `dynsub segment` for one job and gives its results their BIDS names.
 
     dynsub writes all its outputs or none into a private directory beside the
@@ -329,6 +341,12 @@ def run_segmentation(job, outputs, figures, log, dynsub, extra_args, bids, out):
             if os.path.exists(f"{result}/{name}.png"):
                 os.makedirs(os.path.dirname(path), exist_ok=True)
                 os.replace(f"{result}/{name}.png", path)
+        try:  # the QC page's view is an extra: without it the page says so, and the job stands
+            qc_view.write_view(view_key(job.stem, job.structure), job.t1w, outputs["dseg"],
+                               f"{result}/control_mesh.obj", dynsub, view, work)
+        except (OSError, ValueError, subprocess.CalledProcessError) as error:
+            with open(log, "a") as f:
+                f.write(f"QC view not written: {error}\n")
     finally:
         shutil.rmtree(work, ignore_errors=True)
 
@@ -403,7 +421,7 @@ def write_group_table(jobs, out, table):
 # workflow's own files and the outputs the derivatives specification has no
 # rule for.
 BIDSIGNORE = ["logs/", "work/", "report.html", "segmentations.tsv", "segmentations.json", "*_surface.vtp",
-              "*_report.json", "*_convergence.csv", "figures/"]
+              "*_report.json", "*_convergence.csv", "figures/", "viewer/"]
 
 
 def _write_if_changed(path, text):

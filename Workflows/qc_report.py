@@ -1,10 +1,16 @@
-"""The cohort's QC report: one HTML page (no network, no external script)
-with a sortable group table that flags outliers and shows each row's
-warnings and trust flags, a filter for flagged rows, and per segmentation
-its slices with the contour, the 3D view, the convergence plot and its
-numbers. The figures stay separate files beside it, loaded as they scroll
-into view and enlarged on click, so that the page of a large cohort opens
-at once; a copy of the page needs its folder.
+"""The cohort's QC report: one HTML page (no network) with a sortable group
+table that flags outliers and shows each row's warnings and trust flags, a
+filter for flagged rows, a pass/fail rating per row exported as TSV, and
+per segmentation its slices with the contour, the 3D view, the convergence
+plot, its numbers and an interactive view (NiiVue: the image with the
+labelmap on three planes and the surface in 3D). The figures and the
+views' data stay separate files beside it, loaded as they scroll into view
+or when a view is opened, so that the page of a large cohort opens at
+once; a copy of the page needs its folder.
+
+Ratings are kept in the browser (localStorage, per page address) until
+exported: "export ratings" saves qc_ratings.tsv with participant_id,
+session_id, structure, rating (pass, fail or n/a) and flags.
 
 Flags (the reasons a row is marked for a look):
   failed       the job did not complete;
@@ -16,9 +22,11 @@ Flags (the reasons a row is marked for a look):
   residual     the rms distance of the landmarks to the surface exceeds 1 mm (twice the
                default landmark tolerance: the surface did not come to the clicks).
 """
+import filecmp
 import html
 import math
 import os
+import shutil
 import statistics
 
 import dynsub_bids as bids
@@ -102,6 +110,10 @@ a.figure img { width: 100%; border: 1px solid #ddd; cursor: zoom-in; }
 dialog { padding: 0; border: none; max-width: 95vw; max-height: 95vh; }
 dialog img { max-width: 95vw; max-height: 95vh; display: block; cursor: zoom-out; }
 dialog::backdrop { background: rgba(0, 0, 0, 0.7); }
+dialog.live { padding: 0.5em; background: #111; color: #eee; }
+dialog.live div.canvas { width: 90vw; height: 75vh; }
+dialog.live p { margin: 0.3em 0; }
+td.rating select { font-size: 0.9em; }
 td.notes { text-align: left; max-width: 30em; font-size: 0.85em; }
 .missing { color: #888; font-style: italic; }
 dl { display: grid; grid-template-columns: max-content auto; gap: 0.1em 1em; }
@@ -135,6 +147,86 @@ document.querySelectorAll("a.figure").forEach(function (link) {
   });
 });
 viewer.addEventListener("click", function () { viewer.close(); });
+var store = "dynsub-qc " + location.pathname, ratings = {};
+try { ratings = JSON.parse(localStorage.getItem(store) || "{}"); } catch (error) { ratings = {}; }
+function rowKey(row) { return [row.dataset.participant, row.dataset.session, row.dataset.structure].join("\\t"); }
+document.querySelectorAll("#group tbody tr").forEach(function (row) {
+  var select = row.querySelector("td.rating select"), cell = select.parentNode;
+  select.value = ratings[rowKey(row)] || "";
+  cell.setAttribute("data-value", select.value || "n/a");
+  select.addEventListener("change", function () {
+    if (select.value) { ratings[rowKey(row)] = select.value; } else { delete ratings[rowKey(row)]; }
+    cell.setAttribute("data-value", select.value || "n/a");
+    try { localStorage.setItem(store, JSON.stringify(ratings)); } catch (error) { /* kept for this visit only */ }
+  });
+});
+document.getElementById("export").addEventListener("click", function () {
+  var lines = ["participant_id\tsession_id\tstructure\trating\tflags"];
+  document.querySelectorAll("#group tbody tr").forEach(function (row) {
+    var rating = row.querySelector("td.rating select").value || "n/a";
+    lines.push([rowKey(row), rating, row.dataset.flags || "n/a"].join("\\t"));
+  });
+  var link = document.createElement("a");
+  link.href = URL.createObjectURL(new Blob([lines.join("\\n") + "\\n"], {type: "text/tab-separated-values"}));
+  link.download = "qc_ratings.tsv";
+  document.body.appendChild(link);
+  link.click();
+  link.remove();
+});
+var live = document.getElementById("live"), shown = null;
+function loadScript(source) {
+  return new Promise(function (resolve, reject) {
+    var script = document.createElement("script");
+    script.src = source;
+    script.onload = resolve;
+    script.onerror = function () { script.remove(); reject(new Error("cannot load " + source)); };
+    document.head.appendChild(script);
+  });
+}
+function bytes(text) { return Uint8Array.from(atob(text), function (c) { return c.charCodeAt(0); }).buffer; }
+async function openView(button) {
+  var status = live.querySelector("p.status"), key = button.dataset.key;
+  live.removeAttribute("data-drawn");
+  status.textContent = "loading " + button.dataset.title + "...";
+  live.showModal();
+  try {
+    if (!window.niivue) { await loadScript(live.dataset.niivue); }
+    if (!(window.dynsubViews && window.dynsubViews[key])) { await loadScript(button.dataset.view); }
+    var data = window.dynsubViews[key], canvas = document.createElement("canvas");
+    live.querySelector("div.canvas").replaceChildren(canvas);
+    var nv = new niivue.Niivue({backColor: [0, 0, 0, 1], crosshairColor: [0, 0.6, 1, 1], show3Dcrosshair: true,
+                                isColorbar: false,
+                                multiplanarShowRender: niivue.SHOW_RENDER.ALWAYS, meshThicknessOn2D: 0.5,
+                                meshXRay: 0.6});
+    shown = nv;
+    await nv.attachToCanvas(canvas);
+    nv.addVolume(await niivue.NVImage.loadFromBase64({base64: data.image, name: key + "_image.nii.gz"}));
+    nv.addVolume(await niivue.NVImage.loadFromBase64({base64: data.labels, name: key + "_labels.nii.gz",
+                                                      colormap: "red", opacity: 0.4, cal_min: 0, cal_max: 1}));
+    nv.addMesh(new niivue.NVMesh(new Float32Array(bytes(data.points)), new Uint32Array(bytes(data.triangles)),
+                                 key + "_surface", new Uint8Array([255, 200, 0, 255]), 1, true, nv.gl));
+    nv.setSliceType(nv.sliceTypeMultiplanar);
+    nv.drawScene();
+    status.textContent = button.dataset.title;
+    live.setAttribute("data-drawn", key);
+  } catch (error) {
+    status.textContent = button.dataset.title + ": the view could not be opened (" + error.message + ")";
+    console.error("QC view " + key + ": " + error.message);
+  }
+}
+function closeView() {
+  if (shown && shown.gl) {
+    var lose = shown.gl.getExtension("WEBGL_lose_context");
+    if (lose) { lose.loseContext(); }
+  }
+  shown = null;
+  live.querySelector("div.canvas").replaceChildren();
+}
+document.querySelectorAll("button.view").forEach(function (button) {
+  button.addEventListener("click", function () { openView(button); });
+});
+live.querySelector("button.close").addEventListener("click", function () { live.close(); });
+live.addEventListener("close", closeView);
 document.querySelectorAll("table.sortable th").forEach(function (header, column) {
   header.addEventListener("click", function () {
     var table = header.closest("table"), body = table.tBodies[0];
@@ -161,11 +253,15 @@ COLUMNS = [("participant_id", "subject", True), ("session_id", "session", True),
            ("status", "status", True), ("volume_mm3", "volume (mm³)", False),
            ("volume_z", "volume robust z", False), ("dice", "Dice", False), ("hd95_mm", "HD95 (mm)", False),
            ("rms_residual_mm", "landmark rms (mm)", False), ("control_vertices", "control vertices", False),
-           ("seconds", "seconds", False), ("flags", "flags", True), ("notes", "warnings and trust", True)]
+           ("seconds", "seconds", False), ("flags", "flags", True), ("notes", "warnings and trust", True),
+           ("rating", "rating", True)]
 
 
 def _cell(row, key, text):
     value = row.get(key)
+    if key == "rating":  # set from the browser's saved ratings by the page's script
+        return ('<td class="rating text"><select aria-label="rating"><option value="">—</option>'
+                '<option value="pass">pass</option><option value="fail">fail</option></select></td>')
     if key == "notes":
         notes = [n for n in (row.get("trust_flags"), row.get("warnings")) if n not in (None, "", "n/a")]
         return f'<td class="notes">{html.escape("; ".join(notes))}</td>'
@@ -176,27 +272,48 @@ def _cell(row, key, text):
         value = f"{value:.2f}"
     value = "n/a" if value in (None, "") else str(value)
     if key == "structure" and row["status"] == "ok":
-        anchor = f'{row["job"].stem}-{row["structure"]}'
+        anchor = bids.view_key(row["job"].stem, row["structure"])
         return f'<td class="text" data-value="{html.escape(value)}"><a href="#{anchor}">{html.escape(value)}</a></td>'
     return f'<td class="{"text" if text else "num"}">{html.escape(value)}</td>'
 
 
-def write_report(jobs, out, path):
+def _install_niivue(niivue, out):
+    """NiiVue's browser build copied into OUT/viewer (when it changed); its
+    path relative to the page, or None without it."""
+    if not niivue or not os.path.isfile(niivue):
+        return None
+    target = os.path.join(out, "viewer", "niivue.umd.js")
+    if not (os.path.exists(target) and filecmp.cmp(niivue, target, shallow=False)):
+        os.makedirs(os.path.dirname(target), exist_ok=True)
+        shutil.copyfile(niivue, target + ".tmp")
+        os.replace(target + ".tmp", target)
+    return "viewer/niivue.umd.js"
+
+
+def write_report(jobs, out, path, niivue=None):
+    """Writes the page to path (by a rename) and returns its rows. niivue is
+    NiiVue's niivue.umd.js, copied beside the page for the interactive views;
+    without it the page says how to get them."""
     rows = flagged_rows(jobs, out)
+    viewer_script = _install_niivue(niivue, out)
     flagged = sum(1 for r in rows if r["flags"])
     parts = ["<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
              "<title>DynSub QC report</title>", f"<style>{STYLE}</style></head><body>",
              "<h1>DynSub QC report</h1>",
              f"<p>{len(rows)} segmentations, {sum(r['status'] == 'ok' for r in rows)} complete, "
              f"{flagged} flagged. Click a column header to sort; click a structure for its figures, "
-             "a figure to enlarge it.</p>",
+             "a figure to enlarge it. Rate each row pass or fail; ratings stay in this browser until "
+             "exported.</p>",
              '<p><label><input type="checkbox" id="only-flagged"> flagged rows only</label> '
-             '(<a href="#flagged">link</a>)</p>',
+             '(<a href="#flagged">link</a>) <button type="button" id="export">export ratings (TSV)</button></p>',
              '<table class="sortable" id="group"><thead><tr>']
     parts += [f"<th>{html.escape(title)}</th>" for _, title, _ in COLUMNS]
     parts.append("</tr></thead><tbody>")
     for row in rows:
-        parts.append(f'<tr class="{"flagged" if row["flags"] else ""}">')
+        data = {"participant": row["participant_id"], "session": row["session_id"], "structure": row["structure"],
+                "flags": ",".join(row["flags"])}
+        parts.append(f'<tr class="{"flagged" if row["flags"] else ""}" '
+                     + " ".join(f'data-{k}="{html.escape(v)}"' for k, v in data.items()) + ">")
         parts += [_cell(row, key, text) for key, _, text in COLUMNS]
         parts.append("</tr>")
     parts.append("</tbody></table>")
@@ -208,7 +325,8 @@ def write_report(jobs, out, path):
     for row in rows:
         job = row["job"]
         title = f'{row["participant_id"]} {row["session_id"] if row["session_id"] != "n/a" else ""} {job.structure}'
-        parts.append(f'<section id="{job.stem}-{job.structure}"><h2>{html.escape(title)}</h2>')
+        key = bids.view_key(job.stem, job.structure)
+        parts.append(f'<section id="{html.escape(key)}"><h2>{html.escape(title)}</h2>')
         if row["status"] != "ok":
             parts.append(f'<p><span class="flag">{html.escape(row["status"])}</span> '
                          f'{html.escape(row["message"])}</p></section>')
@@ -219,6 +337,16 @@ def write_report(jobs, out, path):
                          "from any)", path),
                   _image(figures["surface3d"], "3D view, coloured the same way", path),
                   _image(figures["convergence"], "convergence", path), "</div>"]
+        view = bids.view_path(out, job.dir, job.stem, job.structure)
+        if viewer_script and os.path.exists(view):
+            parts.append(f'<p><button type="button" class="view" data-key="{html.escape(key)}" '
+                         f'data-title="{html.escape(title)}" '
+                         f'data-view="{html.escape(os.path.relpath(view, os.path.dirname(path)))}">'
+                         "interactive view</button></p>")
+        else:
+            parts.append('<p class="missing">interactive view: ' + ("NiiVue is not installed (./run build installs "
+                         "it into build/niivue)" if not viewer_script else "its data was not written (see the job's "
+                         "log)") + "</p>")
         report = row["report"]
         facts = [("flags", ", ".join(row["flags"]) or "none"), ("volume (mm³)", row["volume_mm3"]),
                  ("Dice", row["dice"]), ("mean surface distance (mm)", row["mean_surface_distance_mm"]),
@@ -233,6 +361,11 @@ def write_report(jobs, out, path):
             parts.append(f"<dt>warning</dt><dd>{html.escape(warning)}</dd>")
         parts.append("</dl></section>")
     parts.append('<dialog id="viewer"><img alt=""></dialog>')
+    parts.append(f'<dialog id="live" class="live" data-niivue="{html.escape(viewer_script or "")}">'
+                 '<p class="status"></p><div class="canvas"></div>'
+                 "<p>Red: the labelmap; yellow: the fitted surface (its trace on the planes). Click a plane to "
+                 "move the crosshair; drag in 3D to turn. Coordinates are the image's RAS.</p>"
+                 '<p><button type="button" class="close">close</button></p></dialog>')
     parts.append(f"<script>{SCRIPT}</script></body></html>")
     temporary = path + ".tmp"
     with open(temporary, "w", encoding="utf-8") as f:

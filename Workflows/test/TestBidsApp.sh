@@ -23,7 +23,7 @@ require_colin27
 here=$(dirname "${BASH_SOURCE[0]}")
 python=/usr/bin/python3
 if [ ! -x "$BIDS_VALIDATOR" ]; then
-  echo "FAILED: $BIDS_VALIDATOR is missing (./run test installs npm's bids-validator into build/bids-validator)"
+  echo "FAILED: $BIDS_VALIDATOR is missing (./run test installs npm's bids-validator into build/test-npm)"
   exit 1
 fi
 work=$(mktemp -d)

@@ -11,11 +11,14 @@
 #    output of its own, the others untouched, the table and the page list it;
 #  - the Slurm profile's dry run passes (TestSlurm.sh runs it on a real
 #    one-node cluster);
-#  - the QC page renders in headless Chromium without console messages;
+#  - the QC page renders in headless Chromium without console messages, and
+#    driven by Playwright (check_qc_page.js) it sorts, keeps and exports
+#    ratings, and its interactive NiiVue view draws;
 #  - bad configurations fail with a clear message; a T1w name the workflow
 #    does not handle is skipped with a warning.
-# Needs DYNSUB, DATA, WORKFLOWS; snakemake, python3-nibabel,
-# python3-bids-validator and chromium.
+# Needs DYNSUB, DATA, WORKFLOWS, NIIVUE (niivue.umd.js) and NODE_PATH (with
+# playwright-core); snakemake, python3-nibabel, python3-bids-validator,
+# chromium and node.
 set -u
 source "$DATA/../Applications/dynsub/test/Checks.sh"
 require_colin27
@@ -24,7 +27,7 @@ python=/usr/bin/python3
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cd "$work"
-snake() { snakemake -s "$WORKFLOWS/Snakefile" --config bids="$work/bids" dynsub="$DYNSUB" "$@"; }
+snake() { snakemake -s "$WORKFLOWS/Snakefile" --config bids="$work/bids" dynsub="$DYNSUB" niivue="$NIIVUE" "$@"; }
 
 "$python" "$here/make_cohort.py" "$templates" "$DATA" "$work/bids"
 check "cohort made" test -s "$work/bids/sub-02/anat/sub-02_T1w.nii.gz"
@@ -134,8 +137,11 @@ PY
 chromium --headless=new --no-sandbox --disable-gpu --dump-dom "file://$work/out/report.html#flagged" \
   >"$work/flagged.html" 2>/dev/null
 check "QC page: #flagged shows the 3 flagged rows only" \
-  test "$(grep -c '<tr class="flagged">' "$work/flagged.html")" -eq 3 -a \
-  "$(grep -c '<tr class="" hidden="">' "$work/flagged.html")" -eq 2
+  test "$(grep -c '<tr class="flagged"' "$work/flagged.html")" -eq 3 -a \
+  "$(grep -c '<tr class="" [^>]*hidden=""' "$work/flagged.html")" -eq 2
+node "$here/check_qc_page.js" cohort "$work/out/report.html" "$work/view.png"
+check "QC page in Chromium (Playwright): sorting, ratings and their export, the interactive view" test $? -eq 0
+if [ -n "${KEEP_SCREENSHOT:-}" ]; then cp "$work/view.png" "${KEEP_SCREENSHOT%.png}_view.png"; fi
 
 # A cohort's page: 500 segmentations (one job's files linked under 500
 # subjects), every row present and no script error. Its load time is printed,
@@ -146,18 +152,19 @@ sys.path.insert(0, sys.argv[1])
 import dynsub_bids as bids, qc_report
 source, out = sys.argv[2], sys.argv[3]
 original = bids.Job("01", None, "", "caudateL", "sub-01_T1w.nii.gz")
-files = {**bids.output_paths(source, original.dir, original.stem, original.structure),
-         **bids.figure_paths(source, original.dir, original.stem, original.structure)}
+def paths(out, job):
+    return {**bids.output_paths(out, job.dir, job.stem, job.structure),
+            **bids.figure_paths(out, job.dir, job.stem, job.structure),
+            "view": bids.view_path(out, job.dir, job.stem, job.structure)}
+files = paths(source, original)
 jobs = {}
 for n in range(1000, 1500):
     job = bids.Job(str(n), None, "", "caudateL", f"sub-{n}_T1w.nii.gz")
-    targets = {**bids.output_paths(out, job.dir, job.stem, job.structure),
-               **bids.figure_paths(out, job.dir, job.stem, job.structure)}
-    for key, path in targets.items():
+    for key, path in paths(out, job).items():
         os.makedirs(os.path.dirname(path), exist_ok=True)
         os.link(files[key], path)
     jobs[job.key] = job
-qc_report.write_report(jobs, out, f"{out}/report.html")
+qc_report.write_report(jobs, out, f"{out}/report.html", os.environ["NIIVUE"])
 PY
 start=$EPOCHREALTIME
 chromium --headless=new --no-sandbox --disable-gpu --enable-logging=stderr --v=0 --dump-dom \
@@ -166,6 +173,8 @@ echo "QC page of 500: $(du -k "$work/qc500/report.html" | cut -f1) kB; Chromium 
   "DOM in $(awk "BEGIN { print $EPOCHREALTIME - $start }") s"
 check "QC page of 500: every row present" test "$(grep -o '<tr class=' "$work/dom500.html" | wc -l)" -eq 500
 check "QC page of 500: no console message" test -z "$(grep CONSOLE "$work/chromium500.log")"
+node "$here/check_qc_page.js" scale "$work/qc500/report.html" 500
+check "QC page of 500 in Chromium (Playwright): every row, sorting, no script error" test $? -eq 0
 
 snakemake -s "$WORKFLOWS/Snakefile" --cores 1 --config out="$work/x" >"$work/bad.log" 2>&1
 check "no bids: exit non-zero" test $? -ne 0

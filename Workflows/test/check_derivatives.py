@@ -29,7 +29,7 @@ L = r"[A-Za-z0-9]+"
 ANAT = re.compile(rf"^sub-(?P<sub>{L})(?:_ses-(?P<ses>{L}))?_space-orig_desc-(?P<desc>{L})_"
                   r"(?P<suffix>dseg\.nii\.gz|dseg\.tsv|dseg\.json|surface\.vtp|report\.json|convergence\.csv)$")
 FIGURE = re.compile(rf"^sub-(?P<sub>{L})(?:_ses-(?P<ses>{L}))?_desc-(?P<desc>{L})_"
-                    r"(?P<suffix>slices|surface3d|convergence)\.png$")
+                    r"(?P<suffix>(?:slices|surface3d|convergence)\.png|view\.js)$")
 LOG = re.compile(rf"^sub-(?P<sub>{L})(?:_ses-(?P<ses>{L}))?_desc-(?P<desc>{L})\.log$")
 problems = []
 
@@ -69,6 +69,8 @@ def main():
                 continue
             parts = relative.split(os.sep)
             if parts[0] == "work":  # the BIDS App's Snakemake bookkeeping and cluster logs
+                continue
+            if path == os.path.join("viewer", "niivue.umd.js"):  # the QC page's viewer
                 continue
             if parts[0] == "logs":
                 match, parts = LOG.match(name), parts[1:]
