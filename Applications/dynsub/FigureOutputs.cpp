@@ -1,6 +1,8 @@
 #include "FigureOutputs.h"
 
 #include <iostream>
+#include <map>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
@@ -10,10 +12,23 @@
 
 namespace dynsub::app {
 
+void addFigureCoordinatesOption(CLI::App& command, FigureCoordinates& coordinates) {
+  const std::map<std::string, FigureCoordinates> names{{"lps", FigureCoordinates::Lps},
+                                                       {"ras", FigureCoordinates::Ras}};
+  command
+      .add_option("--figure-coordinates", coordinates,
+                  "The coordinates the slices figure prints and names: lps (x to the left, y posterior; DICOM, "
+                  "ITK, 3D Slicer's files, this tool's outputs) or ras (x to the right, y anterior; NIfTI, "
+                  "FreeSurfer, MNI)")
+      ->transform(CLI::CheckedTransformer(names, CLI::ignore_case))
+      ->default_str("lps");
+}
+
 void FigureOptions::addOptions(CLI::App& command) {
   command.add_flag("!--no-figures", figures,
                    "Do not render slices.png, surface3d.png and convergence.png (rendering needs an X display; "
                    "without DISPLAY a private Xvfb is started for the run)");
+  addFigureCoordinatesOption(command, coordinates);
 }
 
 void FigureOptions::prepare() const {
@@ -40,6 +55,7 @@ void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const Co
   inputs.dataPoints = dataPoints;
   inputs.history = &history;
   inputs.edgeDistances = edgeDistances;
+  inputs.coordinates = options.coordinates;
   FigureFiles files;
   files.slices = outputs.add("slices.png");
   files.surface3d = outputs.add("surface3d.png");

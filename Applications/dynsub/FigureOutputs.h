@@ -3,6 +3,7 @@
 // history (convergence.csv, always) and the figures of Figures.h
 // (slices.png, surface3d.png, convergence.png) when an X display is there.
 #include "dynsub/ConvergenceHistory.h"
+#include "dynsub/FigureInputs.h"
 #include "dynsub/Tessellation.h"
 
 namespace CLI {
@@ -19,6 +20,7 @@ namespace dynsub::app {
 
 struct FigureOptions {
   bool figures = true;
+  FigureCoordinates coordinates = FigureCoordinates::Lps;
   void addOptions(CLI::App& command);
   // When figures are wanted: their display made ready on a second thread
   // (Figures.h: prepareFigureDisplay) while the run goes on. Call it once the
@@ -33,6 +35,9 @@ struct FigureOptions {
 // #points x 3 (mm), possibly empty; edgeDistances, when not empty, colour the
 // surface and its contours (a segmentation's distance to the nearest edge per
 // point of `surface`, Figures.h).
+// --figure-coordinates lps|ras, for segment, fit and render.
+void addFigureCoordinatesOption(CLI::App& command, FigureCoordinates& coordinates);
+
 void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const ControlMesh& mesh,
                       const TriangleSurface& surface, const ConvergenceHistory& history, const Volume* image,
                       const MatrixX3& landmarks, const MatrixX3& dataPoints,

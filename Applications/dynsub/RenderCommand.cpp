@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include "Commands.h"
+#include "FigureOutputs.h"
 #include "dynsub/Error.h"
 #include "dynsub/FigureInputs.h"
 #include "dynsub/ImageIO.h"
@@ -20,6 +21,7 @@ namespace {
 
 struct RenderCommandOptions {
   std::string surface, image, landmarks, points, convergence, controlMesh, out;
+  FigureCoordinates coordinates = FigureCoordinates::Lps;
 };
 
 void runRender(const RenderCommandOptions& o) {
@@ -29,6 +31,7 @@ void runRender(const RenderCommandOptions& o) {
   // file when the figures are drawn: a bad one leaves nothing behind).
   FigureInputs inputs;
   inputs.surfaceFile = o.surface;
+  inputs.coordinates = o.coordinates;
   std::unique_ptr<Volume> image;
   if (!o.image.empty()) {
     image = std::make_unique<Volume>(readVolume(o.image));
@@ -76,6 +79,7 @@ void addRenderCommand(CLI::App& app) {
   command->add_option("--control-mesh", o->controlMesh, "Control mesh to draw as a wireframe in the 3D figure");
   command->add_option("--convergence", o->convergence, "convergence.csv written by segment or fit");
   command->add_option("--out", o->out, "Output directory (created if missing; its parent must exist)")->required();
+  addFigureCoordinatesOption(*command, o->coordinates);
   command->callback([o] { runRender(*o); });
 }
 

@@ -117,10 +117,10 @@ for name in surface.vtp control_mesh.obj labelmap.nii.gz report.json convergence
 done
 check "convergence.csv has a step per line" \
   test "$(grep -c '^[01],' "$work/caudate/convergence.csv")" -ge 10
-check "slices.png is 1200 x 720" python3 -c "
+check "slices.png is 1200 x 800" python3 -c "
 import struct, sys
 with open(sys.argv[1], 'rb') as f: head = f.read(24)
-sys.exit(0 if head[:8] == b'\x89PNG\r\n\x1a\n' and struct.unpack('>II', head[16:24]) == (1200, 720) else 1)" \
+sys.exit(0 if head[:8] == b'\x89PNG\r\n\x1a\n' and struct.unpack('>II', head[16:24]) == (1200, 800) else 1)" \
   "$work/caudate/slices.png"
 
 # --- figures: off on request, skipped without a display, redrawn by render ---
@@ -154,6 +154,14 @@ check "render redraws segment's slices.png pixel for pixel" cmp -s "$work/render
 # Both colour the surface by surface.vtp's edge_distance_mm, with its bar.
 check "render redraws segment's surface3d.png pixel for pixel" \
   cmp -s "$work/rendered/surface3d.png" "$work/caudate/surface3d.png"
+"$DYNSUB" render --surface "$work/caudate/surface.vtp" --image "$mri/ch2.nii.gz" \
+  --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --figure-coordinates RAS --out "$work/rendered_ras" >/dev/null
+check "render --figure-coordinates RAS: the same surface figure" \
+  cmp -s "$work/rendered_ras/surface3d.png" "$work/caudate/surface3d.png"
+check "render --figure-coordinates RAS: other slice captions" \
+  test -s "$work/rendered_ras/slices.png" -a -n "$(cmp "$work/rendered_ras/slices.png" "$work/caudate/slices.png")"
+expect_error "render: unknown coordinate system" 2 "figure-coordinates" "$work/r0" \
+  "$DYNSUB" render --surface "$work/caudate/surface.vtp" --figure-coordinates xyz --out "$work/r0"
 expect_error "render: missing surface" 1 "no such file" "$work/r1" \
   "$DYNSUB" render --surface "$work/none.vtp" --out "$work/r1"
 expect_error "render: not a surface" 1 "text.vtp" "$work/r2" \

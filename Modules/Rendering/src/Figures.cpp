@@ -1,9 +1,15 @@
 #include "dynsub/Figures.h"
 
 #include <algorithm>
+#include <array>
 #include <cstdlib>
 #include <memory>
+#include <string>
+#include <utility>
+#include <vector>
 
+#include <vtkAnnotatedCubeActor.h>
+#include <vtkCamera.h>
 #include <vtkChartXY.h>
 #include <vtkContextActor.h>
 #include <vtkContextScene.h>
@@ -11,9 +17,12 @@
 #include <vtkImageData.h>
 #include <vtkPointData.h>
 #include <vtkPolyData.h>
+#include <vtkProperty.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
 #include <vtkRendererCollection.h>
+#include <vtkTextActor.h>
+#include <vtkTextProperty.h>
 #include <vtkWindowToImageFilter.h>
 
 #include "dynsub/SceneStyle.h"
@@ -32,7 +41,55 @@ namespace dynsub {
 namespace {
 
 constexpr int kColumns = 5;
-constexpr int kCell = 240;  // pixels per montage cell
+constexpr int kCell = 240;     // pixels per montage cell's image
+constexpr int kCaption = 18;   // pixels of each cell's caption strip, above its image
+constexpr int kLegend = 26;    // pixels of the slices figure's legend strip, at the bottom
+constexpr int kSlicesWidth = kColumns * kCell;
+constexpr int kSlicesHeight = 3 * (kCell + kCaption) + kLegend;
+constexpr int kCaptionFont = 12;
+
+// A renderer over a pixel rectangle of a window of the given size, with a
+// black background.
+vtkSmartPointer<vtkRenderer> strip(int x0, int y0, int x1, int y1, int width, int height) {
+  auto renderer = vtkSmartPointer<vtkRenderer>::New();
+  renderer->SetBackground(0, 0, 0);
+  renderer->SetViewport(double(x0) / width, double(y0) / height, double(x1) / width, double(y1) / height);
+  return renderer;
+}
+
+// Text at the left of a strip, vertically centred, in a colour.
+void addText(vtkRenderer* renderer, const std::string& text, double x, const std::array<double, 3>& colour) {
+  vtkNew<vtkTextActor> actor;
+  style::cornerText(actor, x, 0.5, style::Corner::Left, kCaptionFont);
+  actor->GetTextProperty()->SetVerticalJustificationToCentered();
+  actor->GetTextProperty()->SetColor(colour.data());
+  actor->SetInput(text.c_str());
+  renderer->AddActor2D(actor);
+}
+
+// What the slices' colours mean, in one strip: the contour's colours, the
+// landmarks and the range data as drawn, and the coordinates the captions use.
+void addLegend(const FigureScene& scene, vtkRenderWindow* window) {
+  std::vector<std::pair<std::string, std::array<double, 3>>> items;
+  if (scene.edgeDistances) {
+    items.push_back({"contour on an image edge", style::kOnEdge});
+    items.push_back({"contour 3 mm or more from any edge", style::kOffEdge});
+  } else {
+    items.push_back({"contour on a normal element", style::kNormalElement});
+    items.push_back({"contour on a special element", style::kSpecialElement});
+  }
+  if (scene.landmarks.rows() > 0) {
+    const auto& c = style::kLandmark;
+    items.push_back({"landmarks on the slice", {c[0] / 255.0, c[1] / 255.0, c[2] / 255.0}});
+  }
+  if (scene.dataPoints.rows() > 0) items.push_back({"range data near the slice", {0.85, 0.85, 0.85}});
+  items.push_back({"coordinates: " + coordinatesName(scene.coordinates) + " mm", {1, 1, 1}});
+  auto legend = strip(0, 0, kSlicesWidth, kLegend, kSlicesWidth, kSlicesHeight);
+  legend->SetBackground(0.12, 0.12, 0.12);
+  for (std::size_t i = 0; i < items.size(); ++i)
+    addText(legend, items[i].first, 0.01 + 0.99 * double(i) / items.size(), items[i].second);
+  window->AddRenderer(legend);
+}
 
 void requireSurface(const FigureScene& scene) {
   if (!scene.surface || scene.surface->GetNumberOfPoints() == 0) throw Error("the figure has no surface to show");
@@ -49,6 +106,10 @@ MatrixX3 surfacePoints(vtkPolyData* surface) {
 }
 
 }  // namespace
+
+std::string coordinatesName(FigureCoordinates coordinates) {
+  return coordinates == FigureCoordinates::Ras ? "RAS" : "LPS";
+}
 
 namespace {
 
@@ -67,8 +128,11 @@ void drawSlices(const FigureScene& scene, vtkRenderWindow* window) {
         throw Error("the surface lies outside the image: nothing to show on its slices");
   }
   const double diagonal = (high - low).norm();
+  // The grey window of the structure's neighbourhood, shared by all slices.
+  ImageSlices::GreyWindow grey;
+  if (image) grey = image->windowAround(low, high, 10.0);
 
-  window->SetSize(kColumns * kCell, 3 * kCell);
+  window->SetSize(kSlicesWidth, kSlicesHeight);
   for (int row = 0; row < 3; ++row) {
     const auto orientation = static_cast<SliceOrientation>(row);
     // The surface's extent along the slice normal and across the view.
@@ -79,6 +143,9 @@ void drawSlices(const FigureScene& scene, vtkRenderWindow* window) {
     for (int column = 0; column < kColumns; ++column) {
       SliceView view(orientation);
       view.setImage(image);
+      if (image) view.setGreyWindow(grey.window, grey.level);
+      view.setCoordinates(scene.coordinates);
+      view.setTitleVisible(false);  // in the caption strip, clear of the edge letters
       view.setSurface(scene.surface);
       view.colourByEdgeDistance(scene.edgeDistances);
       // Interior slices, evenly spread: the end slices would only graze it.
@@ -92,12 +159,53 @@ void drawSlices(const FigureScene& scene, vtkRenderWindow* window) {
       view.setLandmarks(scene.landmarks);
       if (scene.dataPoints.rows() > 0) view.setDataPoints(scene.dataPoints);
       view.frame(centre, halfSize);
-      // Row 0 at the top of the window.
-      view.renderer()->SetViewport(double(column) / kColumns, (2.0 - row) / 3.0, (column + 1.0) / kColumns,
-                                   (3.0 - row) / 3.0);
+      // Row 0 at the top of the window; the caption strip above each image.
+      const int top = kSlicesHeight - row * (kCell + kCaption), x0 = column * kCell, x1 = x0 + kCell;
+      view.renderer()->SetViewport(double(x0) / kSlicesWidth, double(top - kCaption - kCell) / kSlicesHeight,
+                                   double(x1) / kSlicesWidth, double(top - kCaption) / kSlicesHeight);
       window->AddRenderer(view.renderer());
+      auto caption = strip(x0, top - kCaption, x1, top, kSlicesWidth, kSlicesHeight);
+      addText(caption, view.caption(), 0.02, {1, 1, 1});
+      window->AddRenderer(caption);
     }
   }
+  addLegend(scene, window);
+}
+
+// An orientation cube in the bottom-left corner, turned as the camera sees
+// the surface; its faces name the anatomical directions.
+void addOrientationMarker(vtkRenderer* main, vtkRenderWindow* window) {
+  vtkNew<vtkAnnotatedCubeActor> cube;
+  // LPS: +x to the patient's left, +y posterior, +z superior.
+  cube->SetXPlusFaceText("L");
+  cube->SetXMinusFaceText("R");
+  cube->SetYPlusFaceText("P");
+  cube->SetYMinusFaceText("A");
+  cube->SetZPlusFaceText("S");
+  cube->SetZMinusFaceText("I");
+  cube->SetFaceTextScale(0.65);
+  cube->GetCubeProperty()->SetColor(0.75, 0.75, 0.75);
+  cube->GetTextEdgesProperty()->SetColor(0.3, 0.3, 0.3);
+  for (vtkProperty* face : {cube->GetXPlusFaceProperty(), cube->GetXMinusFaceProperty(), cube->GetYPlusFaceProperty(),
+                            cube->GetYMinusFaceProperty(), cube->GetZPlusFaceProperty(), cube->GetZMinusFaceProperty()})
+    face->SetColor(0.1, 0.1, 0.5);
+  vtkNew<vtkRenderer> marker;
+  marker->SetViewport(0.0, 0.0, 0.16, 0.16);
+  marker->SetLayer(1);  // drawn over the scene, which it does not erase
+  marker->AddActor(cube);
+  vtkCamera* camera = main->GetActiveCamera();
+  Vector3 position, focal, up;
+  camera->GetPosition(position.data());
+  camera->GetFocalPoint(focal.data());
+  camera->GetViewUp(up.data());
+  const Vector3 direction = (position - focal).normalized();
+  vtkCamera* markerCamera = marker->GetActiveCamera();
+  markerCamera->SetFocalPoint(0, 0, 0);
+  markerCamera->SetPosition((5.0 * direction).eval().data());
+  markerCamera->SetViewUp(up.data());
+  marker->ResetCamera();
+  window->SetNumberOfLayers(2);
+  window->AddRenderer(marker);
 }
 
 void drawSurface(const FigureScene& scene, vtkRenderWindow* window) {
@@ -122,6 +230,15 @@ void drawSurface(const FigureScene& scene, vtkRenderWindow* window) {
   }
   view.resetCamera();
   window->AddRenderer(view.renderer());
+  addOrientationMarker(view.renderer(), window);
+  if (scene.landmarks.rows() > 0) {
+    vtkNew<vtkTextActor> legend;
+    style::cornerText(legend, 0.98, 0.02, style::Corner::BottomRight);
+    const auto& c = style::kLandmark;
+    legend->GetTextProperty()->SetColor(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0);
+    legend->SetInput("red dots: landmarks");
+    view.renderer()->AddActor2D(legend);
+  }
 }
 
 void drawConvergence(const ConvergenceHistory& history, vtkRenderWindow* window) {
@@ -137,7 +254,7 @@ void drawConvergence(const ConvergenceHistory& history, vtkRenderWindow* window)
 }  // namespace
 
 vtkSmartPointer<vtkRenderWindow> slicesFigure(const FigureScene& scene) {
-  auto window = style::offScreenWindow(kColumns * kCell, 3 * kCell);
+  auto window = style::offScreenWindow(kSlicesWidth, kSlicesHeight);
   drawSlices(scene, window);
   return window;
 }
@@ -185,6 +302,7 @@ void writeFigures(const FigureInputs& inputs, const FigureFiles& files) {
   scene.edgeDistances = surface->GetPointData()->GetArray(kEdgeDistanceScalars) != nullptr;
   scene.landmarks = inputs.landmarks;
   scene.dataPoints = inputs.dataPoints;
+  scene.coordinates = inputs.coordinates;
   std::unique_ptr<ImageSlices> slices;
   if (inputs.image) {
     slices = std::make_unique<ImageSlices>(ImageSlices::borrowing(*inputs.image));  // the image outlives the figures
@@ -200,7 +318,7 @@ void writeFigures(const FigureInputs& inputs, const FigureFiles& files) {
   // framebuffer configuration, starting its context) costs a sizeable share
   // of the figures' time. Each figure's renderers leave it before the next's
   // come.
-  const vtkSmartPointer<vtkRenderWindow> window = style::offScreenWindow(kColumns * kCell, 3 * kCell);
+  const vtkSmartPointer<vtkRenderWindow> window = style::offScreenWindow(kSlicesWidth, kSlicesHeight);
   auto draw = [&](const std::string& path, const auto& figure) {
     if (path.empty()) return;
     while (vtkRenderer* previous = window->GetRenderers()->GetFirstRenderer()) window->RemoveRenderer(previous);

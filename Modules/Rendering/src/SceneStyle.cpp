@@ -43,9 +43,7 @@ void colourByElementType(vtkPolyDataMapper* mapper) {
 
 void colourByEdgeDistance(vtkPolyDataMapper* mapper) {
   vtkNew<vtkLookupTable> table;
-  // Green (on an edge) through yellow to magenta (far from any): not red,
-  // which the landmarks are drawn in.
-  const Vector3 stops[3] = {{0.15, 0.8, 0.25}, {1.0, 0.9, 0.15}, {0.9, 0.2, 0.9}};
+  const Vector3 stops[3] = {Vector3(kOnEdge.data()), Vector3(kMidEdge.data()), Vector3(kOffEdge.data())};
   constexpr int kEntries = 64;
   table->SetNumberOfTableValues(kEntries);
   table->SetTableRange(0, kFarFromEdges);
@@ -158,6 +156,7 @@ void cornerText(vtkTextActor* text, double x, double y, Corner corner, int fontS
     case Corner::TopLeft: p->SetJustificationToLeft(); p->SetVerticalJustificationToTop(); break;
     case Corner::TopRight: p->SetJustificationToRight(); p->SetVerticalJustificationToTop(); break;
     case Corner::BottomLeft: p->SetJustificationToLeft(); p->SetVerticalJustificationToBottom(); break;
+    case Corner::BottomRight: p->SetJustificationToRight(); p->SetVerticalJustificationToBottom(); break;
     case Corner::Left: p->SetJustificationToLeft(); break;
     case Corner::Right: p->SetJustificationToRight(); break;
     case Corner::Top: p->SetVerticalJustificationToTop(); break;

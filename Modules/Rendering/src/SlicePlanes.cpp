@@ -1,7 +1,9 @@
 #include "dynsub/SlicePlanes.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <vector>
 
 #include <vtkFloatArray.h>
 #include <vtkImageData.h>
@@ -67,6 +69,7 @@ ImageSlices::ImageSlices(const Volume& volume, bool borrow) : geometry_(volume.g
     std::copy(volume.voxels.begin(), volume.voxels.end(), scalars->GetPointer(0));
   }
   data_->GetPointData()->SetScalars(scalars);
+  voxels_ = scalars->GetPointer(0);
 
   indexToWorld_ = vtkSmartPointer<vtkMatrix4x4>::New();
   const Matrix3 linear = geometry_.direction * geometry_.spacing.asDiagonal();
@@ -81,14 +84,49 @@ ImageSlices::ImageSlices(const Volume& volume, bool borrow) : geometry_(volume.g
   for (std::size_t i = 0; i < volume.voxels.size(); i += 7)
     if (std::isfinite(volume.voxels[i])) sample.push_back(volume.voxels[i]);
   if (sample.empty()) throw Error("the image to display has no finite intensity");
+  const GreyWindow whole = percentileWindow(sample);
+  window_ = whole.window;
+  level_ = whole.level;
+}
+
+ImageSlices::GreyWindow ImageSlices::percentileWindow(std::vector<float>& sample) {
   auto percentile = [&](double p) {
     auto nth = sample.begin() + static_cast<std::ptrdiff_t>(p * (sample.size() - 1));
     std::nth_element(sample.begin(), nth, sample.end());
     return static_cast<double>(*nth);
   };
   const double low = percentile(0.01), high = percentile(0.995);
-  window_ = std::max(high - low, 1e-6);
-  level_ = 0.5 * (low + high);
+  return {std::max(high - low, 1e-6), 0.5 * (low + high)};
+}
+
+ImageSlices::GreyWindow ImageSlices::windowAround(const Vector3& low, const Vector3& high, double margin) const {
+  // The index box holding the physical box's eight corners.
+  Vector3 first = Vector3::Constant(1e300), last = Vector3::Constant(-1e300);
+  for (int corner = 0; corner < 8; ++corner) {
+    Vector3 p;
+    for (int a = 0; a < 3; ++a) p[a] = (corner >> a & 1) ? high[a] + margin : low[a] - margin;
+    const Vector3 index = geometry_.toIndex(p);
+    first = first.cwiseMin(index);
+    last = last.cwiseMax(index);
+  }
+  std::array<int, 3> from{}, to{};
+  for (int a = 0; a < 3; ++a) {
+    from[a] = std::clamp(static_cast<int>(std::floor(first[a])), 0, geometry_.size[a] - 1);
+    to[a] = std::clamp(static_cast<int>(std::ceil(last[a])), 0, geometry_.size[a] - 1);
+  }
+  std::vector<float> sample;
+  for (int k = from[2]; k <= to[2]; ++k)
+    for (int j = from[1]; j <= to[1]; ++j)
+      for (int i = from[0]; i <= to[0]; ++i) {
+        const float v = voxels_[geometry_.offset(i, j, k)];
+        if (std::isfinite(v)) sample.push_back(v);
+      }
+  if (sample.size() < 1000) return {window_, level_};
+  // A tenth of the span more on each side, so that the darkest and brightest
+  // tissues near the structure (CSF, white matter) keep their texture
+  // instead of clipping to black and white.
+  const GreyWindow span = percentileWindow(sample);
+  return {1.2 * span.window, span.level};
 }
 
 vtkImageData* ImageSlices::data() const { return data_; }

@@ -118,6 +118,7 @@ struct SliceView::Impl {
   vtkNew<vtkTextActor> title;
   vtkNew<vtkTextActor> edgeLetters[4];  // left, right, top, bottom
   bool customTitle = false;
+  FigureCoordinates coordinates = FigureCoordinates::Lps;
 
   explicit Impl(SliceOrientation o) : orientation(o) {
     renderer->SetBackground(0, 0, 0);
@@ -185,16 +186,25 @@ struct SliceView::Impl {
     // Edge letters: the anatomical direction each screen edge points to.
     const Vector3 towards[4] = {-plane.right, plane.right, plane.up, -plane.up};
     for (int e = 0; e < 4; ++e) edgeLetters[e]->SetInput(style::anatomicalLetter(towards[e]).c_str());
-    if (!customTitle) {
-      std::ostringstream text;
-      text << orientationName(orientation);
-      if (image) text << "  " << index + 1 << "/" << image->sliceCount(orientation);
-      // The LPS coordinate the slice fixes (x for sagittal, y coronal, z axial).
-      const int lps = orientation == SliceOrientation::Axial ? 2 : orientation == SliceOrientation::Coronal ? 1 : 0;
-      text << std::fixed << std::setprecision(1) << "\n" << "xyz"[lps] << " = " << plane.origin[lps] << " mm";
-      title->SetInput(text.str().c_str());
-    }
+    if (!customTitle) title->SetInput((slice() + "\n" + coordinate()).c_str());
     placeCamera();
+  }
+
+  std::string slice() const {
+    std::ostringstream text;
+    text << orientationName(orientation);
+    if (image) text << " " << index + 1 << "/" << image->sliceCount(orientation);
+    return text.str();
+  }
+
+  // The coordinate the slice fixes (x for sagittal, y coronal, z axial).
+  std::string coordinate() const {
+    const int a = orientation == SliceOrientation::Axial ? 2 : orientation == SliceOrientation::Coronal ? 1 : 0;
+    const double value = coordinates == FigureCoordinates::Ras && a < 2 ? -plane.origin[a] : plane.origin[a];
+    std::ostringstream text;
+    text << std::fixed << std::setprecision(1) << coordinatesName(coordinates) << " " << "xyz"[a] << " = "
+         << (std::abs(value) < 0.05 ? 0.0 : value) << " mm";
+    return text.str();
   }
 
   void placeCamera() {
@@ -287,6 +297,20 @@ void SliceView::frame(const Vector3& centre, double halfSize) {
 void SliceView::setTitle(const std::string& title) {
   impl_->customTitle = true;
   impl_->title->SetInput(title.c_str());
+}
+
+void SliceView::setTitleVisible(bool visible) { impl_->title->SetVisibility(visible); }
+
+std::string SliceView::caption() const { return impl_->slice() + "  " + impl_->coordinate(); }
+
+void SliceView::setCoordinates(FigureCoordinates coordinates) {
+  impl_->coordinates = coordinates;
+  impl_->update();
+}
+
+void SliceView::setGreyWindow(double window, double level) {
+  impl_->imageActor->GetProperty()->SetColorWindow(window);
+  impl_->imageActor->GetProperty()->SetColorLevel(level);
 }
 
 Vector3 SliceView::pointAt(double displayX, double displayY) const {

@@ -13,8 +13,13 @@
 #include <cmath>
 #include <filesystem>
 #include <iostream>
+#include <array>
+#include <string>
+#include <vector>
 
+#include <vtkActor2DCollection.h>
 #include <vtkCellData.h>
+#include <vtkCoordinate.h>
 #include <vtkCutter.h>
 #include <vtkDoubleArray.h>
 #include <vtkImageData.h>
@@ -25,6 +30,8 @@
 #include <vtkPolyData.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
+#include <vtkRendererCollection.h>
+#include <vtkTextActor.h>
 #include <vtkSphereSource.h>
 #include <vtkTesting.h>
 #include <vtkUnsignedCharArray.h>
@@ -321,6 +328,74 @@ TEST_F(Rendering, TestCaudateSlices) {
   scene.surface = surface;
   scene.landmarks = landmarkPositions(readLandmarks(kSource + "/Data/Landmarks/caudate_left.mrk.json"));
   expectMatchesBaseline(slicesFigure(scene));
+}
+
+// Every text of a figure, as display-pixel boxes (x0, x1, y0, y1).
+std::vector<std::array<double, 4>> textBoxes(vtkRenderWindow* window, std::vector<std::string>* texts) {
+  window->Render();
+  std::vector<std::array<double, 4>> boxes;
+  vtkRendererCollection* renderers = window->GetRenderers();
+  renderers->InitTraversal();
+  while (vtkRenderer* renderer = renderers->GetNextItem()) {
+    vtkActor2DCollection* actors = renderer->GetActors2D();
+    actors->InitTraversal();
+    while (vtkActor2D* actor = actors->GetNextActor2D()) {
+      auto* text = vtkTextActor::SafeDownCast(actor);
+      if (!text || !text->GetVisibility() || !text->GetInput() || std::string(text->GetInput()).empty()) continue;
+      std::array<double, 4> box{};
+      // The box around the text's anchor, moved to the anchor's place in
+      // the renderer's viewport, then to the viewport's place in the window.
+      text->GetBoundingBox(renderer, box.data());
+      const int* anchor = text->GetPositionCoordinate()->GetComputedViewportValue(renderer);
+      const double* viewport = renderer->GetViewport();
+      const int* size = window->GetSize();
+      for (int c = 0; c < 2; ++c) box[c] += anchor[0] + viewport[0] * size[0];
+      for (int c = 2; c < 4; ++c) box[c] += anchor[1] + viewport[1] * size[1];
+      boxes.push_back(box);
+      texts->push_back(text->GetInput());
+    }
+  }
+  return boxes;
+}
+
+// No two texts of the slices figure overlap or touch: captions, edge letters and the
+// legend each have room of their own, whatever the slice numbers.
+TEST_F(Rendering, SlicesFigureTextsDoNotOverlap) {
+  const ImageSlices mri(readVolume(kMri));
+  const vtkSmartPointer<vtkPolyData> surface = limitSurfaceOf(kSource + "/Testing/Data/caudate_left_control_mesh.obj");
+  FigureScene scene;
+  scene.image = &mri;
+  scene.surface = surface;
+  scene.landmarks = landmarkPositions(readLandmarks(kSource + "/Data/Landmarks/caudate_left.mrk.json"));
+  scene.edgeDistances = true;
+  std::vector<std::string> texts;
+  const auto boxes = textBoxes(slicesFigure(scene), &texts);
+  // 15 captions, 60 edge letters, 4 legend entries.
+  EXPECT_EQ(boxes.size(), 15u + 60u + 4u);
+  for (std::size_t a = 0; a < boxes.size(); ++a)
+    for (std::size_t b = a + 1; b < boxes.size(); ++b) {
+      // At least kGap pixels apart: texts that touch read as one.
+      constexpr double kGap = 2.0;
+      const bool apart = boxes[a][1] + kGap <= boxes[b][0] || boxes[b][1] + kGap <= boxes[a][0] ||
+                         boxes[a][3] + kGap <= boxes[b][2] || boxes[b][3] + kGap <= boxes[a][2];
+      EXPECT_TRUE(apart) << "'" << texts[a] << "' overlaps '" << texts[b] << "'";
+    }
+}
+
+// The captions name the coordinate system; RAS negates x and y, not z.
+TEST_F(Rendering, SliceCaptionsNameTheirCoordinates) {
+  const ImageSlices mri(readVolume(kMri));
+  SliceView sagittal(SliceOrientation::Sagittal), axial(SliceOrientation::Axial);
+  sagittal.setImage(&mri);
+  axial.setImage(&mri);
+  sagittal.showSlice(mri.sliceThrough(SliceOrientation::Sagittal, Vector3(12, 0, 0)));
+  axial.showSlice(mri.sliceThrough(SliceOrientation::Axial, Vector3(0, 0, 12)));
+  EXPECT_NE(sagittal.caption().find("LPS x = 12.0 mm"), std::string::npos) << sagittal.caption();
+  EXPECT_NE(axial.caption().find("LPS z = 12.0 mm"), std::string::npos) << axial.caption();
+  sagittal.setCoordinates(FigureCoordinates::Ras);
+  axial.setCoordinates(FigureCoordinates::Ras);
+  EXPECT_NE(sagittal.caption().find("RAS x = -12.0 mm"), std::string::npos) << sagittal.caption();
+  EXPECT_NE(axial.caption().find("RAS z = 12.0 mm"), std::string::npos) << axial.caption();
 }
 
 // The 3D figure of a control mesh's limit surface with its wireframe.

@@ -72,5 +72,30 @@ TEST(SlicePlanes, GreyWindowSpansThePercentiles) {
   EXPECT_THROW(ImageSlices{empty}, Error);
 }
 
+// A bright, wide background around a dim structure: the whole image's
+// window is the background's, the neighbourhood's the structure's.
+TEST(SlicePlanes, GreyWindowAroundABoxIsItsNeighbourhoods) {
+  Volume volume;
+  volume.geometry.size = {60, 60, 60};
+  volume.geometry.spacing = Vector3(1, 1, 1);
+  volume.voxels.assign(60 * 60 * 60, 1000.0f);
+  for (int k = 20; k < 40; ++k)
+    for (int j = 20; j < 40; ++j)
+      for (int i = 20; i < 40; ++i) volume.voxels[volume.geometry.offset(i, j, k)] = 10.0f + (i + j + k) % 50;
+  const ImageSlices slices(volume);
+  // The whole image's: from the structure's dim values (its 4 % of the
+  // voxels hold the 1st percentile) to the background's 1000.
+  EXPECT_GT(slices.window(), 900.0);
+  // The box 22..37 mm and 2 mm around it: only the structure's 10..59,
+  // widened by a tenth of their span (4.9) on each side.
+  const ImageSlices::GreyWindow around = slices.windowAround(Vector3(22, 22, 22), Vector3(37, 37, 37), 2.0);
+  EXPECT_NEAR(around.level - 0.5 * around.window, 10.0 - 4.9, 1.0);
+  EXPECT_NEAR(around.level + 0.5 * around.window, 59.0 + 4.9, 1.0);
+  // A box outside the image, clamped to its corner: too few voxels, the whole image's window.
+  const ImageSlices::GreyWindow outside = slices.windowAround(Vector3(-50, -50, -50), Vector3(-40, -40, -40), 1.0);
+  EXPECT_DOUBLE_EQ(outside.window, slices.window());
+  EXPECT_DOUBLE_EQ(outside.level, slices.level());
+}
+
 }  // namespace
 }  // namespace dynsub

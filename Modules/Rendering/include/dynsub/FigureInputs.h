@@ -13,6 +13,12 @@ namespace dynsub {
 class ControlMesh;
 struct Volume;
 
+// The coordinates figures print: LPS (x to the left, y posterior, z superior:
+// DICOM's, ITK's and the tool's own) or RAS (x and y negated: NIfTI's world,
+// FreeSurfer's, MNI's). The figures name the one they use.
+enum class FigureCoordinates { Lps, Ras };
+std::string coordinatesName(FigureCoordinates coordinates);  // "LPS" or "RAS"
+
 // The figures of a result, for callers that hold no VTK object (the commands).
 // Not owned; the surface is `surface`, or else read from `surfaceFile`.
 struct FigureInputs {
@@ -27,6 +33,7 @@ struct FigureInputs {
   // unknown), to colour it by (FigureScene::edgeDistances); empty: none. A
   // surface read from `surfaceFile` is coloured by the same array if it has it.
   Eigen::VectorXd edgeDistances;
+  FigureCoordinates coordinates = FigureCoordinates::Lps;
 };
 // The paths to write slices.png, surface3d.png and convergence.png to; an
 // empty path is not rendered. Needs a display (figureDisplay). Throws as the

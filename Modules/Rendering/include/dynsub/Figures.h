@@ -2,11 +2,14 @@
 // The figures `dynsub segment`, `dynsub fit` and `dynsub render` write
 // (TVCG Figs 6, 10, 11):
 //   slices.png       3 rows (axial, coronal, sagittal) x 5 slices through the
-//                    surface: the image, the surface's contour, the landmarks
-//                    on each slice (or the range data near it); 1200 x 720;
+//                    surface: the image (windowed on the surface's
+//                    neighbourhood), the surface's contour, the landmarks on
+//                    each slice (or the range data near it); a caption strip
+//                    above each slice naming its coordinate (LPS or RAS), and
+//                    a legend strip at the bottom; 1200 x 800;
 //   surface3d.png    the limit surface coloured by element type, landmarks or
 //                    data, and (with an image) three slices behind the surface
-//                    as a backdrop; 800 x 800;
+//                    as a backdrop, an orientation cube; 800 x 800;
 //   A surface that carries its distance to the image's edges (a
 //   segmentation's) is coloured by it instead, in both (FigureScene).
 //   convergence.png  the convergence plot (ConvergencePlot.h); 900 x 500.
@@ -43,6 +46,7 @@ struct FigureScene {
   // figure, instead of by element type: where a segmentation is held by the
   // image's edges and where by tension and landmarks alone.
   bool edgeDistances = false;
+  FigureCoordinates coordinates = FigureCoordinates::Lps;  // the ones the slice captions print
 };
 
 // Throws dynsub::Error when the scene has no surface, or (slices) when the

@@ -40,6 +40,11 @@ void colourByElementType(vtkPolyDataMapper* mapper);
 // (-1). Where only tension and landmarks hold a segmentation, it shows magenta.
 void colourByEdgeDistance(vtkPolyDataMapper* mapper);
 constexpr double kFarFromEdges = 3.0;  // mm: three voxels of the 1 mm MRI
+// The edge-distance colours: green on an edge, through yellow, to magenta at
+// kFarFromEdges and beyond (not red, which the landmarks are drawn in).
+constexpr std::array<double, 3> kOnEdge{0.15, 0.8, 0.25};
+constexpr std::array<double, 3> kMidEdge{1.0, 0.9, 0.15};
+constexpr std::array<double, 3> kOffEdge{0.9, 0.2, 0.9};
 // The colour bar of colourByEdgeDistance, for `mapper`, at the right of its view.
 vtkSmartPointer<vtkScalarBarActor> edgeDistanceBar(vtkPolyDataMapper* mapper);
 // Vertices drawn as round dots of a fixed size in pixels.
@@ -61,7 +66,7 @@ void showDataPoints(vtkRenderer* renderer, vtkPolyData* points, vtkActor* actor)
 // the same input gives the same pixels).
 vtkSmartPointer<vtkRenderWindow> offScreenWindow(int width, int height);
 
-enum class Corner { TopLeft, TopRight, BottomLeft, Left, Right, Top, Bottom };
+enum class Corner { TopLeft, TopRight, BottomLeft, BottomRight, Left, Right, Top, Bottom };
 // White text at a normalized viewport position, justified towards `corner`.
 void cornerText(vtkTextActor* text, double x, double y, Corner corner, int fontSize = kFontSize);
 

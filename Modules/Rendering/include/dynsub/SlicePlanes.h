@@ -12,6 +12,7 @@
 // axial has anterior up, coronal and sagittal superior up, sagittal anterior
 // on the left.
 #include <string>
+#include <vector>
 
 #include <vtkSmartPointer.h>
 
@@ -58,6 +59,16 @@ class ImageSlices {
   // Grey window and level: the 1st to 99.5th percentile of the intensities.
   double window() const { return window_; }
   double level() const { return level_; }
+  // The same percentiles of the voxels in a box (LPS mm, its corners `low`
+  // and `high`) and `margin` mm around it, widened by a tenth of their span
+  // on each side: a structure's neighbourhood, whose tissues then span the
+  // grey scale even where the whole image's bright fat or dark background
+  // would squeeze them, without clipping. The whole image's window when the
+  // box holds fewer than 1000 voxels.
+  struct GreyWindow {
+    double window = 1, level = 0.5;
+  };
+  GreyWindow windowAround(const Vector3& low, const Vector3& high, double margin) const;
 
   // The image axis (0 = i, 1 = j, 2 = k) closest to the orientation's normal.
   int axis(SliceOrientation orientation) const;
@@ -71,8 +82,11 @@ class ImageSlices {
 
  private:
   ImageSlices(const Volume& volume, bool borrow);
+  // The 1st to 99.5th percentile of a sample (reordered).
+  static GreyWindow percentileWindow(std::vector<float>& sample);
 
   ImageGeometry geometry_;
+  const float* voxels_ = nullptr;  // the intensities (data_'s, or the borrowed volume's)
   vtkSmartPointer<vtkImageData> data_;
   vtkSmartPointer<vtkMatrix4x4> indexToWorld_;
   double window_ = 1, level_ = 0.5;

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "dynsub/FigureInputs.h"
 #include "dynsub/SlicePlanes.h"
 
 class vtkPolyData;
@@ -49,8 +50,15 @@ class SliceView {
 
   // A square of half side `halfSize` mm around `centre` fills the viewport.
   void frame(const Vector3& centre, double halfSize);
-  // Text in the top-left corner; by default the orientation and slice.
+  // Text in the top-left corner; by default caption(), on two lines.
   void setTitle(const std::string& title);
+  void setTitleVisible(bool visible);
+  // The slice's orientation and index, and the coordinate it fixes, named in
+  // the chosen system: "coronal 120/217  LPS y = 6.0 mm".
+  std::string caption() const;
+  void setCoordinates(FigureCoordinates coordinates);
+  // Grey window and level of the image (by default the image's own).
+  void setGreyWindow(double window, double level);
 
   // The point of the slice plane under a display position (pixels), and the
   // display position of a point (valid once the view has been rendered or framed).
