@@ -342,8 +342,10 @@ def run_segmentation(job, outputs, figures, view, log, dynsub, extra_args, bids,
                 os.makedirs(os.path.dirname(path), exist_ok=True)
                 os.replace(f"{result}/{name}.png", path)
         try:  # the QC page's view is an extra: without it the page says so, and the job stands
-            qc_view.write_view(view_key(job.stem, job.structure), job.t1w, outputs["dseg"],
-                               f"{result}/control_mesh.obj", dynsub, view, work)
+            script = qc_view.view_script(view_key(job.stem, job.structure), job.t1w, outputs["dseg"],
+                                         f"{result}/control_mesh.obj", dynsub, work)
+            os.makedirs(os.path.dirname(view), exist_ok=True)
+            write_by_rename(view, script)
         except (OSError, ValueError, subprocess.CalledProcessError) as error:
             with open(log, "a") as f:
                 f.write(f"QC view not written: {error}\n")
@@ -429,12 +431,18 @@ def _write_if_changed(path, text):
     that runs of several participants at once can each write it and a rerun
     leaves it untouched."""
     try:
-        if open(path).read() == text:
+        if open(path, encoding="utf-8").read() == text:
             return
     except OSError:
         pass
+    write_by_rename(path, text)
+
+
+def write_by_rename(path, text):
+    """Writes text to a temporary file beside path, then renames it into
+    place: readers see the old file or the whole new one, never a part."""
     temporary = f"{path}.{os.getpid()}.tmp"
-    with open(temporary, "w") as f:
+    with open(temporary, "w", encoding="utf-8") as f:
         f.write(text)
     os.replace(temporary, path)
 

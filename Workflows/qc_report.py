@@ -338,15 +338,16 @@ def write_report(jobs, out, path, niivue=None):
                   _image(figures["surface3d"], "3D view, coloured the same way", path),
                   _image(figures["convergence"], "convergence", path), "</div>"]
         view = bids.view_path(out, job.dir, job.stem, job.structure)
-        if viewer_script and os.path.exists(view):
+        if not viewer_script:
+            parts.append('<p class="missing">interactive view: NiiVue is not installed (./run build installs it '
+                         "into build/niivue)</p>")
+        elif not os.path.exists(view):
+            parts.append('<p class="missing">interactive view: its data was not written (see the job\'s log)</p>')
+        else:
             parts.append(f'<p><button type="button" class="view" data-key="{html.escape(key)}" '
                          f'data-title="{html.escape(title)}" '
                          f'data-view="{html.escape(os.path.relpath(view, os.path.dirname(path)))}">'
                          "interactive view</button></p>")
-        else:
-            parts.append('<p class="missing">interactive view: ' + ("NiiVue is not installed (./run build installs "
-                         "it into build/niivue)" if not viewer_script else "its data was not written (see the job's "
-                         "log)") + "</p>")
         report = row["report"]
         facts = [("flags", ", ".join(row["flags"]) or "none"), ("volume (mm³)", row["volume_mm3"]),
                  ("Dice", row["dice"]), ("mean surface distance (mm)", row["mean_surface_distance_mm"]),
@@ -367,8 +368,5 @@ def write_report(jobs, out, path, niivue=None):
                  "move the crosshair; drag in 3D to turn. Coordinates are the image's RAS.</p>"
                  '<p><button type="button" class="close">close</button></p></dialog>')
     parts.append(f"<script>{SCRIPT}</script></body></html>")
-    temporary = path + ".tmp"
-    with open(temporary, "w", encoding="utf-8") as f:
-        f.write("\n".join(parts) + "\n")
-    os.replace(temporary, path)
+    bids.write_by_rename(path, "\n".join(parts) + "\n")
     return rows

@@ -47,9 +47,8 @@ def _nifti_base64(data, affine):
     return base64.b64encode(gzip.compress(image.to_bytes(), 6)).decode("ascii")
 
 
-def _crop(image, lps_points):
-    """The image's voxel box holding the points (LPS mm) and MARGIN_MM around them."""
-    ras = lps_points * np.array([-1.0, -1.0, 1.0])
+def _crop(image, ras):
+    """The image's voxel box holding the points (RAS mm) and MARGIN_MM around them."""
     corners = np.array([[x, y, z] for x in (ras[:, 0].min() - MARGIN_MM, ras[:, 0].max() + MARGIN_MM)
                         for y in (ras[:, 1].min() - MARGIN_MM, ras[:, 1].max() + MARGIN_MM)
                         for z in (ras[:, 2].min() - MARGIN_MM, ras[:, 2].max() + MARGIN_MM)])
@@ -60,8 +59,8 @@ def _crop(image, lps_points):
     return tuple(slice(a, b) for a, b in zip(low, high))
 
 
-def write_view(key, t1w, labelmap, control_mesh, dynsub, path, work):
-    """Writes the view of one segmentation to path (a .js file) by a rename.
+def view_script(key, t1w, labelmap, control_mesh, dynsub, work):
+    """The view of one segmentation, as the text of its .js file.
 
     key names it on the page; control_mesh is the run's control_mesh.obj
     (LPS mm), whose limit surface `dynsub limit` samples into work/."""
@@ -71,8 +70,9 @@ def write_view(key, t1w, labelmap, control_mesh, dynsub, path, work):
     points, triangles = _read_obj(surface)
     if len(points) == 0 or len(triangles) == 0:
         raise ValueError(f"{surface}: the limit surface has no triangles")
+    ras = points * np.array([-1, -1, 1], dtype=np.float32)  # NiiVue's world is the NIfTI's RAS
     image = nibabel.load(t1w)
-    box = _crop(image, points)
+    box = _crop(image, ras)
     cropped = image.slicer[box]
     intensities = np.asanyarray(cropped.dataobj, dtype=np.float32)
     if intensities.ndim > 3:
@@ -83,13 +83,8 @@ def write_view(key, t1w, labelmap, control_mesh, dynsub, path, work):
     view = {
         "image": _nifti_base64(scaled, cropped.affine),
         "labels": _nifti_base64(np.asanyarray(labels.dataobj).astype(np.uint8), labels.affine),
-        # NiiVue's world is the NIfTI's RAS; the surface is in LPS.
-        "points": base64.b64encode((points * np.array([-1, -1, 1], dtype=np.float32)).tobytes()).decode("ascii"),
+        "points": base64.b64encode(ras.tobytes()).decode("ascii"),
         "triangles": base64.b64encode(triangles.tobytes()).decode("ascii"),
     }
-    os.makedirs(os.path.dirname(path), exist_ok=True)
-    temporary = f"{path}.{os.getpid()}.tmp"
-    with open(temporary, "w") as f:
-        f.write("window.dynsubViews = window.dynsubViews || {};\n")
-        f.write(f"window.dynsubViews[{json.dumps(key)}] = {json.dumps(view)};\n")
-    os.replace(temporary, path)
+    return (f"window.dynsubViews = window.dynsubViews || {{}};\n"
+            f"window.dynsubViews[{json.dumps(key)}] = {json.dumps(view)};\n")

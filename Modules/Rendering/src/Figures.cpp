@@ -61,10 +61,15 @@ vtkSmartPointer<vtkRenderer> strip(int x0, int y0, int x1, int y1, int width, in
 void addText(vtkRenderer* renderer, const std::string& text, double x, const std::array<double, 3>& colour) {
   vtkNew<vtkTextActor> actor;
   style::cornerText(actor, x, 0.5, style::Corner::Left, kCaptionFont);
-  actor->GetTextProperty()->SetVerticalJustificationToCentered();
   actor->GetTextProperty()->SetColor(colour.data());
   actor->SetInput(text.c_str());
   renderer->AddActor2D(actor);
+}
+
+// The landmarks' colour (style::kLandmark, 8-bit) for text.
+std::array<double, 3> landmarkColour() {
+  const auto& c = style::kLandmark;
+  return {c[0] / 255.0, c[1] / 255.0, c[2] / 255.0};
 }
 
 // What the slices' colours mean, in one strip: the contour's colours, the
@@ -78,10 +83,7 @@ void addLegend(const FigureScene& scene, vtkRenderWindow* window) {
     items.push_back({"contour on a normal element", style::kNormalElement});
     items.push_back({"contour on a special element", style::kSpecialElement});
   }
-  if (scene.landmarks.rows() > 0) {
-    const auto& c = style::kLandmark;
-    items.push_back({"landmarks on the slice", {c[0] / 255.0, c[1] / 255.0, c[2] / 255.0}});
-  }
+  if (scene.landmarks.rows() > 0) items.push_back({"landmarks on the slice", landmarkColour()});
   if (scene.dataPoints.rows() > 0) items.push_back({"range data near the slice", {0.85, 0.85, 0.85}});
   items.push_back({"coordinates: " + coordinatesName(scene.coordinates) + " mm", {1, 1, 1}});
   auto legend = strip(0, 0, kSlicesWidth, kLegend, kSlicesWidth, kSlicesHeight);
@@ -234,8 +236,7 @@ void drawSurface(const FigureScene& scene, vtkRenderWindow* window) {
   if (scene.landmarks.rows() > 0) {
     vtkNew<vtkTextActor> legend;
     style::cornerText(legend, 0.98, 0.02, style::Corner::BottomRight);
-    const auto& c = style::kLandmark;
-    legend->GetTextProperty()->SetColor(c[0] / 255.0, c[1] / 255.0, c[2] / 255.0);
+    legend->GetTextProperty()->SetColor(landmarkColour().data());
     legend->SetInput("red dots: landmarks");
     view.renderer()->AddActor2D(legend);
   }

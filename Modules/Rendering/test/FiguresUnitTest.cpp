@@ -320,14 +320,26 @@ TEST(SliceContours, LieOnTheLabelmapBoundaryOfTheirSlice) {
 
 // --- baselines --------------------------------------------------------------
 
-TEST_F(Rendering, TestCaudateSlices) {
-  const ImageSlices mri(readVolume(kMri));
-  const vtkSmartPointer<vtkPolyData> surface = limitSurfaceOf(kSource + "/Testing/Data/caudate_left_control_mesh.obj");
+// The left caudate of Colin27, its surface and its landmarks: the slices
+// figure's scene (it points into this object, which therefore stays put).
+struct CaudateScene {
+  CaudateScene() {
+    scene.image = &mri;
+    scene.surface = surface;
+    scene.landmarks = landmarkPositions(readLandmarks(kSource + "/Data/Landmarks/caudate_left.mrk.json"));
+  }
+  CaudateScene(const CaudateScene&) = delete;
+  CaudateScene& operator=(const CaudateScene&) = delete;
+
+  const ImageSlices mri{readVolume(kMri)};
+  const vtkSmartPointer<vtkPolyData> surface =
+      limitSurfaceOf(kSource + "/Testing/Data/caudate_left_control_mesh.obj");
   FigureScene scene;
-  scene.image = &mri;
-  scene.surface = surface;
-  scene.landmarks = landmarkPositions(readLandmarks(kSource + "/Data/Landmarks/caudate_left.mrk.json"));
-  expectMatchesBaseline(slicesFigure(scene));
+};
+
+TEST_F(Rendering, TestCaudateSlices) {
+  const CaudateScene caudate;
+  expectMatchesBaseline(slicesFigure(caudate.scene));
 }
 
 // Every text of a figure, as display-pixel boxes (x0, x1, y0, y1).
@@ -361,15 +373,10 @@ std::vector<std::array<double, 4>> textBoxes(vtkRenderWindow* window, std::vecto
 // No two texts of the slices figure overlap or touch: captions, edge letters and the
 // legend each have room of their own, whatever the slice numbers.
 TEST_F(Rendering, SlicesFigureTextsDoNotOverlap) {
-  const ImageSlices mri(readVolume(kMri));
-  const vtkSmartPointer<vtkPolyData> surface = limitSurfaceOf(kSource + "/Testing/Data/caudate_left_control_mesh.obj");
-  FigureScene scene;
-  scene.image = &mri;
-  scene.surface = surface;
-  scene.landmarks = landmarkPositions(readLandmarks(kSource + "/Data/Landmarks/caudate_left.mrk.json"));
-  scene.edgeDistances = true;
+  CaudateScene caudate;
+  caudate.scene.edgeDistances = true;
   std::vector<std::string> texts;
-  const auto boxes = textBoxes(slicesFigure(scene), &texts);
+  const auto boxes = textBoxes(slicesFigure(caudate.scene), &texts);
   // 15 captions, 60 edge letters, 4 legend entries.
   EXPECT_EQ(boxes.size(), 15u + 60u + 4u);
   for (std::size_t a = 0; a < boxes.size(); ++a)
