@@ -179,6 +179,10 @@ check "QC page of 500 in Chromium (Playwright): every row, sorting, no script er
 snakemake -s "$WORKFLOWS/Snakefile" --cores 1 --config out="$work/x" >"$work/bad.log" 2>&1
 check "no bids: exit non-zero" test $? -ne 0
 check "no bids: says what is required" grep -q "config bids=DIR is required" "$work/bad.log"
+snake out="$work/x" niivue="$work/none.js" --cores 1 >"$work/bad.log" 2>&1
+check "missing NiiVue file: exit non-zero" test $? -ne 0
+check "missing NiiVue file: named" grep -q "niivue=$work/none.js: no such file" "$work/bad.log"
+check "missing NiiVue file: nothing written" test ! -e "$work/x"
 mkdir -p "$work/bids/sub-05/anat" && cp "$work/bids/sub-01/anat/sub-01_T1w.nii.gz" \
   "$work/bids/sub-05/anat/sub-05_foo-1_T1w.nii.gz"
 snake out="$work/out" --cores 1 >"$work/bad.log" 2>&1
