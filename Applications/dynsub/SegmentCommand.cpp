@@ -1,10 +1,12 @@
 // dynsub segment: a structure in a 3D image from image forces and expert landmarks (Segmentation.h).
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <future>
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include <CLI/CLI.hpp>
@@ -17,8 +19,10 @@
 #include "dynsub/ImageIO.h"
 #include "dynsub/Metrics.h"
 #include "dynsub/ModelOutputs.h"
+#include "dynsub/OutputSet.h"
 #include "dynsub/ParallelFor.h"
 #include "dynsub/SegmentImage.h"
+#include "dynsub/SegmentStructures.h"
 #include "dynsub/SurfaceWriter.h"
 
 namespace dynsub::app {
@@ -29,10 +33,12 @@ namespace {
 struct Arguments {
   std::string image;
   std::string out;
-  std::string landmarks;
+  // One file per structure; several segment the structures together.
+  std::vector<std::string> landmarks;
+  std::vector<std::string> names;  // one per landmarks file, or none (the files' stems)
   std::string init = "auto";
   std::string reference;
-  std::vector<int> referenceLabels;
+  std::vector<std::string> referenceLabels;  // "N[,M...]": one per structure
   std::string atlas = kDefaultAtlasImage;
   std::string atlasLabels = kDefaultAtlasLabels;
   std::string atlasLabel;
@@ -41,13 +47,38 @@ struct Arguments {
   FigureOptions figures;
 };
 
-// The expert's labelmap of the structure, on the image's grid.
-Mask readReference(const Arguments& o, const Volume& image) {
-  const Volume labels = readVolume(o.reference);
+// "71" or "71,72": a structure's label values in --reference.
+std::vector<int> parseLabelValues(const std::string& text) {
+  std::vector<int> values;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    std::size_t used = 0;
+    int value = 0;
+    try {
+      value = std::stoi(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size()) throw Error("--reference-label " + text + ": expected N[,M...] (integers)");
+    values.push_back(value);
+  }
+  if (values.empty()) throw Error("--reference-label " + text + ": expected N[,M...] (integers)");
+  return values;
+}
+
+// The expert's labelmap, on the image's grid.
+Volume readReferenceLabels(const std::string& path, const Volume& image) {
+  Volume labels = readVolume(path);
   if (!labels.geometry.sameGridAs(image.geometry))
-    throw Error(o.reference, "the reference is not on the image's grid (size, origin, spacing or direction differ)");
-  Mask reference = selectLabels(labels, o.referenceLabels);
-  if (reference.count() == 0) throw Error(o.reference, "no voxel has the reference label(s)");
+    throw Error(path, "the reference is not on the image's grid (size, origin, spacing or direction differ)");
+  return labels;
+}
+
+// One structure in the expert's labelmap.
+Mask referenceStructure(const std::string& path, const Volume& labels, const std::vector<int>& values) {
+  Mask reference = selectLabels(labels, values);
+  if (reference.count() == 0) throw Error(path, "no voxel has the reference label(s)");
   return reference;
 }
 
@@ -104,16 +135,21 @@ void printSummary(const Arguments& o, const SegmentOutcome& outcome, const Volum
             << (o.figures.figures ? " and the figures that could be rendered" : "") << '\n';
 }
 
-void runSegment(const Arguments& o) {
+void runSegmentOne(const Arguments& o) {
   // Every input is read and checked before anything is written.
   if (!o.reference.empty() && o.referenceLabels.empty())
     throw Error("--reference needs --reference-label N[,M...]: the label value(s) of the structure");
   SegmentInputs inputs;
   inputs.start = parseSegmentStart(o.init, "--init");
+  // One structure's values, as N[,M...] or as several values (71 72).
+  std::vector<int> referenceLabels;
+  for (const std::string& values : o.referenceLabels)
+    for (const int value : parseLabelValues(values)) referenceLabels.push_back(value);
   const Volume image = readVolume(o.image);
-  if (!o.landmarks.empty()) inputs.landmarks = readLandmarks(o.landmarks, &inputs.landmarkSystem);
+  const std::string landmarks = o.landmarks.empty() ? std::string() : o.landmarks.front();
+  if (!landmarks.empty()) inputs.landmarks = readLandmarks(landmarks, &inputs.landmarkSystem);
   inputs.image = o.image;
-  inputs.landmarkSource = o.landmarks;
+  inputs.landmarkSource = landmarks;
   if (!o.inside.empty()) inputs.inside = parsePoint(o.inside, "--inside");
   if (inputs.start.kind == SegmentStart::Kind::Atlas) {
     if (o.atlasLabel.empty())
@@ -132,10 +168,12 @@ void runSegment(const Arguments& o) {
   std::shared_future<Mask> reference;
   if (!o.reference.empty()) {
     requireExisting(o.reference);  // before the segmentation; its other errors come with its reading
-    reference = std::async(std::launch::async, [&o, &image] { return readReference(o, image); }).share();
+    reference = std::async(std::launch::async, [&o, &image, &referenceLabels] {
+                  return referenceStructure(o.reference, readReferenceLabels(o.reference, image), referenceLabels);
+                }).share();
     inputs.reference = [reference]() -> const Mask& { return reference.get(); };
     inputs.referencePath = o.reference;
-    inputs.referenceLabels = o.referenceLabels;
+    inputs.referenceLabels = referenceLabels;
   }
   const std::filesystem::path dir(o.out);
   prepareOutputDirectory(dir);
@@ -146,6 +184,135 @@ void runSegment(const Arguments& o) {
   line.finish();
   writeSegmentOutputs(dir, outcome, image, o.figures);
   printSummary(o, outcome, image);
+}
+
+// A landmark file's name without its folder and extension: caudate_left
+// for caudate_left.mrk.json.
+std::string structureName(const std::string& path) {
+  std::string name = std::filesystem::path(path).filename().string();
+  for (const char* extension : {".mrk.json", ".json", ".fcsv", ".csv"}) {
+    const std::string e = extension;
+    if (name.size() > e.size() && lowerCaseExtension(name.substr(name.size() - e.size())) == lowerCaseExtension(e) &&
+        name.compare(name.size() - e.size(), e.size(), e) == 0) {
+      name.resize(name.size() - e.size());
+      break;
+    }
+  }
+  return name;
+}
+
+// BIDS's table of a dseg's labels: index, name and a colour for viewers that
+// take one, from a qualitative palette of ten that neighbours tell apart
+// (repeated past ten).
+void writeLabelTable(const std::vector<StructureInputs>& structures, const std::string& path) {
+  static const char* const palette[] = {"#4e79a7", "#f28e2b", "#e15759", "#76b7b2", "#59a14f",
+                                        "#edc948", "#b07aa1", "#ff9da7", "#9c755f", "#bab0ac"};
+  std::ofstream table(path);
+  table << "index\tname\tcolor\n";
+  for (std::size_t s = 0; s < structures.size(); ++s)
+    table << s + 1 << '\t' << structures[s].name << '\t' << palette[s % 10] << '\n';
+  table.close();
+  if (!table) throw Error(path, "could not be written");
+}
+
+// Several structures: each in DIR/NAME as one structure's run writes it, then
+// DIR/dseg.nii.gz, DIR/dseg.tsv and DIR/report.json, the run's report, last:
+// it is there only when everything is.
+void runSegmentTogether(const Arguments& o) {
+  if (!o.names.empty() && o.names.size() != o.landmarks.size())
+    throw Error("--name is given " + std::to_string(o.names.size()) + " times for " +
+                std::to_string(o.landmarks.size()) + " --landmarks files: name each file's structure, or none");
+  if (!o.reference.empty() && o.referenceLabels.size() != o.landmarks.size())
+    throw Error("--reference needs one --reference-label N[,M...] per structure, in the order of --landmarks (" +
+                std::to_string(o.landmarks.size()) + " structures, " + std::to_string(o.referenceLabels.size()) +
+                " given)");
+  if (o.reference.empty() && !o.referenceLabels.empty()) throw Error("--reference-label needs --reference");
+  if (o.init != "auto")
+    throw Error("--init " + o.init + ": several structures start from their landmarks (--init auto)");
+  std::vector<StructureInputs> structures;
+  for (std::size_t s = 0; s < o.landmarks.size(); ++s) {
+    StructureInputs structure;
+    structure.name = o.names.empty() ? structureName(o.landmarks[s]) : o.names[s];
+    SegmentInputs& in = structure.inputs;
+    in.image = o.image;
+    in.landmarkSource = o.landmarks[s];
+    in.start = parseSegmentStart("auto", "--init");
+    in.landmarks = readLandmarks(o.landmarks[s], &in.landmarkSystem);
+    if (!o.reference.empty()) {
+      in.referencePath = o.reference;
+      in.referenceLabels = parseLabelValues(o.referenceLabels[s]);
+    }
+    structures.push_back(std::move(structure));
+  }
+  const Volume image = readVolume(o.image);
+  checkStructures(structures, o.parameters);
+  // The references: one labelmap, read once, each structure's labels picked
+  // when the segmentation asks for them.
+  std::optional<Volume> referenceLabels;
+  std::vector<std::optional<Mask>> references(structures.size());
+  if (!o.reference.empty()) {
+    referenceLabels = readReferenceLabels(o.reference, image);
+    for (std::size_t s = 0; s < structures.size(); ++s) {
+      references[s] = referenceStructure(o.reference, *referenceLabels, structures[s].inputs.referenceLabels);
+      structures[s].inputs.reference = [&references, s]() -> const Mask& { return *references[s]; };
+    }
+  }
+  const std::filesystem::path dir(o.out);
+  prepareOutputDirectory(dir);
+  o.figures.prepare();
+
+  ProgressLine line;
+  const StructuresOutcome outcome = segmentStructures(image, structures, o.parameters, line.callback());
+  line.finish();
+  // Each structure's set of files commits on its own; should a later one
+  // fail, the folders this run made are removed again, so that nothing of
+  // it is left half-written.
+  std::vector<std::filesystem::path> made;
+  try {
+    if (!std::filesystem::exists(dir)) {
+      std::filesystem::create_directory(dir);
+      made.push_back(dir);
+    }
+    for (std::size_t s = 0; s < structures.size(); ++s) {
+      const std::filesystem::path own = dir / structures[s].name;
+      if (!std::filesystem::exists(own)) made.push_back(own);
+      writeSegmentOutputs(own, outcome.structures[s], image, o.figures);
+    }
+    OutputSet outputs(dir);
+    writeVolume(outcome.labels, outputs.add("dseg.nii.gz"), VoxelType::Label16);
+    writeLabelTable(structures, outputs.add("dseg.tsv"));
+    outcome.report.write(outputs.add("report.json"));
+    outputs.commit();
+  } catch (...) {
+    std::error_code ignored;
+    for (auto it = made.rbegin(); it != made.rend(); ++it) std::filesystem::remove_all(*it, ignored);
+    throw;
+  }
+
+  std::cout << std::fixed << std::setprecision(1) << "segmented " << structures.size() << " structures together in "
+            << outcome.seconds << " s; voxels in two structures: " << outcome.sharedAlone << " alone, "
+            << outcome.sharedTogether << " with the barrier, 0 in dseg.nii.gz\n";
+  for (std::size_t s = 0; s < structures.size(); ++s) {
+    const SegmentOutcome& one = outcome.structures[s];
+    std::cout << std::setprecision(1) << "  " << s + 1 << " " << structures[s].name << ": "
+              << static_cast<double>(one.labelmap.count()) * image.geometry.spacing.prod() << " mm^3"
+              << (outcome.segmentedAgain[s] ? ", segmented again against the others" : "");
+    if (references[s])
+      std::cout << std::setprecision(3) << ", Dice " << outcome.aloneMetrics[s].dice << " alone, "
+                << outcome.jointMetrics[s].dice << " in dseg";
+    std::cout << '\n';
+    for (const std::string& warning : one.warnings) std::cerr << "warning (" << structures[s].name << "): " << warning << '\n';
+    for (const TrustFlag& flag : one.trustFlags)
+      std::cerr << "not to trust (" << structures[s].name << ", " << flag.name << "): " << flag.message << '\n';
+  }
+  std::cout << "wrote " << (dir / "dseg.nii.gz").string() << ", dseg.tsv, report.json and a folder per structure\n";
+}
+
+void runSegment(const Arguments& o) {
+  if (o.landmarks.size() > 1)
+    runSegmentTogether(o);
+  else
+    runSegmentOne(o);
 }
 
 }  // namespace
@@ -162,7 +329,18 @@ void addSegmentCommand(CLI::App& app) {
   command->add_option("IMAGE", o->image, "3D image: .nii/.nii.gz, .nrrd, .mha/.mhd, or a DICOM series directory")
       ->required();
   command->add_option("--out", o->out, "Output directory (created if missing; its parent must exist)")->required();
-  command->add_option("--landmarks", o->landmarks, "Boundary points: .mrk.json, .fcsv or .csv (x,y,z in LPS mm)");
+  command
+      ->add_option("--landmarks", o->landmarks,
+                   "Boundary points: .mrk.json, .fcsv or .csv (x,y,z in LPS mm). Given once per structure, "
+                   "the structures are segmented together: they do not overlap, and DIR/dseg.nii.gz with "
+                   "DIR/dseg.tsv names them (each structure's outputs in DIR/NAME)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  command
+      ->add_option("--name", o->names,
+                   "With several --landmarks: each structure's name, in their order (default: the files' stems)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   command->add_option("--init", o->init,
                       "Initial model: auto (the 98-vertex cube inside the landmarks' PCA ellipsoid), "
                       "seed:x,y,z (one click inside the structure, LPS mm: grown through the tissue like the "
@@ -184,8 +362,12 @@ void addSegmentCommand(CLI::App& app) {
                       "With --init atlas: x,y,z (LPS mm), a click inside the structure; it picks the carried "
                       "label's part and moves a misplaced one there");
   command->add_option("--reference", o->reference, "Reference labelmap on the image's grid, for Dice and distances");
-  command->add_option("--reference-label", o->referenceLabels, "Label value(s) of the structure in --reference")
-      ->delimiter(',');
+  command
+      ->add_option("--reference-label", o->referenceLabels,
+                   "Label value(s) of the structure in --reference, N[,M...]; with several --landmarks, once per "
+                   "structure in their order")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   addSegmentParameterOptions(*command, o->parameters);
   o->figures.addOptions(*command);
   command->callback([o] { runSegment(*o); });

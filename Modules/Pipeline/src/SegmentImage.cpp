@@ -387,7 +387,7 @@ void checkSegmentInputs(const SegmentInputs& in, const SegmentParameters& parame
 }
 
 SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& in, const SegmentParameters& parameters,
-                            const ProgressCallback& progress) {
+                            const ProgressCallback& progress, const std::vector<ForceModel*>& forces) {
   SegmentOptions options = optionsFor(in, parameters);
   checkStart(in);
 
@@ -401,7 +401,7 @@ SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& in, const 
   const ControlMesh initial = chooseStart(image, in, parameters, options, outcome);
   const std::vector<Landmark>& springs = outcome.springs;
   // With landmarks, the atlas's prior pulls besides them, softly.
-  std::vector<ForceModel*> extraForces;
+  std::vector<ForceModel*> extraForces = forces;
   std::unique_ptr<SpringForceModel> priorSprings;
   if (outcome.carried && !in.landmarks.empty() && parameters.priorStiffness > 0) {
     const MatrixX3 points = landmarkPositions(outcome.prior);

@@ -195,6 +195,11 @@ std::vector<Parameter> table() {
        "With a seed click and no landmarks: the stiffness of the springs to the region's boundary points",
        [](P& p) -> double& { return p.seed.stiffness; }, 0, 10000, 0.5));
 
+  add(row("barrier_stiffness", "Barrier stiffness", "N/mm^3", "Forces",
+       "With several structures: how hard each pushes the others' surfaces out of its territory, per mm "
+       "they went in (0: no barrier; the joined labelmap still gives each voxel one structure)",
+       [](P& p) -> double& { return p.barrierStiffness; }, 0, 1000, 0.5));
+
   // Atlas.
   add(row("prior_points", "Prior points", "", "Atlas",
        "With an atlas start: the points spread over the carried label's boundary that the prior's springs pull "

@@ -104,9 +104,11 @@ void checkSegmentInputs(const SegmentInputs& inputs, const SegmentParameters& pa
 // Throws dynsub::Error naming the landmark source when the landmarks cannot
 // be used (among them, landmarks that look read in the wrong convention,
 // unless parameters.checkConvention is off), and for impossible parameters; `progress` (may be empty) sees
-// every step.
+// every step. `extraForces` (not owned) act besides the segmentation's own
+// (segment() in Segmentation.h), e.g. the other structures' barrier.
 SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& inputs, const SegmentParameters& parameters,
-                            const ProgressCallback& progress = nullptr);
+                            const ProgressCallback& progress = nullptr,
+                            const std::vector<ForceModel*>& extraForces = {});
 
 // How far the structure's tissue was followed past the outermost clicked
 // slices where a spring or the pressure then acted (SliceEnds.h), e.g. "10.0

@@ -38,6 +38,10 @@ struct SegmentParameters {
   AtlasRegistrationOptions registration;
   int priorPoints = 100;
   double priorStiffness = 2.0;  // N/mm per point (0: no prior)
+  // Several structures segmented together (SegmentStructures.h): the force
+  // per unit area that pushes a surface out of the others' territories, per
+  // mm it went in (N/mm^2 per mm).
+  double barrierStiffness = 0.5;
 };
 
 // One row of the table.

@@ -1,0 +1,109 @@
+#!/usr/bin/env bash
+# Four basal-ganglia structures of the Colin27 MRI segmented in one run
+# (caudate, putamen, pallidum and thalamus, 36 clicks each on 6 coronal
+# slices, scored against the AAL atlas drawn on the same brain):
+#  - the joined labelmap dseg.nii.gz gives no voxel two structures, carries
+#    the image's grid, and dseg.tsv names its labels as BIDS has them;
+#  - each structure keeps its own outputs in DIR/NAME;
+#  - each structure's Dice in dseg.nii.gz is no lower than the same
+#    structure's segmentation alone in the same run (report.json's "alone",
+#    the same as a separate `segment` run), to within 0.001 (the rounding of
+#    the printed figure). The left side is the one the barrier's stiffness
+#    was chosen on; the right side, held out, measured 3 of 4 higher and the
+#    pallidum 0.008 lower (Documentation/Segmentation.md), so there the mean
+#    must not drop and no structure may lose more than 0.01.
+#  - bad combinations of options are refused before anything is written.
+# Needs DYNSUB (the executable), DATA and TOOLS.
+set -u
+source "$(dirname "${BASH_SOURCE[0]}")/Checks.sh"
+require_colin27
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+for s in "72 caudate_right" "74 putamen_right" "76 pallidum_right" "78 thalamus_right"; do
+  set -- $s
+  python3 "$TOOLS/landmarks_from_labels.py" "$templates/aal.nii.gz" "$1" coronal 6 6 "$work/$2.mrk.json" >/dev/null
+done
+
+# together SIDE DIR LANDMARKS... -- LABELS...
+together() {
+  local side=$1 landmarks=() labels=()
+  shift
+  while [ "$1" != "--" ]; do landmarks+=(--landmarks "$1"); shift; done
+  shift
+  for label in "$@"; do labels+=(--reference-label "$label"); done
+  "$DYNSUB" segment "$templates/ch2.nii.gz" "${landmarks[@]}" --reference "$templates/aal.nii.gz" "${labels[@]}" \
+    --out "$work/$side" >"$work/$side.log" 2>&1
+  check "$side: segment succeeds" test $? -eq 0
+  cat "$work/$side.log"
+}
+together left "$DATA/Landmarks/caudate_left.mrk.json" "$DATA/Landmarks/putamen_left.mrk.json" \
+  "$DATA/Landmarks/pallidum_left.mrk.json" "$DATA/Landmarks/thalamus_left.mrk.json" -- 71 73 75 77
+together right "$work/caudate_right.mrk.json" "$work/putamen_right.mrk.json" "$work/pallidum_right.mrk.json" \
+  "$work/thalamus_right.mrk.json" -- 72 74 76 78
+
+# check_side SIDE PER_STRUCTURE_TOLERANCE MEAN_TOLERANCE
+check_side() {
+  check "$1: dseg, dseg.tsv, report and each structure's outputs; no voxel in two structures; Dice no lower" \
+    python3 - "$work/$1" "$templates/ch2.nii.gz" "$2" "$3" <<'PY'
+import gzip, json, os, struct, sys
+out, image, per, mean_tolerance = sys.argv[1], sys.argv[2], float(sys.argv[3]), float(sys.argv[4])
+def nifti(path):
+    data = gzip.open(path).read()
+    dims = struct.unpack_from("<8h", data, 40)
+    datatype, offset = struct.unpack_from("<h", data, 70)[0], int(struct.unpack_from("<f", data, 108)[0])
+    return dims[1:4], struct.unpack_from("<12f", data, 280), datatype, data, offset
+dims, sform, datatype, data, offset = nifti(out + "/dseg.nii.gz")
+mri = nifti(image)
+ok = dims == mri[0] and all(abs(a - b) < 1e-4 for a, b in zip(sform, mri[1]))
+codes = {2: "B", 4: "h", 512: "H"}
+count = dims[0] * dims[1] * dims[2]
+labels = struct.unpack_from("<%d%s" % (count, codes[datatype]), data, offset)
+present = sorted(set(labels))
+ok = ok and present == [0, 1, 2, 3, 4]
+rows = [line.split("\t") for line in open(out + "/dseg.tsv").read().splitlines()]
+ok = ok and rows[0][:2] == ["index", "name"] and [r[0] for r in rows[1:]] == ["1", "2", "3", "4"]
+report = json.load(open(out + "/report.json"))
+structures = report["structures"]
+names = [s["name"] for s in structures]
+ok = ok and names == [r[1] for r in rows[1:]]
+for s in structures:
+    own = out + "/" + s["name"]
+    ok = ok and all(os.path.isfile(own + "/" + f) for f in ("surface.vtp", "control_mesh.obj", "labelmap.nii.gz", "report.json"))
+    # The joined share is what dseg.nii.gz holds of this label.
+    ok = ok and abs(labels.count(s["index"]) - s["joint_volume_mm3"]) < 0.5
+    print(s["name"], "Dice alone %.4f, in dseg %.4f" % (s["alone"]["dice"], s["joint"]["dice"]))
+    ok = ok and s["joint"]["dice"] >= s["alone"]["dice"] - per
+alone = sum(s["alone"]["dice"] for s in structures) / len(structures)
+joint = sum(s["joint"]["dice"] for s in structures) / len(structures)
+print("mean Dice alone %.4f, in dseg %.4f; voxels in two surfaces %d alone, %d with the barrier" %
+      (alone, joint, report["shared_voxels_alone"], report["shared_voxels_together"]))
+ok = ok and joint >= alone - mean_tolerance and report["shared_voxels_alone"] > report["shared_voxels_together"]
+sys.exit(0 if ok else 1)
+PY
+}
+check_side left 0.001 0
+check_side right 0.01 0
+
+# Refused before anything is written.
+refused() {
+  local name=$1 expect=$2; shift 2
+  "$DYNSUB" segment "$templates/ch2.nii.gz" "$@" --out "$work/refused" >"$work/refused.log" 2>&1
+  local status=$?
+  check "$name: a non-zero exit, names the problem, writes nothing" \
+    bash -c "test $status -ne 0 && grep -q -- \"$expect\" \"$work/refused.log\" && test ! -e \"$work/refused\"" ||
+    cat "$work/refused.log"
+}
+caudate="$DATA/Landmarks/caudate_left.mrk.json"
+putamen="$DATA/Landmarks/putamen_left.mrk.json"
+refused "one name for two structures" "\-\-name is given 1 times" --landmarks "$caudate" --landmarks "$putamen" --name a
+refused "a name twice" "given twice" --landmarks "$caudate" --landmarks "$putamen" --name a --name a
+refused "a name that is a path" "use letters" --landmarks "$caudate" --landmarks "$putamen" --name a/b --name c
+refused "one reference label for two" "one --reference-label" --landmarks "$caudate" --landmarks "$putamen" \
+  --reference "$templates/aal.nii.gz" --reference-label 71
+refused "a start other than the landmarks" "several structures start" --landmarks "$caudate" \
+  --landmarks "$putamen" --init sphere:0,0,0,5
+refused "a missing second file" "missing.mrk.json" --landmarks "$caudate" --landmarks "$work/missing.mrk.json"
+
+echo "$failures failure(s)"
+test "$failures" -eq 0
