@@ -116,9 +116,10 @@ void writeSegmentOutputs(const std::filesystem::path& dir, const SegmentOutcome&
 
 void printSummary(const Arguments& o, const SegmentOutcome& outcome, const Volume& image) {
   const SegmentResult& result = outcome.result;
-  std::cout << std::fixed << std::setprecision(1) << "segmented " << outcome.labelmap.count() * image.geometry.spacing.prod()
-            << " mm^3 with " << result.mesh.vertexCount() << " control vertices (" << result.levels.back().level
-            << " refinement(s), " << result.steps << " steps) in " << outcome.seconds << " s\n";
+  std::cout << std::fixed << std::setprecision(1) << "segmented "
+            << outcome.labelmap.count() * image.geometry.spacing.prod() << " mm^3 with " << result.mesh.vertexCount()
+            << " control vertices (" << result.levels.back().level << " refinement(s), " << result.steps
+            << " steps) in " << outcome.seconds << " s\n";
   const std::string carried = carriedPastSlices(outcome.result);
   if (!carried.empty())
     std::cout << "followed the structure's tissue past the outermost clicked slices and pulled the surface there: "
@@ -128,8 +129,8 @@ void printSummary(const Arguments& o, const SegmentOutcome& outcome, const Volum
     std::cerr << "not to trust (" << flag.name << "): " << flag.message << '\n';
   if (!o.reference.empty())
     std::cout << std::setprecision(3) << "Dice " << outcome.metrics.dice << ", mean surface distance "
-              << outcome.metrics.meanSurfaceDistance << " mm, HD95 " << outcome.metrics.hd95 << " mm against " << o.reference
-              << '\n';
+              << outcome.metrics.meanSurfaceDistance << " mm, HD95 " << outcome.metrics.hd95 << " mm against "
+              << o.reference << '\n';
   std::cout << "wrote " << (std::filesystem::path(o.out) / "surface.vtp").string()
             << ", control_mesh.obj, labelmap.nii.gz, report.json, convergence.csv"
             << (o.figures.figures ? " and the figures that could be rendered" : "") << '\n';
@@ -301,7 +302,8 @@ void runSegmentTogether(const Arguments& o) {
       std::cout << std::setprecision(3) << ", Dice " << outcome.aloneMetrics[s].dice << " alone, "
                 << outcome.jointMetrics[s].dice << " in dseg";
     std::cout << '\n';
-    for (const std::string& warning : one.warnings) std::cerr << "warning (" << structures[s].name << "): " << warning << '\n';
+    for (const std::string& warning : one.warnings)
+      std::cerr << "warning (" << structures[s].name << "): " << warning << '\n';
     for (const TrustFlag& flag : one.trustFlags)
       std::cerr << "not to trust (" << structures[s].name << ", " << flag.name << "): " << flag.message << '\n';
   }
@@ -341,22 +343,24 @@ void addSegmentCommand(CLI::App& app) {
                    "With several --landmarks: each structure's name, in their order (default: the files' stems)")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-  command->add_option("--init", o->init,
-                      "Initial model: auto (the 98-vertex cube inside the landmarks' PCA ellipsoid), "
-                      "seed:x,y,z (one click inside the structure, LPS mm: grown through the tissue like the "
-                      "click's, its boundary the springs when no --landmarks are given), "
-                      "sphere:x,y,z,r (LPS mm), atlas (the atlas's structure --atlas-label registered to the image, "
-                      "which also holds the surface softly where clicks and edges say nothing), or a closed "
-                      "control mesh file in LPS mm")
+  command
+      ->add_option("--init", o->init,
+                   "Initial model: auto (the 98-vertex cube inside the landmarks' PCA ellipsoid), "
+                   "seed:x,y,z (one click inside the structure, LPS mm: grown through the tissue like the "
+                   "click's, its boundary the springs when no --landmarks are given), "
+                   "sphere:x,y,z,r (LPS mm), atlas (the atlas's structure --atlas-label registered to the image, "
+                   "which also holds the surface softly where clicks and edges say nothing), or a closed "
+                   "control mesh file in LPS mm")
       ->default_val("auto");
   command->add_option("--atlas-label", o->atlasLabel,
                       "With --init atlas: the structure's label value(s) in the atlas, or names from its table "
                       "(Caudate_L; Caudate_L,Caudate_R)");
   command->add_option("--atlas", o->atlas, "With --init atlas: the atlas's template image")
       ->default_str(kDefaultAtlasImage);
-  command->add_option("--atlas-labels", o->atlasLabels,
-                      "With --init atlas: the atlas's label map, on its template's grid, with its names in "
-                      "LABELS.txt beside it (mricron's format: one 'VALUE NAME' per line)")
+  command
+      ->add_option("--atlas-labels", o->atlasLabels,
+                   "With --init atlas: the atlas's label map, on its template's grid, with its names in "
+                   "LABELS.txt beside it (mricron's format: one 'VALUE NAME' per line)")
       ->default_str(kDefaultAtlasLabels);
   command->add_option("--inside", o->inside,
                       "With --init atlas: x,y,z (LPS mm), a click inside the structure; it picks the carried "

@@ -35,18 +35,6 @@ std::vector<double> numbersAfter(const std::string& value, std::size_t prefix, i
   return v;
 }
 
-Report metricsReport(const OverlapMetrics& m) {
-  Report r;
-  r.set("dice", m.dice);
-  r.set("jaccard", m.jaccard);
-  r.set("volume_difference_percent", m.volumeDifferencePercent);
-  r.set("mean_surface_distance_mm", m.meanSurfaceDistance);
-  r.set("hd95_mm", m.hd95);
-  r.set("hausdorff_mm", m.hausdorff);
-  r.set("volume_mm3", m.volumeA);
-  r.set("reference_volume_mm3", m.volumeB);
-  return r;
-}
 
 // Every row of the table with its value, then what the edge detector used
 // in the end: the reference (the image's when there were no points on the
@@ -286,6 +274,19 @@ Report trustReport(const TrustMeasures& m, const std::vector<TrustFlag>& flags) 
 }
 
 }  // namespace
+
+Report metricsReport(const OverlapMetrics& m) {
+  Report r;
+  r.set("dice", m.dice);
+  r.set("jaccard", m.jaccard);
+  r.set("volume_difference_percent", m.volumeDifferencePercent);
+  r.set("mean_surface_distance_mm", m.meanSurfaceDistance);
+  r.set("hd95_mm", m.hd95);
+  r.set("hausdorff_mm", m.hausdorff);
+  r.set("volume_mm3", m.volumeA);
+  r.set("reference_volume_mm3", m.volumeB);
+  return r;
+}
 
 SegmentStart parseSegmentStart(const std::string& value, const std::string& option) {
   SegmentStart start;

@@ -1,6 +1,7 @@
 #include "dynsub/SegmentStructures.h"
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -109,15 +110,6 @@ bool usableName(const std::string& name) {
   return std::all_of(name.begin(), name.end(), [](char c) {
     return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.';
   });
-}
-
-Report overlapReport(const OverlapMetrics& m) {
-  Report r;
-  r.set("dice", m.dice);
-  r.set("mean_surface_distance_mm", m.meanSurfaceDistance);
-  r.set("hd95_mm", m.hd95);
-  r.set("volume_mm3", m.volumeA);
-  return r;
 }
 
 // Runs segmentImage, naming the structure in its errors.
@@ -235,8 +227,8 @@ StructuresOutcome segmentStructures(const Volume& image, const std::vector<Struc
     r.set("name", structures[s].name);
     r.set("landmarks", in.landmarkSource);
     r.set("segmented_again", static_cast<bool>(out.segmentedAgain[s]));
-    r.set("volume_mm3", static_cast<double>(out.structures[s].labelmap.count()) *
-                            out.structures[s].labelmap.geometry.spacing.prod());
+    r.set("volume_mm3",
+          static_cast<double>(out.structures[s].labelmap.count()) * out.structures[s].labelmap.geometry.spacing.prod());
     Mask share;
     share.geometry = out.labels.geometry;
     share.voxels.resize(out.labels.voxels.size());
@@ -246,9 +238,9 @@ StructuresOutcome segmentStructures(const Volume& image, const std::vector<Struc
       out.jointMetrics.push_back(compareMasks(share, in.reference()));
       r.set("reference", in.referencePath);
       r.set("reference_labels", in.referenceLabels);
-      r.set("alone", overlapReport(out.aloneMetrics[s]));
-      r.set("own", overlapReport(out.structures[s].metrics));
-      r.set("joint", overlapReport(out.jointMetrics.back()));
+      r.set("alone", metricsReport(out.aloneMetrics[s]));
+      r.set("own", metricsReport(out.structures[s].metrics));
+      r.set("joint", metricsReport(out.jointMetrics.back()));
     } else {
       out.jointMetrics.push_back(OverlapMetrics());
     }

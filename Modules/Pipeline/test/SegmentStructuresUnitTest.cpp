@@ -58,7 +58,8 @@ Mask truth(bool a) {
     for (int j = 0; j < 32; ++j)
       for (int i = 0; i < 48; ++i) {
         const Vector3 x = m.geometry.toPhysical(Vector3(i, j, k));
-        m.voxels[m.geometry.offset(i, j, k)] = a ? inSphere(x, kCentreA) && x.x() < 0 : inSphere(x, kCentreB) && x.x() > 0;
+        m.voxels[m.geometry.offset(i, j, k)] =
+            a ? inSphere(x, kCentreA) && x.x() < 0 : inSphere(x, kCentreB) && x.x() > 0;
       }
   return m;
 }

@@ -110,6 +110,10 @@ SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& inputs, co
                             const ProgressCallback& progress = nullptr,
                             const std::vector<ForceModel*>& extraForces = {});
 
+// report.json's scores against a reference: dice, jaccard, the volume
+// difference, the surface distances and both volumes.
+Report metricsReport(const OverlapMetrics& metrics);
+
 // How far the structure's tissue was followed past the outermost clicked
 // slices where a spring or the pressure then acted (SliceEnds.h), e.g. "10.0
 // mm before the first, 4.5 mm after the last (no end seen)"; empty when
