@@ -1,4 +1,6 @@
 // dynsub segment: a structure in a 3D image from image forces and expert landmarks (Segmentation.h).
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -190,15 +192,14 @@ void runSegmentOne(const Arguments& o) {
 // A landmark file's name without its folder and extension: caudate_left
 // for caudate_left.mrk.json.
 std::string structureName(const std::string& path) {
-  std::string name = std::filesystem::path(path).filename().string();
-  for (const char* extension : {".mrk.json", ".json", ".fcsv", ".csv"}) {
-    const std::string e = extension;
-    if (name.size() > e.size() && lowerCaseExtension(name.substr(name.size() - e.size())) == lowerCaseExtension(e) &&
-        name.compare(name.size() - e.size(), e.size(), e) == 0) {
-      name.resize(name.size() - e.size());
-      break;
-    }
-  }
+  const std::string name = std::filesystem::path(path).filename().string();
+  std::string lower = name;
+  std::transform(lower.begin(), lower.end(), lower.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  for (const std::string extension : {".mrk.json", ".json", ".fcsv", ".csv"})
+    if (lower.size() > extension.size() &&
+        lower.compare(lower.size() - extension.size(), extension.size(), extension) == 0)
+      return name.substr(0, name.size() - extension.size());
   return name;
 }
 
@@ -237,7 +238,6 @@ void runSegmentTogether(const Arguments& o) {
     SegmentInputs& in = structure.inputs;
     in.image = o.image;
     in.landmarkSource = o.landmarks[s];
-    in.start = parseSegmentStart("auto", "--init");
     in.landmarks = readLandmarks(o.landmarks[s], &in.landmarkSystem);
     if (!o.reference.empty()) {
       in.referencePath = o.reference;
@@ -248,13 +248,12 @@ void runSegmentTogether(const Arguments& o) {
   const Volume image = readVolume(o.image);
   checkStructures(structures, o.parameters);
   // The references: one labelmap, read once, each structure's labels picked
-  // when the segmentation asks for them.
-  std::optional<Volume> referenceLabels;
+  // from it before the run.
   std::vector<std::optional<Mask>> references(structures.size());
   if (!o.reference.empty()) {
-    referenceLabels = readReferenceLabels(o.reference, image);
+    const Volume labels = readReferenceLabels(o.reference, image);
     for (std::size_t s = 0; s < structures.size(); ++s) {
-      references[s] = referenceStructure(o.reference, *referenceLabels, structures[s].inputs.referenceLabels);
+      references[s] = referenceStructure(o.reference, labels, structures[s].inputs.referenceLabels);
       structures[s].inputs.reference = [&references, s]() -> const Mask& { return *references[s]; };
     }
   }

@@ -15,10 +15,9 @@ namespace dynsub {
 
 namespace {
 
-// The margin (voxels) kept around the structures' voxels when their depths
-// and the territories' distances are computed: the barrier must reach a
-// surface that left its territory, and a voxel's depth needs outside voxels
-// around it.
+// The margin (voxels) around the structures' voxels that the territories,
+// and so the barrier, cover: a surface pushed out of a territory, or one
+// that swells past its first segmentation, still meets the wall there.
 constexpr int kTerritoryMargin = 8;
 
 // A force density that pushes a surface out of a wall (the other structures'
@@ -72,13 +71,20 @@ class WallForce final : public ForceField {
   double step_;
 };
 
-long long sharedVoxels(const std::vector<Mask>& masks) {
-  long long shared = 0;
-  const std::size_t n = masks.front().voxels.size();
-  for (std::size_t v = 0; v < n; ++v) {
+// The voxels in two or more masks (one grid), and which masks hold any.
+struct Sharing {
+  long long voxels = 0;
+  std::vector<bool> masks;
+};
+Sharing sharing(const std::vector<Mask>& masks) {
+  Sharing shared;
+  shared.masks.assign(masks.size(), false);
+  for (std::size_t v = 0; v < masks.front().voxels.size(); ++v) {
     int holders = 0;
     for (const Mask& m : masks) holders += m.voxels[v] != 0;
-    shared += holders > 1;
+    if (holders < 2) continue;
+    ++shared.voxels;
+    for (std::size_t s = 0; s < masks.size(); ++s) shared.masks[s] = shared.masks[s] || masks[s].voxels[v];
   }
   return shared;
 }
@@ -190,17 +196,13 @@ StructuresOutcome segmentStructures(const Volume& image, const std::vector<Struc
   std::vector<MatrixX3> evidence;
   for (const SegmentOutcome& o : out.structures) evidence.push_back(landmarkPositions(o.springs));
   for (const SegmentOutcome& o : out.structures) out.aloneMetrics.push_back(o.metrics);
-  out.sharedAlone = sharedVoxels(masks);
+  const Sharing alone = sharing(masks);
+  out.sharedAlone = alone.voxels;
   out.segmentedAgain.assign(n, false);
 
   if (out.sharedAlone > 0 && parameters.barrierStiffness > 0) {
-    // Which structures shared voxels, and the territories on the structures' box.
-    for (std::size_t v = 0; v < masks.front().voxels.size(); ++v) {
-      int holders = 0;
-      for (const Mask& m : masks) holders += m.voxels[v] != 0;
-      if (holders > 1)
-        for (std::size_t s = 0; s < n; ++s) out.segmentedAgain[s] = out.segmentedAgain[s] || masks[s].voxels[v];
-    }
+    out.segmentedAgain = alone.masks;
+    // The territories, on the structures' box.
     const auto [first, size] = structuresBox(masks);
     const Volume territories = cropVolume(jointLabels(masks, evidence), first, size);
     for (std::size_t s = 0; s < n; ++s) {
@@ -215,7 +217,7 @@ StructuresOutcome segmentStructures(const Volume& image, const std::vector<Struc
     }
     masks = masksOf();
   }
-  out.sharedTogether = sharedVoxels(masks);
+  out.sharedTogether = sharing(masks).voxels;
   out.labels = jointLabels(masks, evidence);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
 

@@ -28,7 +28,7 @@ struct StructureInputs {
 
 struct StructuresOutcome {
   // In the inputs' order; a structure segmented again holds its second
-  // segmentation, its report with its passes.
+  // segmentation (the one with the barrier) and that segmentation's report.
   std::vector<SegmentOutcome> structures;
   std::vector<bool> segmentedAgain;
   // The joined labelmap on the labelmaps' grid: 0 outside every structure,
