@@ -1,10 +1,9 @@
 #include "FigureOutputs.h"
 
+#include <CLI/CLI.hpp>
 #include <iostream>
 #include <map>
 #include <string>
-
-#include <CLI/CLI.hpp>
 
 #include "dynsub/Error.h"
 #include "dynsub/FigureInputs.h"
@@ -12,28 +11,55 @@
 
 namespace dynsub::app {
 
-void addFigureCoordinatesOption(CLI::App& command, FigureCoordinates& coordinates) {
-  const std::map<std::string, FigureCoordinates> names{{"lps", FigureCoordinates::Lps},
-                                                       {"ras", FigureCoordinates::Ras}};
+void FigureOptions::addOptions(CLI::App& command) {
+  command.add_flag("!--no-figures", figures,
+                   "Do not render the figures slices, surface3d and convergence (rendering needs an X display; "
+                   "without DISPLAY a private Xvfb is started for the run)");
+  addStyleOptions(command);
+}
+
+void FigureOptions::addStyleOptions(CLI::App& command) {
+  const std::map<std::string, FigureCoordinates> coordinateNames{{"lps", FigureCoordinates::Lps},
+                                                                 {"ras", FigureCoordinates::Ras}};
   command
       .add_option("--figure-coordinates", coordinates,
                   "The coordinates the slices figure prints and names: lps (x to the left, y posterior; DICOM, "
                   "ITK, 3D Slicer's files, this tool's outputs) or ras (x to the right, y anterior; NIfTI, "
                   "FreeSurfer, MNI)")
-      ->transform(CLI::CheckedTransformer(names, CLI::ignore_case))
+      ->transform(CLI::CheckedTransformer(coordinateNames, CLI::ignore_case))
       ->default_str("lps");
-}
-
-void FigureOptions::addOptions(CLI::App& command) {
-  command.add_flag("!--no-figures", figures,
-                   "Do not render slices.png, surface3d.png and convergence.png (rendering needs an X display; "
-                   "without DISPLAY a private Xvfb is started for the run)");
-  addFigureCoordinatesOption(command, coordinates);
+  const std::map<std::string, FigureFormat> formatNames{
+      {"png", FigureFormat::Png}, {"pdf", FigureFormat::Pdf}, {"svg", FigureFormat::Svg}};
+  command
+      .add_option("--figure-format", format,
+                  "The figures' file format: png, or pdf or svg for papers and posters (text as vector outlines, "
+                  "the image and the surface as a raster at --figure-dpi; made with pdftocairo, Debian's "
+                  "poppler-utils)")
+      ->transform(CLI::CheckedTransformer(formatNames, CLI::ignore_case))
+      ->default_str("png");
+  command
+      .add_option("--figure-dpi", dpi,
+                  "Pixels per inch of the figures at their nominal size (slices 12 x 8 in, 3D view 8 x 8 in, "
+                  "convergence 9 x 5 in); text, lines and dots grow with it. 100 gives 1200 x 800 pixels of slices, "
+                  "300 a print-quality 3600 x 2400")
+      ->check(CLI::Range(kMinFigureDpi, kMaxFigureDpi))
+      ->default_str("100");
 }
 
 void FigureOptions::prepare() const {
   if (!figures) return;
   prepareFigureDisplay();
+}
+
+FigureFiles FigureOptions::files(OutputSet& outputs, bool convergence) const {
+  const std::string extension = "." + figureExtension(format);
+  FigureFiles files;
+  files.slices = outputs.add("slices" + extension);
+  files.surface3d = outputs.add("surface3d" + extension);
+  if (convergence) files.convergence = outputs.add("convergence" + extension);
+  files.format = format;
+  files.dpi = dpi;
+  return files;
 }
 
 void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const ControlMesh& mesh,
@@ -56,11 +82,7 @@ void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const Co
   inputs.history = &history;
   inputs.edgeDistances = edgeDistances;
   inputs.coordinates = options.coordinates;
-  FigureFiles files;
-  files.slices = outputs.add("slices.png");
-  files.surface3d = outputs.add("surface3d.png");
-  files.convergence = outputs.add("convergence.png");
-  writeFigures(inputs, files);
+  writeFigures(inputs, options.files(outputs, true));
 }
 
 }  // namespace dynsub::app

@@ -1,7 +1,8 @@
 #pragma once
 // What `segment` and `fit` add for people to look at: the convergence
 // history (convergence.csv, always) and the figures of Figures.h
-// (slices.png, surface3d.png, convergence.png) when an X display is there.
+// (slices.png, surface3d.png, convergence.png, or PDF or SVG) when an X
+// display is there.
 #include "dynsub/ConvergenceHistory.h"
 #include "dynsub/FigureInputs.h"
 #include "dynsub/Tessellation.h"
@@ -21,11 +22,21 @@ namespace dynsub::app {
 struct FigureOptions {
   bool figures = true;
   FigureCoordinates coordinates = FigureCoordinates::Lps;
+  FigureFormat format = FigureFormat::Png;
+  double dpi = kDefaultFigureDpi;
+  // --no-figures and addStyleOptions' options (segment, fit).
   void addOptions(CLI::App& command);
+  // --figure-coordinates lps|ras, --figure-format png|pdf|svg, --figure-dpi
+  // (segment, fit, render).
+  void addStyleOptions(CLI::App& command);
   // When figures are wanted: their display made ready on a second thread
   // (Figures.h: prepareFigureDisplay) while the run goes on. Call it once the
   // inputs are read and checked, before the run's long part.
   void prepare() const;
+  // The figures' files in `outputs` (slices.png, surface3d.png and, when
+  // `convergence`, convergence.png, or .pdf or .svg), in this format and
+  // resolution.
+  FigureFiles files(OutputSet& outputs, bool convergence) const;
 };
 
 // Adds convergence.csv and, if wanted and possible, the three figures to
@@ -35,9 +46,6 @@ struct FigureOptions {
 // #points x 3 (mm), possibly empty; edgeDistances, when not empty, colour the
 // surface and its contours (a segmentation's distance to the nearest edge per
 // point of `surface`, Figures.h).
-// --figure-coordinates lps|ras, for segment, fit and render.
-void addFigureCoordinatesOption(CLI::App& command, FigureCoordinates& coordinates);
-
 void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const ControlMesh& mesh,
                       const TriangleSurface& surface, const ConvergenceHistory& history, const Volume* image,
                       const MatrixX3& landmarks, const MatrixX3& dataPoints,

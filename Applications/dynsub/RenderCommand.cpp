@@ -1,9 +1,8 @@
 // dynsub render: the figures of segment and fit (Figures.h) from saved results.
+#include <CLI/CLI.hpp>
 #include <filesystem>
 #include <iostream>
 #include <memory>
-
-#include <CLI/CLI.hpp>
 
 #include "Commands.h"
 #include "FigureOutputs.h"
@@ -21,7 +20,7 @@ namespace {
 
 struct RenderCommandOptions {
   std::string surface, image, landmarks, points, convergence, controlMesh, out;
-  FigureCoordinates coordinates = FigureCoordinates::Lps;
+  FigureOptions figures;
 };
 
 void runRender(const RenderCommandOptions& o) {
@@ -31,7 +30,7 @@ void runRender(const RenderCommandOptions& o) {
   // file when the figures are drawn: a bad one leaves nothing behind).
   FigureInputs inputs;
   inputs.surfaceFile = o.surface;
-  inputs.coordinates = o.coordinates;
+  inputs.coordinates = o.figures.coordinates;
   std::unique_ptr<Volume> image;
   if (!o.image.empty()) {
     image = std::make_unique<Volume>(readVolume(o.image));
@@ -53,14 +52,11 @@ void runRender(const RenderCommandOptions& o) {
   const std::filesystem::path dir(o.out);
   prepareOutputDirectory(dir);
   OutputSet outputs(dir);
-  FigureFiles files;
-  files.slices = outputs.add("slices.png");
-  files.surface3d = outputs.add("surface3d.png");
-  if (!o.convergence.empty()) files.convergence = outputs.add("convergence.png");
-  writeFigures(inputs, files);
+  writeFigures(inputs, o.figures.files(outputs, !o.convergence.empty()));
   outputs.commit();
-  std::cout << "wrote " << (dir / "slices.png").string() << ", surface3d.png"
-            << (o.convergence.empty() ? "" : ", convergence.png") << '\n';
+  const std::string extension = "." + figureExtension(o.figures.format);
+  std::cout << "wrote " << (dir / ("slices" + extension)).string() << ", surface3d" << extension
+            << (o.convergence.empty() ? "" : ", convergence" + extension) << '\n';
 }
 
 }  // namespace
@@ -70,7 +66,8 @@ void addRenderCommand(CLI::App& app) {
   CLI::App* command = app.add_subcommand(
       "render",
       "Make the figures of segment and fit from saved results: DIR/slices.png (slices through the surface with "
-      "its contour and the landmarks), DIR/surface3d.png and, with --convergence, DIR/convergence.png.\n"
+      "its contour and the landmarks), DIR/surface3d.png and, with --convergence, DIR/convergence.png (or .pdf "
+      "or .svg: --figure-format).\n"
       "Needs an X display; without DISPLAY a private Xvfb is started for the run.");
   command->add_option("--surface", o->surface, "Limit surface: surface.vtp (or .obj, .ply, .stl), mm")->required();
   command->add_option("--image", o->image, "The image the surface was segmented in (slices show it)");
@@ -79,7 +76,7 @@ void addRenderCommand(CLI::App& app) {
   command->add_option("--control-mesh", o->controlMesh, "Control mesh to draw as a wireframe in the 3D figure");
   command->add_option("--convergence", o->convergence, "convergence.csv written by segment or fit");
   command->add_option("--out", o->out, "Output directory (created if missing; its parent must exist)")->required();
-  addFigureCoordinatesOption(*command, o->coordinates);
+  o->figures.addStyleOptions(*command);
   command->callback([o] { runRender(*o); });
 }
 

@@ -1,22 +1,21 @@
 #include "dynsub/Figures.h"
 
-#include <algorithm>
-#include <array>
-#include <cstdlib>
-#include <memory>
-#include <string>
-#include <utility>
-#include <vector>
-
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <vtkActor.h>
 #include <vtkAnnotatedCubeActor.h>
 #include <vtkCamera.h>
 #include <vtkChartXY.h>
 #include <vtkContextActor.h>
 #include <vtkContextScene.h>
-#include <vtkNew.h>
+#include <vtkGL2PSExporter.h>
 #include <vtkImageData.h>
+#include <vtkNew.h>
 #include <vtkPointData.h>
 #include <vtkPolyData.h>
+#include <vtkPropCollection.h>
 #include <vtkProperty.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
@@ -25,25 +24,40 @@
 #include <vtkTextProperty.h>
 #include <vtkWindowToImageFilter.h>
 
-#include "dynsub/SceneStyle.h"
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "PngFile.h"
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/ConvergencePlot.h"
 #include "dynsub/Error.h"
+#include "dynsub/SceneStyle.h"
 #include "dynsub/SlicePlanes.h"
 #include "dynsub/SliceView.h"
 #include "dynsub/SurfacePolyData.h"
-#include "dynsub/SurfaceWriter.h"
 #include "dynsub/SurfaceView.h"
-#include "PngFile.h"
+#include "dynsub/SurfaceWriter.h"
 
 namespace dynsub {
 
 namespace {
 
 constexpr int kColumns = 5;
-constexpr int kCell = 240;     // pixels per montage cell's image
-constexpr int kCaption = 18;   // pixels of each cell's caption strip, above its image
-constexpr int kLegend = 26;    // pixels of the slices figure's legend strip, at the bottom
+constexpr int kCell = 240;    // pixels per montage cell's image
+constexpr int kCaption = 18;  // pixels of each cell's caption strip, above its image
+constexpr int kLegend = 26;   // pixels of the slices figure's legend strip, at the bottom
 constexpr int kSlicesWidth = kColumns * kCell;
 constexpr int kSlicesHeight = 3 * (kCell + kCaption) + kLegend;
 constexpr int kCaptionFont = 12;
@@ -141,7 +155,8 @@ void drawSlices(const FigureScene& scene, vtkRenderWindow* window) {
     SlicePlane axes = image ? image->plane(orientation, 0) : anatomicalPlane(orientation, centre, 0.015 * diagonal);
     const Eigen::VectorXd along = points * axes.normal;
     const Eigen::VectorXd across = points * axes.right, upward = points * axes.up;
-    const double halfSize = 0.5 * 1.3 * std::max(across.maxCoeff() - across.minCoeff(), upward.maxCoeff() - upward.minCoeff()) + 3.0;
+    const double halfSize =
+        0.5 * 1.3 * std::max(across.maxCoeff() - across.minCoeff(), upward.maxCoeff() - upward.minCoeff()) + 3.0;
     for (int column = 0; column < kColumns; ++column) {
       SliceView view(orientation);
       view.setImage(image);
@@ -242,12 +257,13 @@ void drawSurface(const FigureScene& scene, vtkRenderWindow* window) {
   }
 }
 
-void drawConvergence(const ConvergenceHistory& history, vtkRenderWindow* window) {
+// `scale`: the resolution's, which the chart's lines need when it is built (ConvergencePlot.h).
+void drawConvergence(const ConvergenceHistory& history, vtkRenderWindow* window, double scale) {
   window->SetSize(900, 500);
   vtkNew<vtkRenderer> renderer;
   renderer->SetBackground(1, 1, 1);
   vtkNew<vtkContextActor> actor;
-  actor->GetScene()->AddItem(convergenceChart(history));
+  actor->GetScene()->AddItem(convergenceChart(history, scale));
   renderer->AddActor(actor);
   window->AddRenderer(renderer);
 }
@@ -268,11 +284,51 @@ vtkSmartPointer<vtkRenderWindow> surfaceFigure(const FigureScene& scene) {
 
 vtkSmartPointer<vtkRenderWindow> convergenceFigure(const ConvergenceHistory& history) {
   auto window = style::offScreenWindow(900, 500);
-  drawConvergence(history, window);
+  drawConvergence(history, window, 1.0);
   return window;
 }
 
-void writePng(vtkRenderWindow* window, const std::string& path) {
+std::string figureExtension(FigureFormat format) {
+  switch (format) {
+    case FigureFormat::Pdf:
+      return "pdf";
+    case FigureFormat::Svg:
+      return "svg";
+    case FigureFormat::Png:
+      break;
+  }
+  return "png";
+}
+
+namespace {
+
+// The window, and with it its text (through the window's DPI, which text
+// sizes in points are drawn at), its lines and its dots, `scale` times as
+// large. Viewports and cameras are relative to the window and stay as they are.
+void scaleFigure(vtkRenderWindow* window, double scale) {
+  const int* size = window->GetSize();
+  window->SetSize(static_cast<int>(std::lround(size[0] * scale)), static_cast<int>(std::lround(size[1] * scale)));
+  window->SetDPI(static_cast<int>(std::lround(72 * scale)));
+  if (scale == 1.0) return;
+  vtkRendererCollection* renderers = window->GetRenderers();
+  renderers->InitTraversal();
+  while (vtkRenderer* renderer = renderers->GetNextItem()) {
+    vtkNew<vtkPropCollection> actors;
+    vtkPropCollection* props = renderer->GetViewProps();
+    props->InitTraversal();
+    while (vtkProp* prop = props->GetNextProp()) prop->GetActors(actors);  // an assembly's parts too
+    actors->InitTraversal();
+    while (vtkProp* prop = actors->GetNextProp()) {
+      if (auto* actor = vtkActor::SafeDownCast(prop)) {
+        vtkProperty* property = actor->GetProperty();
+        property->SetLineWidth(static_cast<float>(property->GetLineWidth() * scale));
+        property->SetPointSize(static_cast<float>(property->GetPointSize() * scale));
+      }
+    }
+  }
+}
+
+void writePngAt(vtkRenderWindow* window, const std::string& path, double dpi) {
   AtomicOutput output(path);
   window->Render();
   vtkNew<vtkWindowToImageFilter> capture;
@@ -286,9 +342,92 @@ void writePng(vtkRenderWindow* window, const std::string& path) {
     throw writeFailure(path, "internal: the window's capture is not 8-bit");
   // PngFile.h says why not vtkPNGWriter.
   writePngFile(output.temporaryPath(), size[0], size[1], image->GetNumberOfScalarComponents(),
-               static_cast<const unsigned char*>(image->GetScalarPointer()));
+               static_cast<const unsigned char*>(image->GetScalarPointer()), dpi);
   output.commit();
 }
+
+// Runs pdftocairo with `arguments`; its messages go to `log`, which the
+// error quotes when it fails.
+void runPdftocairo(const std::vector<std::string>& arguments, const std::string& log, const std::string& target) {
+  std::vector<char*> argv;
+  for (const std::string& argument : arguments) argv.push_back(const_cast<char*>(argument.c_str()));
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  pid_t pid = 0;
+  const int spawned = posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (spawned == ENOENT)
+    throw writeFailure(target,
+                       "PDF and SVG figures are made with pdftocairo, which is not installed "
+                       "(Debian package poppler-utils); PNG figures need nothing more");
+  if (spawned != 0)
+    throw writeFailure(target, std::string("pdftocairo could not be started: ") + std::strerror(spawned));
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    std::ifstream in(log);
+    std::string messages((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    throw writeFailure(target, "pdftocairo failed: " + messages.substr(0, 400));
+  }
+}
+
+// PDF or SVG through GL2PS: its PDF (text as outlines, the 3D scene as a
+// raster of the window) is an intermediate that pdftocairo rewrites at the
+// figure's nominal size, as PDF or as SVG (Debian's GL2PS cannot embed a
+// raster in SVG itself, and poppler finds its PDF's graphics states unusual;
+// cairo's files open everywhere).
+void writeVectorFigure(vtkRenderWindow* window, const std::string& path, FigureFormat format, double dpi) {
+  AtomicOutput output(path);
+  const std::string prefix = output.temporaryPath() + "-gl2ps";
+  const std::string intermediate = prefix + ".pdf", log = prefix + ".log";
+  struct Remove {
+    std::vector<std::string> paths;
+    ~Remove() {
+      for (const std::string& p : paths) std::remove(p.c_str());
+    }
+  } remove{{intermediate, log}};
+  window->Render();
+  vtkNew<vtkGL2PSExporter> exporter;
+  exporter->SetRenderWindow(window);
+  exporter->SetFilePrefix(prefix.c_str());
+  exporter->SetFileFormatToPDF();
+  exporter->Write3DPropsAsRasterImageOn();
+  exporter->SetSortToOff();  // in drawing order: the plot's legend box over its grid
+  exporter->TextAsPathOn();
+  exporter->SetTitle("DynSub figure");
+  exporter->Write();
+  if (!std::filesystem::exists(intermediate) || std::filesystem::file_size(intermediate) == 0)
+    throw writeFailure(path, "GL2PS wrote no PDF of the figure");
+  // The nominal size in points. pdftocairo takes the paper upright and
+  // turns it for a landscape page, so the shorter side goes first.
+  const int* size = window->GetSize();
+  const long width = std::lround(size[0] * 72.0 / dpi), height = std::lround(size[1] * 72.0 / dpi);
+  runPdftocairo(
+      {"pdftocairo", format == FigureFormat::Svg ? "-svg" : "-pdf", "-paperw", std::to_string(std::min(width, height)),
+       "-paperh", std::to_string(std::max(width, height)), intermediate, output.temporaryPath()},
+      log, path);
+  output.commit();
+}
+
+}  // namespace
+
+void writeFigure(vtkRenderWindow* window, const std::string& path, FigureFormat format, double dpi) {
+  if (!(dpi >= kMinFigureDpi && dpi <= kMaxFigureDpi))
+    throw writeFailure(path, "internal: a figure resolution outside " + std::to_string(int(kMinFigureDpi)) + "-" +
+                                 std::to_string(int(kMaxFigureDpi)) + " dpi");
+  scaleFigure(window, dpi / kDefaultFigureDpi);
+  if (format == FigureFormat::Png) {
+    writePngAt(window, path, dpi);
+  } else {
+    writeVectorFigure(window, path, format, dpi);
+  }
+}
+
+void writePng(vtkRenderWindow* window, const std::string& path) { writePngAt(window, path, kDefaultFigureDpi); }
 
 void writeFigures(const FigureInputs& inputs, const FigureFiles& files) {
   const vtkSmartPointer<vtkPolyData> surface =
@@ -324,11 +463,11 @@ void writeFigures(const FigureInputs& inputs, const FigureFiles& files) {
     if (path.empty()) return;
     while (vtkRenderer* previous = window->GetRenderers()->GetFirstRenderer()) window->RemoveRenderer(previous);
     figure();
-    writePng(window, path);
+    writeFigure(window, path, files.format, files.dpi);
   };
   draw(files.slices, [&] { drawSlices(scene, window); });
   draw(files.surface3d, [&] { drawSurface(scene, window); });
-  draw(files.convergence, [&] { drawConvergence(*inputs.history, window); });
+  draw(files.convergence, [&] { drawConvergence(*inputs.history, window, files.dpi / kDefaultFigureDpi); });
 }
 
 }  // namespace dynsub

@@ -3,6 +3,7 @@
 #include <libdeflate.h>
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <fstream>
 #include <memory>
@@ -29,8 +30,9 @@ void putChunk(std::vector<unsigned char>& file, const char (&type)[5], const uns
 
 }  // namespace
 
-void writePngFile(const std::string& path, int width, int height, int channels, const unsigned char* bottomRowFirst) {
-  if (width < 1 || height < 1 || (channels != 3 && channels != 4) || !bottomRowFirst)
+void writePngFile(const std::string& path, int width, int height, int channels, const unsigned char* bottomRowFirst,
+                  double dpi) {
+  if (width < 1 || height < 1 || (channels != 3 && channels != 4) || !bottomRowFirst || !(dpi > 0))
     throw Error(path, "internal: a PNG of " + std::to_string(width) + " x " + std::to_string(height) + " pixels of " +
                           std::to_string(channels) + " channels");
   // The rows top first, each behind its filter byte: 2, "up", each sample
@@ -42,8 +44,7 @@ void writePngFile(const std::string& path, int width, int height, int channels, 
     const unsigned char* above = y > 0 ? row + rowBytes : nullptr;
     unsigned char* out = &filtered[(rowBytes + 1) * y];
     out[0] = 2;
-    for (std::size_t i = 0; i < rowBytes; ++i)
-      out[1 + i] = static_cast<unsigned char>(row[i] - (above ? above[i] : 0));
+    for (std::size_t i = 0; i < rowBytes; ++i) out[1 + i] = static_cast<unsigned char>(row[i] - (above ? above[i] : 0));
   }
   // Level 4: as small as VTK's files at its default level, at about a
   // third of the time of level 6.
@@ -62,6 +63,13 @@ void writePngFile(const std::string& path, int width, int height, int channels, 
   // 8 bits per sample, RGB (2) or RGBA (6), deflate, adaptive filtering, no interlace.
   header.insert(header.end(), {8, static_cast<unsigned char>(channels == 3 ? 2 : 6), 0, 0, 0});
   putChunk(file, "IHDR", header.data(), header.size());
+  // Pixels per metre, the same across and down, unit 1 (the metre).
+  std::vector<unsigned char> physical;
+  const auto perMetre = static_cast<std::uint32_t>(std::lround(dpi / 0.0254));
+  putBigEndian(physical, perMetre);
+  putBigEndian(physical, perMetre);
+  physical.push_back(1);
+  putChunk(file, "pHYs", physical.data(), physical.size());
   putChunk(file, "IDAT", deflated.data(), deflatedSize);
   putChunk(file, "IEND", nullptr, 0);
   std::ofstream out(path, std::ios::binary | std::ios::trunc);

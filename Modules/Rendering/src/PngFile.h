@@ -11,8 +11,11 @@ namespace dynsub {
 
 // Writes `height` rows of `width` pixels of `channels` 8-bit samples (3: RGB,
 // 4: RGBA) to `path` (a plain file, replaced). The rows are given bottom
-// first, as VTK's images hold them. Throws dynsub::Error naming the path when
+// first, as VTK's images hold them; `dpi`, the pixels per inch the image is
+// meant to be printed at, is recorded (the pHYs chunk, which viewers and
+// layout programs read for the printed size). Throws dynsub::Error naming the path when
 // the arguments are impossible or the file cannot be written.
-void writePngFile(const std::string& path, int width, int height, int channels, const unsigned char* bottomRowFirst);
+void writePngFile(const std::string& path, int width, int height, int channels, const unsigned char* bottomRowFirst,
+                  double dpi = 100.0);
 
 }  // namespace dynsub

@@ -2,17 +2,19 @@
 // every sample as written, whatever the size and channels, and a clear error
 // for a file that cannot be written. Needs no display.
 #include <gtest/gtest.h>
-
-#include <filesystem>
-#include <string>
-#include <vector>
-
 #include <vtkImageData.h>
 #include <vtkNew.h>
 #include <vtkPNGReader.h>
 
-#include "ScratchFiles.h"
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
 #include "PngFile.h"
+#include "ScratchFiles.h"
 #include "dynsub/Error.h"
 
 namespace dynsub {
@@ -55,6 +57,30 @@ TEST(PngFile, VtksReaderGetsEverySampleBack) {
       for (std::size_t i = 0; i < samples.size(); ++i)
         ASSERT_EQ(read[i], samples[i]) << width << " x " << height << " x " << channels << ", sample " << i;
     }
+}
+
+// The resolution a figure is meant to be printed at, as the pHYs chunk
+// holds it: pixels per metre (300 dpi is 11811), the same across and down,
+// unit 1 (the metre).
+TEST(PngFile, RecordsItsPrintResolution) {
+  const std::vector<unsigned char> samples = pattern(8, 8, 3);
+  const fs::path path = scratch("300dpi.png");
+  writePngFile(path.string(), 8, 8, 3, samples.data(), 300.0);
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t at = bytes.find("pHYs");
+  ASSERT_NE(at, std::string::npos);
+  ASSERT_LT(bytes.find("pHYs"), bytes.find("IDAT"));  // the format puts it before the image data
+  auto bigEndian = [&](std::size_t from) {
+    std::uint32_t value = 0;
+    for (std::size_t i = 0; i < 4; ++i) value = value << 8 | static_cast<unsigned char>(bytes[from + i]);
+    return value;
+  };
+  EXPECT_EQ(bigEndian(at - 4), 9u);  // the chunk's length
+  EXPECT_EQ(bigEndian(at + 4), 11811u);
+  EXPECT_EQ(bigEndian(at + 8), 11811u);
+  EXPECT_EQ(bytes[at + 12], 1);
+  EXPECT_THROW(writePngFile(scratch("bad.png").string(), 4, 4, 3, samples.data(), 0.0), Error);
 }
 
 TEST(PngFile, AFileThatCannotBeWrittenIsAnErrorNamingIt) {

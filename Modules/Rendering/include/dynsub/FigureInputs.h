@@ -35,11 +35,27 @@ struct FigureInputs {
   Eigen::VectorXd edgeDistances;
   FigureCoordinates coordinates = FigureCoordinates::Lps;
 };
-// The paths to write slices.png, surface3d.png and convergence.png to; an
-// empty path is not rendered. Needs a display (figureDisplay). Throws as the
-// figures and writePng do.
+// The figures' file formats. PNG is a raster. In PDF and SVG the text (the
+// captions, the legend, the plot's labels) is vector outlines and the rest
+// (the image, the surface, the contours) a raster at the figure's resolution.
+enum class FigureFormat { Png, Pdf, Svg };
+std::string figureExtension(FigureFormat format);  // "png", "pdf" or "svg"
+
+// Each figure has a nominal size (slices 12 x 8 in, the 3D view 8 x 8 in,
+// the convergence plot 9 x 5 in) and is drawn at `dpi` pixels per inch of it:
+// at the default, 1200 x 800 pixels for the slices. Text, lines and dots grow
+// with the resolution, so a figure looks the same at any dpi, only sharper.
+constexpr double kDefaultFigureDpi = 100.0;
+constexpr double kMinFigureDpi = 50.0, kMaxFigureDpi = 600.0;
+
+// The paths to write the slices, the 3D view and the convergence plot to
+// (slices.png, surface3d.png, convergence.png for PNG); an empty path is not
+// rendered. Needs a display (figureDisplay). Throws as the figures and
+// writeFigure do.
 struct FigureFiles {
   std::string slices, surface3d, convergence;
+  FigureFormat format = FigureFormat::Png;
+  double dpi = kDefaultFigureDpi;
 };
 void writeFigures(const FigureInputs& inputs, const FigureFiles& files);
 
