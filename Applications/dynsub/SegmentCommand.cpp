@@ -1,4 +1,5 @@
 // dynsub segment: a structure in a 3D image from image forces and expert landmarks (Segmentation.h).
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -10,8 +11,6 @@
 #include <memory>
 #include <optional>
 #include <sstream>
-
-#include <CLI/CLI.hpp>
 
 #include "CommandLine.h"
 #include "Commands.h"
@@ -138,7 +137,60 @@ void printSummary(const Arguments& o, const SegmentOutcome& outcome, const Volum
             << (o.figures.figures ? " and the figures that could be rendered" : "") << '\n';
 }
 
-void runSegmentOne(const Arguments& o) {
+// A landmark file's name without its folder and extension: caudate_left
+// for caudate_left.mrk.json.
+std::string structureName(const std::string& path) {
+  const std::string name = std::filesystem::path(path).filename().string();
+  std::string lower = name;
+  std::transform(lower.begin(), lower.end(), lower.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  for (const std::string extension : {".mrk.json", ".json", ".fcsv", ".csv"})
+    if (lower.size() > extension.size() &&
+        lower.compare(lower.size() - extension.size(), extension.size(), extension) == 0)
+      return name.substr(0, name.size() - extension.size());
+  return name;
+}
+
+// The structures the --landmarks files hold, in order: each file's lists (a
+// 3D Slicer markups file may hold one list per structure), each with the
+// name it gets without --name.
+struct LandmarkSource {
+  std::string path, name;
+  LandmarkList list;
+};
+
+// A list's name as a folder name: characters other than letters, digits,
+// '_', '-' and '.' become '_' ("Caudate L" -> Caudate_L).
+std::string folderName(const std::string& name) {
+  std::string folder = name;
+  for (char& c : folder)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-' && c != '.') c = '_';
+  return folder;
+}
+
+std::vector<LandmarkSource> landmarkSources(const std::vector<std::string>& files) {
+  std::vector<LandmarkSource> sources;
+  for (const std::string& path : files) {
+    std::vector<LandmarkList> lists = readLandmarkLists(path);
+    for (std::size_t k = 0; k < lists.size(); ++k) {
+      LandmarkSource source;
+      source.path = path;
+      // One list: the file's stem (caudate_left.mrk.json: caudate_left).
+      // Several: each list's own name, or the stem and its number.
+      if (lists.size() == 1)
+        source.name = structureName(path);
+      else
+        source.name =
+            lists[k].name.empty() ? structureName(path) + "_" + std::to_string(k + 1) : folderName(lists[k].name);
+      source.list = std::move(lists[k]);
+      sources.push_back(std::move(source));
+    }
+  }
+  return sources;
+}
+
+// `landmarks`: the one structure's, if any (landmarkSources).
+void runSegmentOne(const Arguments& o, const std::vector<LandmarkSource>& landmarks) {
   // Every input is read and checked before anything is written.
   if (!o.reference.empty() && o.referenceLabels.empty())
     throw Error("--reference needs --reference-label N[,M...]: the label value(s) of the structure");
@@ -149,10 +201,12 @@ void runSegmentOne(const Arguments& o) {
   for (const std::string& values : o.referenceLabels)
     for (const int value : parseLabelValues(values)) referenceLabels.push_back(value);
   const Volume image = readVolume(o.image);
-  const std::string landmarks = o.landmarks.empty() ? std::string() : o.landmarks.front();
-  if (!landmarks.empty()) inputs.landmarks = readLandmarks(landmarks, &inputs.landmarkSystem);
+  if (!landmarks.empty()) {
+    inputs.landmarks = landmarks.front().list.landmarks;
+    inputs.landmarkSystem = landmarks.front().list.stated;
+    inputs.landmarkSource = landmarks.front().path;
+  }
   inputs.image = o.image;
-  inputs.landmarkSource = landmarks;
   if (!o.inside.empty()) inputs.inside = parsePoint(o.inside, "--inside");
   if (inputs.start.kind == SegmentStart::Kind::Atlas) {
     if (o.atlasLabel.empty())
@@ -189,20 +243,6 @@ void runSegmentOne(const Arguments& o) {
   printSummary(o, outcome, image);
 }
 
-// A landmark file's name without its folder and extension: caudate_left
-// for caudate_left.mrk.json.
-std::string structureName(const std::string& path) {
-  const std::string name = std::filesystem::path(path).filename().string();
-  std::string lower = name;
-  std::transform(lower.begin(), lower.end(), lower.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  for (const std::string extension : {".mrk.json", ".json", ".fcsv", ".csv"})
-    if (lower.size() > extension.size() &&
-        lower.compare(lower.size() - extension.size(), extension.size(), extension) == 0)
-      return name.substr(0, name.size() - extension.size());
-  return name;
-}
-
 // BIDS's table of a dseg's labels: index, name and a colour for viewers that
 // take one, from a qualitative palette of ten that neighbours tell apart
 // (repeated past ten).
@@ -220,25 +260,26 @@ void writeLabelTable(const std::vector<StructureInputs>& structures, const std::
 // Several structures: each in DIR/NAME as one structure's run writes it, then
 // DIR/dseg.nii.gz, DIR/dseg.tsv and DIR/report.json, the run's report, last:
 // it is there only when everything is.
-void runSegmentTogether(const Arguments& o) {
-  if (!o.names.empty() && o.names.size() != o.landmarks.size())
-    throw Error("--name is given " + std::to_string(o.names.size()) + " times for " +
-                std::to_string(o.landmarks.size()) + " --landmarks files: name each file's structure, or none");
-  if (!o.reference.empty() && o.referenceLabels.size() != o.landmarks.size())
+void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& sources) {
+  if (!o.names.empty() && o.names.size() != sources.size())
+    throw Error("--name is given " + std::to_string(o.names.size()) + " times for " + std::to_string(sources.size()) +
+                " structures (the point lists of the --landmarks files): name each structure, or none");
+  if (!o.reference.empty() && o.referenceLabels.size() != sources.size())
     throw Error("--reference needs one --reference-label N[,M...] per structure, in the order of --landmarks (" +
-                std::to_string(o.landmarks.size()) + " structures, " + std::to_string(o.referenceLabels.size()) +
+                std::to_string(sources.size()) + " structures, " + std::to_string(o.referenceLabels.size()) +
                 " given)");
   if (o.reference.empty() && !o.referenceLabels.empty()) throw Error("--reference-label needs --reference");
   if (o.init != "auto")
     throw Error("--init " + o.init + ": several structures start from their landmarks (--init auto)");
   std::vector<StructureInputs> structures;
-  for (std::size_t s = 0; s < o.landmarks.size(); ++s) {
+  for (std::size_t s = 0; s < sources.size(); ++s) {
     StructureInputs structure;
-    structure.name = o.names.empty() ? structureName(o.landmarks[s]) : o.names[s];
+    structure.name = o.names.empty() ? sources[s].name : o.names[s];
     SegmentInputs& in = structure.inputs;
     in.image = o.image;
-    in.landmarkSource = o.landmarks[s];
-    in.landmarks = readLandmarks(o.landmarks[s], &in.landmarkSystem);
+    in.landmarkSource = sources[s].path;
+    in.landmarks = sources[s].list.landmarks;
+    in.landmarkSystem = sources[s].list.stated;
     if (!o.reference.empty()) {
       in.referencePath = o.reference;
       in.referenceLabels = parseLabelValues(o.referenceLabels[s]);
@@ -310,10 +351,11 @@ void runSegmentTogether(const Arguments& o) {
 }
 
 void runSegment(const Arguments& o) {
-  if (o.landmarks.size() > 1)
-    runSegmentTogether(o);
+  const std::vector<LandmarkSource> sources = landmarkSources(o.landmarks);
+  if (sources.size() > 1)
+    runSegmentTogether(o, sources);
   else
-    runSegmentOne(o);
+    runSegmentOne(o, sources);
 }
 
 }  // namespace
@@ -332,14 +374,16 @@ void addSegmentCommand(CLI::App& app) {
   command->add_option("--out", o->out, "Output directory (created if missing; its parent must exist)")->required();
   command
       ->add_option("--landmarks", o->landmarks,
-                   "Boundary points: .mrk.json, .fcsv or .csv (x,y,z in LPS mm). Given once per structure, "
-                   "the structures are segmented together: they do not overlap, and DIR/dseg.nii.gz with "
-                   "DIR/dseg.tsv names them (each structure's outputs in DIR/NAME)")
+                   "Boundary points: .mrk.json, .fcsv or .csv (x,y,z in LPS mm). Given once per structure, or "
+                   "as a .mrk.json with a point list per structure, the structures are segmented together: they "
+                   "do not overlap, and DIR/dseg.nii.gz with DIR/dseg.tsv names them (each structure's outputs "
+                   "in DIR/NAME)")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   command
       ->add_option("--name", o->names,
-                   "With several --landmarks: each structure's name, in their order (default: the files' stems)")
+                   "With several structures: each one's name, in their order (default: the files' stems, or a "
+                   "markups file's list names)")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   command

@@ -12,6 +12,8 @@
 #    was chosen on; the right side, held out, measured 3 of 4 higher and the
 #    pallidum 0.008 lower (Documentation/Segmentation.md), so there the mean
 #    must not drop and no structure may lose more than 0.01.
+#  - a markups file with a point list per structure is the same run as a
+#    file per structure;
 #  - bad combinations of options are refused before anything is written.
 # Needs DYNSUB (the executable), DATA and TOOLS.
 set -u
@@ -85,6 +87,28 @@ PY
 check_side left 0.001 0
 check_side right 0.01 0
 
+# One 3D Slicer markups file holding a point list per structure is the same
+# run as a file per structure: the left caudate and putamen as two lists
+# (one named with a space, which becomes '_'; the other unnamed), then the
+# same two files, give the same labels in dseg.nii.gz.
+python3 - "$DATA/Landmarks/caudate_left.mrk.json" "$DATA/Landmarks/putamen_left.mrk.json" "$work/two.mrk.json" <<'PY'
+import json, sys
+caudate, putamen = (json.load(open(path))["markups"][0] for path in sys.argv[1:3])
+caudate["name"] = "Caudate L"
+putamen.pop("name", None)
+json.dump({"markups": [caudate, putamen]}, open(sys.argv[3], "w"))
+PY
+"$DYNSUB" segment "$templates/ch2.nii.gz" --landmarks "$work/two.mrk.json" --no-figures --out "$work/lists" \
+  >"$work/lists.log" 2>&1
+check "one markups file with two lists: two structures" test $? -eq 0 -a -s "$work/lists/dseg.nii.gz" ||
+  cat "$work/lists.log"
+check "the lists' names: the markup's name made a folder name, else the file's stem and number" \
+  test "$(cut -f2 "$work/lists/dseg.tsv" | tr '\n' ' ')" = "name Caudate_L two_2 "
+"$DYNSUB" segment "$templates/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" \
+  --landmarks "$DATA/Landmarks/putamen_left.mrk.json" --no-figures --out "$work/files" >/dev/null 2>&1
+check "two lists in one file segment as the same two in two files" \
+  cmp -s <(gzip -dc "$work/lists/dseg.nii.gz") <(gzip -dc "$work/files/dseg.nii.gz")
+
 # Refused before anything is written.
 refused() {
   local name=$1 expect=$2; shift 2
@@ -97,6 +121,8 @@ refused() {
 caudate="$DATA/Landmarks/caudate_left.mrk.json"
 putamen="$DATA/Landmarks/putamen_left.mrk.json"
 refused "one name for two structures" "\-\-name is given 1 times" --landmarks "$caudate" --landmarks "$putamen" --name a
+refused "one name for a file of two lists" "\-\-name is given 1 times for 2 structures" --landmarks "$work/two.mrk.json" \
+  --name a
 refused "a name twice" "given twice" --landmarks "$caudate" --landmarks "$putamen" --name a --name a
 refused "a name that is a path" "use letters" --landmarks "$caudate" --landmarks "$putamen" --name a/b --name c
 refused "one reference label for two" "one --reference-label" --landmarks "$caudate" --landmarks "$putamen" \

@@ -3,9 +3,8 @@
 #include <cctype>
 #include <cmath>
 #include <fstream>
-#include <sstream>
-
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
@@ -34,11 +33,13 @@ std::vector<std::string> splitCsv(const std::string& line) {
   std::string field;
   bool quoted = false;
   for (char c : line) {
-    if (c == '"') quoted = !quoted;
+    if (c == '"')
+      quoted = !quoted;
     else if (c == ',' && !quoted) {
       fields.push_back(field);
       field.clear();
-    } else if (c != '\r') field += c;
+    } else if (c != '\r')
+      field += c;
   }
   fields.push_back(field);
   for (auto& f : fields) {
@@ -55,7 +56,8 @@ double finiteNumber(const std::string& text, const std::string& path, int line) 
   return value;
 }
 
-std::vector<Landmark> readMarkupsJson(const std::string& path, std::ifstream& in, CoordinateSystem& stated) {
+// Every markup of the file, in order, with or without points.
+std::vector<LandmarkList> readMarkupsJson(const std::string& path, std::ifstream& in) {
   nlohmann::json document;
   try {
     in >> document;
@@ -64,8 +66,7 @@ std::vector<Landmark> readMarkupsJson(const std::string& path, std::ifstream& in
   }
   if (!document.contains("markups") || !document["markups"].is_array())
     throw Error(path, "no \"markups\" list (not a 3D Slicer markups file)");
-  std::vector<Landmark> landmarks;
-  bool first = true;
+  std::vector<LandmarkList> lists;
   // A field of another JSON type than the format's (a number for a label, a
   // markup that is not an object) makes nlohmann::json throw: the file is
   // malformed, and the message names the file.
@@ -75,8 +76,9 @@ std::vector<Landmark> readMarkupsJson(const std::string& path, std::ifstream& in
       if (system != "LPS" && system != "RAS") throw Error(path, "unknown coordinateSystem \"" + system + "\"");
       if (markup.contains("coordinateUnits") && markup["coordinateUnits"] != "mm")
         throw Error(path, "coordinateUnits must be mm");
-      if (first) stated = system == "RAS" ? CoordinateSystem::RAS : CoordinateSystem::LPS;
-      first = false;
+      LandmarkList& list = lists.emplace_back();
+      list.name = markup.value("name", "");
+      list.stated = system == "RAS" ? CoordinateSystem::RAS : CoordinateSystem::LPS;
       if (!markup.contains("controlPoints")) continue;
       int index = 0;
       for (const auto& point : markup["controlPoints"]) {
@@ -88,13 +90,13 @@ std::vector<Landmark> readMarkupsJson(const std::string& path, std::ifstream& in
           throw Error(path, "control point " + std::to_string(index) + " has no [x, y, z] position");
         Vector3 p(position[0].get<double>(), position[1].get<double>(), position[2].get<double>());
         if (!p.allFinite()) throw Error(path, "control point " + std::to_string(index) + " is not finite");
-        landmarks.push_back({point.value("label", "F-" + std::to_string(index)), system == "RAS" ? flipXY(p) : p});
+        list.landmarks.push_back({point.value("label", "F-" + std::to_string(index)), system == "RAS" ? flipXY(p) : p});
       }
     }
   } catch (const nlohmann::json::exception& e) {
     throw Error(path, std::string("a malformed 3D Slicer markups file: ") + e.what());
   }
-  return landmarks;
+  return lists;
 }
 
 std::vector<Landmark> readFcsv(const std::string& path, std::ifstream& in, CoordinateSystem& system) {
@@ -110,9 +112,12 @@ std::vector<Landmark> readFcsv(const std::string& path, std::ifstream& in, Coord
       if (equals == std::string::npos) continue;
       const std::string key = line.substr(0, equals), value = splitCsv(line.substr(equals + 1))[0];
       if (key.find("CoordinateSystem") != std::string::npos) {
-        if (value == "LPS" || value == "1") system = CoordinateSystem::LPS;
-        else if (value == "RAS" || value == "0") system = CoordinateSystem::RAS;
-        else throw Error(path, "line " + std::to_string(number) + ": unknown coordinate system '" + value + "'");
+        if (value == "LPS" || value == "1")
+          system = CoordinateSystem::LPS;
+        else if (value == "RAS" || value == "0")
+          system = CoordinateSystem::RAS;
+        else
+          throw Error(path, "line " + std::to_string(number) + ": unknown coordinate system '" + value + "'");
       } else if (key.find("columns") != std::string::npos) {
         columns = splitCsv(line.substr(equals + 1));
       }
@@ -174,19 +179,37 @@ std::string labelOf(const std::vector<Landmark>& landmarks, std::size_t i) {
 
 }  // namespace
 
-std::vector<Landmark> readLandmarks(const std::string& path, CoordinateSystem* stated) {
+namespace {
+
+// Every list of the file: a .mrk.json's markups, or the one list of a .fcsv
+// or .csv.
+std::vector<LandmarkList> readAllLists(const std::string& path) {
   const Format format = formatOf(path);
   std::ifstream in(path);
   if (!in) throw Error(path, "no such file or not readable");
+  if (format == Format::MarkupsJson) return readMarkupsJson(path, in);
+  LandmarkList list;
+  list.landmarks = format == Format::Fcsv ? readFcsv(path, in, list.stated) : readCsv(path, in);
+  return {list};
+}
+
+}  // namespace
+
+std::vector<Landmark> readLandmarks(const std::string& path, CoordinateSystem* stated) {
+  const std::vector<LandmarkList> lists = readAllLists(path);
   std::vector<Landmark> landmarks;
-  CoordinateSystem system = CoordinateSystem::LPS;
-  switch (format) {
-    case Format::MarkupsJson: landmarks = readMarkupsJson(path, in, system); break;
-    case Format::Fcsv: landmarks = readFcsv(path, in, system); break;
-    case Format::Csv: landmarks = readCsv(path, in); break;
-  }
-  if (stated) *stated = system;
+  for (const LandmarkList& list : lists)
+    landmarks.insert(landmarks.end(), list.landmarks.begin(), list.landmarks.end());
+  if (stated) *stated = lists.empty() ? CoordinateSystem::LPS : lists.front().stated;
   return landmarks;
+}
+
+std::vector<LandmarkList> readLandmarkLists(const std::string& path) {
+  std::vector<LandmarkList> lists = readAllLists(path), withPoints;
+  for (LandmarkList& list : lists)
+    if (!list.landmarks.empty()) withPoints.push_back(std::move(list));
+  if (withPoints.empty()) withPoints.push_back(lists.empty() ? LandmarkList() : lists.front());
+  return withPoints;
 }
 
 void writeLandmarks(const std::vector<Landmark>& landmarks, const std::string& path, CoordinateSystem system) {
@@ -205,10 +228,14 @@ void writeLandmarks(const std::vector<Landmark>& landmarks, const std::string& p
       nlohmann::json points = nlohmann::json::array();
       for (std::size_t i = 0; i < landmarks.size(); ++i) {
         const Vector3 p = stored(landmarks[i]);
-        points.push_back({{"id", std::to_string(i + 1)}, {"label", labelOf(landmarks, i)}, {"description", ""},
+        points.push_back({{"id", std::to_string(i + 1)},
+                          {"label", labelOf(landmarks, i)},
+                          {"description", ""},
                           {"position", {p.x(), p.y(), p.z()}},
                           {"orientation", {-1.0, -0.0, -0.0, -0.0, -1.0, -0.0, 0.0, 0.0, 1.0}},
-                          {"selected", true}, {"locked", false}, {"visibility", true},
+                          {"selected", true},
+                          {"locked", false},
+                          {"visibility", true},
                           {"positionStatus", "defined"}});
       }
       nlohmann::json document = {
@@ -216,7 +243,9 @@ void writeLandmarks(const std::vector<Landmark>& landmarks, const std::string& p
            "https://raw.githubusercontent.com/slicer/slicer/master/Modules/Loadable/Markups/Resources/Schema/"
            "markups-schema-v1.0.3.json#"},
           {"markups",
-           {{{"type", "Fiducial"}, {"coordinateSystem", ras ? "RAS" : "LPS"}, {"coordinateUnits", "mm"},
+           {{{"type", "Fiducial"},
+             {"coordinateSystem", ras ? "RAS" : "LPS"},
+             {"coordinateUnits", "mm"},
              {"controlPoints", points}}}}};
       out << document.dump(4) << '\n';
     } else if (format == Format::Fcsv) {

@@ -53,6 +53,39 @@ TEST(Landmarks, RasFilesAreTurnedIntoLps) {
   EXPECT_EQ(read[0].label, "F-1");
 }
 
+// A markups file with a point list per structure: each list on its own,
+// with its name and its own coordinate system; a list without points is
+// left out. readLandmarks still gives every point of the file, and a .csv
+// is one list without a name.
+TEST(Landmarks, AMarkupsFileGivesEachPointListOnItsOwn) {
+  const fs::path json = scratch("two.mrk.json");
+  std::ofstream(json.string()) << R"({"markups": [
+    {"name": "Caudate L", "coordinateSystem": "LPS", "controlPoints": [
+      {"label": "c1", "position": [1.0, 2.0, 3.0]}, {"label": "c2", "position": [4.0, 5.0, 6.0]}]},
+    {"name": "empty", "controlPoints": []},
+    {"coordinateSystem": "RAS", "controlPoints": [{"label": "p1", "position": [10.0, 20.0, 30.0]}]}]})";
+  const std::vector<LandmarkList> lists = readLandmarkLists(json.string());
+  ASSERT_EQ(lists.size(), 2u);
+  EXPECT_EQ(lists[0].name, "Caudate L");
+  EXPECT_EQ(lists[0].stated, CoordinateSystem::LPS);
+  ASSERT_EQ(lists[0].landmarks.size(), 2u);
+  EXPECT_EQ(lists[0].landmarks[1].position, Vector3(4, 5, 6));
+  EXPECT_EQ(lists[1].name, "");
+  EXPECT_EQ(lists[1].stated, CoordinateSystem::RAS);
+  ASSERT_EQ(lists[1].landmarks.size(), 1u);
+  EXPECT_EQ(lists[1].landmarks[0].position, Vector3(-10, -20, 30));
+  CoordinateSystem stated = CoordinateSystem::RAS;
+  EXPECT_EQ(readLandmarks(json.string(), &stated).size(), 3u);
+  EXPECT_EQ(stated, CoordinateSystem::LPS);  // the first list's
+
+  const fs::path csv = scratch("one.csv");
+  writeLandmarks(sample(), csv.string());
+  const std::vector<LandmarkList> one = readLandmarkLists(csv.string());
+  ASSERT_EQ(one.size(), 1u);
+  EXPECT_EQ(one[0].name, "");
+  EXPECT_EQ(one[0].landmarks.size(), 3u);
+}
+
 TEST(Landmarks, BadFilesAreRefusedWithTheirName) {
   auto expectError = [](const fs::path& path, const std::string& fragment) {
     try {

@@ -30,6 +30,18 @@ struct Landmark {
 // about a file that says one and holds the other.
 std::vector<Landmark> readLandmarks(const std::string& path, CoordinateSystem* stated = nullptr);
 
+// A list of landmarks as a file holds it: a .mrk.json's markup (3D Slicer's
+// point list), or all of a .fcsv or .csv.
+struct LandmarkList {
+  std::string name;  // the markup's "name"; empty when it has none, and for .fcsv and .csv
+  CoordinateSystem stated = CoordinateSystem::LPS;  // the system the file says its values are in
+  std::vector<Landmark> landmarks;                  // LPS mm
+};
+// The file's lists that hold a point, in order (one list for .fcsv and
+// .csv; the first list when none holds a point): a markups file may hold
+// one list per structure. Throws as readLandmarks.
+std::vector<LandmarkList> readLandmarkLists(const std::string& path);
+
 // Format by extension (.mrk.json, .fcsv, .csv); `system` applies to .mrk.json
 // and .fcsv (CSV is always LPS). The file appears complete or not at all.
 void writeLandmarks(const std::vector<Landmark>& landmarks, const std::string& path,
