@@ -36,8 +36,9 @@ struct FigureInputs {
   FigureCoordinates coordinates = FigureCoordinates::Lps;
 };
 // The figures' file formats. PNG is a raster. In PDF and SVG the text (the
-// captions, the legend, the plot's labels) is vector outlines and the rest
-// (the image, the surface, the contours) a raster at the figure's resolution.
+// captions, the legend, the plot's labels) is vector outlines, and so are
+// the plot's axes and curves; the image, the surface, its contours and the
+// landmarks are a raster at the figure's resolution.
 enum class FigureFormat { Png, Pdf, Svg };
 std::string figureExtension(FigureFormat format);  // "png", "pdf" or "svg"
 
