@@ -48,6 +48,7 @@ void FigureOptions::addStyleOptions(CLI::App& command) {
 
 void FigureOptions::prepare() const {
   if (!figures) return;
+  requireFigureFormat(format);
   prepareFigureDisplay();
 }
 

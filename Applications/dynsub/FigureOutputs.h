@@ -29,7 +29,8 @@ struct FigureOptions {
   // --figure-coordinates lps|ras, --figure-format png|pdf|svg, --figure-dpi
   // (segment, fit, render).
   void addStyleOptions(CLI::App& command);
-  // When figures are wanted: their display made ready on a second thread
+  // When figures are wanted: the format's converter checked for (throws
+  // without it), and their display made ready on a second thread
   // (Figures.h: prepareFigureDisplay) while the run goes on. Call it once the
   // inputs are read and checked, before the run's long part.
   void prepare() const;

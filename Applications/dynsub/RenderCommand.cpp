@@ -24,6 +24,7 @@ struct RenderCommandOptions {
 };
 
 void runRender(const RenderCommandOptions& o) {
+  requireFigureFormat(o.figures.format);
   std::string why;
   if (!figureDisplay(&why)) throw Error("rendering needs an X display: " + why);
   // Every input is read and checked before anything is written (the surface

@@ -34,9 +34,10 @@ namespace {
 struct Arguments {
   std::string image;
   std::string out;
-  // One file per structure; several segment the structures together.
+  // Landmark files: each holds one structure's points, or (a markups file)
+  // a point list per structure. Several structures are segmented together.
   std::vector<std::string> landmarks;
-  std::vector<std::string> names;  // one per landmarks file, or none (the files' stems)
+  std::vector<std::string> names;  // one per structure, or none (landmarkSources' names)
   std::string init = "auto";
   std::string reference;
   std::vector<std::string> referenceLabels;  // "N[,M...]": one per structure
@@ -176,7 +177,8 @@ std::vector<LandmarkSource> landmarkSources(const std::vector<std::string>& file
       LandmarkSource source;
       source.path = path;
       // One list: the file's stem (caudate_left.mrk.json: caudate_left).
-      // Several: each list's own name, or the stem and its number.
+      // Several: each list's own name, or the stem and its number among the
+      // file's lists that hold points.
       if (lists.size() == 1)
         source.name = structureName(path);
       else
@@ -189,8 +191,8 @@ std::vector<LandmarkSource> landmarkSources(const std::vector<std::string>& file
   return sources;
 }
 
-// `landmarks`: the one structure's, if any (landmarkSources).
-void runSegmentOne(const Arguments& o, const std::vector<LandmarkSource>& landmarks) {
+// `landmarks`: the one structure's, or null (no --landmarks).
+void runSegmentOne(const Arguments& o, const LandmarkSource* landmarks) {
   // Every input is read and checked before anything is written.
   if (!o.reference.empty() && o.referenceLabels.empty())
     throw Error("--reference needs --reference-label N[,M...]: the label value(s) of the structure");
@@ -201,10 +203,10 @@ void runSegmentOne(const Arguments& o, const std::vector<LandmarkSource>& landma
   for (const std::string& values : o.referenceLabels)
     for (const int value : parseLabelValues(values)) referenceLabels.push_back(value);
   const Volume image = readVolume(o.image);
-  if (!landmarks.empty()) {
-    inputs.landmarks = landmarks.front().list.landmarks;
-    inputs.landmarkSystem = landmarks.front().list.stated;
-    inputs.landmarkSource = landmarks.front().path;
+  if (landmarks) {
+    inputs.landmarks = landmarks->list.landmarks;
+    inputs.landmarkSystem = landmarks->list.stated;
+    inputs.landmarkSource = landmarks->path;
   }
   inputs.image = o.image;
   if (!o.inside.empty()) inputs.inside = parsePoint(o.inside, "--inside");
@@ -355,7 +357,7 @@ void runSegment(const Arguments& o) {
   if (sources.size() > 1)
     runSegmentTogether(o, sources);
   else
-    runSegmentOne(o, sources);
+    runSegmentOne(o, sources.empty() ? nullptr : &sources.front());
 }
 
 }  // namespace

@@ -5,16 +5,6 @@ set -u
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 source "$(dirname "${BASH_SOURCE[0]}")/Checks.sh"
-# expect_error NAME EXPECTED_CODE MESSAGE_FRAGMENT OUTPUT_FILE COMMAND...
-expect_error() {
-  local name=$1 code=$2 fragment=$3 output=$4; shift 4
-  "$@" >"$work/stdout" 2>"$work/stderr"
-  local rc=$?
-  check "$name: exit code $code (got $rc)" test "$rc" -eq "$code"
-  check "$name: message mentions '$fragment'" grep -q -- "$fragment" "$work/stderr"
-  check "$name: no output file" test ! -e "$output"
-  check "$name: no temporary file left" test -z "$(ls -A "$work" | grep '^\.tmp' || true)"
-}
 
 "$DYNSUB" --help >"$work/help" 2>&1
 check "dynsub --help lists limit" grep -q "limit" "$work/help"

@@ -346,6 +346,10 @@ void writePngAt(vtkRenderWindow* window, const std::string& path, double dpi) {
   output.commit();
 }
 
+constexpr const char* kPdftocairoMissing =
+    "PDF and SVG figures are made with pdftocairo, which is not on PATH (Debian package poppler-utils); PNG "
+    "figures need nothing more";
+
 // Runs pdftocairo with `arguments`; its messages go to `log`, which the
 // error quotes when it fails.
 void runPdftocairo(const std::vector<std::string>& arguments, const std::string& log, const std::string& target) {
@@ -359,62 +363,63 @@ void runPdftocairo(const std::vector<std::string>& arguments, const std::string&
   pid_t pid = 0;
   const int spawned = posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
-  if (spawned == ENOENT)
-    throw writeFailure(target,
-                       "PDF and SVG figures are made with pdftocairo, which is not installed "
-                       "(Debian package poppler-utils); PNG figures need nothing more");
+  if (spawned == ENOENT) throw writeFailure(target, kPdftocairoMissing);
   if (spawned != 0)
     throw writeFailure(target, std::string("pdftocairo could not be started: ") + std::strerror(spawned));
   int status = 0;
-  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  pid_t waited = 0;
+  while ((waited = waitpid(pid, &status, 0)) < 0 && errno == EINTR) {
   }
+  if (waited < 0) throw writeFailure(target, std::string("pdftocairo was lost: ") + std::strerror(errno));
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
     std::ifstream in(log);
-    std::string messages((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    throw writeFailure(target, "pdftocairo failed: " + messages.substr(0, 400));
+    const std::string messages((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    throw writeFailure(target, "pdftocairo failed: " + withoutTemporaryPrefix(messages.substr(0, 400)));
   }
 }
 
-// PDF or SVG through GL2PS: its PDF (text as outlines, the 3D scene as a
-// raster of the window) is an intermediate that pdftocairo rewrites at the
-// figure's nominal size, as PDF or as SVG (Debian's GL2PS cannot embed a
-// raster in SVG itself, and poppler finds its PDF's graphics states unusual;
-// cairo's files open everywhere).
+// PDF or SVG: GL2PS draws the window as a PDF (text as outlines, the 3D
+// scene as a raster of the window) whose page is the window in points;
+// pdftocairo rewrites it at the figure's nominal size, as PDF or SVG.
+// Debian's GL2PS cannot put a raster into SVG itself, and poppler reports
+// undefined graphics states (ExtGState) in its PDFs, which cairo's rewrite
+// does not have. The intermediate and pdftocairo's messages are outputs that
+// are never committed: removed when done, and swept after a killed run.
 void writeVectorFigure(vtkRenderWindow* window, const std::string& path, FigureFormat format, double dpi) {
   AtomicOutput output(path);
-  const std::string prefix = output.temporaryPath() + "-gl2ps";
-  const std::string intermediate = prefix + ".pdf", log = prefix + ".log";
-  struct Remove {
-    std::vector<std::string> paths;
-    ~Remove() {
-      for (const std::string& p : paths) std::remove(p.c_str());
-    }
-  } remove{{intermediate, log}};
+  const std::filesystem::path target(withoutTemporaryPrefix(path));
+  const std::string stem = (target.parent_path() / target.stem()).string();
+  AtomicOutput drawn(stem + ".gl2ps.pdf"), log(stem + ".pdftocairo.log");
+  const std::string& intermediate = drawn.temporaryPath();
   window->Render();
   vtkNew<vtkGL2PSExporter> exporter;
   exporter->SetRenderWindow(window);
-  exporter->SetFilePrefix(prefix.c_str());
+  // GL2PS adds the extension itself.
+  exporter->SetFilePrefix(intermediate.substr(0, intermediate.size() - 4).c_str());
   exporter->SetFileFormatToPDF();
   exporter->Write3DPropsAsRasterImageOn();
   exporter->SetSortToOff();  // in drawing order: the plot's legend box over its grid
   exporter->TextAsPathOn();
   exporter->SetTitle("DynSub figure");
   exporter->Write();
-  if (!std::filesystem::exists(intermediate) || std::filesystem::file_size(intermediate) == 0)
+  std::error_code error;
+  if (std::filesystem::file_size(intermediate, error) == 0 || error)
     throw writeFailure(path, "GL2PS wrote no PDF of the figure");
   // The nominal size in points. pdftocairo takes the paper upright and
-  // turns it for a landscape page, so the shorter side goes first.
+  // turns it for a landscape page, so the shorter side goes first; -expand
+  // lets a page smaller than the paper (below 72 dpi) fill it.
   const int* size = window->GetSize();
   const long width = std::lround(size[0] * 72.0 / dpi), height = std::lround(size[1] * 72.0 / dpi);
-  runPdftocairo(
-      {"pdftocairo", format == FigureFormat::Svg ? "-svg" : "-pdf", "-paperw", std::to_string(std::min(width, height)),
-       "-paperh", std::to_string(std::max(width, height)), intermediate, output.temporaryPath()},
-      log, path);
+  runPdftocairo({"pdftocairo", format == FigureFormat::Svg ? "-svg" : "-pdf", "-expand", "-paperw",
+                 std::to_string(std::min(width, height)), "-paperh", std::to_string(std::max(width, height)),
+                 intermediate, output.temporaryPath()},
+                log.temporaryPath(), path);
   output.commit();
 }
 
-}  // namespace
-
+// Draws the window's figure as `format` at `dpi` (FigureFiles): the window,
+// its text, lines and dots grow by dpi / 100 first, so the figure must be
+// freshly drawn at the default resolution.
 void writeFigure(vtkRenderWindow* window, const std::string& path, FigureFormat format, double dpi) {
   if (!(dpi >= kMinFigureDpi && dpi <= kMaxFigureDpi))
     throw writeFailure(path, "internal: a figure resolution outside " + std::to_string(int(kMinFigureDpi)) + "-" +
@@ -425,6 +430,22 @@ void writeFigure(vtkRenderWindow* window, const std::string& path, FigureFormat 
   } else {
     writeVectorFigure(window, path, format, dpi);
   }
+}
+
+}  // namespace
+
+void requireFigureFormat(FigureFormat format) {
+  if (format == FigureFormat::Png) return;
+  const char* path = std::getenv("PATH");
+  std::string directories = path ? path : "";
+  std::size_t from = 0;
+  while (from <= directories.size()) {
+    const std::size_t to = std::min(directories.find(':', from), directories.size());
+    const std::string directory = directories.substr(from, to - from);
+    if (!directory.empty() && access((directory + "/pdftocairo").c_str(), X_OK) == 0) return;
+    from = to + 1;
+  }
+  throw Error(kPdftocairoMissing);
 }
 
 void writePng(vtkRenderWindow* window, const std::string& path) { writePngAt(window, path, kDefaultFigureDpi); }

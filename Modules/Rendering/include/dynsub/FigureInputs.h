@@ -51,14 +51,20 @@ constexpr double kMinFigureDpi = 50.0, kMaxFigureDpi = 600.0;
 
 // The paths to write the slices, the 3D view and the convergence plot to
 // (slices.png, surface3d.png, convergence.png for PNG); an empty path is not
-// rendered. Needs a display (figureDisplay). Throws as the figures and
-// writeFigure do.
+// rendered. Needs a display (figureDisplay). Throws dynsub::Error as the
+// figures do, and naming a file that could not be written.
+// PDF and SVG are drawn by VTK's GL2PS exporter and rewritten at the nominal
+// size by pdftocairo (Debian's poppler-utils).
 struct FigureFiles {
   std::string slices, surface3d, convergence;
   FigureFormat format = FigureFormat::Png;
   double dpi = kDefaultFigureDpi;
 };
 void writeFigures(const FigureInputs& inputs, const FigureFiles& files);
+// Throws dynsub::Error, naming the package, when `format` needs a program
+// that is not installed (pdftocairo for PDF and SVG): for commands to call
+// before their long part.
+void requireFigureFormat(FigureFormat format);
 
 // True when an X display can be opened; otherwise `why` says what is missing.
 bool displayAvailable(std::string* why = nullptr);

@@ -56,13 +56,6 @@ vtkSmartPointer<vtkRenderWindow> surfaceFigure(const FigureScene& scene);
 // Throws dynsub::Error for an empty history.
 vtkSmartPointer<vtkRenderWindow> convergenceFigure(const ConvergenceHistory& history);
 
-// Renders the window's figure and writes it as `format` at `dpi`
-// (FigureInputs.h): the window, its text, lines and dots grow by dpi / 100
-// first. PDF and SVG are made by GL2PS (text as outlines, the rest as a
-// raster) and converted by pdftocairo (Debian's poppler-utils), which gives
-// the page the figure's nominal size and a file every viewer reads. The file
-// appears complete or not at all. Throws dynsub::Error naming the file.
-void writeFigure(vtkRenderWindow* window, const std::string& path, FigureFormat format, double dpi);
 // The window as it is, as PNG at the default resolution.
 void writePng(vtkRenderWindow* window, const std::string& path);
 
