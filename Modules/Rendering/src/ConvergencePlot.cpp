@@ -1,5 +1,9 @@
 #include "dynsub/ConvergencePlot.h"
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
 #include <vtkAxis.h>
 #include <vtkChartLegend.h>
 #include <vtkChartXY.h>
@@ -9,10 +13,6 @@
 #include <vtkPlot.h>
 #include <vtkTable.h>
 #include <vtkTextProperty.h>
-
-#include <algorithm>
-#include <cmath>
-#include <limits>
 
 #include "dynsub/Error.h"
 
@@ -37,7 +37,7 @@ vtkSmartPointer<vtkTable> twoColumns(const char* x, const char* y, const std::ve
 
 }  // namespace
 
-vtkSmartPointer<vtkChartXY> convergenceChart(const ConvergenceHistory& history, double scale) {
+vtkSmartPointer<vtkChartXY> convergenceChart(const ConvergenceHistory& history) {
   if (history.samples.empty()) throw Error("the convergence history is empty");
   // Steps counted over all levels; a refinement starts where the level changes.
   std::vector<double> steps, energies, errorSteps, errors, refinements;
@@ -71,13 +71,13 @@ vtkSmartPointer<vtkChartXY> convergenceChart(const ConvergenceHistory& history, 
   vtkPlot* energy = chart->AddPlot(vtkChart::LINE);
   energy->SetInputData(twoColumns("step", "energy (N mm)", steps, energies), 0, 1);
   energy->SetColor(40, 90, 200, 255);
-  energy->SetWidth(static_cast<float>(2.0 * scale));
+  energy->SetWidth(2.0);
 
   if (!errors.empty()) {
     vtkPlot* error = chart->AddPlot(vtkChart::LINE);
     error->SetInputData(twoColumns("step", history.fitErrorName.c_str(), errorSteps, errors), 0, 1);
     error->SetColor(220, 80, 30, 255);
-    error->SetWidth(static_cast<float>(2.0 * scale));
+    error->SetWidth(2.0);
     chart->SetPlotCorner(error, 1);  // bottom-right: the right axis
     chart->GetAxis(vtkAxis::RIGHT)->SetTitle(history.fitErrorName);
   }
@@ -88,7 +88,7 @@ vtkSmartPointer<vtkChartXY> convergenceChart(const ConvergenceHistory& history, 
     vtkPlot* mark = chart->AddPlot(vtkChart::LINE);
     mark->SetInputData(twoColumns("step", "refinement", {refinements[r], refinements[r]}, {bottom, top}), 0, 1);
     mark->SetColor(90, 90, 90, 255);
-    mark->SetWidth(static_cast<float>(1.5 * scale));
+    mark->SetWidth(1.5);
     mark->GetPen()->SetLineType(vtkPen::DASH_LINE);
     mark->SetLegendVisibility(r == 0);
   }
@@ -97,11 +97,6 @@ vtkSmartPointer<vtkChartXY> convergenceChart(const ConvergenceHistory& history, 
   left->SetTitle("energy (N mm)");
   left->SetLogScale(logarithmic);
   chart->GetAxis(vtkAxis::BOTTOM)->SetTitle("step (all levels)");
-  for (int a : {vtkAxis::LEFT, vtkAxis::BOTTOM, vtkAxis::RIGHT}) {
-    vtkAxis* axis = chart->GetAxis(a);
-    axis->GetPen()->SetWidth(static_cast<float>(axis->GetPen()->GetWidth() * scale));
-    axis->GetGridPen()->SetWidth(static_cast<float>(axis->GetGridPen()->GetWidth() * scale));
-  }
   return chart;
 }
 

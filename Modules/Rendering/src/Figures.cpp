@@ -6,6 +6,7 @@
 #include <unistd.h>
 #include <vtkActor.h>
 #include <vtkAnnotatedCubeActor.h>
+#include <vtkAxis.h>
 #include <vtkCamera.h>
 #include <vtkChartXY.h>
 #include <vtkContextActor.h>
@@ -13,6 +14,8 @@
 #include <vtkGL2PSExporter.h>
 #include <vtkImageData.h>
 #include <vtkNew.h>
+#include <vtkPen.h>
+#include <vtkPlot.h>
 #include <vtkPointData.h>
 #include <vtkPolyData.h>
 #include <vtkPropCollection.h>
@@ -257,13 +260,12 @@ void drawSurface(const FigureScene& scene, vtkRenderWindow* window) {
   }
 }
 
-// `scale`: the resolution's, which the chart's lines need when it is built (ConvergencePlot.h).
-void drawConvergence(const ConvergenceHistory& history, vtkRenderWindow* window, double scale) {
+void drawConvergence(const ConvergenceHistory& history, vtkRenderWindow* window) {
   window->SetSize(900, 500);
   vtkNew<vtkRenderer> renderer;
   renderer->SetBackground(1, 1, 1);
   vtkNew<vtkContextActor> actor;
-  actor->GetScene()->AddItem(convergenceChart(history, scale));
+  actor->GetScene()->AddItem(convergenceChart(history));
   renderer->AddActor(actor);
   window->AddRenderer(renderer);
 }
@@ -284,7 +286,7 @@ vtkSmartPointer<vtkRenderWindow> surfaceFigure(const FigureScene& scene) {
 
 vtkSmartPointer<vtkRenderWindow> convergenceFigure(const ConvergenceHistory& history) {
   auto window = style::offScreenWindow(900, 500);
-  drawConvergence(history, window, 1.0);
+  drawConvergence(history, window);
   return window;
 }
 
@@ -302,9 +304,22 @@ std::string figureExtension(FigureFormat format) {
 
 namespace {
 
+// A chart's pens (its curves' and its axes' and grid's), `scale` times as
+// wide: a chart's text follows the window's DPI, its pens do not.
+void scaleChart(vtkChartXY* chart, double scale) {
+  for (vtkIdType p = 0; p < chart->GetNumberOfPlots(); ++p) {
+    vtkPen* pen = chart->GetPlot(p)->GetPen();
+    pen->SetWidth(static_cast<float>(pen->GetWidth() * scale));
+  }
+  for (int a = 0; a < 4; ++a)
+    for (vtkPen* pen : {chart->GetAxis(a)->GetPen(), chart->GetAxis(a)->GetGridPen()})
+      pen->SetWidth(static_cast<float>(pen->GetWidth() * scale));
+}
+
 // The window, and with it its text (through the window's DPI, which text
-// sizes in points are drawn at), its lines and its dots, `scale` times as
-// large. Viewports and cameras are relative to the window and stay as they are.
+// sizes in points are drawn at), its lines, its dots and its charts' pens,
+// `scale` times as large. Viewports and cameras are relative to the window
+// and stay as they are.
 void scaleFigure(vtkRenderWindow* window, double scale) {
   const int* size = window->GetSize();
   window->SetSize(static_cast<int>(std::lround(size[0] * scale)), static_cast<int>(std::lround(size[1] * scale)));
@@ -316,7 +331,12 @@ void scaleFigure(vtkRenderWindow* window, double scale) {
     vtkNew<vtkPropCollection> actors;
     vtkPropCollection* props = renderer->GetViewProps();
     props->InitTraversal();
-    while (vtkProp* prop = props->GetNextProp()) prop->GetActors(actors);  // an assembly's parts too
+    while (vtkProp* prop = props->GetNextProp()) {
+      prop->GetActors(actors);  // an assembly's parts too
+      if (auto* context = vtkContextActor::SafeDownCast(prop))
+        for (unsigned int i = 0; i < context->GetScene()->GetNumberOfItems(); ++i)
+          if (auto* chart = vtkChartXY::SafeDownCast(context->GetScene()->GetItem(i))) scaleChart(chart, scale);
+    }
     actors->InitTraversal();
     while (vtkProp* prop = actors->GetNextProp()) {
       if (auto* actor = vtkActor::SafeDownCast(prop)) {
@@ -488,7 +508,7 @@ void writeFigures(const FigureInputs& inputs, const FigureFiles& files) {
   };
   draw(files.slices, [&] { drawSlices(scene, window); });
   draw(files.surface3d, [&] { drawSurface(scene, window); });
-  draw(files.convergence, [&] { drawConvergence(*inputs.history, window, files.dpi / kDefaultFigureDpi); });
+  draw(files.convergence, [&] { drawConvergence(*inputs.history, window); });
 }
 
 }  // namespace dynsub

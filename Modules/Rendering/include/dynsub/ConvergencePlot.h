@@ -11,9 +11,7 @@ class vtkChartXY;
 
 namespace dynsub {
 
-// Its lines are `scale` times their width at the default resolution (a
-// chart's text follows the window's DPI, its pens do not; Figures.h).
 // Throws dynsub::Error for an empty history.
-vtkSmartPointer<vtkChartXY> convergenceChart(const ConvergenceHistory& history, double scale = 1.0);
+vtkSmartPointer<vtkChartXY> convergenceChart(const ConvergenceHistory& history);
 
 }  // namespace dynsub
