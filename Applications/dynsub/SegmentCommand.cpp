@@ -160,12 +160,12 @@ struct LandmarkSource {
   LandmarkList list;
 };
 
-// A list's name as a folder name: characters other than letters, digits,
-// '_', '-' and '.' become '_' ("Caudate L" -> Caudate_L).
+// A list's name as a structure's name: the characters a name may not hold
+// (isNameCharacter) become '_' ("Caudate L" -> Caudate_L).
 std::string folderName(const std::string& name) {
   std::string folder = name;
-  for (char& c : folder)
-    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-' && c != '.') c = '_';
+  std::replace_if(
+      folder.begin(), folder.end(), [](char c) { return !isNameCharacter(c); }, '_');
   return folder;
 }
 

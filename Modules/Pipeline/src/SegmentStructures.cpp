@@ -13,6 +13,8 @@
 
 namespace dynsub {
 
+bool isNameCharacter(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.'; }
+
 namespace {
 
 // The margin (voxels) around the structures' voxels that the territories,
@@ -113,9 +115,7 @@ double nearestPoint(const ImageGeometry& grid, std::size_t v, const MatrixX3& po
 
 bool usableName(const std::string& name) {
   if (name.empty() || name == "." || name == "..") return false;
-  return std::all_of(name.begin(), name.end(), [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.';
-  });
+  return std::all_of(name.begin(), name.end(), isNameCharacter);
 }
 
 // Runs segmentImage, naming the structure in its errors.

@@ -22,9 +22,13 @@
 namespace dynsub {
 
 struct StructureInputs {
-  std::string name;  // its name in dseg.tsv and its output folder
+  std::string name;  // its name in dseg.tsv and its output folder (isNameCharacter's)
   SegmentInputs inputs;
 };
+
+// The characters a structure's name may hold, as it names a folder: letters,
+// digits, '_', '-' and '.'.
+bool isNameCharacter(char c);
 
 struct StructuresOutcome {
   // In the inputs' order; a structure segmented again holds its second
