@@ -2,17 +2,33 @@
 dataset holds, what each job writes and under which BIDS derivative names,
 and the group table.
 
-Naming (BIDS 1.9 derivatives, "imaging data types: segmentations"): one job
-is one structure of one T1w image, written beside the image's own path:
+A job is one `dynsub segment` run on one T1w image: the structures it has
+landmark files for, segmented together so that they do not overlap, or one
+structure started from a seed click (a run of several structures starts
+each from its landmarks, so a seeded structure is a job of its own).
+
+Naming (BIDS 1.9 derivatives, "imaging data types: segmentations"), beside
+the image's own path. A job of one structure names its labelmap by it:
 
     sub-<label>[/ses-<label>]/anat/sub-<label>[_ses-<label>][entities]_space-orig_desc-<structure>_dseg.nii.gz
-    ..._dseg.tsv     the lookup table (index 1 = the structure)
-    ..._dseg.json    sidecar: Sources, SpatialReference, the run's figures
-    ..._surface.vtp  the fitted limit surface (LPS mm)
+    ..._dseg.tsv     the lookup table (index, name, color)
+    ..._dseg.json    sidecar: Sources, SpatialReference, the structures' files
     ..._report.json  dynsub segment's report
-    ..._convergence.csv
-    sub-<label>[/ses-<label>]/figures/sub-<label>[_ses-<label>]_desc-<structure>_{slices,surface3d,convergence}.png
-    ..._view.js      the data of the QC page's interactive view (qc_view.py)
+
+and a job of several structures has one labelmap for them all, with their
+run's report (the overlaps, each structure's share):
+
+    .../anat/sub-<label>[_ses-<label>][entities]_space-orig_dseg.nii.gz, .tsv, .json, _report.json
+
+Each structure keeps its own files either way:
+
+    .../anat/..._space-orig_desc-<structure>_surface.vtp   the fitted limit surface (LPS mm)
+    .../anat/..._space-orig_desc-<structure>_convergence.csv
+    .../anat/..._space-orig_desc-<structure>_report.json   its own segmentation's report
+    sub-<label>[/ses-<label>]/figures/..._desc-<structure>_{slices,surface3d,convergence}.png
+
+and the job's interactive view for the QC page is figures/..._[desc-<structure>_]view.js
+(qc_view.py).
 
 `space-orig` is the T1w's own grid; `desc-` carries the structure, so BIDS
 labels (letters and digits only) are required of structure names. The T1w's
@@ -44,19 +60,22 @@ T1W = re.compile(rf"^sub-(?P<sub>{LABEL})(?:_ses-(?P<ses>{LABEL}))?(?P<entities>
 LANDMARKS = re.compile(rf"^sub-(?P<sub>{LABEL})(?:_ses-(?P<ses>{LABEL}))?(?P<entities>{ENTITY_PATTERN})"
                        rf"_desc-(?P<structure>{LABEL})_landmarks\.(?:mrk\.json|fcsv|csv)$")
 FIGURES = ("slices", "surface3d", "convergence")
+# The colour a structure alone gets in its dseg.tsv: the first of the
+# palette `dynsub segment` gives several structures.
+LABEL_COLOR = "#4e79a7"
 
 
 class CohortError(Exception):
     """A dataset the workflow cannot run on; the message names the file."""
 
 
-class Job:
-    """One structure of one T1w image."""
+class Structure:
+    """One structure of one T1w image, and what it starts from."""
 
-    def __init__(self, subject, session, entities, structure, t1w):
+    def __init__(self, subject, session, entities, name, t1w):
         self.subject, self.session, self.entities = subject, session, entities  # entities: "" or "_run-1", ...
-        self.structure, self.t1w = structure, t1w
-        self.landmarks = None          # a landmark file, or
+        self.name, self.t1w = name, t1w
+        self.landmarks = None          # a landmark file, and/or
         self.seed = None               # (x, y, z) LPS mm of one click inside
         self.reference = None          # an expert labelmap on the T1w's grid
         self.reference_labels = []     # the structure's values in it
@@ -71,27 +90,70 @@ class Job:
 
     @property
     def key(self):
-        return (self.stem, self.structure)
+        return (self.stem, self.name)
+
+
+class Job:
+    """One `dynsub segment` run: structures of one T1w image (dseg.tsv's
+    order), several only when all start from their landmarks."""
+
+    def __init__(self, structures):
+        self.structures = structures
+        first = structures[0]
+        self.subject, self.session, self.entities, self.t1w = first.subject, first.session, first.entities, first.t1w
+        self.dir, self.stem = first.dir, first.stem
+        # The expert labelmap, when it names every structure of the job: a
+        # run of several structures scores all of them or none.
+        named = all(s.reference for s in structures)
+        self.reference = first.reference if named else None
+        self.reference_labels = [s.reference_labels for s in structures] if named else []
+
+    @property
+    def desc(self):  # the wildcard: "_desc-<structure>" for one structure, "" for several
+        return f"_desc-{self.structures[0].name}" if len(self.structures) == 1 else ""
+
+    @property
+    def key(self):
+        return (self.stem, self.desc)
+
+    @property
+    def name(self):  # its log's, its view's and its QC section's name
+        return self.stem + self.desc
+
+    @property
+    def seed(self):
+        return self.structures[0].seed if len(self.structures) == 1 else None
 
     def inputs(self):
         files = {"t1w": self.t1w}
-        if self.landmarks:
-            files["landmarks"] = self.landmarks
+        for s in self.structures:
+            if s.landmarks:
+                files[f"landmarks_{s.name}"] = s.landmarks
         if self.reference:
             files["reference"] = self.reference
         return files
 
 
-def output_paths(out, dir, stem, structure):
-    """The declared outputs of one job (figures are written when they can be rendered)."""
-    base = f"{out}/{dir}/anat/{stem}_space-orig_desc-{structure}"
+def output_paths(out, dir, stem, desc):
+    """The declared outputs of one job (desc: its wildcard, Job.desc)."""
+    base = f"{out}/{dir}/anat/{stem}_space-orig{desc}"
     return {"dseg": base + "_dseg.nii.gz", "lut": base + "_dseg.tsv", "sidecar": base + "_dseg.json",
-            "surface": base + "_surface.vtp", "report": base + "_report.json",
-            "convergence": base + "_convergence.csv"}
+            "report": base + "_report.json"}
 
 
-def log_path(out, dir, stem, structure):
-    return f"{out}/logs/{dir}/{stem}_desc-{structure}.log"
+def structure_paths(out, dir, stem, name):
+    """A structure's own files; for a job of one structure its report is the job's."""
+    base = f"{out}/{dir}/anat/{stem}_space-orig_desc-{name}"
+    return {"surface": base + "_surface.vtp", "convergence": base + "_convergence.csv",
+            "report": base + "_report.json"}
+
+
+def job_paths(out, job):
+    return output_paths(out, job.dir, job.stem, job.desc)
+
+
+def log_path(out, dir, stem, desc):
+    return f"{out}/logs/{dir}/{stem}{desc}.log"
 
 
 def default_seeds(bids):
@@ -99,17 +161,14 @@ def default_seeds(bids):
     return path if os.path.exists(path) else None
 
 
-def figure_paths(out, dir, stem, structure):
-    return {name: f"{out}/{dir}/figures/{stem}_desc-{structure}_{name}.png" for name in FIGURES}
+def figure_paths(out, dir, stem, name):
+    """A structure's figures."""
+    return {figure: f"{out}/{dir}/figures/{stem}_desc-{name}_{figure}.png" for figure in FIGURES}
 
 
-def view_path(out, dir, stem, structure):
-    return f"{out}/{dir}/figures/{stem}_desc-{structure}_view.js"
-
-
-def view_key(stem, structure):
-    """The name of one segmentation on the QC page: its section's id and its view's."""
-    return f"{stem}-{structure}"
+def view_path(out, dir, stem, desc):
+    """A job's interactive view."""
+    return f"{out}/{dir}/figures/{stem}{desc}_view.js"
 
 
 def _relative(path, root):
@@ -129,12 +188,13 @@ def _read_names(table):
     return names
 
 
-def find_jobs(bids, landmarks_dir, seeds_table, reference_dir, warn=_warn):
-    """Every (image, structure) with landmarks or a seed, keyed by (stem, structure).
+def find_structures(bids, landmarks_dir, seeds_table, reference_dir, warn=_warn):
+    """Every (image, structure) with landmarks or a seed, keyed by (stem, structure name).
 
     A T1w whose name has entities other than ENTITIES is skipped with a
     warning; so is a reference found for a job whose structure its table
-    does not name."""
+    does not name.
+    """
     if not os.path.isdir(bids):
         raise CohortError(f"{bids}: no such BIDS directory")
     images = {}  # (subject, session, entities) -> path
@@ -153,10 +213,11 @@ def find_jobs(bids, landmarks_dir, seeds_table, reference_dir, warn=_warn):
             raise CohortError(f"{path}: a second file for the same T1w (also {images[key]})")
         images[key] = path
 
-    jobs = {}
+    structures = {}
 
-    def job_for(subject, session, entities, structure, source):
-        """The job of the T1w a landmark file or seed names; without entities, the one T1w of its session."""
+    def structure_for(subject, session, entities, structure, source):
+        """The structure of the T1w a landmark file or seed names; without entities, the one T1w of its
+        session."""
         where = f"sub-{subject}" + (f" ses-{session}" if session else "")
         if (subject, session, entities) in images:
             path = images[(subject, session, entities)]
@@ -169,8 +230,8 @@ def find_jobs(bids, landmarks_dir, seeds_table, reference_dir, warn=_warn):
                                   + ", ".join(os.path.basename(images[k]) for k in candidates)
                                   + "); name the one meant (e.g. sub-<label>_run-<label>_desc-...)")
             entities, path = candidates[0][2], images[candidates[0]]
-        job = Job(subject, session, entities, structure, path)
-        return jobs.setdefault(job.key, job)
+        found = Structure(subject, session, entities, structure, path)
+        return structures.setdefault(found.key, found)
 
     if landmarks_dir and os.path.isdir(landmarks_dir):
         for path in sorted(glob.glob(f"{landmarks_dir}/sub-*/anat/*_landmarks.*") +
@@ -179,9 +240,9 @@ def find_jobs(bids, landmarks_dir, seeds_table, reference_dir, warn=_warn):
             if not match:
                 raise CohortError(f"{path}: not handled (expected sub-<label>[_ses-<label>][entities]_desc-<structure>"
                                   "_landmarks.mrk.json|.fcsv|.csv, letters and digits in labels)")
-            job = job_for(match["sub"], match["ses"], match["entities"], match["structure"], path)
+            job = structure_for(match["sub"], match["ses"], match["entities"], match["structure"], path)
             if job.landmarks:
-                raise CohortError(f"{path}: a second landmark file for {job.stem} {job.structure} "
+                raise CohortError(f"{path}: a second landmark file for {job.stem} {job.name} "
                                   f"(also {job.landmarks})")
             job.landmarks = path
 
@@ -201,11 +262,11 @@ def find_jobs(bids, landmarks_dir, seeds_table, reference_dir, warn=_warn):
                                   "(LPS mm)") from None
             if not re.fullmatch(LABEL, structure) or not all(abs(v) < float("inf") for v in seed):
                 raise CohortError(f"{where}: structure must be letters and digits, x y z finite numbers")
-            job_for(subject, session, "", structure, where).seed = seed
+            structure_for(subject, session, "", structure, where).seed = seed
 
     if reference_dir and os.path.isdir(reference_dir):
         dataset_table = f"{reference_dir}/dseg.tsv"
-        for job in jobs.values():
+        for job in structures.values():
             # The image's own reference, else its session's; its own table, else the dataset's.
             folder = f"{reference_dir}/{job.dir}/anat"
             session_stem = job.stem[: len(job.stem) - len(job.entities)]
@@ -217,12 +278,36 @@ def find_jobs(bids, landmarks_dir, seeds_table, reference_dir, warn=_warn):
             tables = [f"{folder}/{s}_dseg.tsv" for s in stems] + [dataset_table]
             table = next((t for t in tables if os.path.exists(t)), None)
             names = _read_names(table) if table else {}
-            if job.structure in names:
-                job.reference, job.reference_labels = path, names[job.structure]
+            if job.name in names:
+                job.reference, job.reference_labels = path, names[job.name]
             else:
-                warn(f"{path}: a reference for {job.stem}, not used for {job.structure}: "
-                     + (f"{table} names no '{job.structure}'" if table else
+                warn(f"{path}: a reference for {job.stem}, not used for {job.name}: "
+                     + (f"{table} names no '{job.name}'" if table else
                         f"no dseg.tsv names its labels (looked for {', '.join(tables)})"))
+    return structures
+
+
+def group_jobs(structures, warn=_warn):
+    """The jobs of the structures (find_structures'), keyed by Job.key: per
+    T1w image, the structures that start from their landmarks alone as one
+    job, and each structure with a seed click as a job of its own. A
+    reference that names some of a job's structures but not all is warned
+    of: the job is not scored."""
+    together, jobs = {}, {}
+    for key in sorted(structures):
+        structure = structures[key]
+        if structure.seed:
+            job = Job([structure])
+            jobs[job.key] = job
+        else:
+            together.setdefault(structure.stem, []).append(structure)
+    for group in together.values():
+        job = Job(group)
+        jobs[job.key] = job
+        unscored = [s.name for s in group if s.reference]
+        if not job.reference and unscored:
+            warn(f"{group[0].reference}: not used for {', '.join(unscored)} either: a run of several structures "
+                 "is scored when the reference names them all")
     return jobs
 
 
@@ -263,9 +348,9 @@ def configured_jobs(config):
     """The jobs a workflow configuration names: the Snakefile's --config and
     the BIDS App's settings, with the same defaults."""
     root = os.path.abspath(str(config["bids"]))
-    jobs = find_jobs(root, str(config.get("landmarks", f"{root}/derivatives/landmarks")),
-                     config.get("seeds", default_seeds(root)),
-                     str(config.get("reference", f"{root}/derivatives/reference")))
+    jobs = group_jobs(find_structures(root, str(config.get("landmarks", f"{root}/derivatives/landmarks")),
+                                      config.get("seeds", default_seeds(root)),
+                                      str(config.get("reference", f"{root}/derivatives/reference"))))
     if not jobs:
         raise CohortError(f"{root}: no landmarks or seeds found for any T1w image")
     return select_jobs(jobs, labels(config.get("participant_label")), labels(config.get("session_label")))
@@ -274,7 +359,7 @@ def configured_jobs(config):
 def written_reports(jobs, out):
     """The report.json files of the jobs already segmented in out: what the
     group level summarizes."""
-    reports = (output_paths(out, job.dir, job.stem, job.structure)["report"] for job in jobs.values())
+    reports = (job_paths(out, job)["report"] for job in jobs.values())
     return [path for path in reports if os.path.exists(path)]
 
 
@@ -288,67 +373,92 @@ def _last_error(log):
     return (errors or lines or ["empty log"])[-1]
 
 
-def run_segmentation(job, outputs, figures, view, log, dynsub, extra_args, bids, out):
+def run_segmentation(job, out, log, dynsub, extra_args, bids):
     """Runs `dynsub segment` for one job and gives its results their BIDS names.
 
     dynsub writes all its outputs or none into a private directory beside the
-    final files; they are renamed into place only when it succeeded, so a
-    failed job leaves nothing (Snakemake also removes a failed job's outputs).
+    final files; they are renamed into place only when it succeeded, the
+    job's report last, so a failed job leaves nothing of its own (Snakemake
+    also removes a failed job's declared outputs).
     """
+    outputs = job_paths(out, job)
     anat = os.path.dirname(outputs["dseg"])
     os.makedirs(anat, exist_ok=True)
     work = tempfile.mkdtemp(prefix=".work-", dir=anat)
+    several = len(job.structures) > 1
     try:
         result = os.path.join(work, "result")
         command = [dynsub, "segment", job.t1w, "--out", result]
-        if job.landmarks:
-            command += ["--landmarks", job.landmarks]
+        for s in job.structures:
+            if s.landmarks:
+                command += ["--landmarks", s.landmarks]
+        if several:
+            for s in job.structures:
+                command += ["--name", s.name]
         if job.seed:
             command += ["--init", "seed:%r,%r,%r" % job.seed]
         if job.reference:
-            command += ["--reference", job.reference, "--reference-label", ",".join(map(str, job.reference_labels))]
+            command += ["--reference", job.reference]
+            for values in job.reference_labels:
+                command += ["--reference-label", ",".join(map(str, values))]
         command += shlex.split(extra_args)
         with open(log, "w") as f:
             f.write("$ " + shlex.join(command) + "\n")
             f.flush()
             status = subprocess.run(command, stdout=f, stderr=subprocess.STDOUT).returncode
         if status != 0:
-            raise RuntimeError(f"{job.stem} {job.structure}: dynsub segment failed (exit {status}): "
-                               f"{_last_error(log)} (log: {log})")
-        with open(outputs["lut"], "w") as f:
-            f.write("index\tname\n1\t%s\n" % job.structure)
+            raise RuntimeError(f"{job.name}: dynsub segment failed (exit {status}): {_last_error(log)} (log: {log})")
+
+        # Each structure's own files: DIR/NAME/ for several, DIR/ for one.
+        meshes = []
+        for s in job.structures:
+            own = os.path.join(result, s.name) if several else result
+            paths = structure_paths(out, job.dir, job.stem, s.name)
+            os.replace(f"{own}/surface.vtp", paths["surface"])
+            os.replace(f"{own}/convergence.csv", paths["convergence"])
+            if several:
+                os.replace(f"{own}/report.json", paths["report"])
+            for name, path in figure_paths(out, job.dir, job.stem, s.name).items():
+                if os.path.exists(f"{own}/{name}.png"):  # rendered when an X server could be had
+                    os.makedirs(os.path.dirname(path), exist_ok=True)
+                    os.replace(f"{own}/{name}.png", path)
+            meshes.append(f"{own}/control_mesh.obj")
+
+        if several:
+            os.replace(f"{result}/dseg.tsv", outputs["lut"])
+        else:
+            with open(outputs["lut"], "w") as f:
+                f.write(f"index\tname\tcolor\n1\t{job.structures[0].name}\t{LABEL_COLOR}\n")
         sources = [f"bids:raw:{_relative(job.t1w, bids)}"]
-        if job.landmarks:
-            sources.append(f"bids:raw:{_relative(job.landmarks, bids)}")
+        sources += [f"bids:raw:{_relative(s.landmarks, bids)}" for s in job.structures if s.landmarks]
+        names = ", ".join(s.name for s in job.structures)
         sidecar = {
-            "Description": f"{job.structure} segmented by a dynamic Catmull-Clark subdivision surface "
-                           "(dynsub segment)" + (" from a seed click" if job.seed and not job.landmarks else ""),
+            "Description": f"{names} segmented by dynamic Catmull-Clark subdivision surfaces (dynsub segment)"
+                           + (", together so that they do not overlap" if several else "")
+                           + (" from a seed click" if job.seed and not job.structures[0].landmarks else ""),
             "Sources": sources,
             "SpatialReference": f"bids:raw:{_relative(job.t1w, bids)}",
-            "Surface": os.path.basename(outputs["surface"]),
             "Report": os.path.basename(outputs["report"]),
+            "Structures": [{"Index": i + 1, "Name": s.name,
+                            **{k.capitalize(): os.path.basename(p)
+                               for k, p in structure_paths(out, job.dir, job.stem, s.name).items()}}
+                           for i, s in enumerate(job.structures)],
         }
         if job.seed:
             sidecar["SeedLPS"] = list(job.seed)
         with open(outputs["sidecar"], "w") as f:
             json.dump(sidecar, f, indent=2)
             f.write("\n")
-        os.replace(f"{result}/surface.vtp", outputs["surface"])
-        os.replace(f"{result}/report.json", outputs["report"])
-        os.replace(f"{result}/convergence.csv", outputs["convergence"])
-        os.replace(f"{result}/labelmap.nii.gz", outputs["dseg"])
-        for name, path in figures.items():  # rendered when an X server could be had
-            if os.path.exists(f"{result}/{name}.png"):
-                os.makedirs(os.path.dirname(path), exist_ok=True)
-                os.replace(f"{result}/{name}.png", path)
+        os.replace(f"{result}/dseg.nii.gz" if several else f"{result}/labelmap.nii.gz", outputs["dseg"])
         try:  # the QC page's view is an extra: without it the page says so, and the job stands
-            script = qc_view.view_script(view_key(job.stem, job.structure), job.t1w, outputs["dseg"],
-                                         f"{result}/control_mesh.obj", dynsub, work)
+            script = qc_view.view_script(job.name, job.t1w, outputs["dseg"], meshes, dynsub, work)
+            view = view_path(out, job.dir, job.stem, job.desc)
             os.makedirs(os.path.dirname(view), exist_ok=True)
             write_by_rename(view, script)
         except (OSError, ValueError, subprocess.CalledProcessError) as error:
             with open(log, "a") as f:
                 f.write(f"QC view not written: {error}\n")
+        os.replace(f"{result}/report.json", outputs["report"])
     finally:
         shutil.rmtree(work, ignore_errors=True)
 
@@ -356,7 +466,7 @@ def run_segmentation(job, outputs, figures, view, log, dynsub, extra_args, bids,
 GROUP_COLUMNS = {
     "participant_id": "The subject (sub-<label>).",
     "session_id": "The session (ses-<label>), or n/a.",
-    "structure": "The structure (the desc- entity of the files).",
+    "structure": "The structure (the desc- entity of its files).",
     "status": "ok, failed (see message and the job's log) or not run.",
     "volume_mm3": "Volume of the labelmap, mm^3.",
     "dice": "Dice against the reference labelmap, where there is one.",
@@ -364,46 +474,62 @@ GROUP_COLUMNS = {
     "hd95_mm": "95th percentile of the surface distances to the reference, mm.",
     "control_vertices": "Control vertices of the final surface.",
     "iterations": "Time steps of the evolution.",
-    "seconds": "Wall-clock seconds of the segmentation.",
+    "seconds": "Wall-clock seconds of the structure's segmentation (its last pass, when segmented with others).",
     "warnings": "dynsub's warnings (a collapse, a leak, landmarks off edges), separated by '; '.",
     "trust_flags": "Why not to trust the result (report.json's trust flags: one_click, small, "
                    "atlas_clicks_apart, moved_from_atlas, leaked), separated by spaces, or n/a.",
     "message": "Why a job failed.",
-    "dseg": "The labelmap, relative to the dataset root.",
+    "dseg": "The labelmap holding the structure, relative to the dataset root.",
+    "index": "The structure's value in that labelmap (its dseg.tsv's index).",
     "t1w": "The T1w image segmented, relative to the raw dataset's root.",
 }
 
 
 def group_rows(jobs, out):
+    """One row per structure, in the jobs' order. A structure segmented with
+    others is scored by its share of their labelmap (the run's report), which
+    is what the dseg holds; its own report gives the rest."""
     rows = []
     for key in sorted(jobs):
         job = jobs[key]
-        paths = output_paths(out, job.dir, job.stem, job.structure)
-        row = {c: "n/a" for c in GROUP_COLUMNS}
-        row.update(participant_id=f"sub-{job.subject}", session_id=f"ses-{job.session}" if job.session else "n/a",
-                   structure=job.structure, t1w=os.path.join(job.dir, "anat", os.path.basename(job.t1w)))
-        log = log_path(out, job.dir, job.stem, job.structure)
-        if all(os.path.exists(p) for p in paths.values()):
-            report = json.load(open(paths["report"]))
-            row["report"] = report  # not a column: for the QC page (qc_report.py)
-            row.update(status="ok", dseg=_relative(paths["dseg"], out),
-                       warnings="; ".join(report.get("warnings", [])) or "n/a",
-                       trust_flags=" ".join(f["name"] for f in report.get("trust", {}).get("flags", [])) or "n/a")
-            for column in ("volume_mm3", "dice", "mean_surface_distance_mm", "hd95_mm", "control_vertices",
-                           "iterations", "seconds"):
-                if column in report:
-                    value = report[column]
-                    row[column] = f"{value:.4f}" if isinstance(value, float) else str(value)
-        elif os.path.exists(log):
-            row.update(status="failed", message=_last_error(log))
-        else:
-            row.update(status="not run")
-        rows.append(row)
+        paths = job_paths(out, job)
+        several = len(job.structures) > 1
+        complete = all(os.path.exists(p) for p in paths.values())
+        joint = json.load(open(paths["report"]))["structures"] if complete and several else None
+        log = log_path(out, job.dir, job.stem, job.desc)
+        for index, structure in enumerate(job.structures):
+            row = {c: "n/a" for c in GROUP_COLUMNS}
+            row.update(participant_id=f"sub-{job.subject}",
+                       session_id=f"ses-{job.session}" if job.session else "n/a", structure=structure.name,
+                       t1w=os.path.join(job.dir, "anat", os.path.basename(job.t1w)))
+            row["job"] = job  # not a column: for the QC page (qc_report.py)
+            if complete:
+                own = structure_paths(out, job.dir, job.stem, structure.name)["report"] if several else paths["report"]
+                report = json.load(open(own))
+                row["report"] = report  # not a column either
+                row.update(status="ok", dseg=_relative(paths["dseg"], out), index=str(index + 1),
+                           warnings="; ".join(report.get("warnings", [])) or "n/a",
+                           trust_flags=" ".join(f["name"] for f in report.get("trust", {}).get("flags", [])) or "n/a")
+                scores = dict(report)
+                if joint:
+                    scores["volume_mm3"] = joint[index]["joint_volume_mm3"]
+                    for column in ("dice", "mean_surface_distance_mm", "hd95_mm"):
+                        scores[column] = joint[index].get("joint", {}).get(column, "n/a")
+                for column in ("volume_mm3", "dice", "mean_surface_distance_mm", "hd95_mm", "control_vertices",
+                               "iterations", "seconds"):
+                    if column in scores:
+                        value = scores[column]
+                        row[column] = f"{value:.4f}" if isinstance(value, float) else str(value)
+            elif os.path.exists(log):
+                row.update(status="failed", message=_last_error(log))
+            else:
+                row.update(status="not run")
+            rows.append(row)
     return rows
 
 
 def write_group_table(jobs, out, table):
-    """segmentations.tsv (and its JSON column descriptions): one row per job."""
+    """segmentations.tsv (and its JSON column descriptions): one row per structure."""
     rows = group_rows(jobs, out)
     os.makedirs(os.path.dirname(table) or ".", exist_ok=True)
     temporary = table + ".tmp"

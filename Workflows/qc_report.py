@@ -1,9 +1,10 @@
 """The cohort's QC report: one HTML page (no network) with a sortable group
 table that flags outliers and shows each row's warnings and trust flags, a
 filter for flagged rows, a pass/fail rating per row exported as TSV, and
-per segmentation its slices with the contour, the 3D view, the convergence
-plot, its numbers and an interactive view (NiiVue: the image with the
-labelmap on three planes and the surface in 3D). The figures and the
+per job (one run of `dynsub segment`: an image's structures segmented
+together, or one from a seed) each structure's slices with the contour, its
+3D view, its convergence plot and its numbers, and an interactive view
+(NiiVue: the image with the labelmap on three planes and the surfaces in 3D). The figures and the
 views' data stay separate files beside it, loaded as they scroll into view
 or when a view is opened, so that the page of a large cohort opens at
 once; a copy of the page needs its folder.
@@ -28,6 +29,7 @@ import math
 import os
 import shutil
 import statistics
+import struct
 
 import dynsub_bids as bids
 
@@ -43,13 +45,26 @@ def _number(value):
         return None
 
 
+def _png_size(path):
+    """A PNG's width and height (its IHDR chunk), or None for another file."""
+    with open(path, "rb") as f:
+        head = f.read(24)
+    if len(head) < 24 or head[:8] != b"\x89PNG\r\n\x1a\n" or head[12:16] != b"IHDR":
+        return None
+    return struct.unpack(">II", head[16:24])
+
+
 def _image(path, alt, page):
     """The figure at path, by its path relative to the page; a link to it
-    when scripts are off."""
+    when scripts are off. Its size is given, so that the page is laid out
+    once, before the figures load, instead of moving as each arrives."""
     if not os.path.exists(path):
         return f'<p class="missing">{html.escape(alt)}: not rendered</p>'
     source = html.escape(os.path.relpath(path, os.path.dirname(page)))
-    return f'<a class="figure" href="{source}"><img src="{source}" loading="lazy" alt="{html.escape(alt)}"></a>'
+    size = _png_size(path)
+    dimensions = f' width="{size[0]}" height="{size[1]}"' if size else ""
+    return (f'<a class="figure" href="{source}"><img src="{source}"{dimensions} loading="lazy" '
+            f'alt="{html.escape(alt)}"></a>')
 
 
 def _rms_residual(report):
@@ -59,9 +74,7 @@ def _rms_residual(report):
 
 def flagged_rows(jobs, out):
     rows = bids.group_rows(jobs, out)
-    for row, key in zip(rows, sorted(jobs)):
-        job = jobs[key]
-        row["job"] = job
+    for row in rows:
         row["flags"] = []
         row["rms_residual_mm"] = None
         if row["status"] != "ok":
@@ -106,7 +119,7 @@ tr.flagged td { background: #fde2e2; }
 section { border-top: 2px solid #ccc; margin-top: 2em; padding-top: 0.5em; }
 div.figures { display: flex; gap: 1%; align-items: flex-start; }
 div.figures > * { flex: 1; }
-a.figure img { width: 100%; border: 1px solid #ddd; cursor: zoom-in; }
+a.figure img { width: 100%; height: auto; border: 1px solid #ddd; cursor: zoom-in; }
 dialog { padding: 0; border: none; max-width: 95vw; max-height: 95vh; }
 dialog img { max-width: 95vw; max-height: 95vh; display: block; cursor: zoom-out; }
 dialog::backdrop { background: rgba(0, 0, 0, 0.7); }
@@ -272,9 +285,35 @@ def _cell(row, key, text):
         value = f"{value:.2f}"
     value = "n/a" if value in (None, "") else str(value)
     if key == "structure" and row["status"] == "ok":
-        anchor = bids.view_key(row["job"].stem, row["structure"])
+        anchor = row["job"].name
         return f'<td class="text" data-value="{html.escape(value)}"><a href="#{anchor}">{html.escape(value)}</a></td>'
     return f'<td class="{"text" if text else "num"}">{html.escape(value)}</td>'
+
+
+def _structure_facts(row, out, page, headed):
+    """One structure's figures and numbers on its job's section (headed by
+    its name when the job has several)."""
+    job, report = row["job"], row["report"]
+    figures = bids.figure_paths(out, job.dir, job.stem, row["structure"])
+    parts = [f'<h3>{html.escape(row["structure"])}</h3>'] if headed else []
+    parts += ['<div class="figures">',
+              _image(figures["slices"], "slices with the contour (green on an image edge, magenta 3 mm or more "
+                     "from any)", page),
+              _image(figures["surface3d"], "3D view, coloured the same way", page),
+              _image(figures["convergence"], "convergence", page), "</div>"]
+    facts = [("flags", ", ".join(row["flags"]) or "none"), ("volume (mm³)", row["volume_mm3"]),
+             ("Dice", row["dice"]), ("mean surface distance (mm)", row["mean_surface_distance_mm"]),
+             ("control vertices", row["control_vertices"]), ("steps", row["iterations"]),
+             ("seconds", row["seconds"]), ("landmarks", report.get("landmark_count")),
+             ("start", report.get("init")), ("surface on edges", report.get("surface_on_edges", "n/a"))]
+    shown = [(k, f"{v:.3g}" if isinstance(v, float) else v) for k, v in facts]
+    parts.append("<dl>" + "".join(f"<dt>{html.escape(k)}</dt><dd>{html.escape(str(v))}</dd>" for k, v in shown))
+    for flag in report.get("trust", {}).get("flags", []):
+        parts.append(f"<dt>not to trust ({html.escape(flag['name'])})</dt><dd>{html.escape(flag['message'])}</dd>")
+    for warning in report.get("warnings", []):
+        parts.append(f"<dt>warning</dt><dd>{html.escape(warning)}</dd>")
+    parts.append("</dl>")
+    return parts
 
 
 def _install_niivue(niivue, out):
@@ -300,7 +339,7 @@ def write_report(jobs, out, path, niivue=None):
     parts = ["<!DOCTYPE html>", '<html lang="en"><head><meta charset="utf-8">',
              "<title>DynSub QC report</title>", f"<style>{STYLE}</style></head><body>",
              "<h1>DynSub QC report</h1>",
-             f"<p>{len(rows)} segmentations, {sum(r['status'] == 'ok' for r in rows)} complete, "
+             f"<p>{len(rows)} structures segmented, {sum(r['status'] == 'ok' for r in rows)} complete, "
              f"{flagged} flagged. Click a column header to sort; click a structure for its figures, "
              "a figure to enlarge it. Rate each row pass or fail; ratings stay in this browser until "
              "exported.</p>",
@@ -322,49 +361,37 @@ def write_report(jobs, out, path, niivue=None):
                  f"<b>volume</b> more than {ROBUST_Z_LIMIT:g} robust SD from the structure's median "
                  f"(with at least {MIN_FOR_VOLUME_FLAG} of it); <b>residual</b> landmarks more than "
                  f"{RESIDUAL_LIMIT_MM:g} mm rms from the surface.</p>")
+    by_job = {}
     for row in rows:
-        job = row["job"]
-        title = f'{row["participant_id"]} {row["session_id"] if row["session_id"] != "n/a" else ""} {job.structure}'
-        key = bids.view_key(job.stem, job.structure)
-        parts.append(f'<section id="{html.escape(key)}"><h2>{html.escape(title)}</h2>')
-        if row["status"] != "ok":
-            parts.append(f'<p><span class="flag">{html.escape(row["status"])}</span> '
-                         f'{html.escape(row["message"])}</p></section>')
+        by_job.setdefault(row["job"].key, []).append(row)
+    for job_rows in by_job.values():
+        job = job_rows[0]["job"]
+        session = job_rows[0]["session_id"]
+        title = (f'{job_rows[0]["participant_id"]} {session if session != "n/a" else ""} '
+                 + ", ".join(r["structure"] for r in job_rows))
+        parts.append(f'<section id="{html.escape(job.name)}"><h2>{html.escape(title)}</h2>')
+        if job_rows[0]["status"] != "ok":
+            parts.append(f'<p><span class="flag">{html.escape(job_rows[0]["status"])}</span> '
+                         f'{html.escape(job_rows[0]["message"])}</p></section>')
             continue
-        figures = bids.figure_paths(out, job.dir, job.stem, job.structure)
-        parts += ['<div class="figures">',
-                  _image(figures["slices"], "slices with the contour (green on an image edge, magenta 3 mm or more "
-                         "from any)", path),
-                  _image(figures["surface3d"], "3D view, coloured the same way", path),
-                  _image(figures["convergence"], "convergence", path), "</div>"]
-        view = bids.view_path(out, job.dir, job.stem, job.structure)
+        view = bids.view_path(out, job.dir, job.stem, job.desc)
         if not viewer_script:
             parts.append('<p class="missing">interactive view: NiiVue is not installed (./run build installs it '
                          "into build/niivue)</p>")
         elif not os.path.exists(view):
             parts.append('<p class="missing">interactive view: its data was not written (see the job\'s log)</p>')
         else:
-            parts.append(f'<p><button type="button" class="view" data-key="{html.escape(key)}" '
+            parts.append(f'<p><button type="button" class="view" data-key="{html.escape(job.name)}" '
                          f'data-title="{html.escape(title)}" '
                          f'data-view="{html.escape(os.path.relpath(view, os.path.dirname(path)))}">'
                          "interactive view</button></p>")
-        report = row["report"]
-        facts = [("flags", ", ".join(row["flags"]) or "none"), ("volume (mm³)", row["volume_mm3"]),
-                 ("Dice", row["dice"]), ("mean surface distance (mm)", row["mean_surface_distance_mm"]),
-                 ("control vertices", row["control_vertices"]), ("steps", row["iterations"]),
-                 ("seconds", row["seconds"]), ("landmarks", report.get("landmark_count")),
-                 ("start", report.get("init")), ("surface on edges", report.get("surface_on_edges", "n/a"))]
-        shown = [(k, f"{v:.3g}" if isinstance(v, float) else v) for k, v in facts]
-        parts.append("<dl>" + "".join(f"<dt>{html.escape(k)}</dt><dd>{html.escape(str(v))}</dd>" for k, v in shown))
-        for flag in report.get("trust", {}).get("flags", []):
-            parts.append(f"<dt>not to trust ({html.escape(flag['name'])})</dt><dd>{html.escape(flag['message'])}</dd>")
-        for warning in report.get("warnings", []):
-            parts.append(f"<dt>warning</dt><dd>{html.escape(warning)}</dd>")
-        parts.append("</dl></section>")
+        for row in job_rows:
+            parts += _structure_facts(row, out, path, len(job_rows) > 1)
+        parts.append("</section>")
     parts.append('<dialog id="viewer"><img alt=""></dialog>')
     parts.append(f'<dialog id="live" class="live" data-niivue="{html.escape(viewer_script or "")}">'
                  '<p class="status"></p><div class="canvas"></div>'
-                 "<p>Red: the labelmap; yellow: the fitted surface (its trace on the planes). Click a plane to "
+                 "<p>Red: the labelmap; yellow: the fitted surfaces (their trace on the planes). Click a plane to "
                  "move the crosshair; drag in 3D to turn. Coordinates are the image's RAS.</p>"
                  '<p><button type="button" class="close">close</button></p></dialog>')
     parts.append(f"<script>{SCRIPT}</script></body></html>")

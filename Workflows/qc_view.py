@@ -1,6 +1,6 @@
-"""The data of one segmentation's interactive view on the QC page (NiiVue):
-the T1w cropped to the structure's neighbourhood, its labelmap on the same
-crop, and the fitted surface as triangles.
+"""The data of one job's interactive view on the QC page (NiiVue): the T1w
+cropped to the structures' neighbourhood, their labelmap on the same crop,
+and the fitted surfaces as triangles (one mesh).
 
 It is written as a small script (`window.dynsubViews[ID] = {...}`) rather
 than as NIfTI and mesh files, because a page opened from disk (file://) may
@@ -59,17 +59,23 @@ def _crop(image, ras):
     return tuple(slice(a, b) for a, b in zip(low, high))
 
 
-def view_script(key, t1w, labelmap, control_mesh, dynsub, work):
-    """The view of one segmentation, as the text of its .js file.
+def view_script(key, t1w, labelmap, control_meshes, dynsub, work):
+    """The view of one job, as the text of its .js file.
 
-    key names it on the page; control_mesh is the run's control_mesh.obj
-    (LPS mm), whose limit surface `dynsub limit` samples into work/."""
-    surface = os.path.join(work, "view_surface.obj")
-    subprocess.run([dynsub, "limit", control_mesh, "--samples-per-face", str(SAMPLES_PER_FACE), "--out", surface],
-                   check=True, capture_output=True, text=True)
-    points, triangles = _read_obj(surface)
-    if len(points) == 0 or len(triangles) == 0:
-        raise ValueError(f"{surface}: the limit surface has no triangles")
+    key names it on the page; control_meshes are the structures'
+    control_mesh.obj files (LPS mm), whose limit surfaces `dynsub limit`
+    samples into work/."""
+    all_points, all_triangles = [], []
+    for n, control_mesh in enumerate(control_meshes):
+        surface = os.path.join(work, f"view_surface_{n}.obj")
+        subprocess.run([dynsub, "limit", control_mesh, "--samples-per-face", str(SAMPLES_PER_FACE), "--out", surface],
+                       check=True, capture_output=True, text=True)
+        points, triangles = _read_obj(surface)
+        if len(points) == 0 or len(triangles) == 0:
+            raise ValueError(f"{surface}: the limit surface has no triangles")
+        all_triangles.append(triangles + sum(len(p) for p in all_points))
+        all_points.append(points)
+    points, triangles = np.concatenate(all_points), np.concatenate(all_triangles).astype(np.uint32)
     ras = points * np.array([-1, -1, 1], dtype=np.float32)  # NiiVue's world is the NIfTI's RAS
     image = nibabel.load(t1w)
     box = _crop(image, ras)

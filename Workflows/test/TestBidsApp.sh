@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # dynsub-bids, the BIDS App, on the cohort of make_cohort.py (sub-01: the
-# caudate from landmarks and the thalamus from a seed; sub-02: a moved copy;
+# caudate and putamen together from landmarks and the thalamus from a seed; sub-02: a moved copy;
 # sub-03 ses-2: the 0.5 mm MRI), with its outputs in derivatives/dynsub as
 # most users keep them:
 #  - `participant --participant-label 01` segments sub-01 only and writes no
@@ -35,7 +35,7 @@ out="$bids/derivatives/dynsub"
 
 "$DYNSUB_BIDS" "$bids" "$out" participant --participant-label 01 --cores 2 >"$work/p1.log" 2>&1
 check "participant 01: exit 0" test $? -eq 0 || tail -30 "$work/p1.log"
-check "participant 01: its two segmentations" \
+check "participant 01: its two jobs' labelmaps" \
   test "$(find "$out/sub-01/anat" -name '*_dseg.nii.gz' | wc -l)" -eq 2
 check "participant 01: no other subject" test ! -e "$out/sub-02" -a ! -e "$out/sub-03"
 check "participant 01: no group table" test ! -e "$out/segmentations.tsv"
@@ -56,11 +56,11 @@ check "participants 02 and 03 at once: both exit 0" test $? -eq 0 -a $third -eq 
 check "group: exit 0" test $? -eq 0 || tail -30 "$work/group.log"
 check "group: no segmentation run" test "$(grep -c '^rule segment:' "$work/group.log")" -eq 0
 check "group: table and QC page" test -s "$out/segmentations.tsv" -a -s "$out/report.html"
-check "group: the four segmentations, all ok" "$python" - "$out/segmentations.tsv" <<'PY'
+check "group: the five structures, all ok" "$python" - "$out/segmentations.tsv" <<'PY'
 import csv, sys
 rows = list(csv.DictReader(open(sys.argv[1]), delimiter="\t"))
 assert [(r["participant_id"], r["session_id"], r["structure"], r["status"]) for r in rows] == [
-    ("sub-01", "n/a", "caudateL", "ok"), ("sub-01", "n/a", "thalamusL", "ok"),
+    ("sub-01", "n/a", "caudateL", "ok"), ("sub-01", "n/a", "putamenL", "ok"), ("sub-01", "n/a", "thalamusL", "ok"),
     ("sub-02", "n/a", "caudateL", "ok"), ("sub-03", "ses-2", "caudateL", "ok")], rows
 assert float(rows[0]["dice"]) >= 0.84, rows[0]  # the workflow test's bar on the demo's caudate (0.850)
 PY

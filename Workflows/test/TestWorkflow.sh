@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # The Snakemake cohort workflow (Workflows/Snakefile) on a small BIDS cohort
-# made from Colin27 (make_cohort.py): the 1 mm MRI, a rigidly moved copy with
-# its landmarks (.fcsv, RAS) and reference moved along, the 0.5 mm MRI in a
-# session (.csv landmarks), a seed click from a seeds table.
+# made from Colin27 (make_cohort.py): the 1 mm MRI with two structures'
+# landmarks (one job: the two segmented together) and a seed click from a
+# seeds table (a job of its own), a rigidly moved copy with its landmarks
+# (.fcsv, RAS) and reference moved along, the 0.5 mm MRI in a session (.csv
+# landmarks).
 #  - `snakemake --cores 2` writes derivatives that keep the BIDS naming rules
 #    (check_derivatives.py), the group table and the QC page; the moved copy
 #    scores what the original does (Dice within 0.01);
@@ -37,15 +39,22 @@ check "first run: exit 0" test $? -eq 0 || tail -40 "$work/run1.log"
 check "first run: BIDS derivative names, sidecars, grids (and the raw cohort valid BIDS)" \
   "$python" "$here/check_derivatives.py" "$work/bids" "$work/out" 4
 cat "$work/out/segmentations.tsv"
-check "group table: 4 segmentations, the moved copy as good as the original" "$python" - "$work/out" <<'PY'
+check "group table: 5 structures in 4 jobs, the moved copy as good as the original" "$python" - "$work/out" <<'PY'
 import csv, sys
 rows = {(r["participant_id"], r["session_id"], r["structure"]): r
         for r in csv.DictReader(open(sys.argv[1] + "/segmentations.tsv"), delimiter="\t")}
 original, moved = rows[("sub-01", "n/a", "caudateL")], rows[("sub-02", "n/a", "caudateL")]
+putamen = rows[("sub-01", "n/a", "putamenL")]
 fine = rows[("sub-03", "ses-2", "caudateL")]
 seed = rows[("sub-01", "n/a", "thalamusL")]
-assert len(rows) == 4 and all(r["status"] == "ok" for r in rows.values()), rows
-assert float(original["dice"]) >= 0.84, original          # the demo's 0.850
+assert len(rows) == 5 and all(r["status"] == "ok" for r in rows.values()), rows
+# The caudate and putamen share one labelmap (values 1 and 2; check_derivatives
+# checks that it holds both), the thalamus from its seed has its own.
+assert original["dseg"] == putamen["dseg"] == "sub-01/anat/sub-01_space-orig_dseg.nii.gz", (original, putamen)
+assert (original["index"], putamen["index"], seed["index"]) == ("1", "2", "1"), (original, putamen, seed)
+assert seed["dseg"] == "sub-01/anat/sub-01_space-orig_desc-thalamusL_dseg.nii.gz", seed
+assert float(original["dice"]) >= 0.84, original          # the demo's 0.850 alone
+assert float(putamen["dice"]) >= 0.88, putamen          # measured 0.890 with the caudate
 assert abs(float(moved["dice"]) - float(original["dice"])) <= 0.01, (moved, original)  # rigid motion changes nothing
 assert fine["dice"] == "n/a" and abs(float(fine["volume_mm3"]) / float(original["volume_mm3"]) - 1) < 0.15, fine
 assert float(seed["dice"]) >= 0.4, seed                   # one click: measured 0.517
@@ -75,17 +84,34 @@ touch(f"{reference}/sub-04/anat/sub-04_dseg.nii.gz")
 touch(f"{reference}/sub-04/anat/sub-04_dseg.tsv", "index\tname\n3\tcaudateL\n")  # its own table
 touch(f"{reference}/sub-05/anat/sub-05_acq-mprage_run-2_dseg.nii.gz")  # no table names its labels
 warnings = []
-jobs = bids.find_jobs(root, landmarks, None, reference, warn=warnings.append)
-assert sorted(jobs) == [("sub-04_run-1", "caudateL"), ("sub-05_acq-mprage_run-2", "caudateL")], sorted(jobs)
-job = jobs[("sub-04_run-1", "caudateL")]
-assert job.t1w.endswith("sub-04_run-1_T1w.nii.gz") and job.reference_labels == [3], vars(job)
-assert bids.output_paths("/o", job.dir, job.stem, job.structure)["dseg"] == \
+structures = bids.find_structures(root, landmarks, None, reference, warn=warnings.append)
+assert sorted(structures) == [("sub-04_run-1", "caudateL"), ("sub-05_acq-mprage_run-2", "caudateL")], sorted(structures)
+structure = structures[("sub-04_run-1", "caudateL")]
+assert structure.t1w.endswith("sub-04_run-1_T1w.nii.gz") and structure.reference_labels == [3], vars(structure)
+jobs = bids.group_jobs(structures)
+assert bids.job_paths("/o", jobs[("sub-04_run-1", "_desc-caudateL")])["dseg"] == \
     "/o/sub-04/anat/sub-04_run-1_space-orig_desc-caudateL_dseg.nii.gz"
 assert any("sub-06_foo-1_T1w.nii.gz: skipped" in w for w in warnings), warnings
 assert any("not used for caudateL" in w for w in warnings), warnings
+# Two structures' landmarks for one image are one job, named by no structure;
+# a reference that names only one of them scores neither, with a warning; a
+# structure with a seed is a job of its own.
+touch(f"{landmarks}/sub-04/anat/sub-04_desc-putamenL_landmarks.csv")
+seeds = f"{root}/seeds.tsv"
+touch(seeds, "participant_id\tstructure\tx\ty\tz\nsub-04\tthalamusL\t1\t2\t3\n")
+warnings = []
+jobs = bids.group_jobs(bids.find_structures(root, landmarks, seeds, reference, warn=warnings.append),
+                       warn=warnings.append)
+assert sorted(jobs) == [("sub-04_run-1", ""), ("sub-04_run-1", "_desc-thalamusL"),
+                        ("sub-05_acq-mprage_run-2", "_desc-caudateL")], sorted(jobs)
+together = jobs[("sub-04_run-1", "")]
+assert [s.name for s in together.structures] == ["caudateL", "putamenL"] and together.reference is None, vars(together)
+assert bids.job_paths("/o", together)["dseg"] == "/o/sub-04/anat/sub-04_run-1_space-orig_dseg.nii.gz"
+assert any("not used for caudateL either" in w for w in warnings), warnings
+assert jobs[("sub-04_run-1", "_desc-thalamusL")].seed == (1.0, 2.0, 3.0)
 touch(f"{landmarks}/sub-05/anat/sub-05_desc-putamenL_landmarks.csv")  # which of two runs?
 try:
-    bids.find_jobs(root, landmarks, None, reference, warn=warnings.append)
+    bids.find_structures(root, landmarks, None, reference, warn=warnings.append)
     sys.exit("a landmark file that fits two T1w images was taken")
 except bids.CohortError as error:
     assert "has 2 T1w images" in str(error), error
@@ -124,13 +150,13 @@ check "QC page: no console message (script errors included)" test -z "$(grep CON
 grep CONSOLE "$work/chromium.log"
 chromium --headless=new --no-sandbox --disable-gpu --dump-dom "file://$work/out/report.html" >"$work/dom.html" \
   2>/dev/null
-check "QC page: the DOM holds the 5 rows" test "$(grep -o '<tr class=' "$work/dom.html" | wc -l)" -eq 5
+check "QC page: the DOM holds the 6 rows" test "$(grep -o '<tr class=' "$work/dom.html" | wc -l)" -eq 6
 if [ -n "${KEEP_SCREENSHOT:-}" ]; then cp "$work/report.png" "$KEEP_SCREENSHOT"; fi
 check "QC page: figures are files beside it, each one there" "$python" - "$work/out/report.html" <<'PY'
 import os, re, sys
 page = open(sys.argv[1]).read()
 sources = re.findall(r'<img src="([^"]+)"', page)
-assert "data:" not in page and len(sources) == 3 * 4, sources  # 4 complete segmentations, 3 figures each
+assert "data:" not in page and len(sources) == 3 * 5, sources  # 5 structures complete, 3 figures each
 missing = [s for s in sources if not os.path.exists(os.path.join(os.path.dirname(sys.argv[1]), s))]
 assert not missing, missing
 PY
@@ -138,7 +164,7 @@ chromium --headless=new --no-sandbox --disable-gpu --dump-dom "file://$work/out/
   >"$work/flagged.html" 2>/dev/null
 check "QC page: #flagged shows the 3 flagged rows only" \
   test "$(grep -c '<tr class="flagged"' "$work/flagged.html")" -eq 3 -a \
-  "$(grep -c '<tr class="" [^>]*hidden=""' "$work/flagged.html")" -eq 2
+  "$(grep -c '<tr class="" [^>]*hidden=""' "$work/flagged.html")" -eq 3
 node "$here/check_qc_page.js" cohort "$work/out/report.html" "$work/view.png"
 check "QC page in Chromium (Playwright): sorting, ratings and their export, the interactive view" test $? -eq 0
 if [ -n "${KEEP_SCREENSHOT:-}" ]; then cp "$work/view.png" "${KEEP_SCREENSHOT%.png}_view.png"; fi
@@ -146,25 +172,29 @@ if [ -n "${KEEP_SCREENSHOT:-}" ]; then cp "$work/view.png" "${KEEP_SCREENSHOT%.p
 # A cohort's page: 500 segmentations (one job's files linked under 500
 # subjects), every row present and no script error. Its load time is printed,
 # not asserted (Ecosystem.md has the figure).
-"$python" - "$WORKFLOWS" "$work/out" "$work/qc500" <<'PY'
+check "QC page of 500: written, every row complete" "$python" - "$WORKFLOWS" "$work/out" "$work/qc500" <<'PY'
 import os, sys
 sys.path.insert(0, sys.argv[1])
 import dynsub_bids as bids, qc_report
 source, out = sys.argv[2], sys.argv[3]
-original = bids.Job("01", None, "", "caudateL", "sub-01_T1w.nii.gz")
+def job_of(subject):
+    return bids.Job([bids.Structure(subject, None, "", "caudateL", f"sub-{subject}_T1w.nii.gz")])
 def paths(out, job):
-    return {**bids.output_paths(out, job.dir, job.stem, job.structure),
-            **bids.figure_paths(out, job.dir, job.stem, job.structure),
-            "view": bids.view_path(out, job.dir, job.stem, job.structure)}
-files = paths(source, original)
+    """Every file of a one-structure job (its report is its structure's too)."""
+    files = [bids.job_paths(out, job), bids.structure_paths(out, job.dir, job.stem, "caudateL"),
+             bids.figure_paths(out, job.dir, job.stem, "caudateL")]
+    return sorted({path for group in files for path in group.values()} |
+                  {bids.view_path(out, job.dir, job.stem, job.desc)})
+files = paths(source, job_of("02"))
 jobs = {}
 for n in range(1000, 1500):
-    job = bids.Job(str(n), None, "", "caudateL", f"sub-{n}_T1w.nii.gz")
-    for key, path in paths(out, job).items():
+    job = job_of(str(n))
+    for original, path in zip(files, paths(out, job)):
         os.makedirs(os.path.dirname(path), exist_ok=True)
-        os.link(files[key], path)
+        os.link(original, path)
     jobs[job.key] = job
-qc_report.write_report(jobs, out, f"{out}/report.html", os.environ["NIIVUE"])
+rows = qc_report.write_report(jobs, out, f"{out}/report.html", os.environ["NIIVUE"])
+assert len(rows) == 500 and all(r["status"] == "ok" for r in rows), "the page's rows are not all complete"
 PY
 start=$EPOCHREALTIME
 chromium --headless=new --no-sandbox --disable-gpu --enable-logging=stderr --v=0 --dump-dom \

@@ -8,12 +8,14 @@ valid BIDS by the BIDS validator (Debian python3-bids-validator). In
 DERIVATIVES, every file must be one of: dataset_description.json (with
 DatasetType derivative and GeneratedBy), the group table and its sidecar,
 job logs, the BIDS App's work/ folder, or per-subject files named
-sub-<label>[_ses-<label>]_space-orig_desc-<label>_<suffix> in sub-<label>/[ses-<label>/]anat
-(figures: ..._desc-<label>_<figure>.png in .../figures), with entities in
-BIDS order, labels of letters and digits, folders matching the entities,
-every dseg.nii.gz with its .tsv lookup table and .json sidecar, on the grid
-of its T1w, holding only the values the table names. EXPECTED_JOBS is the
-number of segmentations that must be there.
+sub-<label>[_ses-<label>]_space-orig[_desc-<label>]_<suffix> in sub-<label>/[ses-<label>/]anat
+(figures: ..._desc-<label>_<figure>.png and ..._[desc-<label>_]view.js in
+.../figures), with entities in BIDS order, labels of letters and digits,
+folders matching the entities, every dseg.nii.gz with its .tsv lookup table
+(index, name, color) and .json sidecar, on the grid of its T1w, holding
+every value the table names and no other: a dseg with desc- holds that one
+structure, one without holds several, each with its own surface and report.
+EXPECTED_JOBS is the number of dseg files (jobs) that must be there.
 """
 import csv
 import json
@@ -26,11 +28,11 @@ import numpy
 from bids_validator import BIDSValidator
 
 L = r"[A-Za-z0-9]+"
-ANAT = re.compile(rf"^sub-(?P<sub>{L})(?:_ses-(?P<ses>{L}))?_space-orig_desc-(?P<desc>{L})_"
+ANAT = re.compile(rf"^sub-(?P<sub>{L})(?:_ses-(?P<ses>{L}))?_space-orig(?:_desc-(?P<desc>{L}))?_"
                   r"(?P<suffix>dseg\.nii\.gz|dseg\.tsv|dseg\.json|surface\.vtp|report\.json|convergence\.csv)$")
-FIGURE = re.compile(rf"^sub-(?P<sub>{L})(?:_ses-(?P<ses>{L}))?_desc-(?P<desc>{L})_"
-                    r"(?P<suffix>(?:slices|surface3d|convergence)\.png|view\.js)$")
-LOG = re.compile(rf"^sub-(?P<sub>{L})(?:_ses-(?P<ses>{L}))?_desc-(?P<desc>{L})\.log$")
+FIGURE = re.compile(rf"^sub-(?P<sub>{L})(?:_ses-(?P<ses>{L}))?(?:_desc-(?P<desc>{L})_"
+                    rf"(?P<suffix>(?:slices|surface3d|convergence)\.png|view\.js)|_(?P<view>view\.js))$")
+LOG = re.compile(rf"^sub-(?P<sub>{L})(?:_ses-(?P<ses>{L}))?(?:_desc-(?P<desc>{L}))?\.log$")
 problems = []
 
 
@@ -89,6 +91,8 @@ def main():
             folders = [f"sub-{match['sub']}"] + ([f"ses-{match['ses']}"] if match["ses"] else [])
             if parts != folders:
                 fail(f"{path}: its folder does not match its entities {folders}")
+            if kind == "anat" and not match["desc"] and match["suffix"] in ("surface.vtp", "convergence.csv"):
+                fail(f"{path}: a structure's own file without its desc-")
             if kind == "anat" and match["suffix"] == "dseg.nii.gz":
                 segmentations += 1
                 check_dseg(raw, os.path.join(folder, name), match)
@@ -107,21 +111,31 @@ def check_dseg(raw, path, match):
             fail(f"{path}: no {os.path.basename(companion)} beside it")
             return
     table = list(csv.DictReader(open(stem + ".tsv"), delimiter="\t"))
-    if [list(r.keys()) for r in table][:1] != [["index", "name"]] or len(table) != 1 or \
-            table[0]["name"] != match["desc"]:
-        fail(f"{stem}.tsv: expected columns index, name and one row naming {match['desc']}")
+    names = [r["name"] for r in table]
+    if [list(r.keys()) for r in table][:1] != [["index", "name", "color"]] or \
+            (match["desc"] and names != [match["desc"]]) or (not match["desc"] and len(names) < 2):
+        fail(f"{stem}.tsv: expected columns index, name, color and "
+             + (f"one row naming {match['desc']}" if match["desc"] else "a row per structure, two or more"))
+        return
     sidecar = json.load(open(stem + ".json"))
-    for key in ("Sources", "SpatialReference"):
+    for key in ("Sources", "SpatialReference", "Report", "Structures"):
         if key not in sidecar:
             fail(f"{stem}.json: no {key}")
+    folder = os.path.dirname(path)
+    for structure in sidecar.get("Structures", []):
+        for key in ("Surface", "Report", "Convergence"):
+            if not os.path.exists(os.path.join(folder, structure.get(key, "?"))):
+                fail(f"{stem}.json: {structure.get('Name')}'s {key} {structure.get(key)} is not beside it")
+    if [s.get("Name") for s in sidecar.get("Structures", [])] != names:
+        fail(f"{stem}.json: its Structures are not the table's {names}")
     source = sidecar.get("SpatialReference", "").removeprefix("bids:raw:")
     t1w = nibabel.load(os.path.join(raw, source))
     labels = nibabel.load(path)
     if labels.shape != t1w.shape or not numpy.allclose(labels.affine, t1w.affine, atol=1e-4):
         fail(f"{path}: not on the grid of {source}")
     values = set(numpy.unique(numpy.asanyarray(labels.dataobj)).tolist())
-    if values != {0, int(table[0]["index"])}:
-        fail(f"{path}: values {values}")
+    if values != {0} | {int(r["index"]) for r in table}:
+        fail(f"{path}: values {values}, its table names {[r['index'] for r in table]}")
 
 
 if __name__ == "__main__":

@@ -71,7 +71,7 @@ async function cohort(context, pagePath, screenshot) {
   const url = "file://" + pagePath;
   let page = await openPage(context, url);
   const rows = await page.locator("#group tbody tr").count();
-  check("cohort: 5 rows", rows === 5, rows);
+  check("cohort: 6 rows (a structure each)", rows === 6, rows);
 
   await page.click("#group th:text-is('Dice')");
   const dice = await column(page, "Dice");
@@ -93,23 +93,23 @@ async function cohort(context, pagePath, screenshot) {
     return out;
   });
   check("cohort: ratings kept across a reload", kept[rated[0]] === "fail" && kept[rated[4]] === "pass" &&
-        Object.values(kept).filter((v) => v === "").length === 3, JSON.stringify(kept));
+        Object.values(kept).filter((v) => v === "").length === 4, JSON.stringify(kept));
 
   const [download] = await Promise.all([page.waitForEvent("download"), page.click("#export")]);
   const tsv = fs.readFileSync(await download.path(), "utf8").trimEnd().split("\n").map((l) => l.split("\t"));
   check("cohort: export is named qc_ratings.tsv", download.suggestedFilename() === "qc_ratings.tsv",
         download.suggestedFilename());
-  check("cohort: export has the header and a row per segmentation",
-        tsv[0].join(",") === "participant_id,session_id,structure,rating,flags" && tsv.length === 6, tsv.length);
+  check("cohort: export has the header and a row per structure",
+        tsv[0].join(",") === "participant_id,session_id,structure,rating,flags" && tsv.length === 7, tsv.length);
   const exported = Object.fromEntries(tsv.slice(1).map((r) => [r.slice(0, 3).join(" "), r[3]]));
   check("cohort: exported ratings are the ones given, the rest n/a", exported[rated[0]] === "fail" &&
-        exported[rated[4]] === "pass" && Object.values(exported).filter((v) => v === "n/a").length === 3,
+        exported[rated[4]] === "pass" && Object.values(exported).filter((v) => v === "n/a").length === 4,
         JSON.stringify(exported));
   const failed = tsv.slice(1).find((r) => r[0] === "sub-04");
   check("cohort: export carries the flags", failed !== undefined && failed[4] === "failed", JSON.stringify(failed));
 
   const views = await page.locator("button.view").count();
-  check("cohort: an interactive view per complete segmentation", views === 4, views);
+  check("cohort: an interactive view per complete job", views === 4, views);
   await page.locator("button.view").first().click();
   let drawn = true;
   try {

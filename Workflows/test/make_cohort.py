@@ -4,8 +4,9 @@ the workflow:
 
     make_cohort.py TEMPLATES DATA DIR [--broken]
 
-  sub-01          Colin27 at 1 mm; left caudate landmarks (.mrk.json, LPS), a
-                  seed click in the left thalamus (seeds.tsv); AAL reference
+  sub-01          Colin27 at 1 mm; left caudate and putamen landmarks
+                  (.mrk.json, LPS: one job for both), a seed click in the left
+                  thalamus (seeds.tsv: a job of its own); AAL reference
   sub-02          the same MRI moved by a rigid transform (12 degrees about an
                   oblique axis, then 5, -8, 3 mm): its landmarks (.fcsv, in
                   RAS) and its AAL reference move with it
@@ -13,7 +14,7 @@ the workflow:
   --broken adds only sub-04 to an existing cohort: its T1w is a truncated
   gzip file (the other subjects' files are left as they are).
 
-DATA is the project's Data directory (the demo's caudate landmarks). Uses
+DATA is the project's Data directory (the demo's caudate and putamen landmarks). Uses
 nibabel and numpy (Debian python3-nibabel).
 """
 import json
@@ -104,6 +105,8 @@ def main():
 
     shutil.copy(f"{templates}/ch2.nii.gz", f"{anat(root, '01')}/sub-01_T1w.nii.gz")
     write_mrk(caudate, f"{anat(marks, '01')}/sub-01_desc-caudateL_landmarks.mrk.json")
+    write_mrk(landmarks(f"{data}/Landmarks/putamen_left.mrk.json"),
+              f"{anat(marks, '01')}/sub-01_desc-putamenL_landmarks.mrk.json")
     shutil.copy(f"{templates}/aal.nii.gz", f"{anat(reference, '01')}/sub-01_dseg.nii.gz")
     # A click inside the left thalamus (AAL 77): its voxel nearest the label's centroid.
     aal = nibabel.load(f"{templates}/aal.nii.gz")
@@ -114,7 +117,7 @@ def main():
         f.write("participant_id\tsession_id\tstructure\tx\ty\tz\n")
         f.write("sub-01\tn/a\tthalamusL\t%r\t%r\t%r\n" % tuple(float(v) for v in click))
     with open(f"{reference}/dseg.tsv", "w") as f:
-        f.write("index\tname\n71\tcaudateL\n77\tthalamusL\n")
+        f.write("index\tname\n71\tcaudateL\n73\tputamenL\n77\tthalamusL\n")
 
     transform = rigid()
     save_moved(f"{templates}/ch2.nii.gz", f"{anat(root, '02')}/sub-02_T1w.nii.gz", transform)
