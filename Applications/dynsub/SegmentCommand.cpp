@@ -307,21 +307,18 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
   ProgressLine line;
   const StructuresOutcome outcome = segmentStructures(image, structures, o.parameters, line.callback());
   line.finish();
-  // Each structure's set of files commits on its own; should a later one
-  // fail, the folders this run made are removed again, so that nothing of
-  // it is left half-written.
+  // The structures' folders are written into the run's set: a new DIR
+  // appears whole, with them. Into a DIR that exists, each structure's set
+  // commits on its own; should a later one fail, the folders this run made
+  // are removed again, so that nothing of it is left half-written.
   std::vector<std::filesystem::path> made;
   try {
-    if (!std::filesystem::exists(dir)) {
-      std::filesystem::create_directory(dir);
-      made.push_back(dir);
-    }
+    OutputSet outputs(dir);
     for (std::size_t s = 0; s < structures.size(); ++s) {
-      const std::filesystem::path own = dir / structures[s].name;
-      if (!std::filesystem::exists(own)) made.push_back(own);
+      const std::filesystem::path own = outputs.writingDirectory() / structures[s].name;
+      if (!std::filesystem::exists(own)) made.push_back(dir / structures[s].name);
       writeSegmentOutputs(own, outcome.structures[s], image, o.figures);
     }
-    OutputSet outputs(dir);
     writeVolume(outcome.labels, outputs.add("dseg.nii.gz"), VoxelType::Label16);
     writeLabelTable(structures, outputs.add("dseg.tsv"));
     outcome.report.write(outputs.add("report.json"));

@@ -28,6 +28,7 @@ duration_ms=$((($(date +%s%N) - start) / 1000000))
 expected=$(ls -A "$work/whole" | sort | tr '\n' ' ')
 echo "a whole run: ${duration_ms} ms, writes: $expected"
 check "a whole run leaves no temporary file" test "$(temporaries "$work/whole")" -eq 0
+check "nor the folder it was written in" test -z "$(find "$work" -maxdepth 1 -name '.tmp-*')"
 
 # --- killed at 20 random moments (SIGKILL) ---------------------------------
 # Odd kills at moments from 0 to 1.1 times a whole run, even ones in its
@@ -38,6 +39,9 @@ check "a whole run leaves no temporary file" test "$(temporaries "$work/whole")"
 RANDOM=2026
 complete=0 absent=0 broken=0 leftover=0
 outputs() { ls -A "$1" 2>/dev/null | grep -v '^\.tmp-' | sort | tr '\n' ' '; }
+# What a killed run leaves: the folder its new --out was written in
+# (.tmp-<pid>-killed, beside it; OutputSet.h), or temporary files in --out.
+leftovers() { { find "$work" -maxdepth 1 -name '.tmp-*-killed'; find "$work/killed" -name '.tmp-*' 2>/dev/null; } | wc -l; }
 for i in $(seq 1 20); do
   rm -rf "$work/killed"
   if [ $((i % 2)) -eq 1 ]; then
@@ -50,7 +54,7 @@ for i in $(seq 1 20); do
   sleep "$(awk -v ms="$delay_ms" 'BEGIN { printf "%.3f", ms / 1000 }')"
   kill -KILL "$pid" 2>/dev/null
   wait "$pid" 2>/dev/null
-  [ "$(temporaries "$work/killed")" -ne 0 ] && leftover=$((leftover + 1))
+  [ "$(leftovers)" -ne 0 ] && leftover=$((leftover + 1))
   if [ -z "$(outputs "$work/killed")" ]; then
     absent=$((absent + 1))
   elif [ "$(outputs "$work/killed")" = "$expected" ]; then
@@ -60,11 +64,11 @@ for i in $(seq 1 20); do
     echo "kill $i at ${delay_ms} ms left an incomplete set: $(outputs "$work/killed")"
   fi
   # The rerun of a killed job: it completes and sweeps the killed run's temporaries.
-  if [ "$(temporaries "$work/killed")" -ne 0 ]; then
+  if [ "$(leftovers)" -ne 0 ]; then
     "${segment[@]}" --out "$work/killed" >/dev/null 2>&1
     check "kill $i: the rerun succeeds" test $? -eq 0
     check "kill $i: the rerun leaves the whole set" test "$(outputs "$work/killed")" = "$expected"
-    check "kill $i: the rerun sweeps the killed run's temporaries" test "$(temporaries "$work/killed")" -eq 0
+    check "kill $i: the rerun sweeps the killed run's temporaries" test "$(leftovers)" -eq 0
   fi
 done
 echo "20 kills: $absent before any output, $complete after the whole set, $broken incomplete," \
@@ -151,7 +155,8 @@ for i in $(seq 1 10); do
   stiffness=$(sed -n 's/^ *"default_spring_stiffness": \([0-9.]*\).*/\1/p' "$work/race/report.json")
   solo="$work/solo${stiffness%.*}"
   if ! cmp -s "$work/race/control_mesh.obj" "$solo/control_mesh.obj" ||
-    ! cmp -s "$work/race/surface.vtp" "$solo/surface.vtp" || [ "$(temporaries "$work/race")" -ne 0 ]; then
+    ! cmp -s "$work/race/surface.vtp" "$solo/surface.vtp" || [ "$(temporaries "$work/race")" -ne 0 ] ||
+    [ -n "$(find "$work" -maxdepth 1 -name '.tmp-*-race')" ]; then
     mixed=$((mixed + 1))
     echo "race $i: report.json says stiffness '$stiffness', the other files do not match it"
   fi

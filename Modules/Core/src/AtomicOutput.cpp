@@ -5,8 +5,8 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cctype>
+#include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <string>
@@ -22,9 +22,10 @@ namespace {
 
 std::string temporaryPrefix(long pid) { return ".tmp-" + std::to_string(pid) + "-"; }
 
-// Removes the temporary files a killed run left for `name` in `directory`:
-// ".tmp-<pid>-<name>" whose process no longer exists. A live process's are
-// kept (a concurrent run's, or an unrelated process that took over the pid).
+}  // namespace
+
+std::string temporaryName(const std::string& name) { return temporaryPrefix(::getpid()) + name; }
+
 void removeStaleTemporaries(const fs::path& directory, const std::string& name) {
   std::error_code error;
   for (fs::directory_iterator entry(directory.empty() ? "." : directory, error), end; !error && entry != end;
@@ -40,11 +41,9 @@ void removeStaleTemporaries(const fs::path& directory, const std::string& name) 
     const long pid = std::stol(digits);
     if (pid == ::getpid() || ::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
     std::error_code ignored;
-    fs::remove(entry->path(), ignored);
+    fs::remove_all(entry->path(), ignored);  // a file, or an output set's folder (OutputSet.h)
   }
 }
-
-}  // namespace
 
 AtomicOutput::AtomicOutput(std::string target) : target_(std::move(target)) {
   requireWritableDirectoryFor(target_);

@@ -28,18 +28,29 @@ void prepareOutputDirectory(const std::filesystem::path& dir) {
 }
 
 OutputSet::OutputSet(std::filesystem::path dir) : dir_(std::move(dir)) {
+  // "out/" names the folder "out".
+  if (!dir_.has_filename()) dir_ = dir_.parent_path();
   std::error_code error;
-  if (!std::filesystem::exists(dir_, error)) {
-    if (!std::filesystem::create_directory(dir_, error)) throw Error(dir_.string(), "cannot be created: " + error.message());
-    created_ = true;
+  if (std::filesystem::exists(dir_, error)) {
+    lock(dir_);
+    return;
   }
-  // Two runs writing to one directory at once take turns: each holds a lock
-  // on the directory from its first file to its commit, so their files never
-  // interleave (the last run's set is the one that stays whole).
-  lock_ = ::open(dir_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (lock_ < 0) throw Error(dir_.string(), "cannot be opened: " + std::string(std::strerror(errno)));
+  const std::filesystem::path parent = dir_.has_parent_path() ? dir_.parent_path() : std::filesystem::path(".");
+  const std::string name = dir_.filename().string();
+  removeStaleTemporaries(parent, name);
+  staging_ = parent / temporaryName(name);
+  if (!std::filesystem::create_directory(staging_, error))
+    throw Error(dir_.string(), "cannot be created: " + (error ? error.message() : staging_.string() + " exists"));
+}
+
+// Two runs writing to one directory at once take turns: each holds a lock on
+// the directory until its set is in place, so their files never interleave
+// (the last run's set is the one that stays whole).
+void OutputSet::lock(const std::filesystem::path& dir) {
+  lock_ = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (lock_ < 0) throw Error(dir.string(), "cannot be opened: " + std::string(std::strerror(errno)));
   if (::flock(lock_, LOCK_EX | LOCK_NB) != 0) {
-    std::cerr << "dynsub: waiting for another run writing to " << dir_.string() << '\n';
+    std::cerr << "dynsub: waiting for another run writing to " << dir.string() << '\n';
     while (::flock(lock_, LOCK_EX) != 0 && errno == EINTR) {
     }
   }
@@ -47,20 +58,40 @@ OutputSet::OutputSet(std::filesystem::path dir) : dir_(std::move(dir)) {
 
 OutputSet::~OutputSet() {
   outputs_.clear();  // removes uncommitted temporary files
-  if (created_ && !committed_) {
-    std::error_code error;
-    std::filesystem::remove(dir_, error);
+  if (!staging_.empty() && !committed_) {
+    std::error_code ignored;
+    std::filesystem::remove_all(staging_, ignored);
   }
   if (lock_ >= 0) ::close(lock_);  // releases the lock
 }
 
 std::string OutputSet::add(const std::string& name) {
-  outputs_.push_back(std::make_unique<AtomicOutput>((dir_ / name).string()));
+  outputs_.push_back(std::make_unique<AtomicOutput>((writingDirectory() / name).string()));
   return outputs_.back()->temporaryPath();
 }
 
 void OutputSet::commit() {
   for (auto& output : outputs_) output->commit();
+  if (!staging_.empty()) {
+    std::error_code error;
+    std::filesystem::rename(staging_, dir_, error);
+    if (error) {
+      if (!std::filesystem::is_directory(dir_))
+        throw Error(dir_.string(), "cannot move the finished outputs into place: " + error.message());
+      // Another run made the directory meanwhile: the files move in one by one.
+      lock(dir_);
+      std::vector<std::filesystem::path> entries;
+      for (std::filesystem::directory_iterator it(staging_, error), end; !error && it != end; it.increment(error))
+        entries.push_back(it->path());
+      if (error) throw Error(staging_.string(), "cannot be read: " + error.message());
+      for (const std::filesystem::path& entry : entries) {
+        const std::filesystem::path target = dir_ / entry.filename();
+        std::filesystem::rename(entry, target, error);
+        if (error) throw Error(target.string(), "cannot move the finished output into place: " + error.message());
+      }
+      std::filesystem::remove(staging_, error);
+    }
+  }
   committed_ = true;
 }
 

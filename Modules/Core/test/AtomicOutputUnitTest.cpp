@@ -1,14 +1,14 @@
-// Unit test (no rendering): an output is either complete or absent.
+// Unit test (no rendering): an output, or a set of outputs, is either complete or absent.
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 
-#include <gtest/gtest.h>
-
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
+#include "dynsub/OutputSet.h"
 
 namespace fs = std::filesystem;
 
@@ -99,6 +99,107 @@ TEST(AtomicOutput, TheNextRunRemovesTemporariesOfKilledRuns) {
   EXPECT_TRUE(fs::exists(live));
   EXPECT_TRUE(fs::exists(otherName));
   EXPECT_TRUE(fs::exists(dir / "report.json"));
+}
+
+std::size_t entries(const fs::path& dir) {
+  return static_cast<std::size_t>(std::distance(fs::directory_iterator(dir), fs::directory_iterator()));
+}
+
+// A new directory is written as a folder beside it and appears in one
+// rename, with its files and its folders (an output set inside it), so a
+// run killed at any moment leaves it absent or whole.
+TEST(OutputSet, ANewDirectoryAppearsWholeAtCommit) {
+  const fs::path parent = freshDirectory("set-new");
+  const fs::path dir = parent / "out";
+  {
+    dynsub::OutputSet outputs(dir);
+    std::ofstream(outputs.add("report.json")) << "{}";
+    {
+      dynsub::OutputSet inner(outputs.writingDirectory() / "caudate");
+      std::ofstream(inner.add("surface.vtp")) << "<VTKFile/>";
+      inner.commit();
+    }
+    EXPECT_FALSE(fs::exists(dir));
+    EXPECT_EQ(entries(parent), 1u);  // the set's own folder, .tmp-<pid>-out
+    outputs.commit();
+  }
+  EXPECT_EQ(entries(parent), 1u);
+  EXPECT_TRUE(fs::exists(dir / "report.json"));
+  EXPECT_TRUE(fs::exists(dir / "caudate" / "surface.vtp"));
+  EXPECT_EQ(entries(dir), 2u);
+  EXPECT_EQ(entries(dir / "caudate"), 1u);
+}
+
+TEST(OutputSet, WithoutCommitNothingIsLeft) {
+  const fs::path parent = freshDirectory("set-abandon");
+  {
+    dynsub::OutputSet outputs(parent / "out");
+    std::ofstream(outputs.add("report.json")) << "{}";
+  }
+  EXPECT_EQ(entries(parent), 0u);
+  fs::create_directory(parent / "existing");
+  {
+    dynsub::OutputSet outputs(parent / "existing");
+    std::ofstream(outputs.add("report.json")) << "{}";
+  }
+  EXPECT_EQ(entries(parent / "existing"), 0u);
+}
+
+// Into a directory that exists, the files are renamed into it; the other
+// files there stay.
+TEST(OutputSet, AnExistingDirectoryKeepsItsOtherFiles) {
+  const fs::path dir = freshDirectory("set-existing");
+  std::ofstream(dir / "notes.txt") << "mine";
+  std::ofstream(dir / "report.json") << "old";
+  {
+    dynsub::OutputSet outputs(dir);
+    std::ofstream(outputs.add("report.json")) << "new";
+    outputs.commit();
+  }
+  EXPECT_EQ(entries(dir), 2u);
+  std::string text;
+  std::ifstream(dir / "report.json") >> text;
+  EXPECT_EQ(text, "new");
+}
+
+// Another run made the directory while this set was written: its files move
+// in one by one, replacing that run's.
+TEST(OutputSet, ADirectoryMadeMeanwhileTakesTheFiles) {
+  const fs::path parent = freshDirectory("set-meanwhile");
+  const fs::path dir = parent / "out";
+  {
+    dynsub::OutputSet outputs(dir);
+    std::ofstream(outputs.add("report.json")) << "second";
+    fs::create_directory(dir);
+    std::ofstream(dir / "report.json") << "first";
+    std::ofstream(dir / "labelmap.nii.gz") << "first";
+    outputs.commit();
+  }
+  EXPECT_EQ(entries(parent), 1u);
+  EXPECT_EQ(entries(dir), 2u);
+  std::string text;
+  std::ifstream(dir / "report.json") >> text;
+  EXPECT_EQ(text, "second");
+}
+
+// A killed run's folder is swept by the next set of the same directory.
+TEST(OutputSet, TheNextRunRemovesTheFolderOfAKilledRun) {
+  const fs::path parent = freshDirectory("set-stale");
+  const pid_t child = fork();
+  if (child == 0) _exit(0);
+  ASSERT_GT(child, 0);
+  int status = 0;
+  waitpid(child, &status, 0);
+  const fs::path stale = parent / (".tmp-" + std::to_string(child) + "-out");
+  fs::create_directories(stale / "caudate");
+  std::ofstream(stale / "caudate" / "surface.vtp") << "partial";
+  {
+    dynsub::OutputSet outputs(parent / "out");
+    std::ofstream(outputs.add("report.json")) << "{}";
+    outputs.commit();
+  }
+  EXPECT_FALSE(fs::exists(stale));
+  EXPECT_EQ(entries(parent), 1u);
 }
 
 TEST(AtomicOutput, MissingDirectoryIsNamed) {

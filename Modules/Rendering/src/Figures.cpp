@@ -407,8 +407,11 @@ void runPdftocairo(const std::vector<std::string>& arguments, const std::string&
 // are never committed: removed when done, and swept after a killed run.
 void writeVectorFigure(vtkRenderWindow* window, const std::string& path, FigureFormat format, double dpi) {
   AtomicOutput output(path);
-  const std::filesystem::path target(withoutTemporaryPrefix(path));
-  const std::string stem = (target.parent_path() / target.stem()).string();
+  // Beside the file being written (an output set's folder until it
+  // commits), named after the figure.
+  const std::filesystem::path written(path);
+  const std::filesystem::path name(withoutTemporaryPrefix(written.filename().string()));
+  const std::string stem = (written.parent_path() / name.stem()).string();
   AtomicOutput drawn(stem + ".gl2ps.pdf"), log(stem + ".pdftocairo.log");
   const std::string& intermediate = drawn.temporaryPath();
   window->Render();

@@ -11,6 +11,7 @@
 // A target that is already this process's temporary file (a writer given the
 // path of an enclosing output) is written in place: the enclosing output
 // removes it or makes it appear.
+#include <filesystem>
 #include <string>
 
 #include "dynsub/Error.h"
@@ -37,6 +38,15 @@ class AtomicOutput {
   std::string temporary_;
   bool committed_ = false;
 };
+
+// This process's temporary name for `name`: ".tmp-<pid>-<name>".
+std::string temporaryName(const std::string& name);
+
+// Removes what killed runs left for `name` in `directory`: the files or
+// folders ".tmp-<pid>-<name>" whose process no longer exists. A live
+// process's are kept (a concurrent run's, or an unrelated process that took
+// over the pid).
+void removeStaleTemporaries(const std::filesystem::path& directory, const std::string& name);
 
 // Throws dynsub::Error naming `path` unless its directory exists and is writable.
 void requireWritableDirectoryFor(const std::string& path);

@@ -13,11 +13,19 @@ class AtomicOutput;
 // Throws dynsub::Error unless `dir` is a directory or can be created (its parent exists).
 void prepareOutputDirectory(const std::filesystem::path& dir);
 
-// Files in one directory that appear together: each is written to a temporary
-// file, and commit() renames them all; before that nothing is visible (a
-// directory this created is removed again if commit() is never reached). A
-// set holds an exclusive lock (flock) on its directory for its lifetime, so
-// the sets of two runs writing there at once never interleave.
+// Files in one directory that appear together, or not at all.
+//  - A directory that does not exist yet is written as a folder of its own
+//    beside it, ".tmp-<pid>-<name>", renamed into place by commit(): it
+//    appears whole, with every file and folder of the set, in one step. A
+//    killed run leaves only that folder, which the next set of the same
+//    directory sweeps (AtomicOutput.h). Should another run have made the
+//    directory meanwhile, the files move in one by one, as below.
+//  - Into a directory that exists, each file is written to a temporary file
+//    beside its target, and commit() renames them one by one: a run killed
+//    in that instant can leave some files new and some old. The set holds an
+//    exclusive lock (flock) on the directory from its start to its end, so
+//    the sets of two runs writing there at once never interleave.
+// Without commit() (an error, an exception) nothing of the set is left.
 class OutputSet {
  public:
   explicit OutputSet(std::filesystem::path dir);
@@ -26,11 +34,16 @@ class OutputSet {
   OutputSet& operator=(const OutputSet&) = delete;
   // The temporary path to write `name` to.
   std::string add(const std::string& name);
+  // Where the set is written until commit(): a folder made in it (an
+  // OutputSet of its own) becomes part of the set.
+  const std::filesystem::path& writingDirectory() const { return staging_.empty() ? dir_ : staging_; }
   void commit();
 
  private:
+  void lock(const std::filesystem::path& dir);
+
   std::filesystem::path dir_;
-  bool created_ = false;
+  std::filesystem::path staging_;  // the folder written in place of a new dir_, else empty
   bool committed_ = false;
   int lock_ = -1;  // the directory, opened to hold its lock
   std::vector<std::unique_ptr<AtomicOutput>> outputs_;
