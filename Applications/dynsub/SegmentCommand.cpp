@@ -316,7 +316,7 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
     OutputSet outputs(dir);
     for (std::size_t s = 0; s < structures.size(); ++s) {
       const std::filesystem::path own = outputs.writingDirectory() / structures[s].name;
-      if (!std::filesystem::exists(own)) made.push_back(dir / structures[s].name);
+      if (outputs.writingDirectory() == dir && !std::filesystem::exists(own)) made.push_back(own);
       writeSegmentOutputs(own, outcome.structures[s], image, o.figures);
     }
     writeVolume(outcome.labels, outputs.add("dseg.nii.gz"), VoxelType::Label16);

@@ -30,15 +30,17 @@ void prepareOutputDirectory(const std::filesystem::path& dir) {
 OutputSet::OutputSet(std::filesystem::path dir) : dir_(std::move(dir)) {
   // "out/" names the folder "out".
   if (!dir_.has_filename()) dir_ = dir_.parent_path();
+  const std::filesystem::path parent = dir_.has_parent_path() ? dir_.parent_path() : std::filesystem::path(".");
+  const std::string name = dir_.filename().string();
+  removeStaleTemporaries(parent, name);  // a killed run's folder, whether or not it got as far as dir_
   std::error_code error;
   if (std::filesystem::exists(dir_, error)) {
     lock(dir_);
     return;
   }
-  const std::filesystem::path parent = dir_.has_parent_path() ? dir_.parent_path() : std::filesystem::path(".");
-  const std::string name = dir_.filename().string();
-  removeStaleTemporaries(parent, name);
   staging_ = parent / temporaryName(name);
+  // One left by an earlier process with this pid (pids are reused) is stale.
+  std::filesystem::remove_all(staging_, error);
   if (!std::filesystem::create_directory(staging_, error))
     throw Error(dir_.string(), "cannot be created: " + (error ? error.message() : staging_.string() + " exists"));
 }
@@ -78,17 +80,31 @@ void OutputSet::commit() {
     if (error) {
       if (!std::filesystem::is_directory(dir_))
         throw Error(dir_.string(), "cannot move the finished outputs into place: " + error.message());
-      // Another run made the directory meanwhile: the files move in one by one.
+      // Another run made the directory meanwhile: this set moves in over
+      // that run's, its folders first (one of the same name is moved aside
+      // and removed), then its files in the order they were added, so that
+      // the last added (a report) arrives last.
       lock(dir_);
-      std::vector<std::filesystem::path> entries;
+      std::vector<std::filesystem::path> folders;
       for (std::filesystem::directory_iterator it(staging_, error), end; !error && it != end; it.increment(error))
-        entries.push_back(it->path());
+        if (it->is_directory()) folders.push_back(it->path());
       if (error) throw Error(staging_.string(), "cannot be read: " + error.message());
-      for (const std::filesystem::path& entry : entries) {
-        const std::filesystem::path target = dir_ / entry.filename();
-        std::filesystem::rename(entry, target, error);
+      const auto moveIn = [&](const std::filesystem::path& from) {
+        const std::filesystem::path target = dir_ / from.filename();
+        std::filesystem::rename(from, target, error);
         if (error) throw Error(target.string(), "cannot move the finished output into place: " + error.message());
+      };
+      for (const std::filesystem::path& folder : folders) {
+        const std::filesystem::path target = dir_ / folder.filename();
+        const std::filesystem::path aside = dir_ / temporaryName("replaced-" + folder.filename().string());
+        if (std::filesystem::exists(target)) {
+          std::filesystem::rename(target, aside, error);
+          if (error) throw Error(target.string(), "cannot be replaced: " + error.message());
+        }
+        moveIn(folder);
+        std::filesystem::remove_all(aside, error);
       }
+      for (const auto& output : outputs_) moveIn(output->target());
       std::filesystem::remove(staging_, error);
     }
   }

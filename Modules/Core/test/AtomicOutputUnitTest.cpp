@@ -162,24 +162,49 @@ TEST(OutputSet, AnExistingDirectoryKeepsItsOtherFiles) {
   EXPECT_EQ(text, "new");
 }
 
-// Another run made the directory while this set was written: its files move
-// in one by one, replacing that run's.
-TEST(OutputSet, ADirectoryMadeMeanwhileTakesTheFiles) {
+// Another run made the directory while this set was written: the set moves
+// in over that run's, a folder of the same name replaced whole.
+TEST(OutputSet, ADirectoryMadeMeanwhileTakesTheSet) {
   const fs::path parent = freshDirectory("set-meanwhile");
   const fs::path dir = parent / "out";
   {
     dynsub::OutputSet outputs(dir);
+    {
+      dynsub::OutputSet inner(outputs.writingDirectory() / "caudate");
+      std::ofstream(inner.add("surface.vtp")) << "second";
+      inner.commit();
+    }
     std::ofstream(outputs.add("report.json")) << "second";
-    fs::create_directory(dir);
+    fs::create_directories(dir / "caudate");
+    std::ofstream(dir / "caudate" / "surface.vtp") << "first";
+    std::ofstream(dir / "caudate" / "labelmap.nii.gz") << "first";
     std::ofstream(dir / "report.json") << "first";
     std::ofstream(dir / "labelmap.nii.gz") << "first";
     outputs.commit();
   }
   EXPECT_EQ(entries(parent), 1u);
-  EXPECT_EQ(entries(dir), 2u);
+  EXPECT_EQ(entries(dir), 3u);  // caudate, report.json and the first run's labelmap.nii.gz
+  EXPECT_EQ(entries(dir / "caudate"), 1u);
   std::string text;
   std::ifstream(dir / "report.json") >> text;
   EXPECT_EQ(text, "second");
+  std::ifstream(dir / "caudate" / "surface.vtp") >> text;
+  EXPECT_EQ(text, "second");
+}
+
+// A folder an earlier process with this pid left (pids are reused) does
+// not stop the set.
+TEST(OutputSet, AFolderLeftUnderThisPidIsReplaced) {
+  const fs::path parent = freshDirectory("set-same-pid");
+  fs::create_directories(parent / dynsub::temporaryName("out"));
+  std::ofstream(parent / dynsub::temporaryName("out") / "surface.vtp") << "old";
+  {
+    dynsub::OutputSet outputs(parent / "out");
+    std::ofstream(outputs.add("report.json")) << "{}";
+    outputs.commit();
+  }
+  EXPECT_EQ(entries(parent), 1u);
+  EXPECT_EQ(entries(parent / "out"), 1u);
 }
 
 // A killed run's folder is swept by the next set of the same directory.
@@ -200,6 +225,14 @@ TEST(OutputSet, TheNextRunRemovesTheFolderOfAKilledRun) {
   }
   EXPECT_FALSE(fs::exists(stale));
   EXPECT_EQ(entries(parent), 1u);
+  // Also when the directory is there by now (a rerun into it).
+  fs::create_directories(stale);
+  {
+    dynsub::OutputSet outputs(parent / "out");
+    std::ofstream(outputs.add("report.json")) << "{}";
+    outputs.commit();
+  }
+  EXPECT_FALSE(fs::exists(stale));
 }
 
 TEST(AtomicOutput, MissingDirectoryIsNamed) {

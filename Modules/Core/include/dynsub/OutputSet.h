@@ -19,7 +19,9 @@ void prepareOutputDirectory(const std::filesystem::path& dir);
 //    appears whole, with every file and folder of the set, in one step. A
 //    killed run leaves only that folder, which the next set of the same
 //    directory sweeps (AtomicOutput.h). Should another run have made the
-//    directory meanwhile, the files move in one by one, as below.
+//    directory meanwhile, the set moves in over that run's: its folders
+//    (each replacing one of the same name), then its files one by one, in
+//    the order added.
 //  - Into a directory that exists, each file is written to a temporary file
 //    beside its target, and commit() renames them one by one: a run killed
 //    in that instant can leave some files new and some old. The set holds an
