@@ -25,6 +25,7 @@
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
 #include "dynsub/ImageIO.h"
+#include "dynsub/Landmarks.h"
 #include "dynsub/SegmentImage.h"
 #include "dynsub/SurfaceWriter.h"
 
@@ -128,7 +129,7 @@ slicer::Module describe(Arguments& a) {
   io.parameters.push_back({"file", "fileExtensions=\".mrk.json,.fcsv,.csv\"", "landmarksFile", "landmarks",
                            "Boundary points file",
                            "Boundary points from a file (.mrk.json, .fcsv, or .csv with x,y,z columns in LPS mm), "
-                           "added to the points above.",
+                           "added to the points above: one structure's, so a markups file with one point list.",
                            &a.landmarks, "input", "", "", "", {}, -1});
   io.parameters.push_back({"point", "coordinateSystem=\"lps\"", "inside", "inside", "Point inside",
                            "One click inside the structure: the surface starts from the region of like tissue "
@@ -217,6 +218,17 @@ void run(Arguments& a) {
     in.landmarks.push_back({"seed-" + std::to_string(i + 1), parsePoint(a.seeds[i], "--seed")});
   in.landmarkSource = "--seed";
   if (!a.landmarks.empty()) {
+    // Several lists (point lists, curves) are several structures: merged,
+    // they would make one surface through all of them.
+    const std::vector<LandmarkList> lists = readLandmarkLists(a.landmarks);
+    if (lists.size() > 1) {
+      std::string names;
+      for (std::size_t k = 0; k < lists.size(); ++k)
+        names += (k ? ", " : "") + (lists[k].name.empty() ? "list " + std::to_string(k + 1) : lists[k].name);
+      throw Error(a.landmarks, "holds " + std::to_string(lists.size()) + " lists of points (" + names +
+                                   "): this module segments one structure per run; give a file with one list, or "
+                                   "segment them together with dynsub segment --landmarks " + a.landmarks);
+    }
     const std::vector<Landmark> fromFile = readLandmarks(a.landmarks, &in.landmarkSystem);
     in.landmarks.insert(in.landmarks.end(), fromFile.begin(), fromFile.end());
     in.landmarkSource = a.seeds.empty() ? a.landmarks : "--seed and " + a.landmarks;

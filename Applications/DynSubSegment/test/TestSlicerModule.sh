@@ -105,6 +105,19 @@ expect_failure "unknown labelmap format" 1 "unknown labelmap format" "${seeds[@]
   "$work/ch2.nrrd"
 expect_failure "model in a missing directory" 1 "no-dir" "${seeds[@]}" --labelmap "$work/bad.nrrd" \
   --model "$work/no-dir/m.vtp" "$work/ch2.nrrd"
+# Two structures' point lists in one markups file: refused, not merged into
+# one surface through both.
+"$python" - "$DATA/Landmarks" "$work/two.mrk.json" <<'PY'
+import json, sys
+lists = []
+for name, file in (("Caudate L", "caudate_left"), ("Putamen L", "putamen_left")):
+    markup = json.load(open(f"{sys.argv[1]}/{file}.mrk.json"))["markups"][0]
+    markup["name"] = name
+    lists.append(markup)
+json.dump({"markups": lists}, open(sys.argv[2], "w"))
+PY
+expect_failure "two point lists in one file" 1 "holds 2 lists of points (Caudate L, Putamen L)" \
+  --landmarks "$work/two.mrk.json" --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
 expect_failure "sigma out of range" 2 "sigma" "${seeds[@]}" --sigma 50 --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
 expect_failure "unknown option" 2 "frobnicate" --frobnicate "$work/ch2.nrrd"
 expect_failure "a misspelt option" 2 "did you mean '--sigma'" --sigm 2 "$work/ch2.nrrd"

@@ -56,7 +56,20 @@ double finiteNumber(const std::string& text, const std::string& path, int line) 
   return value;
 }
 
-// Every markup of the file, in order, with or without points.
+// Whether a markup's control points are points on a structure: a point
+// list's, and a curve's drawn along its boundary. A line, an angle, a plane
+// or an ROI (a ruler, a protractor, a cut, a box) is a measurement or a
+// region kept in the same scene: it is left out. Another type is an error,
+// so that a type this reader does not know is never read as landmarks.
+bool onStructure(const std::string& path, const std::string& type) {
+  if (type == "Fiducial" || type == "Curve" || type == "ClosedCurve") return true;
+  if (type == "Line" || type == "Angle" || type == "Plane" || type == "ROI") return false;
+  throw Error(path, "a markup of unknown type \"" + type +
+                        "\" (point lists, curves and closed curves give landmarks; lines, angles, planes and ROIs are "
+                        "left out)");
+}
+
+// Every point list and curve of the file, in order, with or without points.
 std::vector<LandmarkList> readMarkupsJson(const std::string& path, std::ifstream& in) {
   nlohmann::json document;
   try {
@@ -72,6 +85,7 @@ std::vector<LandmarkList> readMarkupsJson(const std::string& path, std::ifstream
   // malformed, and the message names the file.
   try {
     for (const auto& markup : document["markups"]) {
+      if (!onStructure(path, markup.value("type", "Fiducial"))) continue;
       const std::string system = markup.value("coordinateSystem", "LPS");
       if (system != "LPS" && system != "RAS") throw Error(path, "unknown coordinateSystem \"" + system + "\"");
       if (markup.contains("coordinateUnits") && markup["coordinateUnits"] != "mm")

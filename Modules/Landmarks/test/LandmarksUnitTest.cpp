@@ -86,6 +86,38 @@ TEST(Landmarks, AMarkupsFileGivesEachPointListOnItsOwn) {
   EXPECT_EQ(one[0].landmarks.size(), 3u);
 }
 
+// A scene's markups file may hold a ruler or a box beside the point lists:
+// a curve's points are landmarks (drawn along a boundary), a line's, an
+// angle's, a plane's and an ROI's are not; an unknown type is refused.
+TEST(Landmarks, OnlyPointListsAndCurvesGiveLandmarks) {
+  const fs::path json = scratch("scene.mrk.json");
+  std::ofstream(json.string()) << R"({"markups": [
+    {"type": "Line", "name": "ruler", "controlPoints": [
+      {"position": [0.0, 0.0, 0.0]}, {"position": [9.0, 0.0, 0.0]}]},
+    {"type": "Fiducial", "name": "Caudate L", "controlPoints": [{"position": [1.0, 2.0, 3.0]}]},
+    {"type": "ROI", "name": "box", "controlPoints": [{"position": [5.0, 5.0, 5.0]}]},
+    {"type": "ClosedCurve", "name": "Putamen L", "controlPoints": [
+      {"position": [7.0, 8.0, 9.0]}, {"position": [7.0, 9.0, 9.0]}]},
+    {"type": "Angle", "controlPoints": [{"position": [1.0, 1.0, 1.0]}]},
+    {"type": "Plane", "controlPoints": [{"position": [2.0, 2.0, 2.0]}]}]})";
+  const std::vector<LandmarkList> lists = readLandmarkLists(json.string());
+  ASSERT_EQ(lists.size(), 2u);
+  EXPECT_EQ(lists[0].name, "Caudate L");
+  EXPECT_EQ(lists[1].name, "Putamen L");
+  EXPECT_EQ(lists[1].landmarks.size(), 2u);
+  EXPECT_EQ(readLandmarks(json.string()).size(), 3u);
+
+  const fs::path unknown = scratch("unknown.mrk.json");
+  std::ofstream(unknown.string()) << R"({"markups": [{"type": "Spline", "controlPoints": [{"position": [1, 2, 3]}]}]})";
+  try {
+    readLandmarks(unknown.string());
+    FAIL() << "a markup of unknown type was read";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown.mrk.json"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("unknown type \"Spline\""), std::string::npos) << e.what();
+  }
+}
+
 TEST(Landmarks, BadFilesAreRefusedWithTheirName) {
   auto expectError = [](const fs::path& path, const std::string& fragment) {
     try {

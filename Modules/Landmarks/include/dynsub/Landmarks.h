@@ -3,7 +3,9 @@
 // read from and written to the files 3D Slicer and spreadsheets use:
 //  - 3D Slicer markups JSON (.mrk.json): "coordinateSystem" "LPS" (the
 //    default when absent) or "RAS"; every control point whose positionStatus
-//    is "defined" (or absent) is read, from every fiducial markup in the file.
+//    is "defined" (or absent) is read, from every point list ("Fiducial"),
+//    curve and closed curve in the file; lines, angles, planes and ROIs are
+//    left out.
 //  - Legacy 3D Slicer fiducials (.fcsv): the "# CoordinateSystem =" header
 //    gives LPS or RAS (also the old 1 = LPS, 0 = RAS); columns id,x,y,z,...,label.
 //  - CSV (.csv): a header line naming columns x, y, z (and optionally label),
@@ -24,14 +26,16 @@ struct Landmark {
 };
 
 // Throws dynsub::Error naming the file for a missing file, an unknown format,
-// a malformed entry (with its line or index) or a non-finite coordinate.
+// a malformed entry (with its line or index), a markup of an unknown type or
+// a non-finite coordinate.
 // `stated`, when given, receives the system the file says its values are in
 // (a CSV's are LPS; of several markups lists, the first's), for messages
 // about a file that says one and holds the other.
 std::vector<Landmark> readLandmarks(const std::string& path, CoordinateSystem* stated = nullptr);
 
 // A list of landmarks as a file holds it: a .mrk.json's markup (3D Slicer's
-// point list), or all of a .fcsv or .csv.
+// point list, curve or closed curve; its lines, angles, planes and ROIs are
+// left out), or all of a .fcsv or .csv.
 struct LandmarkList {
   std::string name;  // the markup's "name"; empty when it has none, and for .fcsv and .csv
   CoordinateSystem stated = CoordinateSystem::LPS;  // the system the file says its values are in
