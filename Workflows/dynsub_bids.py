@@ -192,8 +192,8 @@ def find_structures(bids, landmarks_dir, seeds_table, reference_dir, warn=_warn)
     """Every (image, structure) with landmarks or a seed, keyed by (stem, structure name).
 
     A T1w whose name has entities other than ENTITIES is skipped with a
-    warning; so is a reference found for a job whose structure its table
-    does not name.
+    warning; so is a reference found for a structure its table does not
+    name.
     """
     if not os.path.isdir(bids):
         raise CohortError(f"{bids}: no such BIDS directory")
@@ -304,10 +304,10 @@ def group_jobs(structures, warn=_warn):
     for group in together.values():
         job = Job(group)
         jobs[job.key] = job
-        unscored = [s.name for s in group if s.reference]
+        unscored = [s for s in group if s.reference]
         if not job.reference and unscored:
-            warn(f"{group[0].reference}: not used for {', '.join(unscored)} either: a run of several structures "
-                 "is scored when the reference names them all")
+            warn(f"{unscored[0].reference}: not used for {', '.join(s.name for s in unscored)} either: a run of "
+                 "several structures is scored when the reference names them all")
     return jobs
 
 
@@ -373,15 +373,52 @@ def _last_error(log):
     return (errors or lines or ["empty log"])[-1]
 
 
+def _earlier_paths(job, out):
+    """What an earlier run may have left of this job's results: its
+    structures' own files, figures and view, which are not declared outputs
+    (Snakemake removes those), and the labelmaps of a grouping the dataset
+    had before (a structure segmented alone that is now segmented with
+    others, or the other way round)."""
+    paths = [view_path(out, job.dir, job.stem, job.desc)]
+    for s in job.structures:
+        paths += list(structure_paths(out, job.dir, job.stem, s.name).values())
+        paths += list(figure_paths(out, job.dir, job.stem, s.name).values())
+    if len(job.structures) > 1:
+        for s in job.structures:
+            alone = output_paths(out, job.dir, job.stem, f"_desc-{s.name}")
+            paths += [alone["dseg"], alone["lut"], alone["sidecar"],
+                      view_path(out, job.dir, job.stem, f"_desc-{s.name}")]
+    if not job.seed:
+        # The image's landmark job: a joint labelmap from before is this
+        # job's, and so are the files of the structures its sidecar lists,
+        # also those the dataset no longer has landmarks for.
+        joint = output_paths(out, job.dir, job.stem, "")
+        try:
+            listed = [s["Name"] for s in json.load(open(joint["sidecar"])).get("Structures", [])]
+        except (OSError, ValueError, KeyError, TypeError, AttributeError):
+            listed = []
+        for name in listed:
+            if re.fullmatch(LABEL, str(name)):
+                paths += list(structure_paths(out, job.dir, job.stem, name).values())
+                paths += list(figure_paths(out, job.dir, job.stem, name).values())
+        if len(job.structures) == 1:
+            paths += list(joint.values()) + [view_path(out, job.dir, job.stem, "")]
+    return paths
+
+
 def run_segmentation(job, out, log, dynsub, extra_args, bids):
     """Runs `dynsub segment` for one job and gives its results their BIDS names.
 
-    dynsub writes all its outputs or none into a private directory beside the
-    final files; they are renamed into place only when it succeeded, the
-    job's report last, so a failed job leaves nothing of its own (Snakemake
-    also removes a failed job's declared outputs).
+    What an earlier run left of the job is removed first (_earlier_paths;
+    Snakemake removes the declared outputs). dynsub writes all its outputs
+    or none into a private directory beside the final files; they are
+    renamed into place only when it succeeded, the job's report last, so a
+    failed job leaves nothing of its own.
     """
     outputs = job_paths(out, job)
+    for path in _earlier_paths(job, out):
+        if os.path.exists(path):
+            os.remove(path)
     anat = os.path.dirname(outputs["dseg"])
     os.makedirs(anat, exist_ok=True)
     work = tempfile.mkdtemp(prefix=".work-", dir=anat)

@@ -71,7 +71,7 @@ async function cohort(context, pagePath, screenshot) {
   const url = "file://" + pagePath;
   let page = await openPage(context, url);
   const rows = await page.locator("#group tbody tr").count();
-  check("cohort: 6 rows (a structure each)", rows === 6, rows);
+  check("cohort: 7 rows (a structure each)", rows === 7, rows);
 
   await page.click("#group th:text-is('Dice')");
   const dice = await column(page, "Dice");
@@ -93,17 +93,17 @@ async function cohort(context, pagePath, screenshot) {
     return out;
   });
   check("cohort: ratings kept across a reload", kept[rated[0]] === "fail" && kept[rated[4]] === "pass" &&
-        Object.values(kept).filter((v) => v === "").length === 4, JSON.stringify(kept));
+        Object.values(kept).filter((v) => v === "").length === 5, JSON.stringify(kept));
 
   const [download] = await Promise.all([page.waitForEvent("download"), page.click("#export")]);
   const tsv = fs.readFileSync(await download.path(), "utf8").trimEnd().split("\n").map((l) => l.split("\t"));
   check("cohort: export is named qc_ratings.tsv", download.suggestedFilename() === "qc_ratings.tsv",
         download.suggestedFilename());
   check("cohort: export has the header and a row per structure",
-        tsv[0].join(",") === "participant_id,session_id,structure,rating,flags" && tsv.length === 7, tsv.length);
+        tsv[0].join(",") === "participant_id,session_id,structure,rating,flags" && tsv.length === 8, tsv.length);
   const exported = Object.fromEntries(tsv.slice(1).map((r) => [r.slice(0, 3).join(" "), r[3]]));
   check("cohort: exported ratings are the ones given, the rest n/a", exported[rated[0]] === "fail" &&
-        exported[rated[4]] === "pass" && Object.values(exported).filter((v) => v === "n/a").length === 4,
+        exported[rated[4]] === "pass" && Object.values(exported).filter((v) => v === "n/a").length === 5,
         JSON.stringify(exported));
   const failed = tsv.slice(1).find((r) => r[0] === "sub-04");
   check("cohort: export carries the flags", failed !== undefined && failed[4] === "failed", JSON.stringify(failed));

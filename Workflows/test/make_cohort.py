@@ -8,8 +8,8 @@ the workflow:
                   (.mrk.json, LPS: one job for both), a seed click in the left
                   thalamus (seeds.tsv: a job of its own); AAL reference
   sub-02          the same MRI moved by a rigid transform (12 degrees about an
-                  oblique axis, then 5, -8, 3 mm): its landmarks (.fcsv, in
-                  RAS) and its AAL reference move with it
+                  oblique axis, then 5, -8, 3 mm): its caudate and putamen
+                  landmarks (.fcsv, in RAS) and its AAL reference move with it
   sub-03/ses-2    the 0.5 mm Colin27 (another grid, no reference); landmarks as CSV
   --broken adds only sub-04 to an existing cohort: its T1w is a truncated
   gzip file (the other subjects' files are left as they are).
@@ -105,8 +105,8 @@ def main():
 
     shutil.copy(f"{templates}/ch2.nii.gz", f"{anat(root, '01')}/sub-01_T1w.nii.gz")
     write_mrk(caudate, f"{anat(marks, '01')}/sub-01_desc-caudateL_landmarks.mrk.json")
-    write_mrk(landmarks(f"{data}/Landmarks/putamen_left.mrk.json"),
-              f"{anat(marks, '01')}/sub-01_desc-putamenL_landmarks.mrk.json")
+    putamen = landmarks(f"{data}/Landmarks/putamen_left.mrk.json")
+    write_mrk(putamen, f"{anat(marks, '01')}/sub-01_desc-putamenL_landmarks.mrk.json")
     shutil.copy(f"{templates}/aal.nii.gz", f"{anat(reference, '01')}/sub-01_dseg.nii.gz")
     # A click inside the left thalamus (AAL 77): its voxel nearest the label's centroid.
     aal = nibabel.load(f"{templates}/aal.nii.gz")
@@ -122,8 +122,9 @@ def main():
     transform = rigid()
     save_moved(f"{templates}/ch2.nii.gz", f"{anat(root, '02')}/sub-02_T1w.nii.gz", transform)
     save_moved(f"{templates}/aal.nii.gz", f"{anat(reference, '02')}/sub-02_dseg.nii.gz", transform)
-    moved = [(transform @ numpy.append(p, 1.0))[:3].tolist() for p in caudate]
-    write_fcsv_ras(moved, f"{anat(marks, '02')}/sub-02_desc-caudateL_landmarks.fcsv")
+    for structure, points in (("caudateL", caudate), ("putamenL", putamen)):
+        moved = [(transform @ numpy.append(p, 1.0))[:3].tolist() for p in points]
+        write_fcsv_ras(moved, f"{anat(marks, '02')}/sub-02_desc-{structure}_landmarks.fcsv")
 
     shutil.copy(f"{templates}/ch2better.nii.gz", f"{anat(root, '03', '2')}/sub-03_ses-2_T1w.nii.gz")
     write_csv(caudate, f"{anat(marks, '03', '2')}/sub-03_ses-2_desc-caudateL_landmarks.csv")
