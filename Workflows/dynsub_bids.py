@@ -215,7 +215,7 @@ def find_structures(bids, landmarks_dir, seeds_table, reference_dir, warn=_warn)
 
     structures = {}
 
-    def structure_for(subject, session, entities, structure, source):
+    def structure_for(subject, session, entities, name, source):
         """The structure of the T1w a landmark file or seed names; without entities, the one T1w of its
         session."""
         where = f"sub-{subject}" + (f" ses-{session}" if session else "")
@@ -230,7 +230,7 @@ def find_structures(bids, landmarks_dir, seeds_table, reference_dir, warn=_warn)
                                   + ", ".join(os.path.basename(images[k]) for k in candidates)
                                   + "); name the one meant (e.g. sub-<label>_run-<label>_desc-...)")
             entities, path = candidates[0][2], images[candidates[0]]
-        found = Structure(subject, session, entities, structure, path)
+        found = Structure(subject, session, entities, name, path)
         return structures.setdefault(found.key, found)
 
     if landmarks_dir and os.path.isdir(landmarks_dir):
@@ -240,11 +240,11 @@ def find_structures(bids, landmarks_dir, seeds_table, reference_dir, warn=_warn)
             if not match:
                 raise CohortError(f"{path}: not handled (expected sub-<label>[_ses-<label>][entities]_desc-<structure>"
                                   "_landmarks.mrk.json|.fcsv|.csv, letters and digits in labels)")
-            job = structure_for(match["sub"], match["ses"], match["entities"], match["structure"], path)
-            if job.landmarks:
-                raise CohortError(f"{path}: a second landmark file for {job.stem} {job.name} "
-                                  f"(also {job.landmarks})")
-            job.landmarks = path
+            structure = structure_for(match["sub"], match["ses"], match["entities"], match["structure"], path)
+            if structure.landmarks:
+                raise CohortError(f"{path}: a second landmark file for {structure.stem} {structure.name} "
+                                  f"(also {structure.landmarks})")
+            structure.landmarks = path
 
     if seeds_table:
         with open(seeds_table, newline="") as f:
@@ -255,22 +255,22 @@ def find_structures(bids, landmarks_dir, seeds_table, reference_dir, warn=_warn)
                 subject = row["participant_id"].removeprefix("sub-")
                 session = (row.get("session_id") or "n/a").removeprefix("ses-")
                 session = None if session == "n/a" else session
-                structure = row["structure"]
+                name = row["structure"]
                 seed = tuple(float(row[c]) for c in ("x", "y", "z"))
             except (KeyError, TypeError, ValueError):
                 raise CohortError(f"{where}: expected columns participant_id, [session_id,] structure, x, y, z "
                                   "(LPS mm)") from None
-            if not re.fullmatch(LABEL, structure) or not all(abs(v) < float("inf") for v in seed):
+            if not re.fullmatch(LABEL, name) or not all(abs(v) < float("inf") for v in seed):
                 raise CohortError(f"{where}: structure must be letters and digits, x y z finite numbers")
-            structure_for(subject, session, "", structure, where).seed = seed
+            structure_for(subject, session, "", name, where).seed = seed
 
     if reference_dir and os.path.isdir(reference_dir):
         dataset_table = f"{reference_dir}/dseg.tsv"
-        for job in structures.values():
+        for structure in structures.values():
             # The image's own reference, else its session's; its own table, else the dataset's.
-            folder = f"{reference_dir}/{job.dir}/anat"
-            session_stem = job.stem[: len(job.stem) - len(job.entities)]
-            stems = [job.stem] + ([session_stem] if job.entities else [])
+            folder = f"{reference_dir}/{structure.dir}/anat"
+            session_stem = structure.stem[: len(structure.stem) - len(structure.entities)]
+            stems = [structure.stem] + ([session_stem] if structure.entities else [])
             path = next((f"{folder}/{s}_dseg.nii.gz" for s in stems if os.path.exists(f"{folder}/{s}_dseg.nii.gz")),
                         None)
             if not path:
@@ -278,11 +278,11 @@ def find_structures(bids, landmarks_dir, seeds_table, reference_dir, warn=_warn)
             tables = [f"{folder}/{s}_dseg.tsv" for s in stems] + [dataset_table]
             table = next((t for t in tables if os.path.exists(t)), None)
             names = _read_names(table) if table else {}
-            if job.name in names:
-                job.reference, job.reference_labels = path, names[job.name]
+            if structure.name in names:
+                structure.reference, structure.reference_labels = path, names[structure.name]
             else:
-                warn(f"{path}: a reference for {job.stem}, not used for {job.name}: "
-                     + (f"{table} names no '{job.name}'" if table else
+                warn(f"{path}: a reference for {structure.stem}, not used for {structure.name}: "
+                     + (f"{table} names no '{structure.name}'" if table else
                         f"no dseg.tsv names its labels (looked for {', '.join(tables)})"))
     return structures
 
@@ -541,8 +541,7 @@ def group_rows(jobs, out):
                        t1w=os.path.join(job.dir, "anat", os.path.basename(job.t1w)))
             row["job"] = job  # not a column: for the QC page (qc_report.py)
             if complete:
-                own = structure_paths(out, job.dir, job.stem, structure.name)["report"] if several else paths["report"]
-                report = json.load(open(own))
+                report = json.load(open(structure_paths(out, job.dir, job.stem, structure.name)["report"]))
                 row["report"] = report  # not a column either
                 row.update(status="ok", dseg=_relative(paths["dseg"], out), index=str(index + 1),
                            warnings="; ".join(report.get("warnings", [])) or "n/a",
