@@ -229,8 +229,8 @@ void run(Arguments& a) {
                                    "): this module segments one structure per run; give a file with one list, or "
                                    "segment them together with dynsub segment --landmarks " + a.landmarks);
     }
-    const std::vector<Landmark> fromFile = readLandmarks(a.landmarks, &in.landmarkSystem);
-    in.landmarks.insert(in.landmarks.end(), fromFile.begin(), fromFile.end());
+    in.landmarkSystem = lists.front().stated;
+    in.landmarks.insert(in.landmarks.end(), lists.front().landmarks.begin(), lists.front().landmarks.end());
     in.landmarkSource = a.seeds.empty() ? a.landmarks : "--seed and " + a.landmarks;
   }
   if (!a.atlasLabel.empty()) {

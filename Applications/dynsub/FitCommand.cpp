@@ -197,7 +197,7 @@ void addFitCommand(CLI::App& app) {
       "largest distance from a data point to the surface is below the tolerance (percent of the diameter of "
       "the smallest sphere enclosing the data).\n"
       "Writes DIR/surface.vtp, DIR/control_mesh.obj, DIR/report.json, DIR/convergence.csv and the figures "
-      "DIR/slices.png, DIR/surface3d.png and DIR/convergence.png.");
+      "DIR/slices.png, DIR/surface3d.png and DIR/convergence.png (or .pdf, .svg: --figure-format).");
   command->add_option("POINTS", o->points, "Point cloud: .xyz/.txt, .csv, .ply, .off, .obj or .vtp (mm)")
       ->required();
   command->add_option("--out", o->out, "Output directory (created if missing; its parent must exist)")->required();

@@ -1,7 +1,6 @@
 // dynsub segment: a structure in a 3D image from image forces and expert landmarks (Segmentation.h).
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -141,15 +140,9 @@ void printSummary(const Arguments& o, const SegmentOutcome& outcome, const Volum
 // A landmark file's name without its folder and extension: caudate_left
 // for caudate_left.mrk.json.
 std::string structureName(const std::string& path) {
-  const std::string name = std::filesystem::path(path).filename().string();
-  std::string lower = name;
-  std::transform(lower.begin(), lower.end(), lower.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  for (const std::string extension : {".mrk.json", ".json", ".fcsv", ".csv"})
-    if (lower.size() > extension.size() &&
-        lower.compare(lower.size() - extension.size(), extension.size(), extension) == 0)
-      return name.substr(0, name.size() - extension.size());
-  return name;
+  std::filesystem::path stem = std::filesystem::path(path).stem();
+  if (lowerCaseExtension(stem.string()) == ".mrk") stem = stem.stem();
+  return stem.string();
 }
 
 // The structures the --landmarks files hold, in order: each file's lists (a
@@ -367,7 +360,7 @@ void addSegmentCommand(CLI::App& app) {
       "springs to landmarks an expert placed on its boundary; the surface is refined at equilibrium.\n"
       "Writes DIR/surface.vtp (LPS mm), DIR/control_mesh.obj, DIR/labelmap.nii.gz (on the image's grid) and "
       "DIR/report.json, DIR/convergence.csv, and the figures DIR/slices.png, DIR/surface3d.png and "
-      "DIR/convergence.png.");
+      "DIR/convergence.png (or .pdf, .svg: --figure-format).");
   command->add_option("IMAGE", o->image, "3D image: .nii/.nii.gz, .nrrd, .mha/.mhd, or a DICOM series directory")
       ->required();
   command->add_option("--out", o->out, "Output directory (created if missing; its parent must exist)")->required();

@@ -35,7 +35,6 @@ std::vector<double> numbersAfter(const std::string& value, std::size_t prefix, i
   return v;
 }
 
-
 // Every row of the table with its value, then what the edge detector used
 // in the end: the reference (the image's when there were no points on the
 // boundary) and its thresholds.

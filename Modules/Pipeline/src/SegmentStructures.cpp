@@ -207,12 +207,10 @@ StructuresOutcome segmentStructures(const Volume& image, const std::vector<Struc
     const Volume territories = cropVolume(jointLabels(masks, evidence), first, size);
     for (std::size_t s = 0; s < n; ++s) {
       if (!out.segmentedAgain[s]) continue;
-      Mask wall;
-      wall.geometry = territories.geometry;
-      wall.voxels.resize(territories.voxels.size());
-      const float own = static_cast<float>(s + 1);
-      for (std::size_t v = 0; v < wall.voxels.size(); ++v)
-        wall.voxels[v] = territories.voxels[v] != 0 && territories.voxels[v] != own;
+      std::vector<int> others;
+      for (std::size_t t = 0; t < n; ++t)
+        if (t != s) others.push_back(static_cast<int>(t + 1));
+      const Mask wall = selectLabels(territories, others);
       out.structures[s] = segmentOne(image, structures[s], parameters, progress, &wall);
     }
     masks = masksOf();
@@ -231,10 +229,7 @@ StructuresOutcome segmentStructures(const Volume& image, const std::vector<Struc
     r.set("segmented_again", static_cast<bool>(out.segmentedAgain[s]));
     r.set("volume_mm3",
           static_cast<double>(out.structures[s].labelmap.count()) * out.structures[s].labelmap.geometry.spacing.prod());
-    Mask share;
-    share.geometry = out.labels.geometry;
-    share.voxels.resize(out.labels.voxels.size());
-    for (std::size_t v = 0; v < share.voxels.size(); ++v) share.voxels[v] = out.labels.voxels[v] == s + 1;
+    const Mask share = selectLabels(out.labels, {static_cast<int>(s + 1)});
     r.set("joint_volume_mm3", static_cast<double>(share.count()) * share.geometry.spacing.prod());
     if (in.reference) {
       out.jointMetrics.push_back(compareMasks(share, in.reference()));

@@ -38,6 +38,7 @@
 #include <fstream>
 #include <iterator>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -95,13 +96,15 @@ void addLegend(const FigureScene& scene, vtkRenderWindow* window) {
   std::vector<std::pair<std::string, std::array<double, 3>>> items;
   if (scene.edgeDistances) {
     items.push_back({"contour on an image edge", style::kOnEdge});
-    items.push_back({"contour 3 mm or more from any edge", style::kOffEdge});
+    std::ostringstream far;
+    far << "contour " << style::kFarFromEdges << " mm or more from any edge";
+    items.push_back({far.str(), style::kOffEdge});
   } else {
     items.push_back({"contour on a normal element", style::kNormalElement});
     items.push_back({"contour on a special element", style::kSpecialElement});
   }
   if (scene.landmarks.rows() > 0) items.push_back({"landmarks on the slice", landmarkColour()});
-  if (scene.dataPoints.rows() > 0) items.push_back({"range data near the slice", {0.85, 0.85, 0.85}});
+  if (scene.dataPoints.rows() > 0) items.push_back({"range data near the slice", style::kDataPoint});
   items.push_back({"coordinates: " + coordinatesName(scene.coordinates) + " mm", {1, 1, 1}});
   auto legend = strip(0, 0, kSlicesWidth, kLegend, kSlicesWidth, kSlicesHeight);
   legend->SetBackground(0.12, 0.12, 0.12);
@@ -149,7 +152,7 @@ void drawSlices(const FigureScene& scene, vtkRenderWindow* window) {
   const double diagonal = (high - low).norm();
   // The grey window of the structure's neighbourhood, shared by all slices.
   ImageSlices::GreyWindow grey;
-  if (image) grey = image->windowAround(low, high, 10.0);
+  if (image) grey = image->windowAround(points, 10.0);
 
   window->SetSize(kSlicesWidth, kSlicesHeight);
   for (int row = 0; row < 3; ++row) {

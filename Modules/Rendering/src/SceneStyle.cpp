@@ -131,7 +131,7 @@ void showDataPoints(vtkRenderer* renderer, vtkPolyData* points, vtkActor* actor)
   mapper->ScalarVisibilityOff();
   actor->SetMapper(mapper);
   pointsAsDots(actor, kDataPixels);
-  actor->GetProperty()->SetColor(0.85, 0.85, 0.85);
+  actor->GetProperty()->SetColor(kDataPoint[0], kDataPoint[1], kDataPoint[2]);
   renderer->AddActor(actor);
 }
 

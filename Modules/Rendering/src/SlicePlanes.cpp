@@ -1,7 +1,6 @@
 #include "dynsub/SlicePlanes.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <vector>
 
@@ -99,25 +98,12 @@ ImageSlices::GreyWindow ImageSlices::percentileWindow(std::vector<float>& sample
   return {std::max(high - low, 1e-6), 0.5 * (low + high)};
 }
 
-ImageSlices::GreyWindow ImageSlices::windowAround(const Vector3& low, const Vector3& high, double margin) const {
-  // The index box holding the physical box's eight corners.
-  Vector3 first = Vector3::Constant(1e300), last = Vector3::Constant(-1e300);
-  for (int corner = 0; corner < 8; ++corner) {
-    Vector3 p;
-    for (int a = 0; a < 3; ++a) p[a] = (corner >> a & 1) ? high[a] + margin : low[a] - margin;
-    const Vector3 index = geometry_.toIndex(p);
-    first = first.cwiseMin(index);
-    last = last.cwiseMax(index);
-  }
-  std::array<int, 3> from{}, to{};
-  for (int a = 0; a < 3; ++a) {
-    from[a] = std::clamp(static_cast<int>(std::floor(first[a])), 0, geometry_.size[a] - 1);
-    to[a] = std::clamp(static_cast<int>(std::ceil(last[a])), 0, geometry_.size[a] - 1);
-  }
+ImageSlices::GreyWindow ImageSlices::windowAround(const MatrixX3& points, double margin) const {
+  const auto [first, size] = boundingRegion(geometry_, points, margin);
   std::vector<float> sample;
-  for (int k = from[2]; k <= to[2]; ++k)
-    for (int j = from[1]; j <= to[1]; ++j)
-      for (int i = from[0]; i <= to[0]; ++i) {
+  for (int k = first[2]; k < first[2] + size[2]; ++k)
+    for (int j = first[1]; j < first[1] + size[1]; ++j)
+      for (int i = first[0]; i < first[0] + size[0]; ++i) {
         const float v = voxels_[geometry_.offset(i, j, k)];
         if (std::isfinite(v)) sample.push_back(v);
       }

@@ -239,8 +239,7 @@ void SliceView::setImage(const ImageSlices* image) {
   impl_->imageMapper->SetInputData(image->data());
   impl_->imageMapper->SetOrientation(image->axis(impl_->orientation));
   impl_->imageActor->SetUserMatrix(image->indexToWorld());
-  impl_->imageActor->GetProperty()->SetColorWindow(image->window());
-  impl_->imageActor->GetProperty()->SetColorLevel(image->level());
+  setGreyWindow(image->window(), image->level());
   impl_->imageActor->GetProperty()->SetInterpolationTypeToNearest();
   impl_->imageActor->VisibilityOn();
   showSlice(image->sliceCount(impl_->orientation) / 2);

@@ -88,11 +88,14 @@ TEST(SlicePlanes, GreyWindowAroundABoxIsItsNeighbourhoods) {
   EXPECT_GT(slices.window(), 900.0);
   // The box 22..37 mm and 2 mm around it: only the structure's 10..59,
   // widened by a tenth of their span (4.9) on each side.
-  const ImageSlices::GreyWindow around = slices.windowAround(Vector3(22, 22, 22), Vector3(37, 37, 37), 2.0);
+  MatrixX3 box(2, 3);
+  box << 22, 22, 22, 37, 37, 37;
+  const ImageSlices::GreyWindow around = slices.windowAround(box, 2.0);
   EXPECT_NEAR(around.level - 0.5 * around.window, 10.0 - 4.9, 1.0);
   EXPECT_NEAR(around.level + 0.5 * around.window, 59.0 + 4.9, 1.0);
   // A box outside the image, clamped to its corner: too few voxels, the whole image's window.
-  const ImageSlices::GreyWindow outside = slices.windowAround(Vector3(-50, -50, -50), Vector3(-40, -40, -40), 1.0);
+  box << -50, -50, -50, -40, -40, -40;
+  const ImageSlices::GreyWindow outside = slices.windowAround(box, 1.0);
   EXPECT_DOUBLE_EQ(outside.window, slices.window());
   EXPECT_DOUBLE_EQ(outside.level, slices.level());
 }

@@ -56,7 +56,9 @@ vtkSmartPointer<vtkRenderWindow> surfaceFigure(const FigureScene& scene);
 // Throws dynsub::Error for an empty history.
 vtkSmartPointer<vtkRenderWindow> convergenceFigure(const ConvergenceHistory& history);
 
-// The window as it is, as PNG at the default resolution.
+// Renders the window as it is and writes it as PNG at the default
+// resolution; the file appears complete or not at all. Throws dynsub::Error
+// naming the file.
 void writePng(vtkRenderWindow* window, const std::string& path);
 
 }  // namespace dynsub

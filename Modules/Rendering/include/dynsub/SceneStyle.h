@@ -45,6 +45,8 @@ constexpr double kFarFromEdges = 3.0;  // mm: three voxels of the 1 mm MRI
 constexpr std::array<double, 3> kOnEdge{0.15, 0.8, 0.25};
 constexpr std::array<double, 3> kMidEdge{1.0, 0.9, 0.15};
 constexpr std::array<double, 3> kOffEdge{0.9, 0.2, 0.9};
+// Range data's dots: light grey, apart from the landmarks' red.
+constexpr std::array<double, 3> kDataPoint{0.85, 0.85, 0.85};
 // The colour bar of colourByEdgeDistance, for `mapper`, at the right of its view.
 vtkSmartPointer<vtkScalarBarActor> edgeDistanceBar(vtkPolyDataMapper* mapper);
 // Vertices drawn as round dots of a fixed size in pixels.

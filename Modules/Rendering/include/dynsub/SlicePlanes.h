@@ -59,8 +59,8 @@ class ImageSlices {
   // Grey window and level: the 1st to 99.5th percentile of the intensities.
   double window() const { return window_; }
   double level() const { return level_; }
-  // The same percentiles of the voxels in a box (LPS mm, its corners `low`
-  // and `high`) and `margin` mm around it, widened by a tenth of their span
+  // The same percentiles of the voxels in the box of `points` (LPS mm) and
+  // `margin` mm around it (boundingRegion), widened by a tenth of their span
   // on each side: a structure's neighbourhood, whose tissues then span the
   // grey scale even where the whole image's bright fat or dark background
   // would squeeze them, without clipping. The whole image's window when the
@@ -68,7 +68,7 @@ class ImageSlices {
   struct GreyWindow {
     double window = 1, level = 0.5;
   };
-  GreyWindow windowAround(const Vector3& low, const Vector3& high, double margin) const;
+  GreyWindow windowAround(const MatrixX3& points, double margin) const;
 
   // The image axis (0 = i, 1 = j, 2 = k) closest to the orientation's normal.
   int axis(SliceOrientation orientation) const;
