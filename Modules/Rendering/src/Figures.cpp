@@ -501,7 +501,7 @@ void writeFigures(const FigureInputs& inputs, const FigureFiles& files) {
     scene.controlMesh = wireframe;
   }
   if (!files.convergence.empty() && !inputs.history) throw Error("internal: a convergence figure without a history");
-  // NB: one window for all three: creating a window (choosing its GLX
+  // One window for all three: creating a window (choosing its GLX
   // framebuffer configuration, starting its context) costs a sizeable share
   // of the figures' time. Each figure's renderers leave it before the next's
   // come.

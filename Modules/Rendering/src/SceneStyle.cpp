@@ -60,7 +60,7 @@ void colourByEdgeDistance(vtkPolyDataMapper* mapper) {
   mapper->SetScalarModeToUsePointFieldData();
   mapper->SelectColorArray(kEdgeDistanceScalars);
   mapper->SetScalarRange(0, kFarFromEdges);
-  // NB: mapped per fragment, not per vertex: a triangle between a held and
+  // Mapped per fragment, not per vertex: a triangle between a held and
   // an unknown point would otherwise blend green into grey.
   mapper->InterpolateScalarsBeforeMappingOn();
   mapper->ScalarVisibilityOn();

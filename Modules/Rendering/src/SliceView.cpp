@@ -129,7 +129,7 @@ struct SliceView::Impl {
     atPlane->SetPlane(cutPlane);
     cutter->SetInputConnection(atPlane->GetOutputPort());
     cutter->SetCutFunction(cutPlane);
-    // NB: the contour's points are not merged, and the locator has one bin:
+    // The contour's points are not merged, and the locator has one bin:
     // a merging locator allocates bins for the whole surface (and the kernel
     // clears their fresh pages) in each of the slices figure's 15 views. Only
     // the lines are drawn, so merging their ends would change nothing.
