@@ -263,7 +263,6 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
     throw Error("--reference needs one --reference-label N[,M...] per structure, in the order of --landmarks (" +
                 std::to_string(sources.size()) + " structures, " + std::to_string(o.referenceLabels.size()) +
                 " given)");
-  if (o.reference.empty() && !o.referenceLabels.empty()) throw Error("--reference-label needs --reference");
   if (o.init != "auto")
     throw Error("--init " + o.init + ": several structures start from their landmarks (--init auto)");
   std::vector<StructureInputs> structures;
@@ -400,13 +399,15 @@ void addSegmentCommand(CLI::App& app) {
   command->add_option("--inside", o->inside,
                       "With --init atlas: x,y,z (LPS mm), a click inside the structure; it picks the carried "
                       "label's part and moves a misplaced one there");
-  command->add_option("--reference", o->reference, "Reference labelmap on the image's grid, for Dice and distances");
+  CLI::Option* reference =
+      command->add_option("--reference", o->reference, "Reference labelmap on the image's grid, for Dice and distances");
   command
       ->add_option("--reference-label", o->referenceLabels,
                    "Label value(s) of the structure in --reference, N[,M...]; with several --landmarks, once per "
                    "structure in their order")
       ->expected(1)
-      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->needs(reference);
   addSegmentParameterOptions(*command, o->parameters);
   o->figures.addOptions(*command);
   command->callback([o] { runSegment(*o); });

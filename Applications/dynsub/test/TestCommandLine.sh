@@ -40,6 +40,8 @@ expect_error "unknown standard mesh" 2 "NAME" "$work/h.obj" "$DYNSUB" mesh spher
 expect_error "a misspelt command" 2 "did you mean 'segment'" "$work/i" "$DYNSUB" segmnet x.nii.gz --out "$work/i"
 expect_error "a misspelt option" 2 "did you mean '--landmarks'" "$work/j" \
   "$DYNSUB" segment x.nii.gz --landmark a.csv --out "$work/j"
+expect_error "a reference label without its reference" 2 "--reference-label requires --reference" "$work/j2" \
+  "$DYNSUB" segment x.nii.gz --reference-label 71 --out "$work/j2"
 
 # --- fit: shape recovery from a point cloud -------------------------------
 # 400 points on a sphere of radius 30 mm around (5, -2, 7), from awk's seeded generator.
