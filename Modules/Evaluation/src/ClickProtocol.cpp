@@ -48,7 +48,9 @@ std::vector<BoundaryPoint> sliceBoundary(const Mask& m, int axis, int index) {
         std::array<int, 3> n = v;
         n[a] += da;
         n[b] += db;
-        if (inside(m, n)) continue;
+        // Where the structure meets the image's side there is nothing to click:
+        // that side is the field of view's, not the structure's.
+        if (inside(m, n) || !m.geometry.contains(n[0], n[1], n[2])) continue;
         Vector3 outward = Vector3::Zero();
         outward[a] = da;
         outward[b] = db;
@@ -145,6 +147,13 @@ std::vector<Landmark> expertClicks(const Mask& reference, const ClickProtocol& p
   for (int m = 0; m < protocol.mistakes && m < static_cast<int>(order.size()); ++m) {
     const double side = unit(random) < 0.5 ? -1.0 : 1.0;
     clicks[order[m]].position += side * protocol.mistakeDistance * outwards[order[m]];
+  }
+  // A viewer places points on the image only: a hand's error or a mistake
+  // beyond the image's side stops at its last voxel.
+  for (Landmark& click : clicks) {
+    Vector3 index = g.toIndex(click.position);
+    for (int d = 0; d < 3; ++d) index[d] = std::clamp(index[d], 0.0, g.size[d] - 1.0);
+    click.position = g.toPhysical(index);
   }
   for (size_t i = 0; i < clicks.size(); ++i) clicks[i].label = "C-" + std::to_string(i + 1);
   return clicks;

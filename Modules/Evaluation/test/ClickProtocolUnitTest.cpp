@@ -96,6 +96,36 @@ TEST(ClickProtocol, ScatterStaysInTheSliceAndMistakesLeaveTheBoundary) {
   EXPECT_LT(std::sqrt(scatter / (clicks.size() - off)), 1.0);
 }
 
+TEST(ClickProtocol, NoClickOnTheImagesSideOrBeyondIt) {
+  // The ball cut by the image's side: its voxels up to x = +5 mm only, so the
+  // slices across y meet the side at x = 5.5 (the last voxel's outer face),
+  // where there is no edge to click; the boundary points beside that voxel lie
+  // at x = 5. With 2 mm of scatter, clicks near the side would leave the image.
+  Ball ball = makeBall();
+  ImageGeometry& g = ball.mask.geometry;
+  Mask cut;
+  cut.geometry = g;
+  cut.geometry.size = {21, 31, 31};
+  cut.voxels.assign(cut.geometry.voxelCount(), 0);
+  for (int k = 0; k < 31; ++k)
+    for (int j = 0; j < 31; ++j)
+      for (int i = 0; i < 21; ++i) cut.voxels[cut.geometry.offset(i, j, k)] = ball.mask.voxels[g.offset(i, j, k)];
+  ClickProtocol protocol;
+  protocol.axis = 1;
+  protocol.slices = 6;
+  protocol.pointsPerSlice = 8;
+  for (const double scatter : {0.0, 2.0}) {
+    protocol.scatter = scatter;
+    for (unsigned seed = 1; seed <= 20; ++seed)
+      for (const Landmark& c : expertClicks(cut, protocol, seed)) {
+        EXPECT_TRUE(cut.geometry.covers(c.position)) << "seed " << seed << ", " << c.label << " beyond the image";
+        if (scatter == 0.0) {
+          EXPECT_LE(c.position.x(), 5.0) << "seed " << seed << ", " << c.label << " on the side";
+        }
+      }
+  }
+}
+
 TEST(ClickProtocol, TheSeedClickIsDeepInside) {
   const Ball ball = makeBall();
   EXPECT_LT((seedClick(ball.mask) - ball.centre).norm(), 1.0);
