@@ -82,6 +82,7 @@ Report sliceEndsReport(const SliceEnds& ends) {
     r.set("to_lps_mm", end.end);
     r.set("length_mm", end.length);
     r.set("stopped_by_reach", end.stoppedByReach);
+    r.set("tapered", end.tapered);
     r.set("pressure", end.pressed);
     marched.push_back(r);
   }

@@ -87,18 +87,36 @@ SliceEnds findSliceEnds(const Volume& image, const std::vector<Landmark>& landma
   const Vector3 u = g.direction.col((axis + 1) % 3).normalized(), v = g.direction.col((axis + 2) % 3).normalized();
   const double spacing = g.spacing(axis), span = (last - first) * spacing;
   const double step = 0.5 * g.spacing.minCoeff();
-  for (const auto& [slice, outward] : {std::pair{first, -1.0}, {last, 1.0}}) {
-    // Step 3: the end slice's landmarks, their centroid and rms radius.
+  const auto clicksOn = [&](double slice) {
     std::vector<Vector3> onSlice;
     for (std::size_t i = 0; i < landmarks.size(); ++i)
       if (std::abs(index[i](axis) - slice) <= kOnSliceVoxels) onSlice.push_back(landmarks[i].position);
-    if (onSlice.size() < 3) continue;
+    return onSlice;
+  };
+  const auto centroid = [](const std::vector<Vector3>& points) {
     Vector3 centre = Vector3::Zero();
-    for (const Vector3& p : onSlice) centre += p;
-    centre /= static_cast<double>(onSlice.size());
+    for (const Vector3& p : points) centre += p;
+    return Vector3(centre / static_cast<double>(points.size()));
+  };
+  const auto rmsRadius = [&](const std::vector<Vector3>& points) {
+    const Vector3 centre = centroid(points);
     double squared = 0;
-    for (const Vector3& p : onSlice) squared += (p - centre).squaredNorm();
-    const double radius = std::max(g.spacing.maxCoeff(), options.disk * std::sqrt(squared / onSlice.size()));
+    for (const Vector3& p : points) squared += (p - centre).squaredNorm();
+    return std::sqrt(squared / static_cast<double>(points.size()));
+  };
+  for (const auto& [slice, outward] : {std::pair{first, -1.0}, {last, 1.0}}) {
+    // Step 3: the end slice's landmarks, their centroid and rms radius.
+    const std::vector<Vector3> onSlice = clicksOn(slice);
+    if (onSlice.size() < 3) continue;
+    const Vector3 centre = centroid(onSlice);
+    const double rms = rmsRadius(onSlice);
+    const double radius = std::max(g.spacing.maxCoeff(), options.disk * rms);
+    // The next clicked slice inwards: whether the clicks narrow toward this end.
+    double inner = outward < 0 ? last : first;
+    for (const Vector3& p : index)
+      if (std::abs(p(axis) - slice) > kOnSliceVoxels && std::abs(p(axis) - slice) < std::abs(inner - slice))
+        inner = p(axis);
+    const std::vector<Vector3> innerClicks = clicksOn(inner);
     SliceEnd end;
     end.side = outward < 0 ? -1 : 1;
     end.start = end.end = centre;
@@ -124,12 +142,17 @@ SliceEnds findSliceEnds(const Volume& image, const std::vector<Landmark>& landma
     end.end = centre + outward * reached * along;
     // Step 4.
     end.sprung = reached > options.gap && (!end.stoppedByReach || options.springAtReach);
+    // A structure whose clicked cross-sections still widen toward this end
+    // (a caudate's head) keeps its width past it; one whose cross-sections
+    // narrow goes on narrowing.
+    end.narrowing = innerClicks.size() >= 3 && rms < rmsRadius(innerClicks);
+    end.tapered = end.sprung && options.taper && end.narrowing;
     result.ends.push_back(end);
     if (end.sprung) {
       const std::string name = outward < 0 ? "slice end (first)" : "slice end (last)";
       result.springs.push_back({name, end.end});
       // Halfway, the end slice's clicks drawn in as an ellipsoid's cross-section narrows.
-      if (options.taper)
+      if (end.tapered)
         for (const Vector3& p : onSlice)
           result.springs.push_back({name + " taper", centre + std::sqrt(0.75) * (p - centre) +
                                                          outward * 0.5 * reached * along});

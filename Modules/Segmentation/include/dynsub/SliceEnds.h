@@ -70,6 +70,8 @@ struct SliceEnd {
   double length = 0;                // mm
   bool stoppedByReach = false;      // the intensity never left the window
   bool sprung = false;              // step 4 put springs at this end (it went more than `gap`)
+  bool narrowing = false;           // the end slice's clicks have a smaller rms radius than the next slice's
+  bool tapered = false;             // step 4 also put taper springs here (sprung, `taper` and narrowing)
   bool pressed = false;             // step 5's pressure acts beyond this end (set by segment())
 };
 
