@@ -23,9 +23,13 @@
 //     intensity (not at its reach, where it found no end: the structure may
 //     go on in like tissue, as a cerebellar hemisphere does across the
 //     midline), a spring of `stiffness` pulls the surface to its last step
-//     inside; with `taper`, the end slice's clicks are also copied halfway
-//     there, drawn in toward their centroid by sqrt(3/4) as an ellipsoid's
-//     cross-section narrows, as springs.
+//     inside; with `taper`, where the clicked cross-sections narrow toward
+//     the end (the end slice's rms radius under the next slice's), the end
+//     slice's clicks are also copied halfway there, drawn in toward their
+//     centroid by sqrt(3/4) as an ellipsoid's cross-section narrows, as
+//     springs. Where they still widen (a caudate's head), no such springs:
+//     the structure keeps its width past the end slice, and the pressure of
+//     step 5 carries the surface there.
 //  5. Beyond the outermost slices, a pressure along the normal from the
 //     appearance the clicks taught (ClickAppearance.h's EndPressure),
 //     `pressure` N/mm^2 at full strength, within the end slice's footprint:
@@ -57,7 +61,7 @@ struct SliceEndOptions {
   double reach = 1.0;       // the march's longest, a fraction of the clicked span
   double gap = 2.0;         // mm: no spring for a shorter march
   double stiffness = 10.0;  // N/mm per spring
-  bool taper = true;        // also springs halfway, the end slice's clicks drawn in (an ellipsoid's taper)
+  bool taper = true;        // springs halfway where the clicks narrow, the end slice's clicks drawn in
   bool springAtReach = false;  // a spring also where the march ended at its reach, not at an intensity change
   double pressure = 0.2;       // N/mm^2 beyond the end slices (step 5; 0: none), chosen on the tuning split
 };
