@@ -142,11 +142,11 @@ SliceEnds findSliceEnds(const Volume& image, const std::vector<Landmark>& landma
     end.end = centre + outward * reached * along;
     // Step 4.
     end.sprung = reached > options.gap && (!end.stoppedByReach || options.springAtReach);
-    // A structure whose clicked cross-sections still widen toward this end
-    // (a caudate's head) keeps its width past it; one whose cross-sections
-    // narrow goes on narrowing.
-    end.narrowing = innerClicks.size() >= 3 && rms < rmsRadius(innerClicks);
-    end.tapered = end.sprung && options.taper && end.narrowing;
+    // A structure whose clicked cross-sections still widen fast toward this
+    // end (a caudate's head) keeps its width past it; one whose cross-sections
+    // narrow, or widen slowly near its widest, goes on as an ellipsoid.
+    end.widening = innerClicks.size() >= 3 && rms > kTaperWidening * rmsRadius(innerClicks);
+    end.tapered = end.sprung && options.taper && !end.widening;
     result.ends.push_back(end);
     if (end.sprung) {
       const std::string name = outward < 0 ? "slice end (first)" : "slice end (last)";

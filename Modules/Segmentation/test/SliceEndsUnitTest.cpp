@@ -86,29 +86,37 @@ TEST(SliceEnds, FindBothEndsOfAStructureClickedOnSlices) {
   EXPECT_EQ(ends.springs.size(), 2u * (1 + 6));
 }
 
-// The taper only where the clicked cross-sections narrow toward an end: a
-// structure still widening at its last clicked slice (a caudate's head) keeps
+// No taper toward an end where the clicked cross-sections widen fast: a
+// structure still growing at its last clicked slice (a caudate's head) keeps
 // its width beyond it. The cigar's last slice of clicks (y = +12 mm, 0.80 of
-// the waist's radius) widened by 1.25 is wider than the slice before it (0.95).
-TEST(SliceEnds, TaperOnlyWhereTheClicksNarrow) {
+// the waist's radius) widened by 1.75 is 1.47 times as wide as the slice
+// before it (0.95), past kTaperWidening (1.3); widened by 1.25 (1.05 times)
+// it keeps its taper.
+TEST(SliceEnds, NoTaperWhereTheClicksWidenFast) {
   const Cigar shape;
   Mask truth;
   const Volume image = cigarImage(shape, &truth);
   std::vector<Landmark> landmarks = clicks(shape, 6);
   const Vector3 lastCentre = shape.centre + Vector3(0, 12, 0);
   for (Landmark& l : landmarks)
-    if (std::abs(l.position.y() - lastCentre.y()) < 0.1) l.position = lastCentre + 1.25 * (l.position - lastCentre);
+    if (std::abs(l.position.y() - lastCentre.y()) < 0.1) l.position = lastCentre + 1.75 * (l.position - lastCentre);
   SliceEndOptions options;
   options.reach = 0.6;
   const SliceEnds ends = findSliceEnds(image, landmarks, initialFromLandmarks(landmarks), options);
   ASSERT_EQ(ends.ends.size(), 2u);
   EXPECT_TRUE(ends.ends[0].sprung && ends.ends[1].sprung);
-  EXPECT_TRUE(ends.ends[0].narrowing && ends.ends[0].tapered);
-  EXPECT_FALSE(ends.ends[1].narrowing || ends.ends[1].tapered);
+  EXPECT_TRUE(!ends.ends[0].widening && ends.ends[0].tapered);
+  EXPECT_TRUE(ends.ends[1].widening && !ends.ends[1].tapered);
   // The first end's tip and 6 taper springs; the last end's tip alone.
   EXPECT_EQ(ends.springs.size(), 1u + 6 + 1);
   options.taper = false;
   EXPECT_EQ(findSliceEnds(image, landmarks, initialFromLandmarks(landmarks), options).springs.size(), 2u);
+  // Widening slowly, as toward an ellipsoid's waist: tapered.
+  std::vector<Landmark> slow = clicks(shape, 6);
+  for (Landmark& l : slow)
+    if (std::abs(l.position.y() - lastCentre.y()) < 0.1) l.position = lastCentre + 1.25 * (l.position - lastCentre);
+  options.taper = true;
+  EXPECT_TRUE(findSliceEnds(image, slow, initialFromLandmarks(slow), options).ends[1].tapered);
 }
 
 // A march that ends at its reach found no end: no spring there, unless asked for.
