@@ -399,8 +399,8 @@ void addSegmentCommand(CLI::App& app) {
   command->add_option("--inside", o->inside,
                       "With --init atlas: x,y,z (LPS mm), a click inside the structure; it picks the carried "
                       "label's part and moves a misplaced one there");
-  CLI::Option* reference =
-      command->add_option("--reference", o->reference, "Reference labelmap on the image's grid, for Dice and distances");
+  CLI::Option* reference = command->add_option("--reference", o->reference,
+                                               "Reference labelmap on the image's grid, for Dice and distances");
   command
       ->add_option("--reference-label", o->referenceLabels,
                    "Label value(s) of the structure in --reference, N[,M...]; with several --landmarks, once per "

@@ -111,7 +111,7 @@ SliceEnds findSliceEnds(const Volume& image, const std::vector<Landmark>& landma
     const Vector3 centre = centroid(onSlice);
     const double rms = rmsRadius(onSlice);
     const double radius = std::max(g.spacing.maxCoeff(), options.disk * rms);
-    // The next clicked slice inwards: whether the clicks narrow toward this end.
+    // The next clicked slice inwards: whether the clicks widen fast toward this end.
     double inner = outward < 0 ? last : first;
     for (const Vector3& p : index)
       if (std::abs(p(axis) - slice) > kOnSliceVoxels && std::abs(p(axis) - slice) < std::abs(inner - slice))
