@@ -379,10 +379,13 @@ def _earlier_paths(job, out):
     (Snakemake removes those), and the labelmaps of a grouping the dataset
     had before (a structure segmented alone that is now segmented with
     others, or the other way round)."""
+    def own_files(name):  # a structure's files and figures
+        return (list(structure_paths(out, job.dir, job.stem, name).values())
+                + list(figure_paths(out, job.dir, job.stem, name).values()))
+
     paths = [view_path(out, job.dir, job.stem, job.desc)]
     for s in job.structures:
-        paths += list(structure_paths(out, job.dir, job.stem, s.name).values())
-        paths += list(figure_paths(out, job.dir, job.stem, s.name).values())
+        paths += own_files(s.name)
     if len(job.structures) > 1:
         for s in job.structures:
             alone = output_paths(out, job.dir, job.stem, f"_desc-{s.name}")
@@ -399,8 +402,7 @@ def _earlier_paths(job, out):
             listed = []
         for name in listed:
             if re.fullmatch(LABEL, str(name)):
-                paths += list(structure_paths(out, job.dir, job.stem, name).values())
-                paths += list(figure_paths(out, job.dir, job.stem, name).values())
+                paths += own_files(name)
         if len(job.structures) == 1:
             paths += list(joint.values()) + [view_path(out, job.dir, job.stem, "")]
     return paths

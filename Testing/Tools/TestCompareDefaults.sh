@@ -2,8 +2,8 @@
 # Tools/compare_defaults.py on a one-run plan (the defaults_plan's first
 # single-scan tuning subject, its left caudate, six slices of clicks): each
 # setting gives one line per group with its change from the defaults, a
-# setting known to cost the caudate (no slice-end march: 0.73 -> 0.46 on the
-# tuning subjects) shows a loss, and a malformed setting is refused.
+# setting known to cost the caudate (no slice-end march: 0.75 -> 0.46 on the
+# single-scan tuning subjects) shows a loss, and a malformed setting is refused.
 # Usage: TestCompareDefaults.sh TOOLS_DIR DATA_DIR DYNSUB
 set -u
 tools=$1 data=$2 dynsub=$3

@@ -21,6 +21,16 @@ fs::path freshDirectory(const std::string& name) {
   return dir;
 }
 
+// The pid of a process that has ended: the pid a killed run's temporaries
+// are named by.
+pid_t endedProcess() {
+  const pid_t child = fork();
+  if (child == 0) _exit(0);
+  int status = 0;
+  if (child > 0) waitpid(child, &status, 0);
+  return child;
+}
+
 TEST(AtomicOutput, CommitMovesTheFileIntoPlace) {
   const fs::path dir = freshDirectory("atomic-commit");
   const std::string target = (dir / "out.obj").string();
@@ -81,11 +91,8 @@ TEST(AtomicOutput, NestedOutputsShareOneTemporaryFile) {
 // process's (a concurrent run's) and other names' alone.
 TEST(AtomicOutput, TheNextRunRemovesTemporariesOfKilledRuns) {
   const fs::path dir = freshDirectory("atomic-stale");
-  const pid_t child = fork();
-  if (child == 0) _exit(0);
+  const pid_t child = endedProcess();  // its pid names a killed run
   ASSERT_GT(child, 0);
-  int status = 0;
-  waitpid(child, &status, 0);  // gone: its pid names a killed run
   const fs::path stale = dir / (".tmp-" + std::to_string(child) + "-report.json");
   const fs::path live = dir / (".tmp-" + std::to_string(getppid()) + "-report.json");
   const fs::path otherName = dir / (".tmp-" + std::to_string(child) + "-surface.vtp");
@@ -210,11 +217,8 @@ TEST(OutputSet, AFolderLeftUnderThisPidIsReplaced) {
 // A killed run's folder is swept by the next set of the same directory.
 TEST(OutputSet, TheNextRunRemovesTheFolderOfAKilledRun) {
   const fs::path parent = freshDirectory("set-stale");
-  const pid_t child = fork();
-  if (child == 0) _exit(0);
+  const pid_t child = endedProcess();
   ASSERT_GT(child, 0);
-  int status = 0;
-  waitpid(child, &status, 0);
   const fs::path stale = parent / (".tmp-" + std::to_string(child) + "-out");
   fs::create_directories(stale / "caudate");
   std::ofstream(stale / "caudate" / "surface.vtp") << "partial";

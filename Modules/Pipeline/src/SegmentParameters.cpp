@@ -151,8 +151,8 @@ std::vector<Parameter> table() {
   add(row("slice_ends_stiffness", "End stiffness", "N/mm", "Slice ends", "The stiffness of each spring at an end",
        [](P& p) -> double& { return p.segment.sliceEnds.stiffness; }, 0.01, 10000, 0.5));
   Parameter taper = row("slice_ends_taper", "End taper", "", "Slice ends",
-                  "Also springs halfway to an end toward which the clicked cross-sections narrow, the end slice's "
-                  "clicks drawn in (an ellipsoid's taper)",
+                  "Also springs halfway to an end, the end slice's clicks drawn in (an ellipsoid's taper), unless "
+                  "the clicked cross-sections widen fast toward it",
                   [](P& p) -> bool& { return p.segment.sliceEnds.taper; });
   taper.opposite = Parameter::Opposite{"sliceEndsWithoutTaper", "No taper springs",
                                        "Only the springs at the ends, none halfway to them."};
