@@ -4,6 +4,9 @@
 // result as the label image and .vtp model it asks for) and each markups
 // point as one `--seed x,y,z` in LPS mm. Progress goes to stdout as
 // <filter-progress> tags, which Slicer shows as the module's progress bar.
+// A points file with several lists (a markups file with one list per
+// structure) segments the structures together, as `dynsub segment` does:
+// one labelmap, one model and one segmentation (.seg.nrrd) hold them all.
 //
 // Exit codes: 0 success; 1 an error in the inputs or the run (stderr names the
 // file and the problem, and nothing is written); 2 a usage error.
@@ -21,20 +24,24 @@
 
 #include "CommandLine.h"
 #include "ExecutionModel.h"
+#include "LandmarkSources.h"
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
 #include "dynsub/ImageIO.h"
 #include "dynsub/Landmarks.h"
 #include "dynsub/SegmentImage.h"
+#include "dynsub/SegmentStructures.h"
 #include "dynsub/SurfaceWriter.h"
 
 namespace {
 
 using namespace dynsub;
+using dynsub::app::LandmarkSource;
+using dynsub::app::landmarkSources;
 
 struct Arguments {
-  std::string image, landmarks, inside, atlasLabel, labelmap, model, report;
+  std::string image, landmarks, inside, atlasLabel, labelmap, model, segmentation, report;
   std::vector<std::string> seeds;
   int labelValue = 1;
   SegmentParameters parameters;
@@ -129,7 +136,8 @@ slicer::Module describe(Arguments& a) {
   io.parameters.push_back({"file", "fileExtensions=\".mrk.json,.fcsv,.csv\"", "landmarksFile", "landmarks",
                            "Boundary points file",
                            "Boundary points from a file (.mrk.json, .fcsv, or .csv with x,y,z columns in LPS mm), "
-                           "added to the points above: one structure's, so a markups file with one point list.",
+                           "added to the points above. A markups file with several point lists is several "
+                           "structures, segmented together so that they do not overlap, each named by its list.",
                            &a.landmarks, "input", "", "", "", {}, -1});
   io.parameters.push_back({"point", "coordinateSystem=\"lps\"", "inside", "inside", "Point inside",
                            "One click inside the structure: the surface starts from the region of like tissue "
@@ -150,11 +158,17 @@ slicer::Module describe(Arguments& a) {
   io.parameters.push_back({"geometry", "type=\"model\" fileExtensions=\"" + modelExtensions + "\"", "outputModel",
                            "model", "Output model", "The fitted limit surface as a triangle model (LPS mm).",
                            &a.model, "output", "", "", "", {}, -1});
+  io.parameters.push_back({"file", "fileExtensions=\".seg.nrrd\"", "outputSegmentation", "segmentation",
+                           "Output segmentation",
+                           "Optional: the structures as a 3D Slicer segmentation (.seg.nrrd), with their names and "
+                           "colours; load it with Add Data.",
+                           &a.segmentation, "output", "", "", "", {}, -1});
   io.parameters.push_back({"file", "fileExtensions=\".json\"", "report", "report", "Report",
                            "Optional: the run's numbers and warnings as JSON (the report.json of dynsub segment).",
                            &a.report, "output", "", "", "", {}, -1});
   io.parameters.push_back({"integer", "", "labelValue", "labelValue", "Label value",
-                           "The structure's value in the output labelmap (Slicer colours it by this value).",
+                           "The structure's value in the output labelmap (Slicer colours it by this value); "
+                           "of several structures, the first's, and the next ones' count up from it.",
                            &a.labelValue, "", "1", "255", "1", {}, -1});
 
   m.groups = {io};
@@ -198,39 +212,63 @@ void requireExtension(const std::string& path, const std::vector<std::string>& k
   throw Error(path, "unknown " + what + " format '" + extension + "' (expected " + list + ")");
 }
 
-void run(Arguments& a) {
-  if (a.labelmap.empty() && a.model.empty() && a.report.empty())
-    throw Error("nothing to write: give --labelmap, --model and/or --report");
-  if (!a.labelmap.empty()) requireExtension(a.labelmap, {".nrrd", ".nii", ".gz", ".mha"}, "labelmap");
-  if (!a.model.empty()) requireExtension(a.model, triangleSurfaceExtensions(), "model");
-  if (!a.report.empty()) requireExtension(a.report, {".json"}, "report");
-  for (const std::string* path : {&a.labelmap, &a.model, &a.report})
-    if (!path->empty()) requireWritableDirectoryFor(*path);
-  for (const auto& apply : a.afterParsing) apply(a);
+bool endsWithSegNrrd(const std::string& path) {
+  std::string lower = path;
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+  return lower.size() > 9 && lower.compare(lower.size() - 9, 9, ".seg.nrrd") == 0;
+}
 
-  SlicerProgress progress(a.parameters.segment.simulation.maxLevel + 1);
-  std::cout << "<filter-start><filter-name>DynSubSegment</filter-name></filter-start>" << std::endl;
-  progress.stage(0.0, "reading the volume and the points");
+// A structure's segment in the .seg.nrrd: its label value, its name and
+// its colour (structureColor, as dynsub segment's dseg.tsv gives it).
+SlicerSegment segmentOf(int label, const std::string& name, std::size_t index) {
+  const std::array<std::uint8_t, 3> rgb = structureColor(index);
+  return {label, name, {rgb[0] / 255.0, rgb[1] / 255.0, rgb[2] / 255.0}};
+}
+
+// What a run writes, all together or none: `labels` (0 outside, each
+// segment's label value inside it) as the labelmap and the segmentation,
+// the surface as the model, and the report.
+void writeOutputs(const Arguments& a, const Volume& labels, const std::vector<SlicerSegment>& segments,
+                  const TriangleSurface& surface, const std::vector<PointScalars>& scalars, const Report& report) {
+  std::vector<std::unique_ptr<AtomicOutput>> outputs;
+  const auto add = [&outputs](const std::string& path) {
+    outputs.push_back(std::make_unique<AtomicOutput>(path));
+    return outputs.back()->temporaryPath();
+  };
+  if (!a.labelmap.empty()) {
+    if (segments.size() == 1) {
+      Mask mask{labels.geometry, std::vector<std::uint8_t>(labels.voxels.size())};
+      for (std::size_t v = 0; v < mask.voxels.size(); ++v) mask.voxels[v] = labels.voxels[v] != 0;
+      writeMask(mask, add(a.labelmap), static_cast<std::uint8_t>(segments.front().label));
+    } else {
+      writeVolume(labels, add(a.labelmap), VoxelType::Label16);
+    }
+  }
+  if (!a.model.empty()) writeTriangleSurface(surface, add(a.model), scalars, "LPS");
+  if (!a.segmentation.empty()) writeSlicerSegmentation(labels, segments, add(a.segmentation));
+  if (!a.report.empty()) report.write(add(a.report));
+  for (auto& output : outputs) output->commit();
+}
+
+void reportWarnings(const SegmentOutcome& outcome, const std::string& structure) {
+  const std::string of = structure.empty() ? "" : structure + ", ";
+  for (const std::string& warning : outcome.warnings)
+    std::cerr << "warning" << (structure.empty() ? "" : " (" + structure + ")") << ": " << warning << '\n';
+  for (const dynsub::TrustFlag& flag : outcome.trustFlags)
+    std::cerr << "not to trust (" << of << flag.name << "): " << flag.message << '\n';
+}
+
+// One structure: from the points, the file's one list, a click inside, or
+// the atlas.
+void runOne(Arguments& a, const Volume& image, const LandmarkSource* file, SlicerProgress& progress) {
   SegmentInputs in;
   in.image = a.image;
-  const Volume image = readVolume(a.image);
   for (std::size_t i = 0; i < a.seeds.size(); ++i)
     in.landmarks.push_back({"seed-" + std::to_string(i + 1), parsePoint(a.seeds[i], "--seed")});
   in.landmarkSource = "--seed";
-  if (!a.landmarks.empty()) {
-    // Several lists (point lists, curves) are several structures: merged,
-    // they would make one surface through all of them.
-    const std::vector<LandmarkList> lists = readLandmarkLists(a.landmarks);
-    if (lists.size() > 1) {
-      std::string names;
-      for (std::size_t k = 0; k < lists.size(); ++k)
-        names += (k ? ", " : "") + (lists[k].name.empty() ? "list " + std::to_string(k + 1) : lists[k].name);
-      throw Error(a.landmarks, "holds " + std::to_string(lists.size()) + " lists of points (" + names +
-                                   "): this module segments one structure per run; give a file with one list, or "
-                                   "segment them together with dynsub segment --landmarks " + a.landmarks);
-    }
-    in.landmarkSystem = lists.front().stated;
-    in.landmarks.insert(in.landmarks.end(), lists.front().landmarks.begin(), lists.front().landmarks.end());
+  if (file) {
+    in.landmarkSystem = file->list.stated;
+    in.landmarks.insert(in.landmarks.end(), file->list.landmarks.begin(), file->list.landmarks.end());
     in.landmarkSource = a.seeds.empty() ? a.landmarks : "--seed and " + a.landmarks;
   }
   if (!a.atlasLabel.empty()) {
@@ -255,23 +293,19 @@ void run(Arguments& a) {
   const SegmentOutcome outcome = segmentImage(image, in, a.parameters, progress.callback());
   progress.stage(0.95, "writing the results");
 
-  // All outputs appear together or none does.
-  std::vector<std::unique_ptr<AtomicOutput>> outputs;
-  if (!a.labelmap.empty()) {
-    outputs.push_back(std::make_unique<AtomicOutput>(a.labelmap));
-    writeMask(outcome.labelmap, outputs.back()->temporaryPath(), static_cast<std::uint8_t>(a.labelValue));
-  }
-  if (!a.model.empty()) {
-    std::vector<PointScalars> scalars;
-    if (outcome.result.surfaceEdgeDistances.size()) scalars.push_back({"edge_distance_mm", outcome.result.surfaceEdgeDistances});
-    outputs.push_back(std::make_unique<AtomicOutput>(a.model));
-    writeTriangleSurface(outcome.result.surface, outputs.back()->temporaryPath(), scalars, "LPS");
-  }
-  if (!a.report.empty()) {
-    outputs.push_back(std::make_unique<AtomicOutput>(a.report));
-    outcome.report.write(outputs.back()->temporaryPath());
-  }
-  for (auto& output : outputs) output->commit();
+  // The segment's name: the points list's, the file's, or the atlas's.
+  std::string name = "structure";
+  if (file)
+    name = file->list.name.empty() ? file->name : file->list.name;
+  else if (!a.atlasLabel.empty())
+    name = a.atlasLabel;
+  Volume labels{image.geometry, std::vector<float>(outcome.labelmap.voxels.size())};
+  for (std::size_t v = 0; v < labels.voxels.size(); ++v)
+    labels.voxels[v] = outcome.labelmap.voxels[v] ? a.labelValue : 0;
+  std::vector<PointScalars> scalars;
+  if (outcome.result.surfaceEdgeDistances.size())
+    scalars.push_back({kEdgeDistanceScalars, outcome.result.surfaceEdgeDistances});
+  writeOutputs(a, labels, {segmentOf(a.labelValue, name, 0)}, outcome.result.surface, scalars, outcome.report);
 
   const double volume = outcome.labelmap.count() * image.geometry.spacing.prod();
   std::cout << std::fixed << std::setprecision(1) << "segmented " << volume << " mm^3 with "
@@ -281,9 +315,108 @@ void run(Arguments& a) {
     std::cout << "<filter-comment>followed the structure's tissue past the outermost slices with points and "
                  "pulled the surface there: "
               << carried << " (check Points reach both ends if your points already reach them)</filter-comment>\n";
-  for (const std::string& warning : outcome.warnings) std::cerr << "warning: " << warning << '\n';
-  for (const dynsub::TrustFlag& flag : outcome.trustFlags)
-    std::cerr << "not to trust (" << flag.name << "): " << flag.message << '\n';
+  reportWarnings(outcome, "");
+}
+
+// The structures of a file with several lists, segmented together
+// (SegmentStructures.h): each starts from its own points, so points given
+// otherwise would be no structure's.
+void runTogether(Arguments& a, const Volume& image, const std::vector<LandmarkSource>& files,
+                 SlicerProgress& progress) {
+  const std::string several = a.landmarks + " holds " + std::to_string(files.size()) + " lists of points, segmented " +
+                              "together from their own points: ";
+  if (!a.seeds.empty()) throw Error(several + "add boundary points to the lists, not as --seed");
+  if (!a.inside.empty()) throw Error(several + "a point inside is one structure's; leave it out");
+  if (!a.atlasLabel.empty()) throw Error(several + "an atlas start is one structure's; leave it out");
+  const int lastLabel = a.labelValue + static_cast<int>(files.size()) - 1;
+  if (lastLabel > 255)
+    throw Error(several + "their label values " + std::to_string(a.labelValue) + "-" + std::to_string(lastLabel) +
+                " pass 255; give a smaller --labelValue");
+  std::vector<StructureInputs> structures;
+  for (const LandmarkSource& file : files) {
+    StructureInputs structure;
+    structure.name = file.name;
+    structure.inputs.image = a.image;
+    structure.inputs.landmarks = file.list.landmarks;
+    structure.inputs.landmarkSystem = file.list.stated;
+    structure.inputs.landmarkSource = a.landmarks;
+    structures.push_back(std::move(structure));
+  }
+  checkStructures(structures, a.parameters);
+
+  progress.stage(0.05, "evolving the surfaces");
+  const StructuresOutcome outcome = segmentStructures(image, structures, a.parameters, progress.callback());
+  progress.stage(0.95, "writing the results");
+
+  Volume labels = outcome.labels;
+  for (float& v : labels.voxels)
+    if (v != 0) v += a.labelValue - 1;
+  std::vector<SlicerSegment> segments;
+  // One model of all the surfaces; its point data "label" says whose each
+  // point is, and the edge distances are kept where every surface has them.
+  TriangleSurface surface;
+  std::vector<double> label, edgeDistance;
+  bool edgeDistances = true;
+  for (std::size_t s = 0; s < files.size(); ++s) {
+    const int value = a.labelValue + static_cast<int>(s);
+    segments.push_back(segmentOf(value, files[s].list.name.empty() ? files[s].name : files[s].list.name, s));
+    const SegmentResult& result = outcome.structures[s].result;
+    const TriangleSurface& own = result.surface;
+    const int offset = static_cast<int>(surface.points.rows());
+    surface.points.conservativeResize(offset + own.points.rows(), 3);
+    surface.points.bottomRows(own.points.rows()) = own.points;
+    surface.normals.conservativeResize(offset + own.normals.rows(), 3);
+    surface.normals.bottomRows(own.normals.rows()) = own.normals;
+    for (const std::array<int, 3>& t : own.triangles)
+      surface.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+    surface.triangleElement.insert(surface.triangleElement.end(), own.triangleElement.begin(),
+                                   own.triangleElement.end());
+    surface.triangleType.insert(surface.triangleType.end(), own.triangleType.begin(), own.triangleType.end());
+    label.insert(label.end(), own.points.rows(), value);
+    edgeDistances = edgeDistances && result.surfaceEdgeDistances.size() == own.points.rows();
+    if (edgeDistances)
+      edgeDistance.insert(edgeDistance.end(), result.surfaceEdgeDistances.data(),
+                          result.surfaceEdgeDistances.data() + result.surfaceEdgeDistances.size());
+  }
+  std::vector<PointScalars> scalars = {{"label", Eigen::Map<const Eigen::VectorXd>(label.data(), label.size())}};
+  if (edgeDistances)
+    scalars.push_back(
+        {kEdgeDistanceScalars, Eigen::Map<const Eigen::VectorXd>(edgeDistance.data(), edgeDistance.size())});
+  writeOutputs(a, labels, segments, surface, scalars, outcome.report);
+
+  std::cout << std::fixed << std::setprecision(1) << "segmented " << files.size() << " structures together in "
+            << outcome.seconds << " s; voxels in two structures: " << outcome.sharedAlone << " alone, "
+            << outcome.sharedTogether << " with the barrier, 0 in the labelmap\n";
+  for (std::size_t s = 0; s < files.size(); ++s) {
+    const SegmentOutcome& one = outcome.structures[s];
+    std::cout << "  " << segments[s].label << " " << segments[s].name << ": "
+              << static_cast<double>(one.labelmap.count()) * image.geometry.spacing.prod() << " mm^3\n";
+    reportWarnings(one, segments[s].name);
+  }
+}
+
+void run(Arguments& a) {
+  if (a.labelmap.empty() && a.model.empty() && a.segmentation.empty() && a.report.empty())
+    throw Error("nothing to write: give --labelmap, --model, --segmentation and/or --report");
+  if (!a.labelmap.empty()) requireExtension(a.labelmap, {".nrrd", ".nii", ".gz", ".mha"}, "labelmap");
+  if (!a.model.empty()) requireExtension(a.model, triangleSurfaceExtensions(), "model");
+  if (!a.segmentation.empty() && !endsWithSegNrrd(a.segmentation))
+    throw Error(a.segmentation, "a 3D Slicer segmentation is written as .seg.nrrd");
+  if (!a.report.empty()) requireExtension(a.report, {".json"}, "report");
+  for (const std::string* path : {&a.labelmap, &a.model, &a.segmentation, &a.report})
+    if (!path->empty()) requireWritableDirectoryFor(*path);
+  for (const auto& apply : a.afterParsing) apply(a);
+
+  SlicerProgress progress(a.parameters.segment.simulation.maxLevel + 1);
+  std::cout << "<filter-start><filter-name>DynSubSegment</filter-name></filter-start>" << std::endl;
+  progress.stage(0.0, "reading the volume and the points");
+  const Volume image = readVolume(a.image);
+  const std::vector<LandmarkSource> files =
+      a.landmarks.empty() ? std::vector<LandmarkSource>{} : landmarkSources({a.landmarks});
+  if (files.size() > 1)
+    runTogether(a, image, files, progress);
+  else
+    runOne(a, image, files.empty() ? nullptr : &files.front(), progress);
   progress.report(1.0);
   std::cout << "<filter-end><filter-name>DynSubSegment</filter-name></filter-end>" << std::endl;
 }

@@ -2,6 +2,7 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <future>
@@ -14,6 +15,7 @@
 #include "CommandLine.h"
 #include "Commands.h"
 #include "FigureOutputs.h"
+#include "LandmarkSources.h"
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
 #include "dynsub/ImageIO.h"
@@ -137,53 +139,6 @@ void printSummary(const Arguments& o, const SegmentOutcome& outcome, const Volum
             << (o.figures.figures ? " and the figures that could be rendered" : "") << '\n';
 }
 
-// A landmark file's name without its folder and extension: caudate_left
-// for caudate_left.mrk.json.
-std::string structureName(const std::string& path) {
-  std::filesystem::path stem = std::filesystem::path(path).stem();
-  if (lowerCaseExtension(stem.string()) == ".mrk") stem = stem.stem();
-  return stem.string();
-}
-
-// The structures the --landmarks files hold, in order: each file's lists (a
-// 3D Slicer markups file may hold one list per structure), each with the
-// name it gets without --name.
-struct LandmarkSource {
-  std::string path, name;
-  LandmarkList list;
-};
-
-// A list's name as a structure's name: the characters a name may not hold
-// (isNameCharacter) become '_' ("Caudate L" -> Caudate_L).
-std::string folderName(const std::string& name) {
-  std::string folder = name;
-  std::replace_if(
-      folder.begin(), folder.end(), [](char c) { return !isNameCharacter(c); }, '_');
-  return folder;
-}
-
-std::vector<LandmarkSource> landmarkSources(const std::vector<std::string>& files) {
-  std::vector<LandmarkSource> sources;
-  for (const std::string& path : files) {
-    std::vector<LandmarkList> lists = readLandmarkLists(path);
-    for (std::size_t k = 0; k < lists.size(); ++k) {
-      LandmarkSource source;
-      source.path = path;
-      // One list: the file's stem (caudate_left.mrk.json: caudate_left).
-      // Several: each list's own name, or the stem and its number among the
-      // file's lists that hold points.
-      if (lists.size() == 1)
-        source.name = structureName(path);
-      else
-        source.name =
-            lists[k].name.empty() ? structureName(path) + "_" + std::to_string(k + 1) : folderName(lists[k].name);
-      source.list = std::move(lists[k]);
-      sources.push_back(std::move(source));
-    }
-  }
-  return sources;
-}
-
 // `landmarks`: the one structure's, or null (no --landmarks).
 void runSegmentOne(const Arguments& o, const LandmarkSource* landmarks) {
   // Every input is read and checked before anything is written.
@@ -238,16 +193,17 @@ void runSegmentOne(const Arguments& o, const LandmarkSource* landmarks) {
   printSummary(o, outcome, image);
 }
 
-// BIDS's table of a dseg's labels: index, name and a colour for viewers that
-// take one, from a qualitative palette of ten that neighbours tell apart
-// (repeated past ten).
+// BIDS's table of a dseg's labels: index, name and a colour (structureColor)
+// for viewers that take one.
 void writeLabelTable(const std::vector<StructureInputs>& structures, const std::string& path) {
-  static const char* const palette[] = {"#4e79a7", "#f28e2b", "#e15759", "#76b7b2", "#59a14f",
-                                        "#edc948", "#b07aa1", "#ff9da7", "#9c755f", "#bab0ac"};
   std::ofstream table(path);
   table << "index\tname\tcolor\n";
-  for (std::size_t s = 0; s < structures.size(); ++s)
-    table << s + 1 << '\t' << structures[s].name << '\t' << palette[s % 10] << '\n';
+  for (std::size_t s = 0; s < structures.size(); ++s) {
+    const std::array<std::uint8_t, 3> rgb = structureColor(s);
+    char hex[8];
+    std::snprintf(hex, sizeof hex, "#%02x%02x%02x", rgb[0], rgb[1], rgb[2]);
+    table << s + 1 << '\t' << structures[s].name << '\t' << hex << '\n';
+  }
   table.close();
   if (!table) throw Error(path, "could not be written");
 }

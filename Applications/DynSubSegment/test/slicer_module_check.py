@@ -10,9 +10,16 @@
         Runs the module through that generated nipype interface.
     slicer_module_check.py dice LABELMAP.nrrd LABEL REFERENCE.nii.gz REF_LABEL MINIMUM
         Reads the module's NRRD labelmap with a reader written here, checks
-        that its grid is the reference's, and that Dice >= MINIMUM.
+        that its grid is the reference's, and that the structure of value
+        LABEL has Dice >= MINIMUM.
+    slicer_module_check.py segmentation SEGMENTATION.seg.nrrd LABELMAP.nrrd NAME=LABEL...
+        The 3D Slicer segmentation as Slicer reads it: teem (the NRRD
+        format's own library, Debian's teem-apps) reads the file; its fields
+        name each segment, in order, with its label value, one layer, a
+        colour of its own and the index box of its voxels; its voxels are
+        the labelmap's.
 
-Run with Debian's python3 (python3-nipype, python3-nibabel).
+Run with Debian's python3 (python3-nipype, python3-nibabel) and teem-apps.
 """
 import gzip
 import os
@@ -173,16 +180,19 @@ def nipype_run(module, image, landmarks, workdir):
             setattr(node.inputs, key, value)
         node.inputs.labelmap = True
         node.inputs.model = True
+        node.inputs.segmentation = True
         node.inputs.report = "report.json"
         if expected not in node.cmdline:
             fail(f"nipype's command line {node.cmdline!r} lacks {expected!r}")
         outputs = node.run().outputs
-        for path in (outputs.labelmap, outputs.model, outputs.report):
+        for path in (outputs.labelmap, outputs.model, outputs.segmentation, outputs.report):
             if not os.path.getsize(path) > 0:
                 fail(f"nipype run with {name}: {path} is missing or empty")
         report = json.load(open(outputs.report))
         if name == "boundary points" and report["landmark_count"] != len(points):
             fail(f"nipype run with {name}: {report['landmark_count']} points reached the module, not {len(points)}")
+        if not outputs.segmentation.endswith(".seg.nrrd"):
+            fail(f"nipype named the segmentation {outputs.segmentation}, not .seg.nrrd")
         if name == "a point inside" and not report["init"].startswith("inside:"):
             fail(f"nipype run with {name}: the module started from {report['init']!r}")
         print(f"nipype ran with {name}: {node.cmdline[:160]}...\n  -> {outputs.labelmap}, {outputs.model}")
@@ -229,8 +239,8 @@ def dice(labelmap, label, reference, reference_label, minimum):
     if ours.shape != ref.shape or not numpy.allclose(affine, ref_lps, atol=1e-4):
         fail(f"{labelmap}: grid {ours.shape} {affine.tolist()} is not the reference's {ref.shape} {ref_lps.tolist()}")
     values = set(numpy.unique(ours).tolist())
-    if values != {0, label}:
-        fail(f"{labelmap}: values {values}, expected 0 and {label}")
+    if 0 not in values or label not in values:
+        fail(f"{labelmap}: values {values}, expected 0 and {label} among them")
     a = ours == label
     b = numpy.asanyarray(ref.dataobj) == reference_label
     score = 2.0 * numpy.count_nonzero(a & b) / (numpy.count_nonzero(a) + numpy.count_nonzero(b))
@@ -239,12 +249,53 @@ def dice(labelmap, label, reference, reference_label, minimum):
         fail(f"Dice {score:.4f} < {minimum}")
 
 
+def segmentation(path, labelmap, segments):
+    import tempfile
+    head = subprocess.run(["teem-unu", "head", path], capture_output=True, text=True)
+    if head.returncode != 0:
+        fail(f"teem cannot read {path}: {head.stderr.strip()}")
+    fields = dict(line.split(":=", 1) for line in head.stdout.splitlines() if ":=" in line)
+    if fields.get("Segmentation_SourceRepresentation") != "Binary labelmap":
+        fail(f"{path}: Segmentation_SourceRepresentation is {fields.get('Segmentation_SourceRepresentation')!r}")
+    with tempfile.TemporaryDirectory() as work:
+        raw = os.path.join(work, "raw.nrrd")
+        subprocess.run(["teem-unu", "save", "-i", path, "-f", "nrrd", "-e", "raw", "-o", raw], check=True)
+        voxels, affine = read_nrrd(raw)
+    expected, expected_affine = read_nrrd(labelmap)
+    if voxels.shape != expected.shape or not numpy.allclose(affine, expected_affine, atol=1e-6):
+        fail(f"{path}: its grid is not the labelmap's")
+    if not numpy.array_equal(voxels.astype(numpy.int32), expected.astype(numpy.int32)):
+        fail(f"{path}: its voxels differ from {labelmap}'s in {numpy.count_nonzero(voxels != expected)} places")
+    colors = set()
+    for index, segment in enumerate(segments):
+        name, label = segment.rsplit("=", 1)
+        key = f"Segment{index}_"
+        if fields.get(key + "Name") != name or fields.get(key + "LabelValue") != label:
+            fail(f"{path}: segment {index} is {fields.get(key + 'Name')!r} = {fields.get(key + 'LabelValue')!r}, "
+                 f"expected {name!r} = {label}")
+        if fields.get(key + "Layer") != "0" or not fields.get(key + "ID"):
+            fail(f"{path}: segment {index} has no ID or is not in layer 0")
+        color = tuple(float(c) for c in fields[key + "Color"].split())
+        if len(color) != 3 or not all(0 <= c <= 1 for c in color) or color in colors:
+            fail(f"{path}: segment {index}'s colour {color} is not three values in 0-1 of its own")
+        colors.add(color)
+        where = numpy.argwhere(voxels == int(label))
+        box = [int(v) for pair in zip(where.min(axis=0), where.max(axis=0)) for v in pair]
+        if [int(v) for v in fields[key + "Extent"].split()] != box:
+            fail(f"{path}: segment {index}'s extent {fields[key + 'Extent']} is not its voxels' box {box}")
+        print(f"segment {index}: {name} = {label}, colour {color}, {len(where)} voxels in {box}")
+    if f"Segment{len(segments)}_ID" in fields:
+        fail(f"{path}: more than the {len(segments)} segments expected")
+
+
 if __name__ == "__main__":
     command = sys.argv[1] if len(sys.argv) > 1 else ""
     if command == "descriptor" and len(sys.argv) == 3:
         check_descriptor(os.path.abspath(sys.argv[2]))
     elif command == "nipype-run" and len(sys.argv) == 6:
         nipype_run(os.path.abspath(sys.argv[2]), *[os.path.abspath(a) for a in sys.argv[3:]])
+    elif command == "segmentation" and len(sys.argv) >= 5:
+        segmentation(sys.argv[2], sys.argv[3], sys.argv[4:])
     elif command == "dice" and len(sys.argv) == 7:
         dice(sys.argv[2], int(sys.argv[3]), sys.argv[4], int(sys.argv[5]), float(sys.argv[6]))
     else:

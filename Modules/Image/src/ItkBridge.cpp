@@ -12,6 +12,7 @@
 #include <itkImageFileWriter.h>
 #include <itkImageIOBase.h>
 #include <itkImageIOFactory.h>
+#include <itkMetaDataObject.h>
 #include <itkMetaImageIOFactory.h>
 #include <itkNiftiImageIOFactory.h>
 #include <itkNrrdImageIOFactory.h>
@@ -115,12 +116,14 @@ namespace {
 // format allows; `what` names it in the error.
 template <typename Image, typename Pixel>
 void writeCompressed(const Geometry& geometry, const std::vector<Pixel>& voxels, const std::string& path,
-                     const char* what) {
+                     const char* what, const std::vector<std::pair<std::string, std::string>>& fields = {}) {
   registerFormats();
   try {
     auto writer = itk::ImageFileWriter<Image>::New();
     writer->SetFileName(path);
-    writer->SetInput(makeImage<Image>(geometry, voxels));
+    auto image = makeImage<Image>(geometry, voxels);
+    for (const auto& [key, value] : fields) itk::EncapsulateMetaData<std::string>(image->GetMetaDataDictionary(), key, value);
+    writer->SetInput(image);
     writer->UseCompressionOn();
     writer->Update();
   } catch (const itk::ExceptionObject& e) {
@@ -130,8 +133,9 @@ void writeCompressed(const Geometry& geometry, const std::vector<Pixel>& voxels,
 
 }  // namespace
 
-void writeLabels(const Geometry& geometry, const std::vector<std::uint8_t>& voxels, const std::string& path) {
-  writeCompressed<MaskImage>(geometry, voxels, path, "labelmap");
+void writeLabels(const Geometry& geometry, const std::vector<std::uint8_t>& voxels, const std::string& path,
+                 const std::vector<std::pair<std::string, std::string>>& fields) {
+  writeCompressed<MaskImage>(geometry, voxels, path, "labelmap", fields);
 }
 
 void writeImage(const Geometry& geometry, const std::vector<float>& voxels, bool labels, const std::string& path) {

@@ -9,6 +9,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #define DYNSUB_ITK_BRIDGE_API __attribute__((visibility("default")))
@@ -32,8 +33,11 @@ DYNSUB_ITK_BRIDGE_API void readImage(const std::string& path, Geometry& geometry
 DYNSUB_ITK_BRIDGE_API void readDicom(const std::string& path, Geometry& geometry, std::vector<float>& voxels);
 
 // An 8-bit labelmap, compressed when the format allows; throws dynsub::Error.
+// `fields` are written as the file's key/value pairs where the format has
+// them (NRRD's "key:=value" lines).
 DYNSUB_ITK_BRIDGE_API void writeLabels(const Geometry& geometry, const std::vector<std::uint8_t>& voxels,
-                                       const std::string& path);
+                                       const std::string& path,
+                                       const std::vector<std::pair<std::string, std::string>>& fields = {});
 
 // A float image (`labels` false) or a label image of 16-bit signed integers
 // (`labels` true, values rounded), compressed when the format allows;

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 
 #include <zlib.h>
 
@@ -44,6 +45,71 @@ TEST(ImageIO, MaskRoundTripKeepsGeometryAndVoxels) {
     EXPECT_LT((read.geometry.direction - mask.geometry.direction).norm(), 1e-5) << name;
     for (std::size_t v = 0; v < mask.voxels.size(); ++v) ASSERT_EQ(read.voxels[v], mask.voxels[v]) << name << v;
   }
+}
+
+// The NRRD header's "key:=value" pairs (the header ends at the first empty
+// line; the gzip data follows).
+std::map<std::string, std::string> nrrdFields(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::map<std::string, std::string> fields;
+  std::string line;
+  while (std::getline(in, line) && !line.empty()) {
+    const std::size_t split = line.find(":=");
+    if (split != std::string::npos) fields[line.substr(0, split)] = line.substr(split + 2);
+  }
+  return fields;
+}
+
+// Three structures as 3D Slicer reads a segmentation: the voxels come back as
+// written (ITK's NRRD reader, which Slicer's own reader is built on), and
+// the header names each segment with its label, colour and the index box of
+// its voxels; an empty segment has Slicer's empty extent.
+TEST(ImageIO, SlicerSegmentationNamesItsSegments) {
+  Volume labels{grid({6, 5, 4}, Vector3(0.5, 1.0, 1.5), Vector3(3, -2, 1), skewDirection()), {}};
+  labels.voxels.assign(labels.geometry.voxelCount(), 0.0f);
+  labels.voxels[labels.geometry.offset(1, 2, 3)] = 2;
+  labels.voxels[labels.geometry.offset(4, 0, 1)] = 2;
+  labels.voxels[labels.geometry.offset(5, 4, 0)] = 7;
+  const std::vector<SlicerSegment> segments = {
+      {2, "Caudate L", {0.25, 0.5, 0.75}}, {7, "putamen", {1, 0, 0}}, {9, "pallidum", {0, 1, 0}}};
+  const fs::path path = scratch("three.seg.nrrd");
+  writeSlicerSegmentation(labels, segments, path.string());
+  const Volume read = readVolume(path.string());
+  EXPECT_EQ(read.geometry.size, labels.geometry.size);
+  EXPECT_LT((read.geometry.direction - labels.geometry.direction).norm(), 1e-9);
+  for (std::size_t v = 0; v < labels.voxels.size(); ++v) ASSERT_EQ(read.voxels[v], labels.voxels[v]) << v;
+  const std::map<std::string, std::string> fields = nrrdFields(path);
+  EXPECT_EQ(fields.at("Segmentation_SourceRepresentation"), "Binary labelmap");
+  EXPECT_EQ(fields.at("Segment0_Name"), "Caudate L");
+  EXPECT_EQ(fields.at("Segment0_LabelValue"), "2");
+  EXPECT_EQ(fields.at("Segment0_Color"), "0.25 0.5 0.75");
+  EXPECT_EQ(fields.at("Segment0_Extent"), "1 4 0 2 1 3");
+  EXPECT_EQ(fields.at("Segment0_Layer"), "0");
+  EXPECT_EQ(fields.at("Segment1_Name"), "putamen");
+  EXPECT_EQ(fields.at("Segment1_Extent"), "5 5 4 4 0 0");
+  EXPECT_EQ(fields.at("Segment2_Extent"), "0 -1 0 -1 0 -1");
+  EXPECT_EQ(fields.count("Segment3_ID"), 0u);
+  // IDs are unique, as Slicer requires.
+  EXPECT_NE(fields.at("Segment0_ID"), fields.at("Segment1_ID"));
+
+  // Refused, naming the file, and nothing written: a voxel no segment
+  // claims, a repeated label, a name with a line break, another extension.
+  const fs::path refused = scratch("refused.seg.nrrd");
+  const auto refuses = [&](const Volume& v, const std::vector<SlicerSegment>& s, const fs::path& p,
+                           const std::string& why) {
+    try {
+      writeSlicerSegmentation(v, s, p.string());
+      ADD_FAILURE() << "written: " << why;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(p.filename().string()), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(p));
+  };
+  refuses(labels, {segments[0]}, refused, "no segment's label");
+  refuses(labels, {segments[0], {2, "again", {0, 0, 0}}, segments[1]}, refused, "given to two segments");
+  refuses(labels, {segments[0], {7, "two\nlines", {0, 0, 0}}}, refused, "control characters");
+  refuses(labels, segments, scratch("labels.nrrd"), ".seg.nrrd");
 }
 
 // A MetaImage header with its voxels in a separate raw file, as other tools

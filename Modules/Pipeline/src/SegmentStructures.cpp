@@ -15,6 +15,13 @@ namespace dynsub {
 
 bool isNameCharacter(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.'; }
 
+std::array<std::uint8_t, 3> structureColor(std::size_t index) {
+  static const std::array<std::uint8_t, 3> palette[] = {
+      {0x4e, 0x79, 0xa7}, {0xf2, 0x8e, 0x2b}, {0xe1, 0x57, 0x59}, {0x76, 0xb7, 0xb2}, {0x59, 0xa1, 0x4f},
+      {0xed, 0xc9, 0x48}, {0xb0, 0x7a, 0xa1}, {0xff, 0x9d, 0xa7}, {0x9c, 0x75, 0x5f}, {0xba, 0xb0, 0xac}};
+  return palette[index % 10];
+}
+
 namespace {
 
 // The margin (voxels) around the structures' voxels that the territories,

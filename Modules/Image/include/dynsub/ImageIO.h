@@ -10,8 +10,10 @@
 // DICOM file, a multi-frame volume, when it has the standard "DICM" preamble). Any pixel
 // type is read as float; an image that is not 3D (a single slice counts as 2D)
 // or has no voxels is refused.
+#include <array>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "dynsub/Volume.h"
 
@@ -43,5 +45,24 @@ enum class VoxelType { Float32, Label16 };
 // extension (.nii.gz, .nii, .nrrd, .mha). Label values must lie in
 // -32768..32767. The file appears complete or not at all.
 void writeVolume(const Volume& volume, const std::string& path, VoxelType type);
+
+// One structure of a 3D Slicer segmentation.
+struct SlicerSegment {
+  int label = 1;                // its value in the labelmap, 1-255
+  std::string name;             // the name Slicer's Segments table shows
+  std::array<double, 3> color;  // red, green and blue, each 0-1
+};
+
+// Writes a labelmap of structures that do not overlap (0 the background,
+// each segment's label on its voxels) as a 3D Slicer segmentation: a
+// .seg.nrrd file, which Slicer opens as a segmentation node with the
+// segments' names and colours (3D Slicer's "Segmentation labelmap file
+// format": one layer of 8-bit labels, the Segmentation_ and SegmentN_
+// fields). Throws dynsub::Error naming the path for a name not ending in
+// .seg.nrrd, no segment, a label outside 1-255 or repeated, a name that is
+// empty or holds a control character, a colour outside 0-1, or a voxel whose
+// value is no segment's label. The file appears complete or not at all.
+void writeSlicerSegmentation(const Volume& labels, const std::vector<SlicerSegment>& segments,
+                             const std::string& path);
 
 }  // namespace dynsub

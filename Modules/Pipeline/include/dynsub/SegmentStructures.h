@@ -14,6 +14,8 @@
 // where the two structures meet, not wherever each alone stopped. Each
 // structure keeps its own surface and labelmap; the joined labelmap is the
 // one without overlap.
+#include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -29,6 +31,11 @@ struct StructureInputs {
 // The characters a structure's name may hold, as it names a folder: letters,
 // digits, '_', '-' and '.'.
 bool isNameCharacter(char c);
+
+// The colour structure `index` (0-based) is shown in (red, green, blue, 0-255):
+// a qualitative palette of ten that neighbours tell apart, repeated past ten.
+// dseg.tsv and 3D Slicer segmentations give it.
+std::array<std::uint8_t, 3> structureColor(std::size_t index);
 
 struct StructuresOutcome {
   // In the inputs' order; a structure segmented again holds its second

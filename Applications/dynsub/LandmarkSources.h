@@ -1,0 +1,28 @@
+#pragma once
+// The structures that landmark files hold, as `dynsub segment --landmarks`
+// and the 3D Slicer module read them: a file's point list is one structure,
+// and a 3D Slicer markups file may hold one list per structure.
+#include <string>
+#include <vector>
+
+#include "dynsub/Landmarks.h"
+
+namespace dynsub::app {
+
+struct LandmarkSource {
+  std::string path;  // the file
+  std::string name;  // the structure's name without --name (a folder's name: isNameCharacter's)
+  LandmarkList list;
+};
+
+// A landmark file's name without its folder and extension: caudate_left
+// for caudate_left.mrk.json.
+std::string structureName(const std::string& path);
+
+// The files' lists, in order. A file of one list gives its stem as the
+// name; of several, each list's own name with the characters a name may not
+// hold made '_' ("Caudate L" -> Caudate_L), or the stem and the list's
+// number when it has no name. Throws as readLandmarkLists.
+std::vector<LandmarkSource> landmarkSources(const std::vector<std::string>& files);
+
+}  // namespace dynsub::app
