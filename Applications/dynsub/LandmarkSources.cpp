@@ -14,6 +14,13 @@ std::string structureName(const std::string& path) {
   return stem.string();
 }
 
+std::string asStructureName(const std::string& text) {
+  std::string name = text;
+  std::replace_if(
+      name.begin(), name.end(), [](char c) { return !isNameCharacter(c); }, '_');
+  return name;
+}
+
 std::vector<LandmarkSource> landmarkSources(const std::vector<std::string>& files) {
   std::vector<LandmarkSource> sources;
   for (const std::string& path : files) {
@@ -26,9 +33,7 @@ std::vector<LandmarkSource> landmarkSources(const std::vector<std::string>& file
       } else if (lists[k].name.empty()) {
         source.name = structureName(path) + "_" + std::to_string(k + 1);
       } else {
-        source.name = lists[k].name;
-        std::replace_if(
-            source.name.begin(), source.name.end(), [](char c) { return !isNameCharacter(c); }, '_');
+        source.name = asStructureName(lists[k].name);
       }
       source.list = std::move(lists[k]);
       sources.push_back(std::move(source));

@@ -19,10 +19,13 @@ struct LandmarkSource {
 // for caudate_left.mrk.json.
 std::string structureName(const std::string& path);
 
+// Text as a structure's name: the characters a name may not hold
+// (isNameCharacter) made '_' ("Caudate L" -> Caudate_L).
+std::string asStructureName(const std::string& text);
+
 // The files' lists, in order. A file of one list gives its stem as the
-// name; of several, each list's own name with the characters a name may not
-// hold made '_' ("Caudate L" -> Caudate_L), or the stem and the list's
-// number when it has no name. Throws as readLandmarkLists.
+// name; of several, each list's own name as a structure's name
+// (asStructureName), or the stem and the list's number when it has none. Throws as readLandmarkLists.
 std::vector<LandmarkSource> landmarkSources(const std::vector<std::string>& files);
 
 }  // namespace dynsub::app

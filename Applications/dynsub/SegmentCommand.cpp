@@ -44,7 +44,7 @@ struct Arguments {
   std::vector<std::string> referenceLabels;  // "N[,M...]": one per structure
   std::string atlas = kDefaultAtlasImage;
   std::string atlasLabels = kDefaultAtlasLabels;
-  std::string atlasLabel;
+  std::vector<std::string> atlasLabel;  // with --init atlas: one structure's labels each
   std::string inside;
   SegmentParameters parameters;
   FigureOptions figures;
@@ -162,7 +162,7 @@ void runSegmentOne(const Arguments& o, const LandmarkSource* landmarks) {
     if (o.atlasLabel.empty())
       throw Error("--init atlas needs --atlas-label N[,M...] or a name from the atlas's table (e.g. Caudate_L)");
     inputs.atlas = std::make_shared<const Atlas>(readAtlas(o.atlas, o.atlasLabels));
-    inputs.atlasLabels = atlasLabelValues(*inputs.atlas, o.atlasLabel);
+    inputs.atlasLabels = atlasLabelValues(*inputs.atlas, o.atlasLabel.front());
   } else if (!o.atlasLabel.empty()) {
     throw Error("--atlas-label serves an atlas start: add --init atlas");
   }
@@ -212,24 +212,51 @@ void writeLabelTable(const std::vector<StructureInputs>& structures, const std::
 // DIR/dseg.nii.gz, DIR/dseg.tsv and DIR/report.json, the run's report, last:
 // it is there only when everything is.
 void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& sources) {
-  if (!o.names.empty() && o.names.size() != sources.size())
-    throw Error("--name is given " + std::to_string(o.names.size()) + " times for " + std::to_string(sources.size()) +
-                " structures (the point lists of the --landmarks files): name each structure, or none");
-  if (!o.reference.empty() && o.referenceLabels.size() != sources.size())
-    throw Error("--reference needs one --reference-label N[,M...] per structure, in the order of --landmarks (" +
-                std::to_string(sources.size()) + " structures, " + std::to_string(o.referenceLabels.size()) +
-                " given)");
-  if (o.init != "auto")
-    throw Error("--init " + o.init + ": several structures start from their landmarks (--init auto)");
+  // The structures: the landmarks' lists, or with --init atlas the atlas
+  // labels, each paired with its list when --landmarks are given too.
+  const bool atlas = o.init == "atlas";
+  if (!atlas && o.init != "auto")
+    throw Error("--init " + o.init + ": several structures start from their landmarks (--init auto) or from the " +
+                "atlas (--init atlas, an --atlas-label per structure)");
+  if (!atlas && !o.atlasLabel.empty()) throw Error("--atlas-label serves an atlas start: add --init atlas");
+  const std::size_t n = atlas ? o.atlasLabel.size() : sources.size();
+  if (atlas && !sources.empty() && sources.size() != n)
+    throw Error("--init atlas with --landmarks: give an --atlas-label per point list, in their order (" +
+                std::to_string(sources.size()) + " lists, " + std::to_string(n) + " atlas labels)");
+  if (!o.inside.empty())
+    throw Error("--inside: a click inside is one structure's; segment several structures without it");
+  const std::string order = atlas ? "--atlas-label" : "--landmarks";
+  if (!o.names.empty() && o.names.size() != n)
+    throw Error("--name is given " + std::to_string(o.names.size()) + " times for " + std::to_string(n) +
+                " structures (one per " + order + "): name each structure, or none");
+  if (!o.reference.empty() && o.referenceLabels.size() != n)
+    throw Error("--reference needs one --reference-label N[,M...] per structure, in the order of " + order + " (" +
+                std::to_string(n) + " structures, " + std::to_string(o.referenceLabels.size()) + " given)");
+  const std::shared_ptr<const Atlas> atlasData =
+      atlas ? std::make_shared<const Atlas>(readAtlas(o.atlas, o.atlasLabels)) : nullptr;
   std::vector<StructureInputs> structures;
-  for (std::size_t s = 0; s < sources.size(); ++s) {
+  for (std::size_t s = 0; s < n; ++s) {
     StructureInputs structure;
-    structure.name = o.names.empty() ? sources[s].name : o.names[s];
     SegmentInputs& in = structure.inputs;
     in.image = o.image;
-    in.landmarkSource = sources[s].path;
-    in.landmarks = sources[s].list.landmarks;
-    in.landmarkSystem = sources[s].list.stated;
+    if (!sources.empty()) {
+      structure.name = sources[s].name;
+      in.landmarkSource = sources[s].path;
+      in.landmarks = sources[s].list.landmarks;
+      in.landmarkSystem = sources[s].list.stated;
+    }
+    if (atlas) {
+      in.start = parseSegmentStart("atlas", "--init");
+      in.atlas = atlasData;
+      in.atlasLabels = atlasLabelValues(*atlasData, o.atlasLabel[s]);
+      // Its name: the table's for one label value (73: Putamen_L), else as given.
+      const auto named = std::find_if(atlasData->names.begin(), atlasData->names.end(),
+                                      [&in](const auto& entry) { return entry.first == in.atlasLabels.front(); });
+      if (sources.empty())
+        structure.name = asStructureName(
+            in.atlasLabels.size() == 1 && named != atlasData->names.end() ? named->second : o.atlasLabel[s]);
+    }
+    if (!o.names.empty()) structure.name = o.names[s];
     if (!o.reference.empty()) {
       in.referencePath = o.reference;
       in.referenceLabels = parseLabelValues(o.referenceLabels[s]);
@@ -299,7 +326,7 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
 
 void runSegment(const Arguments& o) {
   const std::vector<LandmarkSource> sources = landmarkSources(o.landmarks);
-  if (sources.size() > 1)
+  if (sources.size() > 1 || o.atlasLabel.size() > 1)
     runSegmentTogether(o, sources);
   else
     runSegmentOne(o, sources.empty() ? nullptr : &sources.front());
@@ -329,8 +356,8 @@ void addSegmentCommand(CLI::App& app) {
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   command
       ->add_option("--name", o->names,
-                   "With several structures: each one's name, in their order (default: the files' stems, or a "
-                   "markups file's list names)")
+                   "With several structures: each one's name, in their order (default: the files' stems, a "
+                   "markups file's list names, or the atlas labels)")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   command
@@ -342,9 +369,13 @@ void addSegmentCommand(CLI::App& app) {
                    "which also holds the surface softly where clicks and edges say nothing), or a closed "
                    "control mesh file in LPS mm")
       ->default_val("auto");
-  command->add_option("--atlas-label", o->atlasLabel,
-                      "With --init atlas: the structure's label value(s) in the atlas, or names from its table "
-                      "(Caudate_L; Caudate_L,Caudate_R)");
+  command
+      ->add_option("--atlas-label", o->atlasLabel,
+                   "With --init atlas: the structure's label value(s) in the atlas, or names from its table "
+                   "(Caudate_L; Caudate_L,Caudate_R). Given once per structure, the structures are segmented "
+                   "together (with --landmarks, one per point list, in their order)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   command->add_option("--atlas", o->atlas, "With --init atlas: the atlas's template image")
       ->default_str(kDefaultAtlasImage);
   command

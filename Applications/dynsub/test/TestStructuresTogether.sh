@@ -14,6 +14,12 @@
 #    must not drop and no structure may lose more than 0.01.
 #  - a markups file with a point list per structure is the same run as a
 #    file per structure;
+#  - atlas labels as several structures (--init atlas, an --atlas-label
+#    each), on a subject made from Colin27 (`dynsub subject`, seed 2): the
+#    image is registered to the atlas once, no voxel is in two structures,
+#    and each one's Dice in dseg.nii.gz is within 0.01 of its segmentation
+#    alone. The subject's truth is the atlas's own labels carried to it, so
+#    the Dice themselves say nothing of accuracy; only the comparison counts;
 #  - bad combinations of options are refused before anything is written.
 # Needs DYNSUB (the executable), DATA and TOOLS.
 set -u
@@ -109,6 +115,37 @@ check "the lists' names: the markup's name made a folder name, else the file's s
 check "two lists in one file segment as the same two in two files" \
   cmp -s <(gzip -dc "$work/lists/dseg.nii.gz") <(gzip -dc "$work/files/dseg.nii.gz")
 
+# Atlas labels as several structures.
+"$DYNSUB" subject "$templates/ch2.nii.gz" "$templates/aal.nii.gz" --seed 2 --set thick_fraction=0 \
+  --out "$work/subject" >/dev/null 2>&1
+check "a subject made from Colin27" test -s "$work/subject/image.nii.gz"
+"$DYNSUB" segment "$work/subject/image.nii.gz" --init atlas --atlas-label Caudate_L --atlas-label 73 \
+  --reference "$work/subject/labels.nii.gz" --reference-label 71 --reference-label 73 --no-figures \
+  --out "$work/atlas" >"$work/atlas.log" 2>&1
+check "two atlas labels: segment succeeds" test $? -eq 0
+cat "$work/atlas.log"
+check "two atlas labels: one registration, named by the atlas's table, none in two, Dice no lower (0.01)" \
+  python3 - "$work/atlas" <<'PY'
+import gzip, json, struct, sys
+out = sys.argv[1]
+report = json.load(open(out + "/report.json"))
+names = [s["name"] for s in report["structures"]]
+rows = [line.split("\t")[1] for line in open(out + "/dseg.tsv").read().splitlines()[1:]]
+reused = [json.load(open(f"{out}/{name}/report.json"))["atlas"]["registration"]["affine_reused"] for name in names]
+print("names", names, "dseg.tsv", rows, "affine reused", reused)
+ok = names == ["Caudate_L", "Putamen_L"] == rows and reused == [False, True]
+ok = ok and all(s["init"] == "atlas" for s in report["structures"])
+for s in report["structures"]:
+    print(s["name"], "Dice alone %.4f, in dseg %.4f" % (s["alone"]["dice"], s["joint"]["dice"]))
+    ok = ok and s["joint"]["dice"] >= s["alone"]["dice"] - 0.01
+data = gzip.open(out + "/dseg.nii.gz").read()
+dims = struct.unpack_from("<8h", data, 40)[1:4]
+datatype, offset = struct.unpack_from("<h", data, 70)[0], int(struct.unpack_from("<f", data, 108)[0])
+labels = struct.unpack_from("<%d%s" % (dims[0] * dims[1] * dims[2], {2: "B", 4: "h", 512: "H"}[datatype]), data, offset)
+ok = ok and sorted(set(labels)) == [0, 1, 2] and report["shared_voxels_together"] <= report["shared_voxels_alone"]
+sys.exit(0 if ok else 1)
+PY
+
 # Refused before anything is written.
 refused() {
   local name=$1 expect=$2; shift 2
@@ -130,6 +167,12 @@ refused "one reference label for two" "one --reference-label" --landmarks "$caud
 refused "a start other than the landmarks" "several structures start" --landmarks "$caudate" \
   --landmarks "$putamen" --init sphere:0,0,0,5
 refused "a missing second file" "missing.mrk.json" --landmarks "$caudate" --landmarks "$work/missing.mrk.json"
+refused "two lists, one atlas label" "an --atlas-label per point list" --landmarks "$caudate" --landmarks "$putamen" \
+  --init atlas --atlas-label Caudate_L
+refused "a click inside with several" "a click inside is one structure's" --init atlas --atlas-label Caudate_L \
+  --atlas-label Putamen_L --inside 15,-1,16
+refused "atlas labels without an atlas start" "add --init atlas" --atlas-label Caudate_L --atlas-label Putamen_L
+refused "an atlas label not in the table" "did you mean" --init atlas --atlas-label Caudate_L --atlas-label Putamn_L
 
 echo "$failures failure(s)"
 test "$failures" -eq 0

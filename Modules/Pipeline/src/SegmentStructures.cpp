@@ -193,7 +193,20 @@ StructuresOutcome segmentStructures(const Volume& image, const std::vector<Struc
   const auto started = std::chrono::steady_clock::now();
   StructuresOutcome out;
   const std::size_t n = structures.size();
-  for (const StructureInputs& s : structures) out.structures.push_back(segmentOne(image, s, parameters, progress));
+  // Structures started from one atlas share the image's registration to it:
+  // the first one's is made once and given to the others.
+  std::vector<StructureInputs> inputs = structures;
+  std::shared_ptr<const AtlasAffine> registration;
+  const Atlas* registered = nullptr;
+  for (StructureInputs& s : inputs) {
+    if (!s.inputs.atlasAffine && registration && s.inputs.atlas.get() == registered)
+      s.inputs.atlasAffine = registration;
+    out.structures.push_back(segmentOne(image, s, parameters, progress));
+    if (!registration && out.structures.back().atlasAffine) {
+      registration = out.structures.back().atlasAffine;
+      registered = s.inputs.atlas.get();
+    }
+  }
   const auto masksOf = [&out] {
     std::vector<Mask> masks;
     for (const SegmentOutcome& o : out.structures) masks.push_back(o.labelmap);
@@ -218,7 +231,7 @@ StructuresOutcome segmentStructures(const Volume& image, const std::vector<Struc
       for (std::size_t t = 0; t < n; ++t)
         if (t != s) others.push_back(static_cast<int>(t + 1));
       const Mask wall = selectLabels(territories, others);
-      out.structures[s] = segmentOne(image, structures[s], parameters, progress, &wall);
+      out.structures[s] = segmentOne(image, inputs[s], parameters, progress, &wall);
     }
     masks = masksOf();
   }
@@ -232,7 +245,8 @@ StructuresOutcome segmentStructures(const Volume& image, const std::vector<Struc
     Report r;
     r.set("index", static_cast<int>(s + 1));
     r.set("name", structures[s].name);
-    r.set("landmarks", in.landmarkSource);
+    if (!in.landmarkSource.empty()) r.set("landmarks", in.landmarkSource);
+    r.set("init", in.start.text);
     r.set("segmented_again", static_cast<bool>(out.segmentedAgain[s]));
     r.set("volume_mm3",
           static_cast<double>(out.structures[s].labelmap.count()) * out.structures[s].labelmap.geometry.spacing.prod());
