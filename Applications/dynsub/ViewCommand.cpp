@@ -25,7 +25,16 @@ void runView(const Arguments& o) {
   if (!o.landmarks.empty()) {
     input.landmarksPath = o.landmarks;
     // A file that does not exist yet is where the new landmarks will be saved.
-    if (std::filesystem::exists(o.landmarks)) input.landmarks = readLandmarks(o.landmarks);
+    if (std::filesystem::exists(o.landmarks)) {
+      // The viewer edits one structure's points and saves them as one list:
+      // a markups file of several would lose its structures.
+      const std::vector<LandmarkList> lists = readLandmarkLists(o.landmarks);
+      if (lists.size() > 1)
+        throw Error(o.landmarks, "holds " + std::to_string(lists.size()) +
+                                     " lists of points: view edits one structure's points and saves them as one "
+                                     "list; give a file with one list");
+      input.landmarks = lists.front().landmarks;
+    }
   }
   input.surfacePath = o.surface;
   // A live fit pulls the surface to the landmarks on the slices.

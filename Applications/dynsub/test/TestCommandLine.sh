@@ -170,6 +170,14 @@ expect_error "view: missing image" 1 "no such file" "$work/v2" \
   "$DYNSUB" view "$work/none.nii.gz" --landmarks "$work/v2"
 expect_error "view: unreadable landmarks" 1 "unknown landmark format" "$work/v3" \
   "$DYNSUB" view "$mri/ch2.nii.gz" --landmarks "$work/points.txt" --surface "$work/v3"
+# A markups file of two structures' lists: refused, since saving would merge them.
+python3 -c "
+import json, sys
+lists = [json.load(open(p))['markups'][0] for p in sys.argv[1:3]]
+json.dump({'markups': lists}, open(sys.argv[3], 'w'))" "$DATA/Landmarks/caudate_left.mrk.json" \
+  "$DATA/Landmarks/putamen_left.mrk.json" "$work/two_lists.mrk.json"
+expect_error "view: a file of two structures' lists" 1 "holds 2 lists of points: view edits one structure's" \
+  "$work/v4" "$DYNSUB" view "$mri/ch2.nii.gz" --landmarks "$work/two_lists.mrk.json" --surface "$work/v4"
 for key in dice jaccard volume_difference_percent mean_surface_distance_mm hd95_mm hausdorff_mm stage_seconds \
   landmark_residuals final_energy edge_reference_magnitude; do
   check "segment report has $key" grep -q "\"$key\"" "$work/caudate/report.json"
