@@ -19,6 +19,7 @@
 #include <iostream>
 #include <list>
 #include <memory>
+#include <sstream>
 
 #include <CLI/CLI.hpp>
 
@@ -144,10 +145,12 @@ slicer::Module describe(Arguments& a) {
                            "grown from it. Without boundary points that region's boundary guides the surface.",
                            &a.inside, "", "", "", "", {}, -1});
   io.parameters.push_back({"string", "", "atlasLabel", "atlasLabel", "Atlas structure",
-                           "The structure's label value(s) or name(s) in Colin27's AAL atlas (Caudate_L; "
+                           "The structure's label value(s) or name(s) in Colin27's AAL atlas (Caudate_L, or "
                            "Putamen_L,Putamen_R): the atlas, registered to the volume, starts the surface and "
                            "holds it softly where the points and the edges say nothing. The point inside, if "
-                           "given, says where the structure is.",
+                           "given, says where the structure is. Several structures, separated by ';' "
+                           "(Caudate_L;Putamen_L), are segmented together, each paired in order with a list "
+                           "of the points file when it has several.",
                            &a.atlasLabel, "", "", "", "", {}, -1});
   io.parameters.push_back({"image", "type=\"label\" reference=\"inputVolume\"", "outputLabelmap", "labelmap",
                            "Output labelmap", "The structure as a label image on the input volume's grid.",
@@ -318,28 +321,49 @@ void runOne(Arguments& a, const Volume& image, const LandmarkSource* file, Slice
   reportWarnings(outcome, "");
 }
 
-// The structures of a file with several lists, segmented together
-// (SegmentStructures.h): each starts from its own points, so points given
+// Several structures segmented together (SegmentStructures.h): a points
+// file's lists, or atlas labels ("Caudate_L;Putamen_L"), or both paired in
+// order. Each starts from its own points or atlas label, so points given
 // otherwise would be no structure's.
 void runTogether(Arguments& a, const Volume& image, const std::vector<LandmarkSource>& files,
-                 SlicerProgress& progress) {
-  const std::string several = a.landmarks + " holds " + std::to_string(files.size()) + " lists of points, segmented " +
-                              "together from their own points: ";
-  if (!a.seeds.empty()) throw Error(several + "add boundary points to the lists, not as --seed");
+                 const std::vector<std::string>& atlasLabels, SlicerProgress& progress) {
+  const bool atlas = !atlasLabels.empty();
+  const std::size_t n = atlas ? atlasLabels.size() : files.size();
+  const std::string several = std::to_string(n) + " structures, segmented together from their own " +
+                              (atlas ? "atlas labels" : "points") + ": ";
+  if (atlas && !files.empty() && files.size() != n)
+    throw Error(several + a.landmarks + " holds " + std::to_string(files.size()) +
+                " lists of points; give one atlas label per list, in their order (separated by ';')");
+  if (!a.seeds.empty()) throw Error(several + "add boundary points to the lists of a points file, not as --seed");
   if (!a.inside.empty()) throw Error(several + "a point inside is one structure's; leave it out");
-  if (!a.atlasLabel.empty()) throw Error(several + "an atlas start is one structure's; leave it out");
-  const int lastLabel = a.labelValue + static_cast<int>(files.size()) - 1;
+  const int lastLabel = a.labelValue + static_cast<int>(n) - 1;
   if (lastLabel > 255)
     throw Error(several + "their label values " + std::to_string(a.labelValue) + "-" + std::to_string(lastLabel) +
                 " pass 255; give a smaller --labelValue");
+  const std::shared_ptr<const Atlas> atlasData =
+      atlas ? std::make_shared<const Atlas>(readAtlas(kDefaultAtlasImage, kDefaultAtlasLabels)) : nullptr;
   std::vector<StructureInputs> structures;
-  for (const LandmarkSource& file : files) {
+  std::vector<std::string> names;  // the segments' names: the lists', else the atlas's
+  for (std::size_t s = 0; s < n; ++s) {
     StructureInputs structure;
-    structure.name = file.name;
-    structure.inputs.image = a.image;
-    structure.inputs.landmarks = file.list.landmarks;
-    structure.inputs.landmarkSystem = file.list.stated;
-    structure.inputs.landmarkSource = a.landmarks;
+    SegmentInputs& in = structure.inputs;
+    in.image = a.image;
+    if (!files.empty()) {
+      structure.name = files[s].name;
+      names.push_back(files[s].list.name.empty() ? files[s].name : files[s].list.name);
+      in.landmarks = files[s].list.landmarks;
+      in.landmarkSystem = files[s].list.stated;
+      in.landmarkSource = a.landmarks;
+    }
+    if (atlas) {
+      in.start = parseSegmentStart("atlas", "--init");
+      in.atlas = atlasData;
+      in.atlasLabels = atlasLabelValues(*atlasData, atlasLabels[s]);
+      if (files.empty()) {
+        names.push_back(atlasStructureName(*atlasData, atlasLabels[s]));
+        structure.name = dynsub::app::asStructureName(names.back());
+      }
+    }
     structures.push_back(std::move(structure));
   }
   checkStructures(structures, a.parameters);
@@ -357,9 +381,9 @@ void runTogether(Arguments& a, const Volume& image, const std::vector<LandmarkSo
   TriangleSurface surface;
   std::vector<double> label, edgeDistance;
   bool edgeDistances = true;
-  for (std::size_t s = 0; s < files.size(); ++s) {
+  for (std::size_t s = 0; s < n; ++s) {
     const int value = a.labelValue + static_cast<int>(s);
-    segments.push_back(segmentOf(value, files[s].list.name.empty() ? files[s].name : files[s].list.name, s));
+    segments.push_back(segmentOf(value, names[s], s));
     const SegmentResult& result = outcome.structures[s].result;
     const TriangleSurface& own = result.surface;
     const int offset = static_cast<int>(surface.points.rows());
@@ -384,10 +408,10 @@ void runTogether(Arguments& a, const Volume& image, const std::vector<LandmarkSo
         {kEdgeDistanceScalars, Eigen::Map<const Eigen::VectorXd>(edgeDistance.data(), edgeDistance.size())});
   writeOutputs(a, labels, segments, surface, scalars, outcome.report);
 
-  std::cout << std::fixed << std::setprecision(1) << "segmented " << files.size() << " structures together in "
+  std::cout << std::fixed << std::setprecision(1) << "segmented " << n << " structures together in "
             << outcome.seconds << " s; voxels in two structures: " << outcome.sharedAlone << " alone, "
             << outcome.sharedTogether << " with the barrier, 0 in the labelmap\n";
-  for (std::size_t s = 0; s < files.size(); ++s) {
+  for (std::size_t s = 0; s < n; ++s) {
     const SegmentOutcome& one = outcome.structures[s];
     std::cout << "  " << segments[s].label << " " << segments[s].name << ": "
               << static_cast<double>(one.labelmap.count()) * image.geometry.spacing.prod() << " mm^3\n";
@@ -413,8 +437,13 @@ void run(Arguments& a) {
   const Volume image = readVolume(a.image);
   const std::vector<LandmarkSource> files =
       a.landmarks.empty() ? std::vector<LandmarkSource>{} : landmarkSources({a.landmarks});
-  if (files.size() > 1)
-    runTogether(a, image, files, progress);
+  // "Caudate_L;Putamen_L": two structures from the atlas.
+  std::vector<std::string> atlasLabels;
+  std::stringstream labels(a.atlasLabel);
+  for (std::string label; std::getline(labels, label, ';');) atlasLabels.push_back(label);
+  if (atlasLabels.size() == 1 && files.size() < 2) atlasLabels.clear();  // one structure: runOne reads it
+  if (files.size() > 1 || !atlasLabels.empty())
+    runTogether(a, image, files, atlasLabels, progress);
   else
     runOne(a, image, files.empty() ? nullptr : &files.front(), progress);
   progress.report(1.0);

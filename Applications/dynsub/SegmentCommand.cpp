@@ -249,12 +249,7 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
       in.start = parseSegmentStart("atlas", "--init");
       in.atlas = atlasData;
       in.atlasLabels = atlasLabelValues(*atlasData, o.atlasLabel[s]);
-      // Its name: the table's for one label value (73: Putamen_L), else as given.
-      const auto named = std::find_if(atlasData->names.begin(), atlasData->names.end(),
-                                      [&in](const auto& entry) { return entry.first == in.atlasLabels.front(); });
-      if (sources.empty())
-        structure.name = asStructureName(
-            in.atlasLabels.size() == 1 && named != atlasData->names.end() ? named->second : o.atlasLabel[s]);
+      if (sources.empty()) structure.name = asStructureName(atlasStructureName(*atlasData, o.atlasLabel[s]));
     }
     if (!o.names.empty()) structure.name = o.names[s];
     if (!o.reference.empty()) {

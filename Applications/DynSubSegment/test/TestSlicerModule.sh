@@ -8,8 +8,8 @@
 #    labelmap NRRD on the volume's grid, the model a .vtp marked SPACE=LPS,
 #    and <filter-progress> rising to 1;
 #  - one point only: read as a click inside the caudate;
-#  - a markups file with two lists: both segmented together, with a .seg.nrrd
-#    that names them;
+#  - a markups file with two lists, or two atlas labels: both segmented
+#    together, with a .seg.nrrd that names them;
 #  - bad input: exit 1 with a message naming the problem and no output;
 #    a usage error: exit 2.
 # Needs MODULE (the executable), DATA and TOOLS; Debian's python3 with
@@ -136,7 +136,19 @@ check "two point lists: the .seg.nrrd names both, and holds the labelmap's voxel
   "Caudate L=5" "Putamen L=6"
 check "two point lists: one model, its points labelled by structure" grep -q 'Name="label"' "$work/two.vtp"
 check "two point lists: the run's report lists both" grep -q '"name": "Putamen_L"' "$work/two.json"
-expect_failure "two point lists and --seed" 1 "add boundary points to the lists, not as --seed" \
+# Two atlas labels, separated by ';': segmented together, named by the
+# atlas's table. Colin27 is the atlas's own brain, so this checks the run and
+# its outputs, not accuracy.
+"$MODULE" --atlasLabel "Caudate_L;73" --labelmap "$work/atlas2.nrrd" --segmentation "$work/atlas2.seg.nrrd" \
+  "$work/ch2.nrrd" >"$work/atlas2.out" 2>"$work/atlas2.err"
+check "two atlas labels: exit 0" test $? -eq 0
+grep -v filter- "$work/atlas2.out"; cat "$work/atlas2.err"
+check "two atlas labels: the .seg.nrrd names them by the atlas's table, and holds the labelmap's voxels" \
+  "$python" "$here/slicer_module_check.py" segmentation "$work/atlas2.seg.nrrd" "$work/atlas2.nrrd" \
+  "Caudate_L=1" "Putamen_L=2"
+expect_failure "two point lists, one atlas label" 1 "give one atlas label per list" \
+  --landmarks "$work/two.mrk.json" --atlasLabel Caudate_L --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
+expect_failure "two point lists and --seed" 1 "add boundary points to the lists of a points file, not as --seed" \
   --landmarks "$work/two.mrk.json" "${seeds[@]}" --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
 expect_failure "two point lists past label 255" 1 "pass 255" \
   --landmarks "$work/two.mrk.json" --labelValue 255 --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"

@@ -171,6 +171,13 @@ std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec) {
   return values;
 }
 
+std::string atlasStructureName(const Atlas& atlas, const std::string& spec) {
+  const std::vector<int> values = atlasLabelValues(atlas, spec);
+  const auto named = std::find_if(atlas.names.begin(), atlas.names.end(),
+                                  [&values](const auto& entry) { return entry.first == values.front(); });
+  return values.size() == 1 && named != atlas.names.end() ? named->second : spec;
+}
+
 void checkAtlasRegistrationOptions(const AtlasRegistrationOptions& o) {
   auto positiveLevels = [](const std::vector<double>& levels, const char* name) {
     if (levels.empty()) throw Error(std::string(name) + " must name at least one level");
