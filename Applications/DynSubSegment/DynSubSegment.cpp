@@ -300,8 +300,8 @@ void runOne(Arguments& a, const Volume& image, const LandmarkSource* file, Slice
   std::string name = "structure";
   if (file)
     name = file->list.name.empty() ? file->name : file->list.name;
-  else if (!a.atlasLabel.empty())
-    name = a.atlasLabel;
+  else if (in.atlas)
+    name = atlasStructureName(*in.atlas, a.atlasLabel);
   Volume labels{image.geometry, std::vector<float>(outcome.labelmap.voxels.size())};
   for (std::size_t v = 0; v < labels.voxels.size(); ++v)
     labels.voxels[v] = outcome.labelmap.voxels[v] ? a.labelValue : 0;

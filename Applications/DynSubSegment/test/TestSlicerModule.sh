@@ -80,10 +80,12 @@ check "one point: a caudate-sized region (Dice >= 0.5)" \
 
 # The atlas start by name, with the point inside: the run is checked, not
 # its accuracy (Colin27 is the atlas's own brain).
-"$MODULE" --atlasLabel Caudate_L --inside 15.4,-1.5,16.0 --labelmap "$work/atlas.nrrd" --report "$work/atlas.json" \
-  "$work/ch2.nrrd" >"$work/atlas.out" 2>&1
+"$MODULE" --atlasLabel 71 --inside 15.4,-1.5,16.0 --labelmap "$work/atlas.nrrd" --report "$work/atlas.json" \
+  --segmentation "$work/atlas.seg.nrrd" "$work/ch2.nrrd" >"$work/atlas.out" 2>&1
 check "atlas start: exit 0" test $? -eq 0
 check "atlas start: the report has the registration" grep -q '"affine_iterations"' "$work/atlas.json"
+check "atlas start: the segment is named by the atlas's table (71: Caudate_L)" \
+  "$python" "$here/slicer_module_check.py" segmentation "$work/atlas.seg.nrrd" "$work/atlas.nrrd" "Caudate_L=1"
 
 # expect_failure NAME CODE PATTERN ARGS...: exit CODE, PATTERN on stderr, no output file.
 expect_failure() {
