@@ -179,19 +179,24 @@ slicer::Module describe(Arguments& a) {
   return m;
 }
 
-// Slicer's progress bar: <filter-progress> from 0 to 1, each level of the
-// evolution an equal share (a level's steps approach its end).
+// Slicer's progress bar: <filter-progress> from 0 to 1, each of the
+// structures' segmentations an equal share of the evolution's and each
+// level of one an equal share of that (a level's steps approach its end).
+// Structures segmented again against the others stay in the last share.
 class SlicerProgress {
  public:
   explicit SlicerProgress(int levels) : levels_(levels) {}
+  void setStructures(int structures) { structures_ = structures; }
   void stage(double fraction, const std::string& comment) {
     std::cout << "<filter-comment>" << comment << "</filter-comment>\n";
     report(fraction);
   }
   ProgressCallback callback() {
     return [this](const Progress& p) {
+      if (p.level == 0 && p.step == 1) started_ = std::min(started_ + 1, structures_);  // a segmentation begins
       const double withinLevel = 1.0 - 1.0 / (1.0 + p.step / 50.0);
-      report(0.1 + 0.8 * (std::min(p.level, levels_ - 1) + withinLevel) / levels_);
+      const double withinRun = (std::min(p.level, levels_ - 1) + withinLevel) / levels_;
+      report(0.1 + 0.8 * (std::max(started_ - 1, 0) + withinRun) / structures_);
     };
   }
   void report(double fraction) {
@@ -203,6 +208,7 @@ class SlicerProgress {
 
  private:
   int levels_;
+  int structures_ = 1, started_ = 0;
   double last_ = -1;
 };
 
@@ -215,17 +221,15 @@ void requireExtension(const std::string& path, const std::vector<std::string>& k
   throw Error(path, "unknown " + what + " format '" + extension + "' (expected " + list + ")");
 }
 
-bool endsWithSegNrrd(const std::string& path) {
-  std::string lower = path;
-  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
-  return lower.size() > 9 && lower.compare(lower.size() - 9, 9, ".seg.nrrd") == 0;
-}
-
-// A structure's segment in the .seg.nrrd: its label value, its name and
-// its colour (structureColor, as dynsub segment's dseg.tsv gives it).
+// A structure's segment in the .seg.nrrd: its label value, its name (a
+// markups list's may hold control characters, which become spaces) and its
+// colour (structureColor, as dynsub segment's dseg.tsv gives it).
 SlicerSegment segmentOf(int label, const std::string& name, std::size_t index) {
   const std::array<std::uint8_t, 3> rgb = structureColor(index);
-  return {label, name, {rgb[0] / 255.0, rgb[1] / 255.0, rgb[2] / 255.0}};
+  std::string shown = name;
+  std::replace_if(
+      shown.begin(), shown.end(), [](unsigned char c) { return c < 0x20 || c == 0x7f; }, ' ');
+  return {label, shown, {rgb[0] / 255.0, rgb[1] / 255.0, rgb[2] / 255.0}};
 }
 
 // What a run writes, all together or none: `labels` (0 outside, each
@@ -301,7 +305,7 @@ void runOne(Arguments& a, const Volume& image, const LandmarkSource* file, Slice
   if (file)
     name = file->list.name.empty() ? file->name : file->list.name;
   else if (in.atlas)
-    name = atlasStructureName(*in.atlas, a.atlasLabel);
+    name = atlasStructureName(*in.atlas, in.atlasLabels, a.atlasLabel);
   Volume labels{image.geometry, std::vector<float>(outcome.labelmap.voxels.size())};
   for (std::size_t v = 0; v < labels.voxels.size(); ++v)
     labels.voxels[v] = outcome.labelmap.voxels[v] ? a.labelValue : 0;
@@ -360,7 +364,7 @@ void runTogether(Arguments& a, const Volume& image, const std::vector<LandmarkSo
       in.atlas = atlasData;
       in.atlasLabels = atlasLabelValues(*atlasData, atlasLabels[s]);
       if (files.empty()) {
-        names.push_back(atlasStructureName(*atlasData, atlasLabels[s]));
+        names.push_back(atlasStructureName(*atlasData, in.atlasLabels, atlasLabels[s]));
         structure.name = dynsub::app::asStructureName(names.back());
       }
     }
@@ -424,7 +428,7 @@ void run(Arguments& a) {
     throw Error("nothing to write: give --labelmap, --model, --segmentation and/or --report");
   if (!a.labelmap.empty()) requireExtension(a.labelmap, {".nrrd", ".nii", ".gz", ".mha"}, "labelmap");
   if (!a.model.empty()) requireExtension(a.model, triangleSurfaceExtensions(), "model");
-  if (!a.segmentation.empty() && !endsWithSegNrrd(a.segmentation))
+  if (!a.segmentation.empty() && !isSlicerSegmentationName(a.segmentation))
     throw Error(a.segmentation, "a 3D Slicer segmentation is written as .seg.nrrd");
   if (!a.report.empty()) requireExtension(a.report, {".json"}, "report");
   for (const std::string* path : {&a.labelmap, &a.model, &a.segmentation, &a.report})
@@ -440,12 +444,19 @@ void run(Arguments& a) {
   // "Caudate_L;Putamen_L": two structures from the atlas.
   std::vector<std::string> atlasLabels;
   std::stringstream labels(a.atlasLabel);
-  for (std::string label; std::getline(labels, label, ';');) atlasLabels.push_back(label);
-  if (atlasLabels.size() == 1 && files.size() < 2) atlasLabels.clear();  // one structure: runOne reads it
-  if (files.size() > 1 || !atlasLabels.empty())
+  for (std::string label; std::getline(labels, label, ';');) {
+    label.erase(0, label.find_first_not_of(" \t"));
+    label.erase(label.find_last_not_of(" \t") + 1);
+    if (!label.empty()) atlasLabels.push_back(label);
+  }
+  const std::size_t structures = std::max(files.size(), atlasLabels.size());
+  progress.setStructures(static_cast<int>(std::max<std::size_t>(structures, 1)));
+  if (structures > 1) {
     runTogether(a, image, files, atlasLabels, progress);
-  else
+  } else {
+    if (!atlasLabels.empty()) a.atlasLabel = atlasLabels.front();
     runOne(a, image, files.empty() ? nullptr : &files.front(), progress);
+  }
   progress.report(1.0);
   std::cout << "<filter-end><filter-name>DynSubSegment</filter-name></filter-end>" << std::endl;
 }

@@ -28,13 +28,12 @@ std::vector<LandmarkSource> landmarkSources(const std::vector<std::string>& file
     for (std::size_t k = 0; k < lists.size(); ++k) {
       LandmarkSource source;
       source.path = path;
-      if (lists.size() == 1) {
-        source.name = structureName(path);
-      } else if (lists[k].name.empty()) {
-        source.name = structureName(path) + "_" + std::to_string(k + 1);
-      } else {
+      if (lists.size() == 1)
+        source.name = asStructureName(structureName(path));
+      else if (lists[k].name.empty())
+        source.name = asStructureName(structureName(path)) + "_" + std::to_string(k + 1);
+      else
         source.name = asStructureName(lists[k].name);
-      }
       source.list = std::move(lists[k]);
       sources.push_back(std::move(source));
     }

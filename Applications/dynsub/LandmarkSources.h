@@ -24,8 +24,8 @@ std::string structureName(const std::string& path);
 std::string asStructureName(const std::string& text);
 
 // The files' lists, in order. A file of one list gives its stem as the
-// name; of several, each list's own name as a structure's name
-// (asStructureName), or the stem and the list's number when it has none. Throws as readLandmarkLists.
+// name; of several, each list's own name, or the stem and the list's number
+// when it has none; each made a structure's name (asStructureName). Throws as readLandmarkLists.
 std::vector<LandmarkSource> landmarkSources(const std::vector<std::string>& files);
 
 }  // namespace dynsub::app

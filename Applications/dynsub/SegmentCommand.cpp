@@ -249,7 +249,8 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
       in.start = parseSegmentStart("atlas", "--init");
       in.atlas = atlasData;
       in.atlasLabels = atlasLabelValues(*atlasData, o.atlasLabel[s]);
-      if (sources.empty()) structure.name = asStructureName(atlasStructureName(*atlasData, o.atlasLabel[s]));
+      if (sources.empty())
+        structure.name = asStructureName(atlasStructureName(*atlasData, in.atlasLabels, o.atlasLabel[s]));
     }
     if (!o.names.empty()) structure.name = o.names[s];
     if (!o.reference.empty()) {
@@ -367,7 +368,7 @@ void addSegmentCommand(CLI::App& app) {
   command
       ->add_option("--atlas-label", o->atlasLabel,
                    "With --init atlas: the structure's label value(s) in the atlas, or names from its table "
-                   "(Caudate_L; Caudate_L,Caudate_R). Given once per structure, the structures are segmented "
+                   "(Caudate_L, or Caudate_L,Caudate_R). Given once per structure, the structures are segmented "
                    "together (with --landmarks, one per point list, in their order)")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);

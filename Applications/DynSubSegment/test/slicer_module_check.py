@@ -16,7 +16,7 @@
         The 3D Slicer segmentation as Slicer reads it: teem (the NRRD
         format's own library, Debian's teem-apps) reads the file; its fields
         name each segment, in order, with its label value, one layer, a
-        colour of its own and the index box of its voxels; its voxels are
+        colour of its own and the whole grid as its extent; its voxels are
         the labelmap's.
 
 Run with Debian's python3 (python3-nipype, python3-nibabel) and teem-apps.
@@ -279,11 +279,11 @@ def segmentation(path, labelmap, segments):
         if len(color) != 3 or not all(0 <= c <= 1 for c in color) or color in colors:
             fail(f"{path}: segment {index}'s colour {color} is not three values in 0-1 of its own")
         colors.add(color)
-        where = numpy.argwhere(voxels == int(label))
-        box = [int(v) for pair in zip(where.min(axis=0), where.max(axis=0)) for v in pair]
-        if [int(v) for v in fields[key + "Extent"].split()] != box:
-            fail(f"{path}: segment {index}'s extent {fields[key + 'Extent']} is not its voxels' box {box}")
-        print(f"segment {index}: {name} = {label}, colour {color}, {len(where)} voxels in {box}")
+        # Slicer crops a layer to its first segment's extent, so each gives the whole grid.
+        grid = [int(v) for n in voxels.shape for v in (0, n - 1)]
+        if [int(v) for v in fields[key + "Extent"].split()] != grid:
+            fail(f"{path}: segment {index}'s extent {fields[key + 'Extent']} is not the grid {grid}")
+        print(f"segment {index}: {name} = {label}, colour {color}, {numpy.count_nonzero(voxels == int(label))} voxels")
     if f"Segment{len(segments)}_ID" in fields:
         fail(f"{path}: more than the {len(segments)} segments expected")
 

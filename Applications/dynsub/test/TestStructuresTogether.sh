@@ -132,8 +132,11 @@ report = json.load(open(out + "/report.json"))
 names = [s["name"] for s in report["structures"]]
 rows = [line.split("\t")[1] for line in open(out + "/dseg.tsv").read().splitlines()[1:]]
 reused = [json.load(open(f"{out}/{name}/report.json"))["atlas"]["registration"]["affine_reused"] for name in names]
-print("names", names, "dseg.tsv", rows, "affine reused", reused)
-ok = names == ["Caudate_L", "Putamen_L"] == rows and reused == [False, True]
+print("names", names, "dseg.tsv", rows, "affine reused", reused, "registrations", report["atlas_registrations"])
+ok = names == ["Caudate_L", "Putamen_L"] == rows and report["atlas_registrations"] == 1
+# The second structure reuses the first's registration; the first, segmented
+# again against the second, reuses its own.
+ok = ok and reused[1] and reused[0] == report["structures"][0]["segmented_again"]
 ok = ok and all(s["init"] == "atlas" for s in report["structures"])
 for s in report["structures"]:
     print(s["name"], "Dice alone %.4f, in dseg %.4f" % (s["alone"]["dice"], s["joint"]["dice"]))

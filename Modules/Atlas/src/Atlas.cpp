@@ -171,8 +171,8 @@ std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec) {
   return values;
 }
 
-std::string atlasStructureName(const Atlas& atlas, const std::string& spec) {
-  const std::vector<int> values = atlasLabelValues(atlas, spec);
+std::string atlasStructureName(const Atlas& atlas, const std::vector<int>& values, const std::string& spec) {
+  if (values.empty()) return spec;
   const auto named = std::find_if(atlas.names.begin(), atlas.names.end(),
                                   [&values](const auto& entry) { return entry.first == values.front(); });
   return values.size() == 1 && named != atlas.names.end() ? named->second : spec;

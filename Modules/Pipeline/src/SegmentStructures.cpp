@@ -195,15 +195,18 @@ StructuresOutcome segmentStructures(const Volume& image, const std::vector<Struc
   const std::size_t n = structures.size();
   // Structures started from one atlas share the image's registration to it:
   // the first one's is made once and given to the others.
+  // A structure segmented again keeps its own registration.
   std::vector<StructureInputs> inputs = structures;
   std::shared_ptr<const AtlasAffine> registration;
   const Atlas* registered = nullptr;
   for (StructureInputs& s : inputs) {
     if (!s.inputs.atlasAffine && registration && s.inputs.atlas.get() == registered)
       s.inputs.atlasAffine = registration;
+    if (s.inputs.start.kind == SegmentStart::Kind::Atlas && !s.inputs.atlasAffine) ++out.atlasRegistrations;
     out.structures.push_back(segmentOne(image, s, parameters, progress));
-    if (!registration && out.structures.back().atlasAffine) {
-      registration = out.structures.back().atlasAffine;
+    if (!s.inputs.atlasAffine) s.inputs.atlasAffine = out.structures.back().atlasAffine;
+    if (!registration && s.inputs.atlasAffine) {
+      registration = s.inputs.atlasAffine;
       registered = s.inputs.atlas.get();
     }
   }
@@ -245,7 +248,7 @@ StructuresOutcome segmentStructures(const Volume& image, const std::vector<Struc
     Report r;
     r.set("index", static_cast<int>(s + 1));
     r.set("name", structures[s].name);
-    if (!in.landmarkSource.empty()) r.set("landmarks", in.landmarkSource);
+    r.set("landmarks", in.landmarkSource);
     r.set("init", in.start.text);
     r.set("segmented_again", static_cast<bool>(out.segmentedAgain[s]));
     r.set("volume_mm3",
@@ -272,6 +275,7 @@ StructuresOutcome segmentStructures(const Volume& image, const std::vector<Struc
   report.set("shared_voxels_alone", static_cast<long>(out.sharedAlone));
   report.set("shared_voxels_together", static_cast<long>(out.sharedTogether));
   report.set("barrier_stiffness", parameters.barrierStiffness);
+  if (out.atlasRegistrations > 0) report.set("atlas_registrations", out.atlasRegistrations);
   report.set("seconds", out.seconds);
   return out;
 }

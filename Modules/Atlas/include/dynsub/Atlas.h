@@ -47,10 +47,10 @@ Atlas readAtlas(const std::string& imagePath, const std::string& labelsPath);
 // nearest), or a value no voxel of the label map has.
 std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec);
 
-// What a structure given as `spec` (as atlasLabelValues takes it) is called:
-// the table's name when it is one value the table names ("73": Putamen_L),
-// else `spec` itself.
-std::string atlasStructureName(const Atlas& atlas, const std::string& spec);
+// What a structure given as `spec`, of label values `values`
+// (atlasLabelValues's), is called: the table's name when it is one value the
+// table names ("73": Putamen_L), else `spec` itself.
+std::string atlasStructureName(const Atlas& atlas, const std::vector<int>& values, const std::string& spec);
 
 // y = linear x + translation: a subject point (LPS mm) to the template's.
 struct AffineMap {

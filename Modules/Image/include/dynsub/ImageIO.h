@@ -50,15 +50,19 @@ void writeVolume(const Volume& volume, const std::string& path, VoxelType type);
 struct SlicerSegment {
   int label = 1;                // its value in the labelmap, 1-255
   std::string name;             // the name Slicer's Segments table shows
-  std::array<double, 3> color;  // red, green and blue, each 0-1
+  std::array<double, 3> color{};  // red, green and blue, each 0-1
 };
+
+// Whether `path` names a 3D Slicer segmentation file: it ends in .seg.nrrd
+// (in any case).
+bool isSlicerSegmentationName(const std::string& path);
 
 // Writes a labelmap of structures that do not overlap (0 the background,
 // each segment's label on its voxels) as a 3D Slicer segmentation: a
 // .seg.nrrd file, which Slicer opens as a segmentation node with the
 // segments' names and colours (3D Slicer's "Segmentation labelmap file
-// format": one layer of 8-bit labels, the Segmentation_ and SegmentN_
-// fields). Throws dynsub::Error naming the path for a name not ending in
+// format": one layer of 8-bit labels on the volume's whole grid, the
+// Segmentation_ and SegmentN_ fields). Throws dynsub::Error naming the path for a name not ending in
 // .seg.nrrd, no segment, a label outside 1-255 or repeated, a name that is
 // empty or holds a control character, a colour outside 0-1, or a voxel whose
 // value is no segment's label. The file appears complete or not at all.

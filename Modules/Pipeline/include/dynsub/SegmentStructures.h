@@ -51,6 +51,10 @@ struct StructuresOutcome {
   // Voxels in two or more labelmaps: after step 1, and after step 3 (before
   // the join removes them).
   long long sharedAlone = 0, sharedTogether = 0;
+  // The image's affine registrations to an atlas that were made: one per
+  // atlas the structures start from (the first structure's serves the others,
+  // and a structure segmented again keeps its own).
+  int atlasRegistrations = 0;
   double seconds = 0;
   Report report;  // the whole run's: the structures, the overlaps, the scores
 };
