@@ -40,6 +40,7 @@ namespace {
 using namespace dynsub;
 using dynsub::app::LandmarkSource;
 using dynsub::app::landmarkSources;
+using dynsub::app::structuresToSegment;
 
 struct Arguments {
   std::string image, landmarks, inside, atlasLabel, labelmap, model, segmentation, report;
@@ -232,27 +233,21 @@ SlicerSegment segmentOf(int label, const std::string& name, std::size_t index) {
   return {label, shown, {rgb[0] / 255.0, rgb[1] / 255.0, rgb[2] / 255.0}};
 }
 
-// What a run writes, all together or none: `labels` (0 outside, each
-// segment's label value inside it) as the labelmap and the segmentation,
-// the surface as the model, and the report.
-void writeOutputs(const Arguments& a, const Volume& labels, const std::vector<SlicerSegment>& segments,
+// What a run writes, all together or none. `writeLabels(labelmap,
+// segmentation)` writes the structures' voxels to the temporary paths it is
+// given (empty where that output was not asked for); the model and the
+// report are written here.
+void writeOutputs(const Arguments& a, const std::function<void(const std::string&, const std::string&)>& writeLabels,
                   const TriangleSurface& surface, const std::vector<PointScalars>& scalars, const Report& report) {
   std::vector<std::unique_ptr<AtomicOutput>> outputs;
   const auto add = [&outputs](const std::string& path) {
+    if (path.empty()) return std::string();
     outputs.push_back(std::make_unique<AtomicOutput>(path));
     return outputs.back()->temporaryPath();
   };
-  if (!a.labelmap.empty()) {
-    if (segments.size() == 1) {
-      Mask mask{labels.geometry, std::vector<std::uint8_t>(labels.voxels.size())};
-      for (std::size_t v = 0; v < mask.voxels.size(); ++v) mask.voxels[v] = labels.voxels[v] != 0;
-      writeMask(mask, add(a.labelmap), static_cast<std::uint8_t>(segments.front().label));
-    } else {
-      writeVolume(labels, add(a.labelmap), VoxelType::Label16);
-    }
-  }
+  const std::string labelmap = add(a.labelmap);
+  writeLabels(labelmap, add(a.segmentation));
   if (!a.model.empty()) writeTriangleSurface(surface, add(a.model), scalars, "LPS");
-  if (!a.segmentation.empty()) writeSlicerSegmentation(labels, segments, add(a.segmentation));
   if (!a.report.empty()) report.write(add(a.report));
   for (auto& output : outputs) output->commit();
 }
@@ -306,13 +301,15 @@ void runOne(Arguments& a, const Volume& image, const LandmarkSource* file, Slice
     name = file->list.name.empty() ? file->name : file->list.name;
   else if (in.atlas)
     name = atlasStructureName(*in.atlas, in.atlasLabels, a.atlasLabel);
-  Volume labels{image.geometry, std::vector<float>(outcome.labelmap.voxels.size())};
-  for (std::size_t v = 0; v < labels.voxels.size(); ++v)
-    labels.voxels[v] = outcome.labelmap.voxels[v] ? a.labelValue : 0;
   std::vector<PointScalars> scalars;
   if (outcome.result.surfaceEdgeDistances.size())
     scalars.push_back({kEdgeDistanceScalars, outcome.result.surfaceEdgeDistances});
-  writeOutputs(a, labels, {segmentOf(a.labelValue, name, 0)}, outcome.result.surface, scalars, outcome.report);
+  const auto writeLabels = [&](const std::string& labelmap, const std::string& segmentation) {
+    if (!labelmap.empty()) writeMask(outcome.labelmap, labelmap, static_cast<std::uint8_t>(a.labelValue));
+    if (!segmentation.empty())
+      writeSlicerSegmentation(outcome.labelmap, segmentOf(a.labelValue, name, 0), segmentation);
+  };
+  writeOutputs(a, writeLabels, outcome.result.surface, scalars, outcome.report);
 
   const double volume = outcome.labelmap.count() * image.geometry.spacing.prod();
   std::cout << std::fixed << std::setprecision(1) << "segmented " << volume << " mm^3 with "
@@ -346,29 +343,14 @@ void runTogether(Arguments& a, const Volume& image, const std::vector<LandmarkSo
                 " pass 255; give a smaller --labelValue");
   const std::shared_ptr<const Atlas> atlasData =
       atlas ? std::make_shared<const Atlas>(readAtlas(kDefaultAtlasImage, kDefaultAtlasLabels)) : nullptr;
-  std::vector<StructureInputs> structures;
-  std::vector<std::string> names;  // the segments' names: the lists', else the atlas's
+  std::vector<StructureInputs> structures = structuresToSegment(a.image, files, atlasData, atlasLabels);
+  // The segments' names: the lists' own ("Caudate L"), else the atlas's.
+  std::vector<std::string> names;
   for (std::size_t s = 0; s < n; ++s) {
-    StructureInputs structure;
-    SegmentInputs& in = structure.inputs;
-    in.image = a.image;
-    if (!files.empty()) {
-      structure.name = files[s].name;
+    if (files.empty())
+      names.push_back(atlasStructureName(*atlasData, structures[s].inputs.atlasLabels, atlasLabels[s]));
+    else
       names.push_back(files[s].list.name.empty() ? files[s].name : files[s].list.name);
-      in.landmarks = files[s].list.landmarks;
-      in.landmarkSystem = files[s].list.stated;
-      in.landmarkSource = a.landmarks;
-    }
-    if (atlas) {
-      in.start = parseSegmentStart("atlas", "--init");
-      in.atlas = atlasData;
-      in.atlasLabels = atlasLabelValues(*atlasData, atlasLabels[s]);
-      if (files.empty()) {
-        names.push_back(atlasStructureName(*atlasData, in.atlasLabels, atlasLabels[s]));
-        structure.name = dynsub::app::asStructureName(names.back());
-      }
-    }
-    structures.push_back(std::move(structure));
   }
   checkStructures(structures, a.parameters);
 
@@ -410,7 +392,11 @@ void runTogether(Arguments& a, const Volume& image, const std::vector<LandmarkSo
   if (edgeDistances)
     scalars.push_back(
         {kEdgeDistanceScalars, Eigen::Map<const Eigen::VectorXd>(edgeDistance.data(), edgeDistance.size())});
-  writeOutputs(a, labels, segments, surface, scalars, outcome.report);
+  const auto writeLabels = [&](const std::string& labelmap, const std::string& segmentation) {
+    if (!labelmap.empty()) writeVolume(labels, labelmap, VoxelType::Label16);
+    if (!segmentation.empty()) writeSlicerSegmentation(labels, segments, segmentation);
+  };
+  writeOutputs(a, writeLabels, surface, scalars, outcome.report);
 
   std::cout << std::fixed << std::setprecision(1) << "segmented " << n << " structures together in "
             << outcome.seconds << " s; voxels in two structures: " << outcome.sharedAlone << " alone, "

@@ -41,4 +41,30 @@ std::vector<LandmarkSource> landmarkSources(const std::vector<std::string>& file
   return sources;
 }
 
+std::vector<StructureInputs> structuresToSegment(const std::string& image, const std::vector<LandmarkSource>& sources,
+                                                 const std::shared_ptr<const Atlas>& atlas,
+                                                 const std::vector<std::string>& atlasLabels) {
+  const std::size_t n = atlas ? atlasLabels.size() : sources.size();
+  std::vector<StructureInputs> structures;
+  for (std::size_t s = 0; s < n; ++s) {
+    StructureInputs structure;
+    SegmentInputs& in = structure.inputs;
+    in.image = image;
+    if (!sources.empty()) {
+      structure.name = sources[s].name;
+      in.landmarkSource = sources[s].path;
+      in.landmarks = sources[s].list.landmarks;
+      in.landmarkSystem = sources[s].list.stated;
+    }
+    if (atlas) {
+      in.start = parseSegmentStart("atlas", "--init");
+      in.atlas = atlas;
+      in.atlasLabels = atlasLabelValues(*atlas, atlasLabels[s]);
+      if (sources.empty()) structure.name = asStructureName(atlasStructureName(*atlas, in.atlasLabels, atlasLabels[s]));
+    }
+    structures.push_back(std::move(structure));
+  }
+  return structures;
+}
+
 }  // namespace dynsub::app

@@ -234,30 +234,15 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
                 std::to_string(n) + " structures, " + std::to_string(o.referenceLabels.size()) + " given)");
   const std::shared_ptr<const Atlas> atlasData =
       atlas ? std::make_shared<const Atlas>(readAtlas(o.atlas, o.atlasLabels)) : nullptr;
-  std::vector<StructureInputs> structures;
+  std::vector<StructureInputs> structures = structuresToSegment(o.image, sources, atlasData, o.atlasLabel);
   for (std::size_t s = 0; s < n; ++s) {
-    StructureInputs structure;
+    StructureInputs& structure = structures[s];
     SegmentInputs& in = structure.inputs;
-    in.image = o.image;
-    if (!sources.empty()) {
-      structure.name = sources[s].name;
-      in.landmarkSource = sources[s].path;
-      in.landmarks = sources[s].list.landmarks;
-      in.landmarkSystem = sources[s].list.stated;
-    }
-    if (atlas) {
-      in.start = parseSegmentStart("atlas", "--init");
-      in.atlas = atlasData;
-      in.atlasLabels = atlasLabelValues(*atlasData, o.atlasLabel[s]);
-      if (sources.empty())
-        structure.name = asStructureName(atlasStructureName(*atlasData, in.atlasLabels, o.atlasLabel[s]));
-    }
     if (!o.names.empty()) structure.name = o.names[s];
     if (!o.reference.empty()) {
       in.referencePath = o.reference;
       in.referenceLabels = parseLabelValues(o.referenceLabels[s]);
     }
-    structures.push_back(std::move(structure));
   }
   const Volume image = readVolume(o.image);
   checkStructures(structures, o.parameters);

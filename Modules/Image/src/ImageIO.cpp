@@ -99,16 +99,17 @@ void writeVolume(const Volume& volume, const std::string& path, VoxelType type) 
 }
 
 bool isSlicerSegmentationName(const std::string& path) {
-  std::string lower = path;
-  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
-  return lower.size() > 9 && lower.compare(lower.size() - 9, 9, ".seg.nrrd") == 0;
+  return lowerCaseExtension(path) == ".nrrd" &&
+         lowerCaseExtension(std::filesystem::path(path).stem().string()) == ".seg";
 }
 
-void writeSlicerSegmentation(const Volume& labels, const std::vector<SlicerSegment>& segments,
-                             const std::string& path) {
+namespace {
+
+// Which segment each label value is (-1: none; 0 is the background), once
+// the file's name and the segments are checked.
+std::array<int, 256> checkSegmentation(const std::vector<SlicerSegment>& segments, const std::string& path) {
   if (!isSlicerSegmentationName(path)) throw Error(path, "a 3D Slicer segmentation is written as .seg.nrrd");
   if (segments.empty()) throw Error(path, "a segmentation needs at least one segment");
-  // Which segment each label value is (-1: none; 0 is the background).
   std::array<int, 256> segmentOf;
   segmentOf.fill(-1);
   for (std::size_t s = 0; s < segments.size(); ++s) {
@@ -125,20 +126,15 @@ void writeSlicerSegmentation(const Volume& labels, const std::vector<SlicerSegme
     for (const double c : segment.color)
       if (!(c >= 0 && c <= 1)) throw Error(path, "segment '" + segment.name + "': a colour component outside 0-1");
   }
+  return segmentOf;
+}
 
-  std::vector<std::uint8_t> voxels(labels.voxels.size());
-  for (std::size_t v = 0; v < voxels.size(); ++v) {
-    const float value = labels.voxels[v];
-    if (value == 0) continue;
-    if (!(value >= 1 && value <= 255 && value == std::floor(value)) || segmentOf[static_cast<int>(value)] < 0)
-      throw Error(path, "voxel value " + std::to_string(value) + " is no segment's label");
-    voxels[v] = static_cast<std::uint8_t>(value);
-  }
-
+// The checked segments' labels on `g`'s grid, with the fields Slicer reads.
+void writeSegmentationFile(const ImageGeometry& g, const std::vector<std::uint8_t>& voxels,
+                           const std::vector<SlicerSegment>& segments, const std::string& path) {
   // Every segment of a layer gives the layer's extent: Slicer's reader crops
   // the layer to the extent of its first segment. The whole grid keeps every
   // segment's voxels, an empty one's too.
-  const ImageGeometry& g = labels.geometry;
   const std::string extent = "0 " + std::to_string(g.size[0] - 1) + " 0 " + std::to_string(g.size[1] - 1) + " 0 " +
                              std::to_string(g.size[2] - 1);
   std::vector<std::pair<std::string, std::string>> fields = {
@@ -168,6 +164,30 @@ void writeSlicerSegmentation(const Volume& labels, const std::vector<SlicerSegme
   AtomicOutput output(path);
   itkbridge::writeLabels(toBridge(g), voxels, output.temporaryPath(), fields);
   output.commit();
+}
+
+}  // namespace
+
+void writeSlicerSegmentation(const Volume& labels, const std::vector<SlicerSegment>& segments,
+                             const std::string& path) {
+  const std::array<int, 256> segmentOf = checkSegmentation(segments, path);
+  std::vector<std::uint8_t> voxels(labels.voxels.size());
+  for (std::size_t v = 0; v < voxels.size(); ++v) {
+    const float value = labels.voxels[v];
+    if (value == 0) continue;
+    if (!(value >= 1 && value <= 255 && value == std::floor(value)) || segmentOf[static_cast<int>(value)] < 0)
+      throw Error(path, "voxel value " + std::to_string(value) + " is no segment's label");
+    voxels[v] = static_cast<std::uint8_t>(value);
+  }
+  writeSegmentationFile(labels.geometry, voxels, segments, path);
+}
+
+void writeSlicerSegmentation(const Mask& mask, const SlicerSegment& segment, const std::string& path) {
+  checkSegmentation({segment}, path);
+  std::vector<std::uint8_t> voxels(mask.voxels.size());
+  const auto label = static_cast<std::uint8_t>(segment.label);
+  for (std::size_t v = 0; v < voxels.size(); ++v) voxels[v] = mask.voxels[v] ? label : 0;
+  writeSegmentationFile(mask.geometry, voxels, {segment}, path);
 }
 
 }  // namespace dynsub

@@ -68,5 +68,7 @@ bool isSlicerSegmentationName(const std::string& path);
 // value is no segment's label. The file appears complete or not at all.
 void writeSlicerSegmentation(const Volume& labels, const std::vector<SlicerSegment>& segments,
                              const std::string& path);
+// One structure: its mask's voxels as `segment`; throws as above.
+void writeSlicerSegmentation(const Mask& mask, const SlicerSegment& segment, const std::string& path);
 
 }  // namespace dynsub
