@@ -197,7 +197,7 @@ ok = ok and levels[-1]['control_vertices'] == r['control_vertices']
 ok = ok and all(l['divergences'] == 0 for l in levels)
 ok = ok and sum(l['iterations'] for l in levels) == r['iterations']
 ok = ok and all(l['time_step_s'] > 0 and math.isfinite(l['energy']) and 0 <= l['equilibrium_residual'] <= 1
-                and isinstance(l['equilibrium'], bool) and l['equilibrium_rule'] in ('full', 'coarse')
+                and isinstance(l['equilibrium'], bool) and l['equilibrium_rule'] in ('full', 'coarse', 'met')
                 for l in levels)
 sys.exit(0 if ok else 1)" "$work/caudate/report.json"
 # --edge-reference image, and no landmarks, use the image's percentile; the

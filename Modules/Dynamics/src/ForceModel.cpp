@@ -79,6 +79,15 @@ void SpringForceModel::attach(const MatrixX3& controlPoints) {
   });
 }
 
+Eigen::VectorXd SpringForceModel::signedLengths() const {
+  Eigen::VectorXd signedLength = lengths_;
+  for (Eigen::Index i = 0; i < normals_.rows() && i < signedLength.size(); ++i) {
+    const Vector3 n = normals_.row(i).transpose();
+    if (!n.isZero(0.0)) signedLength(i) = n.dot(targets_.row(i).transpose() - positions_.row(i).transpose());
+  }
+  return signedLength;
+}
+
 MatrixX3 SpringForceModel::generalizedForce(const MatrixX3& controlPoints, double& potential) {
   if (attach_ == Attach::NearestAtLevelStart) {
     std::vector<ElementPoint> at;

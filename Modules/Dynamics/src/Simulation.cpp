@@ -200,8 +200,9 @@ class StepShapeMotion {
 
 // Coarse: a level below the maximum settled to the looser rule and its fit
 // was not accepted (EquilibriumOptions::coarseLevelFactor); Accepted: it was,
-// and the simulation stops there (FitVerdict::Stop).
-enum class LevelEnd { Equilibrium, Coarse, Accepted, StepLimit, Diverged };
+// and the simulation stops there (FitVerdict::Stop); Met: the fit was
+// accepted after a step (FitAsk::Step), and the simulation stops there.
+enum class LevelEnd { Equilibrium, Coarse, Accepted, Met, StepLimit, Diverged };
 
 // A level asked at the looser rule: how it ends, if it does.
 std::optional<LevelEnd> coarseEnd(FitVerdict verdict) {
@@ -213,7 +214,7 @@ std::optional<LevelEnd> coarseEnd(FitVerdict verdict) {
 // The papers' time stepping (Integrator.h) from model.start; `points` ends at
 // the last state reached.
 LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& forces, const std::vector<int>& fixed,
-                      const SimulationOptions& options, const AcceptFit& coarseAccept, double& timeStep,
+                      const SimulationOptions& options, const AcceptFit& accept, bool askLoose, double& timeStep,
                       double regrowCeiling, const ProgressCallback& progress, MatrixX3& points,
                       LevelSummary& summary) {
   IntegratorOptions integratorOptions = options.integrator;
@@ -229,11 +230,11 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
   };
   Integrator integrator(model.matrices, stabilizingAt(model.start), fixed, integratorOptions);
   EquilibriumWindow window(options.equilibrium, options.equilibrium.window);
-  // With `coarseAccept`, the level is asked at the first state that meets the
+  // With `askLoose`, the level is asked at the first state that meets the
   // looser rule whether its fit is accepted, as in runStaticSteps.
   const EquilibriumOptions loose = loosened(options.equilibrium);
   EquilibriumWindow looseWindow(loose, options.equilibrium.window);
-  bool asked = !coarseAccept;
+  bool asked = !askLoose;
   MatrixX3 previous = model.start;
   points = model.start;
   StepShapeMotion stepMotion(model);
@@ -251,6 +252,11 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
                           0.5 * quadraticForm(model.matrices.stiffness, points) + potential;
     if (step == 1) firstEnergy = std::abs(energy);
     if (!std::isfinite(energy) || std::abs(energy) > 1e3 * std::max(firstEnergy, 1e-300)) return LevelEnd::Diverged;
+    // The forces were just evaluated at `points`: a fit met there ends here.
+    if (step > 1 && accept && accept(*model.surface, points, FitAsk::Step) == FitVerdict::Stop) {
+      summary.energy = energy;
+      return LevelEnd::Met;
+    }
     if (step > 1) {
       const double change = relativeChange(energy, lastEnergy);
       const double shape = stepMotion.measure(
@@ -275,7 +281,7 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
         return LevelEnd::Equilibrium;
       } else if (looselyStill) {
         asked = true;
-        if (const std::optional<LevelEnd> end = coarseEnd(coarseAccept(*model.surface, points, false))) {
+        if (const std::optional<LevelEnd> end = coarseEnd(accept(*model.surface, points, FitAsk::LooseRule))) {
           summary.energy = energy;
           return *end;
         }
@@ -321,11 +327,12 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
 // to 20 times, by a factor of 2-10 each; a direction that lowers nothing even
 // then means the state is at the minimum to rounding). Otherwise only a step
 // moving a point farther than the model's size is halved.
-// With `coarseAccept` (a level below the maximum), the level is asked at the
+// With `askLoose` (a level below the maximum), the level is asked at the
 // first state that meets the looser rule whether its fit is accepted; if not,
-// it ends there, and if so it goes on, unchanged, to the full rule.
+// it ends there, and if so it goes on, unchanged, to the full rule. With
+// `accept`, it is also asked after every step whether the fit is met there.
 LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>& forces, const std::vector<int>& fixed,
-                        const SimulationOptions& options, const AcceptFit& coarseAccept,
+                        const SimulationOptions& options, const AcceptFit& accept, bool askLoose,
                         const ProgressCallback& progress, MatrixX3& points, LevelSummary& summary) {
   bool lineSearch = true;
   for (const ForceModel* f : forces) lineSearch = lineSearch && f->hasPotential();
@@ -339,7 +346,7 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
   EquilibriumWindow window(options.equilibrium, std::min(options.equilibrium.window, 2));
   const EquilibriumOptions loose = loosened(options.equilibrium);
   EquilibriumWindow looseWindow(loose, std::min(options.equilibrium.window, 2));
-  bool asked = !coarseAccept;
+  bool asked = !askLoose;
   points = model.start;
   double potential = 0.0;
   MatrixX3 force = totalForce(forces, points, potential);
@@ -419,13 +426,15 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
     summary.energy = energy;
     summary.steps = step;
     if (progress) progress(Progress{model.level, step, energy, motion, model.surface.get(), &points});
+    // The accepted trial was the forces' last evaluation: a fit met there ends here.
+    if (accept && accept(*model.surface, points, FitAsk::Step) == FitVerdict::Stop) return finish(LevelEnd::Met);
     const double shape = stepMotion.measure(previous, points, change,
                                              asked ? options.equilibrium.energyTolerance : loose.energyTolerance);
     if (window.settled(change, shape)) return finish(LevelEnd::Equilibrium);
     lastStill = window.still(change, shape);
     if (!asked && looseWindow.settled(change, shape)) {
       asked = true;
-      if (const std::optional<LevelEnd> end = coarseEnd(coarseAccept(*model.surface, points, false))) {
+      if (const std::optional<LevelEnd> end = coarseEnd(accept(*model.surface, points, FitAsk::LooseRule))) {
         return finish(*end);
       }
     }
@@ -451,7 +460,7 @@ double equilibriumResidual(const LevelModel& model, const std::vector<ForceModel
 // One level from model.start to its equilibrium (or step limit); a divergence
 // restarts it with half the time step.
 MatrixX3 runLevel(const LevelModel& model, const std::vector<ForceModel*>& forces, const std::vector<int>& fixed,
-                  const SimulationOptions& options, const AcceptFit& coarseAccept, double& timeStep,
+                  const SimulationOptions& options, const AcceptFit& accept, bool askLoose, double& timeStep,
                   const ProgressCallback& progress, LevelSummary& summary, LevelEnd& end) {
   MatrixX3 points;
   // The largest step a halved one may grow back to: the step asked for, then
@@ -468,18 +477,19 @@ MatrixX3 runLevel(const LevelModel& model, const std::vector<ForceModel*>& force
     summary.solverIterations = 0;
     summary.stabilizerUpdates = 0;
     if (options.integrator.scheme == IntegrationScheme::Static) {
-      end = runStaticSteps(model, forces, fixed, options, coarseAccept, progress, points, summary);
+      end = runStaticSteps(model, forces, fixed, options, accept, askLoose, progress, points, summary);
       if (end == LevelEnd::Diverged) {
         throw Error("the static scheme found no finite step at level " + std::to_string(model.level) +
                     " (try --scheme first-order or softer forces)");
       }
     } else {
-      end = runTimeSteps(model, forces, fixed, options, coarseAccept, timeStep, regrowCeiling, progress, points,
+      end = runTimeSteps(model, forces, fixed, options, accept, askLoose, timeStep, regrowCeiling, progress, points,
                          summary);
     }
     if (end != LevelEnd::Diverged) {
-      summary.converged = end == LevelEnd::Equilibrium || end == LevelEnd::Coarse || end == LevelEnd::Accepted;
+      summary.converged = end != LevelEnd::StepLimit;
       summary.coarse = end == LevelEnd::Coarse || end == LevelEnd::Accepted;
+      summary.met = end == LevelEnd::Met;
       summary.timeStep = timeStep;
       return points;
     }
@@ -567,19 +577,18 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
     // A level that will be refined may end at a looser rule.
     const bool coarse = accept && level < options.maxLevel && options.equilibrium.coarseLevelFactor > 1.0;
     LevelEnd end = LevelEnd::Equilibrium;
-    const MatrixX3 points =
-        runLevel(model, forces, fixed, options, coarse ? accept : AcceptFit(), timeStep, progress, summary, end);
+    const MatrixX3 points = runLevel(model, forces, fixed, options, accept, coarse, timeStep, progress, summary, end);
     summary.residual = equilibriumResidual(model, forces, points, fixed);
     mesh.setPoints(points);
     result.steps += summary.steps;
     summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     result.levels.push_back(summary);
 
-    // A coarse end was asked already: refused, or accepted for good.
-    const bool good = end == LevelEnd::Coarse    ? false
-                      : end == LevelEnd::Accepted ? true
-                      : accept                    ? accept(*model.surface, points, true) != FitVerdict::Refine
-                                                  : true;
+    // An end before the full rule was asked already: refused, or accepted for good.
+    const bool good = end == LevelEnd::Coarse                                ? false
+                      : end == LevelEnd::Accepted || end == LevelEnd::Met ? true
+                      : accept ? accept(*model.surface, points, FitAsk::LevelEnd) != FitVerdict::Refine
+                               : true;
     if (good || level >= options.maxLevel) {
       result.origin = {level, initialIsolation};
       result.surface = model.surface;

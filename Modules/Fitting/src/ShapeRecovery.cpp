@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include <Eigen/Eigenvalues>
@@ -38,6 +39,22 @@ double noiseReach(Eigen::Index points) {
   return std::sqrt(2.0 * std::log(static_cast<double>(std::max<Eigen::Index>(points, 2))));
 }
 
+namespace {
+
+// The largest mean of the signed distances over a point and its
+// kBiasNeighbours nearest (the header's bias), mm.
+double largestBias(const Eigen::VectorXd& signedDistance, const Eigen::MatrixXi& neighbours) {
+  double bias = 0.0;
+  for (Eigen::Index i = 0; i < signedDistance.size(); ++i) {
+    double sum = signedDistance(i);
+    for (int j = 0; j < kBiasNeighbours; ++j) sum += signedDistance(neighbours(i, j));
+    bias = std::max(bias, std::abs(sum) / static_cast<double>(kBiasNeighbours + 1));
+  }
+  return bias;
+}
+
+}  // namespace
+
 FitError measureFitError(const LimitSurface& surface, const MatrixX3& controlPoints, const MatrixX3& data,
                          double diameter, const Eigen::MatrixXi* neighbours) {
   // NB: 8 x 8 samples per control face, as the outputs (Tessellation.h):
@@ -60,13 +77,7 @@ FitError measureFitError(const LimitSurface& surface, const MatrixX3& controlPoi
       const ClosestPoint& c = nearest[static_cast<size_t>(i)];
       signedDistance(i) = c.normal.isZero(0.0) ? c.distance : c.normal.dot(data.row(i).transpose() - c.position);
     }
-    double bias = 0.0;
-    for (Eigen::Index i = 0; i < data.rows(); ++i) {
-      double sum = signedDistance(i);
-      for (int j = 0; j < kBiasNeighbours; ++j) sum += signedDistance((*neighbours)(i, j));
-      bias = std::max(bias, std::abs(sum) / static_cast<double>(kBiasNeighbours + 1));
-    }
-    error.biasPercent = 100.0 * bias / diameter;
+    error.biasPercent = 100.0 * largestBias(signedDistance, *neighbours) / diameter;
   }
   return error;
 }
@@ -99,21 +110,45 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
       Eigen::VectorXd::Constant(data.rows(), options.dataStiffness * area / static_cast<double>(data.rows()));
   SpringForceModel springs(data, stiffness, SpringForceModel::Attach::NearestEachStep);
 
-  AcceptFit accept = [&](const LimitSurface& surface, const MatrixX3& points, bool settled) {
-    // NB: mid-level (the static scheme's looser rule) the springs' lengths are
-    // the data's distances at `points`, measured by their last evaluation
-    // (tracked, so never shorter than a new search's). When they accept, a
-    // new closest-point search is saved, and the level goes on to
-    // its end, where the error is measured; when they do not, it is measured
-    // now, and decides.
+  // NB: the springs' lengths are the data's distances where the forces were
+  // last evaluated (`points`, whenever the fit is asked before a level's
+  // end), measured by the nearest points they track, so never shorter than
+  // a new search's. When all are within the tolerance, or on noisy data
+  // when the bias of their signed lengths is, the fit is measured by a new
+  // search once and, met, ends there: a level need not reach its
+  // equilibrium to be good enough, and the steps on to it would only fit
+  // closer than asked (or fit the noise). Where the search disagrees (a
+  // spring tracked a nearer point than the search found), the estimate must
+  // fall by a tenth more before it is measured again.
+  double maxBelow = std::numeric_limits<double>::infinity();   // percent
+  double biasBelow = std::numeric_limits<double>::infinity();  // percent
+  AcceptFit accept = [&](const LimitSurface& surface, const MatrixX3& points, FitAsk when) {
     const Eigen::VectorXd& lengths = springs.lengths();
-    if (!settled && lengths.size() == data.rows() &&
-        100.0 * lengths.maxCoeff() / diameter <= options.tolerancePercent) {
-      return FitVerdict::Settle;  // the level goes on, and is asked again at its end
+    const bool measured = lengths.size() == data.rows();
+    const double longest = measured ? 100.0 * lengths.maxCoeff() / diameter : std::numeric_limits<double>::infinity();
+    if (when == FitAsk::Step) {
+      if (!measured) return FitVerdict::Settle;
+      const bool maxWithin = longest <= options.tolerancePercent && longest < maxBelow;
+      const double bias = result.noiseLimited && !maxWithin
+                              ? 100.0 * largestBias(springs.signedLengths(), neighbours) / diameter
+                              : std::numeric_limits<double>::infinity();
+      const bool biasWithin = bias <= options.tolerancePercent && bias < biasBelow;
+      if (!maxWithin && !biasWithin) return FitVerdict::Settle;
+      const FitError e = measureFitError(surface, points, data, diameter, result.noiseLimited ? &neighbours : nullptr);
+      if (met(e)) {
+        result.levelErrors.push_back(e);
+        return FitVerdict::Stop;
+      }
+      if (maxWithin) maxBelow = 0.9 * longest;
+      if (biasWithin) biasBelow = 0.9 * bias;
+      return FitVerdict::Settle;
     }
+    // At the looser rule, springs within the tolerance save a search: the
+    // level goes on to its end, where it is asked again.
+    if (when == FitAsk::LooseRule && longest <= options.tolerancePercent) return FitVerdict::Settle;
     const FitError e = measureFitError(surface, points, data, diameter, result.noiseLimited ? &neighbours : nullptr);
     if (e.maxPercent <= options.tolerancePercent) {
-      if (settled) result.levelErrors.push_back(e);  // one per level, where it ends
+      if (when == FitAsk::LevelEnd) result.levelErrors.push_back(e);  // one per level, where it ends
       return FitVerdict::Settle;
     }
     result.levelErrors.push_back(e);

@@ -42,7 +42,9 @@ Report levelReport(const LevelSummary& l, double maxErrorPercent, double rmsErro
   r.set("control_vertices", l.controlVertices);
   r.set("iterations", l.steps);
   r.set("equilibrium", l.converged);
-  r.set("equilibrium_rule", l.coarse ? "coarse" : "full");  // coarse: ended at looser tolerances (LevelSummary::coarse)
+  // coarse: ended at looser tolerances; met: ended where the fit met its
+  // tolerance, before either rule (LevelSummary).
+  r.set("equilibrium_rule", l.met ? "met" : l.coarse ? "coarse" : "full");
   r.set("time_step_s", l.timeStep);
   r.set("divergences", l.divergences);
   r.set("energy", l.energy);

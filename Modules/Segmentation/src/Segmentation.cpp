@@ -247,7 +247,9 @@ SegmentResult evolveInRegion(const SegmentationRegion& region, const std::vector
   // Refine while a landmark is farther than the tolerance (see the header).
   // The last level's distances are the result's.
   std::vector<double> distances;
-  auto landmarksFit = [&](const LimitSurface& surface, const MatrixX3& controlPoints, bool) {
+  auto landmarksFit = [&](const LimitSurface& surface, const MatrixX3& controlPoints, FitAsk when) {
+    // Landmarks are measured where a level ends, not after every step.
+    if (when == FitAsk::Step) return FitVerdict::Settle;
     if (landmarkPoints.rows() == 0) return FitVerdict::Refine;
     distances = distancesToSurface(surface, controlPoints, landmarkPoints);
     for (double distance : distances)

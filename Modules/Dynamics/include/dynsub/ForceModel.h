@@ -72,6 +72,10 @@ class SpringForceModel final : public ForceModel {
 
   // Spring lengths (distances target - attachment, mm) at the last evaluation.
   const Eigen::VectorXd& lengths() const { return lengths_; }
+  // NearestEachStep only: each length signed along the limit normal at the
+  // attachment (positive where the target is on the normal's side), at the
+  // last evaluation; the plain length where the normal is undefined.
+  Eigen::VectorXd signedLengths() const;
 
   // NearestEachStep only: a spring pulls with k (length - zone) beyond `zone`
   // mm and not at all within it, for targets known only to about that much

@@ -112,11 +112,14 @@ struct LevelSummary {
   int level = 0;  // global refinements of the initial control mesh
   int controlVertices = 0;
   int steps = 0;
-  bool converged = false;
+  bool converged = false;  // ended by a rule below (equilibrium, or met), not by maxSteps
   // The level ended at the looser rule of EquilibriumOptions::coarseLevelFactor:
   // its fit was not accepted there, and it was refined, or it was accepted
   // for good (FitVerdict::Stop).
   bool coarse = false;
+  // The level ended after a step where the fit was met (FitAsk::Step),
+  // before either equilibrium rule.
+  bool met = false;
   double timeStep = 0;  // the step the level ended with
   // Times the level diverged and started again (with half the step, or at its
   // starting step after a regrown one diverged); `steps` counts the last start.
@@ -160,16 +163,24 @@ struct Progress {
   const Eigen::VectorXd* dataDistances = nullptr;
 };
 
-// Whether the fit is good enough. Asked at the end of every level, the last
-// one included (`settled`), and also where a level below the maximum first
-// meets the looser rule of EquilibriumOptions::coarseLevelFactor (not
-// `settled`; the forces were last evaluated at `controlPoints`).
-//  - Refine: not yet; the level ends (there, if not settled) and is refined.
+// Whether the fit is good enough, and when it is asked:
+//  - Step: after every step, at the state the forces were last evaluated at
+//    (`controlPoints`). The answer must be cheap: what the forces measured
+//    there, not a new search. Stop ends the simulation at this state; the
+//    other verdicts go on.
+//  - LooseRule: a level below the maximum first meets the looser rule of
+//    EquilibriumOptions::coarseLevelFactor (the forces were last evaluated
+//    at `controlPoints`).
+//  - LevelEnd: the level ended, the last one included.
+// The verdicts:
+//  - Refine: not yet; the level ends (there, if asked at the looser rule)
+//    and is refined.
 //  - Settle: good so far; a level asked before its end goes on to the full
 //    rule and is asked again there. At a level's end, the same as Stop.
 //  - Stop: good; the simulation ends at this state.
+enum class FitAsk { Step, LooseRule, LevelEnd };
 enum class FitVerdict { Refine, Settle, Stop };
-using AcceptFit = std::function<FitVerdict(const LimitSurface& surface, const MatrixX3& controlPoints, bool settled)>;
+using AcceptFit = std::function<FitVerdict(const LimitSurface& surface, const MatrixX3& controlPoints, FitAsk when)>;
 using ProgressCallback = std::function<void(const Progress&)>;
 
 // forces are not owned. fixed: control vertices of the initial mesh that do not
