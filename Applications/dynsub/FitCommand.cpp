@@ -160,6 +160,7 @@ void runFit(FitCommandOptions o) {
   parameters.set("data_stiffness", o.fit.dataStiffness);
   parameters.set("noise", o.noise);
   parameters.set("keep_outliers", o.keepOutliers);
+  parameters.set("to_equilibrium", o.fit.toEquilibrium);
   report.set("parameters", parameters);
 
   const TriangleSurface surface = outputSurface(result.mesh, *result.surface);
@@ -221,6 +222,9 @@ void addFitCommand(CLI::App& app) {
       ->default_val("auto");
   command->add_flag("--keep-outliers", o->keepOutliers,
                     "Fit every point; by default points far off their neighbours' local surface are set aside");
+  command->add_flag("--to-equilibrium", o->fit.toEquilibrium,
+                    "Run the last level on to its equilibrium, as the papers do; by default the fit ends at the "
+                    "first step where the tolerance is met");
   command->add_option("--reference", o->reference,
                       "Points the fitted surface is also measured against (say, the scan before noise was added); "
                       "reported as reference in report.json")

@@ -127,7 +127,7 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
     const bool measured = lengths.size() == data.rows();
     const double longest = measured ? 100.0 * lengths.maxCoeff() / diameter : std::numeric_limits<double>::infinity();
     if (when == FitAsk::Step) {
-      if (!measured) return FitVerdict::Settle;
+      if (!measured || options.toEquilibrium) return FitVerdict::Settle;
       const bool maxWithin = longest <= options.tolerancePercent && longest < maxBelow;
       const double bias = result.noiseLimited && !maxWithin
                               ? 100.0 * largestBias(springs.signedLengths(), neighbours) / diameter

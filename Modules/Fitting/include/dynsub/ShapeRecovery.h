@@ -5,6 +5,14 @@
 // error is measured and, while it is above the tolerance, the control mesh is
 // refined globally (Simulation.h).
 //
+// When to stop: the papers measure the fit at each level's equilibrium. Here
+// the fit is also asked after every step, by what the data springs measured
+// there: when every spring is within the tolerance (or, on noisy data, the
+// bias of their signed lengths is), one closest-point search measures the
+// fit, and if it is met the fit ends at that step. The steps on to the
+// equilibrium would only fit closer than was asked (FitOptions::toEquilibrium
+// keeps the papers' rule).
+//
 // Fit error (the papers' measure): the distance from each data point to the
 // exact limit surface (ClosestPoint.h), as a percentage of the diameter of the
 // smallest sphere enclosing the data (EnclosingSphere.h); max_error_percent
@@ -49,6 +57,9 @@ struct FitOptions {
   double tolerancePercent = 1.0;  // max_error_percent that stops refinement
   double dataStiffness = 100.0;   // N/mm per unit parametric area (see above)
   double noise = 0.0;             // mm, the data's noise sigma (see above); 0: clean data
+  // Run the last level on to its equilibrium, as the papers do, instead of
+  // ending at the first step where the tolerance is met (see above).
+  bool toEquilibrium = false;
   SimulationOptions simulation = defaultSimulation();
 
   static SimulationOptions defaultSimulation();
