@@ -131,12 +131,17 @@ out = sys.argv[1]
 report = json.load(open(out + "/report.json"))
 names = [s["name"] for s in report["structures"]]
 rows = [line.split("\t")[1] for line in open(out + "/dseg.tsv").read().splitlines()[1:]]
-reused = [json.load(open(f"{out}/{name}/report.json"))["atlas"]["registration"]["affine_reused"] for name in names]
-print("names", names, "dseg.tsv", rows, "affine reused", reused, "registrations", report["atlas_registrations"])
+registrations = [json.load(open(f"{out}/{name}/report.json"))["atlas"]["registration"] for name in names]
+reused = [r["affine_reused"] for r in registrations]
+carried = [r["deformable_reused"] for r in registrations]
+print("names", names, "dseg.tsv", rows, "affine reused", reused, "carried label reused", carried,
+      "registrations", report["atlas_registrations"])
 ok = names == ["Caudate_L", "Putamen_L"] == rows and report["atlas_registrations"] == 1
 # The second structure reuses the first's registration; the first, segmented
-# again against the second, reuses its own.
+# again against the second, reuses its own. A structure segmented again
+# keeps the label its first pass carried.
 ok = ok and reused[1] and reused[0] == report["structures"][0]["segmented_again"]
+ok = ok and carried == [s["segmented_again"] for s in report["structures"]]
 ok = ok and all(s["init"] == "atlas" for s in report["structures"])
 for s in report["structures"]:
     print(s["name"], "Dice alone %.4f, in dseg %.4f" % (s["alone"]["dice"], s["joint"]["dice"]))

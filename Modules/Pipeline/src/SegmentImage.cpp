@@ -119,7 +119,8 @@ Report atlasReport(const SegmentInputs& in, const SegmentOutcome& outcome, bool 
   registration.set("affine_reused", reused);
   registration.set("deformable_metric", carried.metric);
   registration.set("deformable_iterations", carried.iterations);
-  registration.set("deformable_seconds", carried.seconds);
+  registration.set("deformable_seconds", in.atlasCarried ? 0.0 : carried.seconds);
+  registration.set("deformable_reused", in.atlasCarried != nullptr);
   registration.set("largest_warp_mm", carried.largestWarpMm);
   r.set("registration", registration);
   r.set("carried_volume_mm3", carriedVolume(carried));
@@ -140,8 +141,9 @@ ControlMesh atlasStart(const Volume& image, const SegmentInputs& in, const Segme
   outcome.atlasAffine = in.atlasAffine ? in.atlasAffine
                                        : std::make_shared<const AtlasAffine>(
                                              registerAtlasAffine(image, *in.atlas, parameters.registration));
-  outcome.carried = carryLabel(image, *in.atlas, in.atlasLabels, *outcome.atlasAffine, in.inside,
-                               parameters.registration);
+  outcome.carried = in.atlasCarried ? *in.atlasCarried
+                                    : carryLabel(image, *in.atlas, in.atlasLabels, *outcome.atlasAffine, in.inside,
+                                                 parameters.registration);
   // Farthest-point sampling is greedy: the prior's points are the first of
   // the fit's, spread as evenly as if sampled alone.
   const std::vector<Landmark> boundary = carriedBoundary(*outcome.carried, 4 * parameters.priorPoints);
@@ -149,6 +151,9 @@ ControlMesh atlasStart(const Volume& image, const SegmentInputs& in, const Segme
   outcome.prior.assign(boundary.begin(), boundary.begin() + static_cast<std::ptrdiff_t>(priorCount));
   FitOptions fit;
   fit.simulation.maxLevel = 0;
+  // The start is the initial level's surface nearest the carried boundary,
+  // not the first one within the fit's tolerance.
+  fit.toEquilibrium = true;
   ControlMesh mesh =
       fitPointCloud(landmarkPositions(boundary), initialFromLandmarks(boundary, parameters.initialFraction), fit)
           .mesh;

@@ -195,7 +195,8 @@ StructuresOutcome segmentStructures(const Volume& image, const std::vector<Struc
   const std::size_t n = structures.size();
   // Structures started from one atlas share the image's registration to it:
   // the first one's is made once and given to the others.
-  // A structure segmented again keeps its own registration.
+  // A structure segmented again keeps its own registration and the label
+  // its first pass carried to the image.
   std::vector<StructureInputs> inputs = structures;
   std::shared_ptr<const AtlasAffine> registration;
   const Atlas* registered = nullptr;
@@ -234,6 +235,9 @@ StructuresOutcome segmentStructures(const Volume& image, const std::vector<Struc
       for (std::size_t t = 0; t < n; ++t)
         if (t != s) others.push_back(static_cast<int>(t + 1));
       const Mask wall = selectLabels(territories, others);
+      if (out.structures[s].carried) {
+        inputs[s].inputs.atlasCarried = std::make_shared<const CarriedLabel>(*out.structures[s].carried);
+      }
       out.structures[s] = segmentOne(image, inputs[s], parameters, progress, &wall);
     }
     masks = masksOf();

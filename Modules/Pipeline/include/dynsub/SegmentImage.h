@@ -68,6 +68,10 @@ struct SegmentInputs {
   std::shared_ptr<const Atlas> atlas;
   std::vector<int> atlasLabels;
   std::shared_ptr<const AtlasAffine> atlasAffine;
+  // The structure's label carried to the image already, with the same
+  // inputs (a structure segmented again keeps its first pass's); the
+  // deformable registration is made otherwise.
+  std::shared_ptr<const CarriedLabel> atlasCarried;
   // With an atlas start: a click inside the structure (LPS mm), which picks
   // the carried label's part and moves a misplaced one to it.
   std::optional<Vector3> inside;
