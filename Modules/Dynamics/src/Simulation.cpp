@@ -215,8 +215,7 @@ std::optional<LevelEnd> coarseEnd(FitVerdict verdict) {
 // the last state reached.
 LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& forces, const std::vector<int>& fixed,
                       const SimulationOptions& options, const AcceptFit& accept, bool askLoose, double& timeStep,
-                      double regrowCeiling, const ProgressCallback& progress, MatrixX3& points,
-                      LevelSummary& summary) {
+                      double regrowCeiling, const ProgressCallback& progress, MatrixX3& points, LevelSummary& summary) {
   IntegratorOptions integratorOptions = options.integrator;
   integratorOptions.timeStep = timeStep;
   // The stabilizing stiffness of the forces at `at` (Integrator.h).
@@ -585,7 +584,7 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
     result.levels.push_back(summary);
 
     // An end before the full rule was asked already: refused, or accepted for good.
-    const bool good = end == LevelEnd::Coarse                                ? false
+    const bool good = end == LevelEnd::Coarse                             ? false
                       : end == LevelEnd::Accepted || end == LevelEnd::Met ? true
                       : accept ? accept(*model.surface, points, FitAsk::LevelEnd) != FitVerdict::Refine
                                : true;
