@@ -456,7 +456,8 @@ double equilibriumResidual(const LevelModel& model, const std::vector<ForceModel
   return (force - elastic).norm() / scale;
 }
 
-// One level from model.start to its equilibrium (or step limit); a divergence
+// One level from model.start to its end (an equilibrium rule, the fit met, or
+// the step limit); a divergence
 // restarts it with half the time step.
 MatrixX3 runLevel(const LevelModel& model, const std::vector<ForceModel*>& forces, const std::vector<int>& fixed,
                   const SimulationOptions& options, const AcceptFit& accept, bool askLoose, double& timeStep,

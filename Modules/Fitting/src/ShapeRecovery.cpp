@@ -112,17 +112,22 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
 
   // NB: the springs' lengths are the data's distances where the forces were
   // last evaluated (`points`, whenever the fit is asked before a level's
-  // end), measured by the nearest points they track, so never shorter than
-  // a new search's. When all are within the tolerance, or on noisy data
+  // end), measured to the surface points they track, so never shorter than
+  // the true distances. When all are within the tolerance, or on noisy data
   // when the bias of their signed lengths is, the fit is measured by a new
-  // search once and, met, ends there: a level need not reach its
-  // equilibrium to be good enough, and the steps on to it would only fit
-  // closer than asked (or fit the noise). Where the search disagrees (a
-  // spring tracked a nearer point than the search found), the estimate must
-  // fall by a tenth more before it is measured again.
+  // search and, met, ends there: a level need not reach its equilibrium to
+  // be good enough, and the steps on to it would only fit closer than asked
+  // (or fit the noise). Where the search says otherwise (the signed
+  // lengths' bias is an estimate, and a search can miss), the estimate must
+  // fall by a tenth more on this level before it is measured again.
   double maxBelow = std::numeric_limits<double>::infinity();   // percent
   double biasBelow = std::numeric_limits<double>::infinity();  // percent
+  const LimitSurface* level = nullptr;                         // the level those bounds are for
   AcceptFit accept = [&](const LimitSurface& surface, const MatrixX3& points, FitAsk when) {
+    if (&surface != level) {
+      level = &surface;
+      maxBelow = biasBelow = std::numeric_limits<double>::infinity();
+    }
     const Eigen::VectorXd& lengths = springs.lengths();
     const bool measured = lengths.size() == data.rows();
     const double longest = measured ? 100.0 * lengths.maxCoeff() / diameter : std::numeric_limits<double>::infinity();
@@ -143,9 +148,12 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
       if (biasWithin) biasBelow = 0.9 * bias;
       return FitVerdict::Settle;
     }
-    // At the looser rule, springs within the tolerance save a search: the
-    // level goes on to its end, where it is asked again.
-    if (when == FitAsk::LooseRule && longest <= options.tolerancePercent) return FitVerdict::Settle;
+    // At the looser rule, springs within the tolerance save a search (unless
+    // one at this level already said otherwise): the level goes on to its
+    // end, where it is asked again.
+    if (when == FitAsk::LooseRule && longest <= options.tolerancePercent && longest < maxBelow) {
+      return FitVerdict::Settle;
+    }
     const FitError e = measureFitError(surface, points, data, diameter, result.noiseLimited ? &neighbours : nullptr);
     if (e.maxPercent <= options.tolerancePercent) {
       if (when == FitAsk::LevelEnd) result.levelErrors.push_back(e);  // one per level, where it ends

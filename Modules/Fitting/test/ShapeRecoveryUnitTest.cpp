@@ -197,6 +197,7 @@ TEST(ShapeRecovery, EndsWhereTheToleranceIsMet) {
     options.simulation.integrator.timeStep = 0.5;
     const FitResult result = fitPointCloud(points, initial, options);
     ASSERT_EQ(result.levels.size(), 1u);
+    EXPECT_EQ(result.levelErrors.size(), 1u);
     EXPECT_TRUE(result.levels.back().met) << static_cast<int>(scheme);
     EXPECT_TRUE(result.toleranceMet);
     EXPECT_LE(result.error.maxPercent, 1.0);

@@ -41,7 +41,7 @@ Report levelReport(const LevelSummary& l, double maxErrorPercent, double rmsErro
   r.set("level", l.level);
   r.set("control_vertices", l.controlVertices);
   r.set("iterations", l.steps);
-  r.set("equilibrium", l.converged);
+  r.set("equilibrium", l.converged && !l.met);
   // coarse: ended at looser tolerances; met: ended where the fit met its
   // tolerance, before either rule (LevelSummary).
   r.set("equilibrium_rule", l.met ? "met" : l.coarse ? "coarse" : "full");

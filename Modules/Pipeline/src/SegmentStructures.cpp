@@ -236,7 +236,7 @@ StructuresOutcome segmentStructures(const Volume& image, const std::vector<Struc
         if (t != s) others.push_back(static_cast<int>(t + 1));
       const Mask wall = selectLabels(territories, others);
       if (out.structures[s].carried) {
-        inputs[s].inputs.atlasCarried = std::make_shared<const CarriedLabel>(*out.structures[s].carried);
+        inputs[s].inputs.atlasCarried = std::make_shared<const CarriedLabel>(std::move(*out.structures[s].carried));
       }
       out.structures[s] = segmentOne(image, inputs[s], parameters, progress, &wall);
     }

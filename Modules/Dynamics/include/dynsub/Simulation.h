@@ -165,8 +165,9 @@ struct Progress {
 
 // Whether the fit is good enough, and when it is asked:
 //  - Step: after every step, at the state the forces were last evaluated at
-//    (`controlPoints`). The answer must be cheap: what the forces measured
-//    there, not a new search. Stop ends the simulation at this state; the
+//    (`controlPoints`). It is asked often, so the answer should come from
+//    what the forces measured there, with a new measurement only where that
+//    says the fit may be met. Stop ends the simulation at this state; the
 //    other verdicts go on.
 //  - LooseRule: a level below the maximum first meets the looser rule of
 //    EquilibriumOptions::coarseLevelFactor (the forces were last evaluated
