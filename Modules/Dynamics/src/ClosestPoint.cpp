@@ -342,6 +342,10 @@ void ClosestPointLocator::update(const MatrixX3& controlPoints) {
   }
 }
 
+double signedDistance(const Vector3& query, const Vector3& position, const Vector3& normal) {
+  return normal.isZero(0.0) ? (query - position).norm() : normal.dot(query - position);
+}
+
 ClosestPoint ClosestPointLocator::find(const Vector3& query) const {
   if (impl_->controlPoints.size() == 0) throw Error("internal: closest-point search used before update()");
   impl_->updateTree();

@@ -80,10 +80,10 @@ void SpringForceModel::attach(const MatrixX3& controlPoints) {
 }
 
 Eigen::VectorXd SpringForceModel::signedLengths() const {
-  Eigen::VectorXd signedLength = lengths_;
-  for (Eigen::Index i = 0; i < normals_.rows() && i < signedLength.size(); ++i) {
-    const Vector3 n = normals_.row(i).transpose();
-    if (!n.isZero(0.0)) signedLength(i) = n.dot(targets_.row(i).transpose() - positions_.row(i).transpose());
+  Eigen::VectorXd signedLength(positions_.rows());
+  for (Eigen::Index i = 0; i < positions_.rows(); ++i) {
+    signedLength(i) =
+        signedDistance(targets_.row(i).transpose(), positions_.row(i).transpose(), normals_.row(i).transpose());
   }
   return signedLength;
 }

@@ -251,12 +251,12 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
                           0.5 * quadraticForm(model.matrices.stiffness, points) + potential;
     if (step == 1) firstEnergy = std::abs(energy);
     if (!std::isfinite(energy) || std::abs(energy) > 1e3 * std::max(firstEnergy, 1e-300)) return LevelEnd::Diverged;
-    // The forces were just evaluated at `points`: a fit met there ends here.
-    if (step > 1 && accept && accept(*model.surface, points, FitAsk::Step) == FitVerdict::Stop) {
-      summary.energy = energy;
-      return LevelEnd::Met;
-    }
     if (step > 1) {
+      // The forces were just evaluated at `points`: a fit met there ends here.
+      if (accept && accept(*model.surface, points, FitAsk::Step) == FitVerdict::Stop) {
+        summary.energy = energy;
+        return LevelEnd::Met;
+      }
       const double change = relativeChange(energy, lastEnergy);
       const double shape = stepMotion.measure(
           previous, points, change, asked ? options.equilibrium.energyTolerance : loose.energyTolerance);
@@ -457,8 +457,7 @@ double equilibriumResidual(const LevelModel& model, const std::vector<ForceModel
 }
 
 // One level from model.start to its end (an equilibrium rule, the fit met, or
-// the step limit); a divergence
-// restarts it with half the time step.
+// the step limit); a divergence restarts it with half the time step.
 MatrixX3 runLevel(const LevelModel& model, const std::vector<ForceModel*>& forces, const std::vector<int>& fixed,
                   const SimulationOptions& options, const AcceptFit& accept, bool askLoose, double& timeStep,
                   const ProgressCallback& progress, LevelSummary& summary, LevelEnd& end) {

@@ -43,11 +43,11 @@ namespace {
 
 // The largest mean of the signed distances over a point and its
 // kBiasNeighbours nearest (the header's bias), mm.
-double largestBias(const Eigen::VectorXd& signedDistance, const Eigen::MatrixXi& neighbours) {
+double largestBias(const Eigen::VectorXd& signedDistances, const Eigen::MatrixXi& neighbours) {
   double bias = 0.0;
-  for (Eigen::Index i = 0; i < signedDistance.size(); ++i) {
-    double sum = signedDistance(i);
-    for (int j = 0; j < kBiasNeighbours; ++j) sum += signedDistance(neighbours(i, j));
+  for (Eigen::Index i = 0; i < signedDistances.size(); ++i) {
+    double sum = signedDistances(i);
+    for (int j = 0; j < kBiasNeighbours; ++j) sum += signedDistances(neighbours(i, j));
     bias = std::max(bias, std::abs(sum) / static_cast<double>(kBiasNeighbours + 1));
   }
   return bias;
@@ -71,13 +71,12 @@ FitError measureFitError(const LimitSurface& surface, const MatrixX3& controlPoi
   }
   FitError error{100.0 * worst / diameter, 100.0 * std::sqrt(squares / nearest.size()) / diameter, 0.0};
   if (neighbours) {
-    // Signed along the surface's normal; where it is undefined, the distance.
-    Eigen::VectorXd signedDistance(data.rows());
+    Eigen::VectorXd signedDistances(data.rows());
     for (Eigen::Index i = 0; i < data.rows(); ++i) {
       const ClosestPoint& c = nearest[static_cast<size_t>(i)];
-      signedDistance(i) = c.normal.isZero(0.0) ? c.distance : c.normal.dot(data.row(i).transpose() - c.position);
+      signedDistances(i) = signedDistance(data.row(i).transpose(), c.position, c.normal);
     }
-    error.biasPercent = 100.0 * largestBias(signedDistance, *neighbours) / diameter;
+    error.biasPercent = 100.0 * largestBias(signedDistances, *neighbours) / diameter;
   }
   return error;
 }
@@ -119,15 +118,11 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
   // be good enough, and the steps on to it would only fit closer than asked
   // (or fit the noise). Where the search says otherwise (the signed
   // lengths' bias is an estimate, and a search can miss), the estimate must
-  // fall by a tenth more on this level before it is measured again.
+  // fall by a tenth more on this level before it is measured again; the
+  // bounds start afresh when the fit is refined.
   double maxBelow = std::numeric_limits<double>::infinity();   // percent
   double biasBelow = std::numeric_limits<double>::infinity();  // percent
-  const LimitSurface* level = nullptr;                         // the level those bounds are for
   AcceptFit accept = [&](const LimitSurface& surface, const MatrixX3& points, FitAsk when) {
-    if (&surface != level) {
-      level = &surface;
-      maxBelow = biasBelow = std::numeric_limits<double>::infinity();
-    }
     const Eigen::VectorXd& lengths = springs.lengths();
     const bool measured = lengths.size() == data.rows();
     const double longest = measured ? 100.0 * lengths.maxCoeff() / diameter : std::numeric_limits<double>::infinity();
@@ -162,7 +157,9 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
     result.levelErrors.push_back(e);
     // Met by the bias rule (noisy data): stop here, since the steps on to
     // this level's full equilibrium would fit the noise.
-    return met(e) ? FitVerdict::Stop : FitVerdict::Refine;
+    if (met(e)) return FitVerdict::Stop;
+    maxBelow = biasBelow = std::numeric_limits<double>::infinity();
+    return FitVerdict::Refine;
   };
 
   // The static scheme's progress comes after the accepted trial, the springs'

@@ -25,6 +25,11 @@ struct ClosestPoint {
   Vector3 normal = Vector3::Zero();  // unit limit normal at the point (zero where undefined)
 };
 
+// The distance from `query` to the surface point `position`, signed along
+// the unit `normal` there (positive on the normal's side); unsigned where
+// the normal is undefined (zero).
+double signedDistance(const Vector3& query, const Vector3& position, const Vector3& normal);
+
 // Not for concurrent use: searches are const but may rebuild the sample tree
 // (each call parallelizes over its queries itself).
 class ClosestPointLocator {
