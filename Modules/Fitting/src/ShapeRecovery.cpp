@@ -109,7 +109,7 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
       Eigen::VectorXd::Constant(data.rows(), options.dataStiffness * area / static_cast<double>(data.rows()));
   SpringForceModel springs(data, stiffness, SpringForceModel::Attach::NearestEachStep);
 
-  // NB: the springs' lengths are the data's distances where the forces were
+  // The springs' lengths are the data's distances where the forces were
   // last evaluated (`points`, whenever the fit is asked before a level's
   // end), measured to the surface points they track, so never shorter than
   // the true distances. When all are within the tolerance, or on noisy data
