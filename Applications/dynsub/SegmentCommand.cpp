@@ -39,13 +39,15 @@ struct Arguments {
   // a point list per structure. Several structures are segmented together.
   std::vector<std::string> landmarks;
   std::vector<std::string> names;  // one per structure, or none (landmarkSources' names)
-  std::string init = "auto";
+  // Initial models: none (auto), one for the run, or one per structure: the
+  // point lists' in their order, then the structures without landmarks.
+  std::vector<std::string> init;
   std::string reference;
   std::vector<std::string> referenceLabels;  // "N[,M...]": one per structure
   std::string atlas = kDefaultAtlasImage;
   std::string atlasLabels = kDefaultAtlasLabels;
   std::vector<std::string> atlasLabel;  // with --init atlas: one structure's labels each
-  std::string inside;
+  std::vector<std::string> inside;      // with --init atlas: none, or one per atlas label
   SegmentParameters parameters;
   FigureOptions figures;
 };
@@ -144,8 +146,11 @@ void runSegmentOne(const Arguments& o, const LandmarkSource* landmarks) {
   // Every input is read and checked before anything is written.
   if (!o.reference.empty() && o.referenceLabels.empty())
     throw Error("--reference needs --reference-label N[,M...]: the label value(s) of the structure");
+  if (o.inside.size() > 1)
+    throw Error("--inside is given " + std::to_string(o.inside.size()) +
+                " times for one structure: give one click inside it");
   SegmentInputs inputs;
-  inputs.start = parseSegmentStart(o.init, "--init");
+  inputs.start = parseSegmentStart(o.init.empty() ? "auto" : o.init.front(), "--init");
   // One structure's values, as N[,M...] or as several values (71 72).
   std::vector<int> referenceLabels;
   for (const std::string& values : o.referenceLabels)
@@ -157,7 +162,7 @@ void runSegmentOne(const Arguments& o, const LandmarkSource* landmarks) {
     inputs.landmarkSource = landmarks->path;
   }
   inputs.image = o.image;
-  if (!o.inside.empty()) inputs.inside = parsePoint(o.inside, "--inside");
+  if (!o.inside.empty()) inputs.inside = parsePoint(o.inside.front(), "--inside");
   if (inputs.start.kind == SegmentStart::Kind::Atlas) {
     if (o.atlasLabel.empty())
       throw Error("--init atlas needs --atlas-label N[,M...] or a name from the atlas's table (e.g. Caudate_L)");
@@ -213,19 +218,43 @@ void writeLabelTable(const std::vector<StructureInputs>& structures, const std::
 // it is there only when everything is.
 void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& sources) {
   // The structures: the landmarks' lists, or with --init atlas the atlas
-  // labels, each paired with its list when --landmarks are given too.
-  const bool atlas = o.init == "atlas";
-  if (!atlas && o.init != "auto")
-    throw Error("--init " + o.init + ": several structures start from their landmarks (--init auto) or from the " +
-                "atlas (--init atlas, an --atlas-label per structure)");
+  // labels, each paired with its list when --landmarks are given too. An
+  // --init per structure starts each from its own model (a seed click, say):
+  // the lists' in their order, then any further structures without
+  // landmarks.
+  const std::string first = o.init.empty() ? "auto" : o.init.front();
+  const bool atlas = first == "atlas";
+  const bool each = o.init.size() > 1;
+  if (each) {
+    for (const std::string& start : o.init)
+      if (start == "atlas")
+        throw Error(
+            "--init atlas starts every structure from the atlas: give it once, with an --atlas-label per "
+            "structure");
+  } else if (!atlas && first != "auto") {
+    throw Error("--init " + first +
+                ": give an --init per structure (the point lists' in their order, then any "
+                "structures without landmarks), or start them all from their landmarks (auto) or from the atlas "
+                "(--init atlas, an --atlas-label per structure)");
+  }
   if (!atlas && !o.atlasLabel.empty()) throw Error("--atlas-label serves an atlas start: add --init atlas");
-  const std::size_t n = atlas ? o.atlasLabel.size() : sources.size();
+  const std::size_t n = atlas ? o.atlasLabel.size() : std::max(sources.size(), o.init.size());
   if (atlas && !sources.empty() && sources.size() != n)
     throw Error("--init atlas with --landmarks: give an --atlas-label per point list, in their order (" +
                 std::to_string(sources.size()) + " lists, " + std::to_string(n) + " atlas labels)");
-  if (!o.inside.empty())
-    throw Error("--inside: a click inside is one structure's; segment several structures without it");
-  const std::string order = atlas ? "--atlas-label" : "--landmarks";
+  if (each && o.init.size() < sources.size())
+    throw Error("--init is given " + std::to_string(o.init.size()) + " times for " + std::to_string(sources.size()) +
+                " point lists: give one per structure, or one for all");
+  if (!atlas && !o.inside.empty())
+    throw Error(
+        "--inside serves an atlas start (--init atlas); to start a structure from one click alone, give "
+        "it --init seed:x,y,z");
+  if (!o.inside.empty() && o.inside.size() != n)
+    throw Error("--inside is given " + std::to_string(o.inside.size()) + " times for " + std::to_string(n) +
+                " atlas structures: give a click inside each, in the order of --atlas-label, or none");
+  if (!atlas && sources.size() < n && o.names.empty())
+    throw Error("structures without landmarks need names: give a --name per structure, in the order of --init");
+  const std::string order = atlas ? "--atlas-label" : each ? "--init" : "--landmarks";
   if (!o.names.empty() && o.names.size() != n)
     throw Error("--name is given " + std::to_string(o.names.size()) + " times for " + std::to_string(n) +
                 " structures (one per " + order + "): name each structure, or none");
@@ -235,9 +264,13 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
   const std::shared_ptr<const Atlas> atlasData =
       atlas ? std::make_shared<const Atlas>(readAtlas(o.atlas, o.atlasLabels)) : nullptr;
   std::vector<StructureInputs> structures = structuresToSegment(o.image, sources, atlasData, o.atlasLabel);
+  structures.resize(n);  // those without landmarks after the lists
   for (std::size_t s = 0; s < n; ++s) {
     StructureInputs& structure = structures[s];
     SegmentInputs& in = structure.inputs;
+    in.image = o.image;
+    if (each) in.start = parseSegmentStart(o.init[s], "--init");
+    if (!o.inside.empty()) in.inside = parsePoint(o.inside[s], "--inside");
     if (!o.names.empty()) structure.name = o.names[s];
     if (!o.reference.empty()) {
       in.referencePath = o.reference;
@@ -307,7 +340,7 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
 
 void runSegment(const Arguments& o) {
   const std::vector<LandmarkSource> sources = landmarkSources(o.landmarks);
-  if (sources.size() > 1 || o.atlasLabel.size() > 1)
+  if (sources.size() > 1 || o.atlasLabel.size() > 1 || o.init.size() > 1)
     runSegmentTogether(o, sources);
   else
     runSegmentOne(o, sources.empty() ? nullptr : &sources.front());
@@ -348,8 +381,11 @@ void addSegmentCommand(CLI::App& app) {
                    "click's, its boundary the springs when no --landmarks are given), "
                    "sphere:x,y,z,r (LPS mm), atlas (the atlas's structure --atlas-label registered to the image, "
                    "which also holds the surface softly where clicks and edges say nothing), or a closed "
-                   "control mesh file in LPS mm")
-      ->default_val("auto");
+                   "control mesh file in LPS mm (default auto). With several structures: once for all (auto or "
+                   "atlas), or once per structure (not atlas), the point lists' in their order, then structures "
+                   "without landmarks (each named by --name)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   command
       ->add_option("--atlas-label", o->atlasLabel,
                    "With --init atlas: the structure's label value(s) in the atlas, or names from its table "
@@ -364,9 +400,12 @@ void addSegmentCommand(CLI::App& app) {
                    "With --init atlas: the atlas's label map, on its template's grid, with its names in "
                    "LABELS.txt beside it (mricron's format: one 'VALUE NAME' per line)")
       ->default_str(kDefaultAtlasLabels);
-  command->add_option("--inside", o->inside,
-                      "With --init atlas: x,y,z (LPS mm), a click inside the structure; it picks the carried "
-                      "label's part and moves a misplaced one there");
+  command
+      ->add_option("--inside", o->inside,
+                   "With --init atlas: x,y,z (LPS mm), a click inside the structure; it picks the carried label's "
+                   "part and moves a misplaced one there. With several atlas structures, once per --atlas-label")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   CLI::Option* reference = command->add_option("--reference", o->reference,
                                                "Reference labelmap on the image's grid, for Dice and distances");
   command

@@ -14,14 +14,17 @@
 #    must not drop and no structure may lose more than 0.01.
 #  - a markups file with a point list per structure is the same run as a
 #    file per structure;
+#  - a structure started from a seed click (an --init per structure) joins
+#    two from landmarks: no voxel in two, and alone it is the same as its
+#    separate `segment --init seed:` run;
 #  - atlas labels as several structures (--init atlas, an --atlas-label
 #    each), on a subject made from Colin27 (`dynsub subject`, seed 2): the
 #    image is registered to the atlas once, no voxel is in two structures,
-#    and each one's Dice in dseg.nii.gz is within 0.01 of its segmentation
-#    alone. The subject's truth is the atlas's own labels carried to it, so
+#    each one's Dice in dseg.nii.gz is within 0.01 of its segmentation
+#    alone, and each has its own click inside (--inside per atlas label). The subject's truth is the atlas's own labels carried to it, so
 #    the Dice themselves say nothing of accuracy; only the comparison counts;
 #  - bad combinations of options are refused before anything is written.
-# Needs DYNSUB (the executable), DATA and TOOLS.
+# Needs DYNSUB (the executable), DATA and TOOLS; python3-nibabel.
 set -u
 source "$(dirname "${BASH_SOURCE[0]}")/Checks.sh"
 require_colin27
@@ -115,17 +118,63 @@ check "the lists' names: the markup's name made a folder name, else the file's s
 check "two lists in one file segment as the same two in two files" \
   cmp -s <(gzip -dc "$work/lists/dseg.nii.gz") <(gzip -dc "$work/files/dseg.nii.gz")
 
+# A structure from a seed click with two from landmarks: the voxel nearest
+# the centroid of AAL's left thalamus (77), in LPS mm. The lists' --init
+# come first (auto), the structure without landmarks after them.
+"$DYNSUB" segment "$templates/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" \
+  --landmarks "$DATA/Landmarks/putamen_left.mrk.json" --init auto --init auto --init seed:12,18,8 \
+  --name caudateL --name putamenL --name thalamusL --reference "$templates/aal.nii.gz" --reference-label 71 \
+  --reference-label 73 --reference-label 77 --no-figures --out "$work/seeded" >"$work/seeded.log" 2>&1
+check "a seeded structure with two from landmarks: segment succeeds" test $? -eq 0
+cat "$work/seeded.log"
+"$DYNSUB" segment "$templates/ch2.nii.gz" --init seed:12,18,8 --reference "$templates/aal.nii.gz" \
+  --reference-label 77 --no-figures --out "$work/thalamus" >/dev/null 2>&1
+check "the seeded structure alone: segment succeeds" test $? -eq 0
+check "a seeded structure with two from landmarks: its start, none in two, alone as its own run" \
+  python3 - "$work/seeded" "$work/thalamus/report.json" <<'PY'
+import gzip, json, struct, sys
+out, own = sys.argv[1], json.load(open(sys.argv[2]))
+report = json.load(open(out + "/report.json"))
+structures = report["structures"]
+ok = [s["name"] for s in structures] == ["caudateL", "putamenL", "thalamusL"]
+ok = ok and [s["init"] for s in structures] == ["auto", "auto", "seed:12,18,8"] and structures[2]["landmarks"] == ""
+# The same inputs give the same surface, alone in a run of three or in a run of its own.
+print("thalamusL Dice alone %.4f, its own run %.4f, in dseg %.4f" %
+      (structures[2]["alone"]["dice"], own["dice"], structures[2]["joint"]["dice"]))
+ok = ok and abs(structures[2]["alone"]["dice"] - own["dice"]) < 1e-9
+ok = ok and all(s["joint"]["dice"] >= s["alone"]["dice"] - 0.01 for s in structures)
+data = gzip.open(out + "/dseg.nii.gz").read()
+dims = struct.unpack_from("<8h", data, 40)[1:4]
+datatype, offset = struct.unpack_from("<h", data, 70)[0], int(struct.unpack_from("<f", data, 108)[0])
+labels = struct.unpack_from("<%d%s" % (dims[0] * dims[1] * dims[2], {2: "B", 4: "h", 512: "H"}[datatype]), data, offset)
+ok = ok and sorted(set(labels)) == [0, 1, 2, 3] and report["shared_voxels_together"] == 0
+sys.exit(0 if ok else 1)
+PY
+
 # Atlas labels as several structures.
 "$DYNSUB" subject "$templates/ch2.nii.gz" "$templates/aal.nii.gz" --seed 2 --set thick_fraction=0 \
   --out "$work/subject" >/dev/null 2>&1
 check "a subject made from Colin27" test -s "$work/subject/image.nii.gz"
-"$DYNSUB" segment "$work/subject/image.nii.gz" --init atlas --atlas-label Caudate_L --atlas-label 73 \
+# A click inside each: the voxel nearest the centroid of each structure's
+# label on the subject, in LPS mm (Debian's Python, which has python3-nibabel).
+insides=$(/usr/bin/python3 - "$work/subject/labels.nii.gz" <<'PY'
+import nibabel, numpy, sys
+labels = nibabel.load(sys.argv[1])
+values = numpy.asanyarray(labels.dataobj)
+for label in (71, 73):
+    voxels = numpy.argwhere(values == label)
+    nearest = voxels[numpy.argmin(numpy.linalg.norm(voxels - voxels.mean(axis=0), axis=1))]
+    point = numpy.diag([-1.0, -1.0, 1.0, 1.0]) @ labels.affine @ numpy.append(nearest, 1.0)
+    print("--inside %r,%r,%r" % tuple(float(v) for v in point[:3]), end=" ")
+PY
+)
+"$DYNSUB" segment "$work/subject/image.nii.gz" --init atlas --atlas-label Caudate_L --atlas-label 73 $insides \
   --reference "$work/subject/labels.nii.gz" --reference-label 71 --reference-label 73 --no-figures \
   --out "$work/atlas" >"$work/atlas.log" 2>&1
 check "two atlas labels: segment succeeds" test $? -eq 0
 cat "$work/atlas.log"
 check "two atlas labels: one registration, named by the atlas's table, none in two, Dice no lower (0.01)" \
-  python3 - "$work/atlas" <<'PY'
+  python3 - "$work/atlas" "$insides" <<'PY'
 import gzip, json, struct, sys
 out = sys.argv[1]
 report = json.load(open(out + "/report.json"))
@@ -143,6 +192,12 @@ ok = names == ["Caudate_L", "Putamen_L"] == rows and report["atlas_registrations
 ok = ok and reused[1] and reused[0] == report["structures"][0]["segmented_again"]
 ok = ok and carried == [s["segmented_again"] for s in report["structures"]] and any(carried)
 ok = ok and all(s["init"] == "atlas" for s in report["structures"])
+# Each structure's own click inside, in the order of --atlas-label.
+insides = [json.load(open(f"{out}/{name}/report.json"))["atlas"].get("inside_lps_mm") for name in names]
+print("inside clicks", insides, "given", sys.argv[2])
+given = [[float(v) for v in item.split(",")] for item in sys.argv[2].split("--inside")[1:]]
+ok = ok and all(c is not None and max(abs(a - b) for a, b in zip(c, g)) < 1e-9 for c, g in zip(insides, given))
+ok = ok and len(given) == 2
 for s in report["structures"]:
     print(s["name"], "Dice alone %.4f, in dseg %.4f" % (s["alone"]["dice"], s["joint"]["dice"]))
     ok = ok and s["joint"]["dice"] >= s["alone"]["dice"] - 0.01
@@ -172,13 +227,22 @@ refused "a name twice" "given twice" --landmarks "$caudate" --landmarks "$putame
 refused "a name that is a path" "use letters" --landmarks "$caudate" --landmarks "$putamen" --name a/b --name c
 refused "one reference label for two" "one --reference-label" --landmarks "$caudate" --landmarks "$putamen" \
   --reference "$templates/aal.nii.gz" --reference-label 71
-refused "a start other than the landmarks" "several structures start" --landmarks "$caudate" \
+refused "one start other than the landmarks for two" "give an --init per structure" --landmarks "$caudate" \
   --landmarks "$putamen" --init sphere:0,0,0,5
+refused "fewer starts than point lists" "\-\-init is given 2 times for 3 point lists" --landmarks "$caudate" \
+  --landmarks "$putamen" --landmarks "$caudate" --init auto --init seed:12,18,8
+refused "an atlas start among several" "give it once" --landmarks "$caudate" --landmarks "$putamen" --init auto \
+  --init atlas
+refused "structures without landmarks, unnamed" "need names" --init seed:12,18,8 --init seed:25,-4,2
+refused "a structure without landmarks from auto" "thalamusL" --landmarks "$caudate" --init auto --init auto \
+  --name caudateL --name thalamusL
 refused "a missing second file" "missing.mrk.json" --landmarks "$caudate" --landmarks "$work/missing.mrk.json"
 refused "two lists, one atlas label" "an --atlas-label per point list" --landmarks "$caudate" --landmarks "$putamen" \
   --init atlas --atlas-label Caudate_L
-refused "a click inside with several" "a click inside is one structure's" --init atlas --atlas-label Caudate_L \
-  --atlas-label Putamen_L --inside 15,-1,16
+refused "one click inside for two atlas structures" "give a click inside each" --init atlas \
+  --atlas-label Caudate_L --atlas-label Putamen_L --inside 15,-1,16
+refused "a click inside without an atlas" "serves an atlas start" --landmarks "$caudate" --landmarks "$putamen" \
+  --inside 15,-1,16
 refused "atlas labels without an atlas start" "add --init atlas" --atlas-label Caudate_L --atlas-label Putamen_L
 refused "an atlas label not in the table" "did you mean" --init atlas --atlas-label Caudate_L --atlas-label Putamn_L
 
