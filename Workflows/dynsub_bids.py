@@ -2,10 +2,9 @@
 dataset holds, what each job writes and under which BIDS derivative names,
 and the group table.
 
-A job is one `dynsub segment` run on one T1w image: the structures it has
-landmark files for, segmented together so that they do not overlap, or one
-structure started from a seed click (a run of several structures starts
-each from its landmarks, so a seeded structure is a job of its own).
+A job is one `dynsub segment` run on one T1w image: every structure it has
+landmarks or a seed click for, segmented together so that they do not
+overlap.
 
 Naming (BIDS 1.9 derivatives, "imaging data types: segmentations"), beside
 the image's own path. A job of one structure names its labelmap by it:
@@ -94,8 +93,10 @@ class Structure:
 
 
 class Job:
-    """One `dynsub segment` run: structures of one T1w image (dseg.tsv's
-    order), several only when all start from their landmarks."""
+    """One `dynsub segment` run: the structures of one T1w image, in
+    dseg.tsv's order: those with landmarks first, then those from a seed
+    click alone (the order in which `dynsub segment` pairs an --init per
+    structure with the point lists)."""
 
     def __init__(self, structures):
         self.structures = structures
@@ -121,8 +122,8 @@ class Job:
         return self.stem + self.desc
 
     @property
-    def seed(self):
-        return self.structures[0].seed if len(self.structures) == 1 else None
+    def seeds(self):  # each structure's seed click, or None
+        return [s.seed for s in self.structures]
 
     def inputs(self):
         files = {"t1w": self.t1w}
@@ -288,19 +289,13 @@ def find_structures(bids, landmarks_dir, seeds_table, reference_dir, warn=_warn)
 
 
 def group_jobs(structures, warn=_warn):
-    """The jobs of the structures (find_structures'), keyed by Job.key: per
-    T1w image, the structures that start from their landmarks alone as one
-    job, and each structure with a seed click as a job of its own. A
+    """The jobs of the structures (find_structures'), keyed by Job.key: one
+    per T1w image, its structures segmented together (Job's order). A
     reference that names some of a job's structures but not all is warned
     of: the job is not scored."""
     together, jobs = {}, {}
-    for key in sorted(structures):
-        structure = structures[key]
-        if structure.seed:
-            job = Job([structure])
-            jobs[job.key] = job
-        else:
-            together.setdefault(structure.stem, []).append(structure)
+    for key in sorted(structures, key=lambda key: (key[0], not structures[key].landmarks, key[1])):
+        together.setdefault(structures[key].stem, []).append(structures[key])
     for group in together.values():
         job = Job(group)
         jobs[job.key] = job
@@ -391,20 +386,19 @@ def _earlier_paths(job, out):
             alone = output_paths(out, job.dir, job.stem, f"_desc-{s.name}")
             paths += [alone["dseg"], alone["lut"], alone["sidecar"],
                       view_path(out, job.dir, job.stem, f"_desc-{s.name}")]
-    if not job.seed:
-        # The image's landmark job: a joint labelmap from before is this
-        # job's, and so are the files of the structures its sidecar lists,
-        # also those the dataset no longer has landmarks for.
-        joint = output_paths(out, job.dir, job.stem, "")
-        try:
-            listed = [s["Name"] for s in json.load(open(joint["sidecar"])).get("Structures", [])]
-        except (OSError, ValueError, KeyError, TypeError, AttributeError):
-            listed = []
-        for name in listed:
-            if re.fullmatch(LABEL, str(name)):
-                paths += own_files(name)
-        if len(job.structures) == 1:
-            paths += list(joint.values()) + [view_path(out, job.dir, job.stem, "")]
+    # The image's job: a joint labelmap from before is this job's, and
+    # so are the files of the structures its sidecar lists, also those
+    # the dataset no longer has landmarks or a seed for.
+    joint = output_paths(out, job.dir, job.stem, "")
+    try:
+        listed = [s["Name"] for s in json.load(open(joint["sidecar"])).get("Structures", [])]
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        listed = []
+    for name in listed:
+        if re.fullmatch(LABEL, str(name)):
+            paths += own_files(name)
+    if len(job.structures) == 1:
+        paths += list(joint.values()) + [view_path(out, job.dir, job.stem, "")]
     return paths
 
 
@@ -434,8 +428,9 @@ def run_segmentation(job, out, log, dynsub, extra_args, bids):
         if several:
             for s in job.structures:
                 command += ["--name", s.name]
-        if job.seed:
-            command += ["--init", "seed:%r,%r,%r" % job.seed]
+        if any(job.seeds):  # an --init per structure, in its order
+            for seed in job.seeds:
+                command += ["--init", "seed:%r,%r,%r" % seed if seed else "auto"]
         if job.reference:
             command += ["--reference", job.reference]
             for values in job.reference_labels:
@@ -474,17 +469,17 @@ def run_segmentation(job, out, log, dynsub, extra_args, bids):
         sidecar = {
             "Description": f"{names} segmented by dynamic Catmull-Clark subdivision surfaces (dynsub segment)"
                            + (", together so that they do not overlap" if several else "")
-                           + (" from a seed click" if job.seed and not job.structures[0].landmarks else ""),
+                           + "".join(f", {s.name} from a seed click" for s in job.structures
+                                     if s.seed and not s.landmarks),
             "Sources": sources,
             "SpatialReference": f"bids:raw:{_relative(job.t1w, bids)}",
             "Report": os.path.basename(outputs["report"]),
             "Structures": [{"Index": i + 1, "Name": s.name,
                             **{k.capitalize(): os.path.basename(p)
-                               for k, p in structure_paths(out, job.dir, job.stem, s.name).items()}}
+                               for k, p in structure_paths(out, job.dir, job.stem, s.name).items()},
+                            **({"SeedLPS": list(s.seed)} if s.seed else {})}
                            for i, s in enumerate(job.structures)],
         }
-        if job.seed:
-            sidecar["SeedLPS"] = list(job.seed)
         with open(outputs["sidecar"], "w") as f:
             json.dump(sidecar, f, indent=2)
             f.write("\n")

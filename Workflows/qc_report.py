@@ -2,7 +2,7 @@
 table that flags outliers and shows each row's warnings and trust flags, a
 filter for flagged rows, a pass/fail rating per row exported as TSV, and
 per job (one run of `dynsub segment`: an image's structures segmented
-together, or one from a seed) each structure's slices with the contour, its
+together) each structure's slices with the contour, its
 3D view, its convergence plot and its numbers, and an interactive view
 (NiiVue: the image with the labelmap on three planes and the surfaces in 3D). The figures and the
 views' data stay separate files beside it, loaded as they scroll into view

@@ -103,11 +103,11 @@ out="$bids/derivatives/dynsub"
 "$DYNSUB_BIDS" "$bids" "$out" participant --profile "$work/profile" >"$work/run.log" 2>&1
 check "participant level through Slurm: exit 0" test $? -eq 0 || tail -40 "$work/run.log"
 grep -o "external jobid '[0-9]*'" "$work/run.log" | grep -o "[0-9]*" >"$work/ids"
-check "4 jobs submitted with sbatch" test "$(wc -l <"$work/ids")" -eq 4
+check "3 jobs submitted with sbatch" test "$(wc -l <"$work/ids")" -eq 3
 check "every job completed under Slurm, with the profile's partition, account and time" "$python" - "$work/ids" <<'PY'
 import subprocess, sys
 jobs = open(sys.argv[1]).read().split()
-assert len(jobs) == 4, jobs
+assert len(jobs) == 3, jobs
 for job in jobs:
     fields = dict(f.split("=", 1) for f in subprocess.run(["scontrol", "show", "job", "-o", job], capture_output=True,
                                                           text=True, check=True).stdout.split() if "=" in f)
@@ -116,10 +116,10 @@ for job in jobs:
     assert (fields["Partition"], fields["Account"], fields["TimeLimit"]) == ("dynsubtest", "neuro", "00:20:00"), fields
     assert fields["JobName"] == "dynsub-segment", fields
 PY
-check "Slurm's job logs in the work folder" test "$(ls "$out/work/slurm-logs" | wc -l)" -eq 4
+check "Slurm's job logs in the work folder" test "$(ls "$out/work/slurm-logs" | wc -l)" -eq 3
 "$DYNSUB_BIDS" "$bids" "$out" group >"$work/group.log" 2>&1
 check "group level: exit 0" test $? -eq 0 || tail -20 "$work/group.log"
-check "derivatives as on one machine" "$python" "$here/check_derivatives.py" "$bids" "$out" 4
+check "derivatives as on one machine" "$python" "$here/check_derivatives.py" "$bids" "$out" 3
 check "the caudate's Dice as on one machine" "$python" - "$out/segmentations.tsv" <<'PY'
 import csv, sys
 rows = {(r["participant_id"], r["structure"]): r for r in csv.DictReader(open(sys.argv[1]), delimiter="\t")}

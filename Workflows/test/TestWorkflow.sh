@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The Snakemake cohort workflow (Workflows/Snakefile) on a small BIDS cohort
 # made from Colin27 (make_cohort.py): the 1 mm MRI with two structures'
-# landmarks (one job: the two segmented together) and a seed click from a
-# seeds table (a job of its own), a rigidly moved copy with its two
+# landmarks and a seed click from a seeds table (one job: the three
+# segmented together), a rigidly moved copy with its two
 # structures' landmarks (.fcsv, RAS) and reference moved along, the 0.5 mm
 # MRI in a session (.csv landmarks).
 #  - `snakemake --cores 2` writes derivatives that keep the BIDS naming rules
@@ -37,10 +37,10 @@ check "cohort made" test -s "$work/bids/sub-02/anat/sub-02_T1w.nii.gz"
 snake out="$work/out" --cores 2 >"$work/run1.log" 2>&1
 check "first run: exit 0" test $? -eq 0 || tail -40 "$work/run1.log"
 check "first run: BIDS derivative names, sidecars, grids (and the raw cohort valid BIDS)" \
-  "$python" "$here/check_derivatives.py" "$work/bids" "$work/out" 4
+  "$python" "$here/check_derivatives.py" "$work/bids" "$work/out" 3
 cat "$work/out/segmentations.tsv"
-check "group table: 6 structures in 4 jobs, the moved copy as good as the original" "$python" - "$work/out" <<'PY'
-import csv, sys
+check "group table: 6 structures in 3 jobs, the moved copy as good as the original" "$python" - "$work/out" <<'PY'
+import csv, json, os, sys
 rows = {(r["participant_id"], r["session_id"], r["structure"]): r
         for r in csv.DictReader(open(sys.argv[1] + "/segmentations.tsv"), delimiter="\t")}
 original, moved = rows[("sub-01", "n/a", "caudateL")], rows[("sub-02", "n/a", "caudateL")]
@@ -48,11 +48,18 @@ putamen, moved_putamen = rows[("sub-01", "n/a", "putamenL")], rows[("sub-02", "n
 fine = rows[("sub-03", "ses-2", "caudateL")]
 seed = rows[("sub-01", "n/a", "thalamusL")]
 assert len(rows) == 6 and all(r["status"] == "ok" for r in rows.values()), rows
-# The caudate and putamen share one labelmap (values 1 and 2; check_derivatives
-# checks that it holds both), the thalamus from its seed has its own.
-assert original["dseg"] == putamen["dseg"] == "sub-01/anat/sub-01_space-orig_dseg.nii.gz", (original, putamen)
-assert (original["index"], putamen["index"], seed["index"]) == ("1", "2", "1"), (original, putamen, seed)
-assert seed["dseg"] == "sub-01/anat/sub-01_space-orig_desc-thalamusL_dseg.nii.gz", seed
+# The caudate, the putamen and the thalamus from its seed share one labelmap
+# (values 1-3, the structures with landmarks first; check_derivatives checks
+# that it holds them all).
+assert original["dseg"] == putamen["dseg"] == seed["dseg"] == "sub-01/anat/sub-01_space-orig_dseg.nii.gz", \
+    (original, putamen, seed)
+assert (original["index"], putamen["index"], seed["index"]) == ("1", "2", "3"), (original, putamen, seed)
+# The sidecar keeps the seeded structure's click, as the seeds table gives it.
+sidecar = json.load(open(sys.argv[1] + "/sub-01/anat/sub-01_space-orig_dseg.json"))
+entries = {e["Name"]: e for e in sidecar["Structures"]}
+click = next(csv.DictReader(open(os.path.dirname(sys.argv[1]) + "/bids/derivatives/seeds.tsv"), delimiter="\t"))
+assert entries["thalamusL"]["SeedLPS"] == [float(click[c]) for c in "xyz"] and "SeedLPS" not in entries["caudateL"], \
+    entries
 assert float(original["dice"]) >= 0.84, original          # the demo's 0.850 alone, 0.853 with the putamen
 assert float(putamen["dice"]) >= 0.88, putamen          # measured 0.890 with the caudate
 assert abs(float(moved["dice"]) - float(original["dice"])) <= 0.01, (moved, original)  # rigid motion changes nothing
@@ -94,22 +101,21 @@ assert bids.job_paths("/o", jobs[("sub-04_run-1", "_desc-caudateL")])["dseg"] ==
     "/o/sub-04/anat/sub-04_run-1_space-orig_desc-caudateL_dseg.nii.gz"
 assert any("sub-06_foo-1_T1w.nii.gz: skipped" in w for w in warnings), warnings
 assert any("not used for caudateL" in w for w in warnings), warnings
-# Two structures' landmarks for one image are one job, named by no structure;
-# a reference that names only one of them scores neither, with a warning; a
-# structure with a seed is a job of its own.
+# Two structures' landmarks and a third's seed for one image are one job,
+# named by no structure, the structures with landmarks first; a reference
+# that names only one of them scores none, with a warning.
 touch(f"{landmarks}/sub-04/anat/sub-04_desc-putamenL_landmarks.csv")
 seeds = f"{root}/seeds.tsv"
 touch(seeds, "participant_id\tstructure\tx\ty\tz\nsub-04\tthalamusL\t1\t2\t3\n")
 warnings = []
 jobs = bids.group_jobs(bids.find_structures(root, landmarks, seeds, reference, warn=warnings.append),
                        warn=warnings.append)
-assert sorted(jobs) == [("sub-04_run-1", ""), ("sub-04_run-1", "_desc-thalamusL"),
-                        ("sub-05_acq-mprage_run-2", "_desc-caudateL")], sorted(jobs)
+assert sorted(jobs) == [("sub-04_run-1", ""), ("sub-05_acq-mprage_run-2", "_desc-caudateL")], sorted(jobs)
 together = jobs[("sub-04_run-1", "")]
-assert [s.name for s in together.structures] == ["caudateL", "putamenL"] and together.reference is None, vars(together)
+assert [s.name for s in together.structures] == ["caudateL", "putamenL", "thalamusL"], vars(together)
+assert together.reference is None and together.seeds == [None, None, (1.0, 2.0, 3.0)], vars(together)
 assert bids.job_paths("/o", together)["dseg"] == "/o/sub-04/anat/sub-04_run-1_space-orig_dseg.nii.gz"
 assert any("not used for caudateL either" in w for w in warnings), warnings
-assert jobs[("sub-04_run-1", "_desc-thalamusL")].seed == (1.0, 2.0, 3.0)
 touch(f"{landmarks}/sub-05/anat/sub-05_desc-putamenL_landmarks.csv")  # which of two runs?
 try:
     bids.find_structures(root, landmarks, None, reference, warn=warnings.append)
@@ -140,7 +146,7 @@ check "broken subject: flagged on the QC page" grep -q '<span class="flag">faile
 
 snake out="$work/cluster" --profile "$WORKFLOWS/profiles/slurm" -n >"$work/dry.log" 2>&1
 check "Slurm profile: dry run exits 0" test $? -eq 0
-check "Slurm profile: dry run plans 5 segmentations" grep -q -P "^segment\s+5\s" "$work/dry.log"
+check "Slurm profile: dry run plans 4 segmentations" grep -q -P "^segment\s+4\s" "$work/dry.log"
 check "Slurm profile: dry run writes nothing" test ! -e "$work/cluster/segmentations.tsv"
 rm "$work/bids/sub-04" "$work/bids/derivatives/landmarks/sub-04" -r  # the broken subject, done with
 
@@ -218,7 +224,7 @@ check "regrouped: the caudate alone has its own labelmap" \
 check "regrouped: the joint labelmap and the putamen's files are gone" \
   test -z "$(find "$work/out/sub-02" -name 'sub-02_space-orig_dseg*' -o -name '*putamenL*')"
 check "regrouped: the derivatives keep the naming rules" \
-  "$python" "$here/check_derivatives.py" "$work/bids" "$work/out" 4
+  "$python" "$here/check_derivatives.py" "$work/bids" "$work/out" 3
 
 snakemake -s "$WORKFLOWS/Snakefile" --cores 1 --config out="$work/x" >"$work/bad.log" 2>&1
 check "no bids: exit non-zero" test $? -ne 0

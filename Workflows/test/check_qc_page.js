@@ -109,7 +109,7 @@ async function cohort(context, pagePath, screenshot) {
   check("cohort: export carries the flags", failed !== undefined && failed[4] === "failed", JSON.stringify(failed));
 
   const views = await page.locator("button.view").count();
-  check("cohort: an interactive view per complete job", views === 4, views);
+  check("cohort: an interactive view per complete job", views === 3, views);
   await page.locator("button.view").first().click();
   let drawn = true;
   try {

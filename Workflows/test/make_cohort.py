@@ -5,8 +5,8 @@ the workflow:
     make_cohort.py TEMPLATES DATA DIR [--broken]
 
   sub-01          Colin27 at 1 mm; left caudate and putamen landmarks
-                  (.mrk.json, LPS: one job for both), a seed click in the left
-                  thalamus (seeds.tsv: a job of its own); AAL reference
+                  (.mrk.json, LPS) and a seed click in the left thalamus
+                  (seeds.tsv): one job for the three; AAL reference
   sub-02          the same MRI moved by a rigid transform (12 degrees about an
                   oblique axis, then 5, -8, 3 mm): its caudate and putamen
                   landmarks (.fcsv, in RAS) and its AAL reference move with it
