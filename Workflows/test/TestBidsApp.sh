@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # dynsub-bids, the BIDS App, on the cohort of make_cohort.py (sub-01: the
 # caudate and putamen from landmarks and the thalamus from a seed, in one
-# job; sub-02: a moved copy; sub-03 ses-2: the 0.5 mm MRI), with its outputs in derivatives/dynsub as
-# most users keep them:
+# job; sub-02: a moved copy; sub-03 ses-2: the 0.5 mm MRI), with its
+# outputs in derivatives/dynsub as most users keep them:
 #  - `participant --participant-label 01` segments sub-01 only and writes no
 #    group table; sub-02 and sub-03 then run at once, in two processes on one
 #    output folder, spelt the BIDS Apps way (--participant_label, sub- prefix,

@@ -21,8 +21,9 @@
 #    each), on a subject made from Colin27 (`dynsub subject`, seed 2): the
 #    image is registered to the atlas once, no voxel is in two structures,
 #    each one's Dice in dseg.nii.gz is within 0.01 of its segmentation
-#    alone, and each has its own click inside (--inside per atlas label). The subject's truth is the atlas's own labels carried to it, so
-#    the Dice themselves say nothing of accuracy; only the comparison counts;
+#    alone, and each has its own click inside (--inside per atlas label).
+#    The subject's truth is the atlas's own labels carried to it, so the
+#    Dice themselves say nothing of accuracy; only the comparison counts;
 #  - bad combinations of options are refused before anything is written.
 # Needs DYNSUB (the executable), DATA and TOOLS; python3-nibabel.
 set -u
@@ -30,6 +31,22 @@ source "$(dirname "${BASH_SOURCE[0]}")/Checks.sh"
 require_colin27
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
+# The checks' NIfTI reading (gzip'd .nii.gz, no nibabel needed), imported by each.
+cat >"$work/nifti.py" <<'PY'
+import gzip, struct
+def header(path):
+    """The grid's size and the sform's 12 values."""
+    data = gzip.open(path).read(348)
+    return struct.unpack_from("<8h", data, 40)[1:4], struct.unpack_from("<12f", data, 280)
+def labels(path):
+    """The voxels of a labelmap (uint8, int16 or uint16)."""
+    data = gzip.open(path).read()
+    dims = struct.unpack_from("<8h", data, 40)[1:4]
+    datatype, offset = struct.unpack_from("<h", data, 70)[0], int(struct.unpack_from("<f", data, 108)[0])
+    return struct.unpack_from("<%d%s" % (dims[0] * dims[1] * dims[2], {2: "B", 4: "h", 512: "H"}[datatype]), data,
+                              offset)
+PY
+export PYTHONPATH="$work"
 
 for s in "72 caudate_right" "74 putamen_right" "76 pallidum_right" "78 thalamus_right"; do
   set -- $s
@@ -57,19 +74,12 @@ together right "$work/caudate_right.mrk.json" "$work/putamen_right.mrk.json" "$w
 check_side() {
   check "$1: dseg, dseg.tsv, report and each structure's outputs; no voxel in two structures; Dice no lower" \
     python3 - "$work/$1" "$templates/ch2.nii.gz" "$2" "$3" <<'PY'
-import gzip, json, os, struct, sys
+import json, os, sys
+import nifti
 out, image, per, mean_tolerance = sys.argv[1], sys.argv[2], float(sys.argv[3]), float(sys.argv[4])
-def nifti(path):
-    data = gzip.open(path).read()
-    dims = struct.unpack_from("<8h", data, 40)
-    datatype, offset = struct.unpack_from("<h", data, 70)[0], int(struct.unpack_from("<f", data, 108)[0])
-    return dims[1:4], struct.unpack_from("<12f", data, 280), datatype, data, offset
-dims, sform, datatype, data, offset = nifti(out + "/dseg.nii.gz")
-mri = nifti(image)
+(dims, sform), mri = nifti.header(out + "/dseg.nii.gz"), nifti.header(image)
 ok = dims == mri[0] and all(abs(a - b) < 1e-4 for a, b in zip(sform, mri[1]))
-codes = {2: "B", 4: "h", 512: "H"}
-count = dims[0] * dims[1] * dims[2]
-labels = struct.unpack_from("<%d%s" % (count, codes[datatype]), data, offset)
+labels = nifti.labels(out + "/dseg.nii.gz")
 present = sorted(set(labels))
 ok = ok and present == [0, 1, 2, 3, 4]
 rows = [line.split("\t") for line in open(out + "/dseg.tsv").read().splitlines()]
@@ -132,7 +142,8 @@ cat "$work/seeded.log"
 check "the seeded structure alone: segment succeeds" test $? -eq 0
 check "a seeded structure with two from landmarks: its start, none in two, alone as its own run" \
   python3 - "$work/seeded" "$work/thalamus/report.json" <<'PY'
-import gzip, json, struct, sys
+import json, sys
+import nifti
 out, own = sys.argv[1], json.load(open(sys.argv[2]))
 report = json.load(open(out + "/report.json"))
 structures = report["structures"]
@@ -143,10 +154,7 @@ print("thalamusL Dice alone %.4f, its own run %.4f, in dseg %.4f" %
       (structures[2]["alone"]["dice"], own["dice"], structures[2]["joint"]["dice"]))
 ok = ok and abs(structures[2]["alone"]["dice"] - own["dice"]) < 1e-9
 ok = ok and all(s["joint"]["dice"] >= s["alone"]["dice"] - 0.01 for s in structures)
-data = gzip.open(out + "/dseg.nii.gz").read()
-dims = struct.unpack_from("<8h", data, 40)[1:4]
-datatype, offset = struct.unpack_from("<h", data, 70)[0], int(struct.unpack_from("<f", data, 108)[0])
-labels = struct.unpack_from("<%d%s" % (dims[0] * dims[1] * dims[2], {2: "B", 4: "h", 512: "H"}[datatype]), data, offset)
+labels = nifti.labels(out + "/dseg.nii.gz")
 ok = ok and sorted(set(labels)) == [0, 1, 2, 3] and report["shared_voxels_together"] == 0
 sys.exit(0 if ok else 1)
 PY
@@ -175,7 +183,8 @@ check "two atlas labels: segment succeeds" test $? -eq 0
 cat "$work/atlas.log"
 check "two atlas labels: one registration, named by the atlas's table, none in two, Dice no lower (0.01)" \
   python3 - "$work/atlas" "$insides" <<'PY'
-import gzip, json, struct, sys
+import json, sys
+import nifti
 out = sys.argv[1]
 report = json.load(open(out + "/report.json"))
 names = [s["name"] for s in report["structures"]]
@@ -201,10 +210,7 @@ ok = ok and len(given) == 2
 for s in report["structures"]:
     print(s["name"], "Dice alone %.4f, in dseg %.4f" % (s["alone"]["dice"], s["joint"]["dice"]))
     ok = ok and s["joint"]["dice"] >= s["alone"]["dice"] - 0.01
-data = gzip.open(out + "/dseg.nii.gz").read()
-dims = struct.unpack_from("<8h", data, 40)[1:4]
-datatype, offset = struct.unpack_from("<h", data, 70)[0], int(struct.unpack_from("<f", data, 108)[0])
-labels = struct.unpack_from("<%d%s" % (dims[0] * dims[1] * dims[2], {2: "B", 4: "h", 512: "H"}[datatype]), data, offset)
+labels = nifti.labels(out + "/dseg.nii.gz")
 ok = ok and sorted(set(labels)) == [0, 1, 2] and report["shared_voxels_together"] <= report["shared_voxels_alone"]
 sys.exit(0 if ok else 1)
 PY
