@@ -3,11 +3,11 @@
 # (`dynsub segment` with four --landmarks) against the same structures alone
 # (report.json's "alone": each structure's first segmentation, as a separate
 # run gives it): on Colin27 and on realistic single-scan subjects made from it
-# (`dynsub subject`, seeds 1-3, no thick slices), 36 clicks per structure on 6
+# (`dynsub subject`, seeds 1-3 or SEEDS, no thick slices), 36 clicks per structure on 6
 # coronal slices made from each image's own labels. Prints, per run, each
 # structure's Dice alone and in dseg.nii.gz, then the mean change, the worst
 # and how many are lower.
-# Usage: Tools/structures_together.sh [WORKDIR]   (from the repository; build first)
+# Usage: [SEEDS="4 5 6"] Tools/structures_together.sh [WORKDIR]   (from the repository; build first)
 set -eu
 root=$(cd "$(dirname "$0")/.." && pwd)
 dynsub=$root/build/bin/dynsub
@@ -33,7 +33,7 @@ run() {  # run NAME IMAGE LABELS
 }
 mkdir -p "$work/colin27"
 run colin27 "$templates/ch2.nii.gz" "$templates/aal.nii.gz"
-for seed in 1 2 3; do
+for seed in ${SEEDS:-1 2 3}; do
   subject=$work/subject$seed
   [ -f "$subject/image.nii.gz" ] ||
     "$dynsub" subject "$templates/ch2.nii.gz" "$templates/aal.nii.gz" --seed $seed --set thick_fraction=0 \
