@@ -141,6 +141,9 @@ void printSummary(const Arguments& o, const SegmentOutcome& outcome, const Volum
             << (o.figures.figures ? " and the figures that could be rendered" : "") << '\n';
 }
 
+// The start given first, or the default (auto) when --init is not given.
+std::string firstStart(const Arguments& o) { return o.init.empty() ? "auto" : o.init.front(); }
+
 // `landmarks`: the one structure's, or null (no --landmarks).
 void runSegmentOne(const Arguments& o, const LandmarkSource* landmarks) {
   // Every input is read and checked before anything is written.
@@ -150,7 +153,7 @@ void runSegmentOne(const Arguments& o, const LandmarkSource* landmarks) {
     throw Error("--inside is given " + std::to_string(o.inside.size()) +
                 " times for one structure: give one click inside it");
   SegmentInputs inputs;
-  inputs.start = parseSegmentStart(o.init.empty() ? "auto" : o.init.front(), "--init");
+  inputs.start = parseSegmentStart(firstStart(o), "--init");
   // One structure's values, as N[,M...] or as several values (71 72).
   std::vector<int> referenceLabels;
   for (const std::string& values : o.referenceLabels)
@@ -222,7 +225,7 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
   // --init per structure starts each from its own model (a seed click, say):
   // the lists' in their order, then any further structures without
   // landmarks.
-  const std::string first = o.init.empty() ? "auto" : o.init.front();
+  const std::string first = firstStart(o);
   const bool atlas = first == "atlas";
   const bool each = o.init.size() > 1;
   if (each) {
