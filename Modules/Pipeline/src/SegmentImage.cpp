@@ -430,7 +430,7 @@ SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& in, const 
       5);
   outcome.result = [&] {
     try {
-      return segment(image, springs, initial, options, recorder.callback(progress), extraForces);
+      return segment(image, springs, initial, options, recorder.callback(progress), extraForces, in.resume.get());
     } catch (const LandmarksOffEdges& error) {
       // Name where the points came from, and the options that help.
       throw Error(in.landmarkSource, std::string(error.what()) + " (--edge-landmark-reach, --edge-reference image)");

@@ -238,6 +238,7 @@ StructuresOutcome segmentStructures(const Volume& image, const std::vector<Struc
       if (out.structures[s].carried) {
         inputs[s].inputs.atlasCarried = std::make_shared<const CarriedLabel>(std::move(*out.structures[s].carried));
       }
+      inputs[s].inputs.resume = std::make_shared<const SegmentResult>(std::move(out.structures[s].result));
       out.structures[s] = segmentOne(image, inputs[s], parameters, progress, &wall);
     }
     masks = masksOf();

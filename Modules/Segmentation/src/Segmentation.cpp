@@ -278,7 +278,7 @@ SegmentResult evolveInRegion(const SegmentationRegion& region, const std::vector
 
 SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmarks, const ControlMesh& initial,
                       const SegmentOptions& options, const ProgressCallback& progress,
-                      const std::vector<ForceModel*>& extraForces) {
+                      const std::vector<ForceModel*>& extraForces, const SegmentResult* resume) {
   // Soft springs at the structure's ends beyond the clicked slices (SliceEnds.h).
   SliceEnds ends;
   if (options.sliceEnds.enabled) ends = findSliceEnds(image, landmarks, initial, options.sliceEnds);
@@ -295,8 +295,10 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
     const LimitSurface limit(initial);
     return enclosedVolume(tessellate(limit, initial.points(), outputSegments(limit)));
   });
-  SegmentResult result = evolveInRegion(region, landmarks, initial, {}, options, progress, forces,
-                                        pressure ? &*pressure : nullptr);
+  const bool resumes = resume && region.covers(limitPoints(resume->mesh, 2));
+  SegmentResult result =
+      evolveInRegion(region, landmarks, resumes ? resume->mesh : initial, resumes ? resume->origin : LevelOrigin{},
+                     options, progress, forces, pressure ? &*pressure : nullptr);
   result.sliceEnds = std::move(ends);
 
   if (!result.mesh.points().allFinite()) throw Error("the evolution produced a non-finite surface");

@@ -75,6 +75,10 @@ struct SegmentInputs {
   // With an atlas start: a click inside the structure (LPS mm), which picks
   // the carried label's part and moves a misplaced one to it.
   std::optional<Vector3> inside;
+  // An earlier segmentation of these inputs, whose surface and levels the
+  // evolution resumes from (segment()'s `resume`): a structure segmented
+  // again beside others (SegmentStructures.h).
+  std::shared_ptr<const SegmentResult> resume;
 };
 
 struct SegmentOutcome {

@@ -6,9 +6,12 @@
 //     nearest landmark: a surface near its springs is held there by the
 //     expert's evidence, one far from them only by its smoothness and the
 //     image. This splits the image into territories;
-//  3. each structure that shared voxels is segmented again, with the others'
+//  3. each structure that shared voxels evolves again, with the others'
 //     territories as a barrier: a force that pushes its surface out of them,
-//     in proportion to how deep it went (SegmentParameters::barrierStiffness);
+//     in proportion to how deep it went (SegmentParameters::barrierStiffness).
+//     It resumes from its first surface and levels (segment()'s `resume`),
+//     already at equilibrium with its clicks and edges, so that the barrier
+//     moves it near the wall and the rest stays as its run alone left it;
 //  4. the labelmaps are joined as in 2, so that no voxel has two structures.
 // A shared boundary with no edge on it (putamen and pallidum on a T1) is then
 // where the two structures meet, not wherever each alone stopped. Each

@@ -149,9 +149,15 @@ ControlMesh initialFromLandmarks(const std::vector<Landmark>& landmarks, double 
 // the landmarks are on no edge (EdgePotential.h). extraForces (not owned) act besides the
 // image, landmark and inflation forces, e.g. an interactive pull
 // (ForceModel.h); the progress callback may throw to stop the evolution.
+// `resume`, if given, is an earlier result of the same inputs: the region,
+// the ends and the collapse check still come from `initial`, but the
+// evolution resumes from that result's surface and levels, so that extra
+// forces move it only where they act (a structure pushed back from its
+// neighbours keeps the rest of its equilibrium). A result whose surface left
+// the region is not resumed from: the evolution starts from `initial`.
 SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmarks, const ControlMesh& initial,
                       const SegmentOptions& options, const ProgressCallback& progress = nullptr,
-                      const std::vector<ForceModel*>& extraForces = {});
+                      const std::vector<ForceModel*>& extraForces = {}, const SegmentResult* resume = nullptr);
 
 // The evolution alone, in a region built for these options (no labelmap; the
 // result's landmarkDistances and levels are filled): what an interactive
