@@ -344,6 +344,22 @@ void runTogether(Arguments& a, const Volume& image, const std::vector<LandmarkSo
   const std::shared_ptr<const Atlas> atlasData =
       atlas ? std::make_shared<const Atlas>(readAtlas(kDefaultAtlasImage, kDefaultAtlasLabels)) : nullptr;
   std::vector<StructureInputs> structures = structuresToSegment(a.image, files, atlasData, atlasLabels);
+  // A list of one point is a click inside its structure, as one point is for
+  // one structure: the start of a structure without an atlas label, the click
+  // that places its atlas label otherwise.
+  for (StructureInputs& structure : structures) {
+    SegmentInputs& in = structure.inputs;
+    if (in.landmarks.size() != 1) continue;
+    const Vector3 click = in.landmarks.front().position;
+    in.landmarks.clear();
+    if (in.atlas) {
+      in.inside = click;
+    } else {
+      in.start.kind = SegmentStart::Kind::Seed;
+      in.start.center = click;
+      in.start.text = "inside:the one point of " + structure.name;
+    }
+  }
   // The segments' names: the lists' own ("Caudate L"), else the atlas's.
   std::vector<std::string> names;
   for (std::size_t s = 0; s < n; ++s) {
