@@ -10,7 +10,7 @@
 #  - one point only: read as a click inside the caudate;
 #  - a markups file with two lists, or two atlas labels: both segmented
 #    together, with a .seg.nrrd that names them; a list of one point is a
-#    click inside its structure;
+#    click inside its structure (its start, or its atlas label's click);
 #  - bad input: exit 1 with a message naming the problem and no output;
 #    a usage error: exit 2.
 # Needs MODULE (the executable), DATA and TOOLS; Debian's python3 with
@@ -166,6 +166,20 @@ check "a list of one point: the caudate (1) has Dice >= 0.80" \
 check "a list of one point: the .seg.nrrd names both" \
   "$python" "$here/slicer_module_check.py" segmentation "$work/click.seg.nrrd" "$work/click.nrrd" \
   "Caudate L=1" "Thalamus L=2"
+# Lists of one point each, paired with atlas labels: each point is the click
+# inside its atlas structure (--inside), which the run's report keeps.
+"$python" - "$work/clicks.mrk.json" <<'PY'
+import json, sys
+lists = [{"type": "Fiducial", "coordinateSystem": "LPS", "name": name,
+          "controlPoints": [{"label": "inside", "position": position}]}
+         for name, position in (("Caudate L", [15.4, -1.5, 16.0]), ("Putamen L", [25.0, -2.0, 2.0]))]
+json.dump({"markups": lists}, open(sys.argv[1], "w"))
+PY
+"$MODULE" --landmarks "$work/clicks.mrk.json" --atlasLabel "Caudate_L;73" --labelmap "$work/clicks.nrrd" \
+  --report "$work/clicks.json" "$work/ch2.nrrd" >"$work/clicks.out" 2>"$work/clicks.err"
+check "lists of one point with atlas labels: exit 0" test $? -eq 0
+check "lists of one point with atlas labels: each structure's click inside is in the report" \
+  test "$(grep -c '"inside_lps_mm"' "$work/clicks.json")" -eq 2
 # Two atlas labels, separated by ';': segmented together, named by the
 # atlas's table. Colin27 is the atlas's own brain, so this checks the run and
 # its outputs, not accuracy.

@@ -255,6 +255,7 @@ StructuresOutcome segmentStructures(const Volume& image, const std::vector<Struc
     r.set("name", structures[s].name);
     r.set("landmarks", in.landmarkSource);
     r.set("init", in.start.text);
+    if (in.inside) r.set("inside_lps_mm", *in.inside);
     r.set("segmented_again", static_cast<bool>(out.segmentedAgain[s]));
     r.set("volume_mm3",
           static_cast<double>(out.structures[s].labelmap.count()) * out.structures[s].labelmap.geometry.spacing.prod());
