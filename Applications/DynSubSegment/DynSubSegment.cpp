@@ -260,6 +260,15 @@ void reportWarnings(const SegmentOutcome& outcome, const std::string& structure)
     std::cerr << "not to trust (" << of << flag.name << "): " << flag.message << '\n';
 }
 
+// One point cannot outline a structure: it is read as a click inside it, the
+// structure's seed start. `from` says where the point came from, for the report.
+void startFromTheOnePoint(SegmentInputs& in, const std::string& from) {
+  in.start.kind = SegmentStart::Kind::Seed;
+  in.start.center = in.landmarks.front().position;
+  in.start.text = "inside:" + from;
+  in.landmarks.clear();
+}
+
 // One structure: from the points, the file's one list, a click inside, or
 // the atlas.
 void runOne(Arguments& a, const Volume& image, const LandmarkSource* file, SlicerProgress& progress) {
@@ -283,11 +292,7 @@ void runOne(Arguments& a, const Volume& image, const LandmarkSource* file, Slice
     in.start.center = parsePoint(a.inside, "--inside");
     in.start.text = "inside:" + a.inside;
   } else if (in.landmarks.size() == 1) {
-    // One point cannot outline a structure: it is read as a click inside it.
-    in.start.kind = SegmentStart::Kind::Seed;
-    in.start.center = in.landmarks.front().position;
-    in.start.text = "inside:" + (a.seeds.empty() ? std::string("the one point of ") + a.landmarks : a.seeds.front());
-    in.landmarks.clear();
+    startFromTheOnePoint(in, a.seeds.empty() ? "the one point of " + a.landmarks : a.seeds.front());
   }
   checkSegmentInputs(in, a.parameters);
 
@@ -350,14 +355,11 @@ void runTogether(Arguments& a, const Volume& image, const std::vector<LandmarkSo
   for (StructureInputs& structure : structures) {
     SegmentInputs& in = structure.inputs;
     if (in.landmarks.size() != 1) continue;
-    const Vector3 click = in.landmarks.front().position;
-    in.landmarks.clear();
     if (in.atlas) {
-      in.inside = click;
+      in.inside = in.landmarks.front().position;
+      in.landmarks.clear();
     } else {
-      in.start.kind = SegmentStart::Kind::Seed;
-      in.start.center = click;
-      in.start.text = "inside:the one point of " + structure.name;
+      startFromTheOnePoint(in, "the one point of " + structure.name);
     }
   }
   // The segments' names: the lists' own ("Caudate L"), else the atlas's.

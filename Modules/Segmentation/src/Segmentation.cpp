@@ -295,7 +295,8 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
     const LimitSurface limit(initial);
     return enclosedVolume(tessellate(limit, initial.points(), outputSegments(limit)));
   });
-  const bool resumes = resume && region.covers(limitPoints(resume->mesh, 2));
+  // The earlier result's own limit surface (its topology's tables) serves the check.
+  const bool resumes = resume && region.covers(tessellate(*resume->limit, resume->mesh.points(), 2).points);
   SegmentResult result =
       evolveInRegion(region, landmarks, resumes ? resume->mesh : initial, resumes ? resume->origin : LevelOrigin{},
                      options, progress, forces, pressure ? &*pressure : nullptr);

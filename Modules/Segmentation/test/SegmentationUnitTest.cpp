@@ -173,8 +173,7 @@ TEST(TorusPhantom, SegmentsToDice95AndHalfAVoxel) {
 TEST(Segment, AResumedResultKeepsItsSurfaceAndLevel) {
   const Ellipsoid shape{Vector3(5, -3, 8), Vector3(20, 15, 12)};
   const ImageGeometry grid = gridAround(shape.centre, Vector3(60, 60, 60), Vector3(1, 1, 1), Matrix3::Identity());
-  const Phantom phantom = makePhantom(
-      grid, [&](const Vector3& x) { return shape.inside(x); }, 10.0, 7);
+  const Phantom phantom = makePhantom(grid, [&](const Vector3& x) { return shape.inside(x); }, 10.0, 7);
   const std::vector<Landmark> landmarks = shape.landmarks(5, 6);
   const ControlMesh initial = initialFromLandmarks(landmarks);
   const SegmentOptions options;
