@@ -1,12 +1,14 @@
 #include "NiftiLabelmap.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <memory>
+#include <vector>
 
 #include <Eigen/SVD>
-#include <libdeflate.h>
+#include <zlib.h>
 
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
@@ -18,9 +20,11 @@ namespace {
 constexpr std::size_t kHeaderBytes = 348;
 // The header and four zero bytes that say no extension follows.
 constexpr std::size_t kVoxelOffset = 352;
-// libdeflate's level 6 (zlib's default, and what ITK's writer uses): the
-// file about the size ITK wrote.
-constexpr int kCompressionLevel = 6;
+// A labelmap is long runs of one value, mostly 0: zlib's run-length strategy
+// (matches at distance 1 only) packs Colin27's caudate within 6 % of the
+// size of zlib's default level, which ITK's writer uses, in about a third
+// of its time.
+constexpr int kCompressionStrategy = Z_RLE;
 
 // A buffer left uninitialized until written.
 struct Bytes {
@@ -96,6 +100,36 @@ void writeHeader(unsigned char* file, const ImageGeometry& g) {
   std::memcpy(file + 344, "n+1", 4);
 }
 
+// `size` bytes from `data` as one gzip member, or an error naming `path`.
+// Fed to zlib in pieces: its counts are 32-bit.
+std::vector<unsigned char> gzip(const unsigned char* data, std::size_t size, const std::string& path) {
+  z_stream stream{};
+  // 15 + 16: a 32 KiB window with a gzip header and trailer.
+  if (deflateInit2(&stream, Z_DEFAULT_COMPRESSION, Z_DEFLATED, 15 + 16, 8, kCompressionStrategy) != Z_OK)
+    throw Error(path, "cannot start compressing the labelmap (out of memory?)");
+  const std::unique_ptr<z_stream, int (*)(z_stream*)> end(&stream, &deflateEnd);
+  constexpr std::size_t kPiece = std::size_t{1} << 30;
+  std::vector<unsigned char> packed;
+  unsigned char buffer[1 << 16];
+  int status = Z_OK;
+  std::size_t fed = 0;
+  while (status != Z_STREAM_END) {
+    if (stream.avail_in == 0 && fed < size) {
+      const std::size_t piece = std::min(kPiece, size - fed);
+      stream.next_in = const_cast<unsigned char*>(data + fed);
+      stream.avail_in = static_cast<uInt>(piece);
+      fed += piece;
+    }
+    stream.next_out = buffer;
+    stream.avail_out = sizeof buffer;
+    status = deflate(&stream, fed == size ? Z_FINISH : Z_NO_FLUSH);
+    if (status != Z_OK && status != Z_STREAM_END && status != Z_BUF_ERROR)
+      throw Error(path, "the labelmap could not be compressed (zlib status " + std::to_string(status) + ")");
+    packed.insert(packed.end(), buffer, buffer + (sizeof buffer - stream.avail_out));
+  }
+  return packed;
+}
+
 }  // namespace
 
 void writeNiftiLabelmap(const Mask& mask, std::uint8_t label, const std::string& path) {
@@ -119,17 +153,12 @@ void writeNiftiLabelmap(const Mask& mask, std::uint8_t label, const std::string&
   unsigned char* voxels = file.data.get() + kVoxelOffset;
   for (std::size_t v = 0; v < count; ++v) voxels[v] = mine[v] ? label : 0;
   const bool compressed = lowerCaseExtension(path) == ".gz";
+  const std::vector<unsigned char> gzipped = compressed ? gzip(file.data.get(), file.size, path)
+                                                        : std::vector<unsigned char>();
   AtomicOutput output(path);
   std::ofstream out(output.temporaryPath(), std::ios::binary);
   if (compressed) {
-    const std::unique_ptr<libdeflate_compressor, void (*)(libdeflate_compressor*)> compressor(
-        libdeflate_alloc_compressor(kCompressionLevel), &libdeflate_free_compressor);
-    if (!compressor) throw Error(path, "cannot start compressing the labelmap (out of memory?)");
-    Bytes packed(libdeflate_gzip_compress_bound(compressor.get(), file.size));
-    const std::size_t size =
-        libdeflate_gzip_compress(compressor.get(), file.data.get(), file.size, packed.data.get(), packed.size);
-    if (size == 0) throw Error(path, "the labelmap could not be compressed");
-    out.write(reinterpret_cast<const char*>(packed.data.get()), static_cast<std::streamsize>(size));
+    out.write(reinterpret_cast<const char*>(gzipped.data()), static_cast<std::streamsize>(gzipped.size()));
   } else {
     out.write(reinterpret_cast<const char*>(file.data.get()), static_cast<std::streamsize>(file.size));
   }
