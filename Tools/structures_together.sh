@@ -7,10 +7,11 @@
 # coronal slices made from each image's own labels. Prints, per run, each
 # structure's Dice alone and in dseg.nii.gz, then the mean change, the worst
 # and how many are lower.
-# Usage: [SEEDS="4 5 6"] Tools/structures_together.sh [WORKDIR]   (from the repository; build first)
+# Usage: [SEEDS="4 5 6"] [DYNSUB=BINARY] Tools/structures_together.sh [WORKDIR]
+# (from the repository; build first; DYNSUB is build/bin/dynsub unless given)
 set -eu
 root=$(cd "$(dirname "$0")/.." && pwd)
-dynsub=$root/build/bin/dynsub
+dynsub=${DYNSUB:-$root/build/bin/dynsub}
 templates=/usr/share/mricron/templates
 work=${1:-$(mktemp -d)}
 mkdir -p "$work"
