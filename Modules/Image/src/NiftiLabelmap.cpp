@@ -21,9 +21,9 @@ constexpr std::size_t kHeaderBytes = 348;
 // The header and four zero bytes that say no extension follows.
 constexpr std::size_t kVoxelOffset = 352;
 // A labelmap is long runs of one value, mostly 0: zlib's run-length strategy
-// (matches at distance 1 only) packs Colin27's caudate within 6 % of the
-// size of zlib's default level, which ITK's writer uses, in about a third
-// of its time.
+// (matches at distance 1 only) packs it a few per cent larger than zlib's
+// default level, which ITK's writer uses, in about a third of the time
+// (Documentation/Performance.md, "Outputs").
 constexpr int kCompressionStrategy = Z_RLE;
 
 // A buffer left uninitialized until written.
