@@ -68,13 +68,16 @@ vtkSmartPointer<vtkChartXY> convergenceChart(const ConvergenceHistory& history) 
   chart->GetLegend()->SetHorizontalAlignment(vtkChartLegend::RIGHT);
   chart->GetLegend()->SetVerticalAlignment(vtkChartLegend::TOP);
 
-  vtkPlot* energy = chart->AddPlot(vtkChart::LINE);
+  // A series of one point (a run that ended at its first step, or measured
+  // its fit once) is a marker: VTK refuses to draw a line through one point.
+  const auto kindFor = [](std::size_t points) { return points < 2 ? vtkChart::POINTS : vtkChart::LINE; };
+  vtkPlot* energy = chart->AddPlot(kindFor(steps.size()));
   energy->SetInputData(twoColumns("step", "energy (N mm)", steps, energies), 0, 1);
   energy->SetColor(40, 90, 200, 255);
   energy->SetWidth(2.0);
 
   if (!errors.empty()) {
-    vtkPlot* error = chart->AddPlot(vtkChart::LINE);
+    vtkPlot* error = chart->AddPlot(kindFor(errors.size()));
     error->SetInputData(twoColumns("step", history.fitErrorName.c_str(), errorSteps, errors), 0, 1);
     error->SetColor(220, 80, 30, 255);
     error->SetWidth(2.0);

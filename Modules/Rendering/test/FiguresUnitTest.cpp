@@ -19,12 +19,14 @@
 
 #include <vtkActor2DCollection.h>
 #include <vtkCellData.h>
+#include <vtkChartXY.h>
 #include <vtkCoordinate.h>
 #include <vtkCutter.h>
 #include <vtkDoubleArray.h>
 #include <vtkImageData.h>
 #include <vtkNew.h>
 #include <vtkPlane.h>
+#include <vtkPlot.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
@@ -39,6 +41,7 @@
 
 #include "BallPhantom.h"
 #include "dynsub/ConvergenceHistory.h"
+#include "dynsub/ConvergencePlot.h"
 #include "dynsub/Figures.h"
 #include "dynsub/ImageIO.h"
 #include "dynsub/Landmarks.h"
@@ -421,6 +424,20 @@ TEST_F(Rendering, TestTorusElements) { expectElementsMatchBaseline(kSource + "/D
 
 TEST_F(Rendering, TestConvergencePlot) {
   expectMatchesBaseline(convergenceFigure(readConvergenceCsv(kSource + "/Testing/Data/caudate_left_convergence.csv")));
+}
+
+// A fit that ends in two steps and measured its error at one of them (the
+// torus demo's): the error is a marker, as VTK draws no line through one point.
+TEST(ConvergencePlot, ASeriesOfOnePointIsAMarker) {
+  ConvergenceHistory history;
+  history.fitErrorName = "max error (%)";
+  history.add({0, 1, 6404.9, 1.02});
+  history.add({0, 2, 6399.1});
+  const vtkSmartPointer<vtkChartXY> chart = convergenceChart(history);
+  ASSERT_EQ(chart->GetNumberOfPlots(), 2);
+  EXPECT_TRUE(chart->GetPlot(0)->IsA("vtkPlotLine")) << "the energy, two points";
+  EXPECT_FALSE(chart->GetPlot(1)->IsA("vtkPlotLine")) << "the error, one point";
+  EXPECT_TRUE(chart->GetPlot(1)->IsA("vtkPlotPoints"));
 }
 
 // Sculpted Cube 3^3: the base fixed (red points), an arm of three extruded
