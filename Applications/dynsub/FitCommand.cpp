@@ -112,6 +112,9 @@ void runFit(FitCommandOptions o) {
       5);
   const FitResult result = fitPointCloud(data, initial, o.fit, recorder.callback(line.callback()));
   line.finish();
+  ConvergenceHistory history = recorder.history();
+  for (size_t i = 0; i < result.levels.size(); ++i)
+    history.setLevelEndError(result.levels[i].level, result.levelErrors[i].maxPercent);
 
   Report report;
   report.set("input", o.points);
@@ -165,7 +168,7 @@ void runFit(FitCommandOptions o) {
 
   const TriangleSurface surface = outputSurface(result.mesh, *result.surface);
   writeModelOutputs(dir, result.mesh, surface, report, [&](OutputSet& outputs) {
-    addFigureOutputs(outputs, o.figures, result.mesh, surface, recorder.history(), nullptr, MatrixX3(), data);
+    addFigureOutputs(outputs, o.figures, result.mesh, surface, history, nullptr, MatrixX3(), data);
   });
 
   std::cout << std::fixed << std::setprecision(3) << "fitted " << data.rows() << " points with "

@@ -1,5 +1,6 @@
 #include "dynsub/ConvergenceHistory.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -20,6 +21,12 @@ void ConvergenceHistory::add(const ConvergenceSample& sample) {
   while (!samples.empty() && samples.back().level == sample.level && samples.back().step >= sample.step)
     samples.pop_back();
   samples.push_back(sample);
+}
+
+void ConvergenceHistory::setLevelEndError(int level, double fitError) {
+  const auto last = std::find_if(samples.rbegin(), samples.rend(),
+                                 [level](const ConvergenceSample& s) { return s.level == level; });
+  if (last != samples.rend()) last->fitError = fitError;
 }
 
 ConvergenceRecorder::ConvergenceRecorder(std::string fitErrorName, FitError fitError, int stride)

@@ -1,4 +1,5 @@
-// The convergence record (ConvergenceHistory.h): restarted levels, and its CSV.
+// The convergence record (ConvergenceHistory.h): restarted levels, the levels'
+// end measures, and its CSV.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -22,6 +23,22 @@ TEST(ConvergenceHistory, ARestartedLevelDropsItsEarlierSteps) {
   EXPECT_EQ(h.samples[5].level, 1);
   EXPECT_EQ(h.samples[5].step, 1);
   EXPECT_DOUBLE_EQ(h.samples[5].energy, 3.5);
+}
+
+TEST(ConvergenceHistory, ALevelsEndErrorGoesOnItsLastStep) {
+  ConvergenceHistory h;
+  h.add({0, 1, 10.0, 1.5});
+  h.add({0, 2, 9.0});
+  h.add({1, 1, 4.0, 0.9});
+  h.add({1, 2, 3.0});
+  h.setLevelEndError(0, 0.75);
+  h.setLevelEndError(1, 0.5);
+  h.setLevelEndError(2, 0.25);  // no such level: nothing changes
+  ASSERT_EQ(h.samples.size(), 4u);
+  EXPECT_DOUBLE_EQ(h.samples[0].fitError, 1.5);
+  EXPECT_DOUBLE_EQ(h.samples[1].fitError, 0.75);
+  EXPECT_DOUBLE_EQ(h.samples[2].fitError, 0.9);
+  EXPECT_DOUBLE_EQ(h.samples[3].fitError, 0.5);
 }
 
 TEST(ConvergenceHistory, CsvRoundTripKeepsUnmeasuredErrors) {

@@ -444,6 +444,12 @@ SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& in, const 
   const auto finished = std::chrono::steady_clock::now();
   outcome.seconds = std::chrono::duration<double>(finished - started).count();
   outcome.history = recorder.history();
+  if (!outcome.result.landmarkDistances.empty() && !outcome.result.levels.empty()) {
+    const Eigen::Map<const Eigen::VectorXd> d(outcome.result.landmarkDistances.data(),
+                                              static_cast<Eigen::Index>(outcome.result.landmarkDistances.size()));
+    outcome.history.setLevelEndError(outcome.result.levels.back().level,
+                                     std::sqrt(d.squaredNorm() / static_cast<double>(d.size())));
+  }
   const SegmentResult& result = outcome.result;
   outcome.warnings = result.warnings;
   if (outcome.carried && in.landmarks.empty()) {

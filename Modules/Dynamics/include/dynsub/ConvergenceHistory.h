@@ -28,6 +28,10 @@ struct ConvergenceHistory {
   // Adds a step. A step number not after the level's last one means the level
   // restarted (a smaller time step after divergence): its earlier samples go.
   void add(const ConvergenceSample& sample);
+  // Puts `fitError` on the level's last step: the measure a command takes
+  // where the level ended, so that the chart ends where the report does. No
+  // sample of the level: nothing.
+  void setLevelEndError(int level, double fitError);
 };
 
 // Records every step's energy and, every `stride` steps (and at each level's
