@@ -420,13 +420,13 @@ SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& in, const 
   // The rms landmark distance every 5 steps, the landmarks' nearest points
   // tracked from sample to sample (a new locator only when the level changes).
   TrackedDistances tracked(landmarkPositions(springs));
+  const auto rms = [](const Eigen::Ref<const Eigen::VectorXd>& d) {
+    return std::sqrt(d.squaredNorm() / static_cast<double>(d.size()));
+  };
   ConvergenceRecorder recorder(
       "rms landmark distance (mm)",
       springs.empty() ? ConvergenceRecorder::FitError()
-                      : [&](const Progress& p) {
-                          const Eigen::VectorXd d = tracked.measure(*p.surface, p.level, *p.controlPoints);
-                          return std::sqrt(d.squaredNorm() / static_cast<double>(d.size()));
-                        },
+                      : [&](const Progress& p) { return rms(tracked.measure(*p.surface, p.level, *p.controlPoints)); },
       5);
   outcome.result = [&] {
     try {
@@ -444,12 +444,12 @@ SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& in, const 
   const auto finished = std::chrono::steady_clock::now();
   outcome.seconds = std::chrono::duration<double>(finished - started).count();
   outcome.history = recorder.history();
-  if (!outcome.result.landmarkDistances.empty() && !outcome.result.levels.empty()) {
-    const Eigen::Map<const Eigen::VectorXd> d(outcome.result.landmarkDistances.data(),
-                                              static_cast<Eigen::Index>(outcome.result.landmarkDistances.size()));
-    outcome.history.setLevelEndError(outcome.result.levels.back().level,
-                                     std::sqrt(d.squaredNorm() / static_cast<double>(d.size())));
-  }
+  // The chart ends on the landmarks' distances where the last level ended.
+  const std::vector<double>& ends = outcome.result.landmarkDistances;
+  if (!ends.empty() && !outcome.result.levels.empty())
+    outcome.history.setLevelEndError(
+        outcome.result.levels.back().level,
+        rms(Eigen::Map<const Eigen::VectorXd>(ends.data(), static_cast<Eigen::Index>(ends.size()))));
   const SegmentResult& result = outcome.result;
   outcome.warnings = result.warnings;
   if (outcome.carried && in.landmarks.empty()) {
