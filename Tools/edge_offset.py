@@ -32,6 +32,14 @@ def signed_distance(mask, spacing):
     return numpy.where(mask, -inside, outside)
 
 
+def load(path):
+    """A NIfTI image, or an error naming the file."""
+    try:
+        return nibabel.load(path)
+    except (OSError, nibabel.filebasedimages.ImageFileError) as error:
+        raise SystemExit(f"{path}: cannot read it as an image ({error})")
+
+
 def surface_points_in_voxels(path, affine):
     """surface.vtp's points (LPS mm) as continuous voxel indices of the NIfTI grid (RAS)."""
     from vtkmodules.util.numpy_support import vtk_to_numpy
@@ -55,8 +63,8 @@ def main():
     parser.add_argument("--surface", help="a segmentation's surface.vtp (LPS mm)")
     args = parser.parse_args()
 
-    labels_file = nibabel.load(args.labels)
-    image_file = nibabel.load(args.image)
+    labels_file = load(args.labels)
+    image_file = load(args.image)
     if labels_file.shape[:3] != image_file.shape[:3] or not numpy.allclose(labels_file.affine, image_file.affine):
         raise SystemExit(f"{args.image} and {args.labels} are not on one grid")
     spacing = tuple(float(s) for s in labels_file.header.get_zooms()[:3])

@@ -5,7 +5,8 @@
 # moves the peak in by about sigma^2 / 2R = 0.04 mm, and the profile is
 # sampled every 0.05 mm); with a brighter shell (200) from 13.5 to 15.5 mm,
 # whose edge is four times as strong and 1.5 mm out, the peak follows that
-# edge (median at least 1 mm out). A missing label is refused.
+# edge (median at least 1 mm out). A missing label and a missing file are
+# refused, each named.
 # Usage: TestEdgeOffset.sh TOOL
 set -u
 tool=$1
@@ -36,4 +37,8 @@ if /usr/bin/python3 "$tool" "$work/ball.nii.gz" "$work/labels.nii.gz" --label 7 
   echo "FAIL: a label with no voxel was accepted"; status=1
 fi
 grep -q "no voxel has label 7" "$work/err" || { echo "FAIL: the missing label's error"; cat "$work/err"; status=1; }
+if /usr/bin/python3 "$tool" "$work/none.nii.gz" "$work/labels.nii.gz" --label 1 2>"$work/err"; then
+  echo "FAIL: a missing image was accepted"; status=1
+fi
+grep -q "none.nii.gz: cannot read it as an image" "$work/err" || { echo "FAIL: the missing image's error"; cat "$work/err"; status=1; }
 exit $status
