@@ -21,6 +21,15 @@ std::unique_ptr<Far::TopologyRefiner> openSubdivRefiner(const ControlMesh& mesh)
   descriptor.numFaces = static_cast<int>(faceSizes.size());
   descriptor.numVertsPerFace = faceSizes.data();
   descriptor.vertIndicesPerFace = faceVertices.data();
+  std::vector<int> creaseEnds;
+  std::vector<float> creaseSharpness;
+  for (const Crease& crease : mesh.creases()) {
+    creaseEnds.insert(creaseEnds.end(), {crease.a, crease.b});
+    creaseSharpness.push_back(static_cast<float>(crease.sharpness));
+  }
+  descriptor.numCreases = static_cast<int>(creaseSharpness.size());
+  descriptor.creaseVertexIndexPairs = creaseEnds.data();
+  descriptor.creaseWeights = creaseSharpness.data();
   Sdc::Options rules;
   rules.SetVtxBoundaryInterpolation(Sdc::Options::VTX_BOUNDARY_EDGE_AND_CORNER);
   using Factory = Far::TopologyRefinerFactory<Far::TopologyDescriptor>;
@@ -32,7 +41,12 @@ std::unique_ptr<Far::TopologyRefiner> openSubdivRefiner(const ControlMesh& mesh)
 std::vector<ReferenceSample> openSubdivLimit(const ControlMesh& mesh, const std::vector<SurfacePoint>& points,
                                              int isolationLevel) {
   std::unique_ptr<Far::TopologyRefiner> refiner = openSubdivRefiner(mesh);
-  refiner->RefineAdaptive(Far::TopologyRefiner::AdaptiveOptions(isolationLevel));
+  // Infinitely sharp creases as boundary patches, exact, rather than isolated
+  // to the deepest level and approximated there by end caps (2^-10 of the
+  // patch's size off).
+  Far::TopologyRefiner::AdaptiveOptions options(isolationLevel);
+  options.useInfSharpPatch = true;
+  refiner->RefineAdaptive(options);
 
   // One location array per point keeps the bookkeeping trivial.
   std::vector<double> s(points.size()), t(points.size());

@@ -1,7 +1,8 @@
 #pragma once
 // OpenSubdiv's limit surface at given Ptex locations, in double precision, with
-// the boundary rules DynSub uses (boundary edges and corners sharp). A test
-// oracle only: DynSub does not use OpenSubdiv.
+// the boundary rules DynSub uses (boundary edges and corners sharp) and the
+// mesh's creases (OpenSubdiv's uniform sharpness rule). A test oracle only:
+// DynSub does not use OpenSubdiv.
 #include <memory>
 #include <vector>
 
@@ -17,7 +18,7 @@ struct ReferenceSample {
 };
 
 // An OpenSubdiv refiner for the mesh's topology with DynSub's boundary rules
-// (Catmull-Clark; boundary edges and corners sharp), not yet refined.
+// (Catmull-Clark; boundary edges and corners sharp) and its creases, not yet refined.
 std::unique_ptr<OpenSubdiv::Far::TopologyRefiner> openSubdivRefiner(const ControlMesh& mesh);
 
 // isolationLevel: OpenSubdiv's adaptive refinement depth (at most 10); points

@@ -1,5 +1,6 @@
 #include "TestMeshes.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "dynsub/StandardMeshes.h"
@@ -103,6 +104,82 @@ std::vector<NamedMesh> allTestMeshes() {
   meshes.push_back({"tetrahedron", makeTetrahedron()});
   meshes.push_back({"lshape", makeLShape()});
   meshes.push_back({"bumpytorus", makeBumpyTorus()});
+  return meshes;
+}
+
+namespace {
+
+// Sets the sharpness of every edge for which `sharpness(a, b)` is positive.
+template <class Rule>
+ControlMesh withCreases(ControlMesh mesh, Rule sharpness) {
+  std::vector<Crease> creases;
+  for (int e = 0; e < mesh.edgeCount(); ++e) {
+    const auto [a, b] = mesh.topology().edgeVertices(e);
+    const double s = sharpness(a, b);
+    if (s > 0.0) creases.push_back({a, b, s});
+  }
+  mesh.setCreases(creases, "test mesh");
+  return mesh;
+}
+
+// A cube of 8 vertices with its corners moved off the cube, so that no face is planar.
+ControlMesh makeCube8() {
+  MatrixX3 points(8, 3);
+  points << -1, -1, -1, 1, -1, -1, 1, 1, -1, -1, 1, -1, -1, -1, 1, 1, -1, 1, 1, 1, 1, -1, 1, 1;
+  for (Eigen::Index v = 0; v < 8; ++v) points.row(v) *= 1.0 + 0.15 * std::sin(2.0 * v + 1.0);
+  return ControlMesh::fromPolygons(
+      points, {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}}, "cube8");
+}
+
+}  // namespace
+
+std::vector<NamedMesh> creasedTestMeshes() {
+  constexpr double sharp = kInfiniteSharpness;
+  std::vector<NamedMesh> meshes;
+  meshes.push_back({"cube8sharp", withCreases(makeCube8(), [](int, int) { return sharp; })});
+  // Top face's edges 1.5, one vertical edge 2 and one 0.5 (a dart at its lower end).
+  meshes.push_back({"cube8semi", withCreases(makeCube8(), [](int a, int b) {
+                      if (a >= 4 && b >= 4) return 1.5;
+                      if (std::min(a, b) == 1 && std::max(a, b) == 5) return 2.0;
+                      if (std::min(a, b) == 3 && std::max(a, b) == 7) return 0.5;
+                      return 0.0;
+                    })});
+  // The 98-vertex cube (bent) with its twelve edges sharp, then semi-sharp (2.5).
+  ControlMesh cube = makeCube98();
+  MatrixX3 bent = cube.points();
+  for (Eigen::Index v = 0; v < bent.rows(); ++v) bent.row(v) *= 1.0 + 0.1 * std::sin(2.0 * bent(v, 0) + bent(v, 1));
+  const MatrixX3 lattice = cube.points();
+  cube.setPoints(bent);
+  // A cube edge joins two lattice points with two coordinates at +-1.
+  auto onCubeEdge = [&lattice](int a, int b) {
+    int shared = 0;
+    for (int c = 0; c < 3; ++c) shared += std::abs(lattice(a, c)) == 1.0 && lattice(a, c) == lattice(b, c);
+    return shared == 2;
+  };
+  meshes.push_back({"cube98sharp", withCreases(cube, [&](int a, int b) { return onCubeEdge(a, b) ? sharp : 0.0; })});
+  meshes.push_back({"cube98semi", withCreases(cube, [&](int a, int b) { return onCubeEdge(a, b) ? 2.5 : 0.0; })});
+  // The bumpy torus with one loop around its major circle sharp and another semi-sharp (2).
+  const ControlMesh torus = makeBumpyTorus();
+  meshes.push_back({"toruscreases", withCreases(torus, [](int a, int b) {
+                      const int ja = a % 4, jb = b % 4;  // position around the minor circle (makeTorus32)
+                      if (ja != jb) return 0.0;
+                      return ja == 0 ? sharp : ja == 2 ? 2.0 : 0.0;
+                    })});
+  // The sheet, bent, with a sharp crease across it from boundary to boundary
+  // and a semi-sharp one (0.5) crossing it.
+  ControlMesh sheet = makeSheet81();
+  MatrixX3 points = sheet.points();
+  for (Eigen::Index v = 0; v < points.rows(); ++v) {
+    points(v, 2) = 0.3 * std::abs(points(v, 1)) + 0.2 * points(v, 0) * points(v, 0);
+  }
+  sheet.setPoints(points);
+  meshes.push_back({"sheetcrease", withCreases(sheet, [&points](int a, int b) {
+                      if (points(a, 1) == 0.0 && points(b, 1) == 0.0) return sharp;
+                      if (points(a, 0) == 0.25 && points(b, 0) == 0.25) return 0.5;
+                      return 0.0;
+                    })});
+  // Triangles and an extraordinary apex with a semi-sharp base.
+  meshes.push_back({"pyramidsemi", withCreases(makePyramid(), [](int a, int b) { return a < 4 && b < 4 ? 2.0 : 0.0; })});
   return meshes;
 }
 

@@ -32,6 +32,13 @@ ControlMesh makeLShape();
 // The torus with its points moved by a fixed smooth displacement.
 ControlMesh makeBumpyTorus();
 
+// Meshes with creases (Topology.h), each of a kind checkCreases accepts:
+// infinitely sharp creases that meet at corners or end on boundaries, semi-sharp
+// ones of sharpness 0.5 to 2.5 (fractional, decaying at different steps, as
+// darts, crossing a sharp crease), on quads, triangles and extraordinary
+// vertices. Curved, like the meshes above.
+std::vector<NamedMesh> creasedTestMeshes();
+
 // GoogleTest prints a parameter by its name.
 inline void PrintTo(const NamedMesh& mesh, std::ostream* out) { *out << mesh.name; }
 

@@ -1,5 +1,6 @@
 #include "dynsub/ControlMesh.h"
 
+#include <cmath>
 #include <numeric>
 
 #include "dynsub/Error.h"
@@ -29,6 +30,35 @@ ControlMesh ControlMesh::fromTopology(const MatrixX3& points, Topology topology,
   mesh.points_ = points;
   mesh.topology_ = std::make_shared<const Topology>(std::move(topology));
   return mesh;
+}
+
+void ControlMesh::setCreases(const std::vector<Crease>& creases, const std::string& source) {
+  if (creases.empty()) return;
+  Topology topology = *topology_;
+  std::vector<double> sharpness(topology.edgeCount());
+  for (int e = 0; e < topology.edgeCount(); ++e) sharpness[e] = topology.edgeSharpness(e);
+  for (const Crease& crease : creases) {
+    const std::string edge = "crease (" + std::to_string(crease.a) + ", " + std::to_string(crease.b) + ")";
+    const bool inRange = crease.a >= 0 && crease.b >= 0 && crease.a < vertexCount() && crease.b < vertexCount();
+    const int e = inRange ? topology.findEdge(crease.a, crease.b) : -1;
+    if (e < 0) throw Error(source, edge + " is not an edge of the mesh (vertices are numbered from 0)");
+    if (!(crease.sharpness >= 0.0 && std::isfinite(crease.sharpness)))
+      throw Error(source, edge + " has sharpness " + std::to_string(crease.sharpness) +
+                              " (expected a finite value >= 0)");
+    sharpness[e] = crease.sharpness;
+  }
+  topology.setEdgeSharpness(std::move(sharpness));
+  checkCreases(topology, source);
+  topology_ = std::make_shared<const Topology>(std::move(topology));
+}
+
+std::vector<Crease> ControlMesh::creases() const {
+  std::vector<Crease> result;
+  for (int e = 0; e < edgeCount(); ++e) {
+    const double sharpness = topology_->edgeSharpness(e);
+    if (sharpness > 0.0) result.push_back({topology_->edgeVertices(e)[0], topology_->edgeVertices(e)[1], sharpness});
+  }
+  return result;
 }
 
 int ControlMesh::eulerCharacteristic() const { return vertexCount() - edgeCount() + faceCount(); }

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "dynsub/Error.h"
+#include "dynsub/Topology.h"
 
 namespace dynsub {
 
@@ -124,6 +125,35 @@ void checkPolygonMesh(const MatrixX3& points, const std::vector<std::vector<int>
     if (fans > 1) {
       throw Error(source, "vertex " + std::to_string(v) + " joins " + std::to_string(fans) +
                               " separate fans of faces: the mesh is not manifold there");
+    }
+  }
+}
+
+void checkCreases(const Topology& topology, const std::string& source) {
+  if (!topology.hasCreases()) return;
+  for (int v = 0; v < topology.vertexCount(); ++v) {
+    int sharp = 0, infinite = 0;
+    for (int e : topology.vertexEdges(v)) {
+      sharp += topology.isSharpEdge(e);
+      infinite += !topology.isBoundaryEdge(e) && topology.edgeSharpness(e) >= kInfiniteSharpness;
+    }
+    if (infinite == 0) continue;
+    const std::string at = "vertex " + std::to_string(v) + ": ";
+    if (sharp == 1) {
+      throw Error(source, at + "a sharp crease ends inside the surface (a dart), which is not supported; "
+                               "end it at a corner of three or more creases or on a boundary, or make it semi-sharp "
+                               "(sharpness below " + std::to_string(static_cast<int>(kInfiniteSharpness)) + ")");
+    }
+    const bool corner = sharp > 2 || topology.vertexFaces(v).size() == 1;
+    for (const std::vector<int>& sector : topology.sharpSectors(v)) {
+      if (corner && sector.size() != 1) {
+        throw Error(source, at + "a corner of " + std::to_string(sharp) + " sharp edges with " +
+                                std::to_string(sector.size()) +
+                                " faces between two of them is not supported (one face is)");
+      }
+      if (!corner && sector.size() < 2) {
+        throw Error(source, at + "a sharp crease with a single face on one side is not supported (two or more are)");
+      }
     }
   }
 }

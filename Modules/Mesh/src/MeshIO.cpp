@@ -56,6 +56,24 @@ long parseInteger(const std::string& token, const std::string& path, int line) {
   }
 }
 
+// The rest of a "t" record: only "crease 2/1/0 a b sharpness" is DynSub's to read.
+Crease parseCreaseTag(std::istringstream& record, const std::string& path, int line) {
+  const std::string at = "line " + std::to_string(line) + ": ";
+  std::string name, counts, a, b, sharpness, extra;
+  record >> name >> counts;
+  if (name != "crease") {
+    throw Error(path, at + "the tag '" + name + "' is not supported (DynSub reads 't crease' tags only)");
+  }
+  if (counts != "2/1/0" || !(record >> a >> b >> sharpness) || (record >> extra)) {
+    throw Error(path, at + "a crease tag must read 't crease 2/1/0 a b sharpness'");
+  }
+  const long first = parseInteger(a, path, line), second = parseInteger(b, path, line);
+  if (first < 0 || second < 0 || first > std::numeric_limits<int>::max() || second > std::numeric_limits<int>::max()) {
+    throw Error(path, at + "crease vertex indices are numbered from 0 and cannot be negative");
+  }
+  return Crease{static_cast<int>(first), static_cast<int>(second), parseNumber(sharpness, path, line)};
+}
+
 PolygonData readObj(const std::string& path) {
   std::ifstream in = openForReading(path);
   std::vector<Vector3> points;
@@ -89,6 +107,8 @@ PolygonData readObj(const std::string& path) {
         face.push_back(static_cast<int>(resolved));
       }
       data.faces.push_back(std::move(face));
+    } else if (keyword == "t") {
+      data.creases.push_back(parseCreaseTag(record, path, line));
     }
   }
   data.points = toMatrix(points);
@@ -346,7 +366,9 @@ PolygonData readPolygonData(const std::string& path) {
 
 ControlMesh readControlMesh(const std::string& path) {
   const PolygonData data = readPolygonData(path);
-  return ControlMesh::fromPolygons(data.points, data.faces, path);
+  ControlMesh mesh = ControlMesh::fromPolygons(data.points, data.faces, path);
+  mesh.setCreases(data.creases, path);
+  return mesh;
 }
 
 void writeObj(const ControlMesh& mesh, const std::string& path) {
@@ -365,6 +387,9 @@ void writeObj(const ControlMesh& mesh, const std::string& path) {
       out << 'f';
       for (int v : face) out << ' ' << v + 1;
       out << '\n';
+    }
+    for (const Crease& crease : mesh.creases()) {
+      out << "t crease 2/1/0 " << crease.a << ' ' << crease.b << ' ' << crease.sharpness << '\n';
     }
     out.close();
     if (!out) throw writeFailure(path);

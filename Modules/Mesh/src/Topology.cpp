@@ -1,6 +1,7 @@
 #include "dynsub/Topology.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "dynsub/Error.h"
 
@@ -40,6 +41,54 @@ Topology::Topology(int vertexCount, std::vector<Polygon> faces)
       faceEdges_[f][k] = it->second;
     }
   }
+}
+
+void Topology::setEdgeSharpness(std::vector<double> sharpness) {
+  if (static_cast<int>(sharpness.size()) != edgeCount()) {
+    throw Error("topology: " + std::to_string(sharpness.size()) + " sharpness values for " +
+                std::to_string(edgeCount()) + " edges");
+  }
+  bool creased = false;
+  for (int e = 0; e < edgeCount(); ++e) {
+    if (!(sharpness[e] >= 0.0 && std::isfinite(sharpness[e]))) {
+      throw Error("topology: edge (" + std::to_string(edgeVertices_[e][0]) + ", " +
+                  std::to_string(edgeVertices_[e][1]) + ") has sharpness " + std::to_string(sharpness[e]) +
+                  " (expected a finite value >= 0)");
+    }
+    creased = creased || sharpness[e] > 0.0;
+  }
+  if (creased) {
+    edgeSharpness_ = std::move(sharpness);
+  } else {
+    edgeSharpness_.clear();
+  }
+}
+
+std::vector<std::vector<int>> Topology::sharpSectors(int v) const {
+  // Faces at v that share a smooth edge at v are in one sector.
+  const std::vector<int>& faces = vertexFaces_[v];
+  std::vector<int> sector(faces.size());
+  for (size_t i = 0; i < faces.size(); ++i) sector[i] = static_cast<int>(i);
+  auto find = [&sector](int i) {
+    while (sector[i] != i) i = sector[i] = sector[sector[i]];
+    return i;
+  };
+  auto indexOf = [&faces](int f) { return static_cast<int>(std::find(faces.begin(), faces.end(), f) - faces.begin()); };
+  for (int e : vertexEdges_[v]) {
+    if (isSharpEdge(e)) continue;
+    sector[find(indexOf(edgeFaces_[e][0]))] = find(indexOf(edgeFaces_[e][1]));
+  }
+  std::vector<std::vector<int>> result;
+  std::vector<int> slot(faces.size(), -1);
+  for (size_t i = 0; i < faces.size(); ++i) {
+    const int root = find(static_cast<int>(i));
+    if (slot[root] < 0) {
+      slot[root] = static_cast<int>(result.size());
+      result.emplace_back();
+    }
+    result[slot[root]].push_back(faces[i]);
+  }
+  return result;
 }
 
 int Topology::corner(int f, int v) const {

@@ -4,6 +4,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -113,6 +116,52 @@ TEST(MeshIO, BrokenFilesAreNamed) {
   const std::string empty = scratch("empty.obj").string();
   writeText(empty, "");
   expectError(empty, "no vertices");
+}
+
+// OpenSubdiv's crease tags: vertices numbered from 0, one edge per tag.
+constexpr const char* kCreasedSquares =
+    "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nv 1 1 0\nv 2 1 0\nv 0 2 0\nv 1 2 0\nv 2 2 0\n"
+    "f 1 2 5 4\nf 2 3 6 5\nf 4 5 8 7\nf 5 6 9 8\n";
+
+TEST(MeshIO, CreaseTagsRoundTrip) {
+  const std::string path = scratch("creased.obj").string();
+  // A sharp crease across the grid, boundary to boundary, and a semi-sharp one.
+  writeText(path, std::string(kCreasedSquares) + "t crease 2/1/0 3 4 10\nt crease 2/1/0 4 5 10\nt crease 2/1/0 1 4 1.5\n");
+  const dynsub::ControlMesh mesh = dynsub::readControlMesh(path);
+  const dynsub::Topology& topology = mesh.topology();
+  EXPECT_EQ(topology.edgeSharpness(topology.findEdge(3, 4)), 10.0);
+  EXPECT_EQ(topology.edgeSharpness(topology.findEdge(4, 5)), 10.0);
+  EXPECT_EQ(topology.edgeSharpness(topology.findEdge(1, 4)), 1.5);
+  EXPECT_EQ(topology.edgeSharpness(topology.findEdge(4, 7)), 0.0);
+  ASSERT_EQ(mesh.creases().size(), 3u);
+
+  const std::string copy = scratch("creased-copy.obj").string();
+  dynsub::writeObj(mesh, copy);
+  const dynsub::ControlMesh again = dynsub::readControlMesh(copy);
+  for (int e = 0; e < topology.edgeCount(); ++e) {
+    const auto [a, b] = topology.edgeVertices(e);
+    EXPECT_EQ(again.topology().edgeSharpness(again.topology().findEdge(a, b)), topology.edgeSharpness(e));
+  }
+}
+
+TEST(MeshIO, BadCreaseTagsAreNamed) {
+  const std::string square = std::string(kCreasedSquares);
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"t corner 1/1/0 4 2.0\n", "'corner' is not supported"},
+      {"t crease 2/1/0 4 5\n", "must read 't crease 2/1/0 a b sharpness'"},
+      {"t crease 2/1/0 0 4 1\n", "crease (0, 4) is not an edge"},
+      {"t crease 2/1/0 4 9 1\n", "crease (4, 9) is not an edge"},
+      {"t crease 2/1/0 4 5 -1\n", "has sharpness -1"},
+      {"t crease 2/1/0 4 5 nan\n", "has sharpness nan"},
+      {"t crease 2/1/0 3 4 10\n", "a dart"},
+      // Two sharp creases at the centre with one face between them.
+      {"t crease 2/1/0 1 4 10\nt crease 2/1/0 4 5 10\n", "single face on one side"},
+  };
+  for (size_t k = 0; k < cases.size(); ++k) {
+    const std::string path = scratch("badcrease" + std::to_string(k) + ".obj").string();
+    writeText(path, square + cases[k].first);
+    expectError(path, cases[k].second);
+  }
 }
 
 TEST(MeshIO, FailedWriteLeavesNoFile) {

@@ -15,6 +15,7 @@
 #include "dynsub/CatmullClark.h"
 #include "dynsub/ControlMesh.h"
 #include "dynsub/Error.h"
+#include "dynsub/MeshCheck.h"
 
 namespace dynsub {
 
@@ -89,6 +90,55 @@ bool needsIsolation(const Topology& topology) {
     if (irregular > 1) return true;
   }
   return false;
+}
+
+// Semi-sharp creases are refined away before anything else: after
+// ceil(s) steps an edge of sharpness s is smooth, and what is left is smooth
+// or infinitely sharp. Each step multiplies the elements by four.
+constexpr double kLargestSemiSharpness = 4.0;
+
+int semiSharpLevels(const Topology& topology) {
+  double largest = 0.0;
+  for (int e = 0; e < topology.edgeCount(); ++e) {
+    const double sharpness = topology.edgeSharpness(e);
+    if (sharpness < kInfiniteSharpness) largest = std::max(largest, sharpness);
+  }
+  if (largest > kLargestSemiSharpness) {
+    throw Error("a semi-sharp crease of sharpness " + std::to_string(largest) + " would refine the whole mesh " +
+                std::to_string(static_cast<int>(std::ceil(largest))) + " times; semi-sharp creases up to " +
+                std::to_string(static_cast<int>(kLargestSemiSharpness)) + " are supported, and from " +
+                std::to_string(static_cast<int>(kInfiniteSharpness)) + " on a crease is sharp");
+  }
+  return static_cast<int>(std::ceil(largest));
+}
+
+// The mesh cut along its infinitely sharp creases: each vertex on them
+// becomes one vertex per sector (Topology::sharpSectors), so the creases are
+// boundaries, and `duplication` (if not null) maps the original vertices to
+// the cut mesh's. The boundary rules on the cut mesh are the crease rules on
+// the original where checkCreases (MeshCheck.h) accepts the creases: a crease
+// vertex keeps two or more faces on each side (the boundary vertex rule), a
+// corner one face between two sharp edges (a corner). Faces keep their numbers.
+Topology cutAlongCreases(const Topology& topology, SparseMatrix* duplication) {
+  checkCreases(topology, "control mesh");
+  std::vector<Polygon> faces = topology.faces();
+  std::vector<int> source(topology.vertexCount());
+  for (int v = 0; v < topology.vertexCount(); ++v) source[v] = v;
+  for (int v = 0; v < topology.vertexCount(); ++v) {
+    const std::vector<std::vector<int>> sectors = topology.sharpSectors(v);
+    for (size_t k = 1; k < sectors.size(); ++k) {
+      const int copy = static_cast<int>(source.size());
+      source.push_back(v);
+      for (int f : sectors[k]) faces[f][topology.corner(f, v)] = copy;
+    }
+  }
+  if (duplication) {
+    std::vector<Triplet> ones;
+    for (size_t i = 0; i < source.size(); ++i) ones.emplace_back(static_cast<int>(i), source[i], 1.0);
+    duplication->resize(static_cast<Eigen::Index>(source.size()), topology.vertexCount());
+    duplication->setFromTriplets(ones.begin(), ones.end());
+  }
+  return Topology(static_cast<int>(source.size()), std::move(faces));
 }
 
 // Rewrites derivative rows taken in parameters (a, b) into parameters (u, v),
@@ -646,10 +696,7 @@ LimitSurface::LimitSurface(const ControlMesh& mesh) : impl_(std::make_unique<Imp
   s.isolation.setIdentity();
   std::vector<int> controlFaceOf(s.base.faceCount());
   for (int f = 0; f < s.base.faceCount(); ++f) controlFaceOf[f] = f;
-  while (needsIsolation(s.base)) {
-    // One step isolates every extraordinary vertex of an all-quad mesh; a second
-    // one those at the centres of former n-gons.
-    if (s.isolationLevels == 2) throw Error("internal: extraordinary vertices are not isolated after two steps");
+  auto refineBase = [&] {
     Refinement refinement = refine(s.base);
     s.isolation = refinement.subdivisionMatrix * s.isolation;
     std::vector<int> childControlFace(refinement.topology.faceCount());
@@ -665,6 +712,21 @@ LimitSurface::LimitSurface(const ControlMesh& mesh) : impl_(std::make_unique<Imp
     s.childFaceOffset.push_back(std::move(refinement.childFaceOffset));
     s.base = std::move(refinement.topology);
     ++s.isolationLevels;
+  };
+  const int creaseLevels = semiSharpLevels(s.base);
+  while (s.isolationLevels < creaseLevels) refineBase();
+  if (s.base.hasCreases()) {
+    SparseMatrix duplication;
+    s.base = cutAlongCreases(s.base, &duplication);
+    s.isolation = duplication * s.isolation;
+  }
+  while (needsIsolation(s.base)) {
+    // One step isolates every extraordinary vertex of an all-quad mesh; a second
+    // one those at the centres of former n-gons.
+    if (s.isolationLevels == creaseLevels + 2) {
+      throw Error("internal: extraordinary vertices are not isolated after two steps");
+    }
+    refineBase();
   }
   s.isolation.makeCompressed();
 
@@ -685,8 +747,11 @@ LimitSurface::LimitSurface(const ControlMesh& mesh) : impl_(std::make_unique<Imp
 }
 
 int LimitSurface::elementCountOf(const ControlMesh& mesh) {
-  // The constructor's isolation, on the topology alone.
+  // The constructor's refinements, on the topology alone.
   Topology base = mesh.topology();
+  const int creaseLevels = semiSharpLevels(base);
+  for (int level = 0; level < creaseLevels; ++level) base = refine(base).topology;
+  if (base.hasCreases()) base = cutAlongCreases(base, nullptr);
   for (int levels = 0; needsIsolation(base); ++levels) {
     if (levels == 2) throw Error("internal: extraordinary vertices are not isolated after two steps");
     base = refine(base).topology;

@@ -241,6 +241,56 @@ TEST_P(LimitSurfaceProperties, ControlVertexLimitsLieOnTheSurface) {
 INSTANTIATE_TEST_SUITE_P(AllMeshes, LimitSurfaceProperties, ::testing::ValuesIn(dynsub::testing::allTestMeshes()),
                          [](const auto& info) { return info.param.name; });
 
+INSTANTIATE_TEST_SUITE_P(Creased, LimitSurfaceProperties, ::testing::ValuesIn(dynsub::testing::creasedTestMeshes()),
+                         [](const auto& info) { return info.param.name; });
+
+// A creased surface is one surface: along every creased edge of the control
+// mesh (quads on both sides) the faces on its two sides meet, and at a sharp
+// crease their normals differ (the cube's faces meet at about 90 degrees).
+TEST(LimitSurface, CreasedFacesMeetAlongTheirCreases) {
+  for (const dynsub::testing::NamedMesh& named : dynsub::testing::creasedTestMeshes()) {
+    const dynsub::ControlMesh& mesh = named.mesh;
+    const dynsub::Topology& topology = mesh.topology();
+    const LimitSurface surface(mesh);
+    const dynsub::MatrixX3 control = mesh.points();
+    const double tolerance = 1e-12 * diagonalOf(control);
+    auto along = [](int face, int side, double t) {
+      const double corners[5][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}, {0, 0}};
+      return SurfacePoint{face, (1 - t) * corners[side][0] + t * corners[side + 1][0],
+                          (1 - t) * corners[side][1] + t * corners[side + 1][1]};
+    };
+    int checked = 0;
+    for (int e = 0; e < topology.edgeCount(); ++e) {
+      if (topology.isBoundaryEdge(e) || topology.edgeSharpness(e) == 0.0) continue;
+      const auto [f, g] = topology.edgeFaces(e);
+      if (topology.faceSize(f) != 4 || topology.faceSize(g) != 4) continue;
+      int sideF = 0, sideG = 0;
+      while (topology.faceEdge(f, sideF) != e) ++sideF;
+      while (topology.faceEdge(g, sideG) != e) ++sideG;
+      for (double t : {0.0, 0.3, 0.5, 1.0}) {
+        const dynsub::LimitSample a = surface.evaluate(along(f, sideF, t), control);
+        const dynsub::LimitSample b = surface.evaluate(along(g, sideG, 1.0 - t), control);
+        EXPECT_LE((a.position - b.position).norm(), tolerance) << named.name << " edge " << e << " t " << t;
+        if (named.name == "cube8sharp" && t == 0.5) EXPECT_LT(a.normal.dot(b.normal), 0.5) << "edge " << e;
+        ++checked;
+      }
+    }
+    EXPECT_GT(checked, 0) << named.name;
+  }
+}
+
+TEST(LimitSurface, SemiSharpCreasesAboveFourAreRefused) {
+  dynsub::ControlMesh cube = dynsub::makeCube98();
+  const auto [a, b] = cube.topology().edgeVertices(0);
+  cube.setCreases({{a, b, 4.5}});
+  try {
+    const LimitSurface surface(cube);
+    FAIL() << "a crease of sharpness 4.5 was accepted";
+  } catch (const dynsub::Error& error) {
+    EXPECT_NE(std::string(error.what()).find("semi-sharp creases up to 4"), std::string::npos) << error.what();
+  }
+}
+
 TEST(LimitSurface, CubeHasThePapersElements) {
   const LimitSurface surface(dynsub::makeCube98());
   int special = 0;

@@ -16,6 +16,14 @@
 
 namespace dynsub {
 
+// A crease tag: the edge joining vertices a and b, with its sharpness
+// (Topology.h: 0 smooth, up to kInfiniteSharpness semi-sharp, from it on sharp).
+struct Crease {
+  int a = 0;
+  int b = 0;
+  double sharpness = 0;
+};
+
 class ControlMesh {
  public:
   ControlMesh();
@@ -45,6 +53,13 @@ class ControlMesh {
   void setPoints(const MatrixX3& points);
   const std::vector<Polygon>& faces() const { return topology_->faces(); }
   const Topology& topology() const { return *topology_; }
+
+  // Tags edges as creases (the others keep their sharpness). Throws
+  // dynsub::Error naming `source` if a tag names no edge of the mesh or its
+  // sharpness is negative, NaN or infinite.
+  void setCreases(const std::vector<Crease>& creases, const std::string& source = "mesh");
+  // The edges of non-zero sharpness, in edge order.
+  std::vector<Crease> creases() const;
 
  private:
   MatrixX3 points_;

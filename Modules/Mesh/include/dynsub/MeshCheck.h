@@ -18,4 +18,19 @@ namespace dynsub {
 void checkPolygonMesh(const MatrixX3& points, const std::vector<std::vector<int>>& faces,
                       const std::string& source);
 
+class Topology;
+
+// Throws dynsub::Error("<source>: <problem>") for an infinitely sharp crease
+// (sharpness >= kInfiniteSharpness) whose limit surface DynSub cannot evaluate
+// exactly. It evaluates one by cutting the mesh along such creases into
+// pieces with boundaries, which is exact where each vertex on them is
+//  - a crease vertex (exactly two sharp edges, boundary edges included) with
+//    at least two faces on each side, or
+//  - a corner (three or more sharp edges, or a boundary vertex of one face)
+//    with one face between each two neighbouring sharp edges.
+// Refused: a crease that ends inside the surface (a dart), and the other
+// configurations. Semi-sharp creases are refined away before the cut and are
+// not restricted.
+void checkCreases(const Topology& topology, const std::string& source);
+
 }  // namespace dynsub

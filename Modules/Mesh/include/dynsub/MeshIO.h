@@ -1,8 +1,11 @@
 #pragma once
 // Control mesh files. Reading: Wavefront OBJ (v and f records; v/vt/vn and
-// negative indices accepted, other records ignored), OFF, and PLY (ascii and
-// binary, either byte order; element "vertex" with x, y, z and element "face"
-// with a "vertex_indices" list). Writing: OBJ with round-trip precision.
+// negative indices accepted; crease tags as OpenSubdiv writes them,
+// "t crease 2/1/0 a b sharpness" with vertices numbered from 0; other tags
+// refused, other records ignored), OFF, and PLY (ascii and binary, either byte
+// order; element "vertex" with x, y, z and element "face" with a
+// "vertex_indices" list). Writing: OBJ with round-trip precision and the
+// mesh's crease tags.
 //
 // The readers are DynSub's own rather than OpenMesh::IO because a control
 // mesh must survive a round trip exactly and a bad record must be refused:
@@ -20,6 +23,7 @@ namespace dynsub {
 struct PolygonData {
   MatrixX3 points;
   std::vector<Polygon> faces;
+  std::vector<Crease> creases;
 };
 
 // Parses the file by extension (.obj, .off, .ply; case-insensitive) without

@@ -5,6 +5,12 @@
 //
 // Vertices, edges and faces are numbered from 0. Edge e joins edgeVertices(e)
 // and has one face (a boundary edge) or two. An edge with more faces throws.
+//
+// Creases (DeRose, Kass and Truong 1998, with OpenSubdiv's conventions): each
+// edge has a sharpness, 0 (smooth) unless set. Each refinement lowers a
+// semi-sharp edge's sharpness by 1 (OpenSubdiv's uniform rule); from
+// kInfiniteSharpness up an edge stays sharp at every level. Boundary edges are
+// always sharp, whatever they are given.
 #include <array>
 #include <unordered_map>
 #include <vector>
@@ -12,6 +18,8 @@
 namespace dynsub {
 
 using Polygon = std::vector<int>;
+
+constexpr double kInfiniteSharpness = 10.0;
 
 class Topology {
  public:
@@ -42,6 +50,18 @@ class Topology {
   const std::vector<int>& vertexFaces(int v) const { return vertexFaces_[v]; }
   const std::vector<int>& vertexEdges(int v) const { return vertexEdges_[v]; }
   bool isBoundaryVertex(int v) const;
+  double edgeSharpness(int e) const { return edgeSharpness_.empty() ? 0.0 : edgeSharpness_[e]; }
+  bool hasCreases() const { return !edgeSharpness_.empty(); }
+  // One value per edge, finite and >= 0 (throws dynsub::Error otherwise); all
+  // zeros leave the topology without creases.
+  void setEdgeSharpness(std::vector<double> sharpness);
+  // Boundary edges and edges of sharpness >= kInfiniteSharpness.
+  bool isSharpEdge(int e) const { return isBoundaryEdge(e) || edgeSharpness(e) >= kInfiniteSharpness; }
+  // The faces at vertex v grouped into the fans its sharp edges separate: one
+  // fan for a vertex with fewer than two sharp edges, one per pair of
+  // neighbouring sharp edges otherwise.
+  std::vector<std::vector<int>> sharpSectors(int v) const;
+
   // Regular for Catmull-Clark: an interior vertex with 4 edges, a boundary
   // vertex with 2 faces, or a corner (a boundary vertex with 1 face). Around a
   // regular vertex the limit surface is a bicubic B-spline.
@@ -56,6 +76,7 @@ class Topology {
   std::vector<std::vector<int>> vertexFaces_;
   std::vector<std::vector<int>> vertexEdges_;
   std::unordered_map<unsigned long long, int> edgeIndex_;
+  std::vector<double> edgeSharpness_;  // empty: every edge smooth
 };
 
 }  // namespace dynsub

@@ -12,6 +12,15 @@
 // boundary edge point = the edge midpoint; boundary vertex = 1/8, 3/4, 1/8 of
 // its two boundary neighbours and itself; a corner (one face) stays fixed.
 //
+// Creases (DeRose, Kass and Truong 1998, with OpenSubdiv's rules, which its
+// oracle tests check): an edge of sharpness >= 1 gets the boundary's edge rule,
+// one of sharpness s in (0, 1) the blend s midpoint + (1 - s) smooth point. A
+// vertex with two sharp edges (boundary edges count) gets the boundary vertex
+// rule along them, with more it stays fixed, with fewer (a dart) it is smooth.
+// Where a sharpness decays to 0 in the step, the vertex's rules before and
+// after are blended by the decaying sharpnesses' mean. The refined edges carry
+// childSharpness() of their parent's.
+//
 // Numbering of the refined mesh: vertex points first (old vertex i stays vertex
 // i), then edge points (#vertices + edge), then face points (#vertices + #edges
 // + face). An n-gon f becomes n quads, child k = (vertex point of corner k,
@@ -32,6 +41,10 @@ struct Refinement {
 };
 
 Refinement refine(const Topology& topology);
+
+// A refined half-edge's sharpness: s - 1 for a semi-sharp edge (0 once s <= 1),
+// unchanged from kInfiniteSharpness up.
+double childSharpness(double sharpness);
 
 // A control mesh refined once: mesh.points() == subdivisionMatrix * old points,
 // and its limit surface is the old one.
