@@ -1,11 +1,12 @@
 #include "dynsub/SurfaceView.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <set>
 
 #include <vtkActor.h>
 #include <vtkCamera.h>
+#include <vtkCellData.h>
 #include <vtkCellArray.h>
 #include <vtkImageProperty.h>
 #include <vtkImageSlice.h>
@@ -18,6 +19,7 @@
 #include <vtkProperty.h>
 #include <vtkRenderer.h>
 #include <vtkScalarBarActor.h>
+#include <vtkUnsignedCharArray.h>
 
 #include "dynsub/SceneStyle.h"
 #include "dynsub/ControlMesh.h"
@@ -30,18 +32,25 @@ vtkSmartPointer<vtkPolyData> controlMeshWireframe(const ControlMesh& mesh) {
   const MatrixX3 p = mesh.points();
   for (Eigen::Index i = 0; i < p.rows(); ++i) points->InsertNextPoint(p(i, 0), p(i, 1), p(i, 2));
   vtkNew<vtkCellArray> lines;
-  std::set<std::pair<int, int>> edges;
-  for (const Polygon& face : mesh.faces()) {
-    for (std::size_t i = 0; i < face.size(); ++i) {
-      const int a = face[i], b = face[(i + 1) % face.size()];
-      if (!edges.insert({std::min(a, b), std::max(a, b)}).second) continue;
-      const vtkIdType ids[2] = {a, b};
-      lines->InsertNextCell(2, ids);
+  const Topology& topology = mesh.topology();
+  // A creased mesh's edges carry their colours: creases stand out from the rest.
+  vtkNew<vtkUnsignedCharArray> colours;
+  colours->SetNumberOfComponents(3);
+  colours->SetName("Colors");
+  for (int e = 0; e < topology.edgeCount(); ++e) {
+    const auto [a, b] = topology.edgeVertices(e);
+    const vtkIdType ids[2] = {a, b};
+    lines->InsertNextCell(2, ids);
+    if (topology.hasCreases()) {
+      const bool creased = topology.edgeSharpness(e) > 0.0 && !topology.isBoundaryEdge(e);
+      const std::array<unsigned char, 3> wire{153, 179, 255}, crease{255, 90, 40};
+      colours->InsertNextTypedTuple(creased ? crease.data() : wire.data());
     }
   }
   auto wireframe = vtkSmartPointer<vtkPolyData>::New();
   wireframe->SetPoints(points);
   wireframe->SetLines(lines);
+  if (topology.hasCreases()) wireframe->GetCellData()->SetScalars(colours);
   return wireframe;
 }
 

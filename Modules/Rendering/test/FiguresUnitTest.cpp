@@ -19,6 +19,7 @@
 
 #include <vtkActor2DCollection.h>
 #include <vtkCellData.h>
+#include <vtkDataArray.h>
 #include <vtkChartXY.h>
 #include <vtkCoordinate.h>
 #include <vtkCutter.h>
@@ -421,6 +422,24 @@ void expectElementsMatchBaseline(const std::string& meshFile) {
 TEST_F(Rendering, TestCubeElements) { expectElementsMatchBaseline(kSource + "/Data/Meshes/cube.obj"); }
 
 TEST_F(Rendering, TestTorusElements) { expectElementsMatchBaseline(kSource + "/Data/Meshes/torus.obj"); }
+
+// The cube with sharp edges: flat faces lit apart, its creases drawn orange-red.
+TEST_F(Rendering, TestSharpCubeElements) { expectElementsMatchBaseline(kSource + "/Data/Meshes/cube_sharp.obj"); }
+
+TEST(ControlMeshWireframe, CreasesAreColouredApart) {
+  const vtkSmartPointer<vtkPolyData> plain = controlMeshWireframe(readControlMesh(kSource + "/Data/Meshes/cube.obj"));
+  EXPECT_EQ(plain->GetNumberOfLines(), 192);
+  EXPECT_EQ(plain->GetCellData()->GetScalars(), nullptr);  // the actor's colour, as before
+
+  const vtkSmartPointer<vtkPolyData> sharp =
+      controlMeshWireframe(readControlMesh(kSource + "/Data/Meshes/cube_sharp.obj"));
+  ASSERT_EQ(sharp->GetNumberOfLines(), 12);
+  vtkDataArray* colours = sharp->GetCellData()->GetScalars();
+  ASSERT_NE(colours, nullptr);
+  int creases = 0;
+  for (vtkIdType c = 0; c < colours->GetNumberOfTuples(); ++c) creases += colours->GetComponent(c, 0) == 255;
+  EXPECT_EQ(creases, 12);
+}
 
 TEST_F(Rendering, TestConvergencePlot) {
   expectMatchesBaseline(convergenceFigure(readConvergenceCsv(kSource + "/Testing/Data/caudate_left_convergence.csv")));

@@ -16,7 +16,9 @@ namespace dynsub {
 
 class ControlMesh;
 
-// The control mesh's edges as lines (one line per edge), LPS mm.
+// The control mesh's edges as lines (one line per edge, in Topology's edge
+// order), LPS mm; a creased mesh's lines carry colours (cell scalars), its
+// creases orange-red, the rest the wireframe's blue.
 vtkSmartPointer<vtkPolyData> controlMeshWireframe(const ControlMesh& mesh);
 
 class SurfaceView {

@@ -3,6 +3,12 @@
 // topology (TVCG 1998 §2.2-2.4; ICCV 1998 §2.1-2.3), as values and as sparse
 // linear operators over the control vertices.
 //
+// Creases (Topology.h, CatmullClark.h). Semi-sharp creases are refined away
+// first (ceil of the largest sharpness below kInfiniteSharpness global steps,
+// at most 4); the mesh is then cut along its sharp creases, one vertex per
+// sector (Topology::sharpSectors), so that they are boundaries whose rules are
+// the crease rules (the configurations checkCreases in MeshCheck.h accepts).
+//
 // Isolation (TVCG §2.4.2). While the mesh has a face that is not a quad, or a
 // quad with more than one irregular vertex, it is refined globally (at most
 // twice). The quads of the result, the *base mesh*, are the elements:
@@ -130,10 +136,12 @@ class LimitSurface {
   // elementCount() of `mesh`'s limit surface, from its isolation alone
   // (without the elements' tables).
   static int elementCountOf(const ControlMesh& mesh);
-  // Global refinements done to isolate extraordinary vertices: 0, 1 or 2.
+  // Global refinements done before the elements: those that refine
+  // semi-sharp creases away, then 0, 1 or 2 to isolate extraordinary vertices.
   int isolationLevels() const;
-  // The base mesh (the elements are its faces) and its vertices as a linear
-  // blend of the control vertices (#base vertices by #control vertices).
+  // The base mesh (the elements are its faces; cut along sharp creases) and
+  // its vertices as a linear blend of the control vertices (#base vertices by
+  // #control vertices).
   const Topology& baseTopology() const;
   const SparseMatrix& isolationMatrix() const;
 
