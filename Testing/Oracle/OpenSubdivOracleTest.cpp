@@ -217,7 +217,9 @@ TEST_P(CreasedRefinementTest, TwoStepsMatchOpenSubdiv) {
   double worst = 0;
   for (const Point& theirs : level2) {
     double nearest = std::numeric_limits<double>::infinity();
-    for (Eigen::Index v = 0; v < ours.rows(); ++v) nearest = std::min(nearest, (ours.row(v).transpose() - theirs.p).norm());
+    for (Eigen::Index v = 0; v < ours.rows(); ++v) {
+      nearest = std::min(nearest, (ours.row(v).transpose() - theirs.p).norm());
+    }
     worst = std::max(worst, nearest);
   }
   EXPECT_LE(worst, 1e-6 * diagonal) << GetParam().name;

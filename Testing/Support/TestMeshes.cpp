@@ -179,7 +179,8 @@ std::vector<NamedMesh> creasedTestMeshes() {
                       return 0.0;
                     })});
   // Triangles and an extraordinary apex with a semi-sharp base.
-  meshes.push_back({"pyramidsemi", withCreases(makePyramid(), [](int a, int b) { return a < 4 && b < 4 ? 2.0 : 0.0; })});
+  meshes.push_back(
+      {"pyramidsemi", withCreases(makePyramid(), [](int a, int b) { return a < 4 && b < 4 ? 2.0 : 0.0; })});
   return meshes;
 }
 

@@ -131,6 +131,17 @@ void checkPolygonMesh(const MatrixX3& points, const std::vector<std::vector<int>
 
 void checkCreases(const Topology& topology, const std::string& source) {
   if (!topology.hasCreases()) return;
+  for (int e = 0; e < topology.edgeCount(); ++e) {
+    const double sharpness = topology.edgeSharpness(e);
+    if (sharpness > kLargestSemiSharpness && sharpness < kInfiniteSharpness) {
+      const auto [a, b] = topology.edgeVertices(e);
+      throw Error(source, "crease (" + std::to_string(a) + ", " + std::to_string(b) + ") has sharpness " +
+                              std::to_string(sharpness) + ": semi-sharp creases up to " +
+                              std::to_string(static_cast<int>(kLargestSemiSharpness)) +
+                              " are supported (each step of sharpness refines the whole surface once), and from " +
+                              std::to_string(static_cast<int>(kInfiniteSharpness)) + " on a crease is sharp");
+    }
+  }
   for (int v = 0; v < topology.vertexCount(); ++v) {
     int sharp = 0, infinite = 0;
     for (int e : topology.vertexEdges(v)) {
@@ -140,9 +151,11 @@ void checkCreases(const Topology& topology, const std::string& source) {
     if (infinite == 0) continue;
     const std::string at = "vertex " + std::to_string(v) + ": ";
     if (sharp == 1) {
-      throw Error(source, at + "a sharp crease ends inside the surface (a dart), which is not supported; "
-                               "end it at a corner of three or more creases or on a boundary, or make it semi-sharp "
-                               "(sharpness below " + std::to_string(static_cast<int>(kInfiniteSharpness)) + ")");
+      const std::string below = std::to_string(static_cast<int>(kInfiniteSharpness));
+      throw Error(source, at +
+                              "a sharp crease ends inside the surface (a dart), which is not supported; end it at a "
+                              "corner of three or more creases or on a boundary, or make it semi-sharp (sharpness "
+                              "below " + below + ")");
     }
     const bool corner = sharp > 2 || topology.vertexFaces(v).size() == 1;
     for (const std::vector<int>& sector : topology.sharpSectors(v)) {

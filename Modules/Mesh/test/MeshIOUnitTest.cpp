@@ -126,7 +126,8 @@ constexpr const char* kCreasedSquares =
 TEST(MeshIO, CreaseTagsRoundTrip) {
   const std::string path = scratch("creased.obj").string();
   // A sharp crease across the grid, boundary to boundary, and a semi-sharp one.
-  writeText(path, std::string(kCreasedSquares) + "t crease 2/1/0 3 4 10\nt crease 2/1/0 4 5 10\nt crease 2/1/0 1 4 1.5\n");
+  writeText(path,
+            std::string(kCreasedSquares) + "t crease 2/1/0 3 4 10\nt crease 2/1/0 4 5 10\nt crease 2/1/0 1 4 1.5\n");
   const dynsub::ControlMesh mesh = dynsub::readControlMesh(path);
   const dynsub::Topology& topology = mesh.topology();
   EXPECT_EQ(topology.edgeSharpness(topology.findEdge(3, 4)), 10.0);
@@ -153,6 +154,7 @@ TEST(MeshIO, BadCreaseTagsAreNamed) {
       {"t crease 2/1/0 4 9 1\n", "crease (4, 9) is not an edge"},
       {"t crease 2/1/0 4 5 -1\n", "has sharpness -1"},
       {"t crease 2/1/0 4 5 nan\n", "has sharpness nan"},
+      {"t crease 2/1/0 4 5 5\n", "semi-sharp creases up to 4"},
       {"t crease 2/1/0 3 4 10\n", "a dart"},
       // Two sharp creases at the centre with one face between them.
       {"t crease 2/1/0 1 4 10\nt crease 2/1/0 4 5 10\n", "single face on one side"},

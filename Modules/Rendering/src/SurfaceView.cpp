@@ -6,8 +6,8 @@
 
 #include <vtkActor.h>
 #include <vtkCamera.h>
-#include <vtkCellData.h>
 #include <vtkCellArray.h>
+#include <vtkCellData.h>
 #include <vtkImageProperty.h>
 #include <vtkImageSlice.h>
 #include <vtkImageSliceMapper.h>

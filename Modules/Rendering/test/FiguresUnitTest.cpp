@@ -19,10 +19,10 @@
 
 #include <vtkActor2DCollection.h>
 #include <vtkCellData.h>
-#include <vtkDataArray.h>
 #include <vtkChartXY.h>
 #include <vtkCoordinate.h>
 #include <vtkCutter.h>
+#include <vtkDataArray.h>
 #include <vtkDoubleArray.h>
 #include <vtkImageData.h>
 #include <vtkNew.h>

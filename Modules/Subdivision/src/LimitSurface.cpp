@@ -92,22 +92,16 @@ bool needsIsolation(const Topology& topology) {
   return false;
 }
 
-// Semi-sharp creases are refined away before anything else: after
-// ceil(s) steps an edge of sharpness s is smooth, and what is left is smooth
-// or infinitely sharp. Each step multiplies the elements by four.
-constexpr double kLargestSemiSharpness = 4.0;
-
+// Semi-sharp creases are refined away before anything else: after ceil(s)
+// steps an edge of sharpness s is smooth, and what is left is smooth or
+// sharp. The topology's creases are checked here (checkCreases) for meshes
+// that were not read from a file.
 int semiSharpLevels(const Topology& topology) {
+  checkCreases(topology, "control mesh");
   double largest = 0.0;
   for (int e = 0; e < topology.edgeCount(); ++e) {
     const double sharpness = topology.edgeSharpness(e);
     if (sharpness < kInfiniteSharpness) largest = std::max(largest, sharpness);
-  }
-  if (largest > kLargestSemiSharpness) {
-    throw Error("a semi-sharp crease of sharpness " + std::to_string(largest) + " would refine the whole mesh " +
-                std::to_string(static_cast<int>(std::ceil(largest))) + " times; semi-sharp creases up to " +
-                std::to_string(static_cast<int>(kLargestSemiSharpness)) + " are supported, and from " +
-                std::to_string(static_cast<int>(kInfiniteSharpness)) + " on a crease is sharp");
   }
   return static_cast<int>(std::ceil(largest));
 }
@@ -116,11 +110,11 @@ int semiSharpLevels(const Topology& topology) {
 // becomes one vertex per sector (Topology::sharpSectors), so the creases are
 // boundaries, and `duplication` (if not null) maps the original vertices to
 // the cut mesh's. The boundary rules on the cut mesh are the crease rules on
-// the original where checkCreases (MeshCheck.h) accepts the creases: a crease
-// vertex keeps two or more faces on each side (the boundary vertex rule), a
-// corner one face between two sharp edges (a corner). Faces keep their numbers.
+// the original where checkCreases (MeshCheck.h) accepts the creases, as it
+// did before the semi-sharp steps, which keep what it checks: a crease vertex
+// keeps two or more faces on each side (the boundary vertex rule), a corner
+// one face between two sharp edges (a corner). Faces keep their numbers.
 Topology cutAlongCreases(const Topology& topology, SparseMatrix* duplication) {
-  checkCreases(topology, "control mesh");
   std::vector<Polygon> faces = topology.faces();
   std::vector<int> source(topology.vertexCount());
   for (int v = 0; v < topology.vertexCount(); ++v) source[v] = v;

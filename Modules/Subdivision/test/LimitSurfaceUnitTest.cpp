@@ -245,8 +245,8 @@ INSTANTIATE_TEST_SUITE_P(Creased, LimitSurfaceProperties, ::testing::ValuesIn(dy
                          [](const auto& info) { return info.param.name; });
 
 // A creased surface is one surface: along every creased edge of the control
-// mesh (quads on both sides) the faces on its two sides meet, and at a sharp
-// crease their normals differ (the cube's faces meet at about 90 degrees).
+// mesh the faces on its two sides meet, and at a sharp crease their normals
+// differ (the cube's faces meet at about 90 degrees).
 TEST(LimitSurface, CreasedFacesMeetAlongTheirCreases) {
   for (const dynsub::testing::NamedMesh& named : dynsub::testing::creasedTestMeshes()) {
     const dynsub::ControlMesh& mesh = named.mesh;
@@ -254,22 +254,33 @@ TEST(LimitSurface, CreasedFacesMeetAlongTheirCreases) {
     const LimitSurface surface(mesh);
     const dynsub::MatrixX3 control = mesh.points();
     const double tolerance = 1e-12 * diagonalOf(control);
-    auto along = [](int face, int side, double t) {
+    std::vector<int> offset{0};  // first parametric face of each control face
+    for (int f = 0; f < topology.faceCount(); ++f) {
+      offset.push_back(offset.back() + (topology.faceSize(f) == 4 ? 1 : topology.faceSize(f)));
+    }
+    // The point at t along side k of face f (corner k to k + 1): on a quad's
+    // one parametric face; on an n-gon's sub-faces k (first half, side 0) and
+    // k + 1 (second half, side 3 from its corner 3 to 0).
+    auto onSide = [&](int f, int k, double t) {
+      const int n = topology.faceSize(f);
+      if (n != 4) {
+        return t <= 0.5 ? SurfacePoint{offset[f] + k, 2 * t, 0.0}
+                        : SurfacePoint{offset[f] + (k + 1) % n, 0.0, 2 - 2 * t};
+      }
       const double corners[5][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}, {0, 0}};
-      return SurfacePoint{face, (1 - t) * corners[side][0] + t * corners[side + 1][0],
-                          (1 - t) * corners[side][1] + t * corners[side + 1][1]};
+      return SurfacePoint{offset[f], (1 - t) * corners[k][0] + t * corners[k + 1][0],
+                          (1 - t) * corners[k][1] + t * corners[k + 1][1]};
     };
     int checked = 0;
     for (int e = 0; e < topology.edgeCount(); ++e) {
       if (topology.isBoundaryEdge(e) || topology.edgeSharpness(e) == 0.0) continue;
       const auto [f, g] = topology.edgeFaces(e);
-      if (topology.faceSize(f) != 4 || topology.faceSize(g) != 4) continue;
       int sideF = 0, sideG = 0;
       while (topology.faceEdge(f, sideF) != e) ++sideF;
       while (topology.faceEdge(g, sideG) != e) ++sideG;
-      for (double t : {0.0, 0.3, 0.5, 1.0}) {
-        const dynsub::LimitSample a = surface.evaluate(along(f, sideF, t), control);
-        const dynsub::LimitSample b = surface.evaluate(along(g, sideG, 1.0 - t), control);
+      for (double t : {0.0, 0.3, 0.5, 0.8, 1.0}) {
+        const dynsub::LimitSample a = surface.evaluate(onSide(f, sideF, t), control);
+        const dynsub::LimitSample b = surface.evaluate(onSide(g, sideG, 1.0 - t), control);
         EXPECT_LE((a.position - b.position).norm(), tolerance) << named.name << " edge " << e << " t " << t;
         if (named.name == "cube8sharp" && t == 0.5) EXPECT_LT(a.normal.dot(b.normal), 0.5) << "edge " << e;
         ++checked;
@@ -279,15 +290,21 @@ TEST(LimitSurface, CreasedFacesMeetAlongTheirCreases) {
   }
 }
 
+// Each step of semi-sharpness refines the whole surface; above 4 a mesh is
+// refused when its creases are set, naming the crease.
 TEST(LimitSurface, SemiSharpCreasesAboveFourAreRefused) {
   dynsub::ControlMesh cube = dynsub::makeCube98();
   const auto [a, b] = cube.topology().edgeVertices(0);
-  cube.setCreases({{a, b, 4.5}});
+  cube.setCreases({{a, b, 4.0}});
+  EXPECT_EQ(LimitSurface(cube).isolationLevels(), 4);  // four crease steps; the cube needs no isolation
   try {
-    const LimitSurface surface(cube);
+    cube.setCreases({{a, b, 4.5}}, "cube");
     FAIL() << "a crease of sharpness 4.5 was accepted";
   } catch (const dynsub::Error& error) {
-    EXPECT_NE(std::string(error.what()).find("semi-sharp creases up to 4"), std::string::npos) << error.what();
+    const std::string message = error.what();
+    EXPECT_NE(message.find("cube: crease (" + std::to_string(a) + ", " + std::to_string(b) + ")"), std::string::npos)
+        << message;
+    EXPECT_NE(message.find("semi-sharp creases up to 4"), std::string::npos) << message;
   }
 }
 

@@ -29,8 +29,8 @@ class Topology;
 //  - a corner (three or more sharp edges, or a boundary vertex of one face)
 //    with one face between each two neighbouring sharp edges.
 // Refused: a crease that ends inside the surface (a dart), and the other
-// configurations. Semi-sharp creases are refined away before the cut and are
-// not restricted.
+// configurations. Semi-sharp creases are refined away before the cut: any
+// configuration, up to kLargestSemiSharpness (Topology.h).
 void checkCreases(const Topology& topology, const std::string& source);
 
 }  // namespace dynsub

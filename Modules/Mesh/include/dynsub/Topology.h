@@ -20,6 +20,9 @@ namespace dynsub {
 using Polygon = std::vector<int>;
 
 constexpr double kInfiniteSharpness = 10.0;
+// The exact limit surface refines semi-sharp creases away globally, ceil(s)
+// steps that each multiply the elements by four: up to this sharpness.
+constexpr double kLargestSemiSharpness = 4.0;
 
 class Topology {
  public:
