@@ -80,6 +80,7 @@ Refinement refine(const Topology& topology) {
     }
   }
 
+  std::vector<int> sharpNow, sharpAfter;  // a vertex's sharp edges before and after the step
   for (int v = 0; v < vertexCount; ++v) {
     const std::vector<int>& edges = topology.vertexEdges(v);
     const std::vector<int>& faces = topology.vertexFaces(v);
@@ -92,7 +93,8 @@ Refinement refine(const Topology& topology) {
     // extraordinary vertices, where such points are never used) a boundary
     // vertex without two boundary edges stay where they are.
     int boundaryEdges = 0;
-    std::vector<int> sharpNow, sharpAfter;
+    sharpNow.clear();
+    sharpAfter.clear();
     double transitionSum = 0.0;
     int transitions = 0;
     for (int e : edges) {
