@@ -186,7 +186,8 @@ INSTANTIATE_TEST_SUITE_P(Creased, OracleTest, ::testing::ValuesIn(dynsub::testin
 // which numbers its vertices otherwise: each refined vertex must have its
 // match in the other mesh (the meshes' refined points are distinct). Same
 // tolerance as the limit surface; the rules are exact rationals, so the
-// agreement is to rounding.
+// agreement is to rounding, or to OpenSubdiv's single-precision weights
+// where a sharpness is fractional.
 class CreasedRefinementTest : public ::testing::TestWithParam<dynsub::testing::NamedMesh> {};
 
 TEST_P(CreasedRefinementTest, TwoStepsMatchOpenSubdiv) {

@@ -1,6 +1,5 @@
 #include "dynsub/ControlMesh.h"
 
-#include <cmath>
 #include <numeric>
 
 #include "dynsub/Error.h"
@@ -42,12 +41,9 @@ void ControlMesh::setCreases(const std::vector<Crease>& creases, const std::stri
     const bool inRange = crease.a >= 0 && crease.b >= 0 && crease.a < vertexCount() && crease.b < vertexCount();
     const int e = inRange ? topology.findEdge(crease.a, crease.b) : -1;
     if (e < 0) throw Error(source, edge + " is not an edge of the mesh (vertices are numbered from 0)");
-    if (!(crease.sharpness >= 0.0 && std::isfinite(crease.sharpness)))
-      throw Error(source,
-                  edge + " has sharpness " + std::to_string(crease.sharpness) + " (expected a finite value >= 0)");
     sharpness[e] = crease.sharpness;
   }
-  topology.setEdgeSharpness(std::move(sharpness));
+  topology.setEdgeSharpness(std::move(sharpness), source);
   checkCreases(topology, source);
   topology_ = std::make_shared<const Topology>(std::move(topology));
 }

@@ -43,17 +43,17 @@ Topology::Topology(int vertexCount, std::vector<Polygon> faces)
   }
 }
 
-void Topology::setEdgeSharpness(std::vector<double> sharpness) {
+void Topology::setEdgeSharpness(std::vector<double> sharpness, const std::string& source) {
   if (static_cast<int>(sharpness.size()) != edgeCount()) {
-    throw Error("topology: " + std::to_string(sharpness.size()) + " sharpness values for " +
-                std::to_string(edgeCount()) + " edges");
+    throw Error(source, std::to_string(sharpness.size()) + " sharpness values for " + std::to_string(edgeCount()) +
+                            " edges");
   }
   bool creased = false;
   for (int e = 0; e < edgeCount(); ++e) {
     if (!(sharpness[e] >= 0.0 && std::isfinite(sharpness[e]))) {
-      throw Error("topology: edge (" + std::to_string(edgeVertices_[e][0]) + ", " +
-                  std::to_string(edgeVertices_[e][1]) + ") has sharpness " + std::to_string(sharpness[e]) +
-                  " (expected a finite value >= 0)");
+      throw Error(source, "crease (" + std::to_string(edgeVertices_[e][0]) + ", " +
+                              std::to_string(edgeVertices_[e][1]) + ") has sharpness " +
+                              std::to_string(sharpness[e]) + " (expected a finite value >= 0)");
     }
     creased = creased || sharpness[e] > 0.0;
   }

@@ -282,7 +282,9 @@ TEST(LimitSurface, CreasedFacesMeetAlongTheirCreases) {
         const dynsub::LimitSample a = surface.evaluate(onSide(f, sideF, t), control);
         const dynsub::LimitSample b = surface.evaluate(onSide(g, sideG, 1.0 - t), control);
         EXPECT_LE((a.position - b.position).norm(), tolerance) << named.name << " edge " << e << " t " << t;
-        if (named.name == "cube8sharp" && t == 0.5) EXPECT_LT(a.normal.dot(b.normal), 0.5) << "edge " << e;
+        if (named.name == "cube8sharp" && t == 0.5) {
+          EXPECT_LT(a.normal.dot(b.normal), 0.5) << "edge " << e;
+        }
         ++checked;
       }
     }

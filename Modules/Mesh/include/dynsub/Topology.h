@@ -12,6 +12,7 @@
 // kInfiniteSharpness up an edge stays sharp at every level. Boundary edges are
 // always sharp, whatever they are given.
 #include <array>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -55,9 +56,9 @@ class Topology {
   bool isBoundaryVertex(int v) const;
   double edgeSharpness(int e) const { return edgeSharpness_.empty() ? 0.0 : edgeSharpness_[e]; }
   bool hasCreases() const { return !edgeSharpness_.empty(); }
-  // One value per edge, finite and >= 0 (throws dynsub::Error otherwise); all
-  // zeros leave the topology without creases.
-  void setEdgeSharpness(std::vector<double> sharpness);
+  // One value per edge, finite and >= 0 (throws dynsub::Error naming `source`
+  // and the edge otherwise); all zeros leave the topology without creases.
+  void setEdgeSharpness(std::vector<double> sharpness, const std::string& source = "topology");
   // Boundary edges and edges of sharpness >= kInfiniteSharpness.
   bool isSharpEdge(int e) const { return isBoundaryEdge(e) || edgeSharpness(e) >= kInfiniteSharpness; }
   // The faces at vertex v grouped into the fans its sharp edges separate: one
