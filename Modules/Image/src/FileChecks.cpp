@@ -80,10 +80,11 @@ void requireMemoryFor(const std::string& path, std::uintmax_t voxels) {
   }
 }
 
-void checkImageFile(const std::string& path) {
+DataCheck checkImageHeader(const std::string& path) {
   const std::string extension = lowerCaseExtension(path);
-  if (isNiftiName(path)) checkNiftiFile(path);
+  if (isNiftiName(path)) return checkNiftiHeader(path);
   if (extension == ".mha" || extension == ".mhd") checkMetaImageFile(path);
+  return {};
 }
 
 }  // namespace dynsub::filechecks

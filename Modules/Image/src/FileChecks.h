@@ -6,6 +6,7 @@
 // share is in FileChecks.cpp.
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,12 +31,19 @@ std::vector<unsigned char> inflateGzipFile(const std::string& path, std::uintmax
 // allocates it.
 void requireMemoryFor(const std::string& path, std::uintmax_t voxels);
 
+// A file's checks come in two parts: the header's, which must pass before a
+// reader allocates what the header announces, and the data's (all there,
+// finite), which read the whole file and so may run while a reader reads it.
+// The header's part returns the data's (empty when there is none).
+using DataCheck = std::function<void()>;
+
 // A NIfTI file (.nii, or .nii.gz when `path` ends in .gz): its header is
 // NIfTI-1 or NIfTI-2 in either byte order, its sizes and datatype possible,
-// the image fits in memory, and its data (inflated) is all there. Throws
-// dynsub::Error naming the file and the problem, and for NaN or infinite
-// float voxels (which ITK's reader would turn into 0).
-void checkNiftiFile(const std::string& path);
+// and the image fits in memory; then (the DataCheck) its data (inflated) is
+// all there, and its float voxels finite (ITK's reader would turn NaN and
+// infinities into 0). Each throws dynsub::Error naming the file and the problem.
+DataCheck checkNiftiHeader(const std::string& path);
+inline void checkNiftiFile(const std::string& path) { checkNiftiHeader(path)(); }
 
 // A MetaImage file (.mha, .mhd): NDims, DimSize and ElementType are there and
 // possible, the image fits in memory, and its data is all there, after the
@@ -47,8 +55,9 @@ void checkMetaImageFile(const std::string& path);
 bool isNiftiName(const std::string& path);
 
 // The checks above that the file's name calls for: NIfTI for .nii and
-// .nii.gz, MetaImage for .mha and .mhd; none for other names.
-void checkImageFile(const std::string& path);
+// .nii.gz, MetaImage for .mha and .mhd (all of it in the header's part);
+// none for other names.
+DataCheck checkImageHeader(const std::string& path);
 
 // Whether a file says it is DICOM: "DICM" after the 128-byte preamble.
 bool isDicomFile(const std::filesystem::path& file);

@@ -25,7 +25,8 @@ struct Geometry {
 
 // A file in a format ITK reads without GDCM (NIfTI, NRRD, MetaImage), as
 // float. Throws dynsub::Error naming the path. A file's own checks
-// (FileChecks.h: checkImageFile) are the caller's, made before.
+// (FileChecks.h: checkImageHeader) are the caller's: its header's before,
+// its data's before or beside.
 DYNSUB_ITK_BRIDGE_API void readImage(const std::string& path, Geometry& geometry, std::vector<float>& voxels);
 
 // A directory holding one DICOM series, or one DICOM file (FileChecks.h:

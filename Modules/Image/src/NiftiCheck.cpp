@@ -84,7 +84,7 @@ std::vector<unsigned char> readBytes(const std::string& path, std::uintmax_t off
 // NIfTI-1 (348-byte header) and NIfTI-2 (540), either byte order. ITK's reader
 // fills a truncated .nii, or a .nii.gz whose gzip stream is cut short, with
 // zeros without complaint, and allocates whatever the header announces.
-void checkNiftiFile(const std::string& path) {
+DataCheck checkNiftiHeader(const std::string& path) {
   const bool gzipped = lowerCaseExtension(path) == ".gz";
   unsigned char header[540] = {};
   std::uintmax_t got = 0;
@@ -154,19 +154,22 @@ void checkNiftiFile(const std::string& path) {
   const auto needed = static_cast<std::uintmax_t>(offset) + count * bytesPerVoxel;
   std::array<std::int64_t, 3> size{1, 1, 1};
   for (int a = 0; a < 3 && a < dimensions; ++a) size[a] = dim(a + 1);
-  // The whole stream is inflated: a gzip stream cut short or corrupt after
-  // the image's bytes is refused too.
-  const std::vector<unsigned char> inflated = gzipped ? inflateGzipFile(path, needed) : std::vector<unsigned char>();
-  const auto actual = gzipped ? inflated.size() : fs::file_size(path);
-  if (actual < needed) throw truncatedData(path, actual, gzipped, needed);
-  // ITK's NIfTI reader turns NaN and infinite voxels into 0 without a word
-  // (ITK 5.2): float data is scanned for them here.
-  if (datatype == 16 || datatype == 64) {
-    const int bytes = datatype == 16 ? 4 : 8;
-    const auto start = static_cast<std::uintmax_t>(offset);
-    const std::vector<unsigned char> plain = gzipped ? std::vector<unsigned char>() : readBytes(path, start, count * bytes);
-    requireFiniteVoxels(path, gzipped ? inflated.data() + start : plain.data(), count, bytes, swap, size);
-  }
+  return [=] {
+    // The whole stream is inflated: a gzip stream cut short or corrupt after
+    // the image's bytes is refused too.
+    const std::vector<unsigned char> inflated = gzipped ? inflateGzipFile(path, needed) : std::vector<unsigned char>();
+    const auto actual = gzipped ? inflated.size() : fs::file_size(path);
+    if (actual < needed) throw truncatedData(path, actual, gzipped, needed);
+    // ITK's NIfTI reader turns NaN and infinite voxels into 0 without a word
+    // (ITK 5.2): float data is scanned for them here.
+    if (datatype == 16 || datatype == 64) {
+      const int bytes = datatype == 16 ? 4 : 8;
+      const auto start = static_cast<std::uintmax_t>(offset);
+      const std::vector<unsigned char> plain =
+          gzipped ? std::vector<unsigned char>() : readBytes(path, start, count * bytes);
+      requireFiniteVoxels(path, gzipped ? inflated.data() + start : plain.data(), count, bytes, swap, size);
+    }
+  };
 }
 
 bool isNiftiName(const std::string& path) {
