@@ -36,7 +36,7 @@ std::vector<unsigned char> inflateGzipFile(const std::string& path, std::uintmax
   }
   // Deflate inflates at most 1032-fold: no buffer beyond what the file can
   // hold is allocated, whatever a hostile header or trailer announces.
-  const std::size_t possible = packed.size() * 1032 + (1 << 16);
+  const std::size_t possible = packed.size() * kLargestDeflateRatio + (1 << 16);
   const std::size_t largest =
       std::min(possible, static_cast<std::size_t>(std::min<std::uintmax_t>(expected, possible)) * 4 + (1 << 16));
   capacity = std::min(std::max<std::size_t>(capacity, 1), largest);
@@ -84,7 +84,7 @@ DataCheck checkImageHeader(const std::string& path) {
   const std::string extension = lowerCaseExtension(path);
   if (isNiftiName(path)) return checkNiftiHeader(path);
   if (extension == ".mha" || extension == ".mhd") checkMetaImageFile(path);
-  return {};
+  return [] {};
 }
 
 }  // namespace dynsub::filechecks

@@ -34,12 +34,16 @@ void requireMemoryFor(const std::string& path, std::uintmax_t voxels);
 // A file's checks come in two parts: the header's, which must pass before a
 // reader allocates what the header announces, and the data's (all there,
 // finite), which read the whole file and so may run while a reader reads it.
-// The header's part returns the data's (empty when there is none).
+// The header's part returns the data's (a no-op when there is none).
 using DataCheck = std::function<void()>;
+
+// The most a deflate stream inflates: 1032 bytes out per byte in.
+constexpr std::uintmax_t kLargestDeflateRatio = 1032;
 
 // A NIfTI file (.nii, or .nii.gz when `path` ends in .gz): its header is
 // NIfTI-1 or NIfTI-2 in either byte order, its sizes and datatype possible,
-// and the image fits in memory; then (the DataCheck) its data (inflated) is
+// the image fits in memory, and the file is large enough to hold (or, gzipped,
+// to inflate to) the data announced; then (the DataCheck) its data (inflated) is
 // all there, and its float voxels finite (ITK's reader would turn NaN and
 // infinities into 0). Each throws dynsub::Error naming the file and the problem.
 DataCheck checkNiftiHeader(const std::string& path);

@@ -28,7 +28,7 @@ Volume readVolume(const std::string& path) {
     // .nii.gz inflated whole, float voxels scanned) take about as long as
     // ITK's read, so they run beside it, on the second core.
     const filechecks::DataCheck checkData = filechecks::checkImageHeader(path);
-    std::future<void> dataChecked = std::async(std::launch::async, checkData ? checkData : [] {});
+    std::future<void> dataChecked = std::async(std::launch::async, checkData);
     try {
       itkbridge::readImage(path, raw, volume.voxels);
     } catch (...) {

@@ -154,7 +154,7 @@ DataCheck checkNiftiHeader(const std::string& path) {
   const auto needed = static_cast<std::uintmax_t>(offset) + count * bytesPerVoxel;
   std::array<std::int64_t, 3> size{1, 1, 1};
   for (int a = 0; a < 3 && a < dimensions; ++a) size[a] = dim(a + 1);
-  return [=] {
+  DataCheck checkData = [=] {
     // The whole stream is inflated: a gzip stream cut short or corrupt after
     // the image's bytes is refused too.
     const std::vector<unsigned char> inflated = gzipped ? inflateGzipFile(path, needed) : std::vector<unsigned char>();
@@ -170,6 +170,13 @@ DataCheck checkNiftiHeader(const std::string& path) {
       requireFiniteVoxels(path, gzipped ? inflated.data() + start : plain.data(), count, bytes, swap, size);
     }
   };
+  // A file too small to hold the data its header announces (inflated, a
+  // deflate stream grows at most 1032-fold) is refused now, before any reader
+  // allocates the announced image.
+  const std::uintmax_t fileSize = fs::file_size(path);
+  const auto reach = gzipped ? checkedProduct(fileSize, kLargestDeflateRatio) : std::optional<std::uintmax_t>(fileSize);
+  if (reach && *reach < needed) checkData();
+  return checkData;
 }
 
 bool isNiftiName(const std::string& path) {

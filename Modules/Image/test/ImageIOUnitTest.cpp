@@ -324,6 +324,10 @@ TEST(HostileImages, HeadersAnnouncingHugeImagesAreRefusedBeforeAllocating) {
   writeNifti(scratch("huge.nii"), {1000, 1000, 1000}, Vector3(1, 1, 1), ramp(8, 1.0f));
   std::string error = readError(scratch("huge.nii"));
   EXPECT_NE(error.find("huge.nii: truncated"), std::string::npos) << error;
+  // The same gzipped: a file that cannot inflate to what it announces.
+  gzipFile(scratch("huge.nii"), scratch("huge.nii.gz"));
+  error = readError(scratch("huge.nii.gz"));
+  EXPECT_NE(error.find("huge.nii.gz: truncated"), std::string::npos) << error;
   // 32767^3 (1.3e5 GiB): more than any memory, in NIfTI, MetaImage and NRRD
   // (the last through ITK's header reader).
   writeNifti(scratch("huge.nii"), {32767, 32767, 32767}, Vector3(1, 1, 1), ramp(8, 1.0f));
