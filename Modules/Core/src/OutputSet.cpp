@@ -13,7 +13,9 @@
 
 namespace dynsub {
 
-void prepareOutputDirectory(const std::filesystem::path& dir) {
+void prepareOutputDirectory(const std::filesystem::path& given) {
+  // "out/" names the folder "out", as in OutputSet.
+  const std::filesystem::path dir = given.has_filename() ? given : given.parent_path();
   std::error_code error;
   if (std::filesystem::exists(dir, error)) {
     if (!std::filesystem::is_directory(dir, error)) throw Error(dir.string(), "exists and is not a directory");

@@ -137,6 +137,23 @@ TEST(OutputSet, ANewDirectoryAppearsWholeAtCommit) {
   EXPECT_EQ(entries(dir / "caudate"), 1u);
 }
 
+// A shell's completion writes "out/": it names the folder "out", whether or
+// not it exists yet; a missing parent is still refused.
+TEST(OutputSet, ATrailingSlashNamesTheFolder) {
+  const fs::path parent = freshDirectory("set-slash");
+  const fs::path slashed = fs::path((parent / "out").string() + "/");
+  EXPECT_NO_THROW(dynsub::prepareOutputDirectory(slashed));
+  {
+    dynsub::OutputSet outputs(slashed);
+    std::ofstream(outputs.add("report.json")) << "{}";
+    outputs.commit();
+  }
+  EXPECT_TRUE(fs::exists(parent / "out" / "report.json"));
+  EXPECT_NO_THROW(dynsub::prepareOutputDirectory(slashed));
+  EXPECT_THROW(dynsub::prepareOutputDirectory(fs::path((parent / "missing" / "out").string() + "/")),
+               dynsub::Error);
+}
+
 TEST(OutputSet, WithoutCommitNothingIsLeft) {
   const fs::path parent = freshDirectory("set-abandon");
   {
