@@ -66,7 +66,7 @@ void addSubjectCommand(CLI::App& app) {
                       "structure_labels (L1,L2,...: the labels a synthesized subject draws as structures), "
                       "rotation_degrees, scale_spread, shear_spread, translation_mm, "
                       "warp_spacing_mm, warp_mm, gamma_spread, bias_spread, blur_mm (LOW,HIGH), snr (LOW,HIGH), "
-                      "source_snr, thick_fraction, thick_mm");
+                      "source_snr, thick_fraction, thick_mm, thick_axis (0, 1 or 2; drawn if not given)");
   command->add_option("--out", arguments->out, "Output directory")->required();
   command->callback([arguments] { runSubject(*arguments); });
 }

@@ -276,6 +276,13 @@ void setSubjectSetting(SubjectSettings& s, const std::string& key, const std::st
     }
     return;
   }
+  if (key == "thick_axis") {
+    const double axis = number(value);
+    if (axis != -1 && axis != 0 && axis != 1 && axis != 2)
+      throw Error("subject settings", "thick_axis must be 0, 1 or 2 (an index axis), or -1 to draw it, got '" + value + "'");
+    s.thickAxis = static_cast<int>(axis);
+    return;
+  }
   if (key == "blur_mm") return range(s.blurMm);
   if (key == "snr") return range(s.snr);
   throw Error("subject settings", "unknown setting '" + key + "'");
@@ -410,7 +417,8 @@ Subject makeSubject(const Volume& image, const Volume& labels, const SubjectSett
   Volume acquired = subject.draw.blurMm > 0 ? gaussianSmoothed(anatomy, subject.draw.blurMm) : anatomy;
   anatomy = Volume();
   if (draw.uniform() < settings.thickFraction) {
-    const int axis = std::min(2, static_cast<int>(draw.uniform() * 3));
+    const int drawn = std::min(2, static_cast<int>(draw.uniform() * 3));
+    const int axis = settings.thickAxis >= 0 ? settings.thickAxis : drawn;
     const int factor = static_cast<int>(std::lround(settings.thickMm / grid.spacing[axis]));
     if (factor >= 2 && grid.size[axis] >= 2 * factor) {
       subject.draw.thickAxis = axis;

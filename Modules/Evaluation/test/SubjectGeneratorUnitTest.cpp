@@ -154,6 +154,32 @@ TEST(SubjectGenerator, ThickSlicesKeepTheExtentAndTheFineLabels) {
 }
 
 
+// thick_axis names the thick axis; the axis is still drawn for, so the
+// subject is otherwise the one its seed gives: the same labels, SNR and
+// noise as with the axis drawn.
+TEST(SubjectGenerator, ANamedThickAxisChangesOnlyTheAxis) {
+  const Phantom p = phantom();
+  SubjectSettings settings = moveOnly();
+  settings.thickFraction = 1;
+  const Subject drawn = makeSubject(p.image, p.labels, settings, 21);
+  ASSERT_TRUE(drawn.draw.thickAxis.has_value());
+  for (const int axis : {0, 1, 2}) {
+    SubjectSettings named = settings;
+    setSubjectSetting(named, "thick_axis", std::to_string(axis));
+    const Subject s = makeSubject(p.image, p.labels, named, 21);
+    ASSERT_EQ(s.draw.thickAxis, axis);
+    EXPECT_DOUBLE_EQ(s.image.geometry.spacing[axis], 3.0);
+    EXPECT_EQ(s.labels.voxels, drawn.labels.voxels);
+    EXPECT_EQ(s.draw.snr, drawn.draw.snr);
+    if (axis == *drawn.draw.thickAxis) {
+      EXPECT_EQ(s.image.voxels, drawn.image.voxels);
+    }
+  }
+  SubjectSettings bad = settings;
+  EXPECT_THROW(setSubjectSetting(bad, "thick_axis", "3"), Error);
+  EXPECT_THROW(setSubjectSetting(bad, "thick_axis", "1.5"), Error);
+}
+
 // Nested shells for synthesized subjects: a ball of label 1 (source
 // intensity 100) inside white (200), grey (100) and dark (30) shells with
 // no label, air (0) around them.

@@ -72,9 +72,12 @@ struct SubjectSettings {
   std::array<double, 2> snr{20, 30};
   double sourceSnr = 70;
   // The share of subjects acquired in thick slices (thickMm along one axis,
-  // drawn among the three; the labels stay on the fine grid).
+  // drawn among the three unless thickAxis names it: 0, 1 or 2, the image's
+  // index axes; the labels stay on the fine grid). A named axis is still
+  // drawn for, so that it changes nothing else of the subject.
   double thickFraction = 0;
   double thickMm = 3;
+  int thickAxis = -1;
 };
 
 // What was drawn for one subject (for its record and the report's groups).
@@ -97,9 +100,9 @@ struct Subject {
 // structure_labels ("71,72,..."),
 // rotation_degrees, scale_spread, shear_spread, translation_mm,
 // warp_spacing_mm, warp_mm, gamma_spread, bias_spread, blur_mm (a range,
-// "LOW,HIGH" or one number), snr (a range), source_snr, thick_fraction and
-// thick_mm. Throws dynsub::Error naming the key for an unknown key or a value
-// that is not a number.
+// "LOW,HIGH" or one number), snr (a range), source_snr, thick_fraction,
+// thick_mm and thick_axis. Throws dynsub::Error naming the key for an
+// unknown key or a value that is not a number.
 void setSubjectSetting(SubjectSettings& settings, const std::string& key, const std::string& value);
 
 // Throws dynsub::Error for impossible settings (naming the setting).
