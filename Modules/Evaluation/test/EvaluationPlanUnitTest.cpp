@@ -116,5 +116,24 @@ TEST(EvaluationPlan, CohortsWithSharedSubjectsUnknownSplitsOrBadSettingsAreRefus
             std::string::npos);
 }
 
+// The plans the documentation reruns are read as they are bundled (their
+// images are not opened here). The thick-slice plan's cohorts are one
+// subject set at 1 mm and in 3 mm slices along each index axis.
+TEST(EvaluationPlan, TheBundledPlansAreRead) {
+  for (const auto& entry : std::filesystem::directory_iterator(DYNSUB_DATA_DIR "/Evaluation")) {
+    if (entry.path().extension() != ".json") continue;
+    EXPECT_NO_THROW(readEvaluationPlan(entry.path().string())) << entry.path();
+  }
+  const EvaluationPlan thick = readEvaluationPlan(DYNSUB_DATA_DIR "/Evaluation/thick_orientation_plan.json");
+  ASSERT_EQ(thick.cohorts.size(), 4u);
+  EXPECT_EQ(thick.cohorts[0].settings.thickMm, 1);  // slices of one voxel: 1 mm, with the others' draws
+  for (int axis = 0; axis < 3; ++axis) {
+    const SubjectSettings& settings = thick.cohorts[static_cast<std::size_t>(axis) + 1].settings;
+    EXPECT_EQ(settings.thickFraction, 1);
+    EXPECT_EQ(settings.thickAxis, axis);
+    EXPECT_EQ(thick.cohorts[static_cast<std::size_t>(axis) + 1].subjects, thick.cohorts[0].subjects);
+  }
+}
+
 }  // namespace
 }  // namespace dynsub
