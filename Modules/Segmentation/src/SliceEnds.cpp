@@ -10,7 +10,12 @@ namespace dynsub {
 namespace {
 
 // Step 1: the axis whose landmark positions (continuous voxel index) fall on
-// the fewest distinct slices, or -1.
+// the fewest distinct slices, or -1. Positions within kOnSliceVoxels of the
+// previous one join its slice, and a slice may span no more than that: on
+// an axis of thick voxels, a narrow structure's clicks from other slices lie
+// a fraction of a voxel apart and would otherwise chain into a few
+// "slices" (a caudate three voxels wide clicked on coronal slices of an
+// image with 3 mm voxels from left to right).
 int sliceAxis(const std::vector<Vector3>& index, int* slices) {
   int best = -1, fewest = static_cast<int>(index.size()) / 3 + 1;
   for (int a = 0; a < 3; ++a) {
@@ -18,8 +23,17 @@ int sliceAxis(const std::vector<Vector3>& index, int* slices) {
     for (const Vector3& p : index) along.push_back(p(a));
     std::sort(along.begin(), along.end());
     int distinct = 1;
-    for (std::size_t i = 1; i < along.size(); ++i) distinct += along[i] - along[i - 1] > kOnSliceVoxels;
-    if (distinct >= 2 && distinct < fewest) {
+    double sliceStart = along.front();
+    bool onSlices = true;
+    for (std::size_t i = 1; i < along.size(); ++i) {
+      if (along[i] - along[i - 1] > kOnSliceVoxels) {
+        ++distinct;
+        sliceStart = along[i];
+      } else if (along[i] - sliceStart > kOnSliceVoxels) {
+        onSlices = false;
+      }
+    }
+    if (onSlices && distinct >= 2 && distinct < fewest) {
       fewest = distinct;
       best = a;
     }

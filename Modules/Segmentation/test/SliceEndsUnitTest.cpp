@@ -292,6 +292,28 @@ TEST(SliceEnds, NoSpringsForLandmarksOffSlicesOrTooFew) {
   EXPECT_TRUE(findSliceEnds(image, few, initialFromLandmarks(scattered), options).springs.empty());
 }
 
+// Clicks on coronal slices of an image with 4 mm voxels from left to right,
+// 12 per slice with a hand's 0.4 mm scatter: the cigar is 16 mm wide there,
+// four voxels, so its 60 clicks' left-right positions lie a fraction of a
+// voxel apart and chain into fewer "slices" than the five coronal ones. The
+// slices are still the coronal ones, where the clicks lie exactly.
+TEST(SliceEnds, ThickVoxelsAcrossTheSlicesDoNotMakeSlices) {
+  const Cigar shape;
+  Mask truth;
+  Volume image = cigarImage(shape, &truth);
+  ImageGeometry& g = image.geometry;
+  g.spacing = Vector3(4, 1, 1);
+  g.size[0] = 11;
+  image.voxels.resize(static_cast<std::size_t>(g.voxelCount()));
+  std::vector<Landmark> landmarks = clicks(shape, 12);
+  std::mt19937_64 random(7);
+  std::normal_distribution<double> scatter(0.0, 0.4);
+  for (Landmark& l : landmarks) l.position += Vector3(scatter(random), 0, scatter(random));
+  const SliceEnds ends = findSliceEnds(image, landmarks, initialFromLandmarks(landmarks), SliceEndOptions());
+  EXPECT_EQ(ends.axis, 1);
+  EXPECT_EQ(ends.slices, 5);
+}
+
 TEST(SliceEnds, RefusesImpossibleOptions) {
   for (auto bad : {+[](SliceEndOptions& o) { o.window = 0; }, +[](SliceEndOptions& o) { o.reach = -1; },
                    +[](SliceEndOptions& o) { o.disk = std::nan(""); },

@@ -5,8 +5,9 @@
 // it started from. This looks for where the structure ends beyond them and
 // puts a soft spring there, at each end:
 //  1. The slices: the image axis along which the landmarks take the fewest
-//     distinct positions (at least 2, at most a third of the landmarks);
-//     landmarks that are not on slices of the image get no springs.
+//     distinct positions (at least 2, at most a third of the landmarks),
+//     each within kOnSliceVoxels; landmarks that are not on slices of the
+//     image get no springs.
 //  2. Appearance: the median m and robust spread s (1.4826 MAD) of the
 //     intensities inside the initial model.
 //  3. At each end, from the centroid of the outermost slice's landmarks
