@@ -150,8 +150,7 @@ TEST(OutputSet, ATrailingSlashNamesTheFolder) {
   }
   EXPECT_TRUE(fs::exists(parent / "out" / "report.json"));
   EXPECT_NO_THROW(dynsub::prepareOutputDirectory(slashed));
-  EXPECT_THROW(dynsub::prepareOutputDirectory(fs::path((parent / "missing" / "out").string() + "/")),
-               dynsub::Error);
+  EXPECT_THROW(dynsub::prepareOutputDirectory(fs::path((parent / "missing" / "out").string() + "/")), dynsub::Error);
 }
 
 TEST(OutputSet, WithoutCommitNothingIsLeft) {

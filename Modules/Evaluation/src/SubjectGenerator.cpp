@@ -279,7 +279,8 @@ void setSubjectSetting(SubjectSettings& s, const std::string& key, const std::st
   if (key == "thick_axis") {
     const double axis = number(value);
     if (axis != -1 && axis != 0 && axis != 1 && axis != 2)
-      throw Error("subject settings", "thick_axis must be 0, 1 or 2 (an index axis), or -1 to draw it, got '" + value + "'");
+      throw Error("subject settings",
+                  "thick_axis must be 0, 1 or 2 (an index axis), or -1 to draw it, got '" + value + "'");
     s.thickAxis = static_cast<int>(axis);
     return;
   }

@@ -153,10 +153,9 @@ TEST(SubjectGenerator, ThickSlicesKeepTheExtentAndTheFineLabels) {
   EXPECT_NEAR(s.image.geometry.origin[axis], p.image.geometry.origin[axis] + 1.0, 1e-12);
 }
 
-
 // thick_axis names the thick axis; the axis is still drawn for, so the
-// subject is otherwise the one its seed gives: the same labels, SNR and
-// noise as with the axis drawn.
+// subject is otherwise the one its seed gives: the same labels and SNR as
+// with the axis drawn, and on the drawn axis the same image.
 TEST(SubjectGenerator, ANamedThickAxisChangesOnlyTheAxis) {
   const Phantom p = phantom();
   SubjectSettings settings = moveOnly();
