@@ -5,6 +5,7 @@
 #include <atomic>
 #include <complex>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <mutex>
 
@@ -133,6 +134,34 @@ Topology cutAlongCreases(const Topology& topology, SparseMatrix* duplication) {
     duplication->setFromTriplets(ones.begin(), ones.end());
   }
   return Topology(static_cast<int>(source.size()), std::move(faces));
+}
+
+// The global refinements before the elements (LimitSurface.h): semi-sharp
+// creases refined away, the cut along sharp creases, then the steps that
+// isolate extraordinary vertices. `refined` sees each step (the topology it
+// refined and its refinement, whose topology it must leave), `cut` the
+// cut's duplication matrix. Returns the base topology.
+Topology refineToBase(Topology base, const std::function<void(const Topology&, Refinement&)>& refined,
+                      const std::function<void(const SparseMatrix&)>& cut) {
+  const auto step = [&] {
+    Refinement refinement = refine(base);
+    refined(base, refinement);
+    base = std::move(refinement.topology);
+  };
+  const int creaseLevels = semiSharpLevels(base);
+  for (int level = 0; level < creaseLevels; ++level) step();
+  if (base.hasCreases()) {
+    SparseMatrix duplication;
+    base = cutAlongCreases(base, &duplication);
+    cut(duplication);
+  }
+  // One step isolates every extraordinary vertex of an all-quad mesh; a second
+  // one those at the centres of former n-gons.
+  for (int levels = 0; needsIsolation(base); ++levels) {
+    if (levels == 2) throw Error("internal: extraordinary vertices are not isolated after two steps");
+    step();
+  }
+  return base;
 }
 
 // Rewrites derivative rows taken in parameters (a, b) into parameters (u, v),
@@ -690,38 +719,25 @@ LimitSurface::LimitSurface(const ControlMesh& mesh) : impl_(std::make_unique<Imp
   s.isolation.setIdentity();
   std::vector<int> controlFaceOf(s.base.faceCount());
   for (int f = 0; f < s.base.faceCount(); ++f) controlFaceOf[f] = f;
-  auto refineBase = [&] {
-    Refinement refinement = refine(s.base);
+  const auto refined = [&](const Topology& parent, Refinement& refinement) {
     s.isolation = refinement.subdivisionMatrix * s.isolation;
     std::vector<int> childControlFace(refinement.topology.faceCount());
-    for (int f = 0; f < s.base.faceCount(); ++f) {
-      for (int k = 0; k < s.base.faceSize(f); ++k) childControlFace[refinement.childFaceOffset[f] + k] = controlFaceOf[f];
+    for (int f = 0; f < parent.faceCount(); ++f) {
+      for (int k = 0; k < parent.faceSize(f); ++k) {
+        childControlFace[refinement.childFaceOffset[f] + k] = controlFaceOf[f];
+      }
     }
     controlFaceOf = std::move(childControlFace);
     std::vector<std::pair<int, int>> parents(refinement.topology.faceCount());
-    for (int f = 0; f < s.base.faceCount(); ++f) {
-      for (int k = 0; k < s.base.faceSize(f); ++k) parents[refinement.childFaceOffset[f] + k] = {f, k};
+    for (int f = 0; f < parent.faceCount(); ++f) {
+      for (int k = 0; k < parent.faceSize(f); ++k) parents[refinement.childFaceOffset[f] + k] = {f, k};
     }
     s.parentOf.push_back(std::move(parents));
     s.childFaceOffset.push_back(std::move(refinement.childFaceOffset));
-    s.base = std::move(refinement.topology);
     ++s.isolationLevels;
   };
-  const int creaseLevels = semiSharpLevels(s.base);
-  while (s.isolationLevels < creaseLevels) refineBase();
-  if (s.base.hasCreases()) {
-    SparseMatrix duplication;
-    s.base = cutAlongCreases(s.base, &duplication);
-    s.isolation = duplication * s.isolation;
-  }
-  while (needsIsolation(s.base)) {
-    // One step isolates every extraordinary vertex of an all-quad mesh; a second
-    // one those at the centres of former n-gons.
-    if (s.isolationLevels == creaseLevels + 2) {
-      throw Error("internal: extraordinary vertices are not isolated after two steps");
-    }
-    refineBase();
-  }
+  s.base = refineToBase(std::move(s.base), refined,
+                        [&s](const SparseMatrix& duplication) { s.isolation = duplication * s.isolation; });
   s.isolation.makeCompressed();
 
   s.elements.resize(s.base.faceCount());
@@ -742,15 +758,7 @@ LimitSurface::LimitSurface(const ControlMesh& mesh) : impl_(std::make_unique<Imp
 
 int LimitSurface::elementCountOf(const ControlMesh& mesh) {
   // The constructor's refinements, on the topology alone.
-  Topology base = mesh.topology();
-  const int creaseLevels = semiSharpLevels(base);
-  for (int level = 0; level < creaseLevels; ++level) base = refine(base).topology;
-  if (base.hasCreases()) base = cutAlongCreases(base, nullptr);
-  for (int levels = 0; needsIsolation(base); ++levels) {
-    if (levels == 2) throw Error("internal: extraordinary vertices are not isolated after two steps");
-    base = refine(base).topology;
-  }
-  return base.faceCount();
+  return refineToBase(mesh.topology(), [](const Topology&, Refinement&) {}, [](const SparseMatrix&) {}).faceCount();
 }
 
 LimitSurface::~LimitSurface() = default;
