@@ -37,14 +37,15 @@ vtkSmartPointer<vtkPolyData> controlMeshWireframe(const ControlMesh& mesh) {
   vtkNew<vtkUnsignedCharArray> colours;
   colours->SetNumberOfComponents(3);
   colours->SetName("Colors");
+  std::array<unsigned char, 3> wire{};
+  for (int c = 0; c < 3; ++c) wire[c] = static_cast<unsigned char>(std::lround(255.0 * style::kWireframe[c]));
   for (int e = 0; e < topology.edgeCount(); ++e) {
     const auto [a, b] = topology.edgeVertices(e);
     const vtkIdType ids[2] = {a, b};
     lines->InsertNextCell(2, ids);
     if (topology.hasCreases()) {
       const bool creased = topology.edgeSharpness(e) > 0.0 && !topology.isBoundaryEdge(e);
-      const std::array<unsigned char, 3> wire{153, 179, 255}, crease{255, 90, 40};
-      colours->InsertNextTypedTuple(creased ? crease.data() : wire.data());
+      colours->InsertNextTypedTuple(creased ? style::kCrease.data() : wire.data());
     }
   }
   auto wireframe = vtkSmartPointer<vtkPolyData>::New();
@@ -79,7 +80,7 @@ struct SurfaceView::Impl {
     renderer->AddActor(surfaceActor);
 
     wireActor->SetMapper(wireMapper);
-    wireActor->GetProperty()->SetColor(0.6, 0.7, 1.0);
+    wireActor->GetProperty()->SetColor(style::kWireframe[0], style::kWireframe[1], style::kWireframe[2]);
     wireActor->GetProperty()->LightingOff();
     wireActor->VisibilityOff();
     renderer->AddActor(wireActor);

@@ -47,6 +47,9 @@ constexpr std::array<double, 3> kMidEdge{1.0, 0.9, 0.15};
 constexpr std::array<double, 3> kOffEdge{0.9, 0.2, 0.9};
 // Range data's dots: light grey, apart from the landmarks' red.
 constexpr std::array<double, 3> kDataPoint{0.85, 0.85, 0.85};
+// The control mesh's wireframe, and in a creased mesh its creases.
+constexpr std::array<double, 3> kWireframe{0.6, 0.7, 1.0};
+constexpr std::array<unsigned char, 3> kCrease{255, 90, 40};
 // The colour bar of colourByEdgeDistance, for `mapper`, at the right of its view.
 vtkSmartPointer<vtkScalarBarActor> edgeDistanceBar(vtkPolyDataMapper* mapper);
 // Vertices drawn as round dots of a fixed size in pixels.
