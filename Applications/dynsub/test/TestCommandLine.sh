@@ -94,9 +94,9 @@ expect_error "missing output parent" 1 "does not exist" "$work/no/o10" \
 # creases: 1200 points on the faces of a cube of side 44 mm, turned 10 degrees
 # about z and moved 3 mm up. The smooth model needs 6146 control vertices for
 # 0.1 % here (measured: `fit cube.xyz --tolerance 0.1`, 0.078 %); the creased
-# cube needs 386 (0.059 %), and 98 with stiffer data springs (0.038 %; the
-# issue's bar is 100). At 8 vertices the closest-point springs settle in a
-# twisted local minimum (0.9 %), so the fit refines.
+# cube needs 386 (0.059 %), and 98 with stiffer data springs (0.038 %). At 8
+# vertices the closest-point springs settle in a twisted local minimum
+# (0.9 %), so the fit refines.
 awk 'BEGIN { srand(5); c = cos(0.1745329); s = sin(0.1745329);
   for (i = 0; i < 1200; i++) { f = int(6 * rand()); a = 44 * rand() - 22; b = 44 * rand() - 22; side = (f % 2) ? 22 : -22;
     if (f < 2) { x = side; y = a; z = b } else if (f < 4) { x = a; y = side; z = b } else { x = a; y = b; z = side }
