@@ -125,7 +125,7 @@ Eigen::VectorXd EndPressure::pressuresAt(const MatrixX3& points) const {
     const double t = along_.dot(x);
     if (t >= first_ && t <= last_) continue;  // the clicked span
     const std::optional<End>& end = t < first_ ? before_ : after_;
-    if (!end) continue;
+    if (!end || std::max(first_ - t, t - last_) > end->reach) continue;
     Vector3 across = x - end->centre;
     across -= across.dot(along_) * along_;
     if (across.norm() > end->radius) continue;

@@ -86,13 +86,17 @@ double enclosedVolume(const TriangleSurface& s) {
 // structure ending within `gap` of the outermost slice (an end the clicks
 // already reach, as the bundled caudate's do); none at all
 // when off, when the clicks are not on slices, or when they gave too few
-// samples.
+// samples. It reaches as far along the axis as the region was asked to.
 std::optional<EndPressure> endPressure(const SegmentationRegion& region, const std::vector<Landmark>& landmarks,
                                        const SliceEndOptions& options, SliceEnds& ends) {
   if (ends.axis < 0 || !(options.pressure > 0)) return std::nullopt;
   std::optional<EndPressure::End> beyond[2];  // before and after the clicked span, along the axis
   for (const SliceEnd& end : ends.ends)
-    if (end.stoppedByReach || end.length > options.gap) beyond[end.side > 0] = EndPressure::End{end.start, end.sliceRadius};
+    if (end.stoppedByReach || end.length > options.gap) {
+      const auto [low, high] = region.spanAlong(ends.axis);
+      const double slice = region.image().geometry.direction.col(ends.axis).normalized().dot(end.start);
+      beyond[end.side > 0] = EndPressure::End{end.start, end.sliceRadius, end.side > 0 ? high - slice : slice - low};
+    }
   if (!beyond[0] && !beyond[1]) return std::nullopt;
   std::optional<ClickAppearance> appearance = ClickAppearance::learn(region.image(), landmarks, ends.axis);
   if (!appearance) return std::nullopt;
@@ -193,6 +197,10 @@ SegmentationRegion::SegmentationRegion(const Volume& image, const std::vector<La
   MatrixX3 extent(start.rows() + landmarkPoints.rows() + coverPoints.rows(), 3);
   extent << start, landmarkPoints, coverPoints;
   std::tie(first_, size_) = boundingRegion(grid, extent, options.margin);
+  for (int a = 0; a < 3; ++a) {
+    const Eigen::VectorXd t = extent * grid.direction.col(a).normalized();
+    span_[a] = {t.minCoeff() - options.margin, t.maxCoeff() + options.margin};
+  }
   image_ = cropVolume(image, first_, size_);
   // readVolume refuses such images; a volume made in memory is checked here,
   // on the region the forces come from.

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "dynsub/ClickAppearance.h"
@@ -24,10 +25,12 @@ struct Cigar {
   bool inside(const Vector3& x) const { return (x - centre).cwiseQuotient(axes).squaredNorm() <= 1.0; }
 };
 
-Volume cigarImage(const Cigar& shape, Mask* truth) {
+// `sliceMm`: the voxels' size along y (61 mm of it).
+Volume cigarImage(const Cigar& shape, Mask* truth, int sliceMm = 1) {
   Volume image;
   ImageGeometry& g = image.geometry;
-  g.size = {41, 61, 41};
+  g.size = {41, 60 / sliceMm + 1, 41};
+  g.spacing.y() = sliceMm;
   g.origin = shape.centre - Vector3(20, 30, 20);
   image.voxels.resize(g.voxelCount());
   truth->geometry = g;
@@ -197,21 +200,22 @@ TEST(ClickAppearance, ThePressureActsOnlyBeyondTheClickedSpan) {
   Mask truth;
   const Volume image = cigarImage(shape, &truth);
   const std::vector<Landmark> landmarks = clicks(shape, 6);  // slices at y = -12 .. 12 mm from the centre
-  const auto pressureAt = [&](bool before, bool after) {
+  const auto pressureAt = [&](bool before, bool after, double reach = std::numeric_limits<double>::infinity()) {
     // Each end's footprint: its slice's centroid (on the axis) and farthest click.
     const auto end = [&](double y, bool on) {
       const double radius = shape.axes.x() * std::sqrt(1.0 - (y / shape.axes.y()) * (y / shape.axes.y()));
-      return on ? std::optional<EndPressure::End>({shape.centre + Vector3(0, y, 0), radius}) : std::nullopt;
+      return on ? std::optional<EndPressure::End>({shape.centre + Vector3(0, y, 0), radius, reach}) : std::nullopt;
     };
     const EndPressure pressure(image, *ClickAppearance::learn(image, landmarks, 1), landmarks, 1, 0.2,
                                end(-12, before), end(12, after));
-    MatrixX3 points(6, 3);
+    MatrixX3 points(7, 3);
     points.row(0) = (shape.centre + Vector3(0, 0, 0)).transpose();    // inside, within the span
     points.row(1) = (shape.centre + Vector3(0, 16, 0)).transpose();   // inside, beyond the last slice
     points.row(2) = (shape.centre + Vector3(0, -16, 0)).transpose();  // inside, before the first
     points.row(3) = (shape.centre + Vector3(0, 25, 0)).transpose();   // background, beyond the last slice
     points.row(4) = (shape.centre + Vector3(0, 35, 0)).transpose();   // on the axis, beyond the image's end
     points.row(5) = (shape.centre + Vector3(7, 16, 0)).transpose();   // beyond the last slice's footprint (6.4 mm)
+    points.row(6) = (shape.centre + Vector3(0, 14, 0)).transpose();   // inside, 2 mm beyond the last slice
     EXPECT_GT(pressure.slopeBound(), 0.0);
     return pressure.pressuresAt(points);
   };
@@ -225,6 +229,36 @@ TEST(ClickAppearance, ThePressureActsOnlyBeyondTheClickedSpan) {
   const Eigen::VectorXd after = pressureAt(false, true);
   EXPECT_GT(after(1), 0.15);
   EXPECT_EQ(after(2), 0.0);
+  // Reaching 3 mm beyond the end slices: the points 2 mm beyond are pushed,
+  // those 4 mm beyond are not.
+  const Eigen::VectorXd near = pressureAt(true, true, 3.0);
+  EXPECT_GT(near(6), 0.15);
+  EXPECT_EQ(near(1), 0.0);
+  EXPECT_EQ(near(2), 0.0);
+  EXPECT_EQ(near(3), 0.0);
+}
+
+// On 3 mm slices the region's whole voxels reach past the margin asked for;
+// its span in mm (how far the end pressure reaches) does not.
+TEST(SegmentationRegion, ItsSpanIsTheMarginAskedForWhateverTheVoxels) {
+  const Cigar shape;
+  Mask truth;
+  const std::vector<Landmark> landmarks = clicks(shape, 6);  // y from -12 to 12 mm of the centre
+  for (int sliceMm : {1, 3}) {
+    const Volume image = cigarImage(shape, &truth, sliceMm);
+    SegmentOptions options;
+    options.margin = 7.0;
+    const SegmentationRegion region(image, landmarks, initialFromLandmarks(landmarks), options);
+    const auto [low, high] = region.spanAlong(1);
+    // The initial model lies within the clicks' span along y, so that span
+    // grown by the margin.
+    EXPECT_NEAR(low, shape.centre.y() - 12 - 7, 1e-9) << sliceMm;
+    EXPECT_NEAR(high, shape.centre.y() + 12 + 7, 1e-9) << sliceMm;
+    const ImageGeometry& grid = region.image().geometry;
+    EXPECT_LE(grid.origin.y(), low) << sliceMm;
+    EXPECT_GE(grid.origin.y() + (grid.size[1] - 1) * grid.spacing.y(), high) << sliceMm;
+    if (sliceMm == 3) EXPECT_LT(grid.origin.y(), low - 1.0);  // a third of a voxel and more
+  }
 }
 
 // From clicks over the middle 60 % only, the pressure carries the surface to

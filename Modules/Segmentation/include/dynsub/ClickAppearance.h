@@ -21,6 +21,7 @@
 // (Integrator.h): without it the pressure flips sign across the boundary
 // from step to step, and a level can run to its step limit instead of
 // settling.
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -62,10 +63,15 @@ class EndPressure final : public PressureField {
   // clicks' centroid (radius: its farthest click). A structure's unclicked
   // end is taken to be no wider than its last clicked section: without this
   // bound the pressure can grow an end sideways into like tissue beside it
-  // (a cerebellum's lateral ends into the temporal lobes).
+  // (a cerebellum's lateral ends into the temporal lobes). Nor farther
+  // than `reach` mm beyond the end slice: where like tissue goes on past the
+  // structure's end (below a thalamus), the pressure stops only there, and a
+  // bound in mm stops it at the same place on 1 mm and 3 mm slices, where the
+  // region's whole voxels would reach up to a voxel farther.
   struct End {
     Vector3 centre = Vector3::Zero();
     double radius = 0;
+    double reach = std::numeric_limits<double>::infinity();
   };
   // `region`: the image the pressure samples (not copied: it must outlive
   // this); the clicked span is that of `landmarks` along `axis`; `before`

@@ -122,6 +122,10 @@ class SegmentationRegion {
 
   const EdgeField& edgeField() const { return *edgeField_; }
   const Volume& image() const { return image_; }  // the image cropped to the region
+  // The region as asked for along image axis `axis`, in mm along its
+  // direction: the box's points projected, grown by the margin. The grid's
+  // whole voxels reach up to a voxel beyond it.
+  std::pair<double, double> spanAlong(int axis) const { return span_[axis]; }
   const std::array<int, 3>& first() const { return first_; }  // voxel box in the image
   const std::array<int, 3>& size() const { return size_; }
   double cropSeconds() const { return cropSeconds_; }
@@ -129,6 +133,7 @@ class SegmentationRegion {
 
  private:
   std::array<int, 3> first_{}, size_{};
+  std::array<std::pair<double, double>, 3> span_;
   ImageGeometry geometry_;
   Volume image_;
   double cropSeconds_ = 0, potentialSeconds_ = 0;
