@@ -118,7 +118,8 @@ TEST(EvaluationPlan, CohortsWithSharedSubjectsUnknownSplitsOrBadSettingsAreRefus
 
 // The plans the documentation reruns are read as they are bundled (their
 // images are not opened here). The thick-slice plan's cohorts are one
-// subject set at 1 mm and in 3 mm slices along each index axis.
+// subject set at 1 mm and in 3 mm slices along each index axis, with a
+// held-out split of other subjects.
 TEST(EvaluationPlan, TheBundledPlansAreRead) {
   for (const auto& entry : std::filesystem::directory_iterator(DYNSUB_DATA_DIR "/Evaluation")) {
     if (entry.path().extension() != ".json") continue;
@@ -126,6 +127,10 @@ TEST(EvaluationPlan, TheBundledPlansAreRead) {
   }
   const EvaluationPlan thick = readEvaluationPlan(DYNSUB_DATA_DIR "/Evaluation/thick_orientation_plan.json");
   ASSERT_EQ(thick.cohorts.size(), 4u);
+  ASSERT_EQ(thick.splits.size(), 2u);
+  const std::vector<std::pair<std::string, std::vector<std::uint64_t>>> subjects{
+      {"held_out", {704, 705, 706}}, {"thick_orientation", {701, 702, 703}}};  // in the order of their names
+  EXPECT_EQ(thick.cohorts[0].subjects, subjects);
   EXPECT_EQ(thick.cohorts[0].settings.thickMm, 1);  // slices of one voxel: 1 mm, with the others' draws
   for (int axis = 0; axis < 3; ++axis) {
     const SubjectSettings& settings = thick.cohorts[static_cast<std::size_t>(axis) + 1].settings;
