@@ -84,6 +84,7 @@ Report sliceEndsReport(const SliceEnds& ends) {
     r.set("stopped_by_reach", end.stoppedByReach);
     r.set("tapered", end.tapered);
     r.set("pressure", end.pressed);
+    if (end.pressed) r.set("pressure_reach_mm", end.pressureReach);
     marched.push_back(r);
   }
   std::vector<Vector3> springPoints;

@@ -86,7 +86,11 @@ double enclosedVolume(const TriangleSurface& s) {
 // structure ending within `gap` of the outermost slice (an end the clicks
 // already reach, as the bundled caudate's do); none at all
 // when off, when the clicks are not on slices, or when they gave too few
-// samples. It reaches as far along the axis as the region was asked to.
+// samples. It reaches as far along the axis as the region was asked to, and
+// beyond a tapering end (SliceEnds.h, step 4) only as far as its march went:
+// there the spring holds the end the march saw, and a pressure past it grows
+// the end on into like tissue (a putamen's lower end into the grey matter
+// below it).
 std::optional<EndPressure> endPressure(const SegmentationRegion& region, const std::vector<Landmark>& landmarks,
                                        const SliceEndOptions& options, SliceEnds& ends) {
   if (ends.axis < 0 || !(options.pressure > 0)) return std::nullopt;
@@ -95,12 +99,18 @@ std::optional<EndPressure> endPressure(const SegmentationRegion& region, const s
     if (end.stoppedByReach || end.length > options.gap) {
       const auto [low, high] = region.spanAlong(ends.axis);
       const double slice = region.image().geometry.direction.col(ends.axis).normalized().dot(end.start);
-      beyond[end.side > 0] = EndPressure::End{end.start, end.sliceRadius, end.side > 0 ? high - slice : slice - low};
+      double reach = end.side > 0 ? high - slice : slice - low;
+      // A tapering end's march saw where it ends: no farther.
+      if (end.tapered) reach = std::min(reach, end.length);
+      beyond[end.side > 0] = EndPressure::End{end.start, end.sliceRadius, reach};
     }
   if (!beyond[0] && !beyond[1]) return std::nullopt;
   std::optional<ClickAppearance> appearance = ClickAppearance::learn(region.image(), landmarks, ends.axis);
   if (!appearance) return std::nullopt;
-  for (SliceEnd& end : ends.ends) end.pressed = beyond[end.side > 0].has_value();
+  for (SliceEnd& end : ends.ends) {
+    end.pressed = beyond[end.side > 0].has_value();
+    if (end.pressed) end.pressureReach = beyond[end.side > 0]->reach;
+  }
   ends.pressure = options.pressure;
   ends.insideSamples = appearance->insideSamples();
   ends.outsideSamples = appearance->outsideSamples();

@@ -257,7 +257,9 @@ TEST(SegmentationRegion, ItsSpanIsTheMarginAskedForWhateverTheVoxels) {
     const ImageGeometry& grid = region.image().geometry;
     EXPECT_LE(grid.origin.y(), low) << sliceMm;
     EXPECT_GE(grid.origin.y() + (grid.size[1] - 1) * grid.spacing.y(), high) << sliceMm;
-    if (sliceMm == 3) EXPECT_LT(grid.origin.y(), low - 1.0);  // a third of a voxel and more
+    if (sliceMm == 3) {
+      EXPECT_LT(grid.origin.y(), low - 1.0);  // a third of a voxel and more
+    }
   }
 }
 
@@ -273,7 +275,12 @@ TEST(SliceEnds, ThePressureCarriesTheSurfaceToTheEnds) {
   EXPECT_EQ(springsOnly.result.sliceEnds.pressure, 0.0);
   EXPECT_EQ(with.result.sliceEnds.pressure, 0.2);
   EXPECT_EQ(with.result.sliceEnds.insideSamples, 60);
-  // Measured 0.975 -> 0.981: the tips the taper drew in are filled; half of
+  // The cigar's ends taper: the pressure acts as far as each march went.
+  for (const SliceEnd& end : with.result.sliceEnds.ends) {
+    EXPECT_TRUE(end.tapered && end.pressed);
+    EXPECT_EQ(end.pressureReach, end.length);
+  }
+  // Measured 0.975 -> 0.980: the tips the taper drew in are filled; half of
   // that gain is asked for.
   EXPECT_GE(with.dice, springsOnly.dice + 0.003);
   EXPECT_GE(with.dice, 0.95);

@@ -36,7 +36,8 @@
 //     it carries the surface to the structure's own boundary where only the
 //     tip and taper springs held it (a caudate's blunt head, a hemisphere's
 //     lateral ends). Not beyond an end whose march stopped within `gap` of
-//     the slice: the clicks already reach that end.
+//     the slice: the clicks already reach that end. Beyond a tapered end no
+//     farther than its march went: the end is where the march saw it.
 // A march through the structure's own tissue is what a one-dimensional
 // region growth from the clicked end sees; it cannot leak sideways into
 // like tissue the way a grown volume does.
@@ -85,6 +86,7 @@ struct SliceEnd {
   bool widening = false;            // the end slice's clicks are kTaperWidening times as wide as the next's
   bool tapered = false;             // step 4 also put taper springs here (sprung, `taper`, not widening)
   bool pressed = false;             // step 5's pressure acts beyond this end (set by segment())
+  double pressureReach = 0;         // mm: how far beyond the slice it acts (set by segment())
 };
 
 struct SliceEnds {
