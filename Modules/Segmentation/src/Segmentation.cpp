@@ -95,10 +95,11 @@ std::optional<EndPressure> endPressure(const SegmentationRegion& region, const s
                                        const SliceEndOptions& options, SliceEnds& ends) {
   if (ends.axis < 0 || !(options.pressure > 0)) return std::nullopt;
   std::optional<EndPressure::End> beyond[2];  // before and after the clicked span, along the axis
+  const auto [low, high] = region.spanAlong(ends.axis);
+  const Vector3 along = region.image().geometry.direction.col(ends.axis).normalized();
   for (const SliceEnd& end : ends.ends)
     if (end.stoppedByReach || end.length > options.gap) {
-      const auto [low, high] = region.spanAlong(ends.axis);
-      const double slice = region.image().geometry.direction.col(ends.axis).normalized().dot(end.start);
+      const double slice = along.dot(end.start);
       double reach = end.side > 0 ? high - slice : slice - low;
       // A tapering end's march saw where it ends: no farther.
       if (end.tapered) reach = std::min(reach, end.length);

@@ -140,20 +140,21 @@ Topology cutAlongCreases(const Topology& topology, SparseMatrix* duplication) {
 // creases refined away, the cut along sharp creases, then the steps that
 // isolate extraordinary vertices. `refined` sees each step (the topology it
 // refined and its refinement, whose topology it must leave), `cut` the
-// cut's duplication matrix. Returns the base topology.
+// cut's duplication matrix; either may be empty (then no matrix is built for
+// it). Returns the base topology.
 Topology refineToBase(Topology base, const std::function<void(const Topology&, Refinement&)>& refined,
                       const std::function<void(const SparseMatrix&)>& cut) {
   const auto step = [&] {
     Refinement refinement = refine(base);
-    refined(base, refinement);
+    if (refined) refined(base, refinement);
     base = std::move(refinement.topology);
   };
   const int creaseLevels = semiSharpLevels(base);
   for (int level = 0; level < creaseLevels; ++level) step();
   if (base.hasCreases()) {
     SparseMatrix duplication;
-    base = cutAlongCreases(base, &duplication);
-    cut(duplication);
+    base = cutAlongCreases(base, cut ? &duplication : nullptr);
+    if (cut) cut(duplication);
   }
   // One step isolates every extraordinary vertex of an all-quad mesh; a second
   // one those at the centres of former n-gons.
@@ -722,16 +723,15 @@ LimitSurface::LimitSurface(const ControlMesh& mesh) : impl_(std::make_unique<Imp
   const auto refined = [&](const Topology& parent, Refinement& refinement) {
     s.isolation = refinement.subdivisionMatrix * s.isolation;
     std::vector<int> childControlFace(refinement.topology.faceCount());
+    std::vector<std::pair<int, int>> parents(refinement.topology.faceCount());
     for (int f = 0; f < parent.faceCount(); ++f) {
       for (int k = 0; k < parent.faceSize(f); ++k) {
-        childControlFace[refinement.childFaceOffset[f] + k] = controlFaceOf[f];
+        const int child = refinement.childFaceOffset[f] + k;
+        childControlFace[child] = controlFaceOf[f];
+        parents[child] = {f, k};
       }
     }
     controlFaceOf = std::move(childControlFace);
-    std::vector<std::pair<int, int>> parents(refinement.topology.faceCount());
-    for (int f = 0; f < parent.faceCount(); ++f) {
-      for (int k = 0; k < parent.faceSize(f); ++k) parents[refinement.childFaceOffset[f] + k] = {f, k};
-    }
     s.parentOf.push_back(std::move(parents));
     s.childFaceOffset.push_back(std::move(refinement.childFaceOffset));
     ++s.isolationLevels;
@@ -758,7 +758,7 @@ LimitSurface::LimitSurface(const ControlMesh& mesh) : impl_(std::make_unique<Imp
 
 int LimitSurface::elementCountOf(const ControlMesh& mesh) {
   // The constructor's refinements, on the topology alone.
-  return refineToBase(mesh.topology(), [](const Topology&, Refinement&) {}, [](const SparseMatrix&) {}).faceCount();
+  return refineToBase(mesh.topology(), {}, {}).faceCount();
 }
 
 LimitSurface::~LimitSurface() = default;
