@@ -37,4 +37,19 @@ inline MatrixX3 torusPoints(int n, double ring, double tube, unsigned seed) {
   return points;
 }
 
+// n points uniform over the faces of the cube [-half, half]^3.
+inline MatrixX3 boxPoints(int n, double half, unsigned seed) {
+  std::mt19937_64 random(seed);
+  std::uniform_int_distribution<int> face(0, 5);
+  std::uniform_real_distribution<double> across(-half, half);
+  MatrixX3 points(n, 3);
+  for (int i = 0; i < n; ++i) {
+    const int f = face(random), axis = f / 2;
+    points(i, axis) = f % 2 == 0 ? -half : half;
+    points(i, (axis + 1) % 3) = across(random);
+    points(i, (axis + 2) % 3) = across(random);
+  }
+  return points;
+}
+
 }  // namespace dynsub

@@ -30,6 +30,11 @@ using PointTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adapt
 // 1 / Phi^-1(3/4): turns a median absolute deviation into a Gaussian's sigma.
 constexpr double kMadToSigma = 1.4826;
 
+// The noise is read from this quantile of |t| over the points, and
+// Phi^-1((1 + q) / 2) turns it into a Gaussian's sigma (see ScanNoise.h).
+constexpr double kNoiseQuantile = 0.25;
+constexpr double kQuantileToSigma = 0.318639;
+
 double medianAbs(const Eigen::VectorXd& values) {
   std::vector<double> a(static_cast<size_t>(values.size()));
   for (Eigen::Index i = 0; i < values.size(); ++i) a[static_cast<size_t>(i)] = std::abs(values(i));
@@ -161,7 +166,7 @@ ScanNoise estimateScanNoise(const MatrixX3& points) {
     if (valid[static_cast<size_t>(i)]) magnitudes.push_back(std::abs(standardized(i)));
   }
   ScanNoise noise;
-  if (!magnitudes.empty()) noise.sigma = kMadToSigma * percentile(std::move(magnitudes), 0.5);
+  if (!magnitudes.empty()) noise.sigma = percentile(std::move(magnitudes), kNoiseQuantile) / kQuantileToSigma;
   const double spacing = percentile(std::vector<double>(nearest.data(), nearest.data() + n), 0.5);
   const double usualReach = percentile(std::vector<double>(reach.data(), reach.data() + n), 0.5);
   for (Eigen::Index i = 0; i < n; ++i) {
