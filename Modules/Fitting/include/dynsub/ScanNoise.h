@@ -12,12 +12,11 @@
 //    quadric follows the surface's curvature, so on a densely sampled smooth
 //    surface t is the noise alone; near a crease or a corner, where
 //    neighbours from both sides bend the quadric, |t| is larger. The lower
-//    quartile holds while up to three quarters of the points are such: a
+//    quartile holds while up to three quarters of the points are such: on a
 //    clean scan of a cube, most of whose points have neighbours across an
-//    edge, read as noise of 0.11 % of its diagonal by the median of |t|, and
-//    reads none by the quartile, while the quartile and the median agree
-//    within 0.5-3 % on noisy scans of smooth shapes (CGAL's bear and kitten,
-//    0.1 and 0.3 % noise).
+//    edge, the median of |t| reads 0.11 % of its diagonal as noise and the
+//    quartile none, while the two agree within 0.5-3 % on noisy scans of
+//    smooth shapes (CGAL's bear and kitten, 0.1 and 0.3 % noise).
 //  - Outliers: points whose |t| exceeds kOutlierFactor times both sigma and
 //    their neighbourhood's own scale (1.4826 median |r| of the neighbours'
 //    residuals from the same quadric), and half the points' usual spacing.
