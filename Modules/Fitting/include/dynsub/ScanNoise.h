@@ -14,7 +14,7 @@
 //    neighbours from both sides bend the quadric, |t| is larger. The lower
 //    quartile holds while up to three quarters of the points are such: on a
 //    clean scan of a cube, most of whose points have neighbours across an
-//    edge, the median of |t| reads 0.11 % of its diagonal as noise and the
+//    edge, the median of |t| reads 0.14 % of its diagonal as noise and the
 //    quartile none, while the two agree within 0.5-3 % on noisy scans of
 //    smooth shapes (CGAL's bear and kitten, 0.1 and 0.3 % noise).
 //  - Outliers: points whose |t| exceeds kOutlierFactor times both sigma and
