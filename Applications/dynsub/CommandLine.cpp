@@ -53,6 +53,7 @@ void SimulationArguments::addOptions(CLI::App& command, const SimulationOptions&
 
 SimulationOptions SimulationArguments::apply(SimulationOptions base) const {
   base.maxLevel = values.maxLevel;
+  base.relaxations = values.relaxations;
   base.integrator.scheme = parseIntegrationScheme(scheme);
   base.integrator.solver = parseLinearSolver(solver);
   base.integrator.timeStep = values.integrator.timeStep;

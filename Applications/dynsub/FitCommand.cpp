@@ -233,6 +233,12 @@ void addFitCommand(CLI::App& app) {
                       "reported as reference in report.json")
       ->check(CLI::ExistingFile);
   o->simulation.addOptions(*command, FitOptions::defaultSimulation());
+  command
+      ->add_option("--relaxations", o->simulation.values.relaxations,
+                   "Times a level whose fit is refused within twice the tolerance is run on with its tension and "
+                   "rigidity weakened 4-fold more, before it is refined")
+      ->default_val(FitOptions::defaultSimulation().relaxations)
+      ->check(CLI::Range(0, 6));
   o->figures.addOptions(*command);
   command->callback([o] { runFit(*o); });
 }

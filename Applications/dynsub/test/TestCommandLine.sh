@@ -94,9 +94,8 @@ expect_error "missing output parent" 1 "does not exist" "$work/no/o10" \
 # creases: 1200 points on the faces of a cube of side 44 mm, turned 10 degrees
 # about z and moved 3 mm up. The smooth model needs 6146 control vertices for
 # 0.1 % here (measured: `fit cube.xyz --tolerance 0.1`, 0.078 %); the creased
-# cube needs 386 (0.059 %), and 98 with stiffer data springs (0.038 %). At 8
-# vertices the closest-point springs settle in a twisted local minimum
-# (0.9 %), so the fit refines.
+# cube needs 98 (0.063 %, its last level relaxed; with stiffer data springs
+# 0.038 % without), and 386 without relaxing (`--relaxations 0`).
 awk 'BEGIN { srand(5); c = cos(0.1745329); s = sin(0.1745329);
   for (i = 0; i < 1200; i++) { f = int(6 * rand()); a = 44 * rand() - 22; b = 44 * rand() - 22; side = (f % 2) ? 22 : -22;
     if (f < 2) { x = side; y = a; z = b } else if (f < 4) { x = a; y = side; z = b } else { x = a; y = b; z = side }
@@ -107,11 +106,10 @@ for stiffness in 100 1000; do
   error=$(sed -n 's/.*"max_error_percent": \([0-9.eE+-]*\).*/\1/p' "$work/cubefit$stiffness/report.json" | head -1)
   vertices=$(sed -n 's/.*"control_vertices": \([0-9]*\).*/\1/p' "$work/cubefit$stiffness/report.json" | head -1)
   check "the creased cube fits to 0.1 % (data stiffness $stiffness: got $error)" awk -v e="$error" 'BEGIN { exit !(e <= 0.1) }'
-  limit=$([ $stiffness = 100 ] && echo 400 || echo 100)
-  check "with at most $limit control vertices (got $vertices)" test "${vertices:-100000}" -le $limit
+  check "with at most 100 control vertices (got $vertices)" test "${vertices:-100000}" -le 100
 done
 check "the fitted control mesh keeps its 12 crease tags, refined" \
-  test "$(grep -c '^t crease 2/1/0 .* 10$' "$work/cubefit100/control_mesh.obj")" -eq 96
+  test "$(grep -c '^t crease 2/1/0 .* 10$' "$work/cubefit100/control_mesh.obj")" -eq 48
 "$DYNSUB" limit "$work/cubefit100/control_mesh.obj" --out "$work/cube_sharp.vtp" >/dev/null 2>&1
 check "limit reads the creased control mesh it wrote" test -s "$work/cube_sharp.vtp"
 printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nt crease 2/1/0 0 2 10\n' >"$work/badcrease.obj"

@@ -53,8 +53,10 @@ void setStart(LevelModel& model, const MatrixX3& points) {
   if (!(model.size > 0.0)) throw Error("the control mesh has no extent");
 }
 
-// initialIsolation < 0: `mesh` is the initial model, and sets it.
-LevelModel buildLevel(const ControlMesh& mesh, int level, int& initialIsolation, const SimulationOptions& options) {
+// initialIsolation < 0: `mesh` is the initial model, and sets it. The
+// elasticity is elasticityPerLevel^(level + relaxed).
+LevelModel buildLevel(const ControlMesh& mesh, int level, int& initialIsolation, const SimulationOptions& options,
+                      int relaxed = 0) {
   LevelModel model{level, std::make_shared<const LimitSurface>(mesh), {}, {}, {}, 0.0};
   if (initialIsolation < 0) initialIsolation = model.surface->isolationLevels();
   // Element sides are measured in elements of the initial model: a base mesh
@@ -63,7 +65,7 @@ LevelModel buildLevel(const ControlMesh& mesh, int level, int& initialIsolation,
   AssemblyOptions assembly = options.assembly;
   assembly.elementSize = elementSize;
   Material material = options.material;
-  const double elasticity = std::pow(options.elasticityPerLevel, level);
+  const double elasticity = std::pow(options.elasticityPerLevel, level + relaxed);
   for (double* m : {&material.tensionU, &material.tensionV, &material.rigidityUU, &material.rigidityUV,
                     &material.rigidityVV}) {
     *m *= elasticity;
@@ -206,7 +208,7 @@ enum class LevelEnd { Equilibrium, Coarse, Accepted, Met, StepLimit, Diverged };
 
 // A level asked at the looser rule: how it ends, if it does.
 std::optional<LevelEnd> coarseEnd(FitVerdict verdict) {
-  if (verdict == FitVerdict::Refine) return LevelEnd::Coarse;
+  if (verdict == FitVerdict::Refine || verdict == FitVerdict::Relax) return LevelEnd::Coarse;
   if (verdict == FitVerdict::Stop) return LevelEnd::Accepted;
   return std::nullopt;
 }
@@ -524,6 +526,7 @@ void checkSimulationOptions(const SimulationOptions& o) {
   }
   if (o.maxTimeStepHalvings < 0) throw Error("time-step halvings must be >= 0");
   if (o.timeStepRegrowth < 0) throw Error("the time step's regrowth must be >= 0 steps (0: none)");
+  if (o.relaxations < 0) throw Error("relaxations per level must be >= 0, got " + std::to_string(o.relaxations));
   if (!(o.elasticityPerLevel > 0.0 && o.elasticityPerLevel <= 1.0)) {
     throw Error("the elasticity factor per level must be in (0, 1], got " + std::to_string(o.elasticityPerLevel));
   }
@@ -556,13 +559,12 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
   // sparse matrices have no move, so moving a level would copy its tables.
   std::future<std::unique_ptr<LevelModel>> prepared;  // the next level's, when built ahead
   for (int level = options.origin.level;; ++level) {
-    const auto started = std::chrono::steady_clock::now();
+    auto started = std::chrono::steady_clock::now();
     const bool wasPrepared = prepared.valid();
     const std::unique_ptr<LevelModel> built =
         wasPrepared ? prepared.get()
                     : std::unique_ptr<LevelModel>(new LevelModel(buildLevel(mesh, level, initialIsolation, options)));
     if (wasPrepared) setStart(*built, mesh.points());
-    const LevelModel& model = *built;
     if (options.prepareNextLevel && level < options.maxLevel) {
       // The refined topology does not depend on where this level ends.
       prepared = std::async(std::launch::async, [next = subdivide(mesh).mesh, level, initialIsolation, &options] {
@@ -570,27 +572,50 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
         return std::unique_ptr<LevelModel>(new LevelModel(buildLevel(next, level + 1, isolation, options)));
       });
     }
-    LevelSummary summary;
-    summary.level = level;
-    summary.controlVertices = mesh.vertexCount();
-    // A level that will be refined may end at a looser rule.
-    const bool coarse = accept && level < options.maxLevel && options.equilibrium.coarseLevelFactor > 1.0;
-    LevelEnd end = LevelEnd::Equilibrium;
-    const MatrixX3 points = runLevel(model, forces, fixed, options, accept, coarse, timeStep, progress, summary, end);
-    summary.residual = equilibriumResidual(model, forces, points, fixed);
-    mesh.setPoints(points);
-    result.steps += summary.steps;
-    summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    result.levels.push_back(summary);
+    // A level refused as close is first run on with weaker elasticity
+    // (relaxations), then refined.
+    bool good = false;
+    const LevelModel* model = built.get();
+    std::unique_ptr<LevelModel> relaxedModel;
+    for (int relaxed = 0;; ++relaxed) {
+      if (relaxed > 0) {
+        const auto rebuilt = std::chrono::steady_clock::now();
+        int isolation = initialIsolation;
+        relaxedModel.reset(new LevelModel(buildLevel(mesh, level, isolation, options, relaxed)));
+        model = relaxedModel.get();
+        started = rebuilt;
+      }
+      LevelSummary summary;
+      summary.level = level;
+      summary.controlVertices = mesh.vertexCount();
+      summary.elasticity = std::pow(options.elasticityPerLevel, level + relaxed);
+      // A level that will be refined may end at a looser rule.
+      const bool coarse = accept && level < options.maxLevel && options.equilibrium.coarseLevelFactor > 1.0;
+      LevelEnd end = LevelEnd::Equilibrium;
+      FitVerdict verdict = FitVerdict::Settle;  // the last one asked of this level
+      const AcceptFit asked =
+          !accept ? AcceptFit() : [&](const LimitSurface& surface, const MatrixX3& controlPoints, FitAsk when) {
+            verdict = accept(surface, controlPoints, when);
+            return verdict;
+          };
+      const MatrixX3 points = runLevel(*model, forces, fixed, options, asked, coarse, timeStep, progress, summary, end);
+      summary.residual = equilibriumResidual(*model, forces, points, fixed);
+      mesh.setPoints(points);
+      result.steps += summary.steps;
+      summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+      result.levels.push_back(summary);
 
-    // An end before the full rule was asked already: refused, or accepted for good.
-    const bool good = end == LevelEnd::Coarse                             ? false
-                      : end == LevelEnd::Accepted || end == LevelEnd::Met ? true
-                      : accept ? accept(*model.surface, points, FitAsk::LevelEnd) != FitVerdict::Refine
-                               : true;
+      // An end before the full rule was asked already: refused, or accepted for good.
+      if (end != LevelEnd::Coarse && end != LevelEnd::Accepted && end != LevelEnd::Met && accept) {
+        asked(*model->surface, points, FitAsk::LevelEnd);
+      }
+      good = end == LevelEnd::Accepted || end == LevelEnd::Met ||
+             (end != LevelEnd::Coarse && verdict != FitVerdict::Refine && verdict != FitVerdict::Relax);
+      if (good || verdict != FitVerdict::Relax || relaxed >= options.relaxations) break;
+    }
     if (good || level >= options.maxLevel) {
       result.origin = {level, initialIsolation};
-      result.surface = model.surface;
+      result.surface = model->surface;
       break;
     }
     mesh = subdivide(mesh).mesh;

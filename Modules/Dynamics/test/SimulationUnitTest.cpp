@@ -10,6 +10,7 @@
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 
 #include <Eigen/SparseCholesky>
 #include <unsupported/Eigen/KroneckerProduct>
@@ -99,6 +100,38 @@ TEST(StaticScheme, FixedVerticesStay) {
   EXPECT_EQ(result.mesh.points().row(0), cube.points().row(0));
   EXPECT_EQ(result.mesh.points().row(17), cube.points().row(17));
   EXPECT_GT((result.mesh.points() - cube.points()).cwiseAbs().maxCoeff(), 0.05);
+}
+
+// A level refused as close (FitVerdict::Relax) runs on at its own level with
+// its elasticity weakened by the factor per level, while relaxations are
+// left; refused outright (Refine), or with none left, it is refined.
+TEST(StaticScheme, ALevelRefusedAsCloseRelaxesBeforeItIsRefined) {
+  const ControlMesh cube = makeCube98();
+  const LimitSurface surface(cube);
+  const MatrixX3 targets = tessellate(surface, cube.points(), 1).points * 1.2;
+  for (const auto& [first, relaxations, secondVertices, secondElasticity] :
+       {std::make_tuple(FitVerdict::Relax, 1, 98, 0.25), std::make_tuple(FitVerdict::Relax, 0, 386, 0.25),
+        std::make_tuple(FitVerdict::Refine, 1, 386, 0.25)}) {
+    SpringForceModel springs(targets, Eigen::VectorXd::Constant(targets.rows(), 1.0),
+                             SpringForceModel::Attach::NearestEachStep);
+    SimulationOptions options;
+    options.integrator.scheme = IntegrationScheme::Static;
+    options.maxLevel = 1;
+    options.elasticityPerLevel = 0.25;
+    options.relaxations = relaxations;
+    int asked = 0;  // at levels' ends
+    const AcceptFit accept = [&, first = first](const LimitSurface&, const MatrixX3&, FitAsk when) {
+      if (when != FitAsk::LevelEnd) return FitVerdict::Settle;
+      return ++asked == 1 ? first : FitVerdict::Settle;
+    };
+    const SimulationResult result = simulate(cube, {&springs}, {}, options, accept);
+    ASSERT_EQ(result.levels.size(), 2u) << relaxations;
+    EXPECT_EQ(result.levels[0].elasticity, 1.0);
+    EXPECT_EQ(result.levels[1].controlVertices, secondVertices) << relaxations;
+    EXPECT_EQ(result.levels[1].level, secondVertices == 98 ? 0 : 1);
+    EXPECT_EQ(result.levels[1].elasticity, secondElasticity);
+    EXPECT_EQ(result.mesh.vertexCount(), secondVertices);
+  }
 }
 
 // Springs from each control point to a target, stabilized exactly (their

@@ -32,6 +32,7 @@ SimulationOptions FitOptions::defaultSimulation() {
   // time, the finest level being most of a fit; a level whose fit is
   // accepted still ends by the full rule.
   o.equilibrium.coarseLevelFactor = 30.0;
+  o.relaxations = 1;
   return o;
 }
 
@@ -159,7 +160,9 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
     // this level's full equilibrium would fit the noise.
     if (met(e)) return FitVerdict::Stop;
     maxBelow = biasBelow = std::numeric_limits<double>::infinity();
-    return FitVerdict::Refine;
+    const double close = kRelaxWithin * options.tolerancePercent;
+    return e.maxPercent <= close || (result.noiseLimited && e.biasPercent <= close) ? FitVerdict::Relax
+                                                                                     : FitVerdict::Refine;
   };
 
   // The static scheme's progress comes after the accepted trial, the springs'

@@ -25,6 +25,7 @@ Report simulationReport(const SimulationOptions& o) {
   material.set("rigidity_vv", o.material.rigidityVV);
   r.set("material", material);
   r.set("elasticity_per_level", o.elasticityPerLevel);
+  r.set("relaxations", o.relaxations);
   r.set("plate_levels", o.assembly.plateLevels);
   Report equilibrium;
   equilibrium.set("energy_tolerance", o.equilibrium.energyTolerance);
@@ -40,6 +41,7 @@ Report levelReport(const LevelSummary& l, double maxErrorPercent, double rmsErro
   Report r;
   r.set("level", l.level);
   r.set("control_vertices", l.controlVertices);
+  r.set("elasticity", l.elasticity);
   r.set("iterations", l.steps);
   r.set("equilibrium", l.converged && !l.met);
   // coarse: ended at looser tolerances; met: ended where the fit met its

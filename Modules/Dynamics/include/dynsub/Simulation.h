@@ -93,6 +93,12 @@ struct SimulationOptions {
   // 1 keeps the physics of the initial model (the energy of a surface does not
   // depend on the level); < 1 lets each refinement trade smoothing for detail.
   double elasticityPerLevel = 1.0;
+  // A level whose fit is refused as close (FitVerdict::Relax) is run on from
+  // where it ended with its elasticity weakened by elasticityPerLevel again,
+  // up to this many times, before it is refined. A coarse surface's tension
+  // and plate hold it off data it could reach (the faces of a cube bow in),
+  // and refining costs four times the control vertices.
+  int relaxations = 0;
   int maxTimeStepHalvings = 8;
   // Steps of falling energy after which a halved time step is doubled again
   // (see above; 0: a halved step stays halved). Chosen on the evaluation's
@@ -111,6 +117,8 @@ struct SimulationOptions {
 struct LevelSummary {
   int level = 0;  // global refinements of the initial control mesh
   int controlVertices = 0;
+  // The factor on tension and rigidity: elasticityPerLevel^(level + relaxations run).
+  double elasticity = 1.0;
   int steps = 0;
   bool converged = false;  // ended by a rule below (equilibrium, or met), not by maxSteps
   // The level ended at the looser rule of EquilibriumOptions::coarseLevelFactor:
@@ -176,11 +184,14 @@ struct Progress {
 // The verdicts:
 //  - Refine: not yet; the level ends (there, if asked at the looser rule)
 //    and is refined.
+//  - Relax: not yet, but close; the level ends as for Refine and is run on
+//    with weaker elasticity (SimulationOptions::relaxations) before it is
+//    refined. Refine when no relaxation is left.
 //  - Settle: good so far; a level asked before its end goes on to the full
 //    rule and is asked again there. At a level's end, the same as Stop.
 //  - Stop: good; the simulation ends at this state.
 enum class FitAsk { Step, LooseRule, LevelEnd };
-enum class FitVerdict { Refine, Settle, Stop };
+enum class FitVerdict { Refine, Relax, Settle, Stop };
 using AcceptFit = std::function<FitVerdict(const LimitSurface& surface, const MatrixX3& controlPoints, FitAsk when)>;
 using ProgressCallback = std::function<void(const Progress&)>;
 
