@@ -35,7 +35,8 @@ double relativeChange(double energy, double last) {
 }
 
 // Everything a level is built on: the surface of its control mesh and the
-// matrices and quadrature over it (rebuilt only when the mesh is refined).
+// matrices and quadrature over it (rebuilt only when the mesh is refined; the
+// matrices also when the level is relaxed).
 struct LevelModel {
   int level = 0;
   // Shared so that the last level's can be handed out with the result.
@@ -43,7 +44,9 @@ struct LevelModel {
   PhysicalMatrices matrices;
   SurfaceQuadrature quadrature;
   MatrixX3 start;
-  double size = 0;  // bounding-box diagonal of the control points, mm
+  double size = 0;         // bounding-box diagonal of the control points, mm
+  double elementSize = 0;  // in elements of the initial model
+  double elasticity = 1;   // the factor on the matrices' tension and rigidity
 };
 
 // Sets the model's start, its control points.
@@ -53,43 +56,45 @@ void setStart(LevelModel& model, const MatrixX3& points) {
   if (!(model.size > 0.0)) throw Error("the control mesh has no extent");
 }
 
-// initialIsolation < 0: `mesh` is the initial model, and sets it. The
-// elasticity is elasticityPerLevel^(level + relaxed).
-LevelModel buildLevel(const ControlMesh& mesh, int level, int& initialIsolation, const SimulationOptions& options,
-                      int relaxed = 0) {
-  LevelModel model{level, std::make_shared<const LimitSurface>(mesh), {}, {}, {}, 0.0};
-  if (initialIsolation < 0) initialIsolation = model.surface->isolationLevels();
-  // Element sides are measured in elements of the initial model: a base mesh
-  // that is `b` global refinements past the initial one has side 2^-b.
-  const double elementSize = std::ldexp(1.0, initialIsolation - (level + model.surface->isolationLevels()));
+// The model's mass, damping and stiffness, with tension and rigidity times
+// `elasticity` (elasticityPerLevel^g at level g, once more per relaxation).
+// Swapped in, not assigned: Eigen 3.4's sparse matrices have no move, so
+// assigning the results would copy every table.
+void assembleMatrices(LevelModel& model, double elasticity, const SimulationOptions& options) {
   AssemblyOptions assembly = options.assembly;
-  assembly.elementSize = elementSize;
+  assembly.elementSize = model.elementSize;
   Material material = options.material;
-  const double elasticity = std::pow(options.elasticityPerLevel, level + relaxed);
   for (double* m : {&material.tensionU, &material.tensionV, &material.rigidityUU, &material.rigidityUV,
                     &material.rigidityVV}) {
     *m *= elasticity;
   }
+  PhysicalMatrices built = assemblePhysicalMatrices(*model.surface, material, assembly);
+  model.matrices.mass.swap(built.mass);
+  model.matrices.damping.swap(built.damping);
+  model.matrices.stiffness.swap(built.stiffness);
+  model.elasticity = elasticity;
+}
+
+// initialIsolation < 0: `mesh` is the initial model, and sets it.
+LevelModel buildLevel(const ControlMesh& mesh, int level, int& initialIsolation, const SimulationOptions& options) {
+  LevelModel model{level, std::make_shared<const LimitSurface>(mesh), {}, {}, {}, 0.0};
+  if (initialIsolation < 0) initialIsolation = model.surface->isolationLevels();
+  // Element sides are measured in elements of the initial model: a base mesh
+  // that is `b` global refinements past the initial one has side 2^-b.
+  model.elementSize = std::ldexp(1.0, initialIsolation - (level + model.surface->isolationLevels()));
   // NB: the matrices and the quadrature are independent (the surface's
   // tables are safe to fill from two threads), and each is a sizeable share
   // of a level, so they are built side by side.
-  // Swapped in, not assigned: Eigen 3.4's sparse matrices have no move, so
-  // assigning the results would copy every table.
-  bothAtOnce(
-      [&] {
-        PhysicalMatrices built = assemblePhysicalMatrices(*model.surface, material, assembly);
-        model.matrices.mass.swap(built.mass);
-        model.matrices.damping.swap(built.damping);
-        model.matrices.stiffness.swap(built.stiffness);
-      },
-      [&] {
-        SurfaceQuadrature built = makeSurfaceQuadrature(*model.surface, options.quadraturePoints, elementSize);
-        model.quadrature.points.swap(built.points);
-        model.quadrature.weights.swap(built.weights);
-        model.quadrature.J.swap(built.J);
-        model.quadrature.Ju.swap(built.Ju);
-        model.quadrature.Jv.swap(built.Jv);
-      });
+  bothAtOnce([&] { assembleMatrices(model, std::pow(options.elasticityPerLevel, level), options); },
+             [&] {
+               SurfaceQuadrature built =
+                   makeSurfaceQuadrature(*model.surface, options.quadraturePoints, model.elementSize);
+               model.quadrature.points.swap(built.points);
+               model.quadrature.weights.swap(built.weights);
+               model.quadrature.J.swap(built.J);
+               model.quadrature.Ju.swap(built.Ju);
+               model.quadrature.Jv.swap(built.Jv);
+             });
   setStart(model, mesh.points());
   return model;
 }
@@ -574,48 +579,44 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
     }
     // A level refused as close is first run on with weaker elasticity
     // (relaxations), then refined.
-    bool good = false;
-    const LevelModel* model = built.get();
-    std::unique_ptr<LevelModel> relaxedModel;
+    LevelModel& model = *built;
+    FitVerdict verdict = FitVerdict::Settle;  // the last one asked of this level
+    const AcceptFit asked =
+        !accept ? AcceptFit() : [&](const LimitSurface& surface, const MatrixX3& controlPoints, FitAsk when) {
+          verdict = accept(surface, controlPoints, when);
+          return verdict;
+        };
     for (int relaxed = 0;; ++relaxed) {
       if (relaxed > 0) {
-        const auto rebuilt = std::chrono::steady_clock::now();
-        int isolation = initialIsolation;
-        relaxedModel.reset(new LevelModel(buildLevel(mesh, level, isolation, options, relaxed)));
-        model = relaxedModel.get();
-        started = rebuilt;
+        started = std::chrono::steady_clock::now();
+        assembleMatrices(model, model.elasticity * options.elasticityPerLevel, options);
+        setStart(model, mesh.points());
       }
       LevelSummary summary;
       summary.level = level;
       summary.controlVertices = mesh.vertexCount();
-      summary.elasticity = std::pow(options.elasticityPerLevel, level + relaxed);
+      summary.elasticity = model.elasticity;
       // A level that will be refined may end at a looser rule.
       const bool coarse = accept && level < options.maxLevel && options.equilibrium.coarseLevelFactor > 1.0;
       LevelEnd end = LevelEnd::Equilibrium;
-      FitVerdict verdict = FitVerdict::Settle;  // the last one asked of this level
-      const AcceptFit asked =
-          !accept ? AcceptFit() : [&](const LimitSurface& surface, const MatrixX3& controlPoints, FitAsk when) {
-            verdict = accept(surface, controlPoints, when);
-            return verdict;
-          };
-      const MatrixX3 points = runLevel(*model, forces, fixed, options, asked, coarse, timeStep, progress, summary, end);
-      summary.residual = equilibriumResidual(*model, forces, points, fixed);
+      const MatrixX3 points = runLevel(model, forces, fixed, options, asked, coarse, timeStep, progress, summary, end);
+      summary.residual = equilibriumResidual(model, forces, points, fixed);
       mesh.setPoints(points);
       result.steps += summary.steps;
       summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
       result.levels.push_back(summary);
 
-      // An end before the full rule was asked already: refused, or accepted for good.
-      if (end != LevelEnd::Coarse && end != LevelEnd::Accepted && end != LevelEnd::Met && accept) {
-        asked(*model->surface, points, FitAsk::LevelEnd);
+      // An end before the full rule was asked already: refused (Coarse), or
+      // accepted for good.
+      if (accept && end != LevelEnd::Coarse && end != LevelEnd::Accepted && end != LevelEnd::Met) {
+        asked(*model.surface, points, FitAsk::LevelEnd);
       }
-      good = end == LevelEnd::Accepted || end == LevelEnd::Met ||
-             (end != LevelEnd::Coarse && verdict != FitVerdict::Refine && verdict != FitVerdict::Relax);
-      if (good || verdict != FitVerdict::Relax || relaxed >= options.relaxations) break;
+      if (verdict != FitVerdict::Relax || relaxed >= options.relaxations) break;
     }
+    const bool good = verdict != FitVerdict::Refine && verdict != FitVerdict::Relax;
     if (good || level >= options.maxLevel) {
       result.origin = {level, initialIsolation};
-      result.surface = model->surface;
+      result.surface = model.surface;
       break;
     }
     mesh = subdivide(mesh).mesh;
