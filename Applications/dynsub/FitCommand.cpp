@@ -161,6 +161,7 @@ void runFit(FitCommandOptions o) {
   Report parameters = simulationReport(o.fit.simulation);
   parameters.set("init", o.init);
   parameters.set("data_stiffness", o.fit.dataStiffness);
+  parameters.set("springs_per_element", o.fit.springsPerElement);
   parameters.set("noise", o.noise);
   parameters.set("keep_outliers", o.keepOutliers);
   parameters.set("to_equilibrium", o.fit.toEquilibrium);
@@ -218,6 +219,12 @@ void addFitCommand(CLI::App& app) {
                       "Spring stiffness of the data, N/mm per unit parametric area, shared by all points")
       ->default_val(o->fit.dataStiffness)
       ->check(CLI::PositiveNumber);
+  command->add_option("--springs-per-element", o->fit.springsPerElement,
+                      "Data springs that pull a level, per element of its surface: a fixed random sample of the "
+                      "points, with their total stiffness, where the scan has more (0: every point at every level). "
+                      "Each level's fit is measured on all the points")
+      ->default_val(o->fit.springsPerElement)
+      ->check(CLI::NonNegativeNumber);
   command->add_option("--noise", o->noise,
                       "The scan's noise: auto (measured from the points' scatter about their neighbours' local "
                       "surface) or its standard deviation in mm (0: clean data). When the noise puts the tolerance "

@@ -1,6 +1,7 @@
 #include "dynsub/ForceModel.h"
 
 #include <cmath>
+#include <random>
 #include <string>
 
 #include "dynsub/ParallelFor.h"
@@ -19,18 +20,20 @@ void ForceModel::addTangentStiffness(const MatrixX3& controlPoints, TangentStiff
 }
 
 SpringForceModel::SpringForceModel(MatrixX3 targets, Eigen::VectorXd stiffness, Attach attach)
-    : targets_(std::move(targets)), stiffness_(std::move(stiffness)), attach_(attach) {
-  if (targets_.rows() != stiffness_.size()) {
-    throw Error("got " + std::to_string(stiffness_.size()) + " spring stiffnesses for " +
-                std::to_string(targets_.rows()) + " springs");
+    : allTargets_(std::move(targets)), allStiffness_(std::move(stiffness)), attach_(attach) {
+  if (allTargets_.rows() != allStiffness_.size()) {
+    throw Error("got " + std::to_string(allStiffness_.size()) + " spring stiffnesses for " +
+                std::to_string(allTargets_.rows()) + " springs");
   }
-  if (!targets_.allFinite()) throw Error("a spring target is not finite");
-  for (Eigen::Index i = 0; i < stiffness_.size(); ++i) {
-    if (!(std::isfinite(stiffness_(i)) && stiffness_(i) > 0.0)) {
-      throw Error("spring " + std::to_string(i) + " has stiffness " + std::to_string(stiffness_(i)) +
+  if (!allTargets_.allFinite()) throw Error("a spring target is not finite");
+  for (Eigen::Index i = 0; i < allStiffness_.size(); ++i) {
+    if (!(std::isfinite(allStiffness_(i)) && allStiffness_(i) > 0.0)) {
+      throw Error("spring " + std::to_string(i) + " has stiffness " + std::to_string(allStiffness_(i)) +
                   " (expected a finite value > 0)");
     }
   }
+  targets_ = allTargets_;
+  stiffness_ = allStiffness_;
 }
 
 SpringForceModel::~SpringForceModel() = default;
@@ -39,6 +42,19 @@ void SpringForceModel::beginLevel(const LimitSurface& surface, const SurfaceQuad
                                   const MatrixX3& controlPoints) {
   surface_ = &surface;
   locator_ = std::make_unique<ClosestPointLocator>(surface);
+  const Eigen::Index all = allTargets_.rows();
+  const double wanted = samplePerElement_ * surface.elementCount();
+  const Eigen::Index sample = samplePerElement_ > 0 && wanted < all ? static_cast<Eigen::Index>(wanted) : all;
+  if (sample != targets_.rows()) {
+    targets_.resize(sample, 3);
+    stiffness_.resize(sample);
+    const double share = static_cast<double>(all) / static_cast<double>(sample);
+    for (Eigen::Index i = 0; i < sample; ++i) {
+      const Eigen::Index j = sample == all ? i : sampleOrder_[static_cast<size_t>(i)];
+      targets_.row(i) = allTargets_.row(j);
+      stiffness_(i) = sample == all ? allStiffness_(j) : share * allStiffness_(j);
+    }
+  }
   springs_.clear();  // attachments of the previous level mean nothing on the new surface
   tracked_.clear();
   attach(controlPoints);
@@ -135,6 +151,19 @@ MatrixX3 SpringForceModel::generalizedForce(const MatrixX3& controlPoints, doubl
 void SpringForceModel::setDeadZone(double zone) {
   if (!(zone >= 0) || !std::isfinite(zone)) throw Error("a spring's dead zone must be a finite number >= 0 mm");
   deadZone_ = zone;
+}
+
+void SpringForceModel::setSamplePerElement(double perElement) {
+  if (!(perElement >= 0) || !std::isfinite(perElement)) {
+    throw Error("the springs per element must be a finite number >= 0");
+  }
+  samplePerElement_ = perElement;
+  if (perElement == 0 || !sampleOrder_.empty()) return;
+  // Fisher-Yates with a fixed seed: the same sample on every run and machine.
+  sampleOrder_.resize(static_cast<size_t>(allTargets_.rows()));
+  for (size_t i = 0; i < sampleOrder_.size(); ++i) sampleOrder_[i] = static_cast<Eigen::Index>(i);
+  std::mt19937_64 random(20261205);
+  for (size_t i = sampleOrder_.size(); i > 1; --i) std::swap(sampleOrder_[i - 1], sampleOrder_[random() % i]);
 }
 
 SparseMatrix SpringForceModel::stabilizingStiffness(const MatrixX3&) { return springStiffness(*surface_, springs_); }

@@ -580,10 +580,16 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
     // A level refused as close is first run on with weaker elasticity
     // (relaxations), then refined.
     LevelModel& model = *built;
+    const bool lastLevel = level >= options.maxLevel;
     FitVerdict verdict = FitVerdict::Settle;  // the last one asked of this level
     const AcceptFit asked =
         !accept ? AcceptFit() : [&](const LimitSurface& surface, const MatrixX3& controlPoints, FitAsk when) {
-          verdict = accept(surface, controlPoints, when);
+          if (lastLevel && when == FitAsk::LooseRule) {
+            verdict = accept(surface, controlPoints, FitAsk::LastLevelLooseRule);
+            if (verdict == FitVerdict::Refine) verdict = FitVerdict::Settle;
+          } else {
+            verdict = accept(surface, controlPoints, when);
+          }
           return verdict;
         };
     for (int relaxed = 0;; ++relaxed) {
@@ -596,8 +602,9 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
       summary.level = level;
       summary.controlVertices = mesh.vertexCount();
       summary.elasticity = model.elasticity;
-      // A level that will be refined may end at a looser rule.
-      const bool coarse = accept && level < options.maxLevel && options.equilibrium.coarseLevelFactor > 1.0;
+      // A level that will be refined or relaxed may end at a looser rule.
+      const bool coarse = accept && (!lastLevel || relaxed < options.relaxations) &&
+                          options.equilibrium.coarseLevelFactor > 1.0;
       LevelEnd end = LevelEnd::Equilibrium;
       const MatrixX3 points = runLevel(model, forces, fixed, options, asked, coarse, timeStep, progress, summary, end);
       summary.residual = equilibriumResidual(model, forces, points, fixed);

@@ -1,6 +1,6 @@
-// Force models (ForceModel.h): a spring's dead zone; a field's stabilizing
-// stiffness and its settling on an edge; a pressure field evaluated with a
-// force field.
+// Force models (ForceModel.h): a spring's dead zone and a sample of
+// springs; a field's stabilizing stiffness and its settling on an edge; a
+// pressure field evaluated with a force field.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -58,6 +58,45 @@ TEST(SpringForceModel, ADeadZonePullsOnlyBeyondIt) {
   SpringForceModel springs(onSurface, k, SpringForceModel::Attach::NearestEachStep);
   EXPECT_THROW(springs.setDeadZone(-1.0), Error);
   EXPECT_THROW(springs.setDeadZone(std::nan("")), Error);
+}
+
+// A sample of the springs (setSamplePerElement) pulls with the whole set's
+// total stiffness: targets all lifted the same 0.03 off the surface give
+// the whole set's potential, from perElement x E springs. With perElement
+// x E at least the targets, or 0, every spring pulls.
+TEST(SpringForceModel, ASampleHasTheWholeSetsStiffness) {
+  const ControlMesh cube = makeCube98();
+  const LimitSurface surface(cube);
+  const MatrixX3 onSurface = tessellate(surface, cube.points(), 4).points;
+  ClosestPointLocator locator(surface);
+  locator.update(cube.points());
+  MatrixX3 targets(onSurface.rows(), 3);
+  const std::vector<ClosestPoint> nearest = locator.findAll(onSurface);
+  for (Eigen::Index i = 0; i < onSurface.rows(); ++i) targets.row(i) = onSurface.row(i) + 0.03 * nearest[i].normal.transpose();
+  const SurfaceQuadrature quadrature = makeSurfaceQuadrature(surface);
+  const Eigen::VectorXd k = Eigen::VectorXd::Constant(targets.rows(), 3.0);
+  const double elements = surface.elementCount();
+  ASSERT_GT(targets.rows(), 4 * elements);
+  auto potentialOf = [&](double perElement, Eigen::Index& pulling) {
+    SpringForceModel springs(targets, k, SpringForceModel::Attach::NearestEachStep);
+    springs.setSamplePerElement(perElement);
+    springs.beginLevel(surface, quadrature, cube.points());
+    double potential = 0.0;
+    springs.generalizedForce(cube.points(), potential);
+    pulling = springs.lengths().size();
+    return potential;
+  };
+  Eigen::Index all = 0, sample = 0, enough = 0;
+  const double whole = potentialOf(0.0, all);
+  EXPECT_EQ(all, targets.rows());
+  // The attachments agree to the closest-point search's tolerance (1e-9 of the size).
+  EXPECT_NEAR(potentialOf(2.0, sample), whole, 1e-7 * whole);
+  EXPECT_EQ(sample, static_cast<Eigen::Index>(2.0 * elements));
+  EXPECT_NEAR(potentialOf(static_cast<double>(targets.rows()) / elements, enough), whole, 1e-7 * whole);
+  EXPECT_EQ(enough, targets.rows());
+  SpringForceModel springs(targets, k, SpringForceModel::Attach::NearestEachStep);
+  EXPECT_THROW(springs.setSamplePerElement(-1.0), Error);
+  EXPECT_THROW(springs.setSamplePerElement(std::nan("")), Error);
 }
 
 // A radial well like an image force across an edge: k times the unit

@@ -134,6 +134,42 @@ TEST(StaticScheme, ALevelRefusedAsCloseRelaxesBeforeItIsRefined) {
   }
 }
 
+// The last level, with a relaxation left, is asked at the looser rule too
+// (FitAsk::LastLevelLooseRule): Relax ends it there and runs it on with
+// weaker elasticity; Refine, with no level left to refine into, lets it go
+// on to the full rule.
+TEST(StaticScheme, TheLastLevelRelaxesAtTheLooserRule) {
+  const ControlMesh cube = makeCube98();
+  const LimitSurface surface(cube);
+  const MatrixX3 targets = tessellate(surface, cube.points(), 1).points * 1.2;
+  for (const FitVerdict answer : {FitVerdict::Relax, FitVerdict::Refine}) {
+    SpringForceModel springs(targets, Eigen::VectorXd::Constant(targets.rows(), 1.0),
+                             SpringForceModel::Attach::NearestEachStep);
+    SimulationOptions options;
+    options.integrator.scheme = IntegrationScheme::Static;
+    options.maxLevel = 0;
+    options.elasticityPerLevel = 0.25;
+    options.relaxations = 1;
+    options.equilibrium.coarseLevelFactor = 30.0;
+    int looseAsks = 0, lastLooseAsks = 0;
+    const AcceptFit accept = [&](const LimitSurface&, const MatrixX3&, FitAsk when) {
+      if (when == FitAsk::LooseRule) ++looseAsks;
+      if (when != FitAsk::LastLevelLooseRule) return FitVerdict::Settle;
+      ++lastLooseAsks;
+      return answer;
+    };
+    const SimulationResult result = simulate(cube, {&springs}, {}, options, accept);
+    const bool relaxed = answer == FitVerdict::Relax;
+    EXPECT_EQ(looseAsks, 0);
+    EXPECT_EQ(lastLooseAsks, 1);  // the relaxed run has no relaxation left
+    ASSERT_EQ(result.levels.size(), relaxed ? 2u : 1u);
+    EXPECT_EQ(result.levels[0].coarse, relaxed);
+    EXPECT_FALSE(result.levels.back().coarse);
+    EXPECT_EQ(result.levels.back().elasticity, relaxed ? 0.25 : 1.0);
+    EXPECT_EQ(result.levels.back().level, 0);
+  }
+}
+
 // Springs from each control point to a target, stabilized exactly (their
 // stiffness k I is the integrator's S): the steps are stable at any time step,
 // but a large one moves the points farther than the model's size when the

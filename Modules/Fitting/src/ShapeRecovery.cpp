@@ -91,6 +91,9 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
   if (!(std::isfinite(options.dataStiffness) && options.dataStiffness > 0.0)) {
     throw Error("the data stiffness must be finite and > 0");
   }
+  if (!(std::isfinite(options.springsPerElement) && options.springsPerElement >= 0.0)) {
+    throw Error("the springs per element must be finite and >= 0");
+  }
   if (!(std::isfinite(options.noise) && options.noise >= 0.0)) {
     throw Error("the data's noise must be finite and >= 0 mm");
   }
@@ -109,6 +112,7 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
   const Eigen::VectorXd stiffness =
       Eigen::VectorXd::Constant(data.rows(), options.dataStiffness * area / static_cast<double>(data.rows()));
   SpringForceModel springs(data, stiffness, SpringForceModel::Attach::NearestEachStep);
+  springs.setSamplePerElement(options.springsPerElement);
 
   // The springs' lengths are the data's distances where the forces were
   // last evaluated (`points`, whenever the fit is asked before a level's
@@ -124,13 +128,16 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
   double maxBelow = std::numeric_limits<double>::infinity();   // percent
   double biasBelow = std::numeric_limits<double>::infinity();  // percent
   AcceptFit accept = [&](const LimitSurface& surface, const MatrixX3& points, FitAsk when) {
+    // The springs' lengths: every point's, or on a sampled level the
+    // sample's, which say only that the fit may be met.
     const Eigen::VectorXd& lengths = springs.lengths();
-    const bool measured = lengths.size() == data.rows();
-    const double longest = measured ? 100.0 * lengths.maxCoeff() / diameter : std::numeric_limits<double>::infinity();
+    const bool everyPoint = lengths.size() == data.rows();
+    const double longest =
+        lengths.size() > 0 ? 100.0 * lengths.maxCoeff() / diameter : std::numeric_limits<double>::infinity();
     if (when == FitAsk::Step) {
-      if (!measured || options.toEquilibrium) return FitVerdict::Settle;
+      if (lengths.size() == 0 || options.toEquilibrium) return FitVerdict::Settle;
       const bool maxWithin = longest <= options.tolerancePercent && longest < maxBelow;
-      const double bias = result.noiseLimited && !maxWithin
+      const double bias = result.noiseLimited && !maxWithin && everyPoint
                               ? 100.0 * largestBias(springs.signedLengths(), neighbours) / diameter
                               : std::numeric_limits<double>::infinity();
       const bool biasWithin = bias <= options.tolerancePercent && bias < biasBelow;
@@ -147,7 +154,8 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
     // At the looser rule, springs within the tolerance save a search (unless
     // one at this level already said otherwise): the level goes on to its
     // end, where it is asked again.
-    if (when == FitAsk::LooseRule && longest <= options.tolerancePercent && longest < maxBelow) {
+    const bool loose = when == FitAsk::LooseRule || when == FitAsk::LastLevelLooseRule;
+    if (loose && everyPoint && longest <= options.tolerancePercent && longest < maxBelow) {
       return FitVerdict::Settle;
     }
     const FitError e = measureFitError(surface, points, data, diameter, result.noiseLimited ? &neighbours : nullptr);
@@ -155,14 +163,17 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
       if (when == FitAsk::LevelEnd) result.levelErrors.push_back(e);  // one per level, where it ends
       return FitVerdict::Settle;
     }
+    const double closeTo = kRelaxWithin * options.tolerancePercent;
+    const bool close = e.maxPercent <= closeTo || (result.noiseLimited && e.biasPercent <= closeTo);
+    // Far off on the last level: it goes on to its end, asked (and its
+    // error recorded) there.
+    if (when == FitAsk::LastLevelLooseRule && !met(e) && !close) return FitVerdict::Settle;
     result.levelErrors.push_back(e);
     // Met by the bias rule (noisy data): stop here, since the steps on to
     // this level's full equilibrium would fit the noise.
     if (met(e)) return FitVerdict::Stop;
     maxBelow = biasBelow = std::numeric_limits<double>::infinity();
-    const double close = kRelaxWithin * options.tolerancePercent;
-    return e.maxPercent <= close || (result.noiseLimited && e.biasPercent <= close) ? FitVerdict::Relax
-                                                                                     : FitVerdict::Refine;
+    return close ? FitVerdict::Relax : FitVerdict::Refine;
   };
 
   // The static scheme's progress comes after the accepted trial, the springs'
@@ -171,7 +182,7 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
   if (progress && options.simulation.integrator.scheme == IntegrationScheme::Static) {
     progressWithDistances = [&](const Progress& p) {
       Progress withDistances = p;
-      withDistances.dataDistances = &springs.lengths();
+      if (springs.lengths().size() == data.rows()) withDistances.dataDistances = &springs.lengths();
       progress(withDistances);
     };
   }

@@ -82,11 +82,25 @@ class SpringForceModel final : public ForceModel {
   // (an expert's clicks). 0 (the default) is the plain spring.
   void setDeadZone(double zone);
 
+  // NearestEachStep only: on a surface of E elements with more than
+  // perElement * E targets, only a fixed sample of perElement * E of them
+  // pull (a random sample, the same for every such level and growing with
+  // E), each stiffened by #targets / #sample so that the data's total
+  // stiffness stays what it is. A coarse surface is set by far fewer points
+  // than a dense scan has, and each spring costs a closest-point search at
+  // every evaluation. lengths() and signedLengths() are then the sample's.
+  // 0 (the default): every target pulls at every level.
+  void setSamplePerElement(double perElement);
+
  private:
   void attach(const MatrixX3& controlPoints);
 
-  MatrixX3 targets_;
+  MatrixX3 allTargets_;
+  Eigen::VectorXd allStiffness_;
+  MatrixX3 targets_;  // the springs of this level: all or the sample
   Eigen::VectorXd stiffness_;
+  double samplePerElement_ = 0;
+  std::vector<Eigen::Index> sampleOrder_;  // a fixed random order of the targets
   Attach attach_;
   const LimitSurface* surface_ = nullptr;
   std::unique_ptr<ClosestPointLocator> locator_;

@@ -122,8 +122,8 @@ struct LevelSummary {
   int steps = 0;
   bool converged = false;  // ended by a rule below (equilibrium, or met), not by maxSteps
   // The level ended at the looser rule of EquilibriumOptions::coarseLevelFactor:
-  // its fit was not accepted there, and it was refined, or it was accepted
-  // for good (FitVerdict::Stop).
+  // its fit was not accepted there, and it was refined or relaxed, or it
+  // was accepted for good (FitVerdict::Stop).
   bool coarse = false;
   // The level ended after a step where the fit was met (FitAsk::Step),
   // before either equilibrium rule.
@@ -180,6 +180,9 @@ struct Progress {
 //  - LooseRule: a level below the maximum first meets the looser rule of
 //    EquilibriumOptions::coarseLevelFactor (the forces were last evaluated
 //    at `controlPoints`).
+//  - LastLevelLooseRule: the same, on the last level while it has a
+//    relaxation left. Relax ends it there to be relaxed; Refine, with
+//    nothing to refine into, is taken as Settle.
 //  - LevelEnd: the level ended, the last one included.
 // The verdicts:
 //  - Refine: not yet; the level ends (there, if asked at the looser rule)
@@ -190,7 +193,7 @@ struct Progress {
 //  - Settle: good so far; a level asked before its end goes on to the full
 //    rule and is asked again there. At a level's end, the same as Stop.
 //  - Stop: good; the simulation ends at this state.
-enum class FitAsk { Step, LooseRule, LevelEnd };
+enum class FitAsk { Step, LooseRule, LastLevelLooseRule, LevelEnd };
 enum class FitVerdict { Refine, Relax, Settle, Stop };
 using AcceptFit = std::function<FitVerdict(const LimitSurface& surface, const MatrixX3& controlPoints, FitAsk when)>;
 using ProgressCallback = std::function<void(const Progress&)>;
