@@ -219,10 +219,11 @@ void addFitCommand(CLI::App& app) {
                       "Spring stiffness of the data, N/mm per unit parametric area, shared by all points")
       ->default_val(o->fit.dataStiffness)
       ->check(CLI::PositiveNumber);
-  command->add_option("--springs-per-element", o->fit.springsPerElement,
-                      "Data springs that pull a level, per element of its surface: a fixed random sample of the "
-                      "points, with their total stiffness, where the scan has more (0: every point at every level). "
-                      "Each level's fit is measured on all the points")
+  command
+      ->add_option("--springs-per-element", o->fit.springsPerElement,
+                   "Data springs that pull a level, per element of its surface: a fixed random sample of the "
+                   "points, with their total stiffness, where the scan has more (0: every point at every level). "
+                   "Each level's fit is measured on all the points")
       ->default_val(o->fit.springsPerElement)
       ->check(CLI::NonNegativeNumber);
   command->add_option("--noise", o->noise,

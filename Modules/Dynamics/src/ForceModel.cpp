@@ -4,10 +4,10 @@
 #include <random>
 #include <string>
 
-#include "dynsub/ParallelFor.h"
 #include "dynsub/ApplyOperator.h"
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/Error.h"
+#include "dynsub/ParallelFor.h"
 #include "dynsub/TangentStiffness.h"
 
 namespace dynsub {

@@ -603,8 +603,8 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
       summary.controlVertices = mesh.vertexCount();
       summary.elasticity = model.elasticity;
       // A level that will be refined or relaxed may end at a looser rule.
-      const bool coarse = accept && (!lastLevel || relaxed < options.relaxations) &&
-                          options.equilibrium.coarseLevelFactor > 1.0;
+      const bool coarse =
+          accept && (!lastLevel || relaxed < options.relaxations) && options.equilibrium.coarseLevelFactor > 1.0;
       LevelEnd end = LevelEnd::Equilibrium;
       const MatrixX3 points = runLevel(model, forces, fixed, options, asked, coarse, timeStep, progress, summary, end);
       summary.residual = equilibriumResidual(model, forces, points, fixed);

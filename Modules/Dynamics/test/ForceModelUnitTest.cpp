@@ -19,6 +19,16 @@
 namespace dynsub {
 namespace {
 
+// The unit limit normals at points of the surface.
+MatrixX3 normalsAt(const LimitSurface& surface, const MatrixX3& controlPoints, const MatrixX3& onSurface) {
+  ClosestPointLocator locator(surface);
+  locator.update(controlPoints);
+  const std::vector<ClosestPoint> nearest = locator.findAll(onSurface);
+  MatrixX3 normals(onSurface.rows(), 3);
+  for (Eigen::Index i = 0; i < onSurface.rows(); ++i) normals.row(i) = nearest[i].normal.transpose();
+  return normals;
+}
+
 // A dead zone of z mm: a spring whose target lies within z of the surface
 // pulls not at all; one at distance L beyond pulls as a plain spring to a
 // target L - z away along the same line. Targets are put on the limit
@@ -29,11 +39,7 @@ TEST(SpringForceModel, ADeadZonePullsOnlyBeyondIt) {
   const ControlMesh cube = makeCube98();
   const LimitSurface surface(cube);
   const MatrixX3 onSurface = tessellate(surface, cube.points(), 1).points;
-  ClosestPointLocator locator(surface);
-  locator.update(cube.points());
-  MatrixX3 normals(onSurface.rows(), 3);
-  const std::vector<ClosestPoint> nearest = locator.findAll(onSurface);
-  for (Eigen::Index i = 0; i < onSurface.rows(); ++i) normals.row(i) = nearest[i].normal.transpose();
+  const MatrixX3 normals = normalsAt(surface, cube.points(), onSurface);
   const double zone = 0.02;
   const SurfaceQuadrature quadrature = makeSurfaceQuadrature(surface);
   const Eigen::VectorXd k = Eigen::VectorXd::Constant(onSurface.rows(), 3.0);
@@ -68,11 +74,7 @@ TEST(SpringForceModel, ASampleHasTheWholeSetsStiffness) {
   const ControlMesh cube = makeCube98();
   const LimitSurface surface(cube);
   const MatrixX3 onSurface = tessellate(surface, cube.points(), 4).points;
-  ClosestPointLocator locator(surface);
-  locator.update(cube.points());
-  MatrixX3 targets(onSurface.rows(), 3);
-  const std::vector<ClosestPoint> nearest = locator.findAll(onSurface);
-  for (Eigen::Index i = 0; i < onSurface.rows(); ++i) targets.row(i) = onSurface.row(i) + 0.03 * nearest[i].normal.transpose();
+  const MatrixX3 targets = onSurface + 0.03 * normalsAt(surface, cube.points(), onSurface);
   const SurfaceQuadrature quadrature = makeSurfaceQuadrature(surface);
   const Eigen::VectorXd k = Eigen::VectorXd::Constant(targets.rows(), 3.0);
   const double elements = surface.elementCount();

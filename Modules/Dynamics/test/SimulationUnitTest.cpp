@@ -102,6 +102,16 @@ TEST(StaticScheme, FixedVerticesStay) {
   EXPECT_GT((result.mesh.points() - cube.points()).cwiseAbs().maxCoeff(), 0.05);
 }
 
+// Static steps, elasticity weakened 4-fold per level and per relaxation.
+SimulationOptions relaxingOptions(int maxLevel, int relaxations) {
+  SimulationOptions options;
+  options.integrator.scheme = IntegrationScheme::Static;
+  options.maxLevel = maxLevel;
+  options.elasticityPerLevel = 0.25;
+  options.relaxations = relaxations;
+  return options;
+}
+
 // A level refused as close (FitVerdict::Relax) runs on at its own level with
 // its elasticity weakened by the factor per level, while relaxations are
 // left; refused outright (Refine), or with none left, it is refined.
@@ -114,11 +124,7 @@ TEST(StaticScheme, ALevelRefusedAsCloseRelaxesBeforeItIsRefined) {
         std::make_tuple(FitVerdict::Refine, 1, 386, 0.25)}) {
     SpringForceModel springs(targets, Eigen::VectorXd::Constant(targets.rows(), 1.0),
                              SpringForceModel::Attach::NearestEachStep);
-    SimulationOptions options;
-    options.integrator.scheme = IntegrationScheme::Static;
-    options.maxLevel = 1;
-    options.elasticityPerLevel = 0.25;
-    options.relaxations = relaxations;
+    const SimulationOptions options = relaxingOptions(1, relaxations);
     int asked = 0;  // at levels' ends
     const AcceptFit accept = [&, first = first](const LimitSurface&, const MatrixX3&, FitAsk when) {
       if (when != FitAsk::LevelEnd) return FitVerdict::Settle;
@@ -145,11 +151,7 @@ TEST(StaticScheme, TheLastLevelRelaxesAtTheLooserRule) {
   for (const FitVerdict answer : {FitVerdict::Relax, FitVerdict::Refine}) {
     SpringForceModel springs(targets, Eigen::VectorXd::Constant(targets.rows(), 1.0),
                              SpringForceModel::Attach::NearestEachStep);
-    SimulationOptions options;
-    options.integrator.scheme = IntegrationScheme::Static;
-    options.maxLevel = 0;
-    options.elasticityPerLevel = 0.25;
-    options.relaxations = 1;
+    SimulationOptions options = relaxingOptions(0, 1);
     options.equilibrium.coarseLevelFactor = 30.0;
     int looseAsks = 0, lastLooseAsks = 0;
     const AcceptFit accept = [&](const LimitSurface&, const MatrixX3&, FitAsk when) {
