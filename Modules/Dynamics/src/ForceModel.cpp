@@ -1,5 +1,6 @@
 #include "dynsub/ForceModel.h"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
@@ -44,7 +45,8 @@ void SpringForceModel::beginLevel(const LimitSurface& surface, const SurfaceQuad
   locator_ = std::make_unique<ClosestPointLocator>(surface);
   const Eigen::Index all = allTargets_.rows();
   const double wanted = samplePerElement_ * surface.elementCount();
-  const Eigen::Index sample = samplePerElement_ > 0 && wanted < all ? static_cast<Eigen::Index>(wanted) : all;
+  const Eigen::Index sample =
+      samplePerElement_ > 0 && wanted < all ? std::max<Eigen::Index>(1, static_cast<Eigen::Index>(wanted)) : all;
   if (sample != targets_.rows()) {
     targets_.resize(sample, 3);
     stiffness_.resize(sample);

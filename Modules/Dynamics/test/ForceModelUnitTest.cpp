@@ -96,6 +96,10 @@ TEST(SpringForceModel, ASampleHasTheWholeSetsStiffness) {
   EXPECT_EQ(sample, static_cast<Eigen::Index>(2.0 * elements));
   EXPECT_NEAR(potentialOf(static_cast<double>(targets.rows()) / elements, enough), whole, 1e-7 * whole);
   EXPECT_EQ(enough, targets.rows());
+  // Fewer than one spring's worth still pulls with one.
+  Eigen::Index one = 0;
+  EXPECT_GT(potentialOf(0.1 / elements, one), 0.0);
+  EXPECT_EQ(one, 1);
   SpringForceModel springs(targets, k, SpringForceModel::Attach::NearestEachStep);
   EXPECT_THROW(springs.setSamplePerElement(-1.0), Error);
   EXPECT_THROW(springs.setSamplePerElement(std::nan("")), Error);
