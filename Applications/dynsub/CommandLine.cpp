@@ -4,7 +4,9 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <variant>
 
 #include <CLI/CLI.hpp>
@@ -12,6 +14,25 @@
 #include "dynsub/TextFields.h"
 
 namespace dynsub::app {
+
+namespace {
+
+CLI::Validator numberCheck(const std::string& name, bool zeroAllowed) {
+  return CLI::Validator(
+      [name, zeroAllowed](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double value = std::strtod(text.c_str(), &end);
+        const bool number = !text.empty() && end == text.c_str() + text.size() && std::isfinite(value);
+        return number && (value > 0.0 || (zeroAllowed && value == 0.0)) ? std::string()
+                                                                         : text + " is not " + name;
+      },
+      zeroAllowed ? "NUMBER>=0" : "NUMBER>0");
+}
+
+}  // namespace
+
+CLI::Validator positiveNumber() { return numberCheck("a finite number > 0", false); }
+CLI::Validator nonNegativeNumber() { return numberCheck("a finite number >= 0", true); }
 
 void SimulationArguments::addOptions(CLI::App& command, const SimulationOptions& defaults) {
   values = defaults;
@@ -31,24 +52,24 @@ void SimulationArguments::addOptions(CLI::App& command, const SimulationOptions&
       ->check(CLI::IsMember({"cholesky", "cg", "pcg"}));
   command.add_option("--time-step", values.integrator.timeStep, "Time step, s (halved automatically on divergence, and doubled back once the energy falls)")
       ->default_val(defaults.integrator.timeStep)
-      ->check(CLI::PositiveNumber);
+      ->check(positiveNumber());
   command.add_option("--max-steps", values.equilibrium.maxSteps, "Step limit per level")
       ->default_val(defaults.equilibrium.maxSteps)
       ->check(CLI::Range(1, 1000000));
   command.add_option("--mass", values.material.mass, "Mass density mu, kg per unit parametric area")
       ->default_val(defaults.material.mass)
-      ->check(CLI::NonNegativeNumber);
+      ->check(nonNegativeNumber());
   command.add_option("--damping", values.material.damping, "Damping density gamma, kg/s per unit parametric area")
       ->default_val(defaults.material.damping)
-      ->check(CLI::NonNegativeNumber);
+      ->check(nonNegativeNumber());
   command.add_option("--tension", values.material.tensionU,
                      "Tension alpha11 = alpha22, N/mm per unit parametric area (membrane: resists stretching)")
       ->default_val(defaults.material.tensionU)
-      ->check(CLI::NonNegativeNumber);
+      ->check(nonNegativeNumber());
   command.add_option("--rigidity", values.material.rigidityUU,
                      "Rigidity beta11 = beta22 = beta12/2, N/mm per unit parametric area (thin plate: resists bending)")
       ->default_val(defaults.material.rigidityUU)
-      ->check(CLI::NonNegativeNumber);
+      ->check(nonNegativeNumber());
 }
 
 SimulationOptions SimulationArguments::apply(SimulationOptions base) const {

@@ -9,6 +9,7 @@
 
 namespace CLI {
 class App;
+class Validator;
 }
 
 namespace dynsub::app {
@@ -27,6 +28,12 @@ struct SimulationArguments {
 // and the value in `parameters` now as its default; `parameters` must outlive
 // the parsing.
 void addSegmentParameterOptions(CLI::App& command, SegmentParameters& parameters);
+
+// Checks for a finite number > 0 and >= 0, whose refusals read
+// "--tolerance: -1 is not a finite number > 0" (CLI11's PositiveNumber and
+// NonNegativeNumber print the largest double as their range's end).
+CLI::Validator positiveNumber();
+CLI::Validator nonNegativeNumber();
 
 // For a usage error: "did you mean 'segment'?" for a command that is not one
 // of `app`'s subcommands, or "did you mean '--landmarks'?" for a long option

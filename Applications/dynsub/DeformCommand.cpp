@@ -95,7 +95,7 @@ void addDeformCommand(CLI::App& app) {
   command->add_option("--out", o->out, "Output directory (created if missing; its parent must exist)")->required();
   command->add_option("--stiffness", o->stiffness, "Stiffness of springs that do not give one, N/mm")
       ->default_val(o->stiffness)
-      ->check(CLI::PositiveNumber);
+      ->check(positiveNumber());
   command->add_flag("--fix-boundary", o->fixBoundary, "Hold the boundary control vertices of an open mesh in place");
   SimulationOptions defaults;
   defaults.maxLevel = 0;

@@ -214,18 +214,18 @@ void addFitCommand(CLI::App& app) {
       ->check(CLI::Range(0, 100));
   command->add_option("--tolerance", o->fit.tolerancePercent, "Max error to reach, in percent")
       ->default_val(1.0)
-      ->check(CLI::PositiveNumber);
+      ->check(positiveNumber());
   command->add_option("--data-stiffness", o->fit.dataStiffness,
                       "Spring stiffness of the data, N/mm per unit parametric area, shared by all points")
       ->default_val(o->fit.dataStiffness)
-      ->check(CLI::PositiveNumber);
+      ->check(positiveNumber());
   command
       ->add_option("--springs-per-element", o->fit.springsPerElement,
                    "Data springs that pull a level, per element of its surface: a fixed random sample of the "
                    "points, with their total stiffness, where the scan has more (0: every point at every level). "
                    "Each level's fit is measured on all the points")
       ->default_val(o->fit.springsPerElement)
-      ->check(CLI::NonNegativeNumber);
+      ->check(nonNegativeNumber());
   command->add_option("--noise", o->noise,
                       "The scan's noise: auto (measured from the points' scatter about their neighbours' local "
                       "surface) or its standard deviation in mm (0: clean data). When the noise puts the tolerance "

@@ -85,8 +85,10 @@ expect_error "open initial model" 1 "closed" "$work/o6" \
 expect_error "missing point cloud" 1 "no such file" "$work/o7" "$DYNSUB" fit "$work/none.xyz" --out "$work/o7"
 printf 'x y z\n' >"$work/words.xyz"
 expect_error "malformed point cloud" 1 "line 1" "$work/o8" "$DYNSUB" fit "$work/words.xyz" --out "$work/o8"
-expect_error "impossible tolerance" 2 "tolerance" "$work/o9" \
+expect_error "impossible tolerance" 2 "tolerance: -1 is not a finite number > 0" "$work/o9" \
   "$DYNSUB" fit "$work/sphere.xyz" --tolerance -1 --out "$work/o9"
+expect_error "negative springs per element" 2 "springs-per-element" "$work/o9b" \
+  "$DYNSUB" fit "$work/sphere.xyz" --springs-per-element -1 --out "$work/o9b"
 expect_error "missing output parent" 1 "does not exist" "$work/no/o10" \
   "$DYNSUB" fit "$work/sphere.xyz" --out "$work/no/o10"
 
