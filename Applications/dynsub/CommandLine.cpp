@@ -23,8 +23,7 @@ CLI::Validator numberCheck(const std::string& name, bool zeroAllowed) {
         char* end = nullptr;
         const double value = std::strtod(text.c_str(), &end);
         const bool number = !text.empty() && end == text.c_str() + text.size() && std::isfinite(value);
-        return number && (value > 0.0 || (zeroAllowed && value == 0.0)) ? std::string()
-                                                                         : text + " is not " + name;
+        return number && (value > 0.0 || (zeroAllowed && value == 0.0)) ? std::string() : text + " is not " + name;
       },
       zeroAllowed ? "NUMBER>=0" : "NUMBER>0");
 }
