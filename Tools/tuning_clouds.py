@@ -30,6 +30,10 @@ def write(path, comment, points):
             f.write("%.4f %.4f %.4f\n" % p)
 
 
+def ellipsoid_points(rng, count):
+    return [tuple(a * c for a, c in zip((60.0, 40.0, 20.0), on_sphere(rng))) for _ in range(count)]
+
+
 def peanut_points(rng, count):
     peanut = []
     while len(peanut) < count:
@@ -52,12 +56,12 @@ def main():
     write(os.path.join(out, "sphere.xyz"), "2000 points on a sphere, radius 50 mm; Tools/tuning_clouds.py",
           [tuple(50.0 * c for c in on_sphere(rng)) for _ in range(2000)])
     write(os.path.join(out, "ellipsoid.xyz"), "3000 points on an ellipsoid 60:40:20 mm; Tools/tuning_clouds.py",
-          [tuple(a * c for a, c in zip((60.0, 40.0, 20.0), on_sphere(rng))) for _ in range(3000)])
+          ellipsoid_points(rng, 3000))
     write(os.path.join(out, "peanut.xyz"), "2725 points on two overlapping spheres, 0.2 mm noise; Tools/tuning_clouds.py",
           peanut_points(rng, 2725))
     write(os.path.join(out, "ellipsoid_dense.xyz"),
           "30000 points on an ellipsoid 60:40:20 mm; Tools/tuning_clouds.py",
-          [tuple(a * c for a, c in zip((60.0, 40.0, 20.0), on_sphere(rng))) for _ in range(30000)])
+          ellipsoid_points(rng, 30000))
     write(os.path.join(out, "peanut_dense.xyz"),
           "30000 points on two overlapping spheres, 0.2 mm noise; Tools/tuning_clouds.py",
           peanut_points(rng, 30000))

@@ -621,7 +621,7 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
       if (verdict != FitVerdict::Relax || relaxed >= options.relaxations) break;
     }
     const bool good = verdict != FitVerdict::Refine && verdict != FitVerdict::Relax;
-    if (good || level >= options.maxLevel) {
+    if (good || lastLevel) {
       result.origin = {level, initialIsolation};
       result.surface = model.surface;
       break;

@@ -91,9 +91,6 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
   if (!(std::isfinite(options.dataStiffness) && options.dataStiffness > 0.0)) {
     throw Error("the data stiffness must be finite and > 0");
   }
-  if (!(std::isfinite(options.springsPerElement) && options.springsPerElement >= 0.0)) {
-    throw Error("the springs per element must be finite and >= 0");
-  }
   if (!(std::isfinite(options.noise) && options.noise >= 0.0)) {
     throw Error("the data's noise must be finite and >= 0 mm");
   }
