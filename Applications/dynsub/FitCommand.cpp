@@ -128,6 +128,10 @@ void runFit(FitCommandOptions o) {
   noiseReport.set("sigma_percent", 100.0 * noise.sigma / diameter);
   noiseReport.set("reach_percent", 100.0 * noiseReach(data.rows()) * noise.sigma / diameter);
   noiseReport.set("estimated", measured && stated < 0.0);
+  if (measured) {
+    noiseReport.set("scatter_percent", 100.0 * noise.scatter / diameter);
+    noiseReport.set("scatter_few_percent", 100.0 * noise.scatterFew / diameter);
+  }
   noiseReport.set("outliers", static_cast<int>(noise.outliers.size()));
   noiseReport.set("noise_limited", result.noiseLimited);
   if (result.noiseLimited) noiseReport.set("bias_percent", result.error.biasPercent);
@@ -184,6 +188,14 @@ void runFit(FitCommandOptions o) {
     std::cout << "the data's noise (sigma " << 100.0 * noise.sigma / diameter
               << " %) puts that tolerance out of reach of the max error; the surface's bias is "
               << result.error.biasPercent << " %\n";
+  }
+  // Said only where taking the scatter for noise would have changed the fit.
+  if (measured && stated < 0.0 && noise.sigma == 0.0 &&
+      100.0 * noiseReach(data.rows()) * noise.scatter / diameter >= 0.5 * o.fit.tolerancePercent) {
+    std::cout << "the points' scatter about their neighbours' surface grows from "
+              << 100.0 * noise.scatterFew / diameter << " % with " << kNoiseNeighboursFew << " neighbours to "
+              << 100.0 * noise.scatter / diameter << " % with " << kNoiseNeighbours
+              << ": it is the shape's detail at this sampling, not noise, and the scan was fitted as clean data\n";
   }
   if (!noise.outliers.empty()) std::cout << "set aside " << noise.outliers.size() << " outlier(s)\n";
   std::cout

@@ -87,6 +87,30 @@ LocalFit fitQuadric(const MatrixX3& neighbours, const Vector3& point) {
   return fit;
 }
 
+// fitQuadric, then again without the neighbours the first fit left farther
+// than 3 of its scales, so that an outlier among them neither tilts the frame
+// nor bends the quadric.
+LocalFit fitRobustQuadric(const MatrixX3& around, const Vector3& point) {
+  const LocalFit fit = fitQuadric(around, point);
+  if (!fit.valid) return fit;
+  std::vector<Eigen::Index> kept;
+  for (Eigen::Index j = 0; j < around.rows(); ++j) {
+    if (std::abs(fit.residuals(j)) <= 3.0 * fit.scale) kept.push_back(j);
+  }
+  if (kept.size() == static_cast<size_t>(around.rows()) || kept.size() < 10) return fit;
+  const LocalFit refit = fitQuadric(around(kept, Eigen::all), point);
+  return refit.valid ? refit : fit;
+}
+
+// The robust sigma of the valid standardized residuals (ScanNoise.h); 0 when none is.
+double scatterOf(const Eigen::VectorXd& standardized, const std::vector<char>& valid) {
+  std::vector<double> magnitudes;
+  for (Eigen::Index i = 0; i < standardized.size(); ++i) {
+    if (valid[static_cast<size_t>(i)]) magnitudes.push_back(std::abs(standardized(i)));
+  }
+  return magnitudes.empty() ? 0.0 : percentile(std::move(magnitudes), kNoiseQuantile) / kQuantileToSigma;
+}
+
 }  // namespace
 
 Eigen::MatrixXi nearestNeighbours(const MatrixX3& points, int count) {
@@ -135,7 +159,8 @@ ScanNoise estimateScanNoise(const MatrixX3& points) {
   const Eigen::Index n = points.rows();
   Eigen::VectorXd standardized = Eigen::VectorXd::Zero(n), localScale = Eigen::VectorXd::Zero(n);
   Eigen::VectorXd reach(n), nearest(n);  // mean and least distance to the neighbours
-  std::vector<char> valid(static_cast<size_t>(n), 0);
+  Eigen::VectorXd fewStandardized = Eigen::VectorXd::Zero(n);
+  std::vector<char> valid(static_cast<size_t>(n), 0), fewValid(static_cast<size_t>(n), 0);
   parallelFor(n, threadsWorth(n), [&](Eigen::Index i) {
     MatrixX3 around(kNoiseNeighbours, 3);
     for (int j = 0; j < kNoiseNeighbours; ++j) around.row(j) = points.row(neighbours(i, j));
@@ -143,30 +168,22 @@ ScanNoise estimateScanNoise(const MatrixX3& points) {
     const Eigen::VectorXd distances = (around.rowwise() - point.transpose()).rowwise().norm();
     reach(i) = distances.mean();
     nearest(i) = distances(0);
-    LocalFit fit = fitQuadric(around, point);
-    if (!fit.valid) return;
-    // Again without the neighbours the first fit left far off.
-    std::vector<int> kept;
-    for (int j = 0; j < kNoiseNeighbours; ++j) {
-      if (std::abs(fit.residuals(j)) <= 3.0 * fit.scale) kept.push_back(j);
+    const LocalFit fit = fitRobustQuadric(around, point);
+    if (fit.valid) {
+      standardized(i) = fit.standardized;
+      localScale(i) = fit.scale;
+      valid[static_cast<size_t>(i)] = 1;
     }
-    if (kept.size() < static_cast<size_t>(kNoiseNeighbours) && kept.size() >= 10) {
-      MatrixX3 trimmed(static_cast<Eigen::Index>(kept.size()), 3);
-      for (size_t k = 0; k < kept.size(); ++k) trimmed.row(static_cast<Eigen::Index>(k)) = around.row(kept[k]);
-      const LocalFit refit = fitQuadric(trimmed, point);
-      if (refit.valid) fit = refit;
+    const LocalFit few = fitRobustQuadric(around.topRows(kNoiseNeighboursFew), point);  // the nearest first
+    if (few.valid) {
+      fewStandardized(i) = few.standardized;
+      fewValid[static_cast<size_t>(i)] = 1;
     }
-    standardized(i) = fit.standardized;
-    localScale(i) = fit.scale;
-    valid[static_cast<size_t>(i)] = 1;
   });
-  std::vector<double> magnitudes;
-  magnitudes.reserve(static_cast<size_t>(n));
-  for (Eigen::Index i = 0; i < n; ++i) {
-    if (valid[static_cast<size_t>(i)]) magnitudes.push_back(std::abs(standardized(i)));
-  }
   ScanNoise noise;
-  if (!magnitudes.empty()) noise.sigma = percentile(std::move(magnitudes), kNoiseQuantile) / kQuantileToSigma;
+  noise.scatter = scatterOf(standardized, valid);
+  noise.scatterFew = scatterOf(fewStandardized, fewValid);
+  noise.sigma = noise.scatter > kShapeGrowth * noise.scatterFew ? 0.0 : noise.scatter;
   const double spacing = percentile(std::vector<double>(nearest.data(), nearest.data() + n), 0.5);
   const double usualReach = percentile(std::vector<double>(reach.data(), reach.data() + n), 0.5);
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -183,7 +200,7 @@ ScanNoise estimateScanNoise(const MatrixX3& points) {
     // usual spacing of the points: on clean data the scales are the quadrics'
     // tiny misfit, and an offset within the spacing cannot pull a fit anywhere.
     const bool off = valid[static_cast<size_t>(i)] &&
-                     std::abs(standardized(i)) > kOutlierFactor * std::max(noise.sigma, localScale(i)) &&
+                     std::abs(standardized(i)) > kOutlierFactor * std::max(noise.scatter, localScale(i)) &&
                      std::abs(standardized(i)) > 0.5 * spacing;
     if (isolated || off) noise.outliers.push_back(static_cast<int>(i));
   }

@@ -26,6 +26,15 @@
 //    neighbours that lie on it. Points too far off for their neighbours to
 //    be a patch of the surface are caught by isolation instead
 //    (kIsolationFactor).
+//  - Shape, not noise: a quadric follows the surface only over a
+//    neighbourhood where the scan samples its curvature densely. Where it
+//    does not (a few hundred points on a shape with handles), the residuals
+//    are the surface's own bending, and they grow with the neighbourhood
+//    (a quadric's misfit with its radius cubed), while noise does not
+//    depend on how many neighbours are fitted. The scatter is measured with
+//    kNoiseNeighbours and with kNoiseNeighboursFew; when the first exceeds
+//    the second kShapeGrowth-fold, sigma is 0: the scan is fitted as clean
+//    data, since what its scatter measures is detail the fit must follow.
 // The quadric is fitted twice: the second fit leaves out the neighbours the
 // first left farther than 3 of its scales, so that an outlier among the
 // neighbours neither tilts the frame nor bends the quadric.
@@ -41,13 +50,24 @@
 namespace dynsub {
 
 struct ScanNoise {
-  double sigma = 0.0;         // mm
+  double sigma = 0.0;  // mm; 0 when the scatter is the surface's shape (above)
+  // The robust sigma of the standardized residuals (above), mm, with
+  // kNoiseNeighbours and with kNoiseNeighboursFew neighbours.
+  double scatter = 0.0, scatterFew = 0.0;
   std::vector<int> outliers;  // indices into the points, ascending
 };
 
 // Neighbours per point for the quadrics: 6 coefficients, with room left to
 // measure the residuals' spread.
 constexpr int kNoiseNeighbours = 20;
+// The smaller neighbourhood the scatter is compared with: 6 coefficients
+// and as many residuals left.
+constexpr int kNoiseNeighboursFew = 12;
+// Scatter that grows more than this from kNoiseNeighboursFew to
+// kNoiseNeighbours neighbours is shape, not noise. On the synthetic tuning
+// clouds (Tools/tuning_clouds.py) the noisy peanut's grows 1.06-fold (0.99
+// on its dense version) and the clean sphere's 4.4-fold.
+constexpr double kShapeGrowth = 1.5;
 // |t| beyond this many scales is an outlier: a Gaussian point exceeds 4
 // standard deviations about once in 16 000.
 constexpr double kOutlierFactor = 4.0;
