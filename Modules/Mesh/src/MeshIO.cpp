@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <regex>
 #include <sstream>
 
 #include "dynsub/AtomicOutput.h"
@@ -134,7 +135,12 @@ PolygonData readOff(const std::string& path) {
   std::ifstream in = openForReading(path);
   int line = 0;
   std::vector<std::string> tokens = nextOffRecord(in, path, line, "the OFF header");
-  if (tokens[0] != "OFF") throw Error(path, "line 1: expected the keyword OFF, found '" + tokens[0] + "'");
+  // COFF, NOFF, STOFF, ...: per-vertex colours, normals or texture
+  // coordinates follow x y z, and are not read.
+  static const std::regex keyword("(ST)?C?N?OFF");
+  if (!std::regex_match(tokens[0], keyword))
+    throw Error(path, "line 1: expected the keyword OFF (or COFF, NOFF, STOFF, ...: 3D vertices), found '" +
+                          tokens[0] + "'");
   tokens.erase(tokens.begin());
   if (tokens.empty()) tokens = nextOffRecord(in, path, line, "the vertex and face counts");
   if (tokens.size() < 2) throw Error(path, "line " + std::to_string(line) + ": expected vertex and face counts");

@@ -67,6 +67,23 @@ TEST(MeshIO, OffAndAsciiPlyReadTheSameMesh) {
   EXPECT_EQ(a.points(), b.points());
 }
 
+// COFF (CGAL's and Geomview's per-vertex and per-face colours) reads as
+// the plain OFF; a 4D OFF is refused by name.
+TEST(MeshIO, ColouredOffReadsAsOff) {
+  const std::string coff = scratch("tri.coff.off").string();
+  writeText(coff, "COFF\n4 2 0\n0 0 0 192 192 192 255\n1 0 0 1 2 3 4\n1 1 0 0 0 0 0\n0 1 0 9 9 9 9\n"
+                  "3 0 1 2 255 0 0\n3 0 2 3\n");
+  const std::string off = scratch("tri.plain.off").string();
+  writeText(off, "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n");
+  const dynsub::ControlMesh a = dynsub::readControlMesh(coff);
+  const dynsub::ControlMesh b = dynsub::readControlMesh(off);
+  EXPECT_EQ(a.faces(), b.faces());
+  EXPECT_EQ(a.points(), b.points());
+  const std::string fourD = scratch("tri.4off.off").string();
+  writeText(fourD, "4OFF\n4 2 0\n0 0 0 1\n1 0 0 1\n1 1 0 1\n0 1 0 1\n3 0 1 2\n3 0 2 3\n");
+  expectError(fourD, "found '4OFF'");
+}
+
 TEST(MeshIO, BinaryPlyInBothByteOrders) {
   for (const std::string order : {"binary_little_endian", "binary_big_endian"}) {
     const std::string path = scratch("quad-" + order + ".ply").string();
