@@ -37,7 +37,7 @@ struct Helpers {
   int count = 0;
 };
 
-// NB: never freed, and their threads detached: they wait until the process
+// Never freed, and their threads detached: they wait until the process
 // ends, and nothing at exit may wait for them or destroy what they wait on.
 const Helpers& helpers() {
   static const Helpers started = [] {

@@ -49,7 +49,7 @@ struct ClosestPointLocator::Impl {
   double sampleWeightBound = 0;  // max over samples of the sum of |weights|
   MatrixX3 controlPoints;
   // specialOperator * controlPoints.
-  // NB: computed at every update: the checks for a nearer sample read the
+  // Computed at every update: the checks for a nearer sample read the
   // special elements' samples many times over, and a sparse row each time
   // would cost far more.
   MatrixX3 specialSamples;
@@ -76,7 +76,7 @@ struct ClosestPointLocator::Impl {
         block = specialSamples.middleRows(specialRow[e * perElement], perElement);
       }
     }
-    // NB: 64 samples a leaf, not nanoflann's usual 10-16: the tree is rebuilt
+    // 64 samples a leaf, not nanoflann's usual 10-16: the tree is rebuilt
     // at most evaluations of a fit and queried only a few times per rebuild,
     // so its build time counts most; larger leaves build faster and do not
     // slow these searches.
@@ -115,7 +115,7 @@ struct ClosestPointLocator::Impl {
   // within `radius` of q is checked where it is now, and the search stops at
   // the first one nearer than `distance` (Yes) or when over `mostChecked`
   // are within the radius (Unknown). No list of neighbours is kept.
-  // NB: the ball usually holds a sample or two, so stopping at the first
+  // The ball usually holds a sample or two, so stopping at the first
   // nearer one is cheaper than a search for the 65 nearest, and keeping no
   // list saves a radius search's time growing one.
   struct NearerSampleSearch {
@@ -247,7 +247,7 @@ struct ClosestPointLocator::Impl {
       }
       if (!step.allFinite() || step.norm() < 1e-12) break;
       bool improved = false;
-      // NB: near the minimum Newton converges quadratically, so a short full
+      // Near the minimum Newton converges quadratically, so a short full
       // step that does not improve means the distance is at its rounding
       // floor; halving it 20 times more (an evaluation each) would be most of
       // a search's evaluations, for nothing.
@@ -394,7 +394,7 @@ std::vector<ClosestPoint> ClosestPointLocator::findAll(const MatrixX3& queries,
   // kMostChecked, or a hint is off the surface, or a ball is too full, the
   // tree is rebuilt and every query is decided on the
   // current one.
-  // NB: early in a fit, while the surface moves fast, most queries come out
+  // Early in a fit, while the surface moves fast, most queries come out
   // Unknown (over 64 samples in the ball of the drift): past kMostUndecided
   // the checks stop, as a current tree is cheaper. Late in it only a handful
   // per evaluation are undecided, and deciding them on the old tree saves a
@@ -423,7 +423,7 @@ std::vector<ClosestPoint> ClosestPointLocator::findAll(const MatrixX3& queries,
   // The old tree's decisions check at most a quarter of the tree's samples
   // in all, shared out among the undecided queries; a rebuild evaluates
   // every sample and sorts them again.
-  // NB: without this bound a few queries whose balls hold hundreds of
+  // Without this bound a few queries whose balls hold hundreds of
   // samples (a segmentation's landmarks while the surface moves fast) would
   // check more samples than a rebuild evaluates.
   const std::size_t undecidedQueries = static_cast<std::size_t>(std::max<Eigen::Index>(1, undecidedCount));

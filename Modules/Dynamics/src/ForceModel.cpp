@@ -178,7 +178,7 @@ void SpringForceModel::addTangentStiffness(const MatrixX3& controlPoints, Tangen
     const Spring& spring = springs_[i];
     const Vector3 normal = normals_.row(static_cast<Eigen::Index>(i)).transpose();
     Eigen::Matrix3d block = spring.stiffness * Eigen::Matrix3d::Identity();
-    // NB: where the normal is undefined (a degenerate point) the spring stays isotropic.
+    // Where the normal is undefined (a degenerate point) the spring stays isotropic.
     if (normal.squaredNorm() > 0.0) {
       block = spring.stiffness * ((1.0 - kTangentialShare) * normal * normal.transpose() +
                                   kTangentialShare * Eigen::Matrix3d::Identity());

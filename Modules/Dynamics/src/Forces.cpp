@@ -124,7 +124,7 @@ MatrixX3 fieldForces(const SurfaceQuadrature& q, const MatrixX3& controlPoints, 
 SparseMatrix fieldStiffness(const SurfaceQuadrature& q, const MatrixX3& controlPoints, double slope) {
   const MatrixX3 su = applyOperator(q.Ju, controlPoints), sv = applyOperator(q.Jv, controlPoints);
   const Eigen::VectorXd weights = slope * q.weights.cwiseProduct(areaElements(su, sv));
-  // NB: one element's quadrature points share its columns (J, J_u and J_v
+  // One element's quadrature points share its columns (J, J_u and J_v
   // have one pattern), so their rank-one terms are summed in a dense block
   // per element and only the block goes into the triplets, which costs less
   // than Eigen's sparse product J^T W J.

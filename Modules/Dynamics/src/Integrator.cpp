@@ -157,7 +157,7 @@ void Integrator::Impl::build(const PhysicalMatrices& matrices, const SymmetricMa
                                      : SymmetricMatrix(matrices.damping + 2.0 * dt * stiffness);
   SymmetricMatrix lhsFree = select(lhs, s.freeIndex, free, s.freeIndex, free);
   lhsFree.makeCompressed();
-  // NB: the stabilizer's updates (Simulation.h) change only values: its
+  // The stabilizer's updates (Simulation.h) change only values: its
   // stiffness lies within the elements' pattern, which K and D fill.
   const bool samePattern =
       !analyze && lhsFree.rows() == s.lhsFree.rows() && lhsFree.nonZeros() == s.lhsFree.nonZeros() &&
@@ -169,7 +169,7 @@ void Integrator::Impl::build(const PhysicalMatrices& matrices, const SymmetricMa
   switch (options.solver) {
     case LinearSolver::Cholesky:
       if (!samePattern) s.cholesky.analyzePattern(s.lhsFree);
-      // NB: a singular matrix (K alone: translations cost nothing) factors with
+      // A singular matrix (K alone: translations cost nothing) factors with
       // pivots at rounding level rather than failing; those count as zero.
       if (!s.cholesky.factorize(s.lhsFree)) {
         throw Error("the left-hand matrix of the time step is not positive definite (is the surface anchored? "

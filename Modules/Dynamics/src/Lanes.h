@@ -17,7 +17,7 @@ namespace dynsub {
 typedef double Lanes __attribute__((vector_size(32)));
 constexpr int kLanes = 4;
 
-// NB: by reference, not by value: a 32-byte vector passed by value has a
+// By reference, not by value: a 32-byte vector passed by value has a
 // different ABI with and without AVX (GCC warns), though these are always inlined.
 // Unaligned: a std::vector of doubles is aligned to 16 bytes only.
 DYNSUB_KERNEL void load(Lanes& v, const double* p) { std::memcpy(&v, p, sizeof v); }

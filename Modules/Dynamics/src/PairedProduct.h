@@ -29,7 +29,7 @@ class PairedProduct {
   std::vector<int> start_;       // column j's entries: [start_[j], start_[j + 1]), the diagonal first
   std::vector<int> row_;         // each entry's row i >= j
   std::vector<double> weights_;  // C_ij, P_ij for each entry
-  // NB: starting a thread costs about 50 us, 50 000 entries' worth.
+  // Starting a thread costs about 50 us, 50 000 entries' worth.
   static constexpr long kThreadShare = 50000;
   int split_ = 0;                     // columns from split_ on go to a second thread; 0: none
   // sums_ (+ secondSums_) = C p + P q, points packed as [x y z 0].

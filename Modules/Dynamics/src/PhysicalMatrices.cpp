@@ -34,7 +34,7 @@ UnitIntegrals unitIntegrals(int points) {
   return result;
 }
 
-// NB: the unit integrals depend only on the quadrature order; the default's are cached.
+// The unit integrals depend only on the quadrature order; the default's are cached.
 const UnitIntegrals& exactUnitIntegrals() {
   static const UnitIntegrals exact = unitIntegrals(4);
   return exact;
@@ -121,7 +121,7 @@ std::vector<int> permutationSlots(const Eigen::Matrix<double, 16, Eigen::Dynamic
 // A normal element's integrals when its grid is a permutation P: each
 // P^T U P is U's entries rearranged, the same values the products give (their
 // other terms are exact zeros), without the 12 dense 16 x 16 products.
-// NB: the dense products would be a sizeable share of the assembly.
+// The dense products would be a sizeable share of the assembly.
 ElementIntegrals permutedIntegrals(const UnitIntegrals& unit, const std::vector<int>& slots,
                                    const std::vector<int>& columns, double side) {
   ElementIntegrals result;
@@ -200,7 +200,7 @@ SymmetricMatrix elementPattern(const LimitSurface& surface) {
   std::vector<int> next(firstElement.begin(), firstElement.end() - 1);
   for (int e = 0; e < elements; ++e)
     for (int j : surface.elementColumns(e)) elementsOf[next[j]++] = e;
-  // NB: each column's rows are gathered once each (a stamp per vertex marks
+  // Each column's rows are gathered once each (a stamp per vertex marks
   // the rows seen) and only those sorted: appending every element's columns
   // would repeat each row up to tenfold on an isolated mesh, all to be sorted
   // out again (this pattern is also the Newton matrix's).
@@ -231,7 +231,7 @@ PhysicalMatrices assemblePhysicalMatrices(const LimitSurface& surface, const std
   }
   for (const Material& m : materials) checkMaterial(m);
 
-  // NB: summed in place on the pattern of every pair of control vertices
+  // Summed in place on the pattern of every pair of control vertices
   // sharing an element, in element order: setFromTriplets would need m^2
   // triplets per matrix and element, millions on a fine mesh, and building
   // and sorting them would cost more than the integrals.

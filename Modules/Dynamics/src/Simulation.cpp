@@ -82,7 +82,7 @@ LevelModel buildLevel(const ControlMesh& mesh, int level, int& initialIsolation,
   // Element sides are measured in elements of the initial model: a base mesh
   // that is `b` global refinements past the initial one has side 2^-b.
   model.elementSize = std::ldexp(1.0, initialIsolation - (level + model.surface->isolationLevels()));
-  // NB: the matrices and the quadrature are independent (the surface's
+  // The matrices and the quadrature are independent (the surface's
   // tables are safe to fill from two threads), and each is a sizeable share
   // of a level, so they are built side by side.
   bothAtOnce([&] { assembleMatrices(model, std::pow(options.elasticityPerLevel, level), options); },
@@ -158,7 +158,7 @@ SurfaceFrame surfaceFrame(const SurfaceQuadrature& quadrature, const MatrixX3& p
 // normal at `from`. Steps also slide the parametrization along the surface,
 // which changes no shape, for hundreds of steps after the shape has settled
 // (Simulation.h), so control-point motion would keep it "moving".
-// NB: each state's frame is computed once and compared with the next
+// Each state's frame is computed once and compared with the next
 // state's: one pass over the operators per state, not three per step (J on
 // the move, J_u and J_v at `from`).
 double shapeMotion(const SurfaceFrame& from, const SurfaceFrame& to) {
@@ -300,7 +300,7 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
     falling = step > 2 && energy < energyTwoBefore ? falling + 1 : 0;
     energyTwoBefore = lastEnergy;
     if (options.timeStepRegrowth > 0 && falling >= options.timeStepRegrowth && timeStep < regrowCeiling) {
-      // NB: the next step takes `previous`, one old step back, for one new
+      // The next step takes `previous`, one old step back, for one new
       // step back; the steps after it correct that, and the equilibrium does
       // not depend on it. The stabilizer is frozen anew here too (not counted
       // in stabilizerUpdates, which counts the energy's rises).
@@ -347,7 +347,7 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
     summary.stabilizerUpdates = solver.regularizations();
     return end;
   };
-  // NB: a static step that moves nothing is conclusive by itself (there is no
+  // A static step that moves nothing is conclusive by itself (there is no
   // velocity to carry the state on), so two still steps in a row suffice.
   EquilibriumWindow window(options.equilibrium, std::min(options.equilibrium.window, 2));
   const EquilibriumOptions loose = loosened(options.equilibrium);
@@ -379,7 +379,7 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
       if (!direction.allFinite()) return LevelEnd::Diverged;
       // The energy's slope along the direction: its gradient is K p - f_p.
       const double slope = -(residual.array() * direction.array()).sum();
-      // NB: a Newton direction first tries the length the last one was
+      // A Newton direction first tries the length the last one was
       // accepted at: near an equilibrium the full step can raise the energy
       // step after step while a fraction of it is accepted, and the best
       // length changes slowly. After a still step the next starts at 1
@@ -405,7 +405,7 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
         // The next length is the lowest point of the parabola through the
         // energy here, its slope here and the energy at the rejected length,
         // kept within 0.1-0.5 of that length (safeguarded backtracking).
-        // NB: steps are often accepted at 1/8-1/16 of the Newton step, and
+        // Steps are often accepted at 1/8-1/16 of the Newton step, and
         // every trial is a whole closest-point search: plain halving would
         // take several trials to get there, the parabola's minimum fewer.
         const double rise = trialEnergy - energy - slope * tried;
@@ -560,7 +560,7 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
   ControlMesh mesh = initial;
   int initialIsolation = options.origin.isolation;  // -1 until the first level's surface sets it
   double timeStep = options.integrator.timeStep;
-  // NB: levels are held through pointers and built in place: Eigen 3.4's
+  // Levels are held through pointers and built in place: Eigen 3.4's
   // sparse matrices have no move, so moving a level would copy its tables.
   std::future<std::unique_ptr<LevelModel>> prepared;  // the next level's, when built ahead
   for (int level = options.origin.level;; ++level) {

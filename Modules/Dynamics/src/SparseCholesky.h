@@ -62,7 +62,7 @@ class SparseCholesky {
   }
 
  private:
-  // NB: Debian's CHOLMOD opens OpenMP parallel regions of up to four threads
+  // Debian's CHOLMOD opens OpenMP parallel regions of up to four threads
   // for small loops of its supernodal factorization. On two cores each one
   // wakes libgomp's threads and waits for them through the kernel, which
   // costs more than the loops themselves. OpenMP's max-active-levels 0 makes
@@ -70,7 +70,7 @@ class SparseCholesky {
   // factorizations run on several); DynSub itself uses no OpenMP.
   static void withoutOpenMpThreads() { omp_set_max_active_levels(0); }
 
-  // NB: one factorization or solve at a time in the process. CHOLMOD is
+  // One factorization or solve at a time in the process. CHOLMOD is
   // thread-safe, but the BLAS under it need not be: Debian's serial OpenBLAS
   // fails when two threads call it at once (`dynsub evaluate --jobs 2` runs
   // two segmentations in threads).

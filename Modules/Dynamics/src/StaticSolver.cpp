@@ -36,7 +36,7 @@ struct StaticSolver::Impl {
   // Steps to factor directly before trying the earlier factor again, and the
   // next such wait: it doubles with each failed try (up to 16 steps) and
   // returns to 1 after one that converged.
-  // NB: early in a fit, while H changes fast, the earlier factor seldom
+  // Early in a fit, while H changes fast, the earlier factor seldom
   // preconditions well enough, and each failed try costs its iterations on
   // top of the factorization; the growing wait keeps such tries few.
   int skip = 0, backoff = 1;
@@ -65,7 +65,7 @@ struct StaticSolver::Impl {
     }
     return false;
   }
-  // NB: a Newton direction need not be exact (the line search and the
+  // A Newton direction need not be exact (the line search and the
   // residual f_p - K p decide where the steps end), and from step to step H
   // changes little, so an earlier factor preconditions it well: a few
   // triangular solves instead of a new factorization, which at thousands of
@@ -146,7 +146,7 @@ MatrixX3 StaticSolver::direction(const std::vector<ForceModel*>& forces, const M
   double shift = 0.0;
   for (int attempt = 0;; ++attempt) {
     if (s.factor.factorize(h)) break;
-    // NB: K alone leaves translations free; forces that pin too little (a
+    // K alone leaves translations free; forces that pin too little (a
     // single spring, a field with no slope) leave H singular. A small shift
     // turns the step into a slightly damped one instead of failing.
     if (attempt == 3 || !(meanDiagonal > 0.0)) {

@@ -29,7 +29,7 @@ struct TangentStiffness::Impl {
   // addPoints' two threads take the columns below and from this one: where
   // the elements' blocks (i >= j, one per pair, counted in column j) are
   // split in half.
-  // NB: an element's smallest columns own most of its pairs (column c[j] of
+  // An element's smallest columns own most of its pairs (column c[j] of
   // m has m - j), so halving the columns by number would give the first
   // thread most of the sums.
   int splitColumn = 0;
@@ -76,7 +76,7 @@ struct TangentStiffness::Impl {
 
   // Adds each point's (w w^T) (x) B into the matrix's lower triangle, w its
   // position weights on its element's columns and B its block.
-  // NB: the sum for a block (c[i], c[j]) of an element is made over the
+  // The sum for a block (c[i], c[j]) of an element is made over the
   // element's points and added in at once, element after element in
   // increasing order. The columns are split in two halves, on two threads
   // when there are enough elements, so each value is summed by one thread
@@ -167,7 +167,7 @@ TangentStiffness::TangentStiffness(const LimitSurface& surface) : impl_(std::mak
   s.surface = &surface;
   s.vertices = surface.controlVertexCount();
   const int n = s.vertices;
-  // NB: only the lower triangle is stored: the factorization and the
+  // Only the lower triangle is stored: the factorization and the
   // conjugate gradients read no other, and the points' sums are added into
   // half as many values.
   const SymmetricMatrix pattern = SymmetricMatrix(elementPattern(surface).triangularView<Eigen::Lower>());

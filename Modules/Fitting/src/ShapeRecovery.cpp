@@ -58,7 +58,7 @@ double largestBias(const Eigen::VectorXd& signedDistances, const Eigen::MatrixXi
 
 FitError measureFitError(const LimitSurface& surface, const MatrixX3& controlPoints, const MatrixX3& data,
                          double diameter, const Eigen::MatrixXi* neighbours) {
-  // NB: 8 x 8 samples per control face, as the outputs (Tessellation.h):
+  // 8 x 8 samples per control face, as the outputs (Tessellation.h):
   // isolation's elements are a half or a quarter of a face on a side, and
   // 8 x 8 per element would make the locator's samples, and this
   // measurement, four or sixteen times as costly.

@@ -142,7 +142,7 @@ void writeNiftiLabelmap(const Mask& mask, std::uint8_t label, const std::string&
   if (mask.voxels.size() != count)
     throw Error(path, "internal: a mask of " + std::to_string(mask.voxels.size()) + " voxels on a grid of " +
                           std::to_string(count) + "; nothing written");
-  // NB: the header zeroed, the voxels written once (a vector's resize would
+  // The header zeroed, the voxels written once (a vector's resize would
   // zero them first), through plain pointers so that the loop vectorizes
   // (stores through unsigned char may alias anything, even a vector's own
   // members, which the compiler then reloads at every voxel).

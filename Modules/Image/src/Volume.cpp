@@ -49,7 +49,7 @@ Mask selectLabels(const Volume& labels, const std::vector<int>& values) {
   // A voxel has label L when its value rounds to L (halves away from zero,
   // as std::lround): for L > 0 the values [L - 1/2, L + 1/2), for L < 0
   // (L - 1/2, L + 1/2], for 0 (-1/2, 1/2).
-  // NB: compared as ranges rather than rounded voxel by voxel: lround and a
+  // Compared as ranges rather than rounded voxel by voxel: lround and a
   // search of the values per voxel were a tenth of the caudate demo's
   // command with its reference (7 million voxels).
   struct Range {

@@ -13,7 +13,7 @@ Mask voxelizeSurface(const MatrixX3& points, const std::vector<std::array<int, 3
   // Every edge must be shared by two triangles. The edges bucketed by their
   // lower point (a counting sort), each bucket's higher points sorted and
   // counted in runs: the first edge not shared by two is the lowest pair.
-  // NB: a std::map of the edges was three quarters of the voxelization
+  // A std::map of the edges was three quarters of the voxelization
   // (49 000 triangles for a segmentation's output), sorting them all a third.
   const Eigen::Index pointCount = points.rows();
   std::vector<int> bucketStart(static_cast<std::size_t>(pointCount) + 1, 0);

@@ -167,7 +167,7 @@ TEST_F(ViewerTest, TheSurfaceFitsLiveAndCanBePausedResetAndPulled) {
   input.image = phantom.image;
   input.landmarks = ballLandmarks(phantom, 20);
   input.landmarksPath = path_;
-  // NB: segment()'s 4 s step settles this ball within one redraw interval
+  // Segment()'s 4 s step settles this ball within one redraw interval
   // (40 ms) often enough that only the last surface is drawn; the papers'
   // shorter step keeps it moving long enough to be seen moving.
   input.segment.simulation.integrator.timeStep = 0.5;

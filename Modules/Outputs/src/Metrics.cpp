@@ -50,7 +50,7 @@ OverlapMetrics compareMasks(const Mask& a, const Mask& b) {
   m.jaccard = static_cast<double>(both) / (m.voxelsA + m.voxelsB - both);
   m.volumeDifferencePercent = 100.0 * (m.voxelsA - m.voxelsB) / m.voxelsB;
 
-  // NB: the surface distances only involve the two masks' boundaries, so they
+  // The surface distances only involve the two masks' boundaries, so they
   // are computed on the box around both, one voxel wider on every side
   // (clamped to the image): a mask voxel on that box's edge is then on the
   // image's edge too, so the boundaries are the same voxels, and the exact

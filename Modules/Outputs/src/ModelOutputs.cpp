@@ -73,7 +73,7 @@ void writeModelOutputs(const std::filesystem::path& dir, const ControlMesh& mesh
                        const Report& report, const std::function<void(OutputSet&)>& extra,
                        const std::vector<PointScalars>& surfaceScalars, const std::string& space) {
   OutputSet outputs(dir);
-  // NB: the model's files (surface.vtp, control_mesh.obj, report.json) are
+  // The model's files (surface.vtp, control_mesh.obj, report.json) are
   // written on a second thread while `extra` (a segmentation's labelmap, the
   // figures) writes on this one: compressing the surface and the labelmap
   // each take a sizeable share of a segmentation command. Only this thread

@@ -62,7 +62,7 @@ struct LaunchedServer {
 };
 
 // Forks and starts Xvfb; false, with `why`, when no pipe could be made.
-// NB: on the thread that will outlive the server's use (the main thread):
+// On the thread that will outlive the server's use (the main thread):
 // PR_SET_PDEATHSIG signals the child when the thread that forked it ends,
 // not the process.
 bool launchPrivateXServer(LaunchedServer& server, std::string* why) {

@@ -77,7 +77,7 @@ std::optional<ClickAppearance> ClickAppearance::learn(const Volume& image, const
     for (double v : outside) pOut[k] += std::exp(-0.5 * (x - v) * (x - v) / (width * width));
     pIn[k] /= static_cast<double>(inside.size());
     pOut[k] /= static_cast<double>(outside.size());
-    // NB: far from every sample both densities underflow to 0: no score there.
+    // Far from every sample both densities underflow to 0: no score there.
     const double total = pIn[k] + pOut[k];
     a.table_[k] = total > 0 ? (pIn[k] - pOut[k]) / total : 0.0;
     sumIn += pIn[k], sumOut += pOut[k];

@@ -221,7 +221,7 @@ struct LimitSurface::Impl {
   };
   // A special element's masks at its extraordinary vertex over its columns;
   // a structure's (below) also its subpatches, level by level.
-  // NB: levels are tabulated when a point first needs them, and points are
+  // Levels are tabulated when a point first needs them, and points are
   // evaluated from several threads at once (closest-point searches), so the
   // table grows under `mutex`. levels[n - 1] is written once, before
   // `tabulated` reaches n, and never moved (the vector is sized up front):
@@ -334,7 +334,7 @@ struct LimitSurface::Impl {
     for (int r = 0; r < 3; ++r) {
       for (const auto& [v, w] : *rows[r]) special.vertexMasks.row(r) += w * local.weights.row(v);
     }
-    // NB: the neighbourhood is carried as displacements from the limit point
+    // The neighbourhood is carried as displacements from the limit point
     // (every row minus the limit mask). Subdivision maps displacements to
     // displacements (rows of A sum to 1, and the limit point is invariant), and
     // they shrink like lambda^level, so their relative accuracy survives any
@@ -385,7 +385,7 @@ struct LimitSurface::Impl {
     element.structureMap = local.weights;
     element.columns = columns;
     element.special = static_cast<int>(specials.size());
-    // NB: the element keeps only its masks. Its subpatches are its
+    // The element keeps only its masks. Its subpatches are its
     // structure's times structureMap: subdivision is linear, and a structure's
     // displacements from its limit point, times the blends, are the element's
     // (the blends' rows sum to 1). Tabulated per element they would take
@@ -451,7 +451,7 @@ struct LimitSurface::Impl {
     const Topology& topology = *deep.topology;
     const Polygon& face = topology.face(deep.face);
     const int x = face[0];
-    // NB: the new 1-ring of x (x, and the corners of the faces at x) is made
+    // The new 1-ring of x (x, and the corners of the faces at x) is made
     // from the old 1-ring alone, so S is block triangular: the eigenvalues
     // that matter, and their left eigenvectors (zero off the 1-ring), are
     // those of S restricted to the 1-ring, a quarter of the work of the whole
@@ -564,7 +564,7 @@ struct LimitSurface::Impl {
   void weightsInto(const ElementPoint& point, SampleWeights& w, int rows = 6) const {
     checkPoint(point);
     const Element& element = elements[point.element];
-    // NB: lazyProduct: these products are too small for Eigen's blocked GEMM,
+    // LazyProduct: these products are too small for Eigen's blocked GEMM,
     // whose packing and allocation would dominate closest-point searches.
     auto product = [&](const Eigen::Matrix<double, 6, 16>& b, const auto& grid) {
       if (rows == 6) {
@@ -872,7 +872,7 @@ std::array<SparseMatrix, 6> assemble(const LimitSurface& surface, const WeightsI
   return result;
 }
 
-// NB: swap, not move: Eigen 3.4's SparseMatrix has no move constructor, and
+// Swap, not move: Eigen 3.4's SparseMatrix has no move constructor, and
 // std::move would copy every operator.
 LimitOperators toOperators(std::array<SparseMatrix, 6>& m) {
   LimitOperators result;
@@ -979,7 +979,7 @@ struct SurfaceState::Impl {
   // masks and the structure's vertices), each filled once under `mutex`. grids is sized once, on the
   // first fill, and never moved: a reader that sees ready[slot] set may read
   // that slot without the lock.
-  // NB: one subpatch at a time, not whole levels: where most elements are
+  // One subpatch at a time, not whole levels: where most elements are
   // special and hold few points, filling all three children costs more than
   // it saves.
   static constexpr int kSlots = 3 * kCachedLevels;
@@ -1021,7 +1021,7 @@ LimitSample SurfaceState::evaluate(const ElementPoint& point) const {
   s.checkPoint(point);
   const LimitSurface::Impl::Element& element = s.elements[point.element];
   if (element.type == ElementType::Normal) {
-    // NB: lazyProduct: Eigen sends the plain product to its blocked GEMM (a
+    // LazyProduct: Eigen sends the plain product to its blocked GEMM (a
     // grid block of a dynamic matrix has a runtime stride), whose packing
     // costs more than the 288 multiplications.
     return limitSampleOf(bicubicBsplineWeights(point.u, point.v)

@@ -224,7 +224,7 @@ Neighbourhood extractNeighbourhood(const Topology& topology, int x, int f) {
     return it != faces.end() && *it == g ? static_cast<int>(it - faces.begin()) : -1;
   };
 
-  // NB: the faces are ordered breadth-first across edges from f, each rotated
+  // The faces are ordered breadth-first across edges from f, each rotated
   // to begin where it was entered, and vertices numbered as first met. The
   // order then depends only on the mesh's structure around x, not on its
   // global numbering, so equal neighbourhoods (around every extraordinary

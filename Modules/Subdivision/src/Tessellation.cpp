@@ -42,7 +42,7 @@ TriangleSurface tessellate(const LimitSurface& surface, const MatrixX3& controlP
     return edgeBase + e * (n - 1) + fromFirst - 1;
   };
 
-  // NB: an element's (or subpatch's) 16 grid points are blended from the
+  // An element's (or subpatch's) 16 grid points are blended from the
   // control points once (SurfaceState), not at each of its (n + 1)^2
   // samples; equal to LimitSurface::evaluate to rounding.
   SurfaceState state(surface);

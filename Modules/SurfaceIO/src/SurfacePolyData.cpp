@@ -38,7 +38,7 @@ vtkSmartPointer<vtkPolyData> toPolyData(const TriangleSurface& surface) {
     normals->SetTuple3(i, surface.normals(i, 0), surface.normals(i, 1), surface.normals(i, 2));
   }
   vtkNew<vtkCellArray> triangles;
-  // NB: 32-bit point ids where they fit (always, below 2^31 points): the
+  // 32-bit point ids where they fit (always, below 2^31 points): the
   // connectivity and offsets were half of a fitted surface's bytes as 64-bit
   // ids, all to be compressed and written.
   if (surface.points.rows() < (Eigen::Index{1} << 31)) triangles->Use32BitStorage();

@@ -8,7 +8,7 @@
 namespace dynsub {
 
 // op * points in one pass over the operator, all three coordinates at once.
-// NB: Eigen 3.4 multiplies a sparse matrix by an N x 3 matrix one column at a
+// Eigen 3.4 multiplies a sparse matrix by an N x 3 matrix one column at a
 // time, three passes over the operator: this was measured 3 times as fast
 // (2.2 ms against 6.9 ms for 98 304 rows of 16), with the same sums in the
 // same order, so the same results to the bit.
@@ -114,7 +114,7 @@ void scatterAdd(const Eigen::SparseMatrix<double, Options>& op, const MatrixX3& 
 // op * points for a column-major operator (the physical matrices), in one
 // pass over it, all three coordinates at once. The same sums in the same
 // order as Eigen's op * points, which makes three passes, one per column.
-// NB: the energy's x^T K x and v^T M v at every time step were a twentieth
+// The energy's x^T K x and v^T M v at every time step were a twentieth
 // of a segmentation, most of it Eigen's three scattering passes.
 inline MatrixX3 applyOperator(const Eigen::SparseMatrix<double, Eigen::ColMajor>& op, const MatrixX3& points) {
   eigen_assert(op.cols() == points.rows());

@@ -16,7 +16,7 @@ namespace dynsub {
 // worth), at most one per hardware thread; on this thread alone when that is
 // 1 or less. Each item must be independent of the others, so that results do
 // not depend on the thread count.
-// NB: DynSub's own helper threads, which sleep between calls, instead of
+// DynSub's own helper threads, which sleep between calls, instead of
 // OpenMP: libgomp's workers spin-wait between parallel loops, which took a
 // third of the CPU time of a segmentation whose loops are mostly small.
 // The threads `items` independent pieces of per-point work (a closest-point
@@ -46,7 +46,7 @@ void waitForHelper(int helper);
 
 // An exception thrown by `body` is rethrown here once every thread has
 // ended: the first chunk's that threw, so the same one whatever the timing.
-// NB: chunks go to the waiting helper threads (detail::startOnHelper), or,
+// Chunks go to the waiting helper threads (detail::startOnHelper), or,
 // when another caller has them busy, to threads started for the call:
 // starting a thread took 50-100 us on this virtual machine, and the implicit
 // step, about a millisecond, split its solves in two twice per step.
@@ -78,7 +78,7 @@ void parallelFor(Eigen::Index count, Eigen::Index threadsWorthIt, const Body& bo
       helpers.push_back(helper);
       continue;
     }
-    // NB: nothing may leave this loop by an exception while helpers run
+    // Nothing may leave this loop by an exception while helpers run
     // `run`, which lives on this frame.
     try {
       workers.emplace_back([&run, t] { run(t); });

@@ -41,7 +41,7 @@
 // left-hand matrix refactored), up to the step asked for. A level that then
 // diverges at a regrown step restarts at the step it started with, and grows
 // no more to half of the step that diverged, or beyond.
-// NB: a step left halved for the rest of the simulation can make a level too
+// A step left halved for the rest of the simulation can make a level too
 // slow to settle within maxSteps (Documentation/Segmentation.md, "The time
 // step after a divergence").
 #include <functional>
