@@ -191,7 +191,7 @@ void runFit(FitCommandOptions o) {
   }
   // Said only where taking the scatter for noise would have changed the fit.
   if (measured && stated < 0.0 && noise.sigma == 0.0 &&
-      100.0 * noiseReach(data.rows()) * noise.scatter / diameter >= 0.5 * o.fit.tolerancePercent) {
+      noiseLimits(data.rows(), noise.scatter, diameter, o.fit.tolerancePercent)) {
     std::cout << "the points' scatter about their neighbours' surface grows from "
               << 100.0 * noise.scatterFew / diameter << " % with " << kNoiseNeighboursFew << " neighbours to "
               << 100.0 * noise.scatter / diameter << " % with " << kNoiseNeighbours

@@ -40,6 +40,10 @@ double noiseReach(Eigen::Index points) {
   return std::sqrt(2.0 * std::log(static_cast<double>(std::max<Eigen::Index>(points, 2))));
 }
 
+bool noiseLimits(Eigen::Index points, double noise, double diameter, double tolerancePercent) {
+  return points > kBiasNeighbours && 100.0 * noiseReach(points) * noise / diameter >= 0.5 * tolerancePercent;
+}
+
 namespace {
 
 // The largest mean of the signed distances over a point and its
@@ -97,8 +101,7 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
   FitResult result;
   result.enclosingSphere = smallestEnclosingSphere(data);
   const double diameter = 2.0 * result.enclosingSphere.radius;
-  result.noiseLimited = data.rows() > kBiasNeighbours &&
-                        100.0 * noiseReach(data.rows()) * options.noise / diameter >= 0.5 * options.tolerancePercent;
+  result.noiseLimited = noiseLimits(data.rows(), options.noise, diameter, options.tolerancePercent);
   const Eigen::MatrixXi neighbours =
       result.noiseLimited ? nearestNeighbours(data, kBiasNeighbours) : Eigen::MatrixXi();
   const auto met = [&](const FitError& e) {

@@ -116,6 +116,10 @@ struct FitResult {
 
 // sqrt(2 ln n): about how many sigmas the largest of n Gaussian distances reaches.
 double noiseReach(Eigen::Index points);
+// Whether noise of `noise` mm on `points` points puts tolerancePercent (of
+// `diameter`) out of reach of the max error, and the bias rule applies
+// (see above).
+bool noiseLimits(Eigen::Index points, double noise, double diameter, double tolerancePercent);
 
 // neighbours (optional, #data x k >= kBiasNeighbours): each point's nearest
 // others, for the bias.
