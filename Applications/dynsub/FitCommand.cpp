@@ -215,7 +215,7 @@ void addFitCommand(CLI::App& app) {
       "the smallest sphere enclosing the data).\n"
       "Writes DIR/surface.vtp, DIR/control_mesh.obj, DIR/report.json, DIR/convergence.csv and the figures "
       "DIR/slices.png, DIR/surface3d.png and DIR/convergence.png (or .pdf, .svg: --figure-format).");
-  command->add_option("POINTS", o->points, "Point cloud: .xyz/.txt, .csv, .ply, .off, .obj or .vtp (mm)")
+  command->add_option("POINTS", o->points, "Point cloud: .xyz/.txt/.pwn, .csv, .ply, .off, .obj or .vtp (mm)")
       ->required();
   command->add_option("--out", o->out, "Output directory (created if missing; its parent must exist)")->required();
   command->add_option("--init", o->init,

@@ -70,6 +70,13 @@ sys.exit(0 if ok else 1)" "$work/fit/report.json" "$work/fit_eq/report.json"
 awk 'NR <= 120 { print $1 "," $2 "," $3 }' "$work/sphere.xyz" | sed '1i x,y,z' >"$work/sphere.csv"
 "$DYNSUB" fit "$work/sphere.csv" --out "$work/fitcsv" --max-level 0 >/dev/null 2>&1
 check "fit reads .csv with a header" test -s "$work/fitcsv/report.json"
+# Points with normals (.pwn): x y z nx ny nz per line; the normals are not used.
+awk 'NR <= 120 { print $1, $2, $3, ($1 - 5) / 30, ($2 + 2) / 30, ($3 - 7) / 30 }' \
+  "$work/sphere.xyz" >"$work/sphere.pwn"
+"$DYNSUB" fit "$work/sphere.pwn" --out "$work/fitpwn" --max-level 0 --no-figures >/dev/null 2>&1
+check "fit reads .pwn, all 120 points" python3 -c "
+import json, sys
+sys.exit(0 if json.load(open(sys.argv[1]))['points'] == 120 else 1)" "$work/fitpwn/report.json"
 
 printf '1 2 3\n4 5 6\n7 8 9.5\n' >"$work/three.xyz"
 expect_error "too few points" 1 "at least 4" "$work/o1" "$DYNSUB" fit "$work/three.xyz" --out "$work/o1"

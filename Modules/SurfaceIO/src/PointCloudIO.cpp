@@ -110,7 +110,7 @@ MatrixX3 readVtp(const std::string& path) {
 MatrixX3 readPointCloud(const std::string& path) {
   if (!std::filesystem::exists(path)) throw Error(path, "no such file");
   const std::string extension = lowerCaseExtension(path);
-  if (extension == ".xyz" || extension == ".txt") return readText(path, false);
+  if (extension == ".xyz" || extension == ".txt" || extension == ".pwn") return readText(path, false);
   if (extension == ".csv") return readText(path, true);
   if (extension == ".vtp") return readVtp(path);
   if (extension == ".ply" || extension == ".off" || extension == ".obj") {
@@ -119,7 +119,7 @@ MatrixX3 readPointCloud(const std::string& path) {
     return points;
   }
   throw Error(path, "unknown point-cloud format '" + extension +
-                        "' (expected .xyz, .txt, .csv, .ply, .off, .obj or .vtp)");
+                        "' (expected .xyz, .txt, .pwn, .csv, .ply, .off, .obj or .vtp)");
 }
 
 }  // namespace dynsub

@@ -1,7 +1,8 @@
 #pragma once
 // Point clouds (range data, landmarks as points) in mm, read by extension:
-//   .xyz, .txt  one point per line, the first three whitespace-separated
-//               numbers (more columns, e.g. normals, are ignored); '#' comments
+//   .xyz, .txt, .pwn  one point per line, the first three whitespace-separated
+//               numbers (more columns, e.g. the normals of .pwn, points with
+//               normals, are ignored); '#' comments
 //   .csv        comma- or semicolon-separated, the first three columns; one
 //               header line of names is skipped
 //   .ply .off .obj  the vertices (faces, if any, are ignored)
