@@ -75,8 +75,10 @@ void assembleMatrices(LevelModel& model, double elasticity, const SimulationOpti
   model.elasticity = elasticity;
 }
 
-// initialIsolation < 0: `mesh` is the initial model, and sets it.
-LevelModel buildLevel(const ControlMesh& mesh, int level, int& initialIsolation, const SimulationOptions& options) {
+// initialIsolation < 0: `mesh` is the initial model, and sets it. `relaxed`:
+// the relaxations the level has had already (LevelOrigin).
+LevelModel buildLevel(const ControlMesh& mesh, int level, int relaxed, int& initialIsolation,
+                      const SimulationOptions& options) {
   LevelModel model{level, std::make_shared<const LimitSurface>(mesh), {}, {}, {}, 0.0};
   if (initialIsolation < 0) initialIsolation = model.surface->isolationLevels();
   // Element sides are measured in elements of the initial model: a base mesh
@@ -85,7 +87,7 @@ LevelModel buildLevel(const ControlMesh& mesh, int level, int& initialIsolation,
   // The matrices and the quadrature are independent (the surface's
   // tables are safe to fill from two threads), and each is a sizeable share
   // of a level, so they are built side by side.
-  bothAtOnce([&] { assembleMatrices(model, std::pow(options.elasticityPerLevel, level), options); },
+  bothAtOnce([&] { assembleMatrices(model, std::pow(options.elasticityPerLevel, level + relaxed), options); },
              [&] {
                SurfaceQuadrature built =
                    makeSurfaceQuadrature(*model.surface, options.quadraturePoints, model.elementSize);
@@ -525,9 +527,10 @@ void checkSimulationOptions(const SimulationOptions& o) {
   }
   if (o.maxLevel < 0 || o.maxLevel > 6) throw Error("the maximum level must be in 0..6, got " + std::to_string(o.maxLevel));
   if (o.origin.level < 0 || o.origin.level > o.maxLevel || o.origin.isolation < -1 ||
-      (o.origin.level > 0 && o.origin.isolation < 0)) {
+      (o.origin.level > 0 && o.origin.isolation < 0) || o.origin.relaxed < 0) {
     throw Error("the initial mesh's level must be in 0..maximum level (" + std::to_string(o.maxLevel) + "), got " +
-                std::to_string(o.origin.level) + " (isolation " + std::to_string(o.origin.isolation) + ")");
+                std::to_string(o.origin.level) + " (isolation " + std::to_string(o.origin.isolation) +
+                ", relaxations " + std::to_string(o.origin.relaxed) + ")");
   }
   if (o.maxTimeStepHalvings < 0) throw Error("time-step halvings must be >= 0");
   if (o.timeStepRegrowth < 0) throw Error("the time step's regrowth must be >= 0 steps (0: none)");
@@ -566,15 +569,19 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
   for (int level = options.origin.level;; ++level) {
     auto started = std::chrono::steady_clock::now();
     const bool wasPrepared = prepared.valid();
+    // Only the level a refit starts at has been relaxed before; a prepared
+    // level is never that one.
+    const int relaxedBefore = level == options.origin.level ? options.origin.relaxed : 0;
     const std::unique_ptr<LevelModel> built =
         wasPrepared ? prepared.get()
-                    : std::unique_ptr<LevelModel>(new LevelModel(buildLevel(mesh, level, initialIsolation, options)));
+                    : std::unique_ptr<LevelModel>(
+                          new LevelModel(buildLevel(mesh, level, relaxedBefore, initialIsolation, options)));
     if (wasPrepared) setStart(*built, mesh.points());
     if (options.prepareNextLevel && level < options.maxLevel) {
       // The refined topology does not depend on where this level ends.
       prepared = std::async(std::launch::async, [next = subdivide(mesh).mesh, level, initialIsolation, &options] {
         int isolation = initialIsolation;
-        return std::unique_ptr<LevelModel>(new LevelModel(buildLevel(next, level + 1, isolation, options)));
+        return std::unique_ptr<LevelModel>(new LevelModel(buildLevel(next, level + 1, 0, isolation, options)));
       });
     }
     // A level refused as close is first run on with weaker elasticity
@@ -592,8 +599,9 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
           }
           return verdict;
         };
-    for (int relaxed = 0;; ++relaxed) {
-      if (relaxed > 0) {
+    int relaxed = relaxedBefore;
+    for (;; ++relaxed) {
+      if (relaxed > relaxedBefore) {
         started = std::chrono::steady_clock::now();
         assembleMatrices(model, model.elasticity * options.elasticityPerLevel, options);
         setStart(model, mesh.points());
@@ -622,7 +630,7 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
     }
     const bool good = verdict != FitVerdict::Refine && verdict != FitVerdict::Relax;
     if (good || lastLevel) {
-      result.origin = {level, initialIsolation};
+      result.origin = {level, initialIsolation, relaxed};
       result.surface = model.surface;
       break;
     }

@@ -140,6 +140,46 @@ TEST(StaticScheme, ALevelRefusedAsCloseRelaxesBeforeItIsRefined) {
   }
 }
 
+// A result whose level was relaxed says so in its origin, and a refit from it
+// continues at the relaxed elasticity with only the relaxations left: with
+// none left, a Relax verdict ends the refit at its one level, where a fresh
+// fit from the same mesh would have run on with the elasticity weakened.
+TEST(StaticScheme, ARefitContinuesAtItsOriginsRelaxedElasticity) {
+  const ControlMesh cube = makeCube98();
+  const LimitSurface surface(cube);
+  const MatrixX3 targets = tessellate(surface, cube.points(), 1).points * 1.2;
+  SpringForceModel springs(targets, Eigen::VectorXd::Constant(targets.rows(), 1.0),
+                           SpringForceModel::Attach::NearestEachStep);
+  const SimulationOptions options = relaxingOptions(0, 1);
+  int asked = 0;
+  const AcceptFit relaxOnce = [&](const LimitSurface&, const MatrixX3&, FitAsk when) {
+    if (when != FitAsk::LevelEnd) return FitVerdict::Settle;
+    return ++asked == 1 ? FitVerdict::Relax : FitVerdict::Settle;
+  };
+  const SimulationResult first = simulate(cube, {&springs}, {}, options, relaxOnce);
+  ASSERT_EQ(first.levels.size(), 2u);
+  EXPECT_EQ(first.origin.level, 0);
+  EXPECT_EQ(first.origin.relaxed, 1);
+
+  const AcceptFit alwaysRelax = [](const LimitSurface&, const MatrixX3&, FitAsk when) {
+    return when == FitAsk::LevelEnd ? FitVerdict::Relax : FitVerdict::Settle;
+  };
+  SimulationOptions refit = options;
+  refit.origin = first.origin;
+  const SimulationResult again = simulate(first.mesh, {&springs}, {}, refit, alwaysRelax);
+  ASSERT_EQ(again.levels.size(), 1u);
+  EXPECT_EQ(again.levels[0].elasticity, 0.25);
+  EXPECT_EQ(again.origin.relaxed, 1);
+
+  const SimulationResult fresh = simulate(first.mesh, {&springs}, {}, options, alwaysRelax);
+  ASSERT_EQ(fresh.levels.size(), 2u);
+  EXPECT_EQ(fresh.levels[0].elasticity, 1.0);
+  EXPECT_EQ(fresh.levels[1].elasticity, 0.25);
+
+  refit.origin.relaxed = -1;
+  EXPECT_THROW(simulate(first.mesh, {&springs}, {}, refit, alwaysRelax), Error);
+}
+
 // The last level, with a relaxation left, is asked at the looser rule too
 // (FitAsk::LastLevelLooseRule): Relax ends it there and runs it on with
 // weaker elasticity; Refine, with no level left to refine into, lets it go

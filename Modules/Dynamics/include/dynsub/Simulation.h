@@ -72,10 +72,13 @@ struct EquilibriumOptions {
 // A control mesh's place in a multilevel fit: `level` global refinements of
 // the initial model, whose patches needed `isolation` levels to isolate its
 // extraordinary vertices (LimitSurface::isolationLevels; -1: the mesh is the
-// initial model itself).
+// initial model itself), and the relaxations its level had run
+// (SimulationOptions::relaxations): a refit continues at their weaker
+// elasticity, with only the relaxations left.
 struct LevelOrigin {
   int level = 0;
   int isolation = -1;
+  int relaxed = 0;
 };
 
 struct SimulationOptions {
