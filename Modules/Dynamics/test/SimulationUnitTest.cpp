@@ -87,11 +87,16 @@ INSTANTIATE_TEST_SUITE_P(
 INSTANTIATE_TEST_SUITE_P(StaticScheme, PureSpringTest,
                          ::testing::Values(std::make_tuple(IntegrationScheme::Static, LinearSolver::Cholesky)));
 
+// Points on the limit surface of `mesh`, scaled 1.2-fold about the origin (the
+// cube's centre): targets the surface moves out to.
+MatrixX3 liftedTargets(const ControlMesh& mesh) {
+  return tessellate(LimitSurface(mesh), mesh.points(), 1).points * 1.2;
+}
+
 // A fixed control vertex stays exactly where it was under the static scheme.
 TEST(StaticScheme, FixedVerticesStay) {
   const ControlMesh cube = makeCube98();
-  const LimitSurface surface(cube);
-  MatrixX3 targets = tessellate(surface, cube.points(), 1).points * 1.2;
+  const MatrixX3 targets = liftedTargets(cube);
   SpringForceModel springs(targets, Eigen::VectorXd::Constant(targets.rows(), 1.0),
                            SpringForceModel::Attach::NearestEachStep);
   SimulationOptions options;
@@ -117,8 +122,7 @@ SimulationOptions relaxingOptions(int maxLevel, int relaxations) {
 // left; refused outright (Refine), or with none left, it is refined.
 TEST(StaticScheme, ALevelRefusedAsCloseRelaxesBeforeItIsRefined) {
   const ControlMesh cube = makeCube98();
-  const LimitSurface surface(cube);
-  const MatrixX3 targets = tessellate(surface, cube.points(), 1).points * 1.2;
+  const MatrixX3 targets = liftedTargets(cube);
   for (const auto& [first, relaxations, secondVertices, secondElasticity] :
        {std::make_tuple(FitVerdict::Relax, 1, 98, 0.25), std::make_tuple(FitVerdict::Relax, 0, 386, 0.25),
         std::make_tuple(FitVerdict::Refine, 1, 386, 0.25)}) {
@@ -146,8 +150,7 @@ TEST(StaticScheme, ALevelRefusedAsCloseRelaxesBeforeItIsRefined) {
 // fit from the same mesh would have run on with the elasticity weakened.
 TEST(StaticScheme, ARefitContinuesAtItsOriginsRelaxedElasticity) {
   const ControlMesh cube = makeCube98();
-  const LimitSurface surface(cube);
-  const MatrixX3 targets = tessellate(surface, cube.points(), 1).points * 1.2;
+  const MatrixX3 targets = liftedTargets(cube);
   SpringForceModel springs(targets, Eigen::VectorXd::Constant(targets.rows(), 1.0),
                            SpringForceModel::Attach::NearestEachStep);
   const SimulationOptions options = relaxingOptions(0, 1);
@@ -186,8 +189,7 @@ TEST(StaticScheme, ARefitContinuesAtItsOriginsRelaxedElasticity) {
 // on to the full rule.
 TEST(StaticScheme, TheLastLevelRelaxesAtTheLooserRule) {
   const ControlMesh cube = makeCube98();
-  const LimitSurface surface(cube);
-  const MatrixX3 targets = tessellate(surface, cube.points(), 1).points * 1.2;
+  const MatrixX3 targets = liftedTargets(cube);
   for (const FitVerdict answer : {FitVerdict::Relax, FitVerdict::Refine}) {
     SpringForceModel springs(targets, Eigen::VectorXd::Constant(targets.rows(), 1.0),
                              SpringForceModel::Attach::NearestEachStep);
