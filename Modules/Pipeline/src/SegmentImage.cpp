@@ -81,6 +81,7 @@ Report sliceEndsReport(const SliceEnds& ends) {
     r.set("from_lps_mm", end.start);
     r.set("to_lps_mm", end.end);
     r.set("length_mm", end.length);
+    r.set("window", std::vector<double>{end.low, end.high});
     r.set("stopped_by_reach", end.stoppedByReach);
     r.set("tapered", end.tapered);
     r.set("pressure", end.pressed);

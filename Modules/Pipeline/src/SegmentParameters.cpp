@@ -157,6 +157,10 @@ std::vector<Parameter> table() {
   taper.opposite = Parameter::Opposite{"sliceEndsWithoutTaper", "No taper springs",
                                        "Only the springs at the ends, none halfway to them."};
   add(taper);
+  add(row("slice_ends_end_level", "End level", "", "Slice ends",
+       "How far the march's window moves from the initial model's median intensity to the end slice's own "
+       "(0: not at all, 1: centred on the end's; where the two are within the window of each other)",
+       [](P& p) -> double& { return p.segment.sliceEnds.endLevel; }, 0, 1, 0.1));
   add(row("slice_ends_spring_at_reach", "Spring at reach", "", "Slice ends",
        "A spring also where the march ended at its reach, not at an intensity change",
        [](P& p) -> bool& { return p.segment.sliceEnds.springAtReach; }));

@@ -68,6 +68,7 @@ void checkSliceEndOptions(const SliceEndOptions& o) {
     if (!(value > 0) || !std::isfinite(value))
       throw Error(std::string("the slice ends' ") + name + " must be a finite number > 0");
   if (!(o.gap >= 0) || !std::isfinite(o.gap)) throw Error("the slice ends' gap must be a finite number >= 0");
+  if (!(o.endLevel >= 0 && o.endLevel <= 1)) throw Error("the slice ends' end level must be a number in [0, 1]");
   if (!(o.pressure >= 0) || !std::isfinite(o.pressure))
     throw Error("the pressure beyond the end slices must be a finite number >= 0");
 }
@@ -89,8 +90,7 @@ SliceEnds findSliceEnds(const Volume& image, const std::vector<Landmark>& landma
   result.median = inside->median;
   result.spread = inside->spread;
   if (!(inside->spread > 0) || !std::isfinite(inside->median)) return result;
-  const double low = inside->median - options.window * inside->spread;
-  const double high = inside->median + options.window * inside->spread;
+  const double halfWidth = options.window * inside->spread;
 
   double first = index[0](axis), last = index[0](axis);
   for (const Vector3& p : index) {
@@ -139,12 +139,26 @@ SliceEnds findSliceEnds(const Volume& image, const std::vector<Landmark>& landma
       end.sliceRadius = std::max(end.sliceRadius, across.norm());
     }
     const double longest = options.reach * span;
+    double level = inside->median;
+    if (options.endLevel > 0) {
+      std::vector<double> own;
+      for (int k = 0; k < 3; ++k) {
+        const double m = diskMedian(image, centre - outward * k * step * along, u, v, radius, step);
+        if (std::isfinite(m)) own.push_back(m);
+      }
+      if (!own.empty()) {
+        const double median = robustStatistics(std::move(own)).median;
+        if (std::abs(median - inside->median) <= halfWidth) level += options.endLevel * (median - inside->median);
+      }
+    }
+    end.low = level - halfWidth;
+    end.high = level + halfWidth;
     int outside = 0;
     double reached = 0;
     for (double t = step; t <= longest; t += step) {
       const double m = diskMedian(image, centre + outward * t * along, u, v, radius, step);
       if (!std::isfinite(m)) break;
-      if (m < low || m > high) {
+      if (m < end.low || m > end.high) {
         if (++outside == 2) break;
       } else {
         outside = 0;

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <random>
 
@@ -25,8 +26,16 @@ struct Cigar {
   bool inside(const Vector3& x) const { return (x - centre).cwiseQuotient(axes).squaredNorm() <= 1.0; }
 };
 
+// The intensities of a voxel inside and outside the structure at a point
+// (before partial volume and noise).
+struct Tissue {
+  std::function<double(const Vector3&)> inside = [](const Vector3&) { return 100.0; };
+  std::function<double(const Vector3&)> outside = [](const Vector3&) { return 20.0; };
+  double noise = 10.0;
+};
+
 // `sliceMm`: the voxels' size along y (61 mm of it).
-Volume cigarImage(const Cigar& shape, Mask* truth, int sliceMm = 1) {
+Volume cigarImage(const Cigar& shape, Mask* truth, int sliceMm = 1, const Tissue& tissue = Tissue()) {
   Volume image;
   ImageGeometry& g = image.geometry;
   g.size = {41, 60 / sliceMm + 1, 41};
@@ -36,7 +45,7 @@ Volume cigarImage(const Cigar& shape, Mask* truth, int sliceMm = 1) {
   truth->geometry = g;
   truth->voxels.resize(g.voxelCount());
   std::mt19937_64 random(5);
-  std::normal_distribution<double> noise(0.0, 10.0);
+  std::normal_distribution<double> noise(0.0, tissue.noise);
   for (int k = 0; k < g.size[2]; ++k)
     for (int j = 0; j < g.size[1]; ++j)
       for (int i = 0; i < g.size[0]; ++i) {
@@ -45,7 +54,10 @@ Volume cigarImage(const Cigar& shape, Mask* truth, int sliceMm = 1) {
           const Vector3 offset((c % 4 + 0.5) / 4 - 0.5, ((c / 4) % 4 + 0.5) / 4 - 0.5, (c / 16 + 0.5) / 4 - 0.5);
           in += shape.inside(g.toPhysical(Vector3(i, j, k) + offset));
         }
-        image.voxels[g.offset(i, j, k)] = static_cast<float>(20.0 + 80.0 * in / 64.0 + noise(random));
+        const Vector3 x = g.toPhysical(Vector3(i, j, k));
+        const double share = in / 64.0;
+        image.voxels[g.offset(i, j, k)] =
+            static_cast<float>((1 - share) * tissue.outside(x) + share * tissue.inside(x) + noise(random));
         truth->voxels[g.offset(i, j, k)] = shape.inside(g.toPhysical(Vector3(i, j, k)));
       }
   return image;
@@ -136,6 +148,43 @@ TEST(SliceEnds, NoSpringWhereTheMarchFoundNoEnd) {
   EXPECT_TRUE(ends.springs.empty());
   options.springAtReach = true;
   EXPECT_EQ(findSliceEnds(image, landmarks, initialFromLandmarks(landmarks), options).springs.size(), 14u);
+}
+
+// A structure whose intensity drifts along it (the cigar darkens from 120
+// at y = -20 mm to 80 at +20 mm, noise 4), with like tissue (109) going on
+// past its +y tip within 8 mm of its axis. About the whole structure's
+// median (100 +- 15 on the clicked span) the march from the last clicked
+// slice (y = +12, about 88) leaves the window within a few mm, where the
+// cigar darkens past 85, well short of the tip; about the end's own level
+// it follows the cigar to its tip and stops at the brighter tissue beyond.
+TEST(SliceEnds, TheWindowFollowsTheEndsOwnLevel) {
+  const Cigar shape;
+  Tissue tissue;
+  tissue.inside = [&](const Vector3& x) { return 100.0 - (x.y() - shape.centre.y()); };
+  tissue.outside = [&](const Vector3& x) {
+    const Vector3 d = x - shape.centre;
+    return d.y() > 0 && std::hypot(d.x(), d.z()) < 8 ? 109.0 : 20.0;
+  };
+  tissue.noise = 4.0;
+  Mask truth;
+  const Volume image = cigarImage(shape, &truth, 1, tissue);
+  const std::vector<Landmark> landmarks = clicks(shape, 6);
+  const Vector3 tip = shape.centre + Vector3(0, 20, 0);
+  SliceEndOptions options;
+  options.reach = 0.6;  // 14.4 mm, past the tip 8 mm beyond the last clicked slice
+  options.endLevel = 0;
+  const SliceEnds whole = findSliceEnds(image, landmarks, initialFromLandmarks(landmarks), options);
+  ASSERT_EQ(whole.ends.size(), 2u);
+  EXPECT_GT((whole.ends[1].end - tip).norm(), 3.0) << whole.ends[1].end.transpose();
+  options.endLevel = 1;
+  const SliceEnds own = findSliceEnds(image, landmarks, initialFromLandmarks(landmarks), options);
+  ASSERT_EQ(own.ends.size(), 2u);
+  EXPECT_LT(own.ends[1].low, 80.0);
+  EXPECT_LT(own.ends[1].high, 109.0);
+  EXPECT_FALSE(own.ends[1].stoppedByReach);
+  EXPECT_LT((own.ends[1].end - tip).norm(), 2.0) << own.ends[1].end.transpose();
+  // The other end, past which the tissue is unlike, is found either way.
+  EXPECT_FALSE(whole.ends[0].stoppedByReach || own.ends[0].stoppedByReach);
 }
 
 // The cigar segmented from clicks on its 5 middle slices, and its Dice.
@@ -360,7 +409,8 @@ TEST(SliceEnds, RefusesImpossibleOptions) {
                    +[](SliceEndOptions& o) { o.disk = std::nan(""); },
                    +[](SliceEndOptions& o) { o.stiffness = 0; }, +[](SliceEndOptions& o) { o.gap = -0.5; },
                    +[](SliceEndOptions& o) { o.pressure = -0.1; },
-                   +[](SliceEndOptions& o) { o.pressure = std::nan(""); }}) {
+                   +[](SliceEndOptions& o) { o.pressure = std::nan(""); },
+                   +[](SliceEndOptions& o) { o.endLevel = 1.5; }, +[](SliceEndOptions& o) { o.endLevel = -0.1; }}) {
     SliceEndOptions options;
     bad(options);
     EXPECT_THROW(checkSliceEndOptions(options), Error);
