@@ -21,10 +21,11 @@
 //     the two steps inward from it (where e lies within m +- window s; else
 //     c is m). A structure's intensity drifts along it (a putamen's head is
 //     darker than its middle): a window about the whole structure's median
-//     can hold the tissue past a dark end, or leave out the end itself. Experts leave some 10-20 % of a
-//     structure unclicked at each end, but the clicked span is shorter than
-//     the slices' coverage: three slices over 60 % of a caudate span 40 %
-//     of it, and its head reaches a clicked span beyond the last one.
+//     can hold the tissue past a dark end, or leave out the end itself.
+//     Experts leave some 10-20 % of a structure unclicked at each end, but
+//     the clicked span is shorter than the slices' coverage: three slices
+//     over 60 % of a caudate span 40 % of it, and its head reaches a
+//     clicked span beyond the last one.
 //  4. Where the march went more than `gap` mm and stopped at a change of
 //     intensity (not at its reach, where it found no end: the structure may
 //     go on in like tissue, as a cerebellar hemisphere does across the
