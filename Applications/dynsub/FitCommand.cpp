@@ -58,9 +58,10 @@ ControlMesh chooseInitialModel(const FitCommandOptions& o, const MatrixX3& data)
   return mesh;
 }
 
-// --noise: "auto" or a number of mm >= 0.
+// --noise: "auto", "measure" or a number of mm >= 0 (returned; -1 for the
+// others).
 double statedNoise(const std::string& text) {
-  if (text == "auto") return -1.0;
+  if (text == "auto" || text == "measure") return -1.0;
   double value = 0.0;
   size_t used = 0;
   try {
@@ -69,20 +70,27 @@ double statedNoise(const std::string& text) {
     used = 0;
   }
   if (used != text.size() || !std::isfinite(value) || value < 0.0) {
-    throw CLI::ValidationError("--noise", "expected auto or a number of mm >= 0, got '" + text + "'");
+    throw CLI::ValidationError("--noise", "expected auto, measure or a number of mm >= 0, got '" + text + "'");
   }
   return value;
 }
 
 void runFit(FitCommandOptions o) {
   const double stated = statedNoise(o.noise);
-  const MatrixX3 scan = readPointCloud(o.points);
+  const PointCloud input = readPointCloud(o.points);
+  const MatrixX3& scan = input.points;
   checkPointCloud(scan, o.points);
-  const MatrixX3 reference = o.reference.empty() ? MatrixX3() : readPointCloud(o.reference);
+  const MatrixX3 reference = o.reference.empty() ? MatrixX3() : readPointCloud(o.reference).points;
   if (!o.reference.empty()) checkPointCloud(reference, o.reference);
+  // A mesh's vertices are where its maker put the surface: their scatter
+  // about their neighbours' quadric is the mesh's own detail, which the fit
+  // is asked to follow, and no vertex is an outlier. Taken for noise, that
+  // detail would end the fit by the bias rule (ShapeRecovery.h) short of the
+  // tolerance.
+  const bool exactVertices = input.meshVertices && o.noise != "measure";
   // The scan's own noise and outliers (ScanNoise.h), unless both are stated.
   ScanNoise noise;
-  const bool measured = scan.rows() > kNoiseNeighbours && (stated < 0.0 || !o.keepOutliers);
+  const bool measured = !exactVertices && scan.rows() > kNoiseNeighbours && (stated < 0.0 || !o.keepOutliers);
   if (measured) noise = estimateScanNoise(scan);
   if (stated >= 0.0) noise.sigma = stated;
   if (o.keepOutliers) noise.outliers.clear();
@@ -128,6 +136,7 @@ void runFit(FitCommandOptions o) {
   noiseReport.set("sigma_percent", 100.0 * noise.sigma / diameter);
   noiseReport.set("reach_percent", 100.0 * noiseReach(data.rows()) * noise.sigma / diameter);
   noiseReport.set("estimated", measured && stated < 0.0);
+  noiseReport.set("mesh_vertices_exact", exactVertices);
   if (measured) {
     noiseReport.set("scatter_percent", 100.0 * noise.scatter / diameter);
     noiseReport.set("scatter_few_percent", 100.0 * noise.scatterFew / diameter);
@@ -197,6 +206,10 @@ void runFit(FitCommandOptions o) {
               << 100.0 * noise.scatter / diameter << " % with " << kNoiseNeighbours
               << ": it is the shape's detail at this sampling, not noise, and the scan was fitted as clean data\n";
   }
+  if (exactVertices && stated < 0.0) {
+    std::cout << "the points are a mesh's vertices, taken as exact: no noise and no outliers (--noise measure "
+                 "measures their scatter)\n";
+  }
   if (!noise.outliers.empty()) std::cout << "set aside " << noise.outliers.size() << " outlier(s)\n";
   std::cout
             << "wrote " << (dir / "surface.vtp").string() << ", control_mesh.obj, report.json, convergence.csv"
@@ -240,8 +253,10 @@ void addFitCommand(CLI::App& app) {
       ->check(nonNegativeNumber());
   command->add_option("--noise", o->noise,
                       "The scan's noise: auto (measured from the points' scatter about their neighbours' local "
-                      "surface) or its standard deviation in mm (0: clean data). When the noise puts the tolerance "
-                      "out of reach of the max error, the fit holds the surface's bias to it instead")
+                      "surface; a mesh's vertices, read from a file with faces, are taken as exact, with no noise "
+                      "and no outliers), measure (measured, for a mesh too) or its standard deviation in mm (0: "
+                      "clean data). When the noise puts the tolerance out of reach of the max error, the fit holds "
+                      "the surface's bias to it instead")
       ->default_val("auto");
   command->add_flag("--keep-outliers", o->keepOutliers,
                     "Fit every point; by default points far off their neighbours' local surface are set aside");

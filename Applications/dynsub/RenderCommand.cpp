@@ -38,7 +38,7 @@ void runRender(const RenderCommandOptions& o) {
     inputs.image = image.get();
   }
   if (!o.landmarks.empty()) inputs.landmarks = landmarkPositions(readLandmarks(o.landmarks));
-  if (!o.points.empty()) inputs.dataPoints = readPointCloud(o.points);
+  if (!o.points.empty()) inputs.dataPoints = readPointCloud(o.points).points;
   std::unique_ptr<ControlMesh> controlMesh;
   if (!o.controlMesh.empty()) {
     controlMesh = std::make_unique<ControlMesh>(readControlMesh(o.controlMesh));

@@ -14,7 +14,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string extension = startsWith(data, size, "<") ? ".vtp" : commas ? ".csv" : ".xyz";
   const InputFile input(data, size, extension);
   try {
-    const dynsub::MatrixX3 points = dynsub::readPointCloud(input.path());
+    const dynsub::MatrixX3 points = dynsub::readPointCloud(input.path()).points;
     dynsub::checkPointCloud(points, input.path());
     requireFinite(points);
   } catch (const dynsub::Error& e) {

@@ -96,6 +96,8 @@ expect_error "impossible tolerance" 2 "tolerance: -1 is not a finite number > 0"
   "$DYNSUB" fit "$work/sphere.xyz" --tolerance -1 --out "$work/o9"
 expect_error "negative springs per element" 2 "springs-per-element" "$work/o9b" \
   "$DYNSUB" fit "$work/sphere.xyz" --springs-per-element -1 --out "$work/o9b"
+expect_error "an impossible noise" 2 "expected auto, measure or a number of mm >= 0" "$work/o9c" \
+  "$DYNSUB" fit "$work/sphere.xyz" --noise -0.1 --out "$work/o9c"
 expect_error "missing output parent" 1 "does not exist" "$work/no/o10" \
   "$DYNSUB" fit "$work/sphere.xyz" --out "$work/no/o10"
 

@@ -7,6 +7,7 @@
 #include <string>
 #include <fstream>
 #include <sstream>
+#include <utility>
 #include <vector>
 
 #include <vtkNew.h>
@@ -87,7 +88,7 @@ void checkVtpCounts(const std::string& path) {
   }
 }
 
-MatrixX3 readVtp(const std::string& path) {
+PointCloud readVtp(const std::string& path) {
   checkVtpCounts(path);
   vtkNew<vtkXMLPolyDataReader> reader;
   if (!reader->CanReadFile(path.c_str())) throw Error(path, "is not a VTK XML polydata file");
@@ -96,27 +97,29 @@ MatrixX3 readVtp(const std::string& path) {
   if (reader->GetErrorCode() != 0) throw Error(path, "could not be read (truncated or corrupt?)");
   vtkPolyData* data = reader->GetOutput();
   if (!data || !data->GetPoints() || data->GetNumberOfPoints() == 0) throw Error(path, "has no points");
-  MatrixX3 result(static_cast<Eigen::Index>(data->GetNumberOfPoints()), 3);
+  PointCloud result;
+  result.points.resize(static_cast<Eigen::Index>(data->GetNumberOfPoints()), 3);
   for (vtkIdType i = 0; i < data->GetNumberOfPoints(); ++i) {
     double p[3];
     data->GetPoint(i, p);
-    result.row(i) << p[0], p[1], p[2];
+    result.points.row(i) << p[0], p[1], p[2];
   }
+  result.meshVertices = data->GetNumberOfPolys() > 0 || data->GetNumberOfStrips() > 0;
   return result;
 }
 
 }  // namespace
 
-MatrixX3 readPointCloud(const std::string& path) {
+PointCloud readPointCloud(const std::string& path) {
   if (!std::filesystem::exists(path)) throw Error(path, "no such file");
   const std::string extension = lowerCaseExtension(path);
-  if (extension == ".xyz" || extension == ".txt" || extension == ".pwn") return readText(path, false);
-  if (extension == ".csv") return readText(path, true);
+  if (extension == ".xyz" || extension == ".txt" || extension == ".pwn") return {readText(path, false)};
+  if (extension == ".csv") return {readText(path, true)};
   if (extension == ".vtp") return readVtp(path);
   if (extension == ".ply" || extension == ".off" || extension == ".obj") {
-    MatrixX3 points = readPolygonData(path).points;
-    if (points.rows() == 0) throw Error(path, "has no points");
-    return points;
+    PolygonData data = readPolygonData(path);
+    if (data.points.rows() == 0) throw Error(path, "has no points");
+    return {std::move(data.points), !data.faces.empty()};
   }
   throw Error(path, "unknown point-cloud format '" + extension +
                         "' (expected .xyz, .txt, .pwn, .csv, .ply, .off, .obj or .vtp)");

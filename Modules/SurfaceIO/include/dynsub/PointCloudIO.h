@@ -5,7 +5,7 @@
 //               normals, are ignored); '#' comments
 //   .csv        comma- or semicolon-separated, the first three columns; one
 //               header line of names is skipped
-//   .ply .off .obj  the vertices (faces, if any, are ignored)
+//   .ply .off .obj  the vertices
 //   .vtp        the points of VTK XML polydata
 #include <string>
 
@@ -13,9 +13,16 @@
 
 namespace dynsub {
 
+struct PointCloud {
+  MatrixX3 points;
+  // The file is a surface mesh (it has faces): its points are vertices
+  // someone placed on the surface, not a scanner's samples of it.
+  bool meshVertices = false;
+};
+
 // Throws dynsub::Error naming the file (and line) for a missing, empty,
 // truncated or malformed file or an unknown extension. Coordinates are not
 // checked for finiteness here (see checkPointCloud in InitialModels.h).
-MatrixX3 readPointCloud(const std::string& path);
+PointCloud readPointCloud(const std::string& path);
 
 }  // namespace dynsub

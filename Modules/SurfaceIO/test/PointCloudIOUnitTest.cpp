@@ -1,0 +1,74 @@
+// Unit tests: point clouds read by extension, and whether the file was a
+// mesh (faces as well as vertices), which decides whether a fit measures the
+// points' noise (FitCommand.cpp).
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "dynsub/Error.h"
+#include "dynsub/PointCloudIO.h"
+#include "dynsub/StandardMeshes.h"
+#include "dynsub/SurfaceWriter.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string scratch(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / "dynsub-pointcloudio";
+  fs::create_directories(dir);
+  return (dir / name).string();
+}
+
+std::string writeText(const std::string& name, const std::string& text) {
+  const std::string path = scratch(name);
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(PointCloudIO, SurfaceFilesAreMeshVertices) {
+  const dynsub::ControlMesh cube = dynsub::makeCube98();
+  const dynsub::LimitSurface limit(cube);
+  const dynsub::TriangleSurface surface = dynsub::tessellate(limit, cube.points(), 2);
+  for (const std::string extension : {".vtp", ".obj", ".ply", ".off"}) {
+    const std::string path = scratch("cube" + extension);
+    if (extension == ".off") {
+      std::ofstream off(path);
+      off << "OFF\n" << surface.points.rows() << ' ' << surface.triangles.size() << " 0\n";
+      for (Eigen::Index i = 0; i < surface.points.rows(); ++i)
+        off << surface.points(i, 0) << ' ' << surface.points(i, 1) << ' ' << surface.points(i, 2) << '\n';
+      for (const auto& t : surface.triangles) off << "3 " << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
+    } else {
+      dynsub::writeTriangleSurface(surface, path);
+    }
+    const dynsub::PointCloud cloud = dynsub::readPointCloud(path);
+    EXPECT_EQ(cloud.points.rows(), surface.points.rows()) << extension;
+    EXPECT_TRUE(cloud.meshVertices) << extension;
+  }
+}
+
+TEST(PointCloudIO, PointFilesAreNotMeshVertices) {
+  const std::string points = "0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 1\n";
+  const std::string paths[] = {
+      writeText("cloud.xyz", points),
+      writeText("cloud.csv", "x,y,z\n0,0,0\n1,0,0\n0,1,0\n0,0,1\n1,1,1\n"),
+      writeText("cloud.off", "OFF\n5 0 0\n" + points),
+      writeText("cloud.ply",
+                "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\n"
+                "property float z\nend_header\n" + points),
+  };
+  for (const std::string& path : paths) {
+    const dynsub::PointCloud cloud = dynsub::readPointCloud(path);
+    EXPECT_EQ(cloud.points.rows(), 5) << path;
+    EXPECT_FALSE(cloud.meshVertices) << path;
+  }
+}
+
+TEST(PointCloudIO, RefusesUnknownFormats) {
+  const std::string path = writeText("cloud.pts", "0 0 0\n");
+  EXPECT_THROW(dynsub::readPointCloud(path), dynsub::Error);
+}
+
+}  // namespace
