@@ -136,7 +136,7 @@ void runFit(FitCommandOptions o) {
   noiseReport.set("sigma_percent", 100.0 * noise.sigma / diameter);
   noiseReport.set("reach_percent", 100.0 * noiseReach(data.rows()) * noise.sigma / diameter);
   noiseReport.set("estimated", measured && stated < 0.0);
-  noiseReport.set("mesh_vertices_exact", exactVertices);
+  noiseReport.set("mesh_vertices_exact", exactVertices && stated < 0.0);
   if (measured) {
     noiseReport.set("scatter_percent", 100.0 * noise.scatter / diameter);
     noiseReport.set("scatter_few_percent", 100.0 * noise.scatterFew / diameter);
