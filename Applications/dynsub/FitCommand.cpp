@@ -87,7 +87,7 @@ void runFit(FitCommandOptions o) {
   // is asked to follow, and no vertex is an outlier. Taken for noise, that
   // detail would end the fit by the bias rule (ShapeRecovery.h) short of the
   // tolerance.
-  const bool exactVertices = input.meshVertices && o.noise != "measure";
+  const bool exactVertices = input.meshVertices && o.noise == "auto";
   // The scan's own noise and outliers (ScanNoise.h), unless both are stated.
   ScanNoise noise;
   const bool measured = !exactVertices && scan.rows() > kNoiseNeighbours && (stated < 0.0 || !o.keepOutliers);
@@ -136,7 +136,7 @@ void runFit(FitCommandOptions o) {
   noiseReport.set("sigma_percent", 100.0 * noise.sigma / diameter);
   noiseReport.set("reach_percent", 100.0 * noiseReach(data.rows()) * noise.sigma / diameter);
   noiseReport.set("estimated", measured && stated < 0.0);
-  noiseReport.set("mesh_vertices_exact", exactVertices && stated < 0.0);
+  noiseReport.set("mesh_vertices_exact", exactVertices);
   if (measured) {
     noiseReport.set("scatter_percent", 100.0 * noise.scatter / diameter);
     noiseReport.set("scatter_few_percent", 100.0 * noise.scatterFew / diameter);
@@ -206,7 +206,7 @@ void runFit(FitCommandOptions o) {
               << 100.0 * noise.scatter / diameter << " % with " << kNoiseNeighbours
               << ": it is the shape's detail at this sampling, not noise, and the scan was fitted as clean data\n";
   }
-  if (exactVertices && stated < 0.0) {
+  if (exactVertices) {
     std::cout << "the points are a mesh's vertices, taken as exact: no noise and no outliers (--noise measure "
                  "measures their scatter)\n";
   }

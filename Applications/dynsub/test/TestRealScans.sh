@@ -85,8 +85,8 @@ if [ -f "$work/eight_auto/report.json" ]; then
   check "eight, default start: max_error_percent $eight_error <= 1" \
     awk -v e="$eight_error" 'BEGIN { exit !(e != "" && e <= 1.0) }'
 fi
-# A mesh's vertices are exact by default: the pig's 466 scatter about their
-# neighbours' quadrics 1.4-fold more with 20 neighbours than with 12, under
+# A mesh's vertices are exact by default: the pig's 468 vertices scatter about
+# their neighbours' quadrics 1.4-fold more with 20 neighbours than with 12, under
 # the growth that marks shape (kShapeGrowth), so measured as a scan's points
 # they read as noise and the fit stops by the bias rule 3.4 % from them. As a
 # mesh, none is set aside and the fit meets the tolerance.
