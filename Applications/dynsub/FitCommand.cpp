@@ -28,6 +28,7 @@ struct FitCommandOptions {
   std::string init = "auto";
   int genus = -1;
   std::string noise = "auto";
+  std::string refinement = "local";
   bool keepOutliers = false;
   std::string reference;
   FitOptions fit;
@@ -97,6 +98,7 @@ void runFit(FitCommandOptions o) {
   const MatrixX3 data = withoutRows(scan, noise.outliers);
   if (data.rows() < 4) throw Error(o.points, "fewer than 4 points are left once the outliers are set aside");
   o.fit.noise = noise.sigma;
+  o.fit.localRefinement = o.refinement == "local";
   const ControlMesh initial = chooseInitialModel(o, data);
   const std::filesystem::path dir(o.out);
   prepareOutputDirectory(dir);
@@ -159,6 +161,7 @@ void runFit(FitCommandOptions o) {
   sphere.set("method", "smallest enclosing sphere (Welzl's algorithm, exact)");
   report.set("enclosing_sphere", sphere);
   report.set("control_vertices", result.mesh.vertexCount());
+  report.set("free_control_points", result.levels.back().freeControlPoints);
   report.set("control_faces", result.mesh.faceCount());
   report.set("genus", result.mesh.genus());
   report.set("levels", result.levels.back().level);
@@ -178,6 +181,7 @@ void runFit(FitCommandOptions o) {
   parameters.set("noise", o.noise);
   parameters.set("keep_outliers", o.keepOutliers);
   parameters.set("to_equilibrium", o.fit.toEquilibrium);
+  parameters.set("refinement", o.refinement);
   report.set("parameters", parameters);
 
   const TriangleSurface surface = outputSurface(result.mesh, *result.surface);
@@ -186,9 +190,12 @@ void runFit(FitCommandOptions o) {
   });
 
   std::cout << std::fixed << std::setprecision(3) << "fitted " << data.rows() << " points with "
-            << result.mesh.vertexCount() << " control vertices (" << result.levels.back().level
-            << " refinement(s), " << result.steps << " steps) in " << std::setprecision(1) << result.seconds
-            << " s\n"
+            << result.mesh.vertexCount() << " control vertices";
+  if (result.levels.back().freeControlPoints != result.mesh.vertexCount()) {
+    std::cout << ", " << result.levels.back().freeControlPoints << " of them free";
+  }
+  std::cout << " (" << result.levels.back().level << " refinement(s), " << result.steps << " steps) in "
+            << std::setprecision(1) << result.seconds << " s\n"
             << std::setprecision(3) << "max error " << result.error.maxPercent << " %, rms error "
             << result.error.rmsPercent << " % of the enclosing sphere's diameter ("
             << 2.0 * result.enclosingSphere.radius << " mm)"
@@ -260,6 +267,13 @@ void addFitCommand(CLI::App& app) {
       ->default_val("auto");
   command->add_flag("--keep-outliers", o->keepOutliers,
                     "Fit every point; by default points far off their neighbours' local surface are set aside");
+  command
+      ->add_option("--refinement", o->refinement,
+                   "local: where the fit is refused, a level's faces are refined and their new points move, while "
+                   "elsewhere the refined mesh keeps the coarser level's shape and freedom (the written control "
+                   "mesh is the refined mesh, with the same limit surface); global: every face, as the papers do")
+      ->default_val("local")
+      ->check(CLI::IsMember({"local", "global"}));
   command->add_flag("--to-equilibrium", o->fit.toEquilibrium,
                     "Run the last level on to its equilibrium, as the papers do; by default the fit ends at the "
                     "first step where the tolerance is met");

@@ -98,6 +98,8 @@ expect_error "negative springs per element" 2 "springs-per-element" "$work/o9b" 
   "$DYNSUB" fit "$work/sphere.xyz" --springs-per-element -1 --out "$work/o9b"
 expect_error "an impossible noise" 2 "expected auto, measure or a number of mm >= 0" "$work/o9c" \
   "$DYNSUB" fit "$work/sphere.xyz" --noise -0.1 --out "$work/o9c"
+expect_error "an unknown refinement" 2 "--refinement: everywhere not in {local,global}" "$work/o9d" \
+  "$DYNSUB" fit "$work/sphere.xyz" --refinement everywhere --out "$work/o9d"
 expect_error "missing output parent" 1 "does not exist" "$work/no/o10" \
   "$DYNSUB" fit "$work/sphere.xyz" --out "$work/no/o10"
 

@@ -29,9 +29,9 @@ source "$(dirname "${BASH_SOURCE[0]}")/Checks.sh"
 value() {  # value REPORT KEY: a top-level number from report.json
   sed -n "s/^  \"$2\": \([-0-9.e+]*\),\{0,1\}$/\1/p" "$1"
 }
-# fit_scan NAME POINTS GENUS MAX_CONTROL_VERTICES FIT_OPTIONS...
+# fit_scan NAME POINTS GENUS MAX_CONTROL_VERTICES MAX_FREE_POINTS FIT_OPTIONS...
 fit_scan() {
-  local name=$1 points=$2 genus=$3 max_vertices=$4; shift 4
+  local name=$1 points=$2 genus=$3 max_vertices=$4 max_free=$5; shift 5
   "$DYNSUB" fit "$points" --out "$work/$name" "$@" >"$work/$name.log" 2>&1
   check "$name: fit succeeds" test $? -eq 0
   cat "$work/$name.log"
@@ -43,11 +43,16 @@ fit_scan() {
   check "$name: max_error_percent $error <= 1" awk -v e="$error" 'BEGIN { exit !(e != "" && e <= 1.0) }'
   check "$name: genus $genus" test "$(value "$report" genus)" = "$genus"
   check "$name: $vertices control vertices <= $max_vertices" test "$vertices" -le "$max_vertices"
+  local free
+  free=$(value "$report" free_control_points)
+  check "$name: $free free control points <= $max_free" test "$free" -le "$max_free"
 }
 
-fit_scan bear "$work/data/meshes/bear.off" 0 1538
-fit_scan kitten "$work/data/points_3/kitten.xyz" 1 772 --init "$DATA/Meshes/kitten_genus1.obj"
-fit_scan eight "$work/data/meshes/eight.off" 2 48 --init "$DATA/Meshes/eight_genus2.obj"
+# Local refinement (Simulation.h) frees points only where the bear's level 1
+# is refused: at least 30 % fewer than global refinement's 1538 (531 measured).
+fit_scan bear "$work/data/meshes/bear.off" 0 1538 1076
+fit_scan kitten "$work/data/points_3/kitten.xyz" 1 772 772 --init "$DATA/Meshes/kitten_genus1.obj"
+fit_scan eight "$work/data/meshes/eight.off" 2 48 48 --init "$DATA/Meshes/eight_genus2.obj"
 
 tools=$(cd "$(dirname "${BASH_SOURCE[0]}")/../../../Tools" && pwd)
 nested() {  # nested REPORT KEY.KEY

@@ -47,12 +47,21 @@ struct LevelModel {
   double size = 0;         // bounding-box diagonal of the control points, mm
   double elementSize = 0;  // in elements of the initial model
   double elasticity = 1;   // the factor on the matrices' tension and rigidity
+  // The mesh's points as blends of the free points the level moves
+  // (RefineRegion; #mesh vertices by #free), or empty: every point free.
+  // The surface, the matrices and the states are over the free points.
+  SparseMatrix freeBasis{};
 };
 
-// Sets the model's start, its control points.
+// The mesh's points at free points `points` (LevelModel::freeBasis).
+MatrixX3 meshPoints(const SparseMatrix& freeBasis, const MatrixX3& points) {
+  return freeBasis.size() == 0 ? points : MatrixX3(freeBasis * points);
+}
+
+// Sets the model's start, its free points.
 void setStart(LevelModel& model, const MatrixX3& points) {
   model.start = points;
-  model.size = modelSize(model.start);
+  model.size = modelSize(meshPoints(model.freeBasis, model.start));
   if (!(model.size > 0.0)) throw Error("the control mesh has no extent");
 }
 
@@ -76,10 +85,12 @@ void assembleMatrices(LevelModel& model, double elasticity, const SimulationOpti
 }
 
 // initialIsolation < 0: `mesh` is the initial model, and sets it. `relaxed`:
-// the relaxations the level has had already (LevelOrigin).
+// the relaxations the level has had already (LevelOrigin). freeBasis and
+// points: LevelModel's, and the free points the level starts from.
 LevelModel buildLevel(const ControlMesh& mesh, int level, int relaxed, int& initialIsolation,
-                      const SimulationOptions& options) {
-  LevelModel model{level, std::make_shared<const LimitSurface>(mesh), {}, {}, {}, 0.0};
+                      const SimulationOptions& options, const SparseMatrix& freeBasis, const MatrixX3& points) {
+  LevelModel model{level, std::make_shared<const LimitSurface>(mesh, freeBasis), {}, {}, {}, 0.0};
+  model.freeBasis = freeBasis;
   if (initialIsolation < 0) initialIsolation = model.surface->isolationLevels();
   // Element sides are measured in elements of the initial model: a base mesh
   // that is `b` global refinements past the initial one has side 2^-b.
@@ -97,7 +108,7 @@ LevelModel buildLevel(const ControlMesh& mesh, int level, int relaxed, int& init
                model.quadrature.Ju.swap(built.Ju);
                model.quadrature.Jv.swap(built.Jv);
              });
-  setStart(model, mesh.points());
+  setStart(model, points);
   return model;
 }
 
@@ -549,9 +560,55 @@ void checkSimulationOptions(const SimulationOptions& o) {
   }
 }
 
+namespace {
+
+// The free basis after `coarse` is refined (RefineRegion): the free points
+// before, carried by the subdivision matrix A (A T, or A itself where every
+// point was free), then one new free point per edge point and face point of
+// the faces named. Vertex points never become free: through them the
+// columns of A T stay independent of the new ones (the vertex rule is
+// invertible on its own points), so T^T (K + H) T is positive definite
+// wherever K + H is. Empty (every point free) when the refinement is global.
+SparseMatrix refinedBasis(const Topology& coarse, const SparseMatrix& subdivision, const SparseMatrix& basis,
+                          const std::vector<int>& faces) {
+  std::vector<bool> refined(coarse.faceCount(), false);
+  for (int f : faces) {
+    if (f < 0 || f >= coarse.faceCount()) throw Error("internal: a face to refine does not exist");
+    refined[f] = true;
+  }
+  const bool everyFace = std::find(refined.begin(), refined.end(), false) == refined.end();
+  if (basis.size() == 0 && everyFace) return SparseMatrix();
+  const int vertices = coarse.vertexCount(), edges = coarse.edgeCount();
+  std::vector<bool> freeEdge(edges, false);
+  for (int f = 0; f < coarse.faceCount(); ++f) {
+    for (int k = 0; refined[f] && k < coarse.faceSize(f); ++k) freeEdge[coarse.faceEdge(f, k)] = true;
+  }
+  std::vector<int> newPoints;
+  for (int e = 0; e < edges; ++e) {
+    if (freeEdge[e]) newPoints.push_back(vertices + e);
+  }
+  for (int f = 0; f < coarse.faceCount(); ++f) {
+    if (refined[f]) newPoints.push_back(vertices + edges + f);
+  }
+  const SparseMatrix carried = basis.size() == 0 ? subdivision : SparseMatrix(subdivision * basis);
+  std::vector<Triplet> entries;
+  entries.reserve(static_cast<size_t>(carried.nonZeros()) + newPoints.size());
+  for (Eigen::Index row = 0; row < carried.outerSize(); ++row) {
+    for (SparseMatrix::InnerIterator it(carried, row); it; ++it) entries.emplace_back(row, it.col(), it.value());
+  }
+  for (size_t j = 0; j < newPoints.size(); ++j) {
+    entries.emplace_back(newPoints[j], static_cast<int>(carried.cols() + j), 1.0);
+  }
+  SparseMatrix result(carried.rows(), carried.cols() + static_cast<Eigen::Index>(newPoints.size()));
+  result.setFromTriplets(entries.begin(), entries.end());
+  return result;
+}
+
+}  // namespace
+
 SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceModel*>& forces,
                           const std::vector<int>& fixed, const SimulationOptions& options, const AcceptFit& accept,
-                          const ProgressCallback& progress) {
+                          const ProgressCallback& progress, const RefineRegion& region) {
   checkSimulationOptions(options);
   for (int v : fixed) {
     if (v < 0 || v >= initial.vertexCount()) {
@@ -559,8 +616,12 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
                   std::to_string(initial.vertexCount()) + ")");
     }
   }
+  const bool local = region && options.integrator.scheme == IntegrationScheme::Static;
+  if (local && !fixed.empty()) throw Error("internal: local refinement with fixed control vertices");
   SimulationResult result;
   ControlMesh mesh = initial;
+  SparseMatrix freeBasis;              // LevelModel::freeBasis of the next level
+  MatrixX3 freePoints = mesh.points();  // and its free points
   int initialIsolation = options.origin.isolation;  // -1 until the first level's surface sets it
   double timeStep = options.integrator.timeStep;
   // Levels are held through pointers and built in place: Eigen 3.4's
@@ -574,14 +635,16 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
     const int relaxedBefore = level == options.origin.level ? options.origin.relaxed : 0;
     const std::unique_ptr<LevelModel> built =
         wasPrepared ? prepared.get()
-                    : std::unique_ptr<LevelModel>(
-                          new LevelModel(buildLevel(mesh, level, relaxedBefore, initialIsolation, options)));
-    if (wasPrepared) setStart(*built, mesh.points());
-    if (options.prepareNextLevel && level < options.maxLevel) {
-      // The refined topology does not depend on where this level ends.
+                    : std::unique_ptr<LevelModel>(new LevelModel(
+                          buildLevel(mesh, level, relaxedBefore, initialIsolation, options, freeBasis, freePoints)));
+    if (wasPrepared) setStart(*built, freePoints);
+    // A global refinement's topology does not depend on where this level
+    // ends; a local one's free points do.
+    if (options.prepareNextLevel && !local && level < options.maxLevel) {
       prepared = std::async(std::launch::async, [next = subdivide(mesh).mesh, level, initialIsolation, &options] {
         int isolation = initialIsolation;
-        return std::unique_ptr<LevelModel>(new LevelModel(buildLevel(next, level + 1, 0, isolation, options)));
+        return std::unique_ptr<LevelModel>(
+            new LevelModel(buildLevel(next, level + 1, 0, isolation, options, SparseMatrix(), next.points())));
       });
     }
     // A level refused as close is first run on with weaker elasticity
@@ -604,11 +667,12 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
       if (relaxed > relaxedBefore) {
         started = std::chrono::steady_clock::now();
         assembleMatrices(model, model.elasticity * options.elasticityPerLevel, options);
-        setStart(model, mesh.points());
+        setStart(model, freePoints);
       }
       LevelSummary summary;
       summary.level = level;
       summary.controlVertices = mesh.vertexCount();
+      summary.freeControlPoints = freeBasis.size() == 0 ? mesh.vertexCount() : static_cast<int>(freeBasis.cols());
       summary.elasticity = model.elasticity;
       // A level that will be refined or relaxed may end at a looser rule.
       const bool coarse =
@@ -616,7 +680,8 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
       LevelEnd end = LevelEnd::Equilibrium;
       const MatrixX3 points = runLevel(model, forces, fixed, options, asked, coarse, timeStep, progress, summary, end);
       summary.residual = equilibriumResidual(model, forces, points, fixed);
-      mesh.setPoints(points);
+      mesh.setPoints(meshPoints(freeBasis, points));
+      freePoints = points;
       result.steps += summary.steps;
       summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
       result.levels.push_back(summary);
@@ -631,10 +696,27 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
     const bool good = verdict != FitVerdict::Refine && verdict != FitVerdict::Relax;
     if (good || lastLevel) {
       result.origin = {level, initialIsolation, relaxed};
-      result.surface = model.surface;
+      // The result's surface is over the mesh's own points.
+      result.surface = freeBasis.size() == 0 ? model.surface : std::make_shared<const LimitSurface>(mesh);
       break;
     }
-    mesh = subdivide(mesh).mesh;
+    SubdividedMesh refined = subdivide(mesh);
+    if (local) {
+      const Eigen::Index carried = freeBasis.size() == 0 ? mesh.vertexCount() : freeBasis.cols();
+      freeBasis = refinedBasis(mesh.topology(), refined.subdivisionMatrix, freeBasis, region(mesh.topology()));
+      if (freeBasis.size() == 0) {
+        freePoints = refined.mesh.points();
+      } else {
+        // The new free points are the new edge and face points' offsets
+        // from where subdivision puts them: zero at the start.
+        MatrixX3 start = MatrixX3::Zero(freeBasis.cols(), 3);
+        start.topRows(carried) = freePoints;
+        freePoints = std::move(start);
+      }
+    } else {
+      freePoints = refined.mesh.points();
+    }
+    mesh = std::move(refined.mesh);
   }
   result.mesh = std::move(mesh);
   return result;

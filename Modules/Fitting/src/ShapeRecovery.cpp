@@ -58,17 +58,39 @@ double largestBias(const Eigen::VectorXd& signedDistances, const Eigen::MatrixXi
   return bias;
 }
 
+// `faces` and every face within `rings` rings of them (sharing a vertex);
+// every face of the mesh when `faces` is empty.
+std::vector<int> grownFaces(const Topology& mesh, const std::vector<int>& faces, int rings) {
+  std::vector<bool> chosen(mesh.faceCount(), faces.empty());
+  for (int f : faces) chosen[f] = true;
+  for (int ring = 0; ring < rings && !faces.empty(); ++ring) {
+    std::vector<bool> grown = chosen;
+    for (int f = 0; f < mesh.faceCount(); ++f) {
+      if (!chosen[f]) continue;
+      for (int v : mesh.face(f)) {
+        for (int g : mesh.vertexFaces(v)) grown[g] = true;
+      }
+    }
+    chosen = std::move(grown);
+  }
+  std::vector<int> result;
+  for (int f = 0; f < mesh.faceCount(); ++f) {
+    if (chosen[f]) result.push_back(f);
+  }
+  return result;
+}
+
 }  // namespace
 
 FitError measureFitError(const LimitSurface& surface, const MatrixX3& controlPoints, const MatrixX3& data,
-                         double diameter, const Eigen::MatrixXi* neighbours) {
+                         double diameter, const Eigen::MatrixXi* neighbours, std::vector<ClosestPoint>* nearestOut) {
   // 8 x 8 samples per control face, as the outputs (Tessellation.h):
   // isolation's elements are a half or a quarter of a face on a side, and
   // 8 x 8 per element would make the locator's samples, and this
   // measurement, four or sixteen times as costly.
   ClosestPointLocator locator(surface, outputSegments(surface), 8);
   locator.update(controlPoints);
-  const std::vector<ClosestPoint> nearest = locator.findAll(data);
+  std::vector<ClosestPoint> nearest = locator.findAll(data);
   double worst = 0.0, squares = 0.0;
   for (const ClosestPoint& c : nearest) {
     worst = std::max(worst, c.distance);
@@ -83,6 +105,7 @@ FitError measureFitError(const LimitSurface& surface, const MatrixX3& controlPoi
     }
     error.biasPercent = 100.0 * largestBias(signedDistances, *neighbours) / diameter;
   }
+  if (nearestOut) *nearestOut = std::move(nearest);
   return error;
 }
 
@@ -127,6 +150,26 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
   // bounds start afresh when the fit is refined.
   double maxBelow = std::numeric_limits<double>::infinity();   // percent
   double biasBelow = std::numeric_limits<double>::infinity();  // percent
+  // Local refinement (RefineRegion): the control faces, of the level last
+  // measured, that hold a point's nearest surface point farther than the
+  // tolerance (grown by kRefineRings rings of faces when refined). Empty:
+  // every face.
+  std::vector<int> facesToRefine;
+  const auto measure = [&](const LimitSurface& surface, const MatrixX3& points) {
+    std::vector<ClosestPoint> nearest;
+    const FitError e =
+        measureFitError(surface, points, data, diameter, result.noiseLimited ? &neighbours : nullptr, &nearest);
+    facesToRefine.clear();
+    // On noisy data a level is refused by its bias, which no one point's
+    // distance locates: refined everywhere.
+    if (options.localRefinement && !result.noiseLimited) {
+      const double beyond = 0.01 * options.tolerancePercent * diameter;
+      for (const ClosestPoint& c : nearest) {
+        if (c.distance > beyond) facesToRefine.push_back(surface.elementControlFace(c.point.element));
+      }
+    }
+    return e;
+  };
   AcceptFit accept = [&](const LimitSurface& surface, const MatrixX3& points, FitAsk when) {
     // The springs' lengths: every point's, or on a sampled level the
     // sample's, which say only that the fit may be met.
@@ -142,7 +185,7 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
                               : std::numeric_limits<double>::infinity();
       const bool biasWithin = bias <= options.tolerancePercent && bias < biasBelow;
       if (!maxWithin && !biasWithin) return FitVerdict::Settle;
-      const FitError e = measureFitError(surface, points, data, diameter, result.noiseLimited ? &neighbours : nullptr);
+      const FitError e = measure(surface, points);
       if (met(e)) {
         result.levelErrors.push_back(e);
         return FitVerdict::Stop;
@@ -158,7 +201,7 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
     if (loose && everyPoint && longest <= options.tolerancePercent && longest < maxBelow) {
       return FitVerdict::Settle;
     }
-    const FitError e = measureFitError(surface, points, data, diameter, result.noiseLimited ? &neighbours : nullptr);
+    const FitError e = measure(surface, points);
     if (e.maxPercent <= options.tolerancePercent) {
       if (when == FitAsk::LevelEnd) result.levelErrors.push_back(e);  // one per level, where it ends
       return FitVerdict::Settle;
@@ -186,7 +229,12 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
       progress(withDistances);
     };
   }
-  SimulationResult simulation = simulate(initial, {&springs}, {}, options.simulation, accept, progressWithDistances);
+  RefineRegion region;
+  if (options.localRefinement) {
+    region = [&](const Topology& mesh) { return grownFaces(mesh, facesToRefine, kRefineRings); };
+  }
+  SimulationResult simulation =
+      simulate(initial, {&springs}, {}, options.simulation, accept, progressWithDistances, region);
   result.mesh = std::move(simulation.mesh);
   result.surface = std::move(simulation.surface);
   result.levels = std::move(simulation.levels);

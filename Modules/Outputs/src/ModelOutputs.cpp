@@ -41,6 +41,7 @@ Report levelReport(const LevelSummary& l, double maxErrorPercent, double rmsErro
   Report r;
   r.set("level", l.level);
   r.set("control_vertices", l.controlVertices);
+  r.set("free_control_points", l.freeControlPoints);
   r.set("elasticity", l.elasticity);
   r.set("iterations", l.steps);
   r.set("equilibrium", l.converged && !l.met);

@@ -236,7 +236,8 @@ struct LimitSurface::Impl {
     // levels and deepest hold displacements from the limit position (row 0 of vertexMasks).
   };
 
-  int controlVertexCount = 0;
+  int controlVertexCount = 0;  // the free points' with a free basis
+  int meshVertexCount = 0;
   int isolationLevels = 0;
   Topology base;
   SparseMatrix isolation;                         // base vertices <- control vertices
@@ -708,9 +709,14 @@ struct LimitSurface::Impl {
   const std::vector<int>& columnsOf(int element) const { return elements[element].columns; }
 };
 
-LimitSurface::LimitSurface(const ControlMesh& mesh) : impl_(std::make_unique<Impl>()) {
+LimitSurface::LimitSurface(const ControlMesh& mesh, const SparseMatrix& freeBasis) : impl_(std::make_unique<Impl>()) {
   Impl& s = *impl_;
   s.controlVertexCount = mesh.vertexCount();
+  s.meshVertexCount = mesh.vertexCount();
+  if (freeBasis.size() > 0 && (freeBasis.rows() != mesh.vertexCount() || freeBasis.cols() == 0)) {
+    throw Error("internal: a free basis of " + std::to_string(freeBasis.rows()) + " rows for " +
+                std::to_string(mesh.vertexCount()) + " control vertices");
+  }
   s.base = mesh.topology();
   for (int f = 0; f < s.base.faceCount(); ++f) s.controlFaceSize.push_back(s.base.faceSize(f));
   s.parametricFaceOffset.push_back(0);
@@ -738,6 +744,10 @@ LimitSurface::LimitSurface(const ControlMesh& mesh) : impl_(std::make_unique<Imp
   };
   s.base = refineToBase(std::move(s.base), refined,
                         [&s](const SparseMatrix& duplication) { s.isolation = duplication * s.isolation; });
+  if (freeBasis.size() > 0) {
+    s.isolation = s.isolation * freeBasis;
+    s.controlVertexCount = static_cast<int>(freeBasis.cols());
+  }
   s.isolation.makeCompressed();
 
   s.elements.resize(s.base.faceCount());
@@ -1110,13 +1120,13 @@ SparseMatrix LimitSurface::controlVertexLimitOperator() const {
   const Impl& s = *impl_;
   std::vector<Triplet> triplets;
   // Control vertex i is vertex i of the base mesh (refinement keeps vertex numbers).
-  for (int i = 0; i < s.controlVertexCount; ++i) {
+  for (int i = 0; i < s.meshVertexCount; ++i) {
     const detail::VertexMasks masks = detail::vertexMasks(s.base, i, s.base.vertexFaces(i).front());
     for (const auto& [b, w] : masks.position) {
       for (SparseMatrix::InnerIterator it(s.isolation, b); it; ++it) triplets.emplace_back(i, it.col(), w * it.value());
     }
   }
-  SparseMatrix result(s.controlVertexCount, s.controlVertexCount);
+  SparseMatrix result(s.meshVertexCount, s.controlVertexCount);
   result.setFromTriplets(triplets.begin(), triplets.end());
   return result;
 }

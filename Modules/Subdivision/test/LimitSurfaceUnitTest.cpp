@@ -310,6 +310,48 @@ TEST(LimitSurface, SemiSharpCreasesAboveFourAreRefused) {
   }
 }
 
+// With a free basis T the surface is the mesh's own over the free points q:
+// its operators are the plain surface's times T, and its points those at
+// the mesh points T q, to rounding (1e-12 of the mesh's size).
+TEST(LimitSurface, FreeBasisIsTheMeshsSurfaceOverTheFreePoints) {
+  const dynsub::ControlMesh coarse = dynsub::makeCube98();
+  const dynsub::SubdividedMesh fine = dynsub::subdivide(coarse);
+  // The coarse points carried by subdivision, and three of the fine mesh's
+  // edge and face points free.
+  std::vector<dynsub::Triplet> entries;
+  const dynsub::SparseMatrix& a = fine.subdivisionMatrix;
+  for (Eigen::Index row = 0; row < a.outerSize(); ++row) {
+    for (dynsub::SparseMatrix::InnerIterator it(a, row); it; ++it) entries.emplace_back(row, it.col(), it.value());
+  }
+  const int carried = coarse.vertexCount();
+  const std::vector<int> freed = {carried + 3, carried + 40, fine.mesh.vertexCount() - 1};
+  for (size_t j = 0; j < freed.size(); ++j) entries.emplace_back(freed[j], carried + static_cast<int>(j), 1.0);
+  dynsub::SparseMatrix basis(fine.mesh.vertexCount(), carried + static_cast<int>(freed.size()));
+  basis.setFromTriplets(entries.begin(), entries.end());
+
+  const dynsub::LimitSurface plain(fine.mesh);
+  const dynsub::LimitSurface hierarchical(fine.mesh, basis);
+  ASSERT_EQ(hierarchical.controlVertexCount(), basis.cols());
+  ASSERT_EQ(hierarchical.elementCount(), plain.elementCount());
+  std::mt19937 random(3);
+  dynsub::MatrixX3 q = dynsub::MatrixX3::Random(basis.cols(), 3) * 10.0;
+  q.topRows(carried) += coarse.points();
+  const dynsub::MatrixX3 p = basis * q;
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<dynsub::ElementPoint> points;
+  for (int e = 0; e < plain.elementCount(); e += 7) points.push_back({e, unit(random), unit(random)});
+  const dynsub::LimitOperators ours = hierarchical.operators(points, 1);
+  const dynsub::LimitOperators theirs = plain.operators(points, 1);
+  const double size = (p.colwise().maxCoeff() - p.colwise().minCoeff()).norm();
+  EXPECT_LT((dynsub::MatrixX3(ours.J * q) - theirs.J * p).cwiseAbs().maxCoeff(), 1e-12 * size);
+  EXPECT_LT((dynsub::MatrixX3(ours.Ju * q) - theirs.Ju * p).cwiseAbs().maxCoeff(), 1e-12 * size);
+  for (const dynsub::ElementPoint& point : points) {
+    EXPECT_LT((hierarchical.evaluate(point, q).position - plain.evaluate(point, p).position).norm(), 1e-12 * size);
+  }
+  EXPECT_EQ(hierarchical.controlVertexLimitOperator().rows(), fine.mesh.vertexCount());
+  EXPECT_THROW(dynsub::LimitSurface(coarse, basis), dynsub::Error);  // rows must be the mesh's vertices
+}
+
 TEST(LimitSurface, CubeHasThePapersElements) {
   const LimitSurface surface(dynsub::makeCube98());
   int special = 0;

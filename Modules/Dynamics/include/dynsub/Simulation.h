@@ -120,6 +120,9 @@ struct SimulationOptions {
 struct LevelSummary {
   int level = 0;  // global refinements of the initial control mesh
   int controlVertices = 0;
+  // The control points that move (RefineRegion): controlVertices unless the
+  // refinement was local.
+  int freeControlPoints = 0;
   // The factor on tension and rigidity: elasticityPerLevel^(level + relaxations run).
   double elasticity = 1.0;
   int steps = 0;
@@ -201,12 +204,26 @@ enum class FitVerdict { Refine, Relax, Settle, Stop };
 using AcceptFit = std::function<FitVerdict(const LimitSurface& surface, const MatrixX3& controlPoints, FitAsk when)>;
 using ProgressCallback = std::function<void(const Progress&)>;
 
+// Local refinement (hierarchical, as hierarchical B-splines refine): asked
+// when a level is refined, with that level's control mesh, the faces whose refinement
+// the fit needs. The mesh is still subdivided everywhere, so the surface and
+// its elements are global refinement's, exactly; but only the edge and face
+// points of the faces named become new free control points. Every other
+// point of the refined mesh stays where subdivision puts it from the free
+// points before, so away from those faces the surface keeps the coarser
+// level's shape and freedom (StaticSolver.h: the Newton steps are solved for
+// the free points alone). Used by the static scheme only; without it, or
+// when every face is named on a mesh whose points are all free, every point
+// of the refined mesh is free.
+using RefineRegion = std::function<std::vector<int>(const Topology& mesh)>;
+
 // forces are not owned. fixed: control vertices of the initial mesh that do not
-// move (they keep their numbers through refinement). Throws dynsub::Error on
-// bad options or unrecoverable divergence.
+// move (they keep their numbers through refinement); not with `region`.
+// Throws dynsub::Error on bad options or unrecoverable divergence.
 SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceModel*>& forces,
                           const std::vector<int>& fixed, const SimulationOptions& options,
-                          const AcceptFit& accept = nullptr, const ProgressCallback& progress = nullptr);
+                          const AcceptFit& accept = nullptr, const ProgressCallback& progress = nullptr,
+                          const RefineRegion& region = nullptr);
 
 void checkSimulationOptions(const SimulationOptions& options);
 

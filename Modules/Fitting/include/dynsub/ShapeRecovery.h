@@ -58,6 +58,8 @@
 
 namespace dynsub {
 
+struct ClosestPoint;
+
 // Neighbours a point's bias is averaged over (see above). Larger means
 // average the noise out further but dilute an offset confined to a narrow
 // band, like the rounding of a crease: on the synthetic tuning clouds
@@ -78,6 +80,11 @@ constexpr double kRelaxWithin = 2.0;
 // peanut once more at 0.25 %; 64 keeps a margin of 4 over that.
 constexpr double kSpringsPerElement = 64.0;
 
+// Local refinement (FitOptions::localRefinement): the faces refined are
+// those holding a data point's nearest surface point farther than the
+// tolerance, and this many rings of faces around them.
+constexpr int kRefineRings = 1;
+
 struct FitOptions {
   double tolerancePercent = 1.0;  // max_error_percent that stops refinement
   double dataStiffness = 100.0;   // N/mm per unit parametric area (see above)
@@ -88,6 +95,9 @@ struct FitOptions {
   // Run the last level on to its equilibrium, as the papers do, instead of
   // ending at the first step where the tolerance is met (see above).
   bool toEquilibrium = false;
+  // Refine only where the fit is refused (RefineRegion, Simulation.h; the
+  // static scheme only); false: every face, as the papers do.
+  bool localRefinement = true;
   SimulationOptions simulation = defaultSimulation();
 
   static SimulationOptions defaultSimulation();
@@ -122,9 +132,10 @@ double noiseReach(Eigen::Index points);
 bool noiseLimits(Eigen::Index points, double noise, double diameter, double tolerancePercent);
 
 // neighbours (optional, #data x k >= kBiasNeighbours): each point's nearest
-// others, for the bias.
+// others, for the bias. nearest (optional): each point's nearest surface point.
 FitError measureFitError(const LimitSurface& surface, const MatrixX3& controlPoints, const MatrixX3& data,
-                         double diameter, const Eigen::MatrixXi* neighbours = nullptr);
+                         double diameter, const Eigen::MatrixXi* neighbours = nullptr,
+                         std::vector<ClosestPoint>* nearest = nullptr);
 
 // `initial` must be closed. Throws dynsub::Error on bad input or divergence.
 FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const FitOptions& options,

@@ -41,6 +41,12 @@
 // being the quad (corner k, midpoint of edge k, centre, midpoint of edge k-1).
 // Derivatives are taken with respect to the parameters of the point's kind.
 //
+// Free basis (hierarchical refinement, Simulation.h's RefineRegion): with a
+// basis T (#mesh vertices by m), the mesh's points are T q for m free points
+// q, and the surface is built over q: every operator's columns, and every
+// `controlPoints` argument, are the free points, and controlVertexCount() is
+// m. The elements are still the mesh's.
+//
 // Cost: construction is O(#control vertices); a special element tabulates
 // each level of its subpatches the first time a point needs it (thread-safe),
 // so evaluating a point is O(1) after the first one at its level. Nothing is
@@ -127,7 +133,7 @@ class LimitSurface {
  public:
   // Throws dynsub::Error if the mesh's topology is unusable (it cannot be for
   // a ControlMesh, which is checked on construction).
-  explicit LimitSurface(const ControlMesh& mesh);
+  explicit LimitSurface(const ControlMesh& mesh, const SparseMatrix& freeBasis = SparseMatrix());
   ~LimitSurface();
   LimitSurface(LimitSurface&&) noexcept;
   LimitSurface& operator=(LimitSurface&&) noexcept;
@@ -195,7 +201,8 @@ class LimitSurface {
   // shared grid and offset times `map`, to rounding.
   SharedPieces sharedPieces(int element, int levels) const;
 
-  // Row i gives the limit position of control vertex i (#control by #control).
+  // Row i gives the limit position of the mesh's vertex i (#mesh vertices by
+  // #control vertices).
   SparseMatrix controlVertexLimitOperator() const;
 
  private:
