@@ -620,8 +620,8 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
   if (local && !fixed.empty()) throw Error("internal: local refinement with fixed control vertices");
   SimulationResult result;
   ControlMesh mesh = initial;
-  SparseMatrix freeBasis;              // LevelModel::freeBasis of the next level
-  MatrixX3 freePoints = mesh.points();  // and its free points
+  SparseMatrix freeBasis;                           // LevelModel::freeBasis of the next level
+  MatrixX3 freePoints = mesh.points();              // and its free points
   int initialIsolation = options.origin.isolation;  // -1 until the first level's surface sets it
   double timeStep = options.integrator.timeStep;
   // Levels are held through pointers and built in place: Eigen 3.4's

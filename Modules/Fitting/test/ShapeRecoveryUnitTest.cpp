@@ -288,8 +288,8 @@ TEST(ShapeRecovery, LocalRefinementFreesPointsWhereTheDataAsk) {
   EXPECT_LT(where.levels.back().freeControlPoints, everywhere.mesh.vertexCount() / 2);
   const double diameter = 2.0 * where.enclosingSphere.radius;
   EXPECT_EQ(where.surface->controlVertexCount(), where.mesh.vertexCount());
-  EXPECT_NEAR(measureFitError(*where.surface, where.mesh.points(), points, diameter).maxPercent,
-              where.error.maxPercent, 1e-9);
+  EXPECT_NEAR(measureFitError(*where.surface, where.mesh.points(), points, diameter).maxPercent, where.error.maxPercent,
+              1e-9);
 }
 
 }  // namespace
