@@ -181,7 +181,10 @@ void runFit(FitCommandOptions o) {
   parameters.set("noise", o.noise);
   parameters.set("keep_outliers", o.keepOutliers);
   parameters.set("to_equilibrium", o.fit.toEquilibrium);
-  parameters.set("refinement", o.refinement);
+  // The time-stepping schemes refine globally (RefineRegion, Simulation.h).
+  parameters.set("refinement", o.fit.localRefinement && o.fit.simulation.integrator.scheme == IntegrationScheme::Static
+                                   ? "local"
+                                   : "global");
   report.set("parameters", parameters);
 
   const TriangleSurface surface = outputSurface(result.mesh, *result.surface);
@@ -271,7 +274,8 @@ void addFitCommand(CLI::App& app) {
       ->add_option("--refinement", o->refinement,
                    "local: where the fit is refused, a level's faces are refined and their new points move, while "
                    "elsewhere the refined mesh keeps the coarser level's shape and freedom (the written control "
-                   "mesh is the refined mesh, with the same limit surface); global: every face, as the papers do")
+                   "mesh is the refined mesh, with the same limit surface; the static scheme only, the others refine "
+                   "globally); global: every face, as the papers do")
       ->default_val("local")
       ->check(CLI::IsMember({"local", "global"}));
   command->add_flag("--to-equilibrium", o->fit.toEquilibrium,

@@ -10,6 +10,8 @@
 #include <optional>
 #include <string>
 
+#include <Eigen/SparseCholesky>
+
 #include "dynsub/ParallelFor.h"
 #include "dynsub/ApplyOperator.h"
 #include "dynsub/CatmullClark.h"
@@ -562,13 +564,35 @@ void checkSimulationOptions(const SimulationOptions& o) {
 
 namespace {
 
+// Whether the columns of `m` are independent on the rows not in `rows`: their
+// Gram matrix there factors with pivots above 1e-12 of the largest.
+bool independentOffRows(const SparseMatrix& m, const std::vector<int>& rows) {
+  std::vector<bool> skipped(m.rows(), false);
+  for (int r : rows) skipped[r] = true;
+  std::vector<Triplet> kept;
+  for (Eigen::Index row = 0; row < m.outerSize(); ++row) {
+    for (SparseMatrix::InnerIterator it(m, row); it && !skipped[row]; ++it) kept.emplace_back(row, it.col(), it.value());
+  }
+  SymmetricMatrix off(m.rows(), m.cols());
+  off.setFromTriplets(kept.begin(), kept.end());
+  const SymmetricMatrix gram = off.transpose() * off;
+  const Eigen::SimplicialLDLT<SymmetricMatrix> factor(gram);
+  if (factor.info() != Eigen::Success) return false;
+  const Eigen::VectorXd pivots = factor.vectorD();
+  return pivots.minCoeff() > 1e-12 * pivots.cwiseAbs().maxCoeff();
+}
+
 // The free basis after `coarse` is refined (RefineRegion): the free points
 // before, carried by the subdivision matrix A (A T, or A itself where every
 // point was free), then one new free point per edge point and face point of
-// the faces named. Vertex points never become free: through them the
-// columns of A T stay independent of the new ones (the vertex rule is
-// invertible on its own points), so T^T (K + H) T is positive definite
-// wherever K + H is. Empty (every point free) when the refinement is global.
+// the faces named. The new points' columns are unit columns on their own
+// rows, so T's columns are independent when the carried columns are on the
+// other rows; almost always they are (the vertex points alone usually
+// determine them), but A can have a null vector (on a cube of 8 vertices of
+// valence 3, alternating signs give zero face, edge and vertex points).
+// There a direction of the free points would move nothing and the Newton
+// systems T^T (K + H) T would be singular, so the step is refined globally
+// instead. Empty (every point free) when the refinement is global.
 SparseMatrix refinedBasis(const Topology& coarse, const SparseMatrix& subdivision, const SparseMatrix& basis,
                           const std::vector<int>& faces) {
   std::vector<bool> refined(coarse.faceCount(), false);
@@ -591,6 +615,7 @@ SparseMatrix refinedBasis(const Topology& coarse, const SparseMatrix& subdivisio
     if (refined[f]) newPoints.push_back(vertices + edges + f);
   }
   const SparseMatrix carried = basis.size() == 0 ? subdivision : SparseMatrix(subdivision * basis);
+  if (!independentOffRows(carried, newPoints)) return SparseMatrix();
   std::vector<Triplet> entries;
   entries.reserve(static_cast<size_t>(carried.nonZeros()) + newPoints.size());
   for (Eigen::Index row = 0; row < carried.outerSize(); ++row) {

@@ -19,6 +19,7 @@
 #include "TestPointClouds.h"
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/Error.h"
+#include "dynsub/CatmullClark.h"
 #include "dynsub/ForceModel.h"
 #include "dynsub/InitialModels.h"
 #include "dynsub/LimitSurface.h"
@@ -141,6 +142,38 @@ TEST(StaticScheme, ALevelRefusedAsCloseRelaxesBeforeItIsRefined) {
     EXPECT_EQ(result.levels[1].level, secondVertices == 98 ? 0 : 1);
     EXPECT_EQ(result.levels[1].elasticity, secondElasticity);
     EXPECT_EQ(result.mesh.vertexCount(), secondVertices);
+  }
+}
+
+// Local refinement (RefineRegion): naming one face of the 98-vertex cube
+// frees that face's 4 edge points and its face point beside the 98 carried
+// points, and the level's Newton systems factor without a shift. On a cube
+// of 8 vertices of valence 3 the subdivision matrix has a null vector
+// (alternating signs), so a local step there would leave a direction that
+// moves nothing: it is refined globally instead, every point free.
+TEST(StaticScheme, LocalRefinementFreesTheNamedFacesPoints) {
+  const ControlMesh cube98 = makeCube98();
+  MatrixX3 corners(8, 3);
+  corners << -1, -1, -1, 1, -1, -1, 1, 1, -1, -1, 1, -1, -1, -1, 1, 1, -1, 1, 1, 1, 1, -1, 1, 1;
+  const ControlMesh cube8 = ControlMesh::fromPolygons(
+      20.0 * corners, {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}});
+  for (const auto& [mesh, expectedFree] : {std::make_pair(cube98, 98 + 5), std::make_pair(cube8, 26)}) {
+    const MatrixX3 targets = liftedTargets(mesh);
+    SpringForceModel springs(targets, Eigen::VectorXd::Constant(targets.rows(), 1.0),
+                             SpringForceModel::Attach::NearestEachStep);
+    int asked = 0;
+    const AcceptFit accept = [&](const LimitSurface&, const MatrixX3&, FitAsk when) {
+      if (when != FitAsk::LevelEnd) return FitVerdict::Settle;
+      return ++asked == 1 ? FitVerdict::Refine : FitVerdict::Settle;
+    };
+    const RefineRegion oneFace = [](const Topology&) { return std::vector<int>{0}; };
+    const SimulationResult result =
+        simulate(mesh, {&springs}, {}, relaxingOptions(1, 0), accept, nullptr, oneFace);
+    ASSERT_EQ(result.levels.size(), 2u);
+    EXPECT_EQ(result.levels[1].controlVertices, subdivide(mesh).mesh.vertexCount());
+    EXPECT_EQ(result.levels[1].freeControlPoints, expectedFree) << mesh.vertexCount();
+    EXPECT_EQ(result.levels[1].stabilizerUpdates, 0) << mesh.vertexCount();
+    EXPECT_EQ(result.surface->controlVertexCount(), result.mesh.vertexCount());
   }
 }
 

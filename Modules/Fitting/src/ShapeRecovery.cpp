@@ -163,9 +163,11 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
     // On noisy data a level is refused by its bias, which no one point's
     // distance locates: refined everywhere.
     if (options.localRefinement && !result.noiseLimited) {
-      const double beyond = 0.01 * options.tolerancePercent * diameter;
       for (const ClosestPoint& c : nearest) {
-        if (c.distance > beyond) facesToRefine.push_back(surface.elementControlFace(c.point.element));
+        // The same percentage as the verdict's max error.
+        if (100.0 * c.distance / diameter > options.tolerancePercent) {
+          facesToRefine.push_back(surface.elementControlFace(c.point.element));
+        }
       }
     }
     return e;

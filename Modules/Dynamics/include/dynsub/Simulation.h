@@ -90,7 +90,8 @@ struct SimulationOptions {
   // Where the initial mesh stands: a refit that starts from an earlier
   // result's mesh continues that result's levels (SimulationResult::origin),
   // so its elasticity, element sizes and refinement budget are the ones the
-  // earlier fit had reached. The default is a fresh start.
+  // earlier fit had reached; every point of its mesh is free (a local
+  // refinement's free basis is not carried). The default is a fresh start.
   LevelOrigin origin;
   // Tension and rigidity at level g are multiplied by elasticityPerLevel^g.
   // 1 keeps the physics of the initial model (the energy of a surface does not
@@ -164,7 +165,9 @@ struct Progress {
   int level = 0;
   int step = 0;
   double energy = 0;
-  double motion = 0;  // largest control-point move of the step, mm
+  // Largest move of a free point in the step, mm: a control point's, or
+  // with local refinement a free point's or offset's (RefineRegion).
+  double motion = 0;
   // The state after the step, for observers that measure a fit or draw the
   // surface. Valid only during the callback; the callback may throw to stop
   // the simulation (the exception propagates out of simulate).
