@@ -571,7 +571,8 @@ bool independentOffRows(const SparseMatrix& m, const std::vector<int>& rows) {
   for (int r : rows) skipped[r] = true;
   std::vector<Triplet> kept;
   for (Eigen::Index row = 0; row < m.outerSize(); ++row) {
-    for (SparseMatrix::InnerIterator it(m, row); it && !skipped[row]; ++it) kept.emplace_back(row, it.col(), it.value());
+    if (skipped[row]) continue;
+    for (SparseMatrix::InnerIterator it(m, row); it; ++it) kept.emplace_back(row, it.col(), it.value());
   }
   SymmetricMatrix off(m.rows(), m.cols());
   off.setFromTriplets(kept.begin(), kept.end());

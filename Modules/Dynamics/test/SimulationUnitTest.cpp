@@ -167,8 +167,7 @@ TEST(StaticScheme, LocalRefinementFreesTheNamedFacesPoints) {
       return ++asked == 1 ? FitVerdict::Refine : FitVerdict::Settle;
     };
     const RefineRegion oneFace = [](const Topology&) { return std::vector<int>{0}; };
-    const SimulationResult result =
-        simulate(mesh, {&springs}, {}, relaxingOptions(1, 0), accept, nullptr, oneFace);
+    const SimulationResult result = simulate(mesh, {&springs}, {}, relaxingOptions(1, 0), accept, nullptr, oneFace);
     ASSERT_EQ(result.levels.size(), 2u);
     EXPECT_EQ(result.levels[1].controlVertices, subdivide(mesh).mesh.vertexCount());
     EXPECT_EQ(result.levels[1].freeControlPoints, expectedFree) << mesh.vertexCount();
