@@ -181,10 +181,7 @@ void runFit(FitCommandOptions o) {
   parameters.set("noise", o.noise);
   parameters.set("keep_outliers", o.keepOutliers);
   parameters.set("to_equilibrium", o.fit.toEquilibrium);
-  // The time-stepping schemes refine globally (RefineRegion, Simulation.h).
-  parameters.set("refinement", o.fit.localRefinement && o.fit.simulation.integrator.scheme == IntegrationScheme::Static
-                                   ? "local"
-                                   : "global");
+  parameters.set("refinement", o.fit.refinesLocally() ? "local" : "global");
   report.set("parameters", parameters);
 
   const TriangleSurface surface = outputSurface(result.mesh, *result.surface);

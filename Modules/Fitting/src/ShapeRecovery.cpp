@@ -36,6 +36,10 @@ SimulationOptions FitOptions::defaultSimulation() {
   return o;
 }
 
+bool FitOptions::refinesLocally() const {
+  return localRefinement && simulation.integrator.scheme == IntegrationScheme::Static;
+}
+
 double noiseReach(Eigen::Index points) {
   return std::sqrt(2.0 * std::log(static_cast<double>(std::max<Eigen::Index>(points, 2))));
 }
@@ -162,7 +166,7 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
     facesToRefine.clear();
     // On noisy data a level is refused by its bias, which no one point's
     // distance locates: refined everywhere.
-    if (options.localRefinement && !result.noiseLimited) {
+    if (options.refinesLocally() && !result.noiseLimited) {
       for (const ClosestPoint& c : nearest) {
         // The same percentage as the verdict's max error.
         if (100.0 * c.distance / diameter > options.tolerancePercent) {
@@ -232,7 +236,7 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
     };
   }
   RefineRegion region;
-  if (options.localRefinement) {
+  if (options.refinesLocally()) {
     region = [&](const Topology& mesh) { return grownFaces(mesh, facesToRefine, kRefineRings); };
   }
   SimulationResult simulation =

@@ -1,26 +1,20 @@
 // Unit tests: point clouds read by extension, and whether the file was a
 // mesh (faces as well as vertices), which decides whether a fit measures the
 // points' noise (FitCommand.cpp).
-#include <filesystem>
 #include <fstream>
 #include <string>
 
 #include <gtest/gtest.h>
 
+#include "ScratchFiles.h"
 #include "dynsub/Error.h"
 #include "dynsub/PointCloudIO.h"
 #include "dynsub/StandardMeshes.h"
 #include "dynsub/SurfaceWriter.h"
 
-namespace fs = std::filesystem;
-
 namespace {
 
-std::string scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / "dynsub-pointcloudio";
-  fs::create_directories(dir);
-  return (dir / name).string();
-}
+std::string scratch(const std::string& name) { return dynsub::scratchFile("pointcloudio", name).string(); }
 
 std::string writeText(const std::string& name, const std::string& text) {
   const std::string path = scratch(name);

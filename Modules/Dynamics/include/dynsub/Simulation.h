@@ -214,10 +214,11 @@ using ProgressCallback = std::function<void(const Progress&)>;
 // points of the faces named become new free control points. Every other
 // point of the refined mesh stays where subdivision puts it from the free
 // points before, so away from those faces the surface keeps the coarser
-// level's shape and freedom (StaticSolver.h: the Newton steps are solved for
-// the free points alone). Used by the static scheme only; without it, or
-// when every face is named on a mesh whose points are all free, every point
-// of the refined mesh is free.
+// level's shape and freedom (the level is solved for the free points alone,
+// over LimitSurface.h's free basis). Used by the static scheme only; without
+// it, when every face is named on a mesh whose points are all free, or where
+// the free points would not stay independent, every point of the refined
+// mesh is free.
 using RefineRegion = std::function<std::vector<int>(const Topology& mesh)>;
 
 // forces are not owned. fixed: control vertices of the initial mesh that do not

@@ -101,6 +101,8 @@ struct FitOptions {
   SimulationOptions simulation = defaultSimulation();
 
   static SimulationOptions defaultSimulation();
+  // Whether the fit refines locally: asked for, and the static scheme.
+  bool refinesLocally() const;
 };
 
 struct FitError {
