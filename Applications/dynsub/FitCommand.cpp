@@ -3,6 +3,8 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -100,6 +102,16 @@ void runFit(FitCommandOptions o) {
   o.fit.noise = noise.sigma;
   o.fit.localRefinement = o.refinement == "local";
   const ControlMesh initial = chooseInitialModel(o, data);
+  std::vector<std::string> warnings;
+  if (input.meshGenus >= 0 && input.meshGenus != initial.genus()) {
+    const std::string g = std::to_string(input.meshGenus);
+    const std::string builtIn = input.meshGenus == 0 ? "--init auto or " : input.meshGenus == 1 ? "--init torus or " : "";
+    warnings.push_back(o.points + " is a closed mesh of genus " + g + " but the initial model has genus " +
+                       std::to_string(initial.genus()) +
+                       ": no fit of that model takes its shape, and the fit's error, measured from the points to "
+                       "the surface, does not see surface where the scan has none (give " +
+                       builtIn + "a closed control mesh of genus " + g + " with --init MESH)");
+  }
   const std::filesystem::path dir(o.out);
   prepareOutputDirectory(dir);
   o.fit.simulation = o.simulation.apply(o.fit.simulation);
@@ -164,6 +176,8 @@ void runFit(FitCommandOptions o) {
   report.set("free_control_points", result.levels.back().freeControlPoints);
   report.set("control_faces", result.mesh.faceCount());
   report.set("genus", result.mesh.genus());
+  if (input.meshGenus >= 0) report.set("data_genus", input.meshGenus);
+  report.set("warnings", warnings);
   report.set("levels", result.levels.back().level);
   report.set("iterations", result.steps);
   report.set("seconds", result.seconds);
@@ -218,6 +232,7 @@ void runFit(FitCommandOptions o) {
                  "measures their scatter)\n";
   }
   if (!noise.outliers.empty()) std::cout << "set aside " << noise.outliers.size() << " outlier(s)\n";
+  for (const std::string& warning : warnings) std::cerr << "warning: " << warning << '\n';
   std::cout
             << "wrote " << (dir / "surface.vtp").string() << ", control_mesh.obj, report.json, convergence.csv"
             << (o.figures.figures ? " and the figures that could be rendered" : "") << '\n';

@@ -77,6 +77,17 @@ awk 'NR <= 120 { print $1, $2, $3, ($1 - 5) / 30, ($2 + 2) / 30, ($3 - 7) / 30 }
 check "fit reads .pwn, all 120 points" python3 -c "
 import json, sys
 sys.exit(0 if json.load(open(sys.argv[1]))['points'] == 120 else 1)" "$work/fitpwn/report.json"
+# A closed mesh of genus 1 (the torus's limit surface, above): the automatic
+# (genus 0) initial model is warned about, the torus is not.
+"$DYNSUB" fit "$work/torus.vtp" --max-level 0 --no-figures --out "$work/fitgenus" >/dev/null 2>"$work/fitgenus.err"
+"$DYNSUB" fit "$work/torus.vtp" --init torus --max-level 0 --no-figures --out "$work/fitgenus1" >/dev/null 2>&1
+check "fit warns when a closed mesh's genus is not the model's" python3 -c "
+import json, sys
+auto, torus = (json.load(open(path)) for path in sys.argv[1:3])
+ok = auto['data_genus'] == 1 and auto['genus'] == 0 and len(auto['warnings']) == 1
+ok = ok and torus['data_genus'] == 1 and torus['genus'] == 1 and torus['warnings'] == []
+ok = ok and 'genus 1 but the initial model has genus 0' in open(sys.argv[3]).read()
+sys.exit(0 if ok else 1)" "$work/fitgenus/report.json" "$work/fitgenus1/report.json" "$work/fitgenus.err"
 
 printf '1 2 3\n4 5 6\n7 8 9.5\n' >"$work/three.xyz"
 expect_error "too few points" 1 "at least 4" "$work/o1" "$DYNSUB" fit "$work/three.xyz" --out "$work/o1"

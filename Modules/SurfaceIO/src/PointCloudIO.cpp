@@ -4,16 +4,19 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iterator>
+#include <numeric>
 #include <string>
 #include <fstream>
 #include <sstream>
 #include <utility>
 #include <vector>
 
+#include <vtkCellArray.h>
 #include <vtkNew.h>
 #include <vtkPolyData.h>
 #include <vtkXMLPolyDataReader.h>
 
+#include "dynsub/ControlMesh.h"
 #include "dynsub/Error.h"
 #include "dynsub/TextFields.h"
 #include "dynsub/FileNames.h"
@@ -88,6 +91,33 @@ void checkVtpCounts(const std::string& path) {
   }
 }
 
+// PointCloud::meshGenus of `faces` on `points`.
+int closedSurfaceGenus(const MatrixX3& points, const std::vector<Polygon>& faces, const std::string& path) {
+  if (faces.empty()) return -1;
+  ControlMesh mesh;
+  try {
+    mesh = ControlMesh::fromPolygons(points, faces, path);
+  } catch (const Error&) {
+    return -1;  // not a manifold mesh: its genus is not defined
+  }
+  if (!mesh.isClosed()) return -1;
+  // One piece: the faces' vertices joined along their edges.
+  std::vector<int> root(static_cast<size_t>(points.rows()));
+  std::iota(root.begin(), root.end(), 0);
+  const auto find = [&](int v) {
+    while (root[v] != v) v = root[v] = root[root[v]];
+    return v;
+  };
+  for (const Polygon& face : faces) {
+    for (size_t k = 1; k < face.size(); ++k) root[find(face[k])] = find(face[0]);
+  }
+  const int first = find(faces.front().front());
+  for (const Polygon& face : faces) {
+    if (find(face.front()) != first) return -1;
+  }
+  return mesh.genus();
+}
+
 PointCloud readVtp(const std::string& path) {
   checkVtpCounts(path);
   vtkNew<vtkXMLPolyDataReader> reader;
@@ -105,6 +135,14 @@ PointCloud readVtp(const std::string& path) {
     result.points.row(i) << p[0], p[1], p[2];
   }
   result.meshVertices = data->GetNumberOfPolys() > 0 || data->GetNumberOfStrips() > 0;
+  if (data->GetNumberOfStrips() == 0) {
+    std::vector<Polygon> faces;
+    vtkCellArray* polys = data->GetPolys();
+    vtkIdType count = 0;
+    const vtkIdType* ids = nullptr;
+    for (polys->InitTraversal(); polys->GetNextCell(count, ids);) faces.emplace_back(ids, ids + count);
+    result.meshGenus = closedSurfaceGenus(result.points, faces, path);
+  }
   return result;
 }
 
@@ -119,7 +157,8 @@ PointCloud readPointCloud(const std::string& path) {
   if (extension == ".ply" || extension == ".off" || extension == ".obj") {
     PolygonData data = readPolygonData(path);
     if (data.points.rows() == 0) throw Error(path, "has no points");
-    return {std::move(data.points), !data.faces.empty()};
+    const int genus = closedSurfaceGenus(data.points, data.faces, path);
+    return {std::move(data.points), !data.faces.empty(), genus};
   }
   throw Error(path, "unknown point-cloud format '" + extension +
                         "' (expected .xyz, .txt, .pwn, .csv, .ply, .off, .obj or .vtp)");

@@ -3,6 +3,7 @@
 // points' noise (FitCommand.cpp).
 #include <fstream>
 #include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -58,6 +59,33 @@ TEST(PointCloudIO, PointFilesAreNotMeshVertices) {
     EXPECT_EQ(cloud.points.rows(), 5) << path;
     EXPECT_FALSE(cloud.meshVertices) << path;
   }
+}
+
+// A fit warns when its model's genus is not the scan's (FitCommand.cpp), so
+// the genus is given only where it is defined: one closed manifold piece.
+TEST(PointCloudIO, ClosedMeshesGiveTheirGenus) {
+  const std::pair<dynsub::ControlMesh, int> cases[] = {
+      {dynsub::makeCube98(), 0}, {dynsub::makeTorus32(), 1}, {dynsub::makeSheet81(), -1}};
+  for (const auto& [mesh, genus] : cases) {
+    const dynsub::LimitSurface limit(mesh);
+    const dynsub::TriangleSurface surface = dynsub::tessellate(limit, mesh.points(), 2);
+    for (const std::string extension : {".vtp", ".obj", ".ply"}) {
+      const std::string path = scratch("genus" + std::to_string(genus) + extension);
+      dynsub::writeTriangleSurface(surface, path);
+      EXPECT_EQ(dynsub::readPointCloud(path).meshGenus, genus) << path;
+    }
+  }
+  const std::string tetrahedron = "3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n";
+  const std::string twoPieces = writeText(
+      "two.off", "OFF\n8 8 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n5 0 0\n6 0 0\n5 1 0\n5 0 1\n" + tetrahedron +
+                     "3 4 6 5\n3 4 5 7\n3 5 6 7\n3 4 7 6\n");
+  const std::string oneTetrahedron = writeText("one.off", "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n" + tetrahedron);
+  // Three triangles on one edge: not a manifold, no genus.
+  const std::string fin = writeText("fin.off", "OFF\n5 3 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n0 -1 0\n3 0 1 2\n3 0 1 3\n3 0 1 4\n");
+  EXPECT_EQ(dynsub::readPointCloud(oneTetrahedron).meshGenus, 0);
+  EXPECT_EQ(dynsub::readPointCloud(twoPieces).meshGenus, -1);
+  EXPECT_EQ(dynsub::readPointCloud(fin).meshGenus, -1);
+  EXPECT_EQ(dynsub::readPointCloud(writeText("points.xyz", "0 0 0\n1 0 0\n0 1 0\n0 0 1\n")).meshGenus, -1);
 }
 
 TEST(PointCloudIO, RefusesUnknownFormats) {

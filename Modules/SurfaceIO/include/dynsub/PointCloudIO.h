@@ -18,6 +18,12 @@ struct PointCloud {
   // The file is a surface mesh (it has faces): its points are vertices
   // someone placed on the surface, not a scanner's samples of it.
   bool meshVertices = false;
+  // The genus of the file's surface where its faces make one closed,
+  // connected, manifold and consistently oriented mesh; -1 otherwise (no
+  // faces, a boundary, several pieces, or a defect MeshCheck.h names). A
+  // model of another genus cannot follow it, and a fit's error, measured
+  // from the points to the surface, does not see surface spanning a hole.
+  int meshGenus = -1;
 };
 
 // Throws dynsub::Error naming the file (and line) for a missing, empty,
