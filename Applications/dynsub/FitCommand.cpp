@@ -102,15 +102,20 @@ void runFit(FitCommandOptions o) {
   o.fit.noise = noise.sigma;
   o.fit.localRefinement = o.refinement == "local";
   const ControlMesh initial = chooseInitialModel(o, data);
+  const int dataGenus = closedMeshGenus(input, o.points);
   std::vector<std::string> warnings;
-  if (input.meshGenus >= 0 && input.meshGenus != initial.genus()) {
-    const std::string g = std::to_string(input.meshGenus);
-    const std::string builtIn = input.meshGenus == 0 ? "--init auto or " : input.meshGenus == 1 ? "--init torus or " : "";
+  if (dataGenus >= 0 && dataGenus != initial.genus()) {
+    const std::string g = std::to_string(dataGenus);
+    const std::string builtIn = dataGenus == 0 ? "--init auto or " : dataGenus == 1 ? "--init torus or " : "";
+    // A model of lower genus spans the scan's holes with surface its error
+    // does not see; one of higher genus keeps holes the scan has not.
+    const std::string why = dataGenus > initial.genus()
+                                ? "its surface spans the scan's holes, where the fit's error, measured from the points "
+                                  "to the surface, does not see it"
+                                : "its surface keeps holes the scan has not";
     warnings.push_back(o.points + " is a closed mesh of genus " + g + " but the initial model has genus " +
-                       std::to_string(initial.genus()) +
-                       ": no fit of that model takes its shape, and the fit's error, measured from the points to "
-                       "the surface, does not see surface where the scan has none (give " +
-                       builtIn + "a closed control mesh of genus " + g + " with --init MESH)");
+                       std::to_string(initial.genus()) + ": " + why + " (give " + builtIn +
+                       "a closed control mesh of genus " + g + " with --init MESH)");
   }
   const std::filesystem::path dir(o.out);
   prepareOutputDirectory(dir);
@@ -176,7 +181,7 @@ void runFit(FitCommandOptions o) {
   report.set("free_control_points", result.levels.back().freeControlPoints);
   report.set("control_faces", result.mesh.faceCount());
   report.set("genus", result.mesh.genus());
-  if (input.meshGenus >= 0) report.set("data_genus", input.meshGenus);
+  if (dataGenus >= 0) report.set("data_genus", dataGenus);
   report.set("warnings", warnings);
   report.set("levels", result.levels.back().level);
   report.set("iterations", result.steps);

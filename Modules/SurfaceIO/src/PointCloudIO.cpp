@@ -91,33 +91,6 @@ void checkVtpCounts(const std::string& path) {
   }
 }
 
-// PointCloud::meshGenus of `faces` on `points`.
-int closedSurfaceGenus(const MatrixX3& points, const std::vector<Polygon>& faces, const std::string& path) {
-  if (faces.empty()) return -1;
-  ControlMesh mesh;
-  try {
-    mesh = ControlMesh::fromPolygons(points, faces, path);
-  } catch (const Error&) {
-    return -1;  // not a manifold mesh: its genus is not defined
-  }
-  if (!mesh.isClosed()) return -1;
-  // One piece: the faces' vertices joined along their edges.
-  std::vector<int> root(static_cast<size_t>(points.rows()));
-  std::iota(root.begin(), root.end(), 0);
-  const auto find = [&](int v) {
-    while (root[v] != v) v = root[v] = root[root[v]];
-    return v;
-  };
-  for (const Polygon& face : faces) {
-    for (size_t k = 1; k < face.size(); ++k) root[find(face[k])] = find(face[0]);
-  }
-  const int first = find(faces.front().front());
-  for (const Polygon& face : faces) {
-    if (find(face.front()) != first) return -1;
-  }
-  return mesh.genus();
-}
-
 PointCloud readVtp(const std::string& path) {
   checkVtpCounts(path);
   vtkNew<vtkXMLPolyDataReader> reader;
@@ -135,13 +108,20 @@ PointCloud readVtp(const std::string& path) {
     result.points.row(i) << p[0], p[1], p[2];
   }
   result.meshVertices = data->GetNumberOfPolys() > 0 || data->GetNumberOfStrips() > 0;
-  if (data->GetNumberOfStrips() == 0) {
-    std::vector<Polygon> faces;
-    vtkCellArray* polys = data->GetPolys();
-    vtkIdType count = 0;
-    const vtkIdType* ids = nullptr;
-    for (polys->InitTraversal(); polys->GetNextCell(count, ids);) faces.emplace_back(ids, ids + count);
-    result.meshGenus = closedSurfaceGenus(result.points, faces, path);
+  // Triangle strips are not unpacked into faces (the points are read all
+  // the same); a file with strips gets no genus (closedMeshGenus).
+  vtkCellArray* polys = data->GetPolys();
+  vtkIdType count = 0;
+  const vtkIdType* ids = nullptr;
+  for (polys->InitTraversal(); polys->GetNextCell(count, ids);) {
+    std::vector<int> face;
+    for (vtkIdType k = 0; k < count; ++k) {
+      if (ids[k] < 0 || ids[k] >= data->GetNumberOfPoints())
+        throw Error(path, "a polygon names point " + std::to_string(ids[k]) + " of " +
+                              std::to_string(data->GetNumberOfPoints()));
+      face.push_back(static_cast<int>(ids[k]));
+    }
+    result.faces.push_back(std::move(face));
   }
   return result;
 }
@@ -151,17 +131,60 @@ PointCloud readVtp(const std::string& path) {
 PointCloud readPointCloud(const std::string& path) {
   if (!std::filesystem::exists(path)) throw Error(path, "no such file");
   const std::string extension = lowerCaseExtension(path);
-  if (extension == ".xyz" || extension == ".txt" || extension == ".pwn") return {readText(path, false)};
-  if (extension == ".csv") return {readText(path, true)};
+  if (extension == ".xyz" || extension == ".txt" || extension == ".pwn") return {readText(path, false), false, {}};
+  if (extension == ".csv") return {readText(path, true), false, {}};
   if (extension == ".vtp") return readVtp(path);
   if (extension == ".ply" || extension == ".off" || extension == ".obj") {
     PolygonData data = readPolygonData(path);
     if (data.points.rows() == 0) throw Error(path, "has no points");
-    const int genus = closedSurfaceGenus(data.points, data.faces, path);
-    return {std::move(data.points), !data.faces.empty(), genus};
+    const bool faces = !data.faces.empty();
+    return {std::move(data.points), faces, std::move(data.faces)};
   }
   throw Error(path, "unknown point-cloud format '" + extension +
                         "' (expected .xyz, .txt, .pwn, .csv, .ply, .off, .obj or .vtp)");
+}
+
+int closedMeshGenus(const PointCloud& cloud, const std::string& source) {
+  if (cloud.faces.empty()) return -1;
+  // Points no face uses (common in exported files) are dropped, so that the
+  // mesh check judges the surface alone.
+  std::vector<int> index(static_cast<size_t>(cloud.points.rows()), -1);
+  std::vector<Polygon> faces = cloud.faces;
+  int used = 0;
+  for (Polygon& face : faces) {
+    for (int& v : face) {
+      if (v < 0 || v >= cloud.points.rows()) return -1;
+      if (index[v] < 0) index[v] = used++;
+      v = index[v];
+    }
+  }
+  MatrixX3 points(used, 3);
+  for (Eigen::Index v = 0; v < cloud.points.rows(); ++v) {
+    if (index[v] >= 0) points.row(index[v]) = cloud.points.row(v);
+  }
+  ControlMesh mesh;
+  try {
+    mesh = ControlMesh::fromPolygons(points, faces, source);
+  } catch (const Error&) {
+    return -1;  // not a mesh MeshCheck.h accepts: no genus to speak of
+  }
+  if (!mesh.isClosed()) return -1;
+  // One piece: ControlMesh::genus assumes it. The faces' vertices are joined
+  // along their edges.
+  std::vector<int> root(static_cast<size_t>(used));
+  std::iota(root.begin(), root.end(), 0);
+  const auto find = [&](int v) {
+    while (root[v] != v) v = root[v] = root[root[v]];
+    return v;
+  };
+  for (const Polygon& face : faces) {
+    for (size_t k = 1; k < face.size(); ++k) root[find(face[k])] = find(face[0]);
+  }
+  const int first = find(faces.front().front());
+  for (const Polygon& face : faces) {
+    if (find(face.front()) != first) return -1;
+  }
+  return mesh.genus();
 }
 
 }  // namespace dynsub
