@@ -1,6 +1,7 @@
-// Unit tests: point clouds read by extension, and whether the file was a
-// mesh (faces as well as vertices), which decides whether a fit measures the
-// points' noise (FitCommand.cpp).
+// Unit tests: point clouds read by extension, whether the file was a mesh
+// (faces as well as vertices), which decides whether a fit measures the
+// points' noise, and the genus of a closed mesh, which a fit checks its
+// model against (FitCommand.cpp).
 #include <array>
 #include <fstream>
 #include <sstream>
