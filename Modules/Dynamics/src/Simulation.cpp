@@ -569,14 +569,9 @@ namespace {
 bool independentOffRows(const SparseMatrix& m, const std::vector<int>& rows) {
   std::vector<bool> skipped(m.rows(), false);
   for (int r : rows) skipped[r] = true;
-  std::vector<Triplet> kept;
-  for (Eigen::Index row = 0; row < m.outerSize(); ++row) {
-    if (skipped[row]) continue;
-    for (SparseMatrix::InnerIterator it(m, row); it; ++it) kept.emplace_back(row, it.col(), it.value());
-  }
-  SymmetricMatrix off(m.rows(), m.cols());
-  off.setFromTriplets(kept.begin(), kept.end());
-  const SymmetricMatrix gram = off.transpose() * off;
+  SparseMatrix off = m;
+  off.prune([&](const Eigen::Index& row, const Eigen::Index&, const double&) { return !skipped[row]; });
+  const SymmetricMatrix gram = SymmetricMatrix(off.transpose() * off);
   const Eigen::SimplicialLDLT<SymmetricMatrix> factor(gram);
   if (factor.info() != Eigen::Success) return false;
   const Eigen::VectorXd pivots = factor.vectorD();
@@ -698,7 +693,7 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
       LevelSummary summary;
       summary.level = level;
       summary.controlVertices = mesh.vertexCount();
-      summary.freeControlPoints = freeBasis.size() == 0 ? mesh.vertexCount() : static_cast<int>(freeBasis.cols());
+      summary.freeControlPoints = static_cast<int>(freePoints.rows());
       summary.elasticity = model.elasticity;
       // A level that will be refined or relaxed may end at a looser rule.
       const bool coarse =
@@ -727,20 +722,16 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
       break;
     }
     SubdividedMesh refined = subdivide(mesh);
-    if (local) {
-      const Eigen::Index carried = freeBasis.size() == 0 ? mesh.vertexCount() : freeBasis.cols();
-      freeBasis = refinedBasis(mesh.topology(), refined.subdivisionMatrix, freeBasis, region(mesh.topology()));
-      if (freeBasis.size() == 0) {
-        freePoints = refined.mesh.points();
-      } else {
-        // The new free points are the new edge and face points' offsets
-        // from where subdivision puts them: zero at the start.
-        MatrixX3 start = MatrixX3::Zero(freeBasis.cols(), 3);
-        start.topRows(carried) = freePoints;
-        freePoints = std::move(start);
-      }
-    } else {
+    if (local) freeBasis = refinedBasis(mesh.topology(), refined.subdivisionMatrix, freeBasis, region(mesh.topology()));
+    if (freeBasis.size() == 0) {
       freePoints = refined.mesh.points();
+    } else {
+      // The free points carried keep their values; the new ones are the new
+      // edge and face points' offsets from where subdivision puts them: zero
+      // at the start.
+      MatrixX3 start = MatrixX3::Zero(freeBasis.cols(), 3);
+      start.topRows(freePoints.rows()) = freePoints;
+      freePoints = std::move(start);
     }
     mesh = std::move(refined.mesh);
   }
