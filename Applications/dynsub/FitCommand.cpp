@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,7 @@
 #include "dynsub/PointCloudIO.h"
 #include "dynsub/ScanNoise.h"
 #include "dynsub/ShapeRecovery.h"
+#include "dynsub/SurfaceCoverage.h"
 
 namespace dynsub::app {
 
@@ -59,6 +61,28 @@ ControlMesh chooseInitialModel(const FitCommandOptions& o, const MatrixX3& data)
                                   : " (give a control mesh of that genus with --init MESH)"));
   }
   return mesh;
+}
+
+// Uncovered surface (SurfaceCoverage.h) beyond this share of its area is
+// warned about.
+constexpr double kUncoveredWarning = 0.01;
+// Points spread over a mesh's faces to measure its coverage against: the
+// density of a dense scan, found in about 10 ms.
+constexpr int kMeshCoverageSamples = 30000;
+
+std::string uncoveredWarning(const SurfaceCoverage& coverage, const std::string& scan, double maxError,
+                             double diameter) {
+  std::ostringstream text;
+  text << std::fixed << std::setprecision(1) << 100.0 * coverage.uncoveredFraction
+       << " % of the fitted surface's area lies farther than " << kCoverageSpacings
+       << " point spacings plus the max error (" << std::setprecision(3)
+       << kCoverageSpacings * coverage.spacing + maxError << " mm) from " << scan << ", up to " << std::setprecision(2)
+       << 100.0 * coverage.maxGap / diameter
+       << " % of the diameter away: surface where the scan has none, which the fit's error, measured from the points "
+          "to the surface, does not see. It is a web across a gap the model has not followed, a membrane over a hole "
+          "the model's genus cannot keep (--init torus, or --init MESH with a closed control mesh of the scan's "
+          "genus), or a cap over an opening of an open scan";
+  return text.str();
 }
 
 // --noise: "auto", "measure" or a number of mm >= 0 (returned; -1 for the
@@ -143,6 +167,16 @@ void runFit(FitCommandOptions o) {
   for (size_t i = 0; i < result.levels.size(); ++i)
     history.setLevelEndError(result.levels[i].level, result.levelErrors[i].maxPercent);
 
+  const TriangleSurface surface = outputSurface(result.mesh, *result.surface);
+  // A mesh's coverage is measured against its faces, a scan's against its points.
+  const double maxError = result.error.maxPercent * diameter / 100.0;
+  const SurfaceCoverage coverage = measureSurfaceCoverage(
+      surface, input.faces.empty() ? data : sampleMeshFaces(scan, input.faces, kMeshCoverageSamples), maxError);
+  // A closed mesh of another genus has been warned about already, with its cause.
+  if (coverage.uncoveredFraction > kUncoveredWarning && (dataGenus < 0 || dataGenus == initial.genus())) {
+    warnings.push_back(uncoveredWarning(coverage, o.points, maxError, diameter));
+  }
+
   Report report;
   report.set("input", o.points);
   report.set("points", data.rows());
@@ -164,6 +198,12 @@ void runFit(FitCommandOptions o) {
   noiseReport.set("noise_limited", result.noiseLimited);
   if (result.noiseLimited) noiseReport.set("bias_percent", result.error.biasPercent);
   report.set("data_noise", noiseReport);
+  Report coverageReport;
+  coverageReport.set("spacing_mm", coverage.spacing);
+  coverageReport.set("max_gap_percent", 100.0 * coverage.maxGap / diameter);
+  coverageReport.set("uncovered_area_percent", 100.0 * coverage.uncoveredFraction);
+  coverageReport.set("gap_spacings", kCoverageSpacings);
+  report.set("surface_coverage", coverageReport);
   if (!o.reference.empty()) {
     const FitError e = measureFitError(*result.surface, result.mesh.points(), reference, diameter);
     Report against;
@@ -203,7 +243,6 @@ void runFit(FitCommandOptions o) {
   parameters.set("refinement", o.fit.refinesLocally() ? "local" : "global");
   report.set("parameters", parameters);
 
-  const TriangleSurface surface = outputSurface(result.mesh, *result.surface);
   writeModelOutputs(dir, result.mesh, surface, report, [&](OutputSet& outputs) {
     addFigureOutputs(outputs, o.figures, result.mesh, surface, history, nullptr, MatrixX3(), data);
   });

@@ -179,6 +179,17 @@ sys.exit(0 if head[:8] == b'\x89PNG\r\n\x1a\n' and struct.unpack('>II', head[16:
 "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --init torus --no-figures --out "$work/nofig" >/dev/null 2>&1
 check "--no-figures writes no figure" test ! -e "$work/nofig/slices.png"
 check "--no-figures still writes convergence.csv" test -s "$work/nofig/convergence.csv"
+# A cloud has no genus to compare: the automatic (genus 0) model spans the
+# torus's hole, which only the surface's distance to the points shows (10 %
+# of its area at 4 spacings, none from the torus; SurfaceCoverage.h).
+"$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --no-figures --out "$work/fithole" >/dev/null 2>"$work/fithole.err"
+check "fit warns of surface the cloud does not cover" python3 -c "
+import json, sys
+auto, torus = (json.load(open(path))['surface_coverage'] for path in sys.argv[1:3])
+ok = auto['uncovered_area_percent'] > 5 and torus['uncovered_area_percent'] < 0.5
+ok = ok and json.load(open(sys.argv[2]))['warnings'] == []
+ok = ok and 'surface where the scan has none' in open(sys.argv[3]).read()
+sys.exit(0 if ok else 1)" "$work/fithole/report.json" "$work/nofig/report.json" "$work/fithole.err"
 # Without DISPLAY the command starts its own Xvfb for the figures and stops
 # it; without Xvfb either (PATH emptied) it says so and writes the rest.
 private_servers() { pgrep -c -f -- "Xvfb -displayfd" || true; }

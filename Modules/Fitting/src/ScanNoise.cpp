@@ -5,27 +5,15 @@
 #include <string>
 
 #include <Eigen/Eigenvalues>
-#include <nanoflann.hpp>
 
 #include "dynsub/Error.h"
 #include "dynsub/ParallelFor.h"
 #include "dynsub/Percentile.h"
+#include "PointTree.h"
 
 namespace dynsub {
 
 namespace {
-
-// nanoflann's view of the points, without a copy.
-struct PointRows {
-  const MatrixX3& points;
-  size_t kdtree_get_point_count() const { return static_cast<size_t>(points.rows()); }
-  double kdtree_get_pt(size_t i, size_t d) const { return points(static_cast<Eigen::Index>(i), d); }
-  template <class Box>
-  bool kdtree_get_bbox(Box&) const {
-    return false;
-  }
-};
-using PointTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointRows>, PointRows, 3>;
 
 // 1 / Phi^-1(3/4): turns a median absolute deviation into a Gaussian's sigma.
 constexpr double kMadToSigma = 1.4826;
