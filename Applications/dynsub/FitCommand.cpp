@@ -21,6 +21,7 @@
 #include "dynsub/ScanNoise.h"
 #include "dynsub/ShapeRecovery.h"
 #include "dynsub/SurfaceCoverage.h"
+#include "dynsub/SurfaceWriter.h"
 
 namespace dynsub::app {
 
@@ -245,7 +246,7 @@ void runFit(FitCommandOptions o) {
 
   writeModelOutputs(dir, result.mesh, surface, report, [&](OutputSet& outputs) {
     addFigureOutputs(outputs, o.figures, result.mesh, surface, history, nullptr, MatrixX3(), data);
-  });
+  }, {{kScanDistanceScalars, coverage.distances}});
 
   std::cout << std::fixed << std::setprecision(3) << "fitted " << data.rows() << " points with "
             << result.mesh.vertexCount() << " control vertices";

@@ -181,7 +181,8 @@ check "--no-figures writes no figure" test ! -e "$work/nofig/slices.png"
 check "--no-figures still writes convergence.csv" test -s "$work/nofig/convergence.csv"
 # A cloud has no genus to compare: the automatic (genus 0) model spans the
 # torus's hole, which only the surface's distance to the points shows (10 %
-# of its area at 4 spacings, none from the torus; SurfaceCoverage.h).
+# of its area at 4 spacings, none from the torus; SurfaceCoverage.h), and
+# surface.vtp carries that distance for a viewer to colour by.
 "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --no-figures --out "$work/fithole" >/dev/null 2>"$work/fithole.err"
 check "fit warns of surface the cloud does not cover" python3 -c "
 import json, sys
@@ -190,6 +191,8 @@ ok = auto['uncovered_area_percent'] > 5 and torus['uncovered_area_percent'] < 0.
 ok = ok and json.load(open(sys.argv[2]))['warnings'] == []
 ok = ok and 'surface where the scan has none' in open(sys.argv[3]).read()
 sys.exit(0 if ok else 1)" "$work/fithole/report.json" "$work/nofig/report.json" "$work/fithole.err"
+check "the fitted surface carries each point's distance to the scan" \
+  grep -qa 'Name="scan_distance_mm"' "$work/fithole/surface.vtp"
 # Without DISPLAY the command starts its own Xvfb for the figures and stops
 # it; without Xvfb either (PATH emptied) it says so and writes the rest.
 private_servers() { pgrep -c -f -- "Xvfb -displayfd" || true; }

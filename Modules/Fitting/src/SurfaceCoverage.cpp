@@ -27,7 +27,8 @@ SurfaceCoverage measureSurfaceCoverage(const TriangleSurface& surface, const Mat
   coverage.spacing = percentile(std::move(nearest), 0.5);
 
   const Eigen::Index n = surface.points.rows();
-  Eigen::VectorXd gap(n);
+  Eigen::VectorXd& gap = coverage.distances;
+  gap.resize(n);
   parallelFor(n, threadsWorth(n), [&](Eigen::Index v) {
     unsigned found = 0;
     double squared = 0.0;

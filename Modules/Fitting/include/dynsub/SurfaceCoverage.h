@@ -29,6 +29,7 @@ struct SurfaceCoverage {
   double spacing = 0.0;            // mm: the median over the points of the distance to their nearest other point
   double maxGap = 0.0;             // mm: the largest distance from a tessellation vertex to its nearest point
   double uncoveredFraction = 0.0;  // of the surface's area (above)
+  Eigen::VectorXd distances;       // mm: from each tessellation vertex to its nearest point
 };
 
 // `points`: what the surface was fitted to (outliers set aside), at least 2;

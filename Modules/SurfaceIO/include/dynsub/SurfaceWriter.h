@@ -25,6 +25,10 @@ struct PointScalars {
 // the nearest edge of the edge map (mm; -1 outside the region of interest,
 // where it is unknown). The figures colour a surface that has it by it.
 constexpr char kEdgeDistanceScalars[] = "edge_distance_mm";
+// The point data a fitted surface carries: each point's distance to the
+// nearest point of the scan (mm; SurfaceCoverage.h). Where it is large, the
+// surface has no data under it.
+constexpr char kScanDistanceScalars[] = "scan_distance_mm";
 
 // `space`, when not empty, names the coordinate system of a .vtp as the
 // field-data string array "SPACE" that 3D Slicer reads, and of a .vtk as
