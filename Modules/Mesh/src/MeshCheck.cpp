@@ -1,9 +1,11 @@
 #include "dynsub/MeshCheck.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <numeric>
 #include <string>
+#include <tuple>
 
 #include "dynsub/Error.h"
 #include "dynsub/Topology.h"
@@ -60,11 +62,14 @@ void checkPolygonMesh(const MatrixX3& points, const std::vector<std::vector<int>
   const double minimumArea = 1e-12 * diagonal * diagonal;
 
   std::vector<std::vector<int>> vertexFaces(vertexCount);
-  std::map<std::pair<int, int>, int> directedEdgeFace;  // (from, to) -> face
-  std::map<std::pair<int, int>, int> edgeFaceCount;     // (min, max) -> #faces
-  // Reported after the edge counts: an edge with three faces always repeats a
-  // direction, and "not manifold" is then the truer message.
-  std::string orientationProblem;
+  // Every face's edges, each as it runs in that face.
+  struct FaceEdge {
+    int low, high;  // the edge's vertices, in order
+    int from;       // where the face runs along it from
+    int face;
+    size_t order;  // its place in the faces' order
+  };
+  std::vector<FaceEdge> faceEdges;
   for (size_t f = 0; f < faces.size(); ++f) {
     const std::vector<int>& face = faces[f];
     const std::string faceName = "face " + std::to_string(f);
@@ -100,23 +105,43 @@ void checkPolygonMesh(const MatrixX3& points, const std::vector<std::vector<int>
       const int a = face[k];
       const int b = face[(k + 1) % face.size()];
       vertexFaces[a].push_back(static_cast<int>(f));
-      auto [it, inserted] = directedEdgeFace.emplace(std::make_pair(a, b), static_cast<int>(f));
-      if (!inserted && orientationProblem.empty()) {
-        orientationProblem = "faces " + std::to_string(it->second) + " and " + std::to_string(f) +
-                             " both run along edge " + edgeName(a, b) +
-                             " in the same direction: the orientation is inconsistent "
-                             "(or a face is repeated)";
-      }
-      ++edgeFaceCount[{std::min(a, b), std::max(a, b)}];
+      faceEdges.push_back({std::min(a, b), std::max(a, b), a, static_cast<int>(f), faceEdges.size()});
     }
   }
-  for (const auto& [edge, count] : edgeFaceCount) {
-    if (count > 2) {
-      throw Error(source, "edge " + edgeName(edge.first, edge.second) + " is shared by " +
-                              std::to_string(count) + " faces: the mesh is not manifold");
+  // Sorted, the faces of one edge are neighbours, those running along it the
+  // same way too, each run in the faces' order.
+  std::sort(faceEdges.begin(), faceEdges.end(), [](const FaceEdge& x, const FaceEdge& y) {
+    return std::tie(x.low, x.high, x.from, x.order) < std::tie(y.low, y.high, y.from, y.order);
+  });
+  for (size_t first = 0, last = 0; first < faceEdges.size(); first = last) {
+    while (last < faceEdges.size() && faceEdges[last].low == faceEdges[first].low &&
+           faceEdges[last].high == faceEdges[first].high)
+      ++last;
+    if (last - first > 2) {
+      throw Error(source, "edge " + edgeName(faceEdges[first].low, faceEdges[first].high) + " is shared by " +
+                              std::to_string(last - first) + " faces: the mesh is not manifold");
     }
   }
-  if (!orientationProblem.empty()) throw Error(source, orientationProblem);
+  // Checked after the edges' face counts: an edge with three faces always
+  // repeats a direction, and "not manifold" is then the truer message. Of
+  // two faces along an edge the same way, the one met first in the faces'
+  // order is named, with the face that ran along it before.
+  const FaceEdge* repeated = nullptr;
+  const FaceEdge* before = nullptr;
+  for (size_t e = 1; e < faceEdges.size(); ++e) {
+    const FaceEdge& x = faceEdges[e - 1];
+    const FaceEdge& y = faceEdges[e];
+    if (x.low == y.low && x.high == y.high && x.from == y.from && (!repeated || y.order < repeated->order)) {
+      repeated = &y;
+      before = &x;
+    }
+  }
+  if (repeated) {
+    const int to = repeated->from == repeated->low ? repeated->high : repeated->low;
+    throw Error(source, "faces " + std::to_string(before->face) + " and " + std::to_string(repeated->face) +
+                            " both run along edge " + edgeName(repeated->from, to) +
+                            " in the same direction: the orientation is inconsistent (or a face is repeated)");
+  }
   for (int v = 0; v < vertexCount; ++v) {
     if (vertexFaces[v].empty()) {
       throw Error(source, "vertex " + std::to_string(v) + " is isolated: no face uses it");

@@ -68,7 +68,7 @@ TEST(MeshCheck, RejectsIsolatedVertices) {
 TEST(MeshCheck, RejectsNonManifoldEdges) {
   MatrixX3 points(5, 3);
   points << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1;
-  expectRejected(points, {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}}, "shared by 3 faces");
+  expectRejected(points, {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}}, "edge (0, 1) is shared by 3 faces");
 }
 
 TEST(MeshCheck, RejectsNonManifoldVertices) {
@@ -79,7 +79,13 @@ TEST(MeshCheck, RejectsNonManifoldVertices) {
 }
 
 TEST(MeshCheck, RejectsInconsistentOrientation) {
-  expectRejected(gridPoints(3, 2), {{0, 1, 4, 3}, {1, 4, 5, 2}}, "orientation is inconsistent");
+  expectRejected(gridPoints(3, 2), {{0, 1, 4, 3}, {1, 4, 5, 2}},
+                 "faces 0 and 1 both run along edge (1, 4) in the same direction: the orientation is inconsistent");
+  // Of two such edges, the one met first in the faces' order is named: face
+  // 2 runs along (4, 5) as face 0 does before it runs along (1, 4) as face 1
+  // does, though (1, 4) is the lower edge.
+  expectRejected(gridPoints(3, 3), {{4, 5, 8, 7}, {0, 1, 4, 3}, {4, 5, 2, 1}},
+                 "faces 0 and 2 both run along edge (4, 5)");
 }
 
 }  // namespace
