@@ -57,7 +57,8 @@ def main():
     rng = random.Random(args.seed)
     with open(args.output, "w") as out:
         for _ in range(count):
-            a, b, c = (vertices[i] for i in triangles[bisect.bisect(cumulative, rng.random() * total)])
+            t = min(bisect.bisect(cumulative, rng.random() * total), len(triangles) - 1)  # rounding
+            a, b, c = (vertices[i] for i in triangles[t])
             u, v = rng.random(), rng.random()
             if u + v > 1.0:
                 u, v = 1.0 - u, 1.0 - v

@@ -67,15 +67,15 @@ ControlMesh chooseInitialModel(const FitCommandOptions& o, const MatrixX3& data)
 // Uncovered surface (SurfaceCoverage.h) beyond this share of its area is
 // warned about.
 constexpr double kUncoveredWarning = 0.01;
-// Points spread over a mesh's faces to measure its coverage against: the
-// density of a dense scan, found in about 10 ms.
+// Points spread over a mesh's faces to measure its coverage against (at
+// least one per triangle): the density of a dense scan.
 constexpr int kMeshCoverageSamples = 30000;
 
 std::string uncoveredWarning(const SurfaceCoverage& coverage, const std::string& scan, double maxError,
                              double diameter) {
   std::ostringstream text;
   text << std::fixed << std::setprecision(1) << 100.0 * coverage.uncoveredFraction
-       << " % of the fitted surface's area lies farther than " << kCoverageSpacings
+       << " % of the fitted surface's area lies farther than " << std::setprecision(0) << kCoverageSpacings
        << " point spacings plus the max error (" << std::setprecision(3)
        << kCoverageSpacings * coverage.spacing + maxError << " mm) from " << scan << ", up to " << std::setprecision(2)
        << 100.0 * coverage.maxGap / diameter
@@ -171,8 +171,10 @@ void runFit(FitCommandOptions o) {
   const TriangleSurface surface = outputSurface(result.mesh, *result.surface);
   // A mesh's coverage is measured against its faces, a scan's against its points.
   const double maxError = result.error.maxPercent * diameter / 100.0;
-  const SurfaceCoverage coverage = measureSurfaceCoverage(
-      surface, input.faces.empty() ? data : sampleMeshFaces(scan, input.faces, kMeshCoverageSamples), maxError);
+  const MatrixX3 faceSamples =
+      input.faces.empty() ? MatrixX3() : sampleMeshFaces(scan, input.faces, kMeshCoverageSamples);
+  const SurfaceCoverage coverage =
+      measureSurfaceCoverage(surface, faceSamples.rows() >= 2 ? faceSamples : data, maxError);
   // A closed mesh of another genus has been warned about already, with its cause.
   if (coverage.uncoveredFraction > kUncoveredWarning && (dataGenus < 0 || dataGenus == initial.genus())) {
     warnings.push_back(uncoveredWarning(coverage, o.points, maxError, diameter));

@@ -16,15 +16,24 @@ SurfaceCoverage measureSurfaceCoverage(const TriangleSurface& surface, const Mat
   const PointTree tree(3, rows, nanoflann::KDTreeSingleIndexAdaptorParams(16));
   SurfaceCoverage coverage;
 
-  std::vector<double> nearest(static_cast<size_t>(points.rows()));
+  // The nearest other point at a distance: a scan may repeat points (an
+  // export that did not merge them), and their zeros are no spacing.
+  std::vector<double> nearest(static_cast<size_t>(points.rows()), 0.0);
   parallelFor(points.rows(), threadsWorth(points.rows()), [&](Eigen::Index i) {
-    unsigned found[2];  // the point itself, and its nearest other
-    double squared[2];
+    constexpr size_t kAsked = 8;
+    unsigned found[kAsked];
+    double squared[kAsked];
     const Vector3 q = points.row(i).transpose();
-    tree.knnSearch(q.data(), 2, found, squared);
-    nearest[static_cast<size_t>(i)] = std::sqrt(squared[1]);
+    const size_t got = tree.knnSearch(q.data(), std::min<size_t>(kAsked, points.rows()), found, squared);
+    for (size_t k = 0; k < got; ++k) {
+      if (squared[k] > 0.0) {
+        nearest[static_cast<size_t>(i)] = std::sqrt(squared[k]);
+        break;
+      }
+    }
   });
-  coverage.spacing = percentile(std::move(nearest), 0.5);
+  nearest.erase(std::remove(nearest.begin(), nearest.end(), 0.0), nearest.end());
+  coverage.spacing = nearest.empty() ? 0.0 : percentile(std::move(nearest), 0.5);
 
   const Eigen::Index n = surface.points.rows();
   Eigen::VectorXd& gap = coverage.distances;
@@ -64,6 +73,8 @@ MatrixX3 sampleMeshFaces(const MatrixX3& points, const std::vector<std::vector<i
   std::vector<Triangle> triangles;
   double total = 0.0;
   for (const auto& face : faces) {
+    const bool inRange = std::all_of(face.begin(), face.end(), [&](int v) { return v >= 0 && v < points.rows(); });
+    if (!inRange) continue;
     for (size_t k = 1; k + 1 < face.size(); ++k) {
       Triangle t{points.row(face[0]).transpose(), points.row(face[k]).transpose(), points.row(face[k + 1]).transpose(),
                  0.0, 0.0};
@@ -72,7 +83,8 @@ MatrixX3 sampleMeshFaces(const MatrixX3& points, const std::vector<std::vector<i
       triangles.push_back(t);
     }
   }
-  if (!(total > 0.0) || count < 1) throw Error("internal: no mesh area to sample");
+  if (count < 1) throw Error("internal: asked for no samples of a mesh");
+  if (!(total > 0.0)) return MatrixX3();
   // A triangle cut into m x m sub-triangles about h apart along its longest
   // edge L gives m^2 = (L / h)^2 samples: h is set so that they add up to
   // `count`.

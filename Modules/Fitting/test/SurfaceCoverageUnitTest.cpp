@@ -57,6 +57,12 @@ TEST(SurfaceCoverage, SurfaceBeyondTheMarginIsUncovered) {
   EXPECT_NEAR(c.maxGap, std::hypot(0.5, 0.005), 1e-12);  // from (1, 0.005) to (0.5, 0)
   EXPECT_NEAR(measureSurfaceCoverage(s, left, 0.1).uncoveredFraction, 1.0 - 0.64, 0.005);
   EXPECT_THROW(measureSurfaceCoverage(s, left.topRows(1), 0.0), Error);
+
+  // Each point twice, as an export that did not merge them writes it: the
+  // spacing is still the distance to the next point, not 0.
+  MatrixX3 twice(2 * left.rows(), 3);
+  twice << left, left;
+  EXPECT_NEAR(measureSurfaceCoverage(s, twice, 0.0).spacing, 0.01, 1e-12);
 }
 
 TEST(SurfaceCoverage, MeshSamplesSpreadOverTheFacesAndStayInThem) {
@@ -78,7 +84,9 @@ TEST(SurfaceCoverage, MeshSamplesSpreadOverTheFacesAndStayInThem) {
   two << 0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1e-4, 0;
   const MatrixX3 few = sampleMeshFaces(two, {{0, 1, 2}, {0, 3, 1}}, 1000);
   EXPECT_EQ((few.col(1).array() < 1e-4).count(), 4);
-  EXPECT_THROW(sampleMeshFaces(corners, {{0, 1, 1}}, 100), Error);
+  EXPECT_EQ(sampleMeshFaces(corners, {{0, 1, 1}}, 100).rows(), 0);  // no area
+  EXPECT_EQ(sampleMeshFaces(corners, {{0, 1, 7}}, 100).rows(), 0);  // no such vertex
+  EXPECT_THROW(sampleMeshFaces(corners, {{0, 1, 2}}, 0), Error);
 }
 
 }  // namespace

@@ -86,6 +86,8 @@ TEST(MeshCheck, RejectsInconsistentOrientation) {
   // does, though (1, 4) is the lower edge.
   expectRejected(gridPoints(3, 3), {{4, 5, 8, 7}, {0, 1, 4, 3}, {4, 5, 2, 1}},
                  "faces 0 and 2 both run along edge (4, 5)");
+  // The edge is named the way the faces run along it.
+  expectRejected(gridPoints(3, 3), {{0, 1, 4, 3}, {4, 3, 6, 7}}, "faces 0 and 1 both run along edge (4, 3)");
 }
 
 }  // namespace

@@ -137,6 +137,13 @@ PointCloud readPointCloud(const std::string& path) {
   if (extension == ".ply" || extension == ".off" || extension == ".obj") {
     PolygonData data = readPolygonData(path);
     if (data.points.rows() == 0) throw Error(path, "has no points");
+    // The fit measures its coverage against the faces (SurfaceCoverage.h).
+    for (const std::vector<int>& face : data.faces) {
+      for (int v : face) {
+        if (v < 0 || v >= data.points.rows())
+          throw Error(path, "a polygon names point " + std::to_string(v) + " of " + std::to_string(data.points.rows()));
+      }
+    }
     const bool faces = !data.faces.empty();
     return {std::move(data.points), faces, std::move(data.faces)};
   }

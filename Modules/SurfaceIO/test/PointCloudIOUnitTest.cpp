@@ -112,4 +112,14 @@ TEST(PointCloudIO, RefusesUnknownFormats) {
   EXPECT_THROW(dynsub::readPointCloud(path), dynsub::Error);
 }
 
+TEST(PointCloudIO, RefusesPolygonsNamingPointsItHasNot) {
+  const std::string path = writeText("overshoot.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n");
+  try {
+    dynsub::readPointCloud(path);
+    FAIL() << "read a triangle naming point 9 of 3";
+  } catch (const dynsub::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("overshoot.off: a polygon names point 9 of 3"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace

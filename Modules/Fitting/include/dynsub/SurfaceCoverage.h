@@ -13,9 +13,9 @@
 // from the points, which a covered vertex may have too). On the synthetic
 // tuning clouds (Tools/tuning_clouds.py) and the torus fitted from the torus,
 // 3 spacings left at most 0.1 % of the area uncovered and 4 none; on clouds
-// sampled from CGAL's meshes, the webs between a cow's or a camel's legs, a
-// sphere over the torus's hole and the cap over a mushroom's opening left
-// 5-45 %.
+// sampled from CGAL's meshes (Tools/sample_mesh.py), the cap over a
+// mushroom's opening left 4 %, a sphere over the torus's hole 10 % and the
+// webs between a cow's or a camel's legs 13 and 28 %.
 #include <vector>
 
 #include "dynsub/Tessellation.h"
@@ -26,7 +26,7 @@ namespace dynsub {
 constexpr double kCoverageSpacings = 4.0;
 
 struct SurfaceCoverage {
-  double spacing = 0.0;            // mm: the median over the points of the distance to their nearest other point
+  double spacing = 0.0;            // mm: the median over the points of the distance to their nearest point elsewhere
   double maxGap = 0.0;             // mm: the largest distance from a tessellation vertex to its nearest point
   double uncoveredFraction = 0.0;  // of the surface's area (above)
   Eigen::VectorXd distances;       // mm: from each tessellation vertex to its nearest point
@@ -37,10 +37,11 @@ struct SurfaceCoverage {
 SurfaceCoverage measureSurfaceCoverage(const TriangleSurface& surface, const MatrixX3& points, double maxError);
 
 // About `count` points spread evenly over a mesh's polygons (each cut into a
-// fan of triangles): the centroids of a regular subdivision of each
-// triangle. A mesh's vertices are no sample of its surface (a large flat
-// triangle has none inside), so a mesh's coverage is measured against these.
-// Throws dynsub::Error when the faces have no area.
+// fan of triangles), and at least one per triangle: the centroids of a
+// regular subdivision of each triangle. A mesh's vertices are no sample of
+// its surface (a large flat triangle has none inside), so a mesh's coverage
+// is measured against these. Faces naming a vertex out of range are left
+// out; empty when the faces have no area.
 MatrixX3 sampleMeshFaces(const MatrixX3& points, const std::vector<std::vector<int>>& faces, int count);
 
 }  // namespace dynsub
