@@ -3,13 +3,17 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <string>
 
 #include <Eigen/Eigenvalues>
 
+#include "PointTree.h"
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/Error.h"
+#include "dynsub/Forces.h"
 #include "dynsub/LimitSurface.h"
+#include "dynsub/ParallelFor.h"
 #include "dynsub/ScanNoise.h"
 #include "dynsub/StandardMeshes.h"
 #include "dynsub/Tessellation.h"
@@ -84,6 +88,53 @@ std::vector<int> grownFaces(const Topology& mesh, const std::vector<int>& faces,
   return result;
 }
 
+
+// Springs from the surface to the data: at each quadrature point of the
+// surface, a spring of stiffness `stiffness` x its parametric area to the
+// nearest data point, found again at every evaluation. The data springs pull
+// only the surface that some point is nearest to; these pull the rest too,
+// such as a web across a gap between two limbs, onto the scan.
+class SurfaceSprings final : public ForceModel {
+ public:
+  SurfaceSprings(const MatrixX3& data, double stiffness)
+      : rows_{data}, tree_(3, rows_, nanoflann::KDTreeSingleIndexAdaptorParams(16)), stiffness_(stiffness) {}
+
+  void beginLevel(const LimitSurface&, const SurfaceQuadrature& quadrature, const MatrixX3&) override {
+    quadrature_ = &quadrature;
+  }
+
+  MatrixX3 generalizedForce(const MatrixX3& controlPoints, double& potential) override {
+    const MatrixX3 positions = quadrature_->J * controlPoints;
+    MatrixX3 pulls(positions.rows(), 3);
+    Eigen::VectorXd energies(positions.rows());
+    parallelFor(positions.rows(), threadsWorth(positions.rows()), [&](Eigen::Index i) {
+      unsigned nearest = 0;
+      double squared = 0.0;
+      const Vector3 x = positions.row(i).transpose();
+      tree_.knnSearch(x.data(), 1, &nearest, &squared);
+      const double k = stiffness_ * quadrature_->weights(i);
+      pulls.row(i) = k * (rows_.points.row(nearest) - positions.row(i));
+      energies(i) = 0.5 * k * squared;
+    });
+    potential += energies.sum();
+    return quadrature_->J.transpose() * pulls;
+  }
+
+  // k J^T W J: the exact derivative while each spring keeps its data point.
+  SparseMatrix stabilizingStiffness(const MatrixX3&) override {
+    const Eigen::VectorXd k = stiffness_ * quadrature_->weights;
+    return SparseMatrix(quadrature_->J.transpose() * k.asDiagonal() * quadrature_->J);
+  }
+
+  bool hasPotential() const override { return true; }
+
+ private:
+  PointRows rows_;
+  PointTree tree_;
+  double stiffness_;
+  const SurfaceQuadrature* quadrature_ = nullptr;
+};
+
 }  // namespace
 
 FitError measureFitError(const LimitSurface& surface, const MatrixX3& controlPoints, const MatrixX3& data,
@@ -125,6 +176,9 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
   if (!(std::isfinite(options.noise) && options.noise >= 0.0)) {
     throw Error("the data's noise must be finite and >= 0 mm");
   }
+  if (!(std::isfinite(options.surfaceSprings) && options.surfaceSprings >= 0.0)) {
+    throw Error("the surface springs' stiffness must be finite and >= 0");
+  }
   FitResult result;
   result.enclosingSphere = smallestEnclosingSphere(data);
   const double diameter = 2.0 * result.enclosingSphere.radius;
@@ -140,6 +194,12 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
       Eigen::VectorXd::Constant(data.rows(), options.dataStiffness * area / static_cast<double>(data.rows()));
   SpringForceModel springs(data, stiffness, SpringForceModel::Attach::NearestEachStep);
   springs.setSamplePerElement(options.springsPerElement);
+  std::vector<ForceModel*> forces{&springs};
+  std::unique_ptr<SurfaceSprings> surfaceSprings;
+  if (options.surfaceSprings > 0.0) {
+    surfaceSprings = std::make_unique<SurfaceSprings>(data, options.surfaceSprings * options.dataStiffness);
+    forces.push_back(surfaceSprings.get());
+  }
 
   // The springs' lengths are the data's distances where the forces were
   // last evaluated (`points`, whenever the fit is asked before a level's
@@ -240,7 +300,7 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
     region = [&](const Topology& mesh) { return grownFaces(mesh, facesToRefine, kRefineRings); };
   }
   SimulationResult simulation =
-      simulate(initial, {&springs}, {}, options.simulation, accept, progressWithDistances, region);
+      simulate(initial, forces, {}, options.simulation, accept, progressWithDistances, region);
   result.mesh = std::move(simulation.mesh);
   result.surface = std::move(simulation.surface);
   result.levels = std::move(simulation.levels);
