@@ -343,8 +343,8 @@ void addFitCommand(CLI::App& app) {
       ->add_option("--surface-springs", o->fit.surfaceSprings,
                    "Stiffness of springs from each point of the surface to its nearest data point, relative to the "
                    "data springs' (0: none, the papers' fit). They pull webs and membranes that no data point is "
-                   "nearest to onto the scan; 0.1 removed most of those the coverage warning reported on CGAL's "
-                   "meshes, in 1.4-5 times the time")
+                   "nearest to onto the scan; 0.1 removed most of those the coverage warning reported on clouds of "
+                   "CGAL's meshes, in 0.8-1.5 times the time")
       ->default_val(0.0)
       ->check(nonNegativeNumber());
   command->add_flag("--to-equilibrium", o->fit.toEquilibrium,

@@ -49,9 +49,9 @@
 // join each quadrature point of the surface to its nearest data point, and
 // pull such webs onto the scan. On clouds sampled from CGAL's meshes at 1 %,
 // 0.1 of the data springs' stiffness left 0-0.02 % of a cow's, a femur's and
-// a triceratops's surface uncovered where there were 5-13 %, and 2-14 % of a
-// dino's, a man's and a diplodocus's where there were 21-28 %, in 1.4-5 times
-// the time; 0.25 did no better, slower.
+// a triceratops's surface uncovered where there were 5-13 %, and 2-15 % of a
+// dino's, a man's and a diplodocus's where there were 21-28 %, in 0.8-1.5
+// times the time; 0.25 did no better.
 //
 // Springs per element: a level whose surface has E elements is pulled by at
 // most springsPerElement x E of the data's springs, a fixed random sample
