@@ -88,7 +88,6 @@ std::vector<int> grownFaces(const Topology& mesh, const std::vector<int>& faces,
   return result;
 }
 
-
 // Springs from the surface to the data: at each quadrature point of the
 // surface, a spring of stiffness `stiffness` x its parametric area to the
 // nearest data point, found again at every evaluation. The data springs pull
