@@ -193,8 +193,8 @@ ok = ok and 'surface where the scan has none' in open(sys.argv[3]).read()
 sys.exit(0 if ok else 1)" "$work/fithole/report.json" "$work/nofig/report.json" "$work/fithole.err"
 check "the fitted surface carries each point's distance to the scan" \
   grep -qa 'Name="scan_distance_mm"' "$work/fithole/surface.vtp"
-# Surface springs pull the membrane toward the ring (6.7 % of the area left
-# uncovered against 10.2 % when this was written; a fifth less is asked).
+# Surface springs pull the membrane toward the ring: 6.7 % of the area is
+# left uncovered with them against 10.2 % without, and a fifth less is asked.
 "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --surface-springs 0.1 --no-figures --out "$work/fitsprings" \
   >/dev/null 2>"$work/fitsprings.err"
 check "surface springs pull uncovered surface onto the cloud" python3 -c "
