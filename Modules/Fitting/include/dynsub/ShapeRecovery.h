@@ -51,7 +51,10 @@
 // 0.1 of the data springs' stiffness left 0-0.02 % of a cow's, a femur's and
 // a triceratops's surface uncovered where there were 5-13 %, and 2-15 % of a
 // dino's, a man's and a diplodocus's where there were 21-28 %, in 0.8-1.5
-// times the time; 0.25 did no better.
+// times the time; 0.25 did no better. They are off by default: noisy scans
+// fit worse with them (the kitten with 0.3 % noise and 3 % outliers ends 1.5 %
+// from its clean points instead of 0.98 %), and a scan without webs only
+// pays for them (Documentation/Dynamics.md, "Surface springs").
 //
 // Springs per element: a level whose surface has E elements is pulled by at
 // most springsPerElement x E of the data's springs, a fixed random sample
