@@ -63,25 +63,16 @@ FigureFiles FigureOptions::files(OutputSet& outputs, bool convergence) const {
   return files;
 }
 
-void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const ControlMesh& mesh,
-                      const TriangleSurface& surface, const ConvergenceHistory& history, const Volume* image,
-                      const MatrixX3& landmarks, const MatrixX3& dataPoints, const Eigen::VectorXd& edgeDistances) {
-  writeConvergenceCsv(history, outputs.add("convergence.csv"));
+void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const ControlMesh& mesh, FigureInputs inputs) {
+  writeConvergenceCsv(*inputs.history, outputs.add("convergence.csv"));
   if (!options.figures) return;
   std::string why;
   if (!figureDisplay(&why)) {
     std::cerr << "warning: no figures written: " << why << '\n';
     return;
   }
-  FigureInputs inputs;
-  inputs.surface = &surface;
-  inputs.image = image;
   // Without an image the control mesh shows what the surface is made of.
-  if (!image) inputs.controlMesh = &mesh;
-  inputs.landmarks = landmarks;
-  inputs.dataPoints = dataPoints;
-  inputs.history = &history;
-  inputs.edgeDistances = edgeDistances;
+  if (!inputs.image) inputs.controlMesh = &mesh;
   inputs.coordinates = options.coordinates;
   writeFigures(inputs, options.files(outputs, true));
 }

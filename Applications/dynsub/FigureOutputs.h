@@ -40,16 +40,11 @@ struct FigureOptions {
   FigureFiles files(OutputSet& outputs, bool convergence) const;
 };
 
-// Adds convergence.csv and, if wanted and possible, the three figures to
-// `outputs`. Without a display it says so on stderr and writes no figure.
-// `surface` is the result's limit surface (outputSurface); `image` may be
-// null (the control mesh is then drawn too); landmarks and dataPoints are
-// #points x 3 (mm), possibly empty; edgeDistances, when not empty, colour the
-// surface and its contours (a segmentation's distance to the nearest edge per
-// point of `surface`, Figures.h).
-void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const ControlMesh& mesh,
-                      const TriangleSurface& surface, const ConvergenceHistory& history, const Volume* image,
-                      const MatrixX3& landmarks, const MatrixX3& dataPoints,
-                      const Eigen::VectorXd& edgeDistances = Eigen::VectorXd());
+// Adds convergence.csv (of inputs.history, required) and, if wanted and
+// possible, the three figures to `outputs`. Without a display it says so on
+// stderr and writes no figure. `inputs` names the result's limit surface
+// (outputSurface), and what else the figures show; without an image they
+// draw `mesh` too. The figures' coordinates are the options'.
+void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const ControlMesh& mesh, FigureInputs inputs);
 
 }  // namespace dynsub::app

@@ -71,14 +71,13 @@ constexpr double kUncoveredWarning = 0.01;
 // least one per triangle): the density of a dense scan.
 constexpr int kMeshCoverageSamples = 30000;
 
-std::string uncoveredWarning(const SurfaceCoverage& coverage, const std::string& scan, double maxError,
-                             double diameter, bool surfaceSprings) {
+std::string uncoveredWarning(const SurfaceCoverage& coverage, const std::string& scan, double diameter,
+                             bool surfaceSprings) {
   std::ostringstream text;
   text << std::fixed << std::setprecision(1) << 100.0 * coverage.uncoveredFraction
        << " % of the fitted surface's area lies farther than " << std::setprecision(0) << kCoverageSpacings
-       << " point spacings plus the max error (" << std::setprecision(3)
-       << kCoverageSpacings * coverage.spacing + maxError << " mm) from " << scan << ", up to " << std::setprecision(2)
-       << 100.0 * coverage.maxGap / diameter
+       << " point spacings plus the max error (" << std::setprecision(3) << coverage.limit << " mm) from " << scan
+       << ", up to " << std::setprecision(2) << 100.0 * coverage.maxGap / diameter
        << " % of the diameter away: surface where the scan has none, which the fit's error, measured from the points "
           "to the surface, does not see. It is a web across a gap the model has not followed, a membrane over a hole "
           "the model's genus cannot keep (--init torus, or --init MESH with a closed control mesh of the scan's "
@@ -178,7 +177,7 @@ void runFit(FitCommandOptions o) {
       measureSurfaceCoverage(surface, faceSamples.rows() >= 2 ? faceSamples : data, maxError);
   // A closed mesh of another genus has been warned about already, with its cause.
   if (coverage.uncoveredFraction > kUncoveredWarning && (dataGenus < 0 || dataGenus == initial.genus())) {
-    warnings.push_back(uncoveredWarning(coverage, o.points, maxError, diameter, o.fit.surfaceSprings > 0.0));
+    warnings.push_back(uncoveredWarning(coverage, o.points, diameter, o.fit.surfaceSprings > 0.0));
   }
 
   Report report;
@@ -249,8 +248,17 @@ void runFit(FitCommandOptions o) {
   report.set("parameters", parameters);
 
   writeModelOutputs(dir, result.mesh, surface, report, [&](OutputSet& outputs) {
-    addFigureOutputs(outputs, o.figures, result.mesh, surface, history, nullptr, MatrixX3(), data);
-  }, {{kScanDistanceScalars, coverage.distances}});
+    FigureInputs inputs;
+    inputs.surface = &surface;
+    inputs.dataPoints = data;
+    inputs.history = &history;
+    // Coloured by the distance to the scan, magenta where uncovered.
+    if (coverage.limit > 0.0) {
+      inputs.scanDistances = coverage.distances;
+      inputs.scanDistanceFar = coverage.limit;
+    }
+    addFigureOutputs(outputs, o.figures, result.mesh, inputs);
+  }, {{kScanDistanceScalars, coverage.distances, coverage.limit}});
 
   std::cout << std::fixed << std::setprecision(3) << "fitted " << data.rows() << " points with "
             << result.mesh.vertexCount() << " control vertices";

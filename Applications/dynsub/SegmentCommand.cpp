@@ -97,8 +97,13 @@ void writeSegmentOutputs(const std::filesystem::path& dir, const SegmentOutcome&
         const std::string labelmapPath = outputs.add("labelmap.nii.gz");
         const auto labelmap = [&] { writeMask(outcome.labelmap, labelmapPath); };
         const auto figuresAndRecord = [&] {
-          addFigureOutputs(outputs, figures, result.mesh, result.surface, outcome.history, &image,
-                           landmarkPositions(outcome.springs), MatrixX3(), result.surfaceEdgeDistances);
+          FigureInputs inputs;
+          inputs.surface = &result.surface;
+          inputs.image = &image;
+          inputs.landmarks = landmarkPositions(outcome.springs);
+          inputs.history = &outcome.history;
+          inputs.edgeDistances = result.surfaceEdgeDistances;
+          addFigureOutputs(outputs, figures, result.mesh, inputs);
         };
         // With figures, the labelmap is compressed on a thread of its own
         // while they render on this one (a tenth of them). Without, this

@@ -182,8 +182,9 @@ check "--no-figures still writes convergence.csv" test -s "$work/nofig/convergen
 # A cloud has no genus to compare: the automatic (genus 0) model spans the
 # torus's hole, which only the surface's distance to the points shows (10 %
 # of its area at 4 spacings, none from the torus; SurfaceCoverage.h), and
-# surface.vtp carries that distance for a viewer to colour by.
-"$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --no-figures --out "$work/fithole" >/dev/null 2>"$work/fithole.err"
+# surface.vtp carries that distance for a viewer to colour by, with the
+# limit from which the figures colour it magenta.
+"$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --out "$work/fithole" >/dev/null 2>"$work/fithole.err"
 check "fit warns of surface the cloud does not cover" python3 -c "
 import json, sys
 auto, torus = (json.load(open(path))['surface_coverage'] for path in sys.argv[1:3])
@@ -193,6 +194,14 @@ ok = ok and 'surface where the scan has none' in open(sys.argv[3]).read()
 sys.exit(0 if ok else 1)" "$work/fithole/report.json" "$work/nofig/report.json" "$work/fithole.err"
 check "the fitted surface carries each point's distance to the scan" \
   grep -qa 'Name="scan_distance_mm"' "$work/fithole/surface.vtp"
+check "the fitted surface carries the distance's far limit" \
+  grep -qa 'Name="scan_distance_mm_far"' "$work/fithole/surface.vtp"
+"$DYNSUB" render --surface "$work/fithole/surface.vtp" --points "$DATA/PointClouds/torus.xyz" \
+  --control-mesh "$work/fithole/control_mesh.obj" --out "$work/fitholerendered" >/dev/null
+for name in slices.png surface3d.png; do
+  check "render redraws fit's $name, coloured by the distance to the scan, pixel for pixel" \
+    cmp -s "$work/fitholerendered/$name" "$work/fithole/$name"
+done
 # Surface springs pull the membrane toward the ring: 6.7 % of the area is
 # left uncovered with them against 10.2 % without, and a fifth less is asked.
 "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --surface-springs 0.1 --no-figures --out "$work/fitsprings" \

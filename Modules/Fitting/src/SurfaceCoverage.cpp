@@ -57,10 +57,10 @@ SurfaceCoverage measureSurfaceCoverage(const TriangleSurface& surface, const Mat
     for (int corner : t) area(corner) += third;
   }
   const double total = area.sum();
-  const double limit = kCoverageSpacings * coverage.spacing + maxError;
+  coverage.limit = kCoverageSpacings * coverage.spacing + maxError;
   double uncovered = 0.0;
   for (Eigen::Index v = 0; v < n; ++v)
-    if (gap(v) > limit) uncovered += area(v);
+    if (gap(v) > coverage.limit) uncovered += area(v);
   coverage.uncoveredFraction = total > 0.0 ? uncovered / total : 0.0;
   return coverage;
 }

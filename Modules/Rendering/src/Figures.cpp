@@ -12,6 +12,8 @@
 #include <vtkContextActor.h>
 #include <vtkContextScene.h>
 #include <vtkGL2PSExporter.h>
+#include <vtkDataArray.h>
+#include <vtkFieldData.h>
 #include <vtkImageData.h>
 #include <vtkNew.h>
 #include <vtkPen.h>
@@ -36,6 +38,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <iterator>
 #include <memory>
 #include <sstream>
@@ -94,11 +97,11 @@ std::array<double, 3> landmarkColour() {
 // landmarks and the range data as drawn, and the coordinates the captions use.
 void addLegend(const FigureScene& scene, vtkRenderWindow* window) {
   std::vector<std::pair<std::string, std::array<double, 3>>> items;
-  if (scene.edgeDistances) {
-    items.push_back({"contour on an image edge", style::kOnEdge});
+  if (scene.distances) {
+    items.push_back({"contour on " + scene.distances->on, style::kNear});
     std::ostringstream far;
-    far << "contour " << style::kFarFromEdges << " mm or more from any edge";
-    items.push_back({far.str(), style::kOffEdge});
+    far << std::setprecision(3) << "contour " << scene.distances->far << " mm or more from " << scene.distances->from;
+    items.push_back({far.str(), style::kFar});
   } else {
     items.push_back({"contour on a normal element", style::kNormalElement});
     items.push_back({"contour on a special element", style::kSpecialElement});
@@ -133,6 +136,14 @@ std::string coordinatesName(FigureCoordinates coordinates) {
   return coordinates == FigureCoordinates::Ras ? "RAS" : "LPS";
 }
 
+DistanceColours edgeDistanceColours() {
+  return {kEdgeDistanceScalars, style::kFarFromEdges, "an edge", "an image edge", "any edge"};
+}
+
+DistanceColours scanDistanceColours(double far) {
+  return {kScanDistanceScalars, far, "the scan", "the scan", "the scan"};
+}
+
 namespace {
 
 // The figures drawn into a window, which is sized for them (its renderers
@@ -161,8 +172,12 @@ void drawSlices(const FigureScene& scene, vtkRenderWindow* window) {
     SlicePlane axes = image ? image->plane(orientation, 0) : anatomicalPlane(orientation, centre, 0.015 * diagonal);
     const Eigen::VectorXd along = points * axes.normal;
     const Eigen::VectorXd across = points * axes.right, upward = points * axes.up;
+    // Room around the surface, 30 % of its size; around a structure in an
+    // image, 3 mm of its neighbourhood too (not around a scan, which may be
+    // a fraction of a mm across).
     const double halfSize =
-        0.5 * 1.3 * std::max(across.maxCoeff() - across.minCoeff(), upward.maxCoeff() - upward.minCoeff()) + 3.0;
+        0.5 * 1.3 * std::max(across.maxCoeff() - across.minCoeff(), upward.maxCoeff() - upward.minCoeff()) +
+        (image ? 3.0 : 0.0);
     for (int column = 0; column < kColumns; ++column) {
       SliceView view(orientation);
       view.setImage(image);
@@ -170,7 +185,11 @@ void drawSlices(const FigureScene& scene, vtkRenderWindow* window) {
       view.setCoordinates(scene.coordinates);
       view.setTitleVisible(false);  // in the caption strip, clear of the edge letters
       view.setSurface(scene.surface);
-      view.colourByEdgeDistance(scene.edgeDistances);
+      if (scene.distances) {
+        view.colourByDistance(*scene.distances);
+      } else {
+        view.colourByElementType();
+      }
       // Interior slices, evenly spread: the end slices would only graze it.
       const double t = along.minCoeff() + (column + 1.0) / (kColumns + 1.0) * (along.maxCoeff() - along.minCoeff());
       const Vector3 through = centre + (t - centre.dot(axes.normal)) * axes.normal;
@@ -236,7 +255,11 @@ void drawSurface(const FigureScene& scene, vtkRenderWindow* window) {
   window->SetSize(800, 800);
   SurfaceView view;
   view.setSurface(scene.surface);
-  view.colourByEdgeDistance(scene.edgeDistances);
+  if (scene.distances) {
+    view.colourByDistance(*scene.distances);
+  } else {
+    view.colourByElementType();
+  }
   if (scene.controlMesh) view.setControlMesh(scene.controlMesh);
   view.setLandmarks(scene.landmarks);
   if (scene.dataPoints.rows() > 0) view.setDataPoints(scene.dataPoints);
@@ -486,7 +509,23 @@ void writeFigures(const FigureInputs& inputs, const FigureFiles& files) {
   }
   FigureScene scene;
   scene.surface = surface;
-  scene.edgeDistances = surface->GetPointData()->GetArray(kEdgeDistanceScalars) != nullptr;
+  if (surface->GetPointData()->GetArray(kEdgeDistanceScalars)) scene.distances = edgeDistanceColours();
+  // A fitted surface read from its file, with the far distance it was drawn with.
+  vtkDataArray* far = surface->GetFieldData()->GetArray(farName(kScanDistanceScalars).c_str());
+  if (far && surface->GetPointData()->GetArray(kScanDistanceScalars)) {
+    if (far->GetNumberOfTuples() != 1 || far->GetNumberOfComponents() != 1 || !(far->GetTuple1(0) > 0.0) ||
+        !std::isfinite(far->GetTuple1(0)))
+      throw Error(inputs.surfaceFile,
+                  "its field array " + farName(kScanDistanceScalars) + " is not one positive number of mm");
+    scene.distances = scanDistanceColours(far->GetTuple1(0));
+  }
+  if (inputs.scanDistances.size() > 0) {
+    if (inputs.scanDistances.size() != surface->GetNumberOfPoints())
+      throw Error("internal: the scan distances are not one per point of the figure's surface");
+    if (!(inputs.scanDistanceFar > 0.0)) throw Error("internal: the scan distances' far distance is not positive");
+    addPointData(surface, kScanDistanceScalars, inputs.scanDistances);
+    scene.distances = scanDistanceColours(inputs.scanDistanceFar);
+  }
   scene.landmarks = inputs.landmarks;
   scene.dataPoints = inputs.dataPoints;
   scene.coordinates = inputs.coordinates;

@@ -22,8 +22,6 @@
 #include <vtkTextProperty.h>
 #include <vtkUnsignedCharArray.h>
 
-#include "dynsub/SurfaceWriter.h"  // kEdgeDistanceScalars
-
 namespace dynsub::style {
 
 void colourByElementType(vtkPolyDataMapper* mapper) {
@@ -41,12 +39,12 @@ void colourByElementType(vtkPolyDataMapper* mapper) {
   mapper->ScalarVisibilityOn();
 }
 
-void colourByEdgeDistance(vtkPolyDataMapper* mapper) {
+void colourByDistance(vtkPolyDataMapper* mapper, const DistanceColours& colours) {
   vtkNew<vtkLookupTable> table;
-  const Vector3 stops[3] = {Vector3(kOnEdge.data()), Vector3(kMidEdge.data()), Vector3(kOffEdge.data())};
+  const Vector3 stops[3] = {Vector3(kNear.data()), Vector3(kMiddle.data()), Vector3(kFar.data())};
   constexpr int kEntries = 64;
   table->SetNumberOfTableValues(kEntries);
-  table->SetTableRange(0, kFarFromEdges);
+  table->SetTableRange(0, colours.far);
   for (int e = 0; e < kEntries; ++e) {
     const double t = 2.0 * e / (kEntries - 1);
     const int from = std::min(static_cast<int>(t), 1);
@@ -58,20 +56,20 @@ void colourByEdgeDistance(vtkPolyDataMapper* mapper) {
   mapper->SetLookupTable(table);
   mapper->SetColorModeToMapScalars();
   mapper->SetScalarModeToUsePointFieldData();
-  mapper->SelectColorArray(kEdgeDistanceScalars);
-  mapper->SetScalarRange(0, kFarFromEdges);
+  mapper->SelectColorArray(colours.array.c_str());
+  mapper->SetScalarRange(0, colours.far);
   // Mapped per fragment, not per vertex: a triangle between a held and
   // an unknown point would otherwise blend green into grey.
   mapper->InterpolateScalarsBeforeMappingOn();
   mapper->ScalarVisibilityOn();
 }
 
-vtkSmartPointer<vtkScalarBarActor> edgeDistanceBar(vtkPolyDataMapper* mapper) {
+vtkSmartPointer<vtkScalarBarActor> distanceBar(vtkPolyDataMapper* mapper, const DistanceColours& colours) {
   auto bar = vtkSmartPointer<vtkScalarBarActor>::New();
   bar->SetLookupTable(mapper->GetLookupTable());
-  bar->SetTitle("mm to an edge");
+  bar->SetTitle(("mm to " + colours.to).c_str());
   bar->SetNumberOfLabels(4);
-  bar->SetLabelFormat("%.0f");
+  bar->SetLabelFormat("%.3g");  // a scan's far distance may be a fraction of a mm
   bar->SetOrientationToVertical();
   bar->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
   bar->GetPositionCoordinate()->SetValue(0.84, 0.1);

@@ -250,12 +250,10 @@ void SliceView::setSurface(vtkPolyData* surface) {
   impl_->contourActor->SetVisibility(surface != nullptr);
 }
 
-void SliceView::colourByEdgeDistance(bool on) {
-  if (on) {
-    style::colourByEdgeDistance(impl_->contourMapper);
-  } else {
-    style::colourByElementType(impl_->contourMapper);
-  }
+void SliceView::colourByElementType() { style::colourByElementType(impl_->contourMapper); }
+
+void SliceView::colourByDistance(const DistanceColours& colours) {
+  style::colourByDistance(impl_->contourMapper, colours);
 }
 
 void SliceView::setLandmarks(const MatrixX3& landmarks, int selected) {

@@ -68,7 +68,7 @@ struct SurfaceView::Impl {
   const ImageSlices* image = nullptr;
   vtkNew<vtkImageSliceMapper> sliceMappers[3];
   vtkNew<vtkImageSlice> sliceActors[3];
-  vtkSmartPointer<vtkScalarBarActor> edgeDistanceBar;
+  vtkSmartPointer<vtkScalarBarActor> distanceBar;
 
   Impl() {
     renderer->SetBackground(0.1, 0.1, 0.12);
@@ -106,18 +106,17 @@ void SurfaceView::setSurface(vtkPolyData* surface) {
   impl_->surfaceActor->SetVisibility(surface != nullptr);
 }
 
-void SurfaceView::colourByEdgeDistance(bool on) {
-  if (on) {
-    style::colourByEdgeDistance(impl_->surfaceMapper);
-    if (!impl_->edgeDistanceBar) {
-      impl_->edgeDistanceBar = style::edgeDistanceBar(impl_->surfaceMapper);
-      impl_->renderer->AddActor2D(impl_->edgeDistanceBar);
-    }
-  } else {
-    style::colourByElementType(impl_->surfaceMapper);
-    if (impl_->edgeDistanceBar) impl_->renderer->RemoveActor2D(impl_->edgeDistanceBar);
-    impl_->edgeDistanceBar = nullptr;
-  }
+void SurfaceView::colourByElementType() {
+  style::colourByElementType(impl_->surfaceMapper);
+  if (impl_->distanceBar) impl_->renderer->RemoveActor2D(impl_->distanceBar);
+  impl_->distanceBar = nullptr;
+}
+
+void SurfaceView::colourByDistance(const DistanceColours& colours) {
+  style::colourByDistance(impl_->surfaceMapper, colours);
+  if (impl_->distanceBar) impl_->renderer->RemoveActor2D(impl_->distanceBar);
+  impl_->distanceBar = style::distanceBar(impl_->surfaceMapper, colours);
+  impl_->renderer->AddActor2D(impl_->distanceBar);
 }
 
 void SurfaceView::setOpacity(double opacity) { impl_->surfaceActor->GetProperty()->SetOpacity(opacity); }

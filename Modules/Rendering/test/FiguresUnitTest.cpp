@@ -10,6 +10,7 @@
 //    build/Testing/Temporary for review.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
@@ -24,9 +25,11 @@
 #include <vtkCutter.h>
 #include <vtkDataArray.h>
 #include <vtkDoubleArray.h>
+#include <vtkFieldData.h>
 #include <vtkImageData.h>
 #include <vtkNew.h>
 #include <vtkPlane.h>
+#include <vtkPNGReader.h>
 #include <vtkPlot.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
@@ -39,10 +42,12 @@
 #include <vtkTesting.h>
 #include <vtkUnsignedCharArray.h>
 #include <vtkWindowToImageFilter.h>
+#include <vtkXMLPolyDataWriter.h>
 
 #include "BallPhantom.h"
 #include "dynsub/ConvergenceHistory.h"
 #include "dynsub/ConvergencePlot.h"
+#include "dynsub/Error.h"
 #include "dynsub/Figures.h"
 #include "dynsub/ImageIO.h"
 #include "dynsub/Landmarks.h"
@@ -212,7 +217,7 @@ TEST_F(Rendering, SliceViewColoursTheContourByEdgeDistance) {
   SliceView view(SliceOrientation::Coronal);
   view.setImage(&slices);
   view.setSurface(surface);
-  view.colourByEdgeDistance(true);
+  view.colourByDistance(edgeDistanceColours());
   view.showSlice(slices.sliceThrough(SliceOrientation::Coronal, phantom.centre));
   const SlicePlane& plane = view.plane();
   vtkNew<vtkDoubleArray> distances;
@@ -378,7 +383,7 @@ std::vector<std::array<double, 4>> textBoxes(vtkRenderWindow* window, std::vecto
 // legend each have room of their own, whatever the slice numbers.
 TEST_F(Rendering, SlicesFigureTextsDoNotOverlap) {
   CaudateScene caudate;
-  caudate.scene.edgeDistances = true;
+  caudate.scene.distances = edgeDistanceColours();
   std::vector<std::string> texts;
   const auto boxes = textBoxes(slicesFigure(caudate.scene), &texts);
   // 15 captions, 60 edge letters, 4 legend entries.
@@ -391,6 +396,91 @@ TEST_F(Rendering, SlicesFigureTextsDoNotOverlap) {
                          boxes[a][3] + kGap <= boxes[b][2] || boxes[b][3] + kGap <= boxes[a][2];
       EXPECT_TRUE(apart) << "'" << texts[a] << "' overlaps '" << texts[b] << "'";
     }
+}
+
+// A fit's figures colour its surface by the distance to its scan. A cube's
+// limit surface whose points on one side lie on the scan (0 mm) and on the
+// other beyond the far distance shows green and magenta in the 3D figure;
+// with every point on the scan, no magenta. The colour bar (right of 84 % of
+// the width, SceneStyle.cpp) holds both colours whatever the surface, so
+// only the pixels left of it are counted. The slices' legend names the scan
+// and the far distance.
+TEST_F(Rendering, FitFiguresColourTheSurfaceByScanDistance) {
+  const ControlMesh mesh = readControlMesh(kSource + "/Data/Meshes/cube.obj");
+  const TriangleSurface surface = tessellate(LimitSurface(mesh), mesh.points(), 8);
+  const Eigen::Index n = surface.points.rows();
+  const double centre = surface.points.col(0).mean();
+  const std::string directory = std::string(DYNSUB_BINARY_DIR) + "/Testing/Temporary";
+  std::filesystem::create_directories(directory);
+  struct Counts {
+    int green = 0, magenta = 0;
+  };
+  const auto figureColours = [&](const Eigen::VectorXd& distances) {
+    FigureInputs inputs;
+    inputs.surface = &surface;
+    inputs.scanDistances = distances;
+    inputs.scanDistanceFar = 0.5;
+    FigureFiles files;
+    files.surface3d = directory + "/scan_distance_3d.png";
+    writeFigures(inputs, files);
+    vtkNew<vtkPNGReader> reader;
+    reader->SetFileName(files.surface3d.c_str());
+    reader->Update();
+    vtkImageData* image = reader->GetOutput();
+    int size[3];
+    image->GetDimensions(size);
+    Counts counts;
+    for (int y = 0; y < size[1]; ++y)
+      for (int x = 0; x < 0.8 * size[0]; ++x) {
+        const std::array<int, 3> c = pixel(image, Eigen::Vector2d(x, y));
+        counts.green += c[1] > 150 && c[0] < 100 && c[2] < 120;
+        counts.magenta += c[0] > 180 && c[2] > 180 && c[1] < 100;
+      }
+    return counts;
+  };
+  const Eigen::VectorXd halfFar = (surface.points.col(0).array() < centre).select(Eigen::VectorXd::Zero(n), 1.0);
+  const Counts half = figureColours(halfFar);
+  const Counts covered = figureColours(Eigen::VectorXd::Zero(n));
+  // The cube fills about a fifth of the 800 x 800 view: thousands of pixels
+  // a side; a thousand leaves room for lighting and the side seen edge-on.
+  EXPECT_GT(half.green, 1000);
+  EXPECT_GT(half.magenta, 1000);
+  EXPECT_GT(covered.green, 1000);
+  EXPECT_EQ(covered.magenta, 0);
+
+  const vtkSmartPointer<vtkPolyData> polyData = toPolyData(surface);
+  FigureScene scene;
+  scene.surface = polyData;
+  scene.distances = scanDistanceColours(0.5);
+  std::vector<std::string> texts;
+  textBoxes(slicesFigure(scene), &texts);
+  EXPECT_NE(std::find(texts.begin(), texts.end(), "contour on the scan"), texts.end());
+  EXPECT_NE(std::find(texts.begin(), texts.end(), "contour 0.5 mm or more from the scan"), texts.end());
+
+  // A surface file whose far distance is not one positive number is refused,
+  // by name, before any figure is drawn.
+  const std::string file = directory + "/bad_far.vtp";
+  addPointData(polyData, kScanDistanceScalars, halfFar);
+  vtkNew<vtkDoubleArray> far;
+  far->SetName(farName(kScanDistanceScalars).c_str());
+  far->InsertNextValue(-1.0);
+  polyData->GetFieldData()->AddArray(far);
+  vtkNew<vtkXMLPolyDataWriter> writer;
+  writer->SetInputData(polyData);
+  writer->SetFileName(file.c_str());
+  ASSERT_EQ(writer->Write(), 1);
+  FigureInputs fromFile;
+  fromFile.surfaceFile = file;
+  FigureFiles files;
+  files.surface3d = directory + "/bad_far_3d.png";
+  std::filesystem::remove(files.surface3d);
+  try {
+    writeFigures(fromFile, files);
+    ADD_FAILURE() << "a negative far distance was taken";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("bad_far.vtp"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(files.surface3d));
 }
 
 // The captions name the coordinate system; RAS negates x and y, not z.

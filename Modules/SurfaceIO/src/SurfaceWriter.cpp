@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <array>
 #include <charconv>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 
+#include <vtkDoubleArray.h>
 #include <vtkFieldData.h>
 #include <vtkNew.h>
 #include <vtkPolyData.h>
@@ -26,7 +28,15 @@ namespace {
 void writeVtp(const TriangleSurface& surface, const std::string& path, const std::string& name,
               const std::vector<PointScalars>& scalars, const std::string& space) {
   const vtkSmartPointer<vtkPolyData> data = toPolyData(surface);
-  for (const PointScalars& s : scalars) addPointData(data, s.name, s.values);
+  for (const PointScalars& s : scalars) {
+    addPointData(data, s.name, s.values);
+    if (s.far > 0.0) {
+      vtkNew<vtkDoubleArray> far;
+      far->SetName(farName(s.name).c_str());
+      far->InsertNextValue(s.far);
+      data->GetFieldData()->AddArray(far);
+    }
+  }
   if (!space.empty()) {
     vtkNew<vtkStringArray> spaceName;
     spaceName->SetName("SPACE");
@@ -35,6 +45,12 @@ void writeVtp(const TriangleSurface& surface, const std::string& path, const std
   }
   writeVtkXml(data, path, name);
 }
+
+}  // namespace
+
+std::string farName(const std::string& scalars) { return scalars + "_far"; }
+
+namespace {
 
 // Writes `bytes` to `path`, a new file; errors name `name`.
 void writeFile(const std::string& path, const std::string& name, const std::string& bytes) {
@@ -166,9 +182,12 @@ void writeTriangleSurface(const TriangleSurface& surface, const std::string& pat
     throw Error(path, "unknown surface format '" + extension + "' (expected .vtp, .vtk, .obj, .ply or .stl)");
   }
   if (!surface.points.allFinite()) throw Error(path, "the surface has non-finite coordinates; nothing written");
-  for (const PointScalars& s : scalars)
+  for (const PointScalars& s : scalars) {
     if (s.values.size() != surface.points.rows() || !s.values.allFinite())
       throw Error(path, "point data '" + s.name + "' needs one finite value per point; nothing written");
+    if (!(std::isfinite(s.far) && s.far >= 0.0))
+      throw Error(path, "point data '" + s.name + "' has a far distance that is not a finite number >= 0; nothing written");
+  }
   if (!space.empty() && space != "LPS" && space != "RAS")
     throw Error(path, "unknown coordinate space '" + space + "' (expected LPS or RAS)");
   AtomicOutput output(path);

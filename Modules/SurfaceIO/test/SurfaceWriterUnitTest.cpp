@@ -75,13 +75,25 @@ TEST(SurfaceWriter, VtpCarriesPointScalarsAndRefusesBadOnes) {
   ASSERT_NE(array, nullptr);
   ASSERT_EQ(array->GetNumberOfTuples(), values.size());
   for (vtkIdType i = 0; i < array->GetNumberOfTuples(); i += 7) EXPECT_EQ(array->GetTuple1(i), values(i));
-  // Wrong size or NaN: an error and no file.
+  // Without a far distance, no field array for it.
+  EXPECT_EQ(reader->GetOutput()->GetFieldData()->GetArray("edge_distance_mm_far"), nullptr);
+  // With one, a one-value field array beside the point data.
+  dynsub::writeTriangleSurface(surface, path, {{"scan_distance_mm", values, 2.5}});
+  reader->Modified();
+  reader->Update();
+  vtkDataArray* far = reader->GetOutput()->GetFieldData()->GetArray(dynsub::farName("scan_distance_mm").c_str());
+  ASSERT_NE(far, nullptr);
+  ASSERT_EQ(far->GetNumberOfTuples(), 1);
+  EXPECT_EQ(far->GetTuple1(0), 2.5);
+  // Wrong size, NaN, or a far distance that is negative or infinite: an error and no file.
   const std::string bad = scratch("bad_scalars.vtp");
   fs::remove(bad);
   EXPECT_THROW(dynsub::writeTriangleSurface(surface, bad, {{"short", values.head(3)}}), dynsub::Error);
   Eigen::VectorXd nan = values;
   nan(5) = std::nan("");
   EXPECT_THROW(dynsub::writeTriangleSurface(surface, bad, {{"nan", nan}}), dynsub::Error);
+  EXPECT_THROW(dynsub::writeTriangleSurface(surface, bad, {{"far", values, -1.0}}), dynsub::Error);
+  EXPECT_THROW(dynsub::writeTriangleSurface(surface, bad, {{"far", values, HUGE_VAL}}), dynsub::Error);
   EXPECT_FALSE(fs::exists(bad));
 }
 

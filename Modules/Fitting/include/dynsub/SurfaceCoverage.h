@@ -28,6 +28,7 @@ constexpr double kCoverageSpacings = 4.0;
 struct SurfaceCoverage {
   double spacing = 0.0;            // mm: the median over the points of the distance to their nearest point elsewhere
   double maxGap = 0.0;             // mm: the largest distance from a tessellation vertex to its nearest point
+  double limit = 0.0;              // mm: kCoverageSpacings x spacing + the max error, beyond which it is uncovered
   double uncoveredFraction = 0.0;  // of the surface's area (above)
   Eigen::VectorXd distances;       // mm: from each tessellation vertex to its nearest point
 };

@@ -19,6 +19,25 @@ struct Volume;
 enum class FigureCoordinates { Lps, Ras };
 std::string coordinatesName(FigureCoordinates coordinates);  // "LPS" or "RAS"
 
+// A surface coloured by a distance of each point, held in its point array
+// `array` (mm; -1 unknown): green at 0, through yellow, to magenta at `far`
+// and beyond, grey where unknown. The colour bar reads "mm to " + `to`; the
+// slices' legend, "contour on " + `on` and "contour F mm or more from " +
+// `from`.
+struct DistanceColours {
+  std::string array;
+  double far = 0.0;  // mm
+  std::string to, on, from;
+};
+// A segmentation's distance to the image's edges (kEdgeDistanceScalars,
+// SurfaceWriter.h), magenta from style::kFarFromEdges on: where it is held by
+// the edges and where by tension and landmarks alone.
+DistanceColours edgeDistanceColours();
+// A fit's distance to its scan (kScanDistanceScalars), magenta from `far` on,
+// the coverage's threshold (SurfaceCoverage.h): where the surface has no
+// points near it.
+DistanceColours scanDistanceColours(double far);
+
 // The figures of a result, for callers that hold no VTK object (the commands).
 // Not owned; the surface is `surface`, or else read from `surfaceFile`.
 struct FigureInputs {
@@ -33,6 +52,10 @@ struct FigureInputs {
   // unknown), to colour it by (FigureScene::edgeDistances); empty: none. A
   // surface read from `surfaceFile` is coloured by the same array if it has it.
   Eigen::VectorXd edgeDistances;
+  // Per point of `surface`: its distance to the range data (mm), to colour it
+  // by (scanDistanceColours(scanDistanceFar)); empty: none.
+  Eigen::VectorXd scanDistances;
+  double scanDistanceFar = 0.0;
   FigureCoordinates coordinates = FigureCoordinates::Lps;
 };
 // The figures' file formats. PNG is a raster. In PDF and SVG the text (the

@@ -19,6 +19,7 @@
 // Debian's VTK renders through X11 only: an X display is needed, or VTK
 // aborts the process. displayAvailable says whether one can be opened;
 // figureDisplay provides one on a machine without a screen.
+#include <optional>
 #include <string>
 
 #include <vtkSmartPointer.h>
@@ -41,11 +42,10 @@ struct FigureScene {
   vtkPolyData* controlMesh = nullptr; // optional wireframe (SurfaceView.h), 3D figure only
   MatrixX3 landmarks;                 // #landmarks x 3, LPS mm
   MatrixX3 dataPoints;                // range data, mm
-  // The surface and its contours coloured by its point array
-  // kEdgeDistanceScalars (SurfaceWriter.h), with a colour bar in the 3D
-  // figure, instead of by element type: where a segmentation is held by the
-  // image's edges and where by tension and landmarks alone.
-  bool edgeDistances = false;
+  // The surface and its contours coloured by a distance of each point
+  // (FigureInputs.h), with a colour bar in the 3D figure; none: by element
+  // type.
+  std::optional<DistanceColours> distances;
   FigureCoordinates coordinates = FigureCoordinates::Lps;  // the ones the slice captions print
 };
 

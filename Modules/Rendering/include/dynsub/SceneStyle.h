@@ -8,6 +8,7 @@
 
 #include <vtkSmartPointer.h>
 
+#include "dynsub/FigureInputs.h"
 #include "dynsub/Types.h"
 
 class vtkActor;
@@ -34,24 +35,21 @@ constexpr int kFontSize = 14;
 
 // Colours a mapper's cells by the "ElementType" cell array (SurfacePolyData.h).
 void colourByElementType(vtkPolyDataMapper* mapper);
-// Colours a mapper's points by their distance to the nearest edge
-// (kEdgeDistanceScalars, SurfaceWriter.h): green on an edge (0 mm), through
-// yellow, to magenta at kFarFromEdges and beyond; grey where it is unknown
-// (-1). Where only tension and landmarks hold a segmentation, it shows magenta.
-void colourByEdgeDistance(vtkPolyDataMapper* mapper);
+// Colours a mapper's points by a distance (DistanceColours, FigureInputs.h).
+void colourByDistance(vtkPolyDataMapper* mapper, const DistanceColours& colours);
 constexpr double kFarFromEdges = 3.0;  // mm: three voxels of the 1 mm MRI
-// The edge-distance colours: green on an edge, through yellow, to magenta at
-// kFarFromEdges and beyond (not red, which the landmarks are drawn in).
-constexpr std::array<double, 3> kOnEdge{0.15, 0.8, 0.25};
-constexpr std::array<double, 3> kMidEdge{1.0, 0.9, 0.15};
-constexpr std::array<double, 3> kOffEdge{0.9, 0.2, 0.9};
+// The distance colours: green at 0 mm, through yellow, to magenta at the far
+// distance and beyond (not red, which the landmarks are drawn in).
+constexpr std::array<double, 3> kNear{0.15, 0.8, 0.25};
+constexpr std::array<double, 3> kMiddle{1.0, 0.9, 0.15};
+constexpr std::array<double, 3> kFar{0.9, 0.2, 0.9};
 // Range data's dots: light grey, apart from the landmarks' red.
 constexpr std::array<double, 3> kDataPoint{0.85, 0.85, 0.85};
 // The control mesh's wireframe, and in a creased mesh its creases.
 constexpr std::array<double, 3> kWireframe{0.6, 0.7, 1.0};
 constexpr std::array<unsigned char, 3> kCrease{255, 90, 40};
-// The colour bar of colourByEdgeDistance, for `mapper`, at the right of its view.
-vtkSmartPointer<vtkScalarBarActor> edgeDistanceBar(vtkPolyDataMapper* mapper);
+// The colour bar of colourByDistance, for `mapper`, at the right of its view.
+vtkSmartPointer<vtkScalarBarActor> distanceBar(vtkPolyDataMapper* mapper, const DistanceColours& colours);
 // Vertices drawn as round dots of a fixed size in pixels.
 void pointsAsDots(vtkActor* actor, double pixels);
 

@@ -34,9 +34,10 @@ class SliceView {
   // The surface whose cross-section is drawn; the contour follows when the
   // polydata is modified (live fitting).
   void setSurface(vtkPolyData* surface);
-  // The contour by element type (the default), or by its points' distance to
-  // the nearest edge (style::colourByEdgeDistance; the surface must carry it).
-  void colourByEdgeDistance(bool on);
+  // The contour by element type (the default), or by its points' distance
+  // (style::colourByDistance; the surface must carry its array).
+  void colourByElementType();
+  void colourByDistance(const DistanceColours& colours);
   // Landmarks (#landmarks x 3, LPS mm); those within half a slice of the plane are drawn.
   void setLandmarks(const MatrixX3& landmarks, int selected = -1);
   // Range data drawn as small white dots where within half a slice.

@@ -7,6 +7,7 @@
 #include <memory>
 #include <vector>
 
+#include "dynsub/FigureInputs.h"
 #include "dynsub/SlicePlanes.h"
 
 class vtkPolyData;
@@ -32,10 +33,11 @@ class SurfaceView {
 
   void setSurface(vtkPolyData* surface);  // followed when modified
   void setOpacity(double opacity);        // 1 opaque
-  // By element type (the default), or by each point's distance to the
-  // nearest edge (style::colourByEdgeDistance; the surface must carry it),
-  // with its colour bar.
-  void colourByEdgeDistance(bool on);
+  // By element type (the default), or by each point's distance
+  // (style::colourByDistance; the surface must carry its array), with a
+  // colour bar.
+  void colourByElementType();
+  void colourByDistance(const DistanceColours& colours);
   void setControlMesh(vtkPolyData* wireframe);  // nullptr hides it
   void setLandmarks(const MatrixX3& landmarks, int selected = -1);  // #landmarks x 3, LPS mm
   void setDataPoints(const MatrixX3& points);

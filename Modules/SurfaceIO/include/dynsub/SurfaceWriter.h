@@ -19,15 +19,20 @@ namespace dynsub {
 struct PointScalars {
   std::string name;
   Eigen::VectorXd values;  // one per row of TriangleSurface::points, finite
+  // When > 0, the value from which a point counts as far (mm), written in a
+  // .vtp as the one-value field array farName(name), for the figures to
+  // colour by (`dynsub render` redraws what the command drew).
+  double far = 0.0;
 };
+std::string farName(const std::string& scalars);  // scalars + "_far"
 
 // The point data a segmentation's surface carries: each point's distance to
 // the nearest edge of the edge map (mm; -1 outside the region of interest,
 // where it is unknown). The figures colour a surface that has it by it.
 constexpr char kEdgeDistanceScalars[] = "edge_distance_mm";
 // The point data a fitted surface carries: each point's distance to the
-// nearest point of the scan (mm; SurfaceCoverage.h). Where it is large, the
-// surface has no data under it.
+// nearest point of the scan (mm; SurfaceCoverage.h), far from the
+// coverage's limit on: there the surface has no data under it.
 constexpr char kScanDistanceScalars[] = "scan_distance_mm";
 
 // `space`, when not empty, names the coordinate system of a .vtp as the
