@@ -98,8 +98,14 @@ std::array<double, 3> landmarkColour() {
 void addLegend(const FigureScene& scene, vtkRenderWindow* window) {
   std::vector<std::pair<std::string, std::array<double, 3>>> items;
   if (scene.distances) {
-    items.push_back({"contour on " + scene.distances->on, style::kNear});
-    std::ostringstream far;
+    std::ostringstream near, far;
+    near << std::setprecision(3) << "contour ";
+    if (scene.distances->near > 0.0) {
+      near << "within " << scene.distances->near << " mm of " << scene.distances->on;
+    } else {
+      near << "on " << scene.distances->on;
+    }
+    items.push_back({near.str(), style::kNear});
     far << std::setprecision(3) << "contour " << scene.distances->far << " mm or more from " << scene.distances->from;
     items.push_back({far.str(), style::kFar});
   } else {
@@ -137,11 +143,11 @@ std::string coordinatesName(FigureCoordinates coordinates) {
 }
 
 DistanceColours edgeDistanceColours() {
-  return {kEdgeDistanceScalars, style::kFarFromEdges, "an edge", "an image edge", "any edge"};
+  return {kEdgeDistanceScalars, 0.0, style::kFarFromEdges, "an edge", "an image edge", "any edge"};
 }
 
 DistanceColours scanDistanceColours(double far) {
-  return {kScanDistanceScalars, far, "the scan", "the scan", "the scan"};
+  return {kScanDistanceScalars, 0.5 * far, far, "the scan", "the scan", "the scan"};
 }
 
 namespace {

@@ -46,7 +46,8 @@ void colourByDistance(vtkPolyDataMapper* mapper, const DistanceColours& colours)
   table->SetNumberOfTableValues(kEntries);
   table->SetTableRange(0, colours.far);
   for (int e = 0; e < kEntries; ++e) {
-    const double t = 2.0 * e / (kEntries - 1);
+    const double distance = colours.far * e / (kEntries - 1);
+    const double t = 2.0 * std::clamp((distance - colours.near) / (colours.far - colours.near), 0.0, 1.0);
     const int from = std::min(static_cast<int>(t), 1);
     const Vector3 c = stops[from] + (t - from) * (stops[from + 1] - stops[from]);
     table->SetTableValue(e, c.x(), c.y(), c.z(), 1.0);

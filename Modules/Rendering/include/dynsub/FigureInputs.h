@@ -20,13 +20,13 @@ enum class FigureCoordinates { Lps, Ras };
 std::string coordinatesName(FigureCoordinates coordinates);  // "LPS" or "RAS"
 
 // A surface coloured by a distance of each point, held in its point array
-// `array` (mm; -1 unknown): green at 0, through yellow, to magenta at `far`
-// and beyond, grey where unknown. The colour bar reads "mm to " + `to`; the
-// slices' legend, "contour on " + `on` and "contour F mm or more from " +
-// `from`.
+// `array` (mm; -1 unknown): green up to `near`, through yellow, to magenta
+// at `far` and beyond, grey where unknown. The colour bar reads "mm to " +
+// `to`; the slices' legend, "contour on " + `on` (or "contour within N mm
+// of " + `on`) and "contour F mm or more from " + `from`.
 struct DistanceColours {
   std::string array;
-  double far = 0.0;  // mm
+  double near = 0.0, far = 0.0;  // mm, 0 <= near < far
   std::string to, on, from;
 };
 // A segmentation's distance to the image's edges (kEdgeDistanceScalars,
@@ -35,7 +35,9 @@ struct DistanceColours {
 DistanceColours edgeDistanceColours();
 // A fit's distance to its scan (kScanDistanceScalars), magenta from `far` on,
 // the coverage's threshold (SurfaceCoverage.h): where the surface has no
-// points near it.
+// points near it. Green up to half of it, so that the distances between the
+// points of a sparse scan, which are well below, do not mottle a covered
+// surface.
 DistanceColours scanDistanceColours(double far);
 
 // The figures of a result, for callers that hold no VTK object (the commands).
