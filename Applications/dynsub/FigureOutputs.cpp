@@ -64,6 +64,7 @@ FigureFiles FigureOptions::files(OutputSet& outputs, bool convergence) const {
 }
 
 void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const ControlMesh& mesh, FigureInputs inputs) {
+  if (!inputs.history) throw Error("internal: a result's figures need its convergence history");
   writeConvergenceCsv(*inputs.history, outputs.add("convergence.csv"));
   if (!options.figures) return;
   std::string why;

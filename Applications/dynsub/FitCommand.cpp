@@ -5,6 +5,7 @@
 #include <iostream>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -257,7 +258,7 @@ void runFit(FitCommandOptions o) {
       inputs.scanDistances = coverage.distances;
       inputs.scanDistanceFar = coverage.limit;
     }
-    addFigureOutputs(outputs, o.figures, result.mesh, inputs);
+    addFigureOutputs(outputs, o.figures, result.mesh, std::move(inputs));
   }, {{kScanDistanceScalars, coverage.distances, coverage.limit}});
 
   std::cout << std::fixed << std::setprecision(3) << "fitted " << data.rows() << " points with "

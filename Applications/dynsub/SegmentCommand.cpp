@@ -11,6 +11,7 @@
 #include <memory>
 #include <optional>
 #include <sstream>
+#include <utility>
 
 #include "CommandLine.h"
 #include "Commands.h"
@@ -103,7 +104,7 @@ void writeSegmentOutputs(const std::filesystem::path& dir, const SegmentOutcome&
           inputs.landmarks = landmarkPositions(outcome.springs);
           inputs.history = &outcome.history;
           inputs.edgeDistances = result.surfaceEdgeDistances;
-          addFigureOutputs(outputs, figures, result.mesh, inputs);
+          addFigureOutputs(outputs, figures, result.mesh, std::move(inputs));
         };
         // With figures, the labelmap is compressed on a thread of its own
         // while they render on this one (a tenth of them). Without, this

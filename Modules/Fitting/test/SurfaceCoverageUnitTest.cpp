@@ -55,7 +55,9 @@ TEST(SurfaceCoverage, SurfaceBeyondTheMarginIsUncovered) {
   EXPECT_NEAR(c.spacing, 0.01, 1e-12);
   EXPECT_NEAR(c.uncoveredFraction, 1.0 - 0.54, 0.005);
   EXPECT_NEAR(c.maxGap, std::hypot(0.5, 0.005), 1e-12);  // from (1, 0.005) to (0.5, 0)
-  EXPECT_NEAR(measureSurfaceCoverage(s, left, 0.1).uncoveredFraction, 1.0 - 0.64, 0.005);
+  const SurfaceCoverage withError = measureSurfaceCoverage(s, left, 0.1);
+  EXPECT_NEAR(withError.uncoveredFraction, 1.0 - 0.64, 0.005);
+  EXPECT_NEAR(withError.limit, kCoverageSpacings * 0.01 + 0.1, 1e-12);  // what the figures colour magenta from
   EXPECT_THROW(measureSurfaceCoverage(s, left.topRows(1), 0.0), Error);
 
   // Each point twice, as an export that did not merge them writes it: the

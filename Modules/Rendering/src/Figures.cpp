@@ -105,9 +105,9 @@ void addLegend(const FigureScene& scene, vtkRenderWindow* window) {
     } else {
       near << "on " << scene.distances->on;
     }
-    items.push_back({near.str(), style::kNear});
+    items.push_back({near.str(), style::kNearColour});
     far << std::setprecision(3) << "contour " << scene.distances->far << " mm or more from " << scene.distances->from;
-    items.push_back({far.str(), style::kFar});
+    items.push_back({far.str(), style::kFarColour});
   } else {
     items.push_back({"contour on a normal element", style::kNormalElement});
     items.push_back({"contour on a special element", style::kSpecialElement});
@@ -281,6 +281,13 @@ void drawSurface(const FigureScene& scene, vtkRenderWindow* window) {
                     image->sliceThrough(SliceOrientation::Sagittal, corner));
   }
   view.resetCamera();
+  if (scene.distances) {
+    // The colour bar holds the right sixth of the view (SceneStyle.cpp):
+    // the surface is framed in the rest.
+    vtkCamera* camera = view.renderer()->GetActiveCamera();
+    camera->Zoom(0.84);
+    camera->SetWindowCenter(0.16, 0.0);
+  }
   window->AddRenderer(view.renderer());
   addOrientationMarker(view.renderer(), window);
   if (scene.landmarks.rows() > 0) {

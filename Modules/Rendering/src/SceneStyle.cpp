@@ -22,6 +22,8 @@
 #include <vtkTextProperty.h>
 #include <vtkUnsignedCharArray.h>
 
+#include "dynsub/Error.h"
+
 namespace dynsub::style {
 
 void colourByElementType(vtkPolyDataMapper* mapper) {
@@ -39,14 +41,17 @@ void colourByElementType(vtkPolyDataMapper* mapper) {
   mapper->ScalarVisibilityOn();
 }
 
-void colourByDistance(vtkPolyDataMapper* mapper, const DistanceColours& colours) {
-  vtkNew<vtkLookupTable> table;
-  const Vector3 stops[3] = {Vector3(kNear.data()), Vector3(kMiddle.data()), Vector3(kFar.data())};
+namespace {
+
+// The distance colours from `low` to colours.far, grey below `low`.
+vtkSmartPointer<vtkLookupTable> distanceTable(const DistanceColours& colours, double low) {
+  auto table = vtkSmartPointer<vtkLookupTable>::New();
+  const Vector3 stops[3] = {Vector3(kNearColour.data()), Vector3(kMiddleColour.data()), Vector3(kFarColour.data())};
   constexpr int kEntries = 64;
   table->SetNumberOfTableValues(kEntries);
-  table->SetTableRange(0, colours.far);
+  table->SetTableRange(low, colours.far);
   for (int e = 0; e < kEntries; ++e) {
-    const double distance = colours.far * e / (kEntries - 1);
+    const double distance = low + (colours.far - low) * e / (kEntries - 1);
     const double t = 2.0 * std::clamp((distance - colours.near) / (colours.far - colours.near), 0.0, 1.0);
     const int from = std::min(static_cast<int>(t), 1);
     const Vector3 c = stops[from] + (t - from) * (stops[from + 1] - stops[from]);
@@ -54,20 +59,32 @@ void colourByDistance(vtkPolyDataMapper* mapper, const DistanceColours& colours)
   }
   table->SetBelowRangeColor(0.55, 0.55, 0.55, 1.0);  // -1: outside the region, unknown
   table->UseBelowRangeColorOn();
-  mapper->SetLookupTable(table);
+  return table;
+}
+
+}  // namespace
+
+void colourByDistance(vtkPolyDataMapper* mapper, const DistanceColours& colours) {
+  if (!(std::isfinite(colours.far) && colours.near >= 0.0 && colours.near < colours.far))
+    throw Error("internal: distance colours need 0 <= near < far, both finite");
+  // The range starts a little below 0: a distance of exactly 0 at its very
+  // end is drawn, fragment by fragment, in the below-range grey of the
+  // unknown as often as in green (a surface on its scan came out mottled).
+  const double low = -0.01 * colours.far;
+  mapper->SetLookupTable(distanceTable(colours, low));
   mapper->SetColorModeToMapScalars();
   mapper->SetScalarModeToUsePointFieldData();
   mapper->SelectColorArray(colours.array.c_str());
-  mapper->SetScalarRange(0, colours.far);
+  mapper->SetScalarRange(low, colours.far);
   // Mapped per fragment, not per vertex: a triangle between a held and
   // an unknown point would otherwise blend green into grey.
   mapper->InterpolateScalarsBeforeMappingOn();
   mapper->ScalarVisibilityOn();
 }
 
-vtkSmartPointer<vtkScalarBarActor> distanceBar(vtkPolyDataMapper* mapper, const DistanceColours& colours) {
+vtkSmartPointer<vtkScalarBarActor> distanceBar(const DistanceColours& colours) {
   auto bar = vtkSmartPointer<vtkScalarBarActor>::New();
-  bar->SetLookupTable(mapper->GetLookupTable());
+  bar->SetLookupTable(distanceTable(colours, 0.0));  // labelled from 0
   bar->SetTitle(("mm to " + colours.to).c_str());
   bar->SetNumberOfLabels(4);
   bar->SetLabelFormat("%.3g");  // a scan's far distance may be a fraction of a mm

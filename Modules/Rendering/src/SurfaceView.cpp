@@ -115,7 +115,7 @@ void SurfaceView::colourByElementType() {
 void SurfaceView::colourByDistance(const DistanceColours& colours) {
   style::colourByDistance(impl_->surfaceMapper, colours);
   if (impl_->distanceBar) impl_->renderer->RemoveActor2D(impl_->distanceBar);
-  impl_->distanceBar = style::distanceBar(impl_->surfaceMapper, colours);
+  impl_->distanceBar = style::distanceBar(colours);
   impl_->renderer->AddActor2D(impl_->distanceBar);
 }
 

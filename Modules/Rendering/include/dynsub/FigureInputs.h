@@ -34,7 +34,7 @@ struct DistanceColours {
 // the edges and where by tension and landmarks alone.
 DistanceColours edgeDistanceColours();
 // A fit's distance to its scan (kScanDistanceScalars), magenta from `far` on,
-// the coverage's threshold (SurfaceCoverage.h): where the surface has no
+// the coverage's limit (SurfaceCoverage::limit): where the surface has no
 // points near it. Green up to half of it, so that the distances between the
 // points of a sparse scan, which are well below, do not mottle a covered
 // surface.
@@ -51,11 +51,13 @@ struct FigureInputs {
   MatrixX3 dataPoints;                       // range data, mm
   const ConvergenceHistory* history = nullptr;  // needed for the convergence figure
   // Per point of `surface`: its distance to the nearest edge (mm, -1
-  // unknown), to colour it by (FigureScene::edgeDistances); empty: none. A
+  // unknown), to colour it by (edgeDistanceColours()); empty: none. A
   // surface read from `surfaceFile` is coloured by the same array if it has it.
   Eigen::VectorXd edgeDistances;
   // Per point of `surface`: its distance to the range data (mm), to colour it
-  // by (scanDistanceColours(scanDistanceFar)); empty: none.
+  // by (scanDistanceColours(scanDistanceFar)); empty: none. A surface read
+  // from `surfaceFile` is coloured by its scan_distance_mm array if it also
+  // has the far distance beside it (farName, SurfaceWriter.h).
   Eigen::VectorXd scanDistances;
   double scanDistanceFar = 0.0;
   FigureCoordinates coordinates = FigureCoordinates::Lps;

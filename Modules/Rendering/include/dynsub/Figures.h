@@ -11,7 +11,8 @@
 //                    data, and (with an image) three slices behind the surface
 //                    as a backdrop, an orientation cube; 800 x 800;
 //   A surface that carries its distance to the image's edges (a
-//   segmentation's) is coloured by it instead, in both (FigureScene).
+//   segmentation's) or to its scan (a fit's) is coloured by it instead, in
+//   both (FigureScene::distances).
 //   convergence.png  the convergence plot (ConvergencePlot.h); 900 x 500.
 // Windows are fixed-size, without multisampling, and render off screen, so
 // the same input gives the same pixels (rendering regression tests rely on it).

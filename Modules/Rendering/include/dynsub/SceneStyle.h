@@ -36,20 +36,22 @@ constexpr int kFontSize = 14;
 // Colours a mapper's cells by the "ElementType" cell array (SurfacePolyData.h).
 void colourByElementType(vtkPolyDataMapper* mapper);
 // Colours a mapper's points by a distance (DistanceColours, FigureInputs.h).
+// Throws dynsub::Error unless 0 <= near < far, both finite.
 void colourByDistance(vtkPolyDataMapper* mapper, const DistanceColours& colours);
 constexpr double kFarFromEdges = 3.0;  // mm: three voxels of the 1 mm MRI
-// The distance colours: green at 0 mm, through yellow, to magenta at the far
-// distance and beyond (not red, which the landmarks are drawn in).
-constexpr std::array<double, 3> kNear{0.15, 0.8, 0.25};
-constexpr std::array<double, 3> kMiddle{1.0, 0.9, 0.15};
-constexpr std::array<double, 3> kFar{0.9, 0.2, 0.9};
+// The distance colours: green up to the near distance, through yellow, to
+// magenta at the far distance and beyond (not red, which the landmarks are
+// drawn in).
+constexpr std::array<double, 3> kNearColour{0.15, 0.8, 0.25};
+constexpr std::array<double, 3> kMiddleColour{1.0, 0.9, 0.15};
+constexpr std::array<double, 3> kFarColour{0.9, 0.2, 0.9};
 // Range data's dots: light grey, apart from the landmarks' red.
 constexpr std::array<double, 3> kDataPoint{0.85, 0.85, 0.85};
 // The control mesh's wireframe, and in a creased mesh its creases.
 constexpr std::array<double, 3> kWireframe{0.6, 0.7, 1.0};
 constexpr std::array<unsigned char, 3> kCrease{255, 90, 40};
-// The colour bar of colourByDistance, for `mapper`, at the right of its view.
-vtkSmartPointer<vtkScalarBarActor> distanceBar(vtkPolyDataMapper* mapper, const DistanceColours& colours);
+// The colour bar of colourByDistance at the right of its view.
+vtkSmartPointer<vtkScalarBarActor> distanceBar(const DistanceColours& colours);
 // Vertices drawn as round dots of a fixed size in pixels.
 void pointsAsDots(vtkActor* actor, double pixels);
 

@@ -1,7 +1,8 @@
 #pragma once
 // The 3D view: the limit surface lit and coloured by element type (yellow
-// normal, green special elements, as in the papers) or by its distance to the
-// image's edges (a segmentation's), optionally translucent;
+// normal, green special elements, as in the papers) or by a distance of each
+// point (a segmentation's to the image's edges, a fit's to its scan),
+// optionally translucent;
 // the control mesh as a wireframe; landmarks as red dots; range data as white
 // dots; and the image's three slice planes through a point. LPS mm.
 #include <memory>

@@ -37,9 +37,9 @@ constexpr char kScanDistanceScalars[] = "scan_distance_mm";
 
 // `space`, when not empty, names the coordinate system of a .vtp as the
 // field-data string array "SPACE" that 3D Slicer reads, and of a .vtk as
-// "SPACE=" in its title line ("LPS" or "RAS"; Slicer assumes LPS without it). Throws dynsub::Error naming the file for an
-// unknown extension or space, a missing or read-only directory, a failed
-// write, or scalars of the wrong size or not finite.
+// "SPACE=" in its title line ("LPS" or "RAS"; Slicer assumes LPS without it). Throws dynsub::Error naming the file for
+// an unknown extension or space, a missing or read-only directory, a failed write, scalars of the wrong size or not
+// finite, or a far distance that is negative or not finite.
 void writeTriangleSurface(const TriangleSurface& surface, const std::string& path,
                           const std::vector<PointScalars>& scalars = {}, const std::string& space = "");
 
