@@ -520,10 +520,17 @@ void writeFigures(const FigureInputs& inputs, const FigureFiles& files) {
       throw Error("internal: the edge distances are not one per point of the figure's surface");
     addPointData(surface, kEdgeDistanceScalars, inputs.edgeDistances);
   }
+  if (inputs.scanDistances.size() > 0) {
+    if (inputs.scanDistances.size() != surface->GetNumberOfPoints())
+      throw Error("internal: the scan distances are not one per point of the figure's surface");
+    if (!(inputs.scanDistanceFar > 0.0)) throw Error("internal: the scan distances' far distance is not positive");
+    addPointData(surface, kScanDistanceScalars, inputs.scanDistances);
+    addFarDistance(surface, kScanDistanceScalars, inputs.scanDistanceFar);
+  }
+  // The surface, given or read from its file, says what colours it.
   FigureScene scene;
   scene.surface = surface;
   if (surface->GetPointData()->GetArray(kEdgeDistanceScalars)) scene.distances = edgeDistanceColours();
-  // A fitted surface read from its file, with the far distance it was drawn with.
   vtkDataArray* far = surface->GetFieldData()->GetArray(farName(kScanDistanceScalars).c_str());
   if (far && surface->GetPointData()->GetArray(kScanDistanceScalars)) {
     if (far->GetNumberOfTuples() != 1 || far->GetNumberOfComponents() != 1 || !(far->GetTuple1(0) > 0.0) ||
@@ -531,13 +538,6 @@ void writeFigures(const FigureInputs& inputs, const FigureFiles& files) {
       throw Error(inputs.surfaceFile,
                   "its field array " + farName(kScanDistanceScalars) + " is not one positive number of mm");
     scene.distances = scanDistanceColours(far->GetTuple1(0));
-  }
-  if (inputs.scanDistances.size() > 0) {
-    if (inputs.scanDistances.size() != surface->GetNumberOfPoints())
-      throw Error("internal: the scan distances are not one per point of the figure's surface");
-    if (!(inputs.scanDistanceFar > 0.0)) throw Error("internal: the scan distances' far distance is not positive");
-    addPointData(surface, kScanDistanceScalars, inputs.scanDistances);
-    scene.distances = scanDistanceColours(inputs.scanDistanceFar);
   }
   scene.landmarks = inputs.landmarks;
   scene.dataPoints = inputs.dataPoints;

@@ -25,7 +25,6 @@
 #include <vtkCutter.h>
 #include <vtkDataArray.h>
 #include <vtkDoubleArray.h>
-#include <vtkFieldData.h>
 #include <vtkImageData.h>
 #include <vtkNew.h>
 #include <vtkPlane.h>
@@ -467,10 +466,7 @@ TEST_F(Rendering, FitFiguresColourTheSurfaceByScanDistance) {
   // by name, before any figure is drawn.
   const std::string file = directory + "/bad_far.vtp";
   addPointData(polyData, kScanDistanceScalars, halfFar);
-  vtkNew<vtkDoubleArray> far;
-  far->SetName(farName(kScanDistanceScalars).c_str());
-  far->InsertNextValue(-1.0);
-  polyData->GetFieldData()->AddArray(far);
+  addFarDistance(polyData, kScanDistanceScalars, -1.0);
   vtkNew<vtkXMLPolyDataWriter> writer;
   writer->SetInputData(polyData);
   writer->SetFileName(file.c_str());

@@ -6,6 +6,7 @@
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
 #include <vtkDoubleArray.h>
+#include <vtkFieldData.h>
 #include <vtkIntArray.h>
 #include <vtkNew.h>
 #include <vtkOBJReader.h>
@@ -21,6 +22,7 @@
 
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
+#include "dynsub/SurfaceWriter.h"  // farName
 #include "dynsub/VtkErrors.h"
 
 namespace dynsub {
@@ -69,6 +71,13 @@ void addPointData(vtkPolyData* polyData, const std::string& name, const Eigen::V
   array->SetNumberOfValues(values.size());
   for (Eigen::Index i = 0; i < values.size(); ++i) array->SetValue(i, values(i));
   polyData->GetPointData()->AddArray(array);
+}
+
+void addFarDistance(vtkPolyData* polyData, const std::string& name, double far) {
+  vtkNew<vtkDoubleArray> array;
+  array->SetName(farName(name).c_str());
+  array->InsertNextValue(far);
+  polyData->GetFieldData()->AddArray(array);
 }
 
 namespace {

@@ -7,7 +7,6 @@
 #include <cstring>
 #include <fstream>
 
-#include <vtkDoubleArray.h>
 #include <vtkFieldData.h>
 #include <vtkNew.h>
 #include <vtkPolyData.h>
@@ -30,12 +29,7 @@ void writeVtp(const TriangleSurface& surface, const std::string& path, const std
   const vtkSmartPointer<vtkPolyData> data = toPolyData(surface);
   for (const PointScalars& s : scalars) {
     addPointData(data, s.name, s.values);
-    if (s.far > 0.0) {
-      vtkNew<vtkDoubleArray> far;
-      far->SetName(farName(s.name).c_str());
-      far->InsertNextValue(s.far);
-      data->GetFieldData()->AddArray(far);
-    }
+    if (s.far > 0.0) addFarDistance(data, s.name, s.far);
   }
   if (!space.empty()) {
     vtkNew<vtkStringArray> spaceName;

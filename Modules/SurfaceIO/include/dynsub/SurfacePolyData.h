@@ -18,6 +18,9 @@ vtkSmartPointer<vtkPolyData> toPolyData(const TriangleSurface& surface);
 // Adds `values` (one per point of `polyData`, the caller's to check) as the
 // point-data array `name`, in doubles.
 void addPointData(vtkPolyData* polyData, const std::string& name, const Eigen::VectorXd& values);
+// Adds `far` as the one-value field array farName(name) (SurfaceWriter.h):
+// the value of the point-data array `name` from which a point counts as far.
+void addFarDistance(vtkPolyData* polyData, const std::string& name, double far);
 
 // Reads a triangle surface (.vtp, .vtk, .obj, .ply or .stl, by extension). Throws
 // dynsub::Error naming the file when it is missing, unreadable, has no
