@@ -22,7 +22,6 @@
 
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
-#include "dynsub/SurfaceWriter.h"  // farName
 #include "dynsub/VtkErrors.h"
 
 namespace dynsub {
@@ -72,6 +71,8 @@ void addPointData(vtkPolyData* polyData, const std::string& name, const Eigen::V
   for (Eigen::Index i = 0; i < values.size(); ++i) array->SetValue(i, values(i));
   polyData->GetPointData()->AddArray(array);
 }
+
+std::string farName(const std::string& scalars) { return scalars + "_far"; }
 
 void addFarDistance(vtkPolyData* polyData, const std::string& name, double far) {
   vtkNew<vtkDoubleArray> array;

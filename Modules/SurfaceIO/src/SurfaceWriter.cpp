@@ -40,12 +40,6 @@ void writeVtp(const TriangleSurface& surface, const std::string& path, const std
   writeVtkXml(data, path, name);
 }
 
-}  // namespace
-
-std::string farName(const std::string& scalars) { return scalars + "_far"; }
-
-namespace {
-
 // Writes `bytes` to `path`, a new file; errors name `name`.
 void writeFile(const std::string& path, const std::string& name, const std::string& bytes) {
   std::ofstream out(path, std::ios::binary);
@@ -180,7 +174,8 @@ void writeTriangleSurface(const TriangleSurface& surface, const std::string& pat
     if (s.values.size() != surface.points.rows() || !s.values.allFinite())
       throw Error(path, "point data '" + s.name + "' needs one finite value per point; nothing written");
     if (!(std::isfinite(s.far) && s.far >= 0.0))
-      throw Error(path, "point data '" + s.name + "' has a far distance that is not a finite number >= 0; nothing written");
+      throw Error(path,
+                  "point data '" + s.name + "' has a far distance that is not a finite number >= 0; nothing written");
   }
   if (!space.empty() && space != "LPS" && space != "RAS")
     throw Error(path, "unknown coordinate space '" + space + "' (expected LPS or RAS)");

@@ -24,6 +24,7 @@
 
 #include "dynsub/Error.h"
 #include "dynsub/StandardMeshes.h"
+#include "dynsub/SurfacePolyData.h"
 #include "dynsub/SurfaceWriter.h"
 
 namespace fs = std::filesystem;

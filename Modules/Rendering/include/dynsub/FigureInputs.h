@@ -57,7 +57,7 @@ struct FigureInputs {
   // Per point of `surface`: its distance to the range data (mm), to colour it
   // by (scanDistanceColours(scanDistanceFar)); empty: none. A surface read
   // from `surfaceFile` is coloured by its scan_distance_mm array if it also
-  // has the far distance beside it (farName, SurfaceWriter.h).
+  // has the far distance beside it (farName, SurfacePolyData.h).
   Eigen::VectorXd scanDistances;
   double scanDistanceFar = 0.0;
   FigureCoordinates coordinates = FigureCoordinates::Lps;

@@ -18,8 +18,10 @@ vtkSmartPointer<vtkPolyData> toPolyData(const TriangleSurface& surface);
 // Adds `values` (one per point of `polyData`, the caller's to check) as the
 // point-data array `name`, in doubles.
 void addPointData(vtkPolyData* polyData, const std::string& name, const Eigen::VectorXd& values);
-// Adds `far` as the one-value field array farName(name) (SurfaceWriter.h):
-// the value of the point-data array `name` from which a point counts as far.
+// The field array that holds, beside the point-data array `scalars`, the
+// value from which a point counts as far: scalars + "_far".
+std::string farName(const std::string& scalars);
+// Adds `far` as the one-value field array farName(name).
 void addFarDistance(vtkPolyData* polyData, const std::string& name, double far);
 
 // Reads a triangle surface (.vtp, .vtk, .obj, .ply or .stl, by extension). Throws

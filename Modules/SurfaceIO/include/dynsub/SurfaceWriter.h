@@ -20,11 +20,10 @@ struct PointScalars {
   std::string name;
   Eigen::VectorXd values;  // one per row of TriangleSurface::points, finite
   // When > 0, the value from which a point counts as far (mm), written in a
-  // .vtp as the one-value field array farName(name), for the figures to
-  // colour by (`dynsub render` redraws what the command drew).
+  // .vtp as the one-value field array farName(name) (SurfacePolyData.h), for
+  // the figures to colour by (`dynsub render` redraws what the command drew).
   double far = 0.0;
 };
-std::string farName(const std::string& scalars);  // scalars + "_far"
 
 // The point data a segmentation's surface carries: each point's distance to
 // the nearest edge of the edge map (mm; -1 outside the region of interest,
