@@ -104,6 +104,10 @@ double statedNoise(const std::string& text) {
   return value;
 }
 
+// The points set aside as outliers, when there are any (.xyz, exact
+// doubles: `render --outliers` matches them against the scan).
+constexpr const char* kOutliersFile = "outliers.xyz";
+
 void runFit(FitCommandOptions o) {
   const double stated = statedNoise(o.noise);
   const PointCloud input = readPointCloud(o.points);
@@ -124,6 +128,9 @@ void runFit(FitCommandOptions o) {
   if (stated >= 0.0) noise.sigma = stated;
   if (o.keepOutliers) noise.outliers.clear();
   const MatrixX3 data = withoutRows(scan, noise.outliers);
+  // Written beside the results and drawn in the figures: what was set aside
+  // is for the user to judge, not only to count.
+  const MatrixX3 outliers = scan(noise.outliers, Eigen::all);
   if (data.rows() < 4) throw Error(o.points, "fewer than 4 points are left once the outliers are set aside");
   o.fit.noise = noise.sigma;
   o.fit.localRefinement = o.refinement == "local";
@@ -199,6 +206,7 @@ void runFit(FitCommandOptions o) {
     noiseReport.set("scatter_few_percent", 100.0 * noise.scatterFew / diameter);
   }
   noiseReport.set("outliers", static_cast<int>(noise.outliers.size()));
+  if (outliers.rows() > 0) noiseReport.set("outliers_file", kOutliersFile);
   noiseReport.set("noise_limited", result.noiseLimited);
   if (result.noiseLimited) noiseReport.set("bias_percent", result.error.biasPercent);
   report.set("data_noise", noiseReport);
@@ -249,9 +257,11 @@ void runFit(FitCommandOptions o) {
   report.set("parameters", parameters);
 
   writeModelOutputs(dir, result.mesh, surface, report, [&](OutputSet& outputs) {
+    if (outliers.rows() > 0) writePointCloudXyz(outliers, outputs.add(kOutliersFile));
     FigureInputs inputs;
     inputs.surface = &surface;
     inputs.dataPoints = data;
+    inputs.outliers = outliers;
     inputs.history = &history;
     // Coloured by the distance to the scan, magenta where uncovered.
     if (coverage.limit > 0.0) {
@@ -289,7 +299,8 @@ void runFit(FitCommandOptions o) {
     std::cout << "the points are a mesh's vertices, taken as exact: no noise and no outliers (--noise measure "
                  "measures their scatter)\n";
   }
-  if (!noise.outliers.empty()) std::cout << "set aside " << noise.outliers.size() << " outlier(s)\n";
+  if (!noise.outliers.empty())
+    std::cout << "set aside " << noise.outliers.size() << " outlier(s), written to " << kOutliersFile << '\n';
   for (const std::string& warning : warnings) std::cerr << "warning: " << warning << '\n';
   std::cout
             << "wrote " << (dir / "surface.vtp").string() << ", control_mesh.obj, report.json, convergence.csv"
@@ -307,7 +318,8 @@ void addFitCommand(CLI::App& app) {
       "largest distance from a data point to the surface is below the tolerance (percent of the diameter of "
       "the smallest sphere enclosing the data).\n"
       "Writes DIR/surface.vtp, DIR/control_mesh.obj, DIR/report.json, DIR/convergence.csv and the figures "
-      "DIR/slices.png, DIR/surface3d.png and DIR/convergence.png (or .pdf, .svg: --figure-format).");
+      "DIR/slices.png, DIR/surface3d.png and DIR/convergence.png (or .pdf, .svg: --figure-format); and "
+      "DIR/outliers.xyz when points were set aside as outliers (the figures draw them in orange).");
   command->add_option("POINTS", o->points, "Point cloud: .xyz/.txt/.pwn, .csv, .ply, .off, .obj or .vtp (mm)")
       ->required();
   command->add_option("--out", o->out, "Output directory (created if missing; its parent must exist)")->required();
@@ -339,7 +351,8 @@ void addFitCommand(CLI::App& app) {
                       "the surface's bias to it instead")
       ->default_val("auto");
   command->add_flag("--keep-outliers", o->keepOutliers,
-                    "Fit every point; by default points far off their neighbours' local surface are set aside");
+                    "Fit every point; by default points far off their neighbours' local surface are set aside "
+                    "(written to DIR/outliers.xyz)");
   command
       ->add_option("--refinement", o->refinement,
                    "local: where the fit is refused, a level's faces are refined and their new points move, while "

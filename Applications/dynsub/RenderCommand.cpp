@@ -1,8 +1,11 @@
 // dynsub render: the figures of segment and fit (Figures.h) from saved results.
 #include <CLI/CLI.hpp>
+#include <array>
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <set>
+#include <vector>
 
 #include "Commands.h"
 #include "FigureOutputs.h"
@@ -18,8 +21,19 @@ namespace dynsub::app {
 
 namespace {
 
+// The rows of `points` that are not rows of `drop`, compared exactly: fit
+// writes its outliers with the digits that read back as the same doubles.
+MatrixX3 withoutPoints(const MatrixX3& points, const MatrixX3& drop) {
+  std::set<std::array<double, 3>> dropped;
+  for (Eigen::Index r = 0; r < drop.rows(); ++r) dropped.insert({drop(r, 0), drop(r, 1), drop(r, 2)});
+  std::vector<int> keep;
+  for (Eigen::Index r = 0; r < points.rows(); ++r)
+    if (!dropped.count({points(r, 0), points(r, 1), points(r, 2)})) keep.push_back(static_cast<int>(r));
+  return points(keep, Eigen::all);
+}
+
 struct RenderCommandOptions {
-  std::string surface, image, landmarks, points, convergence, controlMesh, out;
+  std::string surface, image, landmarks, points, outliers, convergence, controlMesh, out;
   FigureOptions figures;
 };
 
@@ -39,6 +53,10 @@ void runRender(const RenderCommandOptions& o) {
   }
   if (!o.landmarks.empty()) inputs.landmarks = landmarkPositions(readLandmarks(o.landmarks));
   if (!o.points.empty()) inputs.dataPoints = readPointCloud(o.points).points;
+  if (!o.outliers.empty()) {
+    inputs.outliers = readPointCloud(o.outliers).points;
+    inputs.dataPoints = withoutPoints(inputs.dataPoints, inputs.outliers);
+  }
   std::unique_ptr<ControlMesh> controlMesh;
   if (!o.controlMesh.empty()) {
     controlMesh = std::make_unique<ControlMesh>(readControlMesh(o.controlMesh));
@@ -74,6 +92,8 @@ void addRenderCommand(CLI::App& app) {
   command->add_option("--image", o->image, "The image the surface was segmented in (slices show it)");
   command->add_option("--landmarks", o->landmarks, "Landmarks: .mrk.json, .fcsv or .csv");
   command->add_option("--points", o->points, "Range data the surface was fitted to");
+  command->add_option("--outliers", o->outliers,
+                      "Points fit set aside as outliers (its outliers.xyz): drawn in orange, and left out of --points");
   command->add_option("--control-mesh", o->controlMesh, "Control mesh to draw as a wireframe in the 3D figure");
   command->add_option("--convergence", o->convergence, "convergence.csv written by segment or fit");
   command->add_option("--out", o->out, "Output directory (created if missing; its parent must exist)")->required();

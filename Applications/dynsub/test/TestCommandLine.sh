@@ -202,6 +202,33 @@ for name in slices.png surface3d.png; do
   check "render redraws fit's $name, coloured by the distance to the scan, pixel for pixel" \
     cmp -s "$work/fitholerendered/$name" "$work/fithole/$name"
 done
+# Six points well off the torus (in its hole, 15-17 mm above and below its
+# tube, whose radius is 15 mm) are set aside as outliers: written to
+# outliers.xyz as the very numbers they were read as, and drawn apart from
+# the data, so that render redraws the figures from the scan and that file.
+{ cat "$DATA/PointClouds/torus.xyz"
+  printf '%s\n' "0 0 0" "0.5 -0.25 20" "40 0 30" "-40 0 -30" "0 40 32" "28.3 -28.3 -31"; } >"$work/offtorus.xyz"
+"$DYNSUB" fit "$work/offtorus.xyz" --init torus --out "$work/fitoff" >/dev/null
+check "fit writes the outliers it set aside, exactly as read" python3 -c "
+import json, sys
+report = json.load(open(sys.argv[1]))['data_noise']
+written = {tuple(map(float, line.split())) for line in open(sys.argv[2])}
+added = {(0, 0, 0), (0.5, -0.25, 20), (40, 0, 30), (-40, 0, -30), (0, 40, 32), (28.3, -28.3, -31)}
+sys.exit(0 if added <= written and len(written) == report['outliers'] and report['outliers_file'] == 'outliers.xyz'
+         else 1)" "$work/fitoff/report.json" "$work/fitoff/outliers.xyz"
+check "a fit that sets nothing aside writes no outliers.xyz" test ! -e "$work/nofig/outliers.xyz"
+"$DYNSUB" render --surface "$work/fitoff/surface.vtp" --points "$work/offtorus.xyz" \
+  --outliers "$work/fitoff/outliers.xyz" --control-mesh "$work/fitoff/control_mesh.obj" --out "$work/fitoffrendered" \
+  >/dev/null
+for name in slices.png surface3d.png; do
+  check "render --outliers redraws fit's $name with its outliers, pixel for pixel" \
+    cmp -s "$work/fitoffrendered/$name" "$work/fitoff/$name"
+done
+"$DYNSUB" render --surface "$work/fitoff/surface.vtp" --points "$work/offtorus.xyz" \
+  --control-mesh "$work/fitoff/control_mesh.obj" --out "$work/fitoffnooutliers" >/dev/null
+check "the outliers change the figure" test -n "$(cmp "$work/fitoffnooutliers/slices.png" "$work/fitoff/slices.png")"
+expect_error "render: missing outliers file" 1 "none.xyz: no such file" "$work/r6" \
+  "$DYNSUB" render --surface "$work/fitoff/surface.vtp" --outliers "$work/none.xyz" --out "$work/r6"
 # Surface springs pull the membrane toward the ring: 6.7 % of the area is
 # left uncovered with them against 10.2 % without, and a fifth less is asked.
 "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --surface-springs 0.1 --no-figures --out "$work/fitsprings" \

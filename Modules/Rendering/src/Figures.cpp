@@ -114,6 +114,7 @@ void addLegend(const FigureScene& scene, vtkRenderWindow* window) {
   }
   if (scene.landmarks.rows() > 0) items.push_back({"landmarks on the slice", landmarkColour()});
   if (scene.dataPoints.rows() > 0) items.push_back({"range data near the slice", style::kDataPoint});
+  if (scene.outliers.rows() > 0) items.push_back({"outliers set aside", style::kOutlierPoint});
   items.push_back({"coordinates: " + coordinatesName(scene.coordinates) + " mm", {1, 1, 1}});
   auto legend = strip(0, 0, kSlicesWidth, kLegend, kSlicesWidth, kSlicesHeight);
   legend->SetBackground(0.12, 0.12, 0.12);
@@ -206,6 +207,7 @@ void drawSlices(const FigureScene& scene, vtkRenderWindow* window) {
       }
       view.setLandmarks(scene.landmarks);
       if (scene.dataPoints.rows() > 0) view.setDataPoints(scene.dataPoints);
+      if (scene.outliers.rows() > 0) view.setOutliers(scene.outliers);
       view.frame(centre, halfSize);
       // Row 0 at the top of the window; the caption strip above each image.
       const int top = kSlicesHeight - row * (kCell + kCaption), x0 = column * kCell, x1 = x0 + kCell;
@@ -269,6 +271,7 @@ void drawSurface(const FigureScene& scene, vtkRenderWindow* window) {
   if (scene.controlMesh) view.setControlMesh(scene.controlMesh);
   view.setLandmarks(scene.landmarks);
   if (scene.dataPoints.rows() > 0) view.setDataPoints(scene.dataPoints);
+  if (scene.outliers.rows() > 0) view.setOutliers(scene.outliers);
   if (const ImageSlices* image = scene.image) {
     // Slices just behind the surface as seen by the camera (which looks from
     // the left, front and top): its right, back and bottom.
@@ -541,6 +544,7 @@ void writeFigures(const FigureInputs& inputs, const FigureFiles& files) {
   }
   scene.landmarks = inputs.landmarks;
   scene.dataPoints = inputs.dataPoints;
+  scene.outliers = inputs.outliers;
   scene.coordinates = inputs.coordinates;
   std::unique_ptr<ImageSlices> slices;
   if (inputs.image) {

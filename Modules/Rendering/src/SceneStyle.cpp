@@ -141,14 +141,27 @@ void showLandmarks(vtkRenderer* renderer, vtkPolyData* points, vtkActor* actor) 
   renderer->AddActor(actor);
 }
 
-void showDataPoints(vtkRenderer* renderer, vtkPolyData* points, vtkActor* actor) {
+namespace {
+
+void showPlainDots(vtkRenderer* renderer, vtkPolyData* points, vtkActor* actor, const std::array<double, 3>& colour,
+                   double pixels) {
   vtkNew<vtkPolyDataMapper> mapper;
   mapper->SetInputData(points);
   mapper->ScalarVisibilityOff();
   actor->SetMapper(mapper);
-  pointsAsDots(actor, kDataPixels);
-  actor->GetProperty()->SetColor(kDataPoint[0], kDataPoint[1], kDataPoint[2]);
+  pointsAsDots(actor, pixels);
+  actor->GetProperty()->SetColor(colour[0], colour[1], colour[2]);
   renderer->AddActor(actor);
+}
+
+}  // namespace
+
+void showDataPoints(vtkRenderer* renderer, vtkPolyData* points, vtkActor* actor) {
+  showPlainDots(renderer, points, actor, kDataPoint, kDataPixels);
+}
+
+void showOutliers(vtkRenderer* renderer, vtkPolyData* points, vtkActor* actor) {
+  showPlainDots(renderer, points, actor, kOutlierPoint, kOutlierPixels);
 }
 
 vtkSmartPointer<vtkRenderWindow> offScreenWindow(int width, int height) {

@@ -102,6 +102,7 @@ struct SliceView::Impl {
   MatrixX3 landmarks;
   int selected = -1;
   MatrixX3 dataPoints;
+  MatrixX3 outliers;
 
   vtkNew<vtkRenderer> renderer;
   vtkNew<vtkImageSliceMapper> imageMapper;
@@ -115,6 +116,8 @@ struct SliceView::Impl {
   vtkNew<vtkActor> landmarkActor;
   vtkNew<vtkPolyData> dataOnSlice;
   vtkNew<vtkActor> dataActor;
+  vtkNew<vtkPolyData> outliersOnSlice;
+  vtkNew<vtkActor> outlierActor;
   vtkNew<vtkTextActor> title;
   vtkNew<vtkTextActor> edgeLetters[4];  // left, right, top, bottom
   bool customTitle = false;
@@ -147,6 +150,7 @@ struct SliceView::Impl {
 
     style::showLandmarks(renderer, landmarkPoints, landmarkActor);
     style::showDataPoints(renderer, dataOnSlice, dataActor);
+    style::showOutliers(renderer, outliersOnSlice, outlierActor);
 
     style::cornerText(title, 0.02, 0.97, style::Corner::TopLeft);
     renderer->AddActor2D(title);
@@ -177,11 +181,12 @@ struct SliceView::Impl {
     cutPlane->SetOrigin(plane.origin.x(), plane.origin.y(), plane.origin.z());
     cutPlane->SetNormal(plane.normal.x(), plane.normal.y(), plane.normal.z());
     const Vector3 shift = overlayShift();
-    for (vtkActor* overlay : {contourActor.Get(), landmarkActor.Get(), dataActor.Get()})
+    for (vtkActor* overlay : {contourActor.Get(), landmarkActor.Get(), dataActor.Get(), outlierActor.Get()})
       overlay->SetPosition(shift.x(), shift.y(), shift.z());
 
     landmarkPoints->ShallowCopy(style::dots(landmarks, onSlice(landmarks), selected));
     dataOnSlice->ShallowCopy(style::dots(dataPoints, onSlice(dataPoints)));
+    outliersOnSlice->ShallowCopy(style::dots(outliers, onSlice(outliers)));
 
     // Edge letters: the anatomical direction each screen edge points to.
     const Vector3 towards[4] = {-plane.right, plane.right, plane.up, -plane.up};
@@ -264,6 +269,11 @@ void SliceView::setLandmarks(const MatrixX3& landmarks, int selected) {
 
 void SliceView::setDataPoints(const MatrixX3& points) {
   impl_->dataPoints = points;
+  impl_->update();
+}
+
+void SliceView::setOutliers(const MatrixX3& points) {
+  impl_->outliers = points;
   impl_->update();
 }
 

@@ -65,6 +65,8 @@ struct SurfaceView::Impl {
   vtkNew<vtkActor> landmarkActor;
   vtkNew<vtkPolyData> dataPoints;
   vtkNew<vtkActor> dataActor;
+  vtkNew<vtkPolyData> outliers;
+  vtkNew<vtkActor> outlierActor;
   const ImageSlices* image = nullptr;
   vtkNew<vtkImageSliceMapper> sliceMappers[3];
   vtkNew<vtkImageSlice> sliceActors[3];
@@ -87,6 +89,7 @@ struct SurfaceView::Impl {
 
     style::showLandmarks(renderer, landmarkPoints, landmarkActor);
     style::showDataPoints(renderer, dataPoints, dataActor);
+    style::showOutliers(renderer, outliers, outlierActor);
 
     for (int s = 0; s < 3; ++s) {
       sliceActors[s]->SetMapper(sliceMappers[s]);
@@ -132,6 +135,10 @@ void SurfaceView::setLandmarks(const MatrixX3& landmarks, int selected) {
 
 void SurfaceView::setDataPoints(const MatrixX3& points) {
   impl_->dataPoints->ShallowCopy(style::dots(points, style::allRows(points)));
+}
+
+void SurfaceView::setOutliers(const MatrixX3& points) {
+  impl_->outliers->ShallowCopy(style::dots(points, style::allRows(points)));
 }
 
 void SurfaceView::setImage(const ImageSlices* image) {

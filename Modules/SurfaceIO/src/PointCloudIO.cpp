@@ -1,6 +1,7 @@
 #include "dynsub/PointCloudIO.h"
 
 #include <cerrno>
+#include <charconv>
 #include <cstdlib>
 #include <filesystem>
 #include <iterator>
@@ -16,6 +17,7 @@
 #include <vtkPolyData.h>
 #include <vtkXMLPolyDataReader.h>
 
+#include "dynsub/AtomicOutput.h"
 #include "dynsub/ControlMesh.h"
 #include "dynsub/Error.h"
 #include "dynsub/TextFields.h"
@@ -192,6 +194,24 @@ int closedMeshGenus(const PointCloud& cloud, const std::string& source) {
     if (find(face.front()) != first) return -1;
   }
   return mesh.genus();
+}
+
+void writePointCloudXyz(const MatrixX3& points, const std::string& path) {
+  AtomicOutput output(path);
+  {
+    std::ofstream out(output.temporaryPath());
+    if (!out) throw Error(path, "cannot write the file");
+    // The shortest digits that read back as the same double (to_chars).
+    char number[32];
+    for (Eigen::Index p = 0; p < points.rows(); ++p) {
+      for (int c = 0; c < 3; ++c) {
+        const auto end = std::to_chars(number, number + sizeof number, points(p, c)).ptr;
+        out.write(number, end - number) << (c < 2 ? ' ' : '\n');
+      }
+    }
+    if (!out) throw Error(path, "writing the file failed");
+  }
+  output.commit();
 }
 
 }  // namespace dynsub

@@ -107,6 +107,23 @@ TEST(PointCloudIO, ClosedMeshesGiveTheirGenus) {
   EXPECT_EQ(genusOf(writeText("points.xyz", tetrahedron)), -1);
 }
 
+// Points written as .xyz read back as the very same doubles, awkward ones
+// included (thirds, tiny and huge magnitudes, negative zero): a fit's
+// outliers.xyz is matched row for row against the scan it came from.
+TEST(PointCloudIO, XyzRoundTripIsExact) {
+  dynsub::MatrixX3 points(4, 3);
+  points << 1.0 / 3.0, -2.0 / 7.0, 1e-300, 123456.789012345678, -0.0, 5e307, 0.1, 0.2, 0.3, -1.0 / 3.0,
+      2.0 / 3.0, 1e-17;
+  const std::string path = scratch("roundtrip.xyz");
+  dynsub::writePointCloudXyz(points, path);
+  const dynsub::PointCloud read = dynsub::readPointCloud(path);
+  ASSERT_EQ(read.points.rows(), points.rows());
+  for (Eigen::Index p = 0; p < points.rows(); ++p)
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(read.points(p, c), points(p, c)) << "point " << p << ", column " << c;
+  EXPECT_FALSE(read.meshVertices);
+  EXPECT_THROW(dynsub::writePointCloudXyz(points, scratch("no/such/dir/x.xyz")), dynsub::Error);
+}
+
 TEST(PointCloudIO, RefusesUnknownFormats) {
   const std::string path = writeText("cloud.pts", "0 0 0\n");
   EXPECT_THROW(dynsub::readPointCloud(path), dynsub::Error);

@@ -49,6 +49,7 @@ struct FigureInputs {
   const ControlMesh* controlMesh = nullptr;  // optional wireframe, 3D figure only
   MatrixX3 landmarks;                        // #landmarks x 3, LPS mm
   MatrixX3 dataPoints;                       // range data, mm
+  MatrixX3 outliers;                         // range data set aside as outliers (fit), mm
   const ConvergenceHistory* history = nullptr;  // needed for the convergence figure
   // Per point of `surface`: its distance to the nearest edge (mm, -1
   // unknown), to colour it by (edgeDistanceColours()); empty: none. A

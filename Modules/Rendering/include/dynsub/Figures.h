@@ -43,6 +43,7 @@ struct FigureScene {
   vtkPolyData* controlMesh = nullptr; // optional wireframe (SurfaceView.h), 3D figure only
   MatrixX3 landmarks;                 // #landmarks x 3, LPS mm
   MatrixX3 dataPoints;                // range data, mm
+  MatrixX3 outliers;                  // range data set aside as outliers, mm
   // The surface and its contours coloured by a distance of each point
   // (FigureInputs.h), with a colour bar in the 3D figure; none: by element
   // type.

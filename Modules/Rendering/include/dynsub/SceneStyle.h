@@ -45,8 +45,12 @@ constexpr double kFarFromEdges = 3.0;  // mm: three voxels of the 1 mm MRI
 constexpr std::array<double, 3> kNearColour{0.15, 0.8, 0.25};
 constexpr std::array<double, 3> kMiddleColour{1.0, 0.9, 0.15};
 constexpr std::array<double, 3> kFarColour{0.9, 0.2, 0.9};
-// Range data's dots: light grey, apart from the landmarks' red.
+// Range data's dots: light grey, apart from the landmarks' red. Points a fit
+// set aside as outliers: orange and larger, to stand out from the data that
+// shaped the surface, the green surface and the blue wireframe.
 constexpr std::array<double, 3> kDataPoint{0.85, 0.85, 0.85};
+constexpr std::array<double, 3> kOutlierPoint{1.0, 0.55, 0.0};
+constexpr double kOutlierPixels = 5.0;
 // The control mesh's wireframe, and in a creased mesh its creases.
 constexpr std::array<double, 3> kWireframe{0.6, 0.7, 1.0};
 constexpr std::array<unsigned char, 3> kCrease{255, 90, 40};
@@ -63,9 +67,10 @@ std::vector<int> allRows(const MatrixX3& points);
 
 // Adds `actor` drawing `points` to `renderer`: landmarks as dots coloured by
 // their per-point colours (kLandmark, kSelectedLandmark); range data as small
-// light grey dots.
+// light grey dots; outliers set aside from it as orange ones.
 void showLandmarks(vtkRenderer* renderer, vtkPolyData* points, vtkActor* actor);
 void showDataPoints(vtkRenderer* renderer, vtkPolyData* points, vtkActor* actor);
+void showOutliers(vtkRenderer* renderer, vtkPolyData* points, vtkActor* actor);
 
 // A fixed-size window without multisampling, rendering off screen (figures:
 // the same input gives the same pixels).

@@ -40,8 +40,10 @@ class SliceView {
   void colourByDistance(const DistanceColours& colours);
   // Landmarks (#landmarks x 3, LPS mm); those within half a slice of the plane are drawn.
   void setLandmarks(const MatrixX3& landmarks, int selected = -1);
-  // Range data drawn as small white dots where within half a slice.
+  // Range data drawn as small light grey dots where within half a slice, and
+  // the points set aside from it as outliers as orange ones.
   void setDataPoints(const MatrixX3& points);
+  void setOutliers(const MatrixX3& points);
 
   // Show the image's slice `index` (clamped), or any plane.
   void showSlice(int index);

@@ -42,6 +42,7 @@ class SurfaceView {
   void setControlMesh(vtkPolyData* wireframe);  // nullptr hides it
   void setLandmarks(const MatrixX3& landmarks, int selected = -1);  // #landmarks x 3, LPS mm
   void setDataPoints(const MatrixX3& points);
+  void setOutliers(const MatrixX3& points);  // range data set aside, drawn apart from it
   // The three slice planes of `image` (not owned) at the given slice indices
   // (axial, coronal, sagittal); nullptr hides them.
   void setImage(const ImageSlices* image);
