@@ -79,12 +79,13 @@ vtkSmartPointer<vtkRenderer> strip(int x0, int y0, int x1, int y1, int width, in
 }
 
 // Text at the left of a strip, vertically centred, in a colour.
-void addText(vtkRenderer* renderer, const std::string& text, double x, const std::array<double, 3>& colour) {
+vtkTextActor* addText(vtkRenderer* renderer, const std::string& text, double x, const std::array<double, 3>& colour) {
   vtkNew<vtkTextActor> actor;
   style::cornerText(actor, x, 0.5, style::Corner::Left, kCaptionFont);
   actor->GetTextProperty()->SetColor(colour.data());
   actor->SetInput(text.c_str());
   renderer->AddActor2D(actor);
+  return actor;
 }
 
 // The landmarks' colour (style::kLandmark, 8-bit) for text.
@@ -118,9 +119,25 @@ void addLegend(const FigureScene& scene, vtkRenderWindow* window) {
   items.push_back({"coordinates: " + coordinatesName(scene.coordinates) + " mm", {1, 1, 1}});
   auto legend = strip(0, 0, kSlicesWidth, kLegend, kSlicesWidth, kSlicesHeight);
   legend->SetBackground(0.12, 0.12, 0.12);
-  for (std::size_t i = 0; i < items.size(); ++i)
-    addText(legend, items[i].first, 0.01 + 0.99 * double(i) / items.size(), items[i].second);
-  window->AddRenderer(legend);
+  window->AddRenderer(legend);  // the texts are measured in it
+  // Equal gaps between the texts as measured, not equal slots: a fit's
+  // legend has long texts beside short ones, which slots would run together.
+  std::vector<vtkTextActor*> texts;
+  double width = 0.0;
+  for (const auto& [text, colour] : items) {
+    texts.push_back(addText(legend, text, 0.0, colour));
+    double box[4];
+    texts.back()->GetBoundingBox(legend, box);
+    width += box[1] - box[0];
+  }
+  const double gap = (kSlicesWidth - width) / static_cast<double>(texts.size());
+  double x = 0.5 * gap;
+  for (vtkTextActor* text : texts) {
+    double box[4];
+    text->GetBoundingBox(legend, box);
+    text->SetPosition(x / kSlicesWidth, 0.5);
+    x += box[1] - box[0] + gap;
+  }
 }
 
 void requireSurface(const FigureScene& scene) {

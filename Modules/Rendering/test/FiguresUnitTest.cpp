@@ -379,14 +379,13 @@ std::vector<std::array<double, 4>> textBoxes(vtkRenderWindow* window, std::vecto
 }
 
 // No two texts of the slices figure overlap or touch: captions, edge letters and the
-// legend each have room of their own, whatever the slice numbers.
-TEST_F(Rendering, SlicesFigureTextsDoNotOverlap) {
-  CaudateScene caudate;
-  caudate.scene.distances = edgeDistanceColours();
+// legend each have room of their own, whatever the slice numbers. `legend`
+// entries are expected.
+void expectTextsApart(vtkRenderWindow* window, std::size_t legend) {
   std::vector<std::string> texts;
-  const auto boxes = textBoxes(slicesFigure(caudate.scene), &texts);
-  // 15 captions, 60 edge letters, 4 legend entries.
-  EXPECT_EQ(boxes.size(), 15u + 60u + 4u);
+  const auto boxes = textBoxes(window, &texts);
+  // 15 captions, 60 edge letters and the legend's entries.
+  EXPECT_EQ(boxes.size(), 15u + 60u + legend);
   for (std::size_t a = 0; a < boxes.size(); ++a)
     for (std::size_t b = a + 1; b < boxes.size(); ++b) {
       // At least kGap pixels apart: texts that touch read as one.
@@ -395,6 +394,22 @@ TEST_F(Rendering, SlicesFigureTextsDoNotOverlap) {
                          boxes[a][3] + kGap <= boxes[b][2] || boxes[b][3] + kGap <= boxes[a][2];
       EXPECT_TRUE(apart) << "'" << texts[a] << "' overlaps '" << texts[b] << "'";
     }
+}
+
+TEST_F(Rendering, SlicesFigureTextsDoNotOverlap) {
+  CaudateScene caudate;
+  caudate.scene.distances = edgeDistanceColours();
+  expectTextsApart(slicesFigure(caudate.scene), 4);
+}
+
+// The longest legend: a fit's colours by the distance to the scan (two long
+// texts), with landmarks, range data and outliers set aside beside them.
+TEST_F(Rendering, TheFullestLegendDoesNotOverlap) {
+  CaudateScene caudate;
+  caudate.scene.distances = scanDistanceColours(0.115);
+  caudate.scene.dataPoints = caudate.scene.landmarks;
+  caudate.scene.outliers = caudate.scene.landmarks.topRows(3);
+  expectTextsApart(slicesFigure(caudate.scene), 6);
 }
 
 // A fit's figures colour its surface by the distance to its scan. A cube's
