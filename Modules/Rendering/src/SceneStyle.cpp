@@ -86,7 +86,9 @@ vtkSmartPointer<vtkScalarBarActor> distanceBar(const DistanceColours& colours) {
   auto bar = vtkSmartPointer<vtkScalarBarActor>::New();
   bar->SetLookupTable(distanceTable(colours, 0.0));  // labelled from 0
   bar->SetTitle(("mm to " + colours.to).c_str());
-  bar->SetNumberOfLabels(4);
+  // 0, the middle and the end: for a scan the middle is where green ends
+  // (scanDistanceColours).
+  bar->SetNumberOfLabels(3);
   bar->SetLabelFormat("%.3g");  // a scan's far distance may be a fraction of a mm
   bar->SetOrientationToVertical();
   bar->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
