@@ -257,7 +257,11 @@ void runFit(FitCommandOptions o) {
   report.set("parameters", parameters);
 
   writeModelOutputs(dir, result.mesh, surface, report, [&](OutputSet& outputs) {
-    if (outliers.rows() > 0) writePointCloudXyz(outliers, outputs.add(kOutliersFile));
+    if (outliers.rows() > 0) {
+      writePointCloudXyz(outliers, outputs.add(kOutliersFile));
+    } else {
+      outputs.retire(kOutliersFile);  // an earlier run's would read as this one's
+    }
     FigureInputs inputs;
     inputs.surface = &surface;
     inputs.dataPoints = data;
@@ -300,7 +304,8 @@ void runFit(FitCommandOptions o) {
                  "measures their scatter)\n";
   }
   if (!noise.outliers.empty())
-    std::cout << "set aside " << noise.outliers.size() << " outlier(s), written to " << kOutliersFile << '\n';
+    std::cout << "set aside " << noise.outliers.size() << " outlier(s), written to " << (dir / kOutliersFile).string()
+              << '\n';
   for (const std::string& warning : warnings) std::cerr << "warning: " << warning << '\n';
   std::cout
             << "wrote " << (dir / "surface.vtp").string() << ", control_mesh.obj, report.json, convergence.csv"

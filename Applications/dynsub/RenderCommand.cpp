@@ -5,6 +5,7 @@
 #include <iostream>
 #include <memory>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "Commands.h"
@@ -23,12 +24,25 @@ namespace {
 
 // The rows of `points` that are not rows of `drop`, compared exactly: fit
 // writes its outliers with the digits that read back as the same doubles.
-MatrixX3 withoutPoints(const MatrixX3& points, const MatrixX3& drop) {
+// Every copy of a dropped point goes: fit judges copies alike (they have the
+// same neighbours), so it set them all aside. Warns when some of `drop` are
+// not among `points` (outliers of another scan).
+MatrixX3 withoutPoints(const MatrixX3& points, const MatrixX3& drop, const std::string& dropFile) {
   std::set<std::array<double, 3>> dropped;
   for (Eigen::Index r = 0; r < drop.rows(); ++r) dropped.insert({drop(r, 0), drop(r, 1), drop(r, 2)});
+  std::set<std::array<double, 3>> found;
   std::vector<int> keep;
-  for (Eigen::Index r = 0; r < points.rows(); ++r)
-    if (!dropped.count({points(r, 0), points(r, 1), points(r, 2)})) keep.push_back(static_cast<int>(r));
+  for (Eigen::Index r = 0; r < points.rows(); ++r) {
+    const std::array<double, 3> point{points(r, 0), points(r, 1), points(r, 2)};
+    if (dropped.count(point)) {
+      found.insert(point);
+    } else {
+      keep.push_back(static_cast<int>(r));
+    }
+  }
+  if (found.size() < dropped.size())
+    std::cerr << "warning: " << dropped.size() - found.size() << " of the " << dropped.size() << " points of "
+              << dropFile << " are not points of --points\n";
   return points(keep, Eigen::all);
 }
 
@@ -55,7 +69,8 @@ void runRender(const RenderCommandOptions& o) {
   if (!o.points.empty()) inputs.dataPoints = readPointCloud(o.points).points;
   if (!o.outliers.empty()) {
     inputs.outliers = readPointCloud(o.outliers).points;
-    inputs.dataPoints = withoutPoints(inputs.dataPoints, inputs.outliers);
+    if (!inputs.outliers.allFinite()) throw Error(o.outliers, "a point is not a finite number");
+    if (!o.points.empty()) inputs.dataPoints = withoutPoints(inputs.dataPoints, inputs.outliers, o.outliers);
   }
   std::unique_ptr<ControlMesh> controlMesh;
   if (!o.controlMesh.empty()) {

@@ -74,6 +74,8 @@ std::string OutputSet::add(const std::string& name) {
   return outputs_.back()->temporaryPath();
 }
 
+void OutputSet::retire(const std::string& name) { retired_.push_back(name); }
+
 void OutputSet::commit() {
   for (auto& output : outputs_) output->commit();
   if (!staging_.empty()) {
@@ -109,6 +111,13 @@ void OutputSet::commit() {
       for (const auto& output : outputs_) moveIn(output->target());
       std::filesystem::remove(staging_, error);
     }
+  }
+  // After the set's own files: a run killed before this leaves the old file
+  // beside a complete new set, never a set without it.
+  for (const std::string& name : retired_) {
+    std::error_code error;
+    std::filesystem::remove(dir_ / name, error);
+    if (error) throw Error((dir_ / name).string(), "an earlier run's file cannot be removed: " + error.message());
   }
   committed_ = true;
 }

@@ -185,6 +185,31 @@ TEST(OutputSet, AnExistingDirectoryKeepsItsOtherFiles) {
   EXPECT_EQ(text, "new");
 }
 
+// A file the set retires (one it writes only sometimes) is gone after the
+// commit, not before it; the other files stay.
+TEST(OutputSet, ARetiredFileOfAnEarlierRunIsRemovedAtCommit) {
+  const fs::path dir = freshDirectory("set-retired");
+  std::ofstream(dir / "notes.txt") << "mine";
+  std::ofstream(dir / "outliers.xyz") << "1 2 3";
+  {
+    dynsub::OutputSet outputs(dir);
+    std::ofstream(outputs.add("report.json")) << "{}";
+    outputs.retire("outliers.xyz");
+    outputs.retire("never-written.xyz");  // absent: nothing to do
+    EXPECT_TRUE(fs::exists(dir / "outliers.xyz"));
+    outputs.commit();
+  }
+  EXPECT_FALSE(fs::exists(dir / "outliers.xyz"));
+  EXPECT_TRUE(fs::exists(dir / "notes.txt"));
+  EXPECT_TRUE(fs::exists(dir / "report.json"));
+  {
+    dynsub::OutputSet outputs(dir);  // without commit() nothing is removed
+    std::ofstream(dir / "outliers.xyz") << "1 2 3";
+    outputs.retire("outliers.xyz");
+  }
+  EXPECT_TRUE(fs::exists(dir / "outliers.xyz"));
+}
+
 // Another run made the directory while this set was written: the set moves
 // in over that run's, a folder of the same name replaced whole.
 TEST(OutputSet, ADirectoryMadeMeanwhileTakesTheSet) {

@@ -41,6 +41,7 @@
 #include <iomanip>
 #include <iterator>
 #include <memory>
+#include <numeric>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -115,7 +116,7 @@ void addLegend(const FigureScene& scene, vtkRenderWindow* window) {
   }
   if (scene.landmarks.rows() > 0) items.push_back({"landmarks on the slice", landmarkColour()});
   if (scene.dataPoints.rows() > 0) items.push_back({"range data near the slice", style::kDataPoint});
-  if (scene.outliers.rows() > 0) items.push_back({"outliers set aside", style::kOutlierPoint});
+  if (scene.outliers.rows() > 0) items.push_back({"outliers set aside, near the slice", style::kOutlierPoint});
   items.push_back({"coordinates: " + coordinatesName(scene.coordinates) + " mm", {1, 1, 1}});
   auto legend = strip(0, 0, kSlicesWidth, kLegend, kSlicesWidth, kSlicesHeight);
   legend->SetBackground(0.12, 0.12, 0.12);
@@ -123,20 +124,19 @@ void addLegend(const FigureScene& scene, vtkRenderWindow* window) {
   // Equal gaps between the texts as measured, not equal slots: a fit's
   // legend has long texts beside short ones, which slots would run together.
   std::vector<vtkTextActor*> texts;
-  double width = 0.0;
+  std::vector<double> widths;
   for (const auto& [text, colour] : items) {
     texts.push_back(addText(legend, text, 0.0, colour));
     double box[4];
     texts.back()->GetBoundingBox(legend, box);
-    width += box[1] - box[0];
+    widths.push_back(box[1] - box[0]);
   }
-  const double gap = (kSlicesWidth - width) / static_cast<double>(texts.size());
+  const double total = std::accumulate(widths.begin(), widths.end(), 0.0);
+  const double gap = std::max(0.0, (kSlicesWidth - total) / static_cast<double>(texts.size()));
   double x = 0.5 * gap;
-  for (vtkTextActor* text : texts) {
-    double box[4];
-    text->GetBoundingBox(legend, box);
-    text->SetPosition(x / kSlicesWidth, 0.5);
-    x += box[1] - box[0] + gap;
+  for (std::size_t i = 0; i < texts.size(); ++i) {
+    texts[i]->SetPosition(x / kSlicesWidth, 0.5);
+    x += widths[i] + gap;
   }
 }
 
@@ -190,6 +190,7 @@ void drawSlices(const FigureScene& scene, vtkRenderWindow* window) {
   if (image) grey = image->windowAround(points, 10.0);
 
   window->SetSize(kSlicesWidth, kSlicesHeight);
+  window->SetDPI(72);  // the nominal size's, at which the legend is measured (scaleFigure may have left another)
   for (int row = 0; row < 3; ++row) {
     const auto orientation = static_cast<SliceOrientation>(row);
     // The surface's extent along the slice normal and across the view.

@@ -412,6 +412,58 @@ TEST_F(Rendering, TheFullestLegendDoesNotOverlap) {
   expectTextsApart(slicesFigure(caudate.scene), 6);
 }
 
+// A fit's outliers are drawn as orange dots in both figures, and only when
+// given: points 15-25 % of its half-size off a cube, around it.
+TEST_F(Rendering, OutliersAreDrawnInTheirOwnColour) {
+  const ControlMesh mesh = readControlMesh(kSource + "/Data/Meshes/cube.obj");
+  const TriangleSurface surface = tessellate(LimitSurface(mesh), mesh.points(), 8);
+  const Vector3 low = surface.points.colwise().minCoeff().transpose();
+  const Vector3 high = surface.points.colwise().maxCoeff().transpose();
+  const Vector3 centre = 0.5 * (low + high);
+  const double reach = 0.5 * (high - low).maxCoeff();
+  MatrixX3 outliers(12, 3);
+  for (int i = 0; i < 12; ++i) {
+    const double angle = 2.0 * M_PI * i / 12.0;
+    const Vector3 towards(std::cos(angle), std::sin(angle), i % 2 ? 0.5 : -0.5);
+    outliers.row(i) = (centre + (1.15 + 0.05 * (i % 3)) * reach * towards.normalized()).transpose();
+  }
+  const std::string directory = std::string(DYNSUB_BINARY_DIR) + "/Testing/Temporary";
+  std::filesystem::create_directories(directory);
+  const auto orangePixels = [&](const std::string& name, const MatrixX3& drawn) {
+    FigureInputs inputs;
+    inputs.surface = &surface;
+    inputs.outliers = drawn;
+    FigureFiles files;
+    files.surface3d = directory + "/outliers_" + name + "_3d.png";
+    files.slices = directory + "/outliers_" + name + "_slices.png";
+    writeFigures(inputs, files);
+    std::array<int, 2> counts{0, 0};
+    for (int f = 0; f < 2; ++f) {
+      vtkNew<vtkPNGReader> reader;
+      reader->SetFileName((f == 0 ? files.surface3d : files.slices).c_str());
+      reader->Update();
+      vtkImageData* image = reader->GetOutput();
+      int size[3];
+      image->GetDimensions(size);
+      // The slices' legend (the bottom 26 rows) names the outliers in orange too.
+      for (int y = f == 0 ? 0 : 30; y < size[1]; ++y)
+        for (int x = 0; x < size[0]; ++x) {
+          const std::array<int, 3> c = pixel(image, Eigen::Vector2d(x, y));
+          counts[f] += c[0] > 220 && c[1] > 100 && c[1] < 170 && c[2] < 60;
+        }
+    }
+    return counts;
+  };
+  const std::array<int, 2> with = orangePixels("with", outliers), without = orangePixels("without", MatrixX3());
+  // A dot covers 15-20 pixels. In 3D the cube hides most of the 12 and the
+  // camera frames the cube, so two show (39 pixels, measured); the slices
+  // show those within half a slice of their planes. At least one dot each.
+  EXPECT_GE(with[0], 10) << "3D figure";
+  EXPECT_GE(with[1], 10) << "slices";
+  EXPECT_EQ(without[0], 0);
+  EXPECT_EQ(without[1], 0);
+}
+
 // A fit's figures colour its surface by the distance to its scan. A cube's
 // limit surface whose points on one side lie on the scan (0 mm) and on the
 // other beyond the far distance shows green and magenta in the 3D figure.

@@ -200,7 +200,7 @@ void writePointCloudXyz(const MatrixX3& points, const std::string& path) {
   AtomicOutput output(path);
   {
     std::ofstream out(output.temporaryPath());
-    if (!out) throw Error(path, "cannot write the file");
+    if (!out) throw writeFailure(path);
     // The shortest digits that read back as the same double (to_chars).
     char number[32];
     for (Eigen::Index p = 0; p < points.rows(); ++p) {
@@ -209,7 +209,8 @@ void writePointCloudXyz(const MatrixX3& points, const std::string& path) {
         out.write(number, end - number) << (c < 2 ? ' ' : '\n');
       }
     }
-    if (!out) throw Error(path, "writing the file failed");
+    out.close();  // the last bytes reach the disk here
+    if (!out) throw writeFailure(path);
   }
   output.commit();
 }

@@ -3,6 +3,7 @@
 // points' noise, and the genus of a closed mesh, which a fit checks its
 // model against (FitCommand.cpp).
 #include <array>
+#include <cmath>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -119,7 +120,10 @@ TEST(PointCloudIO, XyzRoundTripIsExact) {
   const dynsub::PointCloud read = dynsub::readPointCloud(path);
   ASSERT_EQ(read.points.rows(), points.rows());
   for (Eigen::Index p = 0; p < points.rows(); ++p)
-    for (int c = 0; c < 3; ++c) EXPECT_EQ(read.points(p, c), points(p, c)) << "point " << p << ", column " << c;
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_EQ(read.points(p, c), points(p, c)) << "point " << p << ", column " << c;
+      EXPECT_EQ(std::signbit(read.points(p, c)), std::signbit(points(p, c))) << "point " << p << ", column " << c;
+    }
   EXPECT_FALSE(read.meshVertices);
   EXPECT_THROW(dynsub::writePointCloudXyz(points, scratch("no/such/dir/x.xyz")), dynsub::Error);
 }

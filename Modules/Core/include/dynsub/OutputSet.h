@@ -36,6 +36,10 @@ class OutputSet {
   OutputSet& operator=(const OutputSet&) = delete;
   // The temporary path to write `name` to.
   std::string add(const std::string& name);
+  // A file this set may write but does not this time (a fit's outliers.xyz
+  // when none were set aside): an earlier run's copy in the directory is
+  // removed at commit(), so that it is not read as this run's.
+  void retire(const std::string& name);
   // Where the set is written until commit(): a folder made in it (an
   // OutputSet of its own) becomes part of the set.
   const std::filesystem::path& writingDirectory() const { return staging_.empty() ? dir_ : staging_; }
@@ -49,6 +53,7 @@ class OutputSet {
   bool committed_ = false;
   int lock_ = -1;  // the directory, opened to hold its lock
   std::vector<std::unique_ptr<AtomicOutput>> outputs_;
+  std::vector<std::string> retired_;
 };
 
 }  // namespace dynsub
