@@ -1,7 +1,6 @@
 #include "dynsub/PointCloudIO.h"
 
 #include <cerrno>
-#include <charconv>
 #include <cstdlib>
 #include <filesystem>
 #include <iterator>
@@ -17,7 +16,6 @@
 #include <vtkPolyData.h>
 #include <vtkXMLPolyDataReader.h>
 
-#include "dynsub/AtomicOutput.h"
 #include "dynsub/ControlMesh.h"
 #include "dynsub/Error.h"
 #include "dynsub/TextFields.h"
@@ -194,25 +192,6 @@ int closedMeshGenus(const PointCloud& cloud, const std::string& source) {
     if (find(face.front()) != first) return -1;
   }
   return mesh.genus();
-}
-
-void writePointCloudXyz(const MatrixX3& points, const std::string& path) {
-  AtomicOutput output(path);
-  {
-    std::ofstream out(output.temporaryPath());
-    if (!out) throw writeFailure(path);
-    // The shortest digits that read back as the same double (to_chars).
-    char number[32];
-    for (Eigen::Index p = 0; p < points.rows(); ++p) {
-      for (int c = 0; c < 3; ++c) {
-        const auto end = std::to_chars(number, number + sizeof number, points(p, c)).ptr;
-        out.write(number, end - number) << (c < 2 ? ' ' : '\n');
-      }
-    }
-    out.close();  // the last bytes reach the disk here
-    if (!out) throw writeFailure(path);
-  }
-  output.commit();
 }
 
 }  // namespace dynsub

@@ -194,4 +194,17 @@ void writeTriangleSurface(const TriangleSurface& surface, const std::string& pat
   output.commit();
 }
 
+void writePointCloudXyz(const MatrixX3& points, const std::string& path) {
+  std::string text;
+  for (Eigen::Index p = 0; p < points.rows(); ++p) {
+    for (int c = 0; c < 3; ++c) {
+      appendNumber(text, points(p, c));
+      text += c < 2 ? ' ' : '\n';
+    }
+  }
+  AtomicOutput output(path);
+  writeFile(output.temporaryPath(), path, text);
+  output.commit();
+}
+
 }  // namespace dynsub

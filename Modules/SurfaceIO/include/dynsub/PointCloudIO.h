@@ -29,12 +29,6 @@ struct PointCloud {
 // checked for finiteness here (see checkPointCloud in InitialModels.h).
 PointCloud readPointCloud(const std::string& path);
 
-// Writes `points` as .xyz text, one "x y z" line per point, with the digits
-// that read back as the same doubles: points a program set aside can be
-// matched exactly against the file they came from. Throws dynsub::Error
-// naming `path` if it cannot be written; a failed write leaves no file.
-void writePointCloudXyz(const MatrixX3& points, const std::string& path);
-
 // The genus of `cloud`'s faces where they make one closed, connected,
 // manifold and consistently oriented mesh (points no face uses aside); -1
 // otherwise: no faces, a boundary, several pieces, or a defect MeshCheck.h

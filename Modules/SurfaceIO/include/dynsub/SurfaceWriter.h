@@ -45,4 +45,11 @@ void writeTriangleSurface(const TriangleSurface& surface, const std::string& pat
 // The extensions writeTriangleSurface accepts, with the dot (".vtp", ...).
 std::vector<std::string> triangleSurfaceExtensions();
 
+// Writes `points` as .xyz text (PointCloudIO.h reads it), one "x y z" line
+// per point, with the digits that read back as the same doubles: points a
+// program set aside can be matched exactly against the file they came from.
+// Throws dynsub::Error naming `path` if it cannot be written; a failed
+// write leaves no file.
+void writePointCloudXyz(const MatrixX3& points, const std::string& path);
+
 }  // namespace dynsub
