@@ -11,6 +11,28 @@
 
 namespace dynsub::app {
 
+namespace {
+
+const std::map<std::string, FigureFormat>& formatNames() {
+  static const std::map<std::string, FigureFormat> names{
+      {"png", FigureFormat::Png}, {"pdf", FigureFormat::Pdf}, {"svg", FigureFormat::Svg}};
+  return names;
+}
+
+const char* const kFigureNames[] = {"slices", "surface3d", "convergence"};
+
+// The figures an earlier run into the directory may have left that this run
+// does not draw: none when `drawn` is empty, else those of the other formats.
+// Beside this run's results they would read as its own.
+void retireOtherFigures(OutputSet& outputs, const std::string& drawn) {
+  for (const auto& [extension, format] : formatNames()) {
+    if (extension == drawn) continue;
+    for (const char* name : kFigureNames) outputs.retire(std::string(name) + "." + extension);
+  }
+}
+
+}  // namespace
+
 void FigureOptions::addOptions(CLI::App& command) {
   command.add_flag("!--no-figures", figures,
                    "Do not render the figures slices, surface3d and convergence (rendering needs an X display; "
@@ -28,14 +50,12 @@ void FigureOptions::addStyleOptions(CLI::App& command) {
                   "FreeSurfer, MNI)")
       ->transform(CLI::CheckedTransformer(coordinateNames, CLI::ignore_case))
       ->default_str("lps");
-  const std::map<std::string, FigureFormat> formatNames{
-      {"png", FigureFormat::Png}, {"pdf", FigureFormat::Pdf}, {"svg", FigureFormat::Svg}};
   command
       .add_option("--figure-format", format,
                   "The figures' file format: png, or pdf or svg for papers and posters (text as vector outlines, "
                   "the image and the surface as a raster at --figure-dpi; made with pdftocairo, Debian's "
                   "poppler-utils)")
-      ->transform(CLI::CheckedTransformer(formatNames, CLI::ignore_case))
+      ->transform(CLI::CheckedTransformer(formatNames(), CLI::ignore_case))
       ->default_str("png");
   command
       .add_option("--figure-dpi", dpi,
@@ -66,12 +86,17 @@ FigureFiles FigureOptions::files(OutputSet& outputs, bool convergence) const {
 void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const ControlMesh& mesh, FigureInputs inputs) {
   if (!inputs.history) throw Error("internal: a result's figures need its convergence history");
   writeConvergenceCsv(*inputs.history, outputs.add("convergence.csv"));
-  if (!options.figures) return;
+  if (!options.figures) {
+    retireOtherFigures(outputs, "");
+    return;
+  }
   std::string why;
   if (!figureDisplay(&why)) {
     std::cerr << "warning: no figures written: " << why << '\n';
+    retireOtherFigures(outputs, "");
     return;
   }
+  retireOtherFigures(outputs, figureExtension(options.format));
   // Without an image the control mesh shows what the surface is made of.
   if (!inputs.image) inputs.controlMesh = &mesh;
   inputs.coordinates = options.coordinates;

@@ -236,10 +236,20 @@ expect_error "render: missing outliers file" 1 "none.xyz: no such file" "$work/r
 printf '1 2 3\n4 nan 6\n' >"$work/nanoutliers.xyz"
 expect_error "render: outliers that are not numbers" 1 "nanoutliers.xyz: a point is not a finite number" "$work/r7" \
   "$DYNSUB" render --surface "$work/fitoff/surface.vtp" --outliers "$work/nanoutliers.xyz" --out "$work/r7"
-# A rerun into the same directory that sets nothing aside removes the
-# earlier run's outliers.xyz, which would otherwise read as its own.
+# A rerun into the same directory removes what an earlier run wrote there
+# and it does not, which would otherwise read as its own: the figures of
+# another format, every figure with --no-figures, and outliers.xyz when
+# nothing is set aside.
+"$DYNSUB" fit "$work/offtorus.xyz" --init torus --figure-format svg --out "$work/fitoff" >/dev/null
+for name in slices surface3d convergence; do
+  check "a rerun drawing SVG figures writes $name.svg" test -s "$work/fitoff/$name.svg"
+  check "a rerun drawing SVG figures removes the earlier $name.png" test ! -e "$work/fitoff/$name.png"
+done
 "$DYNSUB" fit "$work/offtorus.xyz" --init torus --keep-outliers --no-figures --out "$work/fitoff" >/dev/null
 check "a rerun that sets nothing aside removes the earlier outliers.xyz" test ! -e "$work/fitoff/outliers.xyz"
+check "a --no-figures rerun removes the earlier figures" \
+  test -z "$(ls "$work/fitoff" | grep -E '^(slices|surface3d|convergence)\.(png|pdf|svg)$')"
+check "a --no-figures rerun writes convergence.csv" test -s "$work/fitoff/convergence.csv"
 # Surface springs pull the membrane toward the ring: 6.7 % of the area is
 # left uncovered with them against 10.2 % without, and a fifth less is asked.
 "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --surface-springs 0.1 --no-figures --out "$work/fitsprings" \
