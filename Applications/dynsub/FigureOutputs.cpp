@@ -86,17 +86,11 @@ FigureFiles FigureOptions::files(OutputSet& outputs, bool convergence) const {
 void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const ControlMesh& mesh, FigureInputs inputs) {
   if (!inputs.history) throw Error("internal: a result's figures need its convergence history");
   writeConvergenceCsv(*inputs.history, outputs.add("convergence.csv"));
-  if (!options.figures) {
-    retireOtherFigures(outputs, "");
-    return;
-  }
   std::string why;
-  if (!figureDisplay(&why)) {
-    std::cerr << "warning: no figures written: " << why << '\n';
-    retireOtherFigures(outputs, "");
-    return;
-  }
-  retireOtherFigures(outputs, figureExtension(options.format));
+  const bool drawn = options.figures && figureDisplay(&why);
+  if (options.figures && !drawn) std::cerr << "warning: no figures written: " << why << '\n';
+  retireOtherFigures(outputs, drawn ? figureExtension(options.format) : "");
+  if (!drawn) return;
   // Without an image the control mesh shows what the surface is made of.
   if (!inputs.image) inputs.controlMesh = &mesh;
   inputs.coordinates = options.coordinates;

@@ -44,9 +44,10 @@ struct FigureOptions {
 // possible, the three figures to `outputs`. Without a display it says so on
 // stderr and writes no figure. Figures an earlier run left in the directory
 // that this one does not write (any, with --no-figures or no display; those
-// of the other formats otherwise) are removed when the set is committed. `inputs` names the result's limit surface
-// (outputSurface), and what else the figures show; without an image they
-// draw `mesh` too. The figures' coordinates are the options'.
+// of the other formats otherwise) are removed when the set is committed.
+// `inputs` names the result's limit surface (outputSurface), and what else
+// the figures show; without an image they draw `mesh` too. The figures'
+// coordinates are the options'.
 void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const ControlMesh& mesh, FigureInputs inputs);
 
 }  // namespace dynsub::app

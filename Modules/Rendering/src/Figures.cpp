@@ -210,11 +210,7 @@ void drawSlices(const FigureScene& scene, vtkRenderWindow* window) {
       view.setCoordinates(scene.coordinates);
       view.setTitleVisible(false);  // in the caption strip, clear of the edge letters
       view.setSurface(scene.surface);
-      if (scene.distances) {
-        view.colourByDistance(*scene.distances);
-      } else {
-        view.colourByElementType();
-      }
+      if (scene.distances) view.colourByDistance(*scene.distances);  // else by element type
       // Interior slices, evenly spread: the end slices would only graze it.
       const double t = along.minCoeff() + (column + 1.0) / (kColumns + 1.0) * (along.maxCoeff() - along.minCoeff());
       const Vector3 through = centre + (t - centre.dot(axes.normal)) * axes.normal;
@@ -281,11 +277,7 @@ void drawSurface(const FigureScene& scene, vtkRenderWindow* window) {
   window->SetSize(800, 800);
   SurfaceView view;
   view.setSurface(scene.surface);
-  if (scene.distances) {
-    view.colourByDistance(*scene.distances);
-  } else {
-    view.colourByElementType();
-  }
+  if (scene.distances) view.colourByDistance(*scene.distances);  // else by element type
   if (scene.controlMesh) view.setControlMesh(scene.controlMesh);
   view.setLandmarks(scene.landmarks);
   if (scene.dataPoints.rows() > 0) view.setDataPoints(scene.dataPoints);

@@ -255,8 +255,6 @@ void SliceView::setSurface(vtkPolyData* surface) {
   impl_->contourActor->SetVisibility(surface != nullptr);
 }
 
-void SliceView::colourByElementType() { style::colourByElementType(impl_->contourMapper); }
-
 void SliceView::colourByDistance(const DistanceColours& colours) {
   style::colourByDistance(impl_->contourMapper, colours);
 }

@@ -109,12 +109,6 @@ void SurfaceView::setSurface(vtkPolyData* surface) {
   impl_->surfaceActor->SetVisibility(surface != nullptr);
 }
 
-void SurfaceView::colourByElementType() {
-  style::colourByElementType(impl_->surfaceMapper);
-  if (impl_->distanceBar) impl_->renderer->RemoveActor2D(impl_->distanceBar);
-  impl_->distanceBar = nullptr;
-}
-
 void SurfaceView::colourByDistance(const DistanceColours& colours) {
   style::colourByDistance(impl_->surfaceMapper, colours);
   if (impl_->distanceBar) impl_->renderer->RemoveActor2D(impl_->distanceBar);

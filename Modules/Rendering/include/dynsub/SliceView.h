@@ -34,9 +34,8 @@ class SliceView {
   // The surface whose cross-section is drawn; the contour follows when the
   // polydata is modified (live fitting).
   void setSurface(vtkPolyData* surface);
-  // The contour by element type (the default), or by its points' distance
-  // (style::colourByDistance; the surface must carry its array).
-  void colourByElementType();
+  // The contour by its points' distance (style::colourByDistance; the
+  // surface must carry its array) instead of by element type.
   void colourByDistance(const DistanceColours& colours);
   // Landmarks (#landmarks x 3, LPS mm); those within half a slice of the plane are drawn.
   void setLandmarks(const MatrixX3& landmarks, int selected = -1);

@@ -34,10 +34,8 @@ class SurfaceView {
 
   void setSurface(vtkPolyData* surface);  // followed when modified
   void setOpacity(double opacity);        // 1 opaque
-  // By element type (the default), or by each point's distance
-  // (style::colourByDistance; the surface must carry its array), with a
-  // colour bar.
-  void colourByElementType();
+  // By each point's distance (style::colourByDistance; the surface must
+  // carry its array), with a colour bar, instead of by element type.
   void colourByDistance(const DistanceColours& colours);
   void setControlMesh(vtkPolyData* wireframe);  // nullptr hides it
   void setLandmarks(const MatrixX3& landmarks, int selected = -1);  // #landmarks x 3, LPS mm
