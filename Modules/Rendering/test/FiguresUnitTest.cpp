@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <iostream>
 #include <array>
 #include <string>
@@ -75,11 +76,17 @@ class Rendering : public ::testing::Test {
   }
 };
 
+// Where the tests leave their images for review (made if missing).
+std::string temporaryDirectory() {
+  const std::string directory = std::string(DYNSUB_BINARY_DIR) + "/Testing/Temporary";
+  std::filesystem::create_directories(directory);
+  return directory;
+}
+
 void expectMatchesBaseline(vtkRenderWindow* window) {
   const std::string name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
   const std::string baseline = kSource + "/Testing/Data/Baseline/" + name + ".png";
-  const std::string temporary = std::string(DYNSUB_BINARY_DIR) + "/Testing/Temporary";
-  std::filesystem::create_directories(temporary);
+  const std::string temporary = temporaryDirectory();
   window->Render();
   vtkNew<vtkTesting> testing;
   testing->AddArgument("-V");
@@ -91,9 +98,13 @@ void expectMatchesBaseline(vtkRenderWindow* window) {
   EXPECT_EQ(result, vtkTesting::PASSED) << "against " << baseline << " (new image in " << temporary << ")";
 }
 
-vtkSmartPointer<vtkPolyData> limitSurfaceOf(const std::string& meshFile) {
+TriangleSurface limitTessellationOf(const std::string& meshFile) {
   const ControlMesh mesh = readControlMesh(meshFile);
-  return toPolyData(tessellate(LimitSurface(mesh), mesh.points(), 8));
+  return tessellate(LimitSurface(mesh), mesh.points(), 8);
+}
+
+vtkSmartPointer<vtkPolyData> limitSurfaceOf(const std::string& meshFile) {
+  return toPolyData(limitTessellationOf(meshFile));
 }
 
 // --- placement ------------------------------------------------------------
@@ -102,6 +113,22 @@ std::array<int, 3> pixel(vtkImageData* image, const Eigen::Vector2d& at) {
   const int x = static_cast<int>(std::lround(at.x())), y = static_cast<int>(std::lround(at.y()));
   const auto* rgb = static_cast<unsigned char*>(image->GetScalarPointer(x, y, 0));
   return {rgb[0], rgb[1], rgb[2]};
+}
+
+// The pixels of a PNG file that `match`, from row `fromRow` (counted from
+// the bottom) up and left of `widthFraction` of its width.
+int countPixels(const std::string& file, const std::function<bool(const std::array<int, 3>&)>& match, int fromRow = 0,
+                double widthFraction = 1.0) {
+  vtkNew<vtkPNGReader> reader;
+  reader->SetFileName(file.c_str());
+  reader->Update();
+  vtkImageData* image = reader->GetOutput();
+  int size[3];
+  image->GetDimensions(size);
+  int count = 0;
+  for (int y = fromRow; y < size[1]; ++y)
+    for (int x = 0; x < widthFraction * size[0]; ++x) count += match(pixel(image, Eigen::Vector2d(x, y)));
+  return count;
 }
 
 // The phantom's analytic ball as a finely tessellated sphere, for the slice
@@ -273,8 +300,7 @@ TEST_F(Rendering, SliceViewColoursTheContourByEdgeDistance) {
 // the view's cut plane is what it draws.)
 TEST(SliceContours, LieOnTheLabelmapBoundaryOfTheirSlice) {
   const Volume mri = readVolume(kMri);
-  const ControlMesh mesh = readControlMesh(kSource + "/Testing/Data/caudate_left_control_mesh.obj");
-  const TriangleSurface triangles = tessellate(LimitSurface(mesh), mesh.points(), 8);
+  const TriangleSurface triangles = limitTessellationOf(kSource + "/Testing/Data/caudate_left_control_mesh.obj");
   const Mask labelmap = voxelizeSurface(triangles.points, triangles.triangles, mri.geometry);
   const vtkSmartPointer<vtkPolyData> surface = toPolyData(triangles);
   const ImageSlices slices(mri);
@@ -415,8 +441,7 @@ TEST_F(Rendering, TheFullestLegendDoesNotOverlap) {
 // A fit's outliers are drawn as orange dots in both figures, and only when
 // given: points 15-25 % of its half-size off a cube, around it.
 TEST_F(Rendering, OutliersAreDrawnInTheirOwnColour) {
-  const ControlMesh mesh = readControlMesh(kSource + "/Data/Meshes/cube.obj");
-  const TriangleSurface surface = tessellate(LimitSurface(mesh), mesh.points(), 8);
+  const TriangleSurface surface = limitTessellationOf(kSource + "/Data/Meshes/cube.obj");
   const Vector3 low = surface.points.colwise().minCoeff().transpose();
   const Vector3 high = surface.points.colwise().maxCoeff().transpose();
   const Vector3 centre = 0.5 * (low + high);
@@ -427,8 +452,7 @@ TEST_F(Rendering, OutliersAreDrawnInTheirOwnColour) {
     const Vector3 towards(std::cos(angle), std::sin(angle), i % 2 ? 0.5 : -0.5);
     outliers.row(i) = (centre + (1.15 + 0.05 * (i % 3)) * reach * towards.normalized()).transpose();
   }
-  const std::string directory = std::string(DYNSUB_BINARY_DIR) + "/Testing/Temporary";
-  std::filesystem::create_directories(directory);
+  const std::string directory = temporaryDirectory();
   const auto orangePixels = [&](const std::string& name, const MatrixX3& drawn) {
     FigureInputs inputs;
     inputs.surface = &surface;
@@ -437,22 +461,11 @@ TEST_F(Rendering, OutliersAreDrawnInTheirOwnColour) {
     files.surface3d = directory + "/outliers_" + name + "_3d.png";
     files.slices = directory + "/outliers_" + name + "_slices.png";
     writeFigures(inputs, files);
-    std::array<int, 2> counts{0, 0};
-    for (int f = 0; f < 2; ++f) {
-      vtkNew<vtkPNGReader> reader;
-      reader->SetFileName((f == 0 ? files.surface3d : files.slices).c_str());
-      reader->Update();
-      vtkImageData* image = reader->GetOutput();
-      int size[3];
-      image->GetDimensions(size);
-      // The slices' legend (the bottom 26 rows) names the outliers in orange too.
-      for (int y = f == 0 ? 0 : 30; y < size[1]; ++y)
-        for (int x = 0; x < size[0]; ++x) {
-          const std::array<int, 3> c = pixel(image, Eigen::Vector2d(x, y));
-          counts[f] += c[0] > 220 && c[1] > 100 && c[1] < 170 && c[2] < 60;
-        }
-    }
-    return counts;
+    const auto orange = [](const std::array<int, 3>& c) {
+      return c[0] > 220 && c[1] > 100 && c[1] < 170 && c[2] < 60;
+    };
+    // The slices' legend (the bottom 26 rows) names the outliers in orange too.
+    return std::array<int, 2>{countPixels(files.surface3d, orange), countPixels(files.slices, orange, 30)};
   };
   const std::array<int, 2> with = orangePixels("with", outliers), without = orangePixels("without", MatrixX3());
   // A dot covers 15-20 pixels. In 3D the cube hides most of the 12 and the
@@ -472,12 +485,10 @@ TEST_F(Rendering, OutliersAreDrawnInTheirOwnColour) {
 // both colours whatever the surface, so only the pixels left of 80 % are
 // counted. The slices' legend names the scan and the far distance.
 TEST_F(Rendering, FitFiguresColourTheSurfaceByScanDistance) {
-  const ControlMesh mesh = readControlMesh(kSource + "/Data/Meshes/cube.obj");
-  const TriangleSurface surface = tessellate(LimitSurface(mesh), mesh.points(), 8);
+  const TriangleSurface surface = limitTessellationOf(kSource + "/Data/Meshes/cube.obj");
   const Eigen::Index n = surface.points.rows();
   const double centre = surface.points.col(0).mean();
-  const std::string directory = std::string(DYNSUB_BINARY_DIR) + "/Testing/Temporary";
-  std::filesystem::create_directories(directory);
+  const std::string directory = temporaryDirectory();
   struct Counts {
     int green = 0, magenta = 0;
   };
@@ -489,19 +500,11 @@ TEST_F(Rendering, FitFiguresColourTheSurfaceByScanDistance) {
     FigureFiles files;
     files.surface3d = directory + "/scan_distance_" + name + ".png";
     writeFigures(inputs, files);
-    vtkNew<vtkPNGReader> reader;
-    reader->SetFileName(files.surface3d.c_str());
-    reader->Update();
-    vtkImageData* image = reader->GetOutput();
-    int size[3];
-    image->GetDimensions(size);
     Counts counts;
-    for (int y = 0; y < size[1]; ++y)
-      for (int x = 0; x < 0.8 * size[0]; ++x) {
-        const std::array<int, 3> c = pixel(image, Eigen::Vector2d(x, y));
-        counts.green += c[1] > 150 && c[0] < 100 && c[2] < 120;
-        counts.magenta += c[0] > 180 && c[2] > 180 && c[1] < 100;
-      }
+    counts.green = countPixels(
+        files.surface3d, [](const std::array<int, 3>& c) { return c[1] > 150 && c[0] < 100 && c[2] < 120; }, 0, 0.8);
+    counts.magenta = countPixels(
+        files.surface3d, [](const std::array<int, 3>& c) { return c[0] > 180 && c[2] > 180 && c[1] < 100; }, 0, 0.8);
     return counts;
   };
   const Eigen::VectorXd halfFar = (surface.points.col(0).array() < centre).select(Eigen::VectorXd::Zero(n), 1.0);
