@@ -20,6 +20,7 @@ const std::map<std::string, FigureFormat>& formatNames() {
 }
 
 const char* const kFigureNames[] = {"slices", "surface3d", "convergence"};
+const char* const kConvergenceTable = "convergence.csv";
 
 // The figures an earlier run into the directory may have left that this run
 // does not draw: none when `drawn` is empty, else those of the other formats.
@@ -85,7 +86,7 @@ FigureFiles FigureOptions::files(OutputSet& outputs, bool convergence) const {
 
 void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const ControlMesh& mesh, FigureInputs inputs) {
   if (!inputs.history) throw Error("internal: a result's figures need its convergence history");
-  writeConvergenceCsv(*inputs.history, outputs.add("convergence.csv"));
+  writeConvergenceCsv(*inputs.history, outputs.add(kConvergenceTable));
   std::string why;
   const bool drawn = options.figures && figureDisplay(&why);
   if (options.figures && !drawn) std::cerr << "warning: no figures written: " << why << '\n';
@@ -95,6 +96,11 @@ void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const Co
   if (!inputs.image) inputs.controlMesh = &mesh;
   inputs.coordinates = options.coordinates;
   writeFigures(inputs, options.files(outputs, true));
+}
+
+void retireFigureOutputs(OutputSet& outputs) {
+  outputs.retire(kConvergenceTable);
+  retireOtherFigures(outputs, "");
 }
 
 }  // namespace dynsub::app

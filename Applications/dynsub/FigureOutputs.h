@@ -50,4 +50,9 @@ struct FigureOptions {
 // coordinates are the options'.
 void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const ControlMesh& mesh, FigureInputs inputs);
 
+// Every file addFigureOutputs may add, retired (OutputSet::retire): for a
+// directory where an earlier run wrote one model's outputs and this run
+// writes others (several structures' dseg).
+void retireFigureOutputs(OutputSet& outputs);
+
 }  // namespace dynsub::app

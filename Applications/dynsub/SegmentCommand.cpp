@@ -11,7 +11,9 @@
 #include <memory>
 #include <optional>
 #include <sstream>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "CommandLine.h"
 #include "Commands.h"
@@ -88,13 +90,43 @@ Mask referenceStructure(const std::string& path, const Volume& labels, const std
   return reference;
 }
 
+// What a run of several structures writes beside their folders (and a
+// report.json, as a run of one does).
+const char* const kJoinedLabelmap = "dseg.nii.gz";
+const char* const kJoinedTable = "dseg.tsv";
+// The files a run of one structure writes; convergence.csv and the figures are addFigureOutputs'.
+const char* const kOneStructureOutputs[] = {"surface.vtp", "control_mesh.obj", "labelmap.nii.gz"};
+
+// The structures' folders an earlier run of several structures left in
+// `dir`, as its dseg.tsv names them (each holding a report.json), but for
+// `kept`. Beside a later run's outputs they would read as its own.
+std::vector<std::string> earlierStructureFolders(const std::filesystem::path& dir,
+                                                 const std::vector<std::string>& kept) {
+  std::vector<std::string> folders;
+  std::ifstream table(dir / kJoinedTable);
+  std::string line;
+  std::getline(table, line);  // the header
+  while (std::getline(table, line)) {
+    std::stringstream row(line);
+    std::string index, name;
+    if (!std::getline(row, index, '\t') || !std::getline(row, name, '\t')) continue;
+    if (!usableStructureName(name) || std::find(kept.begin(), kept.end(), name) != kept.end()) continue;
+    if (std::filesystem::is_regular_file(dir / name / "report.json")) folders.push_back(name);
+  }
+  return folders;
+}
+
 // surface.vtp, control_mesh.obj, report.json, labelmap.nii.gz, convergence.csv and the figures, all or none.
+// An earlier run of several structures into `dir` is retired: its dseg and its structures' folders.
 void writeSegmentOutputs(const std::filesystem::path& dir, const SegmentOutcome& outcome, const Volume& image,
                          const FigureOptions& figures) {
   const SegmentResult& result = outcome.result;
   writeModelOutputs(
       dir, result.mesh, result.surface, outcome.report,
       [&](OutputSet& outputs) {
+        outputs.retire(kJoinedLabelmap);
+        outputs.retire(kJoinedTable);
+        for (const std::string& folder : earlierStructureFolders(dir, {})) outputs.retire(folder);
         const std::string labelmapPath = outputs.add("labelmap.nii.gz");
         const auto labelmap = [&] { writeMask(outcome.labelmap, labelmapPath); };
         const auto figuresAndRecord = [&] {
@@ -317,8 +349,15 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
       if (outputs.writingDirectory() == dir && !std::filesystem::exists(own)) made.push_back(own);
       writeSegmentOutputs(own, outcome.structures[s], image, o.figures);
     }
-    writeVolume(outcome.labels, outputs.add("dseg.nii.gz"), VoxelType::Label16);
-    writeLabelTable(structures, outputs.add("dseg.tsv"));
+    // What an earlier run into DIR wrote that this one does not: one
+    // structure's outputs, or other structures' folders.
+    for (const char* name : kOneStructureOutputs) outputs.retire(name);
+    retireFigureOutputs(outputs);
+    std::vector<std::string> names;
+    for (const StructureInputs& structure : structures) names.push_back(structure.name);
+    for (const std::string& folder : earlierStructureFolders(dir, names)) outputs.retire(folder);
+    writeVolume(outcome.labels, outputs.add(kJoinedLabelmap), VoxelType::Label16);
+    writeLabelTable(structures, outputs.add(kJoinedTable));
     outcome.report.write(outputs.add("report.json"));
     outputs.commit();
   } catch (...) {

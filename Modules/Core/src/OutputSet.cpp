@@ -116,8 +116,8 @@ void OutputSet::commit() {
   // beside a complete new set, never a set without it.
   for (const std::string& name : retired_) {
     std::error_code error;
-    std::filesystem::remove(dir_ / name, error);
-    if (error) throw Error((dir_ / name).string(), "an earlier run's file cannot be removed: " + error.message());
+    std::filesystem::remove_all(dir_ / name, error);
+    if (error) throw Error((dir_ / name).string(), "an earlier run's output cannot be removed: " + error.message());
   }
   committed_ = true;
 }

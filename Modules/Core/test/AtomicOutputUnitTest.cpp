@@ -185,21 +185,26 @@ TEST(OutputSet, AnExistingDirectoryKeepsItsOtherFiles) {
   EXPECT_EQ(text, "new");
 }
 
-// A file the set retires (one it writes only sometimes) is gone after the
-// commit, not before it; the other files stay.
+// A file or folder the set retires (one it writes only sometimes) is gone
+// after the commit, not before it; the other files stay.
 TEST(OutputSet, ARetiredFileOfAnEarlierRunIsRemovedAtCommit) {
   const fs::path dir = freshDirectory("set-retired");
   std::ofstream(dir / "notes.txt") << "mine";
   std::ofstream(dir / "outliers.xyz") << "1 2 3";
+  fs::create_directories(dir / "putamen" / "figures");
+  std::ofstream(dir / "putamen" / "report.json") << "{}";
   {
     dynsub::OutputSet outputs(dir);
     std::ofstream(outputs.add("report.json")) << "{}";
     outputs.retire("outliers.xyz");
+    outputs.retire("putamen");
     outputs.retire("never-written.xyz");  // absent: nothing to do
     EXPECT_TRUE(fs::exists(dir / "outliers.xyz"));
+    EXPECT_TRUE(fs::exists(dir / "putamen" / "report.json"));
     outputs.commit();
   }
   EXPECT_FALSE(fs::exists(dir / "outliers.xyz"));
+  EXPECT_FALSE(fs::exists(dir / "putamen"));
   EXPECT_TRUE(fs::exists(dir / "notes.txt"));
   EXPECT_TRUE(fs::exists(dir / "report.json"));
   {

@@ -15,6 +15,11 @@ namespace dynsub {
 
 bool isNameCharacter(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.'; }
 
+bool usableStructureName(const std::string& name) {
+  if (name.empty() || name == "." || name == "..") return false;
+  return std::all_of(name.begin(), name.end(), isNameCharacter);
+}
+
 std::array<std::uint8_t, 3> structureColor(std::size_t index) {
   static const std::array<std::uint8_t, 3> palette[] = {
       {0x4e, 0x79, 0xa7}, {0xf2, 0x8e, 0x2b}, {0xe1, 0x57, 0x59}, {0x76, 0xb7, 0xb2}, {0x59, 0xa1, 0x4f},
@@ -120,11 +125,6 @@ double nearestPoint(const ImageGeometry& grid, std::size_t v, const MatrixX3& po
   return nearest;
 }
 
-bool usableName(const std::string& name) {
-  if (name.empty() || name == "." || name == "..") return false;
-  return std::all_of(name.begin(), name.end(), isNameCharacter);
-}
-
 // Runs segmentImage, naming the structure in its errors.
 SegmentOutcome segmentOne(const Volume& image, const StructureInputs& structure, const SegmentParameters& parameters,
                           const ProgressCallback& progress, const Mask* wall = nullptr) {
@@ -174,7 +174,7 @@ void checkStructures(const std::vector<StructureInputs>& structures, const Segme
   if (structures.size() < 2) throw Error("segmenting structures together needs two or more");
   std::set<std::string> names;
   for (const StructureInputs& s : structures) {
-    if (!usableName(s.name))
+    if (!usableStructureName(s.name))
       throw Error("structure name '" + s.name +
                   "': use letters, digits, '_', '-' and '.' only (it names the structure's output folder)");
     if (!names.insert(s.name).second)

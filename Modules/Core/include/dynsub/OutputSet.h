@@ -36,9 +36,10 @@ class OutputSet {
   OutputSet& operator=(const OutputSet&) = delete;
   // The temporary path to write `name` to.
   std::string add(const std::string& name);
-  // A file this set may write but does not this time (a fit's outliers.xyz
-  // when none were set aside): an earlier run's copy in the directory is
-  // removed at commit(), so that it is not read as this run's.
+  // A file or folder this set may write but does not this time (a fit's
+  // outliers.xyz when none were set aside, a structure's folder of an
+  // earlier run of other structures): an earlier run's copy in the directory
+  // is removed at commit(), so that it is not read as this run's.
   void retire(const std::string& name);
   // Where the set is written until commit(): a folder made in it (an
   // OutputSet of its own) becomes part of the set.

@@ -34,6 +34,9 @@ struct StructureInputs {
 // The characters a structure's name may hold, as it names a folder: letters,
 // digits, '_', '-' and '.'.
 bool isNameCharacter(char c);
+// Whether `name` can name a structure and its folder: isNameCharacter's
+// only, and neither empty, "." nor "..".
+bool usableStructureName(const std::string& name);
 
 // The colour structure `index` (0-based) is shown in (red, green, blue, 0-255):
 // a qualitative palette of ten that neighbours tell apart, repeated past ten.
