@@ -4,6 +4,7 @@
 #include <iostream>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "dynsub/Error.h"
 #include "dynsub/FigureInputs.h"
@@ -98,9 +99,15 @@ void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const Co
   writeFigures(inputs, options.files(outputs, true));
 }
 
+std::vector<std::string> figureOutputNames() {
+  std::vector<std::string> names{kConvergenceTable};
+  for (const auto& [extension, format] : formatNames())
+    for (const char* name : kFigureNames) names.push_back(std::string(name) + "." + extension);
+  return names;
+}
+
 void retireFigureOutputs(OutputSet& outputs) {
-  outputs.retire(kConvergenceTable);
-  retireOtherFigures(outputs, "");
+  for (const std::string& name : figureOutputNames()) outputs.retire(name);
 }
 
 }  // namespace dynsub::app

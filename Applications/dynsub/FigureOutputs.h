@@ -3,6 +3,9 @@
 // history (convergence.csv, always) and the figures of Figures.h
 // (slices.png, surface3d.png, convergence.png, or PDF or SVG) when an X
 // display is there.
+#include <string>
+#include <vector>
+
 #include "dynsub/ConvergenceHistory.h"
 #include "dynsub/FigureInputs.h"
 #include "dynsub/Tessellation.h"
@@ -50,9 +53,12 @@ struct FigureOptions {
 // coordinates are the options'.
 void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const ControlMesh& mesh, FigureInputs inputs);
 
-// Every file addFigureOutputs may add, retired (OutputSet::retire): for a
-// directory where an earlier run wrote one model's outputs and this run
-// writes others (several structures' dseg).
+// Every file addFigureOutputs may add: convergence.csv and each figure in
+// each format.
+std::vector<std::string> figureOutputNames();
+// The same, retired (OutputSet::retire): for a directory where an earlier
+// run wrote one model's outputs and this run writes others (several
+// structures' dseg).
 void retireFigureOutputs(OutputSet& outputs);
 
 }  // namespace dynsub::app

@@ -8,6 +8,7 @@
 #include <future>
 #include <iomanip>
 #include <iostream>
+#include <iterator>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -320,6 +321,15 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
   }
   const Volume image = readVolume(o.image);
   checkStructures(structures, o.parameters);
+  // A structure's folder in DIR must not take the name of a file the run
+  // writes or removes there.
+  std::vector<std::string> files = figureOutputNames();
+  files.insert(files.end(), {kJoinedLabelmap, kJoinedTable, "report.json"});
+  files.insert(files.end(), std::begin(kOneStructureOutputs), std::end(kOneStructureOutputs));
+  for (const StructureInputs& structure : structures)
+    if (std::find(files.begin(), files.end(), structure.name) != files.end())
+      throw Error("structure name '" + structure.name + "' is a file the run writes or removes in " + o.out +
+                  ": give the structure another --name");
   // The references: one labelmap, read once, each structure's labels picked
   // from it before the run.
   std::vector<std::optional<Mask>> references(structures.size());

@@ -254,6 +254,8 @@ refused "one name for a file of two lists" "\-\-name is given 1 times for 2 stru
   --name a
 refused "a name twice" "given twice" --landmarks "$caudate" --landmarks "$putamen" --name a --name a
 refused "a name that is a path" "use letters" --landmarks "$caudate" --landmarks "$putamen" --name a/b --name c
+refused "a name that is one of the run's files" "a file the run writes or removes" --landmarks "$caudate" \
+  --landmarks "$putamen" --name a --name surface.vtp
 refused "one reference label for two" "one --reference-label" --landmarks "$caudate" --landmarks "$putamen" \
   --reference "$templates/aal.nii.gz" --reference-label 71
 refused "one start other than the landmarks for two" "give an --init per structure" --landmarks "$caudate" \
