@@ -106,8 +106,4 @@ std::vector<std::string> figureOutputNames() {
   return names;
 }
 
-void retireFigureOutputs(OutputSet& outputs) {
-  for (const std::string& name : figureOutputNames()) outputs.retire(name);
-}
-
 }  // namespace dynsub::app

@@ -56,9 +56,5 @@ void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const Co
 // Every file addFigureOutputs may add: convergence.csv and each figure in
 // each format.
 std::vector<std::string> figureOutputNames();
-// The same, retired (OutputSet::retire): for a directory where an earlier
-// run wrote one model's outputs and this run writes others (several
-// structures' dseg).
-void retireFigureOutputs(OutputSet& outputs);
 
 }  // namespace dynsub::app

@@ -8,7 +8,6 @@
 #include <future>
 #include <iomanip>
 #include <iostream>
-#include <iterator>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -95,8 +94,15 @@ Mask referenceStructure(const std::string& path, const Volume& labels, const std
 // report.json, as a run of one does).
 const char* const kJoinedLabelmap = "dseg.nii.gz";
 const char* const kJoinedTable = "dseg.tsv";
-// The files a run of one structure writes; convergence.csv and the figures are addFigureOutputs'.
-const char* const kOneStructureOutputs[] = {"surface.vtp", "control_mesh.obj", "labelmap.nii.gz"};
+const char* const kLabelmapFile = "labelmap.nii.gz";  // a structure's
+
+// Every file a run of one structure may write in its directory but
+// report.json, which a run of several writes too.
+std::vector<std::string> oneStructureFiles() {
+  std::vector<std::string> names = figureOutputNames();
+  names.insert(names.end(), {kSurfaceFile, kControlMeshFile, kLabelmapFile});
+  return names;
+}
 
 // The structures' folders an earlier run of several structures left in
 // `dir`, as its dseg.tsv names them (each holding a report.json), but for
@@ -112,7 +118,7 @@ std::vector<std::string> earlierStructureFolders(const std::filesystem::path& di
     std::string index, name;
     if (!std::getline(row, index, '\t') || !std::getline(row, name, '\t')) continue;
     if (!usableStructureName(name) || std::find(kept.begin(), kept.end(), name) != kept.end()) continue;
-    if (std::filesystem::is_regular_file(dir / name / "report.json")) folders.push_back(name);
+    if (std::filesystem::is_regular_file(dir / name / kReportFile)) folders.push_back(name);
   }
   return folders;
 }
@@ -128,7 +134,7 @@ void writeSegmentOutputs(const std::filesystem::path& dir, const SegmentOutcome&
         outputs.retire(kJoinedLabelmap);
         outputs.retire(kJoinedTable);
         for (const std::string& folder : earlierStructureFolders(dir, {})) outputs.retire(folder);
-        const std::string labelmapPath = outputs.add("labelmap.nii.gz");
+        const std::string labelmapPath = outputs.add(kLabelmapFile);
         const auto labelmap = [&] { writeMask(outcome.labelmap, labelmapPath); };
         const auto figuresAndRecord = [&] {
           FigureInputs inputs;
@@ -323,9 +329,8 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
   checkStructures(structures, o.parameters);
   // A structure's folder in DIR must not take the name of a file the run
   // writes or removes there.
-  std::vector<std::string> files = figureOutputNames();
-  files.insert(files.end(), {kJoinedLabelmap, kJoinedTable, "report.json"});
-  files.insert(files.end(), std::begin(kOneStructureOutputs), std::end(kOneStructureOutputs));
+  std::vector<std::string> files = oneStructureFiles();
+  files.insert(files.end(), {kJoinedLabelmap, kJoinedTable, kReportFile});
   for (const StructureInputs& structure : structures)
     if (std::find(files.begin(), files.end(), structure.name) != files.end())
       throw Error("structure name '" + structure.name + "' is a file the run writes or removes in " + o.out +
@@ -361,14 +366,13 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
     }
     // What an earlier run into DIR wrote that this one does not: one
     // structure's outputs, or other structures' folders.
-    for (const char* name : kOneStructureOutputs) outputs.retire(name);
-    retireFigureOutputs(outputs);
+    for (const std::string& name : oneStructureFiles()) outputs.retire(name);
     std::vector<std::string> names;
     for (const StructureInputs& structure : structures) names.push_back(structure.name);
     for (const std::string& folder : earlierStructureFolders(dir, names)) outputs.retire(folder);
     writeVolume(outcome.labels, outputs.add(kJoinedLabelmap), VoxelType::Label16);
     writeLabelTable(structures, outputs.add(kJoinedTable));
-    outcome.report.write(outputs.add("report.json"));
+    outcome.report.write(outputs.add(kReportFile));
     outputs.commit();
   } catch (...) {
     std::error_code ignored;

@@ -81,8 +81,8 @@ void writeModelOutputs(const std::filesystem::path& dir, const ControlMesh& mesh
   // adds outputs to the set. An error writing the model's files is reported
   // first, as if they were written first, and nothing is committed unless
   // all went.
-  const std::string surfacePath = outputs.add("surface.vtp"), meshPath = outputs.add("control_mesh.obj"),
-                    reportPath = outputs.add("report.json");
+  const std::string surfacePath = outputs.add(kSurfaceFile), meshPath = outputs.add(kControlMeshFile),
+                    reportPath = outputs.add(kReportFile);
   alongside(
       [&] {
         writeTriangleSurface(surface, surfacePath, surfaceScalars, space);

@@ -25,6 +25,11 @@ TriangleSurface outputSurface(const ControlMesh& mesh);
 // The same from `mesh`'s limit surface built already (SimulationResult::surface).
 TriangleSurface outputSurface(const ControlMesh& mesh, const LimitSurface& surface);
 
+// The files writeModelOutputs writes in its directory.
+constexpr char kSurfaceFile[] = "surface.vtp";
+constexpr char kControlMeshFile[] = "control_mesh.obj";
+constexpr char kReportFile[] = "report.json";
+
 // DIR/surface.vtp (`surface`, from outputSurface), DIR/control_mesh.obj and
 // DIR/report.json, all or none. `extra` may add further files to the same set
 // (e.g. a labelmap); `surfaceScalars` are point data of surface.vtp (one value
