@@ -6,8 +6,9 @@
 # (`dynsub subject`, seeds 1-3 or SEEDS, no thick slices), 36 clicks per structure on 6
 # coronal slices made from each image's own labels. Prints, per run, each
 # structure's Dice alone and in dseg.nii.gz, then the mean change, the worst
-# and how many are lower.
-# Usage: [SEEDS="4 5 6"] [DYNSUB=BINARY] Tools/structures_together.sh [WORKDIR]
+# and how many are lower. OPTIONS are added to every segment run
+# (OPTIONS="--barrier-stiffness 0": the structures joined without the barrier).
+# Usage: [SEEDS="4 5 6"] [OPTIONS="..."] [DYNSUB=BINARY] Tools/structures_together.sh [WORKDIR]
 # (from the repository; build first; DYNSUB is build/bin/dynsub unless given)
 set -eu
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -29,7 +30,7 @@ run() {  # run NAME IMAGE LABELS
     rm -rf "$work/$name/$side"
     "$dynsub" segment "$image" "${landmarks[@]}" --reference "$labels" --reference-label "${values[0]}" \
       --reference-label "${values[1]}" --reference-label "${values[2]}" --reference-label "${values[3]}" \
-      --no-figures --out "$work/$name/$side" >"$work/$name/$side.log" 2>&1
+      ${OPTIONS:-} --no-figures --out "$work/$name/$side" >"$work/$name/$side.log" 2>&1
   done
 }
 mkdir -p "$work/colin27"
