@@ -76,7 +76,7 @@ void runDeform(DeformOptions o) {
             << " springs: " << (result.levels.back().converged ? "equilibrium" : "step limit reached") << " after "
             << result.steps << " steps, " << std::setprecision(2) << seconds << " s; largest spring length "
             << std::setprecision(3) << (lengths.size() ? lengths.maxCoeff() : 0.0) << " mm\n"
-            << "wrote " << (dir / "surface.vtp").string() << ", control_mesh.obj, report.json\n";
+            << "wrote " << (dir / kSurfaceFile).string() << ", control_mesh.obj, report.json\n";
 }
 
 }  // namespace

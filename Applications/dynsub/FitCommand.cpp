@@ -307,8 +307,7 @@ void runFit(FitCommandOptions o) {
     std::cout << "set aside " << noise.outliers.size() << " outlier(s), written to " << (dir / kOutliersFile).string()
               << '\n';
   for (const std::string& warning : warnings) std::cerr << "warning: " << warning << '\n';
-  std::cout
-            << "wrote " << (dir / "surface.vtp").string() << ", control_mesh.obj, report.json, convergence.csv"
+  std::cout << "wrote " << (dir / kSurfaceFile).string() << ", control_mesh.obj, report.json, convergence.csv"
             << (o.figures.figures ? " and the figures that could be rendered" : "") << '\n';
 }
 

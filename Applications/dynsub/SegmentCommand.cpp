@@ -181,7 +181,7 @@ void printSummary(const Arguments& o, const SegmentOutcome& outcome, const Volum
     std::cout << std::setprecision(3) << "Dice " << outcome.metrics.dice << ", mean surface distance "
               << outcome.metrics.meanSurfaceDistance << " mm, HD95 " << outcome.metrics.hd95 << " mm against "
               << o.reference << '\n';
-  std::cout << "wrote " << (std::filesystem::path(o.out) / "surface.vtp").string()
+  std::cout << "wrote " << (std::filesystem::path(o.out) / kSurfaceFile).string()
             << ", control_mesh.obj, labelmap.nii.gz, report.json, convergence.csv"
             << (o.figures.figures ? " and the figures that could be rendered" : "") << '\n';
 }
@@ -397,7 +397,7 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
     for (const TrustFlag& flag : one.trustFlags)
       std::cerr << "not to trust (" << structures[s].name << ", " << flag.name << "): " << flag.message << '\n';
   }
-  std::cout << "wrote " << (dir / "dseg.nii.gz").string() << ", dseg.tsv, report.json and a folder per structure\n";
+  std::cout << "wrote " << (dir / kJoinedLabelmap).string() << ", dseg.tsv, report.json and a folder per structure\n";
 }
 
 void runSegment(const Arguments& o) {
