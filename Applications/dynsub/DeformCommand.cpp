@@ -8,6 +8,7 @@
 
 #include "CommandLine.h"
 #include "Commands.h"
+#include "EarlierRuns.h"
 #include "dynsub/Error.h"
 #include "dynsub/ForceModel.h"
 #include "dynsub/MeshIO.h"
@@ -71,7 +72,8 @@ void runDeform(DeformOptions o) {
   parameters.set("fix_boundary", o.fixBoundary);
   report.set("parameters", parameters);
 
-  writeModelOutputs(dir, result.mesh, outputSurface(result.mesh), report);
+  writeModelOutputs(dir, result.mesh, outputSurface(result.mesh), report,
+                    [&dir](OutputSet& outputs) { retireEarlierRun(outputs, dir); });
   std::cout << std::fixed << std::setprecision(3) << "deformed " << o.mesh << " with " << springs.targets.rows()
             << " springs: " << (result.levels.back().converged ? "equilibrium" : "step limit reached") << " after "
             << result.steps << " steps, " << std::setprecision(2) << seconds << " s; largest spring length "

@@ -23,16 +23,6 @@ const std::map<std::string, FigureFormat>& formatNames() {
 const char* const kFigureNames[] = {"slices", "surface3d", "convergence"};
 const char* const kConvergenceTable = "convergence.csv";
 
-// The figures an earlier run into the directory may have left that this run
-// does not draw: none when `drawn` is empty, else those of the other formats.
-// Beside this run's results they would read as its own.
-void retireOtherFigures(OutputSet& outputs, const std::string& drawn) {
-  for (const auto& [extension, format] : formatNames()) {
-    if (extension == drawn) continue;
-    for (const char* name : kFigureNames) outputs.retire(std::string(name) + "." + extension);
-  }
-}
-
 }  // namespace
 
 void FigureOptions::addOptions(CLI::App& command) {
@@ -91,7 +81,6 @@ void addFigureOutputs(OutputSet& outputs, const FigureOptions& options, const Co
   std::string why;
   const bool drawn = options.figures && figureDisplay(&why);
   if (options.figures && !drawn) std::cerr << "warning: no figures written: " << why << '\n';
-  retireOtherFigures(outputs, drawn ? figureExtension(options.format) : "");
   if (!drawn) return;
   // Without an image the control mesh shows what the surface is made of.
   if (!inputs.image) inputs.controlMesh = &mesh;

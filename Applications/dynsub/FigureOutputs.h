@@ -45,9 +45,9 @@ struct FigureOptions {
 
 // Adds convergence.csv (of inputs.history, required) and, if wanted and
 // possible, the three figures to `outputs`. Without a display it says so on
-// stderr and writes no figure. Figures an earlier run left in the directory
-// that this one does not write (any, with --no-figures or no display; those
-// of the other formats otherwise) are removed when the set is committed.
+// stderr and writes no figure. (The figures an earlier run left in the
+// directory that this one does not write are retired by the command:
+// EarlierRuns.h.)
 // `inputs` names the result's limit surface (outputSurface), and what else
 // the figures show; without an image they draw `mesh` too. The figures'
 // coordinates are the options'.

@@ -12,6 +12,7 @@
 
 #include "CommandLine.h"
 #include "Commands.h"
+#include "EarlierRuns.h"
 #include "FigureOutputs.h"
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/EnclosingSphere.h"
@@ -103,10 +104,6 @@ double statedNoise(const std::string& text) {
   }
   return value;
 }
-
-// The points set aside as outliers, when there are any (.xyz, exact
-// doubles: `render --outliers` matches them against the scan).
-constexpr const char* kOutliersFile = "outliers.xyz";
 
 void runFit(FitCommandOptions o) {
   const double stated = statedNoise(o.noise);
@@ -257,11 +254,8 @@ void runFit(FitCommandOptions o) {
   report.set("parameters", parameters);
 
   writeModelOutputs(dir, result.mesh, surface, report, [&](OutputSet& outputs) {
-    if (outliers.rows() > 0) {
-      writePointCloudXyz(outliers, outputs.add(kOutliersFile));
-    } else {
-      outputs.retire(kOutliersFile);  // an earlier run's would read as this one's
-    }
+    retireEarlierRun(outputs, dir);
+    if (outliers.rows() > 0) writePointCloudXyz(outliers, outputs.add(kOutliersFile));
     FigureInputs inputs;
     inputs.surface = &surface;
     inputs.dataPoints = data;

@@ -17,6 +17,7 @@
 
 #include "CommandLine.h"
 #include "Commands.h"
+#include "EarlierRuns.h"
 #include "FigureOutputs.h"
 #include "LandmarkSources.h"
 #include "dynsub/Error.h"
@@ -90,50 +91,15 @@ Mask referenceStructure(const std::string& path, const Volume& labels, const std
   return reference;
 }
 
-// What a run of several structures writes beside their folders (and a
-// report.json, as a run of one does).
-const char* const kJoinedLabelmap = "dseg.nii.gz";
-const char* const kJoinedTable = "dseg.tsv";
-const char* const kLabelmapFile = "labelmap.nii.gz";  // a structure's
-
-// Every file a run of one structure may write in its directory but
-// report.json, which a run of several writes too.
-std::vector<std::string> oneStructureFiles() {
-  std::vector<std::string> names = figureOutputNames();
-  names.insert(names.end(), {kSurfaceFile, kControlMeshFile, kLabelmapFile});
-  return names;
-}
-
-// The structures' folders an earlier run of several structures left in
-// `dir`, as its dseg.tsv names them (each holding a report.json), but for
-// `kept`. Beside a later run's outputs they would read as its own.
-std::vector<std::string> earlierStructureFolders(const std::filesystem::path& dir,
-                                                 const std::vector<std::string>& kept) {
-  std::vector<std::string> folders;
-  std::ifstream table(dir / kJoinedTable);
-  std::string line;
-  std::getline(table, line);  // the header
-  while (std::getline(table, line)) {
-    std::stringstream row(line);
-    std::string index, name;
-    if (!std::getline(row, index, '\t') || !std::getline(row, name, '\t')) continue;
-    if (!usableStructureName(name) || std::find(kept.begin(), kept.end(), name) != kept.end()) continue;
-    if (std::filesystem::is_regular_file(dir / name / kReportFile)) folders.push_back(name);
-  }
-  return folders;
-}
-
 // surface.vtp, control_mesh.obj, report.json, labelmap.nii.gz, convergence.csv and the figures, all or none.
-// An earlier run of several structures into `dir` is retired: its dseg and its structures' folders.
+// What an earlier run into `dir` wrote that this one does not is retired (EarlierRuns.h).
 void writeSegmentOutputs(const std::filesystem::path& dir, const SegmentOutcome& outcome, const Volume& image,
                          const FigureOptions& figures) {
   const SegmentResult& result = outcome.result;
   writeModelOutputs(
       dir, result.mesh, result.surface, outcome.report,
       [&](OutputSet& outputs) {
-        outputs.retire(kJoinedLabelmap);
-        outputs.retire(kJoinedTable);
-        for (const std::string& folder : earlierStructureFolders(dir, {})) outputs.retire(folder);
+        retireEarlierRun(outputs, dir);
         const std::string labelmapPath = outputs.add(kLabelmapFile);
         const auto labelmap = [&] { writeMask(outcome.labelmap, labelmapPath); };
         const auto figuresAndRecord = [&] {
@@ -329,8 +295,7 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
   checkStructures(structures, o.parameters);
   // A structure's folder in DIR must not take the name of a file the run
   // writes or removes there.
-  std::vector<std::string> files = oneStructureFiles();
-  files.insert(files.end(), {kJoinedLabelmap, kJoinedTable, kReportFile});
+  const std::vector<std::string> files = modelRunFiles();
   for (const StructureInputs& structure : structures)
     if (std::find(files.begin(), files.end(), structure.name) != files.end())
       throw Error("structure name '" + structure.name + "' is a file the run writes or removes in " + o.out +
@@ -365,11 +330,10 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
       writeSegmentOutputs(own, outcome.structures[s], image, o.figures);
     }
     // What an earlier run into DIR wrote that this one does not: one
-    // structure's outputs, or other structures' folders.
-    for (const std::string& name : oneStructureFiles()) outputs.retire(name);
+    // structure's outputs, a fit's, or other structures' folders.
     std::vector<std::string> names;
     for (const StructureInputs& structure : structures) names.push_back(structure.name);
-    for (const std::string& folder : earlierStructureFolders(dir, names)) outputs.retire(folder);
+    retireEarlierRun(outputs, dir, names);
     writeVolume(outcome.labels, outputs.add(kJoinedLabelmap), VoxelType::Label16);
     writeLabelTable(structures, outputs.add(kJoinedTable));
     outcome.report.write(outputs.add(kReportFile));

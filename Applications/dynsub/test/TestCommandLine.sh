@@ -250,6 +250,27 @@ check "a rerun that sets nothing aside removes the earlier outliers.xyz" test ! 
 check "a --no-figures rerun removes the earlier figures" \
   test -z "$(ls "$work/fitoff" | grep -E '^(slices|surface3d|convergence)\.(png|pdf|svg)$')"
 check "a --no-figures rerun writes convergence.csv" test -s "$work/fitoff/convergence.csv"
+# The same across fit, deform and segment: a run into another command's
+# directory leaves only its own outputs there, and a file of the user's.
+mkdir -p "$work/across"
+"$DYNSUB" fit "$work/offtorus.xyz" --init torus --out "$work/across" >/dev/null
+echo mine >"$work/across/notes.txt"
+check "fit into a fresh directory writes outliers.xyz and figures" \
+  test -s "$work/across/outliers.xyz" -a -s "$work/across/slices.png"
+"$DYNSUB" deform "$DATA/Meshes/torus.obj" --springs "$DATA/Deform/torus_pull.springs" --out "$work/across" \
+  >/dev/null 2>&1
+check "deform into a fit's directory leaves only its own outputs and the user's file" python3 -c "
+import os, sys
+left = sorted(os.listdir(sys.argv[1]))
+sys.exit(0 if left == ['control_mesh.obj', 'notes.txt', 'report.json', 'surface.vtp'] else 1)" "$work/across"
+"$DYNSUB" fit "$work/offtorus.xyz" --init torus --no-figures --out "$work/across" >/dev/null
+"$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --max-level 0 --no-figures \
+  --out "$work/across" >/dev/null 2>&1
+check "segment into a fit's directory removes its outliers.xyz" \
+  test ! -e "$work/across/outliers.xyz" -a -s "$work/across/labelmap.nii.gz" -a -e "$work/across/notes.txt"
+"$DYNSUB" fit "$work/offtorus.xyz" --init torus --no-figures --out "$work/across" >/dev/null
+check "fit into a segmentation's directory removes its labelmap.nii.gz" \
+  test ! -e "$work/across/labelmap.nii.gz" -a -s "$work/across/outliers.xyz" -a -e "$work/across/notes.txt"
 # Surface springs pull the membrane toward the ring: 6.7 % of the area is
 # left uncovered with them against 10.2 % without, and a fifth less is asked.
 "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --surface-springs 0.1 --no-figures --out "$work/fitsprings" \

@@ -186,7 +186,8 @@ TEST(OutputSet, AnExistingDirectoryKeepsItsOtherFiles) {
 }
 
 // A file or folder the set retires (one it writes only sometimes) is gone
-// after the commit, not before it; the other files stay.
+// after the commit, not before it; the other files stay, and so does one the
+// set retires and adds.
 TEST(OutputSet, ARetiredFileOfAnEarlierRunIsRemovedAtCommit) {
   const fs::path dir = freshDirectory("set-retired");
   std::ofstream(dir / "notes.txt") << "mine";
@@ -199,6 +200,7 @@ TEST(OutputSet, ARetiredFileOfAnEarlierRunIsRemovedAtCommit) {
     outputs.retire("outliers.xyz");
     outputs.retire("putamen");
     outputs.retire("never-written.xyz");  // absent: nothing to do
+    outputs.retire("report.json");        // added too: the new one stays
     EXPECT_TRUE(fs::exists(dir / "outliers.xyz"));
     EXPECT_TRUE(fs::exists(dir / "putamen" / "report.json"));
     outputs.commit();
@@ -207,6 +209,15 @@ TEST(OutputSet, ARetiredFileOfAnEarlierRunIsRemovedAtCommit) {
   EXPECT_FALSE(fs::exists(dir / "putamen"));
   EXPECT_TRUE(fs::exists(dir / "notes.txt"));
   EXPECT_TRUE(fs::exists(dir / "report.json"));
+  {
+    // The same in a new directory, written in its staging folder first.
+    const fs::path fresh = dir / "fresh";
+    dynsub::OutputSet outputs(fresh);
+    std::ofstream(outputs.add("report.json")) << "{}";
+    outputs.retire("report.json");
+    outputs.commit();
+    EXPECT_TRUE(fs::exists(fresh / "report.json"));
+  }
   {
     dynsub::OutputSet outputs(dir);  // without commit() nothing is removed
     std::ofstream(dir / "outliers.xyz") << "1 2 3";

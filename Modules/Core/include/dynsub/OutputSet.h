@@ -36,10 +36,11 @@ class OutputSet {
   OutputSet& operator=(const OutputSet&) = delete;
   // The temporary path to write `name` to.
   std::string add(const std::string& name);
-  // A file or folder this set may write but does not this time (a fit's
-  // outliers.xyz when none were set aside, a structure's folder of an
-  // earlier run of other structures): an earlier run's copy in the directory
-  // is removed at commit(), so that it is not read as this run's.
+  // A file or folder an earlier run may have left in the directory that
+  // this run must not leave behind (a fit's outliers.xyz when none were set
+  // aside, a structure's folder of an earlier run of other structures): it
+  // is removed at commit(), so that it is not read as this run's. A name the
+  // set adds as well is kept: the set's own file replaces the earlier one.
   void retire(const std::string& name);
   // Where the set is written until commit(): a folder made in it (an
   // OutputSet of its own) becomes part of the set.

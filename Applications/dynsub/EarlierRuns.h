@@ -1,0 +1,37 @@
+#pragma once
+// A run of `fit`, `deform` or `segment` leaves only its own outputs in its
+// directory. What an earlier run of any of them wrote there that this run
+// does not (a segmentation's labelmap beside a fit's surface, a fit's
+// outliers or figures beside a deformed surface, the folders of structures
+// segmented together) would read as this run's, so the run retires it
+// (OutputSet::retire). A file or folder of the user's that none of them
+// writes is never touched.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace dynsub {
+class OutputSet;
+}
+
+namespace dynsub::app {
+
+// The files these commands may write besides writeModelOutputs's (ModelOutputs.h).
+constexpr char kLabelmapFile[] = "labelmap.nii.gz";  // a segmented structure's
+constexpr char kJoinedLabelmap[] = "dseg.nii.gz";     // structures segmented together, with
+constexpr char kJoinedTable[] = "dseg.tsv";           // their names and label values
+// The points a fit set aside (.xyz, exact doubles: `render --outliers` matches them against the scan).
+constexpr char kOutliersFile[] = "outliers.xyz";
+
+// Every file a run of these commands may write in its directory: the model's
+// files, the ones above, convergence.csv and the figures in each format.
+std::vector<std::string> modelRunFiles();
+
+// Retires every file of modelRunFiles() in `dir` (the set keeps those it
+// writes itself), and the structures' folders an earlier run of several
+// structures left there but those named in `keptFolders`: the folders its
+// dseg.tsv names that hold a report.json.
+void retireEarlierRun(OutputSet& outputs, const std::filesystem::path& dir,
+                      const std::vector<std::string>& keptFolders = {});
+
+}  // namespace dynsub::app
