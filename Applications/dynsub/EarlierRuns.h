@@ -18,8 +18,8 @@ namespace dynsub::app {
 
 // The files these commands may write besides writeModelOutputs's (ModelOutputs.h).
 constexpr char kLabelmapFile[] = "labelmap.nii.gz";  // a segmented structure's
-constexpr char kJoinedLabelmap[] = "dseg.nii.gz";     // structures segmented together, with
-constexpr char kJoinedTable[] = "dseg.tsv";           // their names and label values
+constexpr char kJoinedLabelmap[] = "dseg.nii.gz";    // structures segmented together, with
+constexpr char kJoinedTable[] = "dseg.tsv";          // their names and label values
 // The points a fit set aside (.xyz, exact doubles: `render --outliers` matches them against the scan).
 constexpr char kOutliersFile[] = "outliers.xyz";
 

@@ -116,7 +116,9 @@ void OutputSet::commit() {
   // After the set's own files: a run killed before this leaves the old file
   // beside a complete new set, never a set without it.
   for (const std::string& name : retired_) {
-    const auto added = [&name](const auto& output) { return std::filesystem::path(output->target()).filename() == name; };
+    const auto added = [&name](const auto& output) {
+      return std::filesystem::path(output->target()).filename() == name;
+    };
     if (std::any_of(outputs_.begin(), outputs_.end(), added)) continue;
     std::error_code error;
     std::filesystem::remove_all(dir_ / name, error);
