@@ -11,16 +11,16 @@
 
 namespace dynsub::app {
 
-std::vector<std::string> modelRunFiles() {
+std::vector<std::string> runFiles() {
   std::vector<std::string> names = figureOutputNames();
   names.insert(names.end(), {kSurfaceFile, kControlMeshFile, kReportFile, kLabelmapFile, kJoinedLabelmap, kJoinedTable,
-                             kOutliersFile});
+                             kOutliersFile, kSculptedLattice, kSculptedSolid, kSculptedFigure});
   return names;
 }
 
 void retireEarlierRun(OutputSet& outputs, const std::filesystem::path& dir,
                       const std::vector<std::string>& keptFolders) {
-  for (const std::string& name : modelRunFiles()) outputs.retire(name);
+  for (const std::string& name : runFiles()) outputs.retire(name);
   std::ifstream table(dir / kJoinedTable);
   std::string line;
   std::getline(table, line);  // the header

@@ -1,11 +1,11 @@
 #pragma once
-// A run of `fit`, `deform` or `segment` leaves only its own outputs in its
-// directory. What an earlier run of any of them wrote there that this run
-// does not (a segmentation's labelmap beside a fit's surface, a fit's
-// outliers or figures beside a deformed surface, the folders of structures
-// segmented together) would read as this run's, so the run retires it
-// (OutputSet::retire). A file or folder of the user's that none of them
-// writes is never touched.
+// A run of `fit`, `deform`, `segment` or `solid sculpt` leaves only its own
+// outputs in its directory. What an earlier run of any of them wrote there
+// that this run does not (a segmentation's labelmap beside a fit's surface,
+// a fit's outliers or figures beside a deformed surface, the folders of
+// structures segmented together, a sculpture's figure after a run without
+// one) would read as this run's, so the run retires it (OutputSet::retire).
+// A file or folder of the user's that none of them writes is never touched.
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -22,12 +22,16 @@ constexpr char kJoinedLabelmap[] = "dseg.nii.gz";    // structures segmented tog
 constexpr char kJoinedTable[] = "dseg.tsv";          // their names and label values
 // The points a fit set aside (.xyz, exact doubles: `render --outliers` matches them against the scan).
 constexpr char kOutliersFile[] = "outliers.xyz";
+// A sculpted solid: its control lattice, its subdivided solid and its figure.
+constexpr char kSculptedLattice[] = "sculpted.lattice";
+constexpr char kSculptedSolid[] = "sculpted.vtu";
+constexpr char kSculptedFigure[] = "sculpted.png";
 
 // Every file a run of these commands may write in its directory: the model's
 // files, the ones above, convergence.csv and the figures in each format.
-std::vector<std::string> modelRunFiles();
+std::vector<std::string> runFiles();
 
-// Retires every file of modelRunFiles() in `dir` (the set keeps those it
+// Retires every file of runFiles() in `dir` (the set keeps those it
 // writes itself), and the structures' folders an earlier run of several
 // structures left there but those named in `keptFolders`: the folders its
 // dseg.tsv names that hold a report.json.

@@ -262,6 +262,14 @@ void runEvaluate(const EvaluateCommandOptions& o) {
   const std::vector<Group> groups = summarize(runs);
 
   OutputSet outputs(dir);
+  // An earlier evaluation's plot of a split this one did not run would read
+  // as this run's; the set keeps the plots it writes.
+  std::error_code newDirectory;  // a directory the set makes holds no earlier plot
+  for (const std::filesystem::directory_entry& entry : std::filesystem::directory_iterator(dir, newDirectory)) {
+    const std::string name = entry.path().filename().string();
+    if (entry.is_regular_file() && name.rfind("dice_", 0) == 0 && entry.path().extension() == ".svg")
+      outputs.retire(name);
+  }
   writeRunsCsv(runs, outputs.add("runs.csv"));
   writeSummaryCsv(groups, outputs.add("summary.csv"));
   summaryReport(groups, runs, o.plan, seconds).write(outputs.add("summary.json"));

@@ -295,7 +295,7 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
   checkStructures(structures, o.parameters);
   // A structure's folder in DIR must not take the name of a file the run
   // writes or removes there.
-  const std::vector<std::string> files = modelRunFiles();
+  const std::vector<std::string> files = runFiles();
   for (const StructureInputs& structure : structures)
     if (std::find(files.begin(), files.end(), structure.name) != files.end())
       throw Error("structure name '" + structure.name + "' is a file the run writes or removes in " + o.out +

@@ -7,8 +7,10 @@
 #include <CLI/CLI.hpp>
 
 #include "Commands.h"
+#include "EarlierRuns.h"
 #include "dynsub/Error.h"
 #include "dynsub/LatticeIO.h"
+#include "dynsub/ModelOutputs.h"
 #include "dynsub/OutputSet.h"
 #include "dynsub/Report.h"
 #include "dynsub/SculptScript.h"
@@ -54,21 +56,23 @@ Report countsReport(const Lattice& lattice) {
 // DIR/sculpted.lattice (the control lattice, to sculpt on later),
 // DIR/sculpted.vtu (the subdivided solid where the mass points are),
 // DIR/sculpted.png (SolidView's figure, with a display) and DIR/report.json,
-// all together or none. Returns what was written.
+// all together or none; what an earlier run wrote there and this one does
+// not goes (EarlierRuns.h). Returns what was written.
 std::string writeSculpture(const std::filesystem::path& dir, const Sculpture& sculpture, const SculptOptions& o,
                            Report report) {
   prepareOutputDirectory(dir);
   OutputSet outputs(dir);
+  retireEarlierRun(outputs, dir);
   const Lattice control = sculpture.control();
-  writeLattice(control, outputs.add("sculpted.lattice"));
+  writeLattice(control, outputs.add(kSculptedLattice));
   Lattice solid = sculpture.model().dataLattice();
   solid.setPoints(sculpture.model().dataPoints());
-  writeLattice(solid, outputs.add("sculpted.vtu"));
+  writeLattice(solid, outputs.add(kSculptedSolid));
   std::string figure;
   std::string why;
   if (o.figure && figureDisplay(&why)) {
-    writeSculptureFigure(sculpture, outputs.add("sculpted.png"));
-    figure = ", sculpted.png";
+    writeSculptureFigure(sculpture, outputs.add(kSculptedFigure));
+    figure = std::string(", ") + kSculptedFigure;
   } else if (o.figure) {
     std::cerr << "warning: no figure written: " << why << '\n';
   }
@@ -90,9 +94,10 @@ std::string writeSculpture(const std::filesystem::path& dir, const Sculpture& sc
   report.set("solid", countsReport(solid));
   report.set("kinetic_energy_n_mm", sculpture.model().kineticEnergy());
   report.set("spring_energy_n_mm", sculpture.model().springEnergy());
-  report.write(outputs.add("report.json"));
+  report.write(outputs.add(kReportFile));
   outputs.commit();
-  return "saved sculpted.lattice, sculpted.vtu" + figure + ", report.json in " + dir.string();
+  return std::string("saved ") + kSculptedLattice + ", " + kSculptedSolid + figure + ", " + kReportFile + " in " +
+         dir.string();
 }
 
 void runSculpt(const SculptOptions& options) {

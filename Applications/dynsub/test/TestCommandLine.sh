@@ -250,8 +250,9 @@ check "a rerun that sets nothing aside removes the earlier outliers.xyz" test ! 
 check "a --no-figures rerun removes the earlier figures" \
   test -z "$(ls "$work/fitoff" | grep -E '^(slices|surface3d|convergence)\.(png|pdf|svg)$')"
 check "a --no-figures rerun writes convergence.csv" test -s "$work/fitoff/convergence.csv"
-# The same across fit, deform and segment: a run into another command's
-# directory leaves only its own outputs there, and a file of the user's.
+# The same across fit, deform, segment and solid sculpt: a run into another
+# command's directory leaves only its own outputs there, and a file of the
+# user's.
 mkdir -p "$work/across"
 "$DYNSUB" fit "$work/offtorus.xyz" --init torus --out "$work/across" >/dev/null
 echo mine >"$work/across/notes.txt"
@@ -271,6 +272,19 @@ check "segment into a fit's directory removes its outliers.xyz" \
 "$DYNSUB" fit "$work/offtorus.xyz" --init torus --no-figures --out "$work/across" >/dev/null
 check "fit into a segmentation's directory removes its labelmap.nii.gz" \
   test ! -e "$work/across/labelmap.nii.gz" -a -s "$work/across/outliers.xyz" -a -e "$work/across/notes.txt"
+"$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" --script <(echo "run 10") --out "$work/across" >/dev/null 2>&1
+check "a sculpture into a fit's directory leaves only its own outputs and the user's file" python3 -c "
+import os, sys
+left = sorted(os.listdir(sys.argv[1]))
+sys.exit(0 if left == ['notes.txt', 'report.json', 'sculpted.lattice', 'sculpted.png', 'sculpted.vtu'] else 1)" \
+  "$work/across"
+"$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" --script <(echo "run 10") --no-figures --out "$work/across" \
+  >/dev/null 2>&1
+check "a sculpture without a figure removes the earlier one" \
+  test ! -e "$work/across/sculpted.png" -a -s "$work/across/sculpted.vtu"
+"$DYNSUB" fit "$work/offtorus.xyz" --init torus --no-figures --out "$work/across" >/dev/null
+check "fit into a sculpture's directory removes its lattice and solid" \
+  test ! -e "$work/across/sculpted.lattice" -a ! -e "$work/across/sculpted.vtu" -a -s "$work/across/surface.vtp"
 # Surface springs pull the membrane toward the ring: 6.7 % of the area is
 # left uncovered with them against 10.2 % without, and a fifth less is asked.
 "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --surface-springs 0.1 --no-figures --out "$work/fitsprings" \

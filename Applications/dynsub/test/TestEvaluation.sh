@@ -21,12 +21,19 @@ require_colin27
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
+# The directory holds an earlier evaluation's plot of another split and a
+# file of the user's.
+mkdir "$work/eval"
+echo '<svg/>' >"$work/eval/dice_tuning.svg"
+echo mine >"$work/eval/notes.txt"
 "$DYNSUB" evaluate "$DATA/Evaluation/ci_plan.json" --out "$work/eval" --jobs 2 >"$work/eval.log" 2>&1
 check "evaluate succeeds" test $? -eq 0
 cat "$work/eval.log"
 for f in runs.csv summary.csv summary.json dice_test.svg; do
   check "evaluate writes $f" test -s "$work/eval/$f"
 done
+check "evaluate removes an earlier plot of a split it did not run, and keeps the user's file" \
+  test ! -e "$work/eval/dice_tuning.svg" -a -e "$work/eval/notes.txt"
 check "21 runs, all scored, every collapse warned of, Dice floors hold" python3 - "$work/eval/runs.csv" <<'PY'
 import csv, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
