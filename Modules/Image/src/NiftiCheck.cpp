@@ -139,6 +139,47 @@ DataCheck checkNiftiHeader(const std::string& path) {
   }
   const int bytesPerVoxel = niftiBytesPerVoxel(datatype);
   if (!bytesPerVoxel) throw Error(path, "a NIfTI datatype " + std::to_string(datatype) + " that NIfTI does not define");
+  // Intensities are one real number a voxel; ITK would read complex or
+  // colour voxels as something else without a word.
+  if (datatype == 32 || datatype == 1792 || datatype == 2048 || datatype == 128 || datatype == 2304)
+    throw Error(path, std::string("a NIfTI image of ") +
+                          (datatype == 128 || datatype == 2304 ? "colour (RGB)" : "complex") +
+                          " voxels; give one real value a voxel (a magnitude or grey-level image)");
+  // A series of volumes (fMRI, diffusion) is not one 3D image; read as one,
+  // ITK 5.2 also takes another orientation.
+  for (int i = 4; i <= dimensions; ++i) {
+    if (dim(i) > 1)
+      throw Error(path, "a NIfTI image of " + std::to_string(dimensions) + " dimensions, " + std::to_string(dim(i)) +
+                            " along axis " + std::to_string(i - 1) + "; give one 3D volume (extract it first)");
+  }
+  // The orientation the header declares (qform, sform: whichever has a
+  // code above 0) must be finite: ITK 5.2 aborts the process on a NaN there.
+  auto real = [&](int at) {
+    if (version == 2) {
+      const std::uint64_t bits = number(at, 8, swap);
+      double value = 0;
+      std::memcpy(&value, &bits, sizeof value);
+      return value;
+    }
+    const auto bits = static_cast<std::uint32_t>(number(at, 4, swap));
+    float value = 0;
+    std::memcpy(&value, &bits, sizeof value);
+    return static_cast<double>(value);
+  };
+  const int realBytes = version == 1 ? 4 : 8;
+  auto code = [&](int at1, int at2) {  // a short in NIfTI-1, an int in NIfTI-2
+    return version == 1 ? static_cast<int>(static_cast<std::int16_t>(number(at1, 2, swap)))
+                        : static_cast<int>(static_cast<std::int32_t>(number(at2, 4, swap)));
+  };
+  const int qformCode = code(252, 344), sformCode = code(254, 348);
+  auto requireFinite = [&](int first, int count, const char* what) {
+    for (int i = 0; i < count; ++i) {
+      if (!std::isfinite(real(first + i * realBytes)))
+        throw Error(path, std::string("a NIfTI header whose ") + what + " holds a NaN or infinite value");
+    }
+  };
+  if (qformCode > 0) requireFinite(version == 1 ? 256 : 352, 6, "qform (quatern_b-d, qoffset_x-z)");
+  if (sformCode > 0) requireFinite(version == 1 ? 280 : 400, 12, "sform (srow_x, srow_y, srow_z)");
   requireMemoryFor(path, count);
   double offset = 0;
   if (version == 1) {

@@ -308,6 +308,49 @@ TEST(HostileImages, SpacingOutsideWhatDynSubWorksWithIsRefused) {
   EXPECT_EQ(readError(scratch("spacing.nii")), "");
 }
 
+// Overwrites the bytes of `value` at `at` in the file `path`.
+template <typename T>
+void patch(const fs::path& path, std::size_t at, T value) {
+  std::fstream file(path, std::ios::in | std::ios::out | std::ios::binary);
+  file.seekp(static_cast<std::streamoff>(at));
+  file.write(reinterpret_cast<const char*>(&value), sizeof value);
+}
+
+TEST(HostileImages, NonFiniteOrientationsSeriesAndComplexVoxelsAreRefused) {
+  const fs::path path = scratch("header.nii");
+  auto fresh = [&] { writeNifti(path, {4, 4, 4}, Vector3(1, 1, 1), ramp(2 * 64, 1.0f)); };
+  // A NaN in the sform's translation (ITK 5.2 aborts the process on it).
+  fresh();
+  patch(path, 280 + 12, std::numeric_limits<float>::quiet_NaN());
+  std::string error = readError(path);
+  EXPECT_NE(error.find("header.nii: a NIfTI header whose sform"), std::string::npos) << error;
+  // An infinite qoffset with a qform code; the sform is not used (code 0).
+  fresh();
+  patch(path, 254, std::int16_t{0});
+  patch(path, 252, std::int16_t{1});
+  patch(path, 268, std::numeric_limits<float>::infinity());
+  error = readError(path);
+  EXPECT_NE(error.find("header.nii: a NIfTI header whose qform"), std::string::npos) << error;
+  // The same NaN with qform code 0 is not read, and the file is.
+  patch(path, 252, std::int16_t{0});
+  patch(path, 254, std::int16_t{1});
+  EXPECT_EQ(readError(path), "");
+  // Two volumes (dim[0] 4, dim[4] 2); one volume in four dimensions is read.
+  fresh();
+  patch(path, 40, std::int16_t{4});
+  patch(path, 48, std::int16_t{2});
+  error = readError(path);
+  EXPECT_NE(error.find("header.nii: a NIfTI image of 4 dimensions, 2 along axis 3"), std::string::npos) << error;
+  patch(path, 48, std::int16_t{1});
+  EXPECT_EQ(readError(path), "");
+  // Complex voxels (complex64: two floats a voxel, as written).
+  fresh();
+  patch(path, 70, std::int16_t{32});
+  patch(path, 72, std::int16_t{64});
+  error = readError(path);
+  EXPECT_NE(error.find("header.nii: a NIfTI image of complex voxels"), std::string::npos) << error;
+}
+
 TEST(HostileImages, ADegenerateDirectionIsRefused) {
   // NRRD space directions with two parallel axes.
   std::ofstream(scratch("parallel.nrrd"), std::ios::binary)
