@@ -129,6 +129,11 @@ bad negative_seed "$(edited "p['splits'][0]['seeds'] = [-1]")" "a seed must be i
 bad fractional_level "$(edited "p['segment'] = {'max_level': 1.5}")" "segment setting max_level (--max-level) must be a whole number"
 bad unknown_setting "$(edited "p['segment'] = {'sigma': 1}")" "unknown segment setting 'sigma'"
 bad duplicate_structure "$(edited "p['structures'].append(p['structures'][0])")" "two structures are named 'caudate_left'"
+bad escaping_name "$(edited "p['splits'][0]['name'] = '../../escaped'")" \
+  "'../../escaped' is not a usable name for one of the splits"
+bad misspelt_key "$(edited "p['protocols'][0]['slice'] = 6")" "a protocol: unknown key 'slice'"
+bad repeated_seed "$(edited "p['splits'][0]['seeds'] = [101, 101]")" "split 'test' lists seed 101 twice"
+bad no_seeds "$(edited "p['splits'][0]['seeds'] = []")" "split 'test' has no seeds"
 "$DYNSUB" evaluate "$work/missing.json" --out "$work/out_missing" >"$work/missing.log" 2>&1
 check "missing plan: non-zero exit and the file named" grep -q "missing.json" "$work/missing.log"
 

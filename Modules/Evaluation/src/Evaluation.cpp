@@ -17,6 +17,7 @@
 #include "dynsub/ImageIO.h"
 #include "dynsub/Metrics.h"
 #include "dynsub/SegmentImage.h"
+#include "dynsub/SegmentStructures.h"
 #include "dynsub/SubjectGenerator.h"
 
 namespace dynsub {
@@ -131,6 +132,24 @@ EvaluationRun runOne(const EvaluationPlan& plan, const Volume& image, const Mask
 
 }  // namespace
 
+namespace {
+
+// A key the plan's reader does not know is a typo ("slice" for "slices")
+// that would otherwise run with a default, unseen.
+void requireKnownKeys(const nlohmann::json& object, std::initializer_list<const char*> known,
+                      const std::string& where) {
+  if (!object.is_object()) throw Error(where + ": expected a JSON object");
+  for (const auto& [key, value] : object.items()) {
+    if (std::none_of(known.begin(), known.end(), [&key = key](const char* k) { return key == k; })) {
+      std::string list;
+      for (const char* k : known) list += (list.empty() ? "" : ", ") + std::string(k);
+      throw Error(where + ": unknown key '" + key + "' (known: " + list + ")");
+    }
+  }
+}
+
+}  // namespace
+
 EvaluationPlan readEvaluationPlan(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw Error(path, "cannot open the evaluation plan");
@@ -143,6 +162,22 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
   const std::filesystem::path base = std::filesystem::absolute(path).parent_path();
   EvaluationPlan plan;
   try {
+    requireKnownKeys(j, {"images", "reference", "atlas", "cohorts", "structures", "protocols", "segment", "splits"},
+                     "the plan");
+    for (const auto& i : j.value("images", nlohmann::json::array()))
+      requireKnownKeys(i, {"name", "path"}, "an image");
+    for (const auto& c : j.value("cohorts", nlohmann::json::array()))
+      requireKnownKeys(c, {"name", "image", "labels", "settings", "subjects"}, "a cohort");
+    for (const auto& st : j.value("structures", nlohmann::json::array()))
+      requireKnownKeys(st, {"name", "labels", "orientation"}, "a structure");
+    for (const auto& p : j.value("protocols", nlohmann::json::array()))
+      requireKnownKeys(p, {"name", "slices", "points_per_slice", "coverage", "scatter_mm", "mistakes",
+                           "mistake_distance_mm", "orientation", "atlas", "clicks", "seed_only", "seed_depth",
+                           "format"},
+                       "a protocol");
+    for (const auto& sp : j.value("splits", nlohmann::json::array()))
+      requireKnownKeys(sp, {"name", "seeds", "structures"}, "a split");
+    if (j.contains("atlas")) requireKnownKeys(j.at("atlas"), {"image", "labels"}, "the atlas");
     if (j.contains("images")) {
       plan.reference = resolve(j.at("reference").get<std::string>(), base);
       for (const auto& i : j.at("images")) plan.images.push_back({i.at("name"), resolve(i.at("path"), base)});
@@ -241,9 +276,14 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
     }
     for (const auto& s : j.at("splits")) {
       EvaluationSplit split{s.at("name"), s.value("structures", std::vector<std::string>{}), {}};
-      for (const auto& seed : s.at("seeds"))
+      for (const auto& seed : s.at("seeds")) {
         split.seeds.push_back(static_cast<unsigned>(
             wholeNumber(seed, "split '" + split.name + "': a seed", 0, std::numeric_limits<unsigned>::max())));
+        // A seed twice would run the same clicks twice into the same files.
+        if (std::count(split.seeds.begin(), split.seeds.end(), split.seeds.back()) > 1)
+          throw Error(path, "split '" + split.name + "' lists seed " + std::to_string(split.seeds.back()) + " twice");
+      }
+      if (split.seeds.empty()) throw Error(path, "split '" + split.name + "' has no seeds");
       for (const std::string& name : split.structures) {
         bool known = false;
         for (const auto& structure : plan.structures) known = known || structure.name == name;
@@ -266,12 +306,18 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
       for (const EvaluationSplit& s : plan.splits) known = known || s.name == split;
       if (!known) throw Error(path, "cohort '" + cohort.name + "' names unknown split '" + split + "'");
     }
-  // Names make the runs' file names and the summary's groups: each once.
+  // Names make the runs' file names and the summary's groups: each once, and
+  // each a plain file name (no '/' or "..": nothing is written outside the
+  // directories asked for).
   auto unique = [&](const auto& entries, const auto& nameOf, const char* what) {
     std::set<std::string> seen;
-    for (const auto& entry : entries)
+    for (const auto& entry : entries) {
+      if (!usableStructureName(nameOf(entry)))
+        throw Error(path, "'" + nameOf(entry) + "' is not a usable name for one of the " + what +
+                              ": use letters, digits, '_', '-' and '.' (names make file names)");
       if (!seen.insert(nameOf(entry)).second)
         throw Error(path, std::string("two ") + what + " are named '" + nameOf(entry) + "'");
+    }
   };
   const auto name = [](const auto& entry) { return entry.name; };
   unique(plan.images, name, "images");
