@@ -75,6 +75,9 @@ struct Integrator::Impl {
   Eigen::ConjugateGradient<SymmetricMatrix, Eigen::Lower | Eigen::Upper, Eigen::IdentityPreconditioner> cg;
   Eigen::ConjugateGradient<SymmetricMatrix, Eigen::Lower | Eigen::Upper, Eigen::IncompleteCholesky<double>> pcg;
   int iterations = 0;
+  // Added to the diagonals of M and D once a left-hand matrix was singular
+  // (below); 0 until then.
+  double diagonalShift = 0.0;
 
   // The matrices of both sides for `forceStiffness` (Integrator.h); the
   // factorization's analysis is redone only when `analyze` or when the
@@ -128,11 +131,15 @@ void Integrator::Impl::build(const PhysicalMatrices& matrices, const SymmetricMa
   //   second order: 2 dt^2 (f + S p(t)) + 4 M p(t) + (D dt - 2M) p(t-dt)
   //   first order:  2 dt (f + S p(t)) + D p(t-dt)
   const bool second = options.scheme == IntegrationScheme::SecondOrder;
+  SymmetricMatrix mass = matrices.mass, damping = matrices.damping;
+  for (int d = 0; d < n && s.diagonalShift > 0.0; ++d) {
+    mass.coeffRef(d, d) += s.diagonalShift;
+    damping.coeffRef(d, d) += s.diagonalShift;
+  }
   s.forceWeight = second ? 2.0 * dt * dt : 2.0 * dt;
-  const SymmetricMatrix onCurrent = second ? SymmetricMatrix(s.forceWeight * stabilizing + 4.0 * matrices.mass)
+  const SymmetricMatrix onCurrent = second ? SymmetricMatrix(s.forceWeight * stabilizing + 4.0 * mass)
                                            : SymmetricMatrix(s.forceWeight * stabilizing);
-  const SymmetricMatrix onPrevious = second ? SymmetricMatrix(dt * matrices.damping - 2.0 * matrices.mass)
-                                            : matrices.damping;
+  const SymmetricMatrix onPrevious = second ? SymmetricMatrix(dt * damping - 2.0 * mass) : damping;
   s.rightHandSide = PairedProduct(onCurrent, onPrevious);
   s.freeIndex.assign(n, 0);
   s.freeVertices.clear();
@@ -152,9 +159,8 @@ void Integrator::Impl::build(const PhysicalMatrices& matrices, const SymmetricMa
   }
   if (free == 0) throw Error("every control vertex is fixed: nothing can move");
 
-  const SymmetricMatrix lhs = second ? SymmetricMatrix(2.0 * matrices.mass + dt * matrices.damping +
-                                                       2.0 * dt * dt * stiffness)
-                                     : SymmetricMatrix(matrices.damping + 2.0 * dt * stiffness);
+  const SymmetricMatrix lhs = second ? SymmetricMatrix(2.0 * mass + dt * damping + 2.0 * dt * dt * stiffness)
+                                     : SymmetricMatrix(damping + 2.0 * dt * stiffness);
   SymmetricMatrix lhsFree = select(lhs, s.freeIndex, free, s.freeIndex, free);
   lhsFree.makeCompressed();
   // The stabilizer's updates (Simulation.h) change only values: its
@@ -172,6 +178,18 @@ void Integrator::Impl::build(const PhysicalMatrices& matrices, const SymmetricMa
       // A singular matrix (K alone: translations cost nothing) factors with
       // pivots at rounding level rather than failing; those count as zero.
       if (!s.cholesky.factorize(s.lhsFree)) {
+        // Some control meshes have motions of their control points that the
+        // limit surface does not show (the 8-vertex cube: its vertices moved
+        // by +d and -d alternately leave the limit surface where it is), so
+        // M and D, integrals over the surface, are singular for them. A
+        // shift of 1e-9 of D's mean diagonal on M and D alike holds such a
+        // motion still and changes the visible ones by rounding only.
+        const double meanDiagonal = matrices.damping.diagonal().cwiseAbs().mean();
+        if (s.diagonalShift == 0.0 && meanDiagonal > 0.0) {
+          s.diagonalShift = 1e-9 * meanDiagonal;
+          build(matrices, forceStiffness, fixed, analyze);
+          return;
+        }
         throw Error("the left-hand matrix of the time step is not positive definite (is the surface anchored? "
                     "first-order integration needs damping > 0)");
       }
