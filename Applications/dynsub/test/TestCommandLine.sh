@@ -37,6 +37,8 @@ expect_error "missing output directory" 1 "does not exist" "$work/no/f.vtp" \
 expect_error "impossible sample count" 2 "samples-per-face" "$work/g.vtp" \
   "$DYNSUB" limit "$DATA/Meshes/cube.obj" --samples-per-face 0 --out "$work/g.vtp"
 expect_error "unknown standard mesh" 2 "NAME" "$work/h.obj" "$DYNSUB" mesh sphere --out "$work/h.obj"
+expect_error "a standard mesh under another extension" 1 "c.off: the control mesh is written as OBJ" "$work/c.off" \
+  "$DYNSUB" mesh cube --out "$work/c.off"
 expect_error "a misspelt command" 2 "did you mean 'segment'" "$work/i" "$DYNSUB" segmnet x.nii.gz --out "$work/i"
 expect_error "a misspelt option" 2 "did you mean '--landmarks'" "$work/j" \
   "$DYNSUB" segment x.nii.gz --landmark a.csv --out "$work/j"

@@ -87,7 +87,7 @@ std::vector<Parameter> table() {
   add(row("image_force", "Image force", "N/mm^2", "Forces", "The pull toward edges, k, per unit of surface",
        [](P& p) -> double& { return p.segment.imageForce; }, 0, 100, 0.01));
   add(row("landmark_stiffness", "Point stiffness", "N/mm", "Forces", "Spring stiffness of each landmark",
-       [](P& p) -> double& { return p.segment.landmarkStiffness; }, 0, 10000, 0.5));
+       [](P& p) -> double& { return p.segment.landmarkStiffness; }, 1e-6, 10000, 0.5));
   add(row("landmark_dead_zone", "Point dead zone", "mm", "Forces",
        "A landmark's spring pulls only where the surface is farther than this from the click (a click's error; "
        "0: a plain spring)",

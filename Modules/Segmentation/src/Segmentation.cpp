@@ -140,7 +140,9 @@ SimulationOptions SegmentOptions::defaultSimulation() {
 void checkSegmentOptions(const SegmentOptions& options) {
   checkEdgeOptions(options.edges);
   requireFiniteNonNegative(options.imageForce, "image force");
-  requireFiniteNonNegative(options.landmarkStiffness, "landmark stiffness");
+  // A spring of stiffness 0 pulls nothing: landmarks would be read and ignored.
+  if (!(options.landmarkStiffness > 0) || !std::isfinite(options.landmarkStiffness))
+    throw Error("the landmark stiffness must be a finite number > 0, got " + std::to_string(options.landmarkStiffness));
   requireFiniteNonNegative(options.landmarkDeadZone, "landmark dead zone");
   checkSliceEndOptions(options.sliceEnds);
   requireFiniteNonNegative(options.margin, "margin");
