@@ -152,8 +152,7 @@ DataCheck checkNiftiHeader(const std::string& path) {
       throw Error(path, "a NIfTI image of " + std::to_string(dimensions) + " dimensions, " + std::to_string(dim(i)) +
                             " along axis " + std::to_string(i - 1) + "; give one 3D volume (extract it first)");
   }
-  // The orientation the header declares (qform, sform: whichever has a
-  // code above 0) must be finite: ITK 5.2 aborts the process on a NaN there.
+  // A header's real number at byte `at`: a float in NIfTI-1, a double in NIfTI-2.
   auto real = [&](int at) {
     if (version == 2) {
       const std::uint64_t bits = number(at, 8, swap);
@@ -167,6 +166,8 @@ DataCheck checkNiftiHeader(const std::string& path) {
     return static_cast<double>(value);
   };
   const int realBytes = version == 1 ? 4 : 8;
+  // The orientation the header declares (qform, sform: whichever has a
+  // code above 0) must be finite: ITK 5.2 aborts the process on a NaN there.
   auto code = [&](int at1, int at2) {  // a short in NIfTI-1, an int in NIfTI-2
     return version == 1 ? static_cast<int>(static_cast<std::int16_t>(number(at1, 2, swap)))
                         : static_cast<int>(static_cast<std::int32_t>(number(at2, 4, swap)));
@@ -181,15 +182,9 @@ DataCheck checkNiftiHeader(const std::string& path) {
   if (qformCode > 0) requireFinite(version == 1 ? 256 : 352, 6, "qform (quatern_b-d, qoffset_x-z)");
   if (sformCode > 0) requireFinite(version == 1 ? 280 : 400, 12, "sform (srow_x, srow_y, srow_z)");
   requireMemoryFor(path, count);
-  double offset = 0;
-  if (version == 1) {
-    const auto bits = static_cast<std::uint32_t>(number(108, 4, swap));
-    float value = 0;
-    std::memcpy(&value, &bits, sizeof value);
-    offset = value;
-  } else {
-    offset = static_cast<double>(static_cast<std::int64_t>(number(168, 8, swap)));
-  }
+  // vox_offset: a float in NIfTI-1, an integer in NIfTI-2.
+  const double offset =
+      version == 1 ? real(108) : static_cast<double>(static_cast<std::int64_t>(number(168, 8, swap)));
   if (!(offset >= headerSize) || offset > 1e12)
     throw Error(path, "a NIfTI header whose data offset (vox_offset " + std::to_string(offset) + ") is not after it");
   const auto needed = static_cast<std::uintmax_t>(offset) + count * bytesPerVoxel;
