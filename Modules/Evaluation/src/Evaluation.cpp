@@ -130,10 +130,6 @@ EvaluationRun runOne(const EvaluationPlan& plan, const Volume& image, const Mask
   return run;
 }
 
-}  // namespace
-
-namespace {
-
 // A key the plan's reader does not know is a typo ("slice" for "slices")
 // that would otherwise run with a default, unseen.
 void requireKnownKeys(const nlohmann::json& object, std::initializer_list<const char*> known,
