@@ -137,8 +137,8 @@ void Integrator::Impl::build(const PhysicalMatrices& matrices, const SymmetricMa
     damping.coeffRef(d, d) += s.diagonalShift;
   }
   s.forceWeight = second ? 2.0 * dt * dt : 2.0 * dt;
-  const SymmetricMatrix onCurrent = second ? SymmetricMatrix(s.forceWeight * stabilizing + 4.0 * mass)
-                                           : SymmetricMatrix(s.forceWeight * stabilizing);
+  const SymmetricMatrix onCurrent =
+      second ? SymmetricMatrix(s.forceWeight * stabilizing + 4.0 * mass) : SymmetricMatrix(s.forceWeight * stabilizing);
   const SymmetricMatrix onPrevious = second ? SymmetricMatrix(dt * damping - 2.0 * mass) : damping;
   s.rightHandSide = PairedProduct(onCurrent, onPrevious);
   s.freeIndex.assign(n, 0);
