@@ -3,8 +3,6 @@
 #include <CLI/CLI.hpp>
 
 #include "Commands.h"
-#include "dynsub/Error.h"
-#include "dynsub/FileNames.h"
 #include "dynsub/MeshIO.h"
 #include "dynsub/StandardMeshes.h"
 
@@ -26,9 +24,6 @@ void addMeshCommand(CLI::App& app) {
       ->check(CLI::IsMember(standardMeshNames()));
   command->add_option("--out", options->out, "Output file (.obj)")->required();
   command->callback([options] {
-    // OBJ is the one format written; under another name it would be read back as that format.
-    if (lowerCaseExtension(options->out) != ".obj")
-      throw Error(options->out, "the control mesh is written as OBJ: give the file the extension .obj");
     const ControlMesh mesh = makeStandardMesh(options->name);
     writeObj(mesh, options->out);
     std::cout << "wrote " << options->out << ": " << mesh.vertexCount() << " vertices, " << mesh.faceCount()

@@ -185,6 +185,15 @@ TEST(MeshIO, BadCreaseTagsAreNamed) {
 
 TEST(MeshIO, FailedWriteLeavesNoFile) {
   EXPECT_THROW(dynsub::writeObj(dynsub::makeCube98(), "/nonexistent-dynsub/cube.obj"), dynsub::Error);
+  // OBJ text under another format's name would be misread as that format.
+  const std::string off = scratch("cube.off").string();
+  try {
+    dynsub::writeObj(dynsub::makeCube98(), off);
+    ADD_FAILURE() << "an .off name was written";
+  } catch (const dynsub::Error& e) {
+    EXPECT_NE(std::string(e.what()).find(off + ": the control mesh is written as OBJ"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(off));
   EXPECT_FALSE(fs::exists("/nonexistent-dynsub/cube.obj"));
 }
 

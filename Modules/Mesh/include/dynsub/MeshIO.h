@@ -34,7 +34,7 @@ PolygonData readPolygonData(const std::string& path);
 // readPolygonData + checks (MeshCheck.h): the usual way to load a control mesh.
 ControlMesh readControlMesh(const std::string& path);
 
-// Writes an OBJ file atomically (complete or not at all).
+// Writes an OBJ file atomically (complete or not at all); `path` must end in .obj.
 void writeObj(const ControlMesh& mesh, const std::string& path);
 
 }  // namespace dynsub
