@@ -2,6 +2,7 @@
 // against a reference labelmap (Evaluation.h), as tables and plots.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -90,6 +91,16 @@ std::string csvField(const std::string& text) {
   return quoted + "\"";
 }
 
+// A measure that was not taken (NaN: the atlas's measures of a run without an
+// atlas) is an empty field, which spreadsheets and pandas read as missing.
+struct CsvNumber {
+  double value;
+};
+std::ostream& operator<<(std::ostream& out, CsvNumber n) {
+  if (std::isfinite(n.value)) out << n.value;
+  return out;
+}
+
 void writeRunsCsv(const std::vector<EvaluationRun>& runs, const std::string& path) {
   std::ofstream out(path);
   out << "split,image,subject,subject_snr,thick_axis,contrast,structure,protocol,seed,format,landmarks,dice,jaccard,mean_surface_distance_mm,hd95_mm,"
@@ -100,24 +111,25 @@ void writeRunsCsv(const std::vector<EvaluationRun>& runs, const std::string& pat
          "trust_march_share,trust_flags,warnings,error\n";
   out << std::setprecision(6);
   for (const EvaluationRun& r : runs) {
-    out << csvField(r.split) << ',' << csvField(r.image) << ',' << csvField(r.subject) << ',' << r.subjectSnr << ','
-        << r.subjectThickAxis << ',' << csvField(r.subjectContrast) << ',' << csvField(r.structure) << ','
-        << csvField(r.protocol) << ',' << r.seed << ',' << r.format
-        << ',' << r.landmarks << ',' << r.dice << ',' << r.jaccard << ',' << r.meanSurfaceDistance << ',' << r.hd95
-        << ',' << r.volume << ',' << r.referenceVolume << ',' << r.leak << ',' << r.miss << ','
-        << (r.collapsed ? 1 : 0) << ',' << r.surfaceOnEdges << ',';
+    using N = CsvNumber;
+    out << csvField(r.split) << ',' << csvField(r.image) << ',' << csvField(r.subject) << ',' << N{r.subjectSnr}
+        << ',' << r.subjectThickAxis << ',' << csvField(r.subjectContrast) << ',' << csvField(r.structure) << ','
+        << csvField(r.protocol) << ',' << r.seed << ',' << r.format << ',' << r.landmarks << ',' << N{r.dice} << ','
+        << N{r.jaccard} << ',' << N{r.meanSurfaceDistance} << ',' << N{r.hd95} << ',' << N{r.volume} << ','
+        << N{r.referenceVolume} << ',' << N{r.leak} << ',' << N{r.miss} << ',' << (r.collapsed ? 1 : 0) << ','
+        << N{r.surfaceOnEdges} << ',';
     if (r.convention) {
       const ConventionScores& c = *r.convention;
-      out << c.asRead.strength << ',' << c.flipped.strength << ',' << c.mirrored.strength << ',' << c.asRead.alignment
-          << ',' << c.flipped.alignment << ',' << c.mirrored.alignment << ',';
+      out << N{c.asRead.strength} << ',' << N{c.flipped.strength} << ',' << N{c.mirrored.strength} << ','
+          << N{c.asRead.alignment} << ',' << N{c.flipped.alignment} << ',' << N{c.mirrored.alignment} << ',';
     } else {
       out << ",,,,,,";
     }
     const TrustMeasures& t = r.trust;
-    out << r.seconds << ',' << r.steps << ',' << r.controlVertices << ',' << t.outsideRegion << ','
-        << t.volumeRatio << ',' << t.outlineDistance << ',' << t.clicksToAtlas << ',' << t.farthestFromEvidence
-        << ',' << t.marchShare << ',' << csvField(r.trustFlags) << ',' << csvField(r.warnings) << ','
-        << csvField(r.error) << '\n';
+    out << N{r.seconds} << ',' << r.steps << ',' << r.controlVertices << ',' << N{t.outsideRegion} << ','
+        << N{t.volumeRatio} << ',' << N{t.outlineDistance} << ',' << N{t.clicksToAtlas} << ','
+        << N{t.farthestFromEvidence} << ',' << N{t.marchShare} << ',' << csvField(r.trustFlags) << ','
+        << csvField(r.warnings) << ',' << csvField(r.error) << '\n';
   }
   out.close();
   if (!out) throw writeFailure(path);
@@ -232,6 +244,7 @@ void runEvaluate(const EvaluateCommandOptions& o) {
   const EvaluationPlan plan = readEvaluationPlan(o.plan);
   const std::filesystem::path dir(o.out);
   prepareOutputDirectory(dir);
+  if (!o.keepLandmarks.empty()) prepareOutputDirectory(o.keepLandmarks);
   // Each run's landmark file goes through a scratch directory (the plan and
   // the seed reproduce it); only the tables and plots are kept.
   const std::filesystem::path scratch =
@@ -306,7 +319,8 @@ void addEvaluateCommand(CLI::App& app) {
   command->add_option("--split", o->splits, "Run only these splits of the plan (repeatable; default: all)");
   command->add_option("--jobs", o->jobs, "Runs at once")->default_val(2)->check(CLI::Range(1, 64));
   command->add_option("--keep-landmarks", o->keepLandmarks,
-                      "Keep each run's landmark file in this directory (named split_image_structure_protocol_seed)");
+                      "Keep each run's landmark file in this directory (named split_image_structure_protocol_seed; created if "
+                      "missing, its parent must exist)");
   command->callback([o] { runEvaluate(*o); });
 }
 

@@ -78,7 +78,7 @@ std::vector<int> parseLabelValues(const std::string& text) {
 
 // The expert's labelmap, on the image's grid.
 Volume readReferenceLabels(const std::string& path, const Volume& image) {
-  Volume labels = readVolume(path);
+  Volume labels = readLabelMap(path);
   if (!labels.geometry.sameGridAs(image.geometry))
     throw Error(path, "the reference is not on the image's grid (size, origin, spacing or direction differ)");
   return labels;

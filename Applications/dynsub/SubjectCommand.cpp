@@ -29,7 +29,7 @@ void runSubject(const Arguments& arguments) {
   checkSubjectSettings(settings);
   prepareOutputDirectory(arguments.out);
   const Volume image = readVolume(arguments.image);
-  const Volume labels = readVolume(arguments.labels);
+  const Volume labels = readLabelMap(arguments.labels);
   const Subject subject = makeSubject(image, labels, settings, arguments.seed);
   OutputSet outputs(arguments.out);
   writeVolume(subject.image, outputs.add("image.nii.gz"), VoxelType::Float32);
@@ -60,7 +60,14 @@ void addSubjectCommand(CLI::App& app) {
       "and subject.json (what was drawn).");
   command->add_option("IMAGE", arguments->image, "The source image (NIfTI, NRRD, MetaImage or DICOM)")->required();
   command->add_option("LABELS", arguments->labels, "Its label map (integer labels, any grid)")->required();
-  command->add_option("--seed", arguments->seed, "The subject's seed")->default_val(1);
+  // Digits only: the unsigned reader takes "-1" as 2^64-1, another seed.
+  command->add_option("--seed", arguments->seed, "The subject's seed (a whole number, 0 or more)")
+      ->default_val(1)
+      ->check([](const std::string& text) {
+        return !text.empty() && text.find_first_not_of("0123456789") == std::string::npos
+                   ? std::string()
+                   : "expected a whole number, 0 or more, got '" + text + "'";
+      });
   command->add_option("--set", arguments->settings,
                       "KEY=VALUE, repeatable: mode (realistic or synthesized), t2_fraction, label_spread, "
                       "structure_labels (L1,L2,...: the labels a synthesized subject draws as structures), "

@@ -112,6 +112,9 @@ expect_failure "unknown labelmap format" 1 "unknown labelmap format" "${seeds[@]
   "$work/ch2.nrrd"
 expect_failure "model in a missing directory" 1 "no-dir" "${seeds[@]}" --labelmap "$work/bad.nrrd" \
   --model "$work/no-dir/m.vtp" "$work/ch2.nrrd"
+mkdir "$work/folder.vtp"
+expect_failure "a model named like a folder that exists" 1 "folder.vtp: is a directory" "${seeds[@]}" \
+  --labelmap "$work/bad.nrrd" --model "$work/folder.vtp" "$work/ch2.nrrd"
 # Three structures' point lists in one markups file, as Slicer keeps them,
 # the third a single point: segmented together, each a barrier to the
 # others, into one labelmap (values from --labelValue up), one model and one

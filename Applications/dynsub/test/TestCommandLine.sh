@@ -115,6 +115,11 @@ expect_error "an unknown refinement" 2 "--refinement: everywhere not in {local,g
   "$DYNSUB" fit "$work/sphere.xyz" --refinement everywhere --out "$work/o9d"
 expect_error "missing output parent" 1 "does not exist" "$work/no/o10" \
   "$DYNSUB" fit "$work/sphere.xyz" --out "$work/no/o10"
+touch "$work/afile"
+expect_error "an output parent that is a file" 1 "afile is a file, not a directory" "$work/afile/o10" \
+  "$DYNSUB" fit "$work/sphere.xyz" --out "$work/afile/o10"
+expect_error "an empty output name, refused before the fit" 1 "the output directory's name is empty" "$work/o10b" \
+  "$DYNSUB" fit "$work/sphere.xyz" --out ""
 
 # A cube scan with sharp edges, from a control mesh whose edges are tagged
 # creases: 1200 points on the faces of a cube of side 44 mm, turned 10 degrees
@@ -581,6 +586,10 @@ expect_error "subject: a warp that could fold" 1 "warp_mm must be" "$work/s41" \
   "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --set warp_mm=20 --out "$work/s41"
 expect_error "subject: missing labels" 1 "nolabels.nii.gz" "$work/s42" \
   "$DYNSUB" subject "$mri/ch2.nii.gz" "$work/nolabels.nii.gz" --out "$work/s42"
+expect_error "subject: an image given as its labels" 1 "image.nii.gz: not a label map" "$work/s44" \
+  "$DYNSUB" subject "$mri/ch2.nii.gz" "$work/subject/image.nii.gz" --out "$work/s44"
+expect_error "subject: a negative seed" 2 "--seed: expected a whole number, 0 or more, got '-1'" "$work/s45" \
+  "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --seed -1 --out "$work/s45"
 
 # The atlas start on that subject: Colin27 and AAL registered to it, the left
 # putamen carried there by name, with a click inside it.

@@ -54,6 +54,11 @@ for r in rows:
         print("one_click flag wrong:", r); ok = False
     if r["protocol"] != "seed" and not float(r["trust_volume_ratio"]) > 0:
         print("no volume ratio for clicks on slices:", r); ok = False
+    # A measure not taken (the atlas's: this plan has none) is empty, as the README says.
+    if any(v.strip().lower().lstrip("-") in ("nan", "inf") for v in r.values()):
+        print("a field reads nan or inf:", r); ok = False
+    if r["trust_atlas_outline_distance_mm"] != "":
+        print("an atlas measure without an atlas:", r); ok = False
 for protocol, floor in (("six_slices", 0.70), ("sparse", 0.68), ("seed", 0.35)):
     dice = [float(r["dice"]) for r in rows if r["protocol"] == protocol]
     mean = sum(dice) / len(dice)
@@ -136,6 +141,11 @@ bad repeated_seed "$(edited "p['splits'][0]['seeds'] = [101, 101]")" "split 'tes
 bad no_seeds "$(edited "p['splits'][0]['seeds'] = []")" "split 'test' has no seeds"
 "$DYNSUB" evaluate "$work/missing.json" --out "$work/out_missing" >"$work/missing.log" 2>&1
 check "missing plan: non-zero exit and the file named" grep -q "missing.json" "$work/missing.log"
+"$DYNSUB" evaluate "$DATA/Evaluation/ci_plan.json" --out "$work/out_keep" --keep-landmarks "$work/no/clicks" \
+  >"$work/keep.log" 2>&1
+check "--keep-landmarks under a missing folder: non-zero exit, the folder named, nothing made" \
+  test $? -ne 0 -a ! -e "$work/no" -a ! -e "$work/out_keep/runs.csv"
+check "--keep-landmarks under a missing folder: the message" grep -q "no/clicks: cannot be created" "$work/keep.log"
 
 echo "$failures failure(s)"
 test "$failures" -eq 0

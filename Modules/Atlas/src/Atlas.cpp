@@ -127,7 +127,7 @@ Atlas readAtlas(const std::string& imagePath, const std::string& labelsPath) {
   atlas.imagePath = imagePath;
   atlas.labelsPath = labelsPath;
   atlas.image = readVolume(imagePath);
-  atlas.labels = readVolume(labelsPath);
+  atlas.labels = readLabelMap(labelsPath);
   if (!atlas.labels.geometry.sameGridAs(atlas.image.geometry))
     throw Error(labelsPath, "the atlas's label map is not on its template's grid (" + imagePath + ")");
   atlas.names = readNames(labelsPath);

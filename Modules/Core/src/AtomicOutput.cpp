@@ -111,11 +111,16 @@ void requireWritableDirectoryFor(const std::string& path) {
   if (directory.empty()) directory = ".";
   std::error_code error;
   if (!fs::is_directory(directory, error)) {
+    if (fs::exists(directory, error))
+      throw Error(path, "'" + directory.string() + "' is a file, not a directory to write into");
     throw Error(path, "the output directory '" + directory.string() + "' does not exist");
   }
   if (::access(directory.c_str(), W_OK) != 0) {
     throw Error(path, "the output directory '" + directory.string() + "' is not writable");
   }
+  // Found here, before a run, rather than when its finished file cannot be
+  // moved into place.
+  if (fs::is_directory(path, error)) throw Error(path, "is a directory; give the name of a file to write");
 }
 
 }  // namespace dynsub

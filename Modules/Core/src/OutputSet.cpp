@@ -15,6 +15,7 @@
 namespace dynsub {
 
 void prepareOutputDirectory(const std::filesystem::path& given) {
+  if (given.empty()) throw Error("the output directory's name is empty");
   // "out/" names the folder "out", as in OutputSet.
   const std::filesystem::path dir = given.has_filename() ? given : given.parent_path();
   std::error_code error;
@@ -25,6 +26,8 @@ void prepareOutputDirectory(const std::filesystem::path& given) {
   }
   const std::filesystem::path parent = dir.has_parent_path() ? dir.parent_path() : std::filesystem::path(".");
   if (!std::filesystem::is_directory(parent, error)) {
+    if (std::filesystem::exists(parent, error))
+      throw Error(dir.string(), "cannot be created: " + parent.string() + " is a file, not a directory");
     throw Error(dir.string(), "cannot be created: " + parent.string() + " does not exist");
   }
   requireWritableDirectoryFor(dir.string());

@@ -361,7 +361,7 @@ std::vector<EvaluationRun> runEvaluation(const EvaluationPlan& plan, const Evalu
     }
   };
   if (!plan.images.empty()) {
-    const Volume labels = readVolume(plan.reference);
+    const Volume labels = readLabelMap(plan.reference);
     for (const EvaluationImage& i : plan.images) {
       Input& input = inputs.emplace_back();
       input.image = i.name;
@@ -371,7 +371,7 @@ std::vector<EvaluationRun> runEvaluation(const EvaluationPlan& plan, const Evalu
     }
   }
   for (const EvaluationCohort& cohort : plan.cohorts) {
-    const Volume image = readVolume(cohort.image), labels = readVolume(cohort.labels);
+    const Volume image = readVolume(cohort.image), labels = readLabelMap(cohort.labels);
     for (const auto& [split, seeds] : cohort.subjects) {
       bool wanted = false;
       for (const EvaluationSplit* s : splits) wanted = wanted || s->name == split;

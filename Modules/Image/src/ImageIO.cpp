@@ -72,6 +72,20 @@ Volume readVolume(const std::string& path) {
   return volume;
 }
 
+Volume readLabelMap(const std::string& path) {
+  Volume labels = readVolume(path);
+  const auto bad = std::find_if(labels.voxels.begin(), labels.voxels.end(), [](float v) { return v != std::round(v); });
+  if (bad != labels.voxels.end()) {
+    const ImageGeometry& g = labels.geometry;
+    const long long first = bad - labels.voxels.begin();
+    const long long i = first % g.size[0], j = first / g.size[0] % g.size[1], k = first / g.size[0] / g.size[1];
+    throw Error(path, "not a label map: voxel (" + std::to_string(i) + ", " + std::to_string(j) + ", " +
+                          std::to_string(k) + ") holds " + std::to_string(*bad) +
+                          ", and labels are whole numbers (was it resampled with interpolation?)");
+  }
+  return labels;
+}
+
 void writeMask(const Mask& mask, const std::string& path, std::uint8_t label) {
   // The file is written under a temporary name and renamed when complete; a
   // header that names a separate data file would name the temporary one.

@@ -29,6 +29,12 @@ constexpr double kSmallestSpacing = 1e-4, kLargestSpacing = 1e4;
 // infinite.
 Volume readVolume(const std::string& path);
 
+// readVolume for a label map. Also throws naming the path when a voxel is not
+// a whole number (a label map resampled with interpolation, or an image given
+// in its place), whose value would otherwise be rounded into a neighbouring
+// label without a word.
+Volume readLabelMap(const std::string& path);
+
 // Writes a mask as an unsigned 8-bit labelmap (`label` = structure, 0 =
 // background; 3D Slicer colours a segment by its label value) on its grid, in
 // a single-file format chosen by extension (.nii.gz for ITK-SNAP and 3D
