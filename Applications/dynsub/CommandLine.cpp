@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <sstream>
 #include <variant>
 
 #include <CLI/CLI.hpp>
@@ -17,21 +18,33 @@ namespace dynsub::app {
 
 namespace {
 
-CLI::Validator numberCheck(const std::string& name, bool zeroAllowed) {
+CLI::Validator numberCheck(std::string name, bool zeroAllowed, double largest) {
+  if (std::isfinite(largest)) {
+    std::ostringstream bound;
+    bound << " and <= " << largest;
+    name += bound.str();
+  }
   return CLI::Validator(
-      [name, zeroAllowed](std::string& text) -> std::string {
+      [name, zeroAllowed, largest](std::string& text) -> std::string {
         char* end = nullptr;
         const double value = std::strtod(text.c_str(), &end);
         const bool number = !text.empty() && end == text.c_str() + text.size() && std::isfinite(value);
-        return number && (value > 0.0 || (zeroAllowed && value == 0.0)) ? std::string() : text + " is not " + name;
+        return number && (value > 0.0 || (zeroAllowed && value == 0.0)) && value <= largest
+                   ? std::string()
+                   : text + " is not " + name;
       },
       zeroAllowed ? "NUMBER>=0" : "NUMBER>0");
 }
 
 }  // namespace
 
-CLI::Validator positiveNumber() { return numberCheck("a finite number > 0", false); }
-CLI::Validator nonNegativeNumber() { return numberCheck("a finite number >= 0", true); }
+CLI::Validator positiveNumber(double largest) { return numberCheck("a finite number > 0", false, largest); }
+CLI::Validator nonNegativeNumber(double largest) { return numberCheck("a finite number >= 0", true, largest); }
+
+// The material's densities and the time step end where the segmentation's
+// table ends theirs (SegmentParameters.cpp): far beyond any useful value, and
+// well short of products that overflow.
+constexpr double kLargestMaterialValue = 1e6;
 
 void SimulationArguments::addOptions(CLI::App& command, const SimulationOptions& defaults) {
   values = defaults;
@@ -51,24 +64,24 @@ void SimulationArguments::addOptions(CLI::App& command, const SimulationOptions&
       ->check(CLI::IsMember({"cholesky", "cg", "pcg"}));
   command.add_option("--time-step", values.integrator.timeStep, "Time step, s (halved automatically on divergence, and doubled back once the energy falls)")
       ->default_val(defaults.integrator.timeStep)
-      ->check(positiveNumber());
+      ->check(positiveNumber(kLargestMaterialValue));
   command.add_option("--max-steps", values.equilibrium.maxSteps, "Step limit per level")
       ->default_val(defaults.equilibrium.maxSteps)
       ->check(CLI::Range(1, 1000000));
   command.add_option("--mass", values.material.mass, "Mass density mu, kg per unit parametric area")
       ->default_val(defaults.material.mass)
-      ->check(nonNegativeNumber());
+      ->check(nonNegativeNumber(kLargestMaterialValue));
   command.add_option("--damping", values.material.damping, "Damping density gamma, kg/s per unit parametric area")
       ->default_val(defaults.material.damping)
-      ->check(nonNegativeNumber());
+      ->check(nonNegativeNumber(kLargestMaterialValue));
   command.add_option("--tension", values.material.tensionU,
                      "Tension alpha11 = alpha22, N/mm per unit parametric area (membrane: resists stretching)")
       ->default_val(defaults.material.tensionU)
-      ->check(nonNegativeNumber());
+      ->check(nonNegativeNumber(kLargestMaterialValue));
   command.add_option("--rigidity", values.material.rigidityUU,
                      "Rigidity beta11 = beta22 = beta12/2, N/mm per unit parametric area (thin plate: resists bending)")
       ->default_val(defaults.material.rigidityUU)
-      ->check(nonNegativeNumber());
+      ->check(nonNegativeNumber(kLargestMaterialValue));
 }
 
 SimulationOptions SimulationArguments::apply(SimulationOptions base) const {

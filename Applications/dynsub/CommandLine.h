@@ -1,6 +1,7 @@
 #pragma once
 // What the commands that run a simulation share on the command line: the
 // physics and solver options, and a progress line on a terminal.
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -29,11 +30,11 @@ struct SimulationArguments {
 // the parsing.
 void addSegmentParameterOptions(CLI::App& command, SegmentParameters& parameters);
 
-// Checks for a finite number > 0 and >= 0, whose refusals read
-// "--tolerance: -1 is not a finite number > 0" (CLI11's PositiveNumber and
-// NonNegativeNumber print the largest double as their range's end).
-CLI::Validator positiveNumber();
-CLI::Validator nonNegativeNumber();
+// Checks for a finite number > 0 and >= 0, at most `largest`, whose refusals
+// read "--tolerance: -1 is not a finite number > 0" (CLI11's PositiveNumber
+// and NonNegativeNumber print the largest double as their range's end).
+CLI::Validator positiveNumber(double largest = std::numeric_limits<double>::infinity());
+CLI::Validator nonNegativeNumber(double largest = std::numeric_limits<double>::infinity());
 
 // For a usage error: "did you mean 'segment'?" for a command that is not one
 // of `app`'s subcommands, or "did you mean '--landmarks'?" for a long option

@@ -88,7 +88,7 @@ std::string uncoveredWarning(const SurfaceCoverage& coverage, const std::string&
   return text.str();
 }
 
-// --noise: "auto", "measure" or a number of mm >= 0 (returned; -1 for the
+// --noise: "auto", "measure" or a number of mm, 0 to kLargestCoordinate (returned; -1 for the
 // others).
 double statedNoise(const std::string& text) {
   if (text == "auto" || text == "measure") return -1.0;
@@ -99,8 +99,9 @@ double statedNoise(const std::string& text) {
   } catch (const std::exception&) {
     used = 0;
   }
-  if (used != text.size() || !std::isfinite(value) || value < 0.0) {
-    throw CLI::ValidationError("--noise", "expected auto, measure or a number of mm >= 0, got '" + text + "'");
+  // A length beyond the largest coordinate a scan may have (InitialModels.h).
+  if (used != text.size() || !std::isfinite(value) || value < 0.0 || value > kLargestCoordinate) {
+    throw CLI::ValidationError("--noise", "expected auto, measure or a number of mm, 0 to 1e9, got '" + text + "'");
   }
   return value;
 }

@@ -66,7 +66,10 @@ void runRender(const RenderCommandOptions& o) {
     inputs.image = image.get();
   }
   if (!o.landmarks.empty()) inputs.landmarks = landmarkPositions(readLandmarks(o.landmarks));
-  if (!o.points.empty()) inputs.dataPoints = readPointCloud(o.points).points;
+  if (!o.points.empty()) {
+    inputs.dataPoints = readPointCloud(o.points).points;
+    if (!inputs.dataPoints.allFinite()) throw Error(o.points, "a point is not a finite number");
+  }
   if (!o.outliers.empty()) {
     inputs.outliers = readPointCloud(o.outliers).points;
     if (!inputs.outliers.allFinite()) throw Error(o.outliers, "a point is not a finite number");

@@ -99,6 +99,13 @@ printf '1 1 1\n1 1 1\n1 1 1\n1 1 1\n1 1 1\n' >"$work/same.xyz"
 expect_error "coincident points" 1 "coincide" "$work/o3" "$DYNSUB" fit "$work/same.xyz" --out "$work/o3"
 awk 'BEGIN { srand(4); for (i = 0; i < 50; i++) printf "%f %f 2\n", rand(), rand() }' >"$work/flat.xyz"
 expect_error "coplanar points" 1 "plane" "$work/o4" "$DYNSUB" fit "$work/flat.xyz" --out "$work/o4"
+# Coordinates whose squares overflow or underflow: named as such, not "all points coincide".
+printf '1e300 1e300 1e300\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n' >"$work/far.xyz"
+expect_error "a point beyond 1e9 mm" 1 "far.xyz: point 1 (1e+300, 1e+300, 1e+300) lies beyond" "$work/o4b" \
+  "$DYNSUB" fit "$work/far.xyz" --out "$work/o4b"
+printf '0 0 0\n1e-300 0 0\n0 1e-300 0\n0 0 1e-300\n' >"$work/tiny.xyz"
+expect_error "points within 1e-6 mm" 1 "tiny.xyz: the points span only 1e-300 mm" "$work/o4c" \
+  "$DYNSUB" fit "$work/tiny.xyz" --out "$work/o4c"
 expect_error "wrong genus" 1 "genus" "$work/o5" "$DYNSUB" fit "$work/sphere.xyz" --init torus --genus 0 --out "$work/o5"
 expect_error "open initial model" 1 "closed" "$work/o6" \
   "$DYNSUB" fit "$work/sphere.xyz" --init "$DATA/Meshes/sheet.obj" --out "$work/o6"
@@ -109,7 +116,7 @@ expect_error "impossible tolerance" 2 "tolerance: -1 is not a finite number > 0"
   "$DYNSUB" fit "$work/sphere.xyz" --tolerance -1 --out "$work/o9"
 expect_error "negative springs per element" 2 "springs-per-element" "$work/o9b" \
   "$DYNSUB" fit "$work/sphere.xyz" --springs-per-element -1 --out "$work/o9b"
-expect_error "an impossible noise" 2 "expected auto, measure or a number of mm >= 0" "$work/o9c" \
+expect_error "an impossible noise" 2 "expected auto, measure or a number of mm, 0 to 1e9" "$work/o9c" \
   "$DYNSUB" fit "$work/sphere.xyz" --noise -0.1 --out "$work/o9c"
 expect_error "an unknown refinement" 2 "--refinement: everywhere not in {local,global}" "$work/o9d" \
   "$DYNSUB" fit "$work/sphere.xyz" --refinement everywhere --out "$work/o9d"
@@ -243,6 +250,8 @@ expect_error "render: missing outliers file" 1 "none.xyz: no such file" "$work/r
 printf '1 2 3\n4 nan 6\n' >"$work/nanoutliers.xyz"
 expect_error "render: outliers that are not numbers" 1 "nanoutliers.xyz: a point is not a finite number" "$work/r7" \
   "$DYNSUB" render --surface "$work/fitoff/surface.vtp" --outliers "$work/nanoutliers.xyz" --out "$work/r7"
+expect_error "render: points that are not numbers" 1 "nanoutliers.xyz: a point is not a finite number" "$work/r7b" \
+  "$DYNSUB" render --surface "$work/fitoff/surface.vtp" --points "$work/nanoutliers.xyz" --out "$work/r7b"
 # A rerun into the same directory removes what an earlier run wrote there
 # and it does not, which would otherwise read as its own: the figures of
 # another format, every figure with --no-figures, and outliers.xyz when
@@ -430,6 +439,10 @@ check "segment --slice-ends false: carries nothing past them" \
 demo_slices "y == ys[2]" "$work/one_slice.mrk.json"
 expect_error "landmarks on one slice" 1 "one_slice.mrk.json: all [0-9]* landmarks lie on one plane.*two slices" \
   "$work/s14" "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/one_slice.mrk.json" --no-figures --out "$work/s14"
+# Clicks on one line: the file named too.
+printf 'x,y,z\n10,0,10\n10,2,10\n10,4,10\n10,6,10\n10,8,10\n' >"$work/line.csv"
+expect_error "landmarks on one line" 1 "line.csv: the landmarks: all points lie on a line" \
+  "$work/s14b" "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/line.csv" --no-figures --out "$work/s14b"
 expect_error "negative end pressure" 2 "end-pressure" "$work/s13" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --end-pressure -0.1 \
   --out "$work/s13"

@@ -81,9 +81,29 @@ int ControlMesh::boundaryLoopCount() const {
   return loops;
 }
 
+int ControlMesh::pieceCount() const {
+  // Every vertex lies on a face (MeshCheck.h), so the pieces are the
+  // connected sets of edges.
+  const Topology& t = *topology_;
+  std::vector<int> parent(t.vertexCount());
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&parent](int v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (int e = 0; e < t.edgeCount(); ++e) {
+    const auto [a, b] = t.edgeVertices(e);
+    parent[find(a)] = find(b);
+  }
+  int pieces = 0;
+  for (int v = 0; v < t.vertexCount(); ++v) pieces += find(v) == v;
+  return pieces;
+}
+
 int ControlMesh::genus() const {
-  // chi = 2 - 2g - b for a connected orientable surface with b boundary loops.
-  return (2 - eulerCharacteristic() - boundaryLoopCount()) / 2;
+  // chi = 2 - 2g - b for each connected orientable piece with b boundary
+  // loops; summed over the pieces, chi = 2 pieces - 2 g - b.
+  return (2 * pieceCount() - eulerCharacteristic() - boundaryLoopCount()) / 2;
 }
 
 void ControlMesh::setPoints(const MatrixX3& points) {

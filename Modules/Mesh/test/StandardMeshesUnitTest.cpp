@@ -51,6 +51,24 @@ TEST(StandardMeshes, TorusAndSheet) {
   EXPECT_EQ(countValence(sheet, 2), 4);
 }
 
+// A cube and a torus side by side: two pieces whose genera add up (the Euler
+// characteristic alone, taken as one piece's, gave -1 for two cubes).
+TEST(StandardMeshes, PiecesCountedAndTheirGeneraAdded) {
+  const dynsub::ControlMesh cube = dynsub::makeCube98(), torus = dynsub::makeTorus32();
+  std::vector<dynsub::Polygon> faces = cube.faces();
+  for (dynsub::Polygon face : torus.faces()) {
+    for (int& v : face) v += cube.vertexCount();
+    faces.push_back(face);
+  }
+  dynsub::MatrixX3 points(cube.vertexCount() + torus.vertexCount(), 3);
+  points << cube.points(), torus.points().rowwise() + Eigen::RowVector3d(10, 0, 0);
+  const dynsub::ControlMesh both = dynsub::ControlMesh::fromPolygons(points, faces, "cube and torus");
+  EXPECT_EQ(cube.pieceCount(), 1);
+  EXPECT_EQ(both.pieceCount(), 2);
+  EXPECT_EQ(both.genus(), 1);
+  EXPECT_TRUE(both.isClosed());
+}
+
 TEST(StandardMeshes, DataFilesMatchTheConstructedMeshes) {
   for (const std::string& name : dynsub::standardMeshNames()) {
     const dynsub::ControlMesh built = dynsub::makeStandardMesh(name);

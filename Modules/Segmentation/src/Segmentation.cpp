@@ -166,7 +166,11 @@ ControlMesh initialFromLandmarks(const std::vector<Landmark>& landmarks, double 
                         " landmarks lie on one plane, as clicks on a single slice do: a surface needs the boundary "
                         "clicked on at least two slices across the structure, or one click inside it "
                         "(--init seed:x,y,z)");
-  checkPointCloud(points, "the landmarks");
+  try {
+    checkPointCloud(points, "the landmarks");
+  } catch (const Error& error) {
+    throw LandmarkError(error.what());  // the caller names the file
+  }
   return initialModel(points, InitialShape::Sphere, fraction);
 }
 

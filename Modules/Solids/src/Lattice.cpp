@@ -38,6 +38,10 @@ Lattice Lattice::fromCells(MatrixX3 points, std::vector<std::vector<int>> faces,
   if (points.rows() == 0 || cells.empty()) throw Error(source, "the lattice has no points or no cells");
   if (!points.allFinite()) throw Error(source, "a point has a non-finite coordinate");
   const int n = static_cast<int>(points.rows());
+  // A face of no area has no normal to extrude along and makes a cell of no
+  // volume; relative to the lattice's size, as MeshCheck's test of faces.
+  const double diagonal = (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm();
+  const double minimumArea = 1e-12 * diagonal * diagonal;
   Lattice l;
   l.points_ = std::move(points);
   l.faces_ = std::move(faces);
@@ -54,6 +58,8 @@ Lattice Lattice::fromCells(MatrixX3 points, std::vector<std::vector<int>> faces,
       if (p < 0 || p >= n)
         throw Error(source, name + " uses point " + std::to_string(p) + ", but the lattice has " + std::to_string(n));
     if (sortedUnique(loop).size() != loop.size()) throw Error(source, name + " repeats a point");
+    if (!(0.5 * newellNormal(l.points_, loop).norm() > minimumArea))
+      throw Error(source, name + " is degenerate: its area is zero");
     for (std::size_t i = 0; i < loop.size(); ++i) {
       const int a = std::min(loop[i], loop[(i + 1) % loop.size()]), b = std::max(loop[i], loop[(i + 1) % loop.size()]);
       auto [it, added] = edgeIndex.try_emplace({a, b}, static_cast<int>(l.edges_.size()));

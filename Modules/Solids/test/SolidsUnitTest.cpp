@@ -280,6 +280,12 @@ TEST_F(LatticeFiles, InvalidLatticesAreNamed) {
   EXPECT_NE(message(file("nan.lattice", std::string(text).replace(text.find("1 0 0"), 5, "nan 0 0"))).find("line 4"),
             std::string::npos);
   EXPECT_THROW(readLattice(file("cube.obj", "v 0 0 0\n")), Error);
+  // Every point at one place, and a face whose corners lie on a line: faces
+  // of no area.
+  std::string same = std::string(text).replace(text.find("1 0 0\n0 1 0\n0 0 1"), 17, "0 0 0\n0 0 0\n0 0 0");
+  EXPECT_NE(message(file("same.lattice", same)).find("face 0 is degenerate: its area is zero"), std::string::npos);
+  std::string line = std::string(text).replace(text.find("0 1 0\n0 0 1"), 5, "2 0 0");
+  EXPECT_NE(message(file("line.lattice", line)).find("face 0 is degenerate"), std::string::npos);
 }
 
 }  // namespace

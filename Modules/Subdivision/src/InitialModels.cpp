@@ -1,6 +1,7 @@
 #include "dynsub/InitialModels.h"
 
 #include <cmath>
+#include <sstream>
 
 #include <Eigen/Eigenvalues>
 
@@ -53,6 +54,22 @@ void checkPointCloud(const MatrixX3& points, const std::string& source) {
   }
   for (Eigen::Index i = 0; i < points.rows(); ++i) {
     if (!points.row(i).allFinite()) throw Error(source, "point " + std::to_string(i + 1) + " is not finite");
+    // Squared distances of coordinates near 1e154 overflow, and the test of
+    // coincidence below would see NaN.
+    if (points.row(i).cwiseAbs().maxCoeff() > kLargestCoordinate) {
+      std::ostringstream message;
+      message << "point " << i + 1 << " (" << points(i, 0) << ", " << points(i, 1) << ", " << points(i, 2)
+              << ") lies beyond " << kLargestCoordinate << " mm of the origin; coordinates are in mm";
+      throw Error(source, message.str());
+    }
+  }
+  // Likewise, spans below this have squared distances that underflow to 0.
+  const double span = (points.colwise().maxCoeff() - points.colwise().minCoeff()).maxCoeff();
+  if (span > 0 && span < kSmallestSpan) {
+    std::ostringstream message;
+    message << "the points span only " << span << " mm, less than the " << kSmallestSpan
+            << " mm DynSub works with; coordinates are in mm";
+    throw Error(source, message.str());
   }
   switch (spannedDimensions(points)) {
     case 0: throw Error(source, "all points coincide");

@@ -4,7 +4,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iterator>
-#include <numeric>
 #include <string>
 #include <fstream>
 #include <sstream>
@@ -175,22 +174,7 @@ int closedMeshGenus(const PointCloud& cloud, const std::string& source) {
   } catch (const Error&) {
     return -1;  // not a mesh MeshCheck.h accepts: no genus to speak of
   }
-  if (!mesh.isClosed()) return -1;
-  // One piece: ControlMesh::genus assumes it. The faces' vertices are joined
-  // along their edges.
-  std::vector<int> root(static_cast<size_t>(used));
-  std::iota(root.begin(), root.end(), 0);
-  const auto find = [&](int v) {
-    while (root[v] != v) v = root[v] = root[root[v]];
-    return v;
-  };
-  for (const Polygon& face : faces) {
-    for (size_t k = 1; k < face.size(); ++k) root[find(face[k])] = find(face[0]);
-  }
-  const int first = find(faces.front().front());
-  for (const Polygon& face : faces) {
-    if (find(face.front()) != first) return -1;
-  }
+  if (!mesh.isClosed() || mesh.pieceCount() != 1) return -1;
   return mesh.genus();
 }
 

@@ -45,7 +45,10 @@ class ControlMesh {
   int eulerCharacteristic() const;
   int boundaryLoopCount() const;
   bool isClosed() const { return boundaryLoopCount() == 0; }
-  // Genus of the surface, from the Euler characteristic, assuming it is connected.
+  // The connected pieces of the surface (two cubes are 2).
+  int pieceCount() const;
+  // The genus of the surface from its Euler characteristic: the sum of its
+  // pieces' genera.
   int genus() const;
 
   const MatrixX3& points() const { return points_; }

@@ -9,9 +9,14 @@
 
 namespace dynsub {
 
+// The coordinates (mm) and the extent of a point cloud checkPointCloud
+// accepts: a kilometre-scale survey to a nanometre one.
+constexpr double kLargestCoordinate = 1e9, kSmallestSpan = 1e-6;
+
 // Checks a point cloud read from `source`: at least 4 points, finite
-// coordinates, not all coincident, not all on a plane or a line. Throws
-// dynsub::Error naming the source.
+// coordinates within kLargestCoordinate of the origin, a span of at least
+// kSmallestSpan unless they all coincide, not all coincident, not all on a
+// plane or a line. Throws dynsub::Error naming the source.
 void checkPointCloud(const MatrixX3& points, const std::string& source);
 
 // The dimensions finite points span, by checkPointCloud's test: 0 when they
