@@ -4,6 +4,7 @@
 
 #include "dynsub/Error.h"
 #include "dynsub/LimitSurface.h"
+#include "dynsub/MeshCheck.h"
 #include "dynsub/MeshIO.h"
 #include "dynsub/ParallelFor.h"
 
@@ -73,6 +74,14 @@ TriangleSurface outputSurface(const ControlMesh& mesh, const LimitSurface& surfa
 void writeModelOutputs(const std::filesystem::path& dir, const ControlMesh& mesh, const TriangleSurface& surface,
                        const Report& report, const std::function<void(OutputSet&)>& extra,
                        const std::vector<PointScalars>& surfaceScalars, const std::string& space) {
+  // A model the readers refuse (a face of no area: the surface shrank to a
+  // point or a line) is not written as a result.
+  try {
+    checkPolygonMesh(mesh.points(), mesh.faces(), "the resulting control mesh");
+  } catch (const Error& error) {
+    throw Error(std::string("the model collapsed: ") + error.what() +
+                " (tension draws a surface in where no force holds it out: add springs or points, or lower --tension)");
+  }
   OutputSet outputs(dir);
   // The model's files (surface.vtp, control_mesh.obj, report.json) are
   // written on a second thread while `extra` (a segmentation's labelmap, the

@@ -443,6 +443,12 @@ SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& in, const 
   const auto voxelizing = std::chrono::steady_clock::now();
   const ImageGeometry& grid = in.labelmapGrid ? *in.labelmapGrid : image.geometry;
   outcome.labelmap = labelmapOf(outcome.result.surface, grid);
+  // An empty labelmap is no segmentation, whatever the measures of trust say
+  // of a surface that small.
+  if (outcome.labelmap.count() == 0)
+    throw Error(in.landmarkSource.empty() ? in.image : in.landmarkSource,
+                "the result encloses no voxel of the image: the surface shrank below a voxel (landmarks spread "
+                "across the structure, or a click inside it, give it room)");
   const auto finished = std::chrono::steady_clock::now();
   outcome.seconds = std::chrono::duration<double>(finished - started).count();
   outcome.history = recorder.history();

@@ -31,7 +31,8 @@ constexpr char kControlMeshFile[] = "control_mesh.obj";
 constexpr char kReportFile[] = "report.json";
 
 // DIR/surface.vtp (`surface`, from outputSurface), DIR/control_mesh.obj and
-// DIR/report.json, all or none. `extra` may add further files to the same set
+// DIR/report.json, all or none; none, with an error, when the control mesh
+// fails MeshCheck.h (the model collapsed). `extra` may add further files to the same set
 // (e.g. a labelmap); `surfaceScalars` are point data of surface.vtp (one value
 // per point of `surface`); `space` ("LPS" for surfaces in an image's physical
 // space) is recorded in surface.vtp for 3D Slicer (SurfaceWriter.h).
