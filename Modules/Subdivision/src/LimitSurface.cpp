@@ -254,6 +254,7 @@ struct LimitSurface::Impl {
   // is a valence (and whether at a boundary).
   std::map<std::vector<int>, int> structureIndex;
   std::vector<std::unique_ptr<Special>> structures;
+  std::vector<std::shared_ptr<const Topology>> structureTopologies;  // each structure's, before subdivision
   // Their pieces, per (structure, corner, levels), made on first use.
   mutable std::map<std::array<int, 3>, ElementPieces> structurePieces;
   mutable std::mutex structurePiecesMutex;
@@ -364,24 +365,27 @@ struct LimitSurface::Impl {
     for (size_t i = 0; i < neighbourhood.parentVertex.size(); ++i) {
       local.weights.row(i) = rowOver(columns, neighbourhood.parentVertex[i]);
     }
-    local.topology = std::make_shared<const Topology>(std::move(neighbourhood.topology));
     local.face = neighbourhood.face;
 
     // The structure: neighbourhoods are numbered by their structure
-    // (extractNeighbourhood), so equal ones have equal local topologies.
+    // (extractNeighbourhood), so equal ones have equal polygons, and share
+    // one Topology (a mesh of triangles has a special element on every
+    // face, each of whose topologies would otherwise be built and kept).
     std::vector<int> key{local.face};
-    for (int f = 0; f < local.topology->faceCount(); ++f) {
-      key.push_back(-local.topology->faceSize(f));
-      key.insert(key.end(), local.topology->face(f).begin(), local.topology->face(f).end());
+    for (const Polygon& polygon : neighbourhood.faces) {
+      key.push_back(-static_cast<int>(polygon.size()));
+      key.insert(key.end(), polygon.begin(), polygon.end());
     }
     const auto [found, added] = structureIndex.try_emplace(std::move(key), static_cast<int>(structures.size()));
     if (added) {
-      const Eigen::Index n = local.weights.rows();
+      const int n = static_cast<int>(neighbourhood.parentVertex.size());
+      structureTopologies.push_back(std::make_shared<const Topology>(n, std::move(neighbourhood.faces)));
       std::vector<int> vertices(n);
-      for (Eigen::Index i = 0; i < n; ++i) vertices[i] = static_cast<int>(i);
-      structures.push_back(makeSpecial(LocalMesh{local.topology, Eigen::MatrixXd::Identity(n, n), local.face},
-                                       std::move(vertices), true));
+      for (int i = 0; i < n; ++i) vertices[i] = i;
+      structures.push_back(makeSpecial(
+          LocalMesh{structureTopologies.back(), Eigen::MatrixXd::Identity(n, n), local.face}, std::move(vertices), true));
     }
+    local.topology = structureTopologies[found->second];
     element.structure = found->second;
     element.structureMap = local.weights;
     element.columns = columns;

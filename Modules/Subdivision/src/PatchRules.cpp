@@ -257,8 +257,7 @@ Neighbourhood extractNeighbourhood(const Topology& topology, int x, int f) {
   Neighbourhood result;
   result.face = 0;
   std::unordered_map<int, int> localIndex;
-  std::vector<Polygon> polygons;
-  polygons.reserve(order.size());
+  result.faces.reserve(order.size());
   for (const auto& [g, first] : order) {
     Polygon polygon = topology.face(g);
     std::rotate(polygon.begin(), polygon.begin() + first, polygon.end());
@@ -267,9 +266,8 @@ Neighbourhood extractNeighbourhood(const Topology& topology, int x, int f) {
       if (added) result.parentVertex.push_back(v);
       v = it->second;
     }
-    polygons.push_back(std::move(polygon));
+    result.faces.push_back(std::move(polygon));
   }
-  result.topology = Topology(static_cast<int>(result.parentVertex.size()), std::move(polygons));
   return result;
 }
 
@@ -297,7 +295,7 @@ CornerStep cornerStep(std::shared_ptr<const Topology> from, int face) {
   const int x = topology.face(face)[0];
   Neighbourhood next = extractNeighbourhood(refinement.topology, x, firstChild);
   step.next = refined(next.parentVertex, Eigen::all);
-  step.to = std::make_shared<const Topology>(std::move(next.topology));
+  step.to = std::make_shared<const Topology>(static_cast<int>(next.parentVertex.size()), std::move(next.faces));
   step.toFace = next.face;
   return step;
 }

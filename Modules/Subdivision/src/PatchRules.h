@@ -44,8 +44,11 @@ VertexMasks vertexMasks(const Topology& topology, int x, int f);
 
 // The faces touching any face at vertex x, renumbered; `face` is f with its
 // corners rotated so that x is corner 0; parentVertex maps local to original.
+// The faces come as polygons, over parentVertex.size() vertices: neighbourhoods
+// of one structure have equal polygons, and a caller that has met the
+// structure before reuses its Topology instead of building another.
 struct Neighbourhood {
-  Topology topology;
+  std::vector<Polygon> faces;
   std::vector<int> parentVertex;
   int face = -1;
 };
