@@ -112,8 +112,8 @@ void writeRunsCsv(const std::vector<EvaluationRun>& runs, const std::string& pat
   out << std::setprecision(6);
   for (const EvaluationRun& r : runs) {
     using N = CsvNumber;
-    out << csvField(r.split) << ',' << csvField(r.image) << ',' << csvField(r.subject) << ',' << N{r.subjectSnr}
-        << ',' << r.subjectThickAxis << ',' << csvField(r.subjectContrast) << ',' << csvField(r.structure) << ','
+    out << csvField(r.split) << ',' << csvField(r.image) << ',' << csvField(r.subject) << ',' << N{r.subjectSnr} << ','
+        << r.subjectThickAxis << ',' << csvField(r.subjectContrast) << ',' << csvField(r.structure) << ','
         << csvField(r.protocol) << ',' << r.seed << ',' << r.format << ',' << r.landmarks << ',' << N{r.dice} << ','
         << N{r.jaccard} << ',' << N{r.meanSurfaceDistance} << ',' << N{r.hd95} << ',' << N{r.volume} << ','
         << N{r.referenceVolume} << ',' << N{r.leak} << ',' << N{r.miss} << ',' << (r.collapsed ? 1 : 0) << ','
@@ -318,9 +318,10 @@ void addEvaluateCommand(CLI::App& app) {
   command->add_option("--out", o->out, "Output directory (created if missing; its parent must exist)")->required();
   command->add_option("--split", o->splits, "Run only these splits of the plan (repeatable; default: all)");
   command->add_option("--jobs", o->jobs, "Runs at once")->default_val(2)->check(CLI::Range(1, 64));
-  command->add_option("--keep-landmarks", o->keepLandmarks,
-                      "Keep each run's landmark file in this directory (named split_image_structure_protocol_seed; created if "
-                      "missing, its parent must exist)");
+  command->add_option(
+      "--keep-landmarks", o->keepLandmarks,
+      "Keep each run's landmark file in this directory (named split_image_structure_protocol_seed; created if "
+      "missing, its parent must exist)");
   command->callback([o] { runEvaluate(*o); });
 }
 

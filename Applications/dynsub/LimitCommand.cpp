@@ -27,7 +27,8 @@ void runLimit(const LimitOptions& options) {
   for (int e = 0; e < surface.elementCount(); ++e) special += surface.elementType(e) == ElementType::Special;
   const int pieces = mesh.pieceCount();
   std::cout << "control mesh: " << mesh.vertexCount() << " vertices, " << mesh.faceCount() << " faces, "
-            << (pieces > 1 ? std::to_string(pieces) + " pieces, " : "") << "genus " << mesh.genus() << (mesh.isClosed() ? ", closed" : ", with boundary") << '\n'
+            << (pieces > 1 ? std::to_string(pieces) + " pieces, " : "") << "genus " << mesh.genus()
+            << (mesh.isClosed() ? ", closed" : ", with boundary") << '\n'
             << "limit surface: " << surface.elementCount() << " elements (" << surface.elementCount() - special
             << " normal, " << special << " special) after " << surface.isolationLevels()
             << " isolating subdivision(s)\n"

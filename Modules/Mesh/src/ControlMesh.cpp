@@ -59,44 +59,51 @@ std::vector<Crease> ControlMesh::creases() const {
 
 int ControlMesh::eulerCharacteristic() const { return vertexCount() - edgeCount() + faceCount(); }
 
-int ControlMesh::boundaryLoopCount() const {
-  // Every boundary vertex of a manifold mesh has exactly two boundary edges, so
-  // the loops are the connected sets of boundary edges.
-  const Topology& t = *topology_;
+namespace {
+
+// Each vertex's set, by its representative, once the edges `joins` accepts
+// have joined their two ends.
+template <typename Joins>
+std::vector<int> joinedVertices(const Topology& t, Joins joins) {
   std::vector<int> parent(t.vertexCount());
   std::iota(parent.begin(), parent.end(), 0);
   auto find = [&parent](int v) {
     while (parent[v] != v) v = parent[v] = parent[parent[v]];
     return v;
   };
+  for (int e = 0; e < t.edgeCount(); ++e) {
+    if (!joins(e)) continue;
+    const auto [a, b] = t.edgeVertices(e);
+    parent[find(a)] = find(b);
+  }
+  for (int v = 0; v < t.vertexCount(); ++v) parent[v] = find(v);
+  return parent;
+}
+
+}  // namespace
+
+int ControlMesh::boundaryLoopCount() const {
+  // Every boundary vertex of a manifold mesh has exactly two boundary edges, so
+  // the loops are the connected sets of boundary edges.
+  const Topology& t = *topology_;
   std::vector<bool> onBoundary(t.vertexCount(), false);
   for (int e = 0; e < t.edgeCount(); ++e) {
     if (!t.isBoundaryEdge(e)) continue;
     const auto [a, b] = t.edgeVertices(e);
     onBoundary[a] = onBoundary[b] = true;
-    parent[find(a)] = find(b);
   }
+  const std::vector<int> set = joinedVertices(t, [&t](int e) { return t.isBoundaryEdge(e); });
   int loops = 0;
-  for (int v = 0; v < t.vertexCount(); ++v) loops += onBoundary[v] && find(v) == v;
+  for (int v = 0; v < t.vertexCount(); ++v) loops += onBoundary[v] && set[v] == v;
   return loops;
 }
 
 int ControlMesh::pieceCount() const {
   // Every vertex lies on a face (MeshCheck.h), so the pieces are the
   // connected sets of edges.
-  const Topology& t = *topology_;
-  std::vector<int> parent(t.vertexCount());
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&parent](int v) {
-    while (parent[v] != v) v = parent[v] = parent[parent[v]];
-    return v;
-  };
-  for (int e = 0; e < t.edgeCount(); ++e) {
-    const auto [a, b] = t.edgeVertices(e);
-    parent[find(a)] = find(b);
-  }
+  const std::vector<int> set = joinedVertices(*topology_, [](int) { return true; });
   int pieces = 0;
-  for (int v = 0; v < t.vertexCount(); ++v) pieces += find(v) == v;
+  for (int v = 0; v < vertexCount(); ++v) pieces += set[v] == v;
   return pieces;
 }
 

@@ -382,8 +382,9 @@ struct LimitSurface::Impl {
       structureTopologies.push_back(std::make_shared<const Topology>(n, std::move(neighbourhood.faces)));
       std::vector<int> vertices(n);
       for (int i = 0; i < n; ++i) vertices[i] = i;
-      structures.push_back(makeSpecial(
-          LocalMesh{structureTopologies.back(), Eigen::MatrixXd::Identity(n, n), local.face}, std::move(vertices), true));
+      structures.push_back(
+          makeSpecial(LocalMesh{structureTopologies.back(), Eigen::MatrixXd::Identity(n, n), local.face},
+                      std::move(vertices), true));
     }
     local.topology = structureTopologies[found->second];
     element.structure = found->second;

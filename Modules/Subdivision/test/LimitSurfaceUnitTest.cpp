@@ -400,7 +400,8 @@ TEST(LimitSurface, EqualNeighbourhoodsShareOneLocalTopology) {
   std::vector<std::vector<dynsub::Polygon>> neighbourhoods;
   for (int x = 0; x < topology.vertexCount(); ++x) {
     if (topology.isRegularVertex(x)) continue;
-    for (int f : topology.vertexFaces(x)) neighbourhoods.push_back(dynsub::detail::extractNeighbourhood(topology, x, f).faces);
+    for (int f : topology.vertexFaces(x))
+      neighbourhoods.push_back(dynsub::detail::extractNeighbourhood(topology, x, f).faces);
   }
   ASSERT_EQ(neighbourhoods.size(), 24u);
   for (const std::vector<dynsub::Polygon>& neighbourhood : neighbourhoods) {
