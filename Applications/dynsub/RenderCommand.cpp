@@ -66,13 +66,14 @@ void runRender(const RenderCommandOptions& o) {
     inputs.image = image.get();
   }
   if (!o.landmarks.empty()) inputs.landmarks = landmarkPositions(readLandmarks(o.landmarks));
-  if (!o.points.empty()) {
-    inputs.dataPoints = readPointCloud(o.points).points;
-    if (!inputs.dataPoints.allFinite()) throw Error(o.points, "a point is not a finite number");
-  }
+  const auto readDrawnPoints = [](const std::string& path) {
+    MatrixX3 points = readPointCloud(path).points;
+    if (!points.allFinite()) throw Error(path, "a point is not a finite number");
+    return points;
+  };
+  if (!o.points.empty()) inputs.dataPoints = readDrawnPoints(o.points);
   if (!o.outliers.empty()) {
-    inputs.outliers = readPointCloud(o.outliers).points;
-    if (!inputs.outliers.allFinite()) throw Error(o.outliers, "a point is not a finite number");
+    inputs.outliers = readDrawnPoints(o.outliers);
     if (!o.points.empty()) inputs.dataPoints = withoutPoints(inputs.dataPoints, inputs.outliers, o.outliers);
   }
   std::unique_ptr<ControlMesh> controlMesh;

@@ -16,6 +16,16 @@
 
 namespace dynsub {
 
+namespace {
+
+// "(i, j, k)" of the voxel at `offset`, for messages.
+std::string voxelText(const ImageGeometry& grid, long long offset) {
+  const std::array<int, 3> v = grid.voxelAt(offset);
+  return "(" + std::to_string(v[0]) + ", " + std::to_string(v[1]) + ", " + std::to_string(v[2]) + ")";
+}
+
+}  // namespace
+
 Volume readVolume(const std::string& path) {
   requireExisting(path);
   std::error_code ignored;
@@ -61,13 +71,9 @@ Volume readVolume(const std::string& path) {
   const auto bad =
       std::find_if(volume.voxels.begin(), volume.voxels.end(), [](float v) { return !std::isfinite(v); });
   if (bad != volume.voxels.end()) {
-    const long long first = bad - volume.voxels.begin(), count = std::count_if(bad, volume.voxels.end(), [](float v) {
-      return !std::isfinite(v);
-    });
-    const long long i = first % g.size[0], j = first / g.size[0] % g.size[1], k = first / g.size[0] / g.size[1];
-    throw Error(path, std::to_string(count) + " voxel(s) are NaN or infinite, the first at index (" +
-                          std::to_string(i) + ", " + std::to_string(j) + ", " + std::to_string(k) +
-                          "); intensities must be finite");
+    const long long count = std::count_if(bad, volume.voxels.end(), [](float v) { return !std::isfinite(v); });
+    throw Error(path, std::to_string(count) + " voxel(s) are NaN or infinite, the first at index " +
+                          voxelText(g, bad - volume.voxels.begin()) + "; intensities must be finite");
   }
   return volume;
 }
@@ -75,14 +81,10 @@ Volume readVolume(const std::string& path) {
 Volume readLabelMap(const std::string& path) {
   Volume labels = readVolume(path);
   const auto bad = std::find_if(labels.voxels.begin(), labels.voxels.end(), [](float v) { return v != std::round(v); });
-  if (bad != labels.voxels.end()) {
-    const ImageGeometry& g = labels.geometry;
-    const long long first = bad - labels.voxels.begin();
-    const long long i = first % g.size[0], j = first / g.size[0] % g.size[1], k = first / g.size[0] / g.size[1];
-    throw Error(path, "not a label map: voxel (" + std::to_string(i) + ", " + std::to_string(j) + ", " +
-                          std::to_string(k) + ") holds " + std::to_string(*bad) +
+  if (bad != labels.voxels.end())
+    throw Error(path, "not a label map: voxel " + voxelText(labels.geometry, bad - labels.voxels.begin()) + " holds " +
+                          std::to_string(*bad) +
                           ", and labels are whole numbers (was it resampled with interpolation?)");
-  }
   return labels;
 }
 

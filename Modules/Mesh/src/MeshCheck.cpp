@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "dynsub/Error.h"
+#include "dynsub/PolygonArea.h"
 #include "dynsub/Topology.h"
 
 namespace dynsub {
@@ -58,8 +59,7 @@ void checkPolygonMesh(const MatrixX3& points, const std::vector<std::vector<int>
       throw Error(source, "vertex " + std::to_string(v) + " has a coordinate that is NaN or infinite");
     }
   }
-  const double diagonal = (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm();
-  const double minimumArea = 1e-12 * diagonal * diagonal;
+  const double minimumArea = degenerateArea(points);
 
   std::vector<std::vector<int>> vertexFaces(vertexCount);
   // Every face's edges, each as it runs in that face.
@@ -91,14 +91,7 @@ void checkPolygonMesh(const MatrixX3& points, const std::vector<std::vector<int>
         }
       }
     }
-    // Newell's vector area: exact for planar polygons, robust for others.
-    Vector3 area = Vector3::Zero();
-    for (size_t k = 0; k < face.size(); ++k) {
-      const Vector3 a = points.row(face[k]).transpose();
-      const Vector3 b = points.row(face[(k + 1) % face.size()]).transpose();
-      area += a.cross(b);
-    }
-    if (0.5 * area.norm() <= minimumArea) {
+    if (0.5 * newellNormal(points, face).norm() <= minimumArea) {
       throw Error(source, faceName + " is degenerate: its area is zero");
     }
     for (size_t k = 0; k < face.size(); ++k) {

@@ -114,11 +114,8 @@ std::pair<std::array<int, 3>, std::array<int, 3>> structuresBox(const std::vecto
 // The distance (mm) from voxel `v`'s centre to the nearest of `points`;
 // infinity for none.
 double nearestPoint(const ImageGeometry& grid, std::size_t v, const MatrixX3& points) {
-  const auto i = static_cast<long long>(v);
-  const long long plane = static_cast<long long>(grid.size[0]) * grid.size[1];
-  const Vector3 index(static_cast<double>(i % grid.size[0]), static_cast<double>((i % plane) / grid.size[0]),
-                      static_cast<double>(i / plane));
-  const Vector3 centre = grid.toPhysical(index);
+  const std::array<int, 3> voxel = grid.voxelAt(static_cast<long long>(v));
+  const Vector3 centre = grid.toPhysical(Vector3(voxel[0], voxel[1], voxel[2]));
   double nearest = std::numeric_limits<double>::infinity();
   for (Eigen::Index p = 0; p < points.rows(); ++p)
     nearest = std::min(nearest, (points.row(p).transpose() - centre).norm());

@@ -134,9 +134,7 @@ Mask edgeMap(const Volume& magnitude, const std::vector<Vector3>& gradient, cons
   while (!stack.empty()) {
     const long long v = stack.back();
     stack.pop_back();
-    const int i = static_cast<int>(v % g.size[0]);
-    const int j = static_cast<int>((v / g.size[0]) % g.size[1]);
-    const int k = static_cast<int>(v / (static_cast<long long>(g.size[0]) * g.size[1]));
+    const auto [i, j, k] = g.voxelAt(v);
     for (int dk = -1; dk <= 1; ++dk)
       for (int dj = -1; dj <= 1; ++dj)
         for (int di = -1; di <= 1; ++di) {

@@ -5,6 +5,7 @@
 #include <set>
 
 #include "dynsub/Error.h"
+#include "dynsub/PolygonArea.h"
 
 namespace dynsub {
 
@@ -14,15 +15,6 @@ std::vector<int> sortedUnique(std::vector<int> v) {
   std::sort(v.begin(), v.end());
   v.erase(std::unique(v.begin(), v.end()), v.end());
   return v;
-}
-
-// Newell's normal of a loop: its length is twice the area of a planar loop;
-// it points the way the loop runs counter-clockwise around.
-Vector3 newellNormal(const MatrixX3& points, const std::vector<int>& loop) {
-  Vector3 normal = Vector3::Zero();
-  for (std::size_t i = 0; i < loop.size(); ++i)
-    normal += Vector3(points.row(loop[i]).transpose()).cross(points.row(loop[(i + 1) % loop.size()]).transpose());
-  return normal;
 }
 
 }  // namespace
@@ -39,9 +31,8 @@ Lattice Lattice::fromCells(MatrixX3 points, std::vector<std::vector<int>> faces,
   if (!points.allFinite()) throw Error(source, "a point has a non-finite coordinate");
   const int n = static_cast<int>(points.rows());
   // A face of no area has no normal to extrude along and makes a cell of no
-  // volume; relative to the lattice's size, as MeshCheck's test of faces.
-  const double diagonal = (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm();
-  const double minimumArea = 1e-12 * diagonal * diagonal;
+  // volume; judged as MeshCheck judges a control mesh's faces.
+  const double minimumArea = degenerateArea(points);
   Lattice l;
   l.points_ = std::move(points);
   l.faces_ = std::move(faces);

@@ -24,6 +24,12 @@ struct ImageGeometry {
   long long offset(int i, int j, int k) const {
     return i + static_cast<long long>(size[0]) * (j + static_cast<long long>(size[1]) * k);
   }
+  // The voxel (i, j, k) at a linear offset: offset()'s inverse.
+  std::array<int, 3> voxelAt(long long offset) const {
+    const long long plane = static_cast<long long>(size[0]) * size[1];
+    return {static_cast<int>(offset % size[0]), static_cast<int>(offset % plane / size[0]),
+            static_cast<int>(offset / plane)};
+  }
   bool contains(int i, int j, int k) const {
     return i >= 0 && j >= 0 && k >= 0 && i < size[0] && j < size[1] && k < size[2];
   }
