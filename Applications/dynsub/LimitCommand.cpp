@@ -19,6 +19,7 @@ struct LimitOptions {
 };
 
 void runLimit(const LimitOptions& options) {
+  requireTriangleSurfaceTarget(options.out);
   const ControlMesh mesh = readControlMesh(options.mesh);
   const LimitSurface surface(mesh);
   const TriangleSurface triangles = tessellate(surface, mesh.points(), options.samplesPerFace);

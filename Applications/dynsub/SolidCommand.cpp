@@ -156,6 +156,7 @@ void addSolidCommand(CLI::App& app) {
   subdivide->add_option("--level", o->level, "Subdivisions")->default_val(1)->check(CLI::Range(0, 6));
   subdivide->add_option("--out", o->out, "Output file (.lattice or .vtu)")->required();
   subdivide->callback([o] {
+    requireLatticeTarget(o->out);
     const Lattice lattice = subdivideSolid(readLattice(o->lattice), o->level).lattice;
     writeLattice(lattice, o->out);
     std::cout << "wrote " << o->out << ": " << lattice.pointCount() << " points, " << lattice.cellCount()

@@ -32,6 +32,11 @@ expect_error "unparsable number" 1 "nan.obj" "$work/c.vtp" "$DYNSUB" limit "$wor
 expect_error "empty mesh" 1 "no vertices" "$work/d.vtp" "$DYNSUB" limit "$work/empty.obj" --out "$work/d.vtp"
 expect_error "unknown output format" 1 "unknown surface format" "$work/e.xyz" \
   "$DYNSUB" limit "$DATA/Meshes/cube.obj" --out "$work/e.xyz"
+# The output's name is checked before the mesh is read and its limit evaluated.
+expect_error "unknown output format, before the work" 1 "unknown surface format" "$work/e.xyz" \
+  "$DYNSUB" limit "$work/none.obj" --out "$work/e.xyz"
+expect_error "a missing output directory, before the work" 1 "does not exist" "$work/no/f.vtp" \
+  "$DYNSUB" limit "$work/none.obj" --out "$work/no/f.vtp"
 expect_error "missing output directory" 1 "does not exist" "$work/no/f.vtp" \
   "$DYNSUB" limit "$DATA/Meshes/cube.obj" --out "$work/no/f.vtp"
 expect_error "impossible sample count" 2 "samples-per-face" "$work/g.vtp" \
@@ -542,8 +547,11 @@ check "solid subdivide writes .vtu" grep -q "UnstructuredGrid" "$work/cube4.vtu"
 "$DYNSUB" solid make cube3 --out "$work/cube3.lattice" >/dev/null
 check "solid make cube3 equals Data/Solids/cube3.lattice" cmp -s "$work/cube3.lattice" "$DATA/Solids/cube3.lattice"
 sed 's/^6 0 1 2 3 4 5$/5 0 1 2 3 4/' "$DATA/Solids/cube3.lattice" >"$work/open.lattice"
-expect_error "solid: a cell that is not closed" 1 "cell 0 is not closed" "$work/o20" \
-  "$DYNSUB" solid subdivide "$work/open.lattice" --out "$work/o20"
+expect_error "solid: a cell that is not closed" 1 "cell 0 is not closed" "$work/o20.lattice" \
+  "$DYNSUB" solid subdivide "$work/open.lattice" --out "$work/o20.lattice"
+# The output's name is checked before the lattice is read and subdivided.
+expect_error "solid: an unknown output format, before the work" 1 "unknown lattice format" "$work/o20" \
+  "$DYNSUB" solid subdivide "$work/none.lattice" --out "$work/o20"
 sed 's/^4 0 3 4 1$/4 0 3 4 99/' "$DATA/Solids/cube3.lattice" >"$work/range.lattice"
 expect_error "solid: a point index out of range" 1 "uses point 99" "$work/o21.vtu" \
   "$DYNSUB" solid subdivide "$work/range.lattice" --out "$work/o21.vtu"

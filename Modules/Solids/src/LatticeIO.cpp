@@ -169,10 +169,16 @@ void writeVtu(const Lattice& l, const std::string& path, const std::string& name
 
 }  // namespace
 
-void writeLattice(const Lattice& lattice, const std::string& path) {
+void requireLatticeTarget(const std::string& path) {
   const std::string extension = lowerCaseExtension(path);
   if (extension != ".lattice" && extension != ".vtu")
     throw Error(path, "unknown lattice format '" + extension + "' (expected .lattice or .vtu)");
+  requireWritableDirectoryFor(path);
+}
+
+void writeLattice(const Lattice& lattice, const std::string& path) {
+  requireLatticeTarget(path);
+  const std::string extension = lowerCaseExtension(path);
   AtomicOutput output(path);
   if (extension == ".lattice") {
     writeText(lattice, output.temporaryPath());

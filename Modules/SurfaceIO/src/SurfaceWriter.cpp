@@ -162,13 +162,19 @@ std::string legacyVtkBytes(const TriangleSurface& surface, const std::vector<Poi
 
 std::vector<std::string> triangleSurfaceExtensions() { return {".vtp", ".vtk", ".obj", ".ply", ".stl"}; }
 
-void writeTriangleSurface(const TriangleSurface& surface, const std::string& path,
-                          const std::vector<PointScalars>& scalars, const std::string& space) {
+void requireTriangleSurfaceTarget(const std::string& path) {
   const std::string extension = lowerCaseExtension(path);
   const std::vector<std::string> known = triangleSurfaceExtensions();
   if (std::find(known.begin(), known.end(), extension) == known.end()) {
     throw Error(path, "unknown surface format '" + extension + "' (expected .vtp, .vtk, .obj, .ply or .stl)");
   }
+  requireWritableDirectoryFor(path);
+}
+
+void writeTriangleSurface(const TriangleSurface& surface, const std::string& path,
+                          const std::vector<PointScalars>& scalars, const std::string& space) {
+  requireTriangleSurfaceTarget(path);
+  const std::string extension = lowerCaseExtension(path);
   if (!surface.points.allFinite()) throw Error(path, "the surface has non-finite coordinates; nothing written");
   for (const PointScalars& s : scalars) {
     if (s.values.size() != surface.points.rows() || !s.values.allFinite())

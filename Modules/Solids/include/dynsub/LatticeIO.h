@@ -24,4 +24,9 @@ Lattice readLattice(const std::string& path);
 // By extension: .lattice or .vtu. The file appears complete or not at all.
 void writeLattice(const Lattice& lattice, const std::string& path);
 
+// Throws dynsub::Error naming `path` when writeLattice could not write it: an
+// extension other than .lattice or .vtu, or a directory that is missing,
+// read-only or a file. Commands call it before their work.
+void requireLatticeTarget(const std::string& path);
+
 }  // namespace dynsub

@@ -45,6 +45,12 @@ void writeTriangleSurface(const TriangleSurface& surface, const std::string& pat
 // The extensions writeTriangleSurface accepts, with the dot (".vtp", ...).
 std::vector<std::string> triangleSurfaceExtensions();
 
+// Throws dynsub::Error naming `path` when writeTriangleSurface could not
+// write it: an unknown extension, or a directory that is missing, read-only
+// or a file. Commands call it before their work, so that a long evaluation
+// does not end in a refusal of its output's name.
+void requireTriangleSurfaceTarget(const std::string& path);
+
 // Writes `points` as .xyz text (PointCloudIO.h reads it), one "x y z" line
 // per point, with the digits that read back as the same doubles: points a
 // program set aside can be matched exactly against the file they came from.
