@@ -991,19 +991,23 @@ struct SurfaceState::Impl {
   MatrixX3 grids;  // patchOperator * controlPoints
   // Per special element: the grid points of each subpatch a point has needed
   // at this state (slot 3 (level - 1) + child - 1; slot kSlots: the vertex
-  // masks and the structure's vertices), each filled once under `mutex`. grids is sized once, on the
-  // first fill, and never moved: a reader that sees ready[slot] set may read
-  // that slot without the lock.
+  // masks and the structure's vertices), each filled once under `mutex`. A
+  // slot's grid is allocated when first filled and not moved until the
+  // next reset(): a reader that sees ready[slot] set may read it without
+  // the lock.
   // One subpatch at a time, not whole levels: where most elements are
   // special and hold few points, filling all three children costs more than
-  // it saves.
+  // it saves. And only the slots used are allocated: a tessellation touches
+  // a few of an element's 36, and all 36 for each of a dense triangle mesh's
+  // 448,128 special elements were 6 GB.
   static constexpr int kSlots = 3 * kCachedLevels;
+  using Grid = Eigen::Matrix<double, 16, 3>;
   struct Cache {
     std::array<std::atomic<bool>, kSlots + 1> ready{};
     std::mutex mutex;
-    Eigen::Matrix<double, 3, 3> masks;                // limit position and tangents at the vertex
-    Eigen::Matrix<double, Eigen::Dynamic, 3> local;   // the structure's vertices (structureMap's blends)
-    std::vector<Eigen::Matrix<double, 16, 3>> grids;  // [slot]
+    Eigen::Matrix<double, 3, 3> masks;               // limit position and tangents at the vertex
+    Eigen::Matrix<double, Eigen::Dynamic, 3> local;  // the structure's vertices (structureMap's blends)
+    std::array<std::unique_ptr<Grid>, kSlots> grids;
   };
   std::unique_ptr<Cache[]> caches;
 };
@@ -1049,7 +1053,6 @@ LimitSample SurfaceState::evaluate(const ElementPoint& point) const {
   const int slot = 3 * (at.level - 1) + at.child - 1;
   if (!cache.ready[slot].load(std::memory_order_acquire) || !cache.ready[Impl::kSlots].load(std::memory_order_acquire)) {
     const std::lock_guard<std::mutex> lock(cache.mutex);
-    if (cache.grids.empty()) cache.grids.resize(Impl::kSlots);
     if (!cache.ready[Impl::kSlots].load(std::memory_order_relaxed)) {
       LimitSurface::Impl::blend(special.vertexMasks, special.columns, p, cache.masks);
       cache.local.resize(element.structureMap.rows(), 3);
@@ -1057,11 +1060,12 @@ LimitSample SurfaceState::evaluate(const ElementPoint& point) const {
       cache.ready[Impl::kSlots].store(true, std::memory_order_release);
     }
     if (!cache.ready[slot].load(std::memory_order_relaxed)) {
-      cache.grids[slot].noalias() = s.level(*s.structures[element.structure], at.level)[at.child - 1] * cache.local;
+      if (!cache.grids[slot]) cache.grids[slot] = std::make_unique<Impl::Grid>();
+      cache.grids[slot]->noalias() = s.level(*s.structures[element.structure], at.level)[at.child - 1] * cache.local;
       cache.ready[slot].store(true, std::memory_order_release);
     }
   }
-  Eigen::Matrix<double, 6, 3> result = detail::bsplineWeights(at.u, at.v) * cache.grids[slot];
+  Eigen::Matrix<double, 6, 3> result = detail::bsplineWeights(at.u, at.v) * *cache.grids[slot];
   result.row(0) += cache.masks.row(0);
   applyChainRule(result, at.jacobian);
   return limitSampleOf(result);
