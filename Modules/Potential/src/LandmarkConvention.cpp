@@ -14,16 +14,13 @@
 namespace dynsub {
 namespace {
 
-// The edges at one reading of the points, from the gradient of the points'
-// box alone: a reading's box is a few percent of the head, and the
-// smoothing needs only a few sigma around it to be exact in it.
+// The edges at one reading of the points. Each point's strongest edge is
+// looked for within `reach` of it, so the smoothed gradient is computed on
+// that small box alone (smoothedGradientIn): the points' whole box, smoothed
+// for each of the three readings, was a tenth of the caudate demo's command.
 ReadingEdges edgesAt(const Volume& image, const MatrixX3& points, double sigma, double reach) {
   for (Eigen::Index p = 0; p < points.rows(); ++p)
     if (!image.geometry.covers(points.row(p).transpose())) return {};
-  const auto [first, size] = boundingRegion(image.geometry, points, reach + 4 * sigma);
-  const Volume box = cropVolume(image, first, size);
-  const std::vector<Vector3> gradient = smoothedGradient(box, sigma);
-  const Volume magnitude = magnitudeOf(box.geometry, gradient);
   // The outward normal of the points' PCA ellipsoid at each point, C^-1 (p - c):
   // where a boundary click's edge should face.
   const Eigen::RowVector3d centre = points.colwise().mean();
@@ -31,10 +28,17 @@ ReadingEdges edgesAt(const Volume& image, const MatrixX3& points, double sigma, 
   const Matrix3 covariance = centred.transpose() * centred / static_cast<double>(points.rows()) +
                              1e-6 * Matrix3::Identity();
   const Eigen::LDLT<Matrix3> inverse(covariance);
+  // A voxel more than the reach: the box holds every voxel
+  // strongestVoxelNear weighs, half a voxel beyond the reach on thick axes.
+  const double margin = reach + image.geometry.spacing.maxCoeff();
   std::vector<double> strengths;
   double alignment = 0;
   for (Eigen::Index p = 0; p < points.rows(); ++p) {
-    const StrongestVoxel strongest = strongestVoxelNear(magnitude, points.row(p).transpose(), reach);
+    const Vector3 point = points.row(p).transpose();
+    const auto [first, size] = boundingRegion(image.geometry, points.row(p), margin);
+    const std::vector<Vector3> gradient = smoothedGradientIn(image, sigma, first, size);
+    const Volume magnitude = magnitudeOf(image.geometry.region(first, size), gradient);
+    const StrongestVoxel strongest = strongestVoxelNear(magnitude, point, reach);
     strengths.push_back(strongest.magnitude);
     const Vector3 normal = inverse.solve(Vector3(centred.row(p).transpose()));
     if (strongest.offset >= 0 && strongest.magnitude > 0 && normal.norm() > 0)

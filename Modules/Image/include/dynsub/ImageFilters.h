@@ -14,6 +14,16 @@ namespace dynsub {
 // voxels' order.
 std::vector<Vector3> smoothedGradient(const Volume& image, double sigma);
 
+// The same gradient on the index box [first, first + size) of `image` alone
+// (the box inside the image), in the box's voxel order: separable sampled
+// Gaussians to 4 sigma, from the image's voxels within 4 sigma of the box
+// (repeated beyond the image's faces, as the recursive filters' boundary
+// does). Its cost is the box's and not the image's: for the gradient near a
+// few points. It agrees with smoothedGradient to within 1.5 % of the
+// gradient's largest magnitude (ImageFilters' unit test, on Colin27).
+std::vector<Vector3> smoothedGradientIn(const Volume& image, double sigma, const std::array<int, 3>& first,
+                                        const std::array<int, 3>& size);
+
 // The image smoothed by a Gaussian of sigma mm (Deriche's recursive filters).
 Volume gaussianSmoothed(const Volume& image, double sigma);
 

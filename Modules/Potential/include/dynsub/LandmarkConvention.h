@@ -46,7 +46,7 @@ ConventionScores conventionScores(const Volume& image, const MatrixX3& points, d
 // three (flat tissue has a gradient near zero, and the ratio of two near-zero
 // gradients says nothing). A misreading is named at kMisreadingEvidence or
 // more. The largest evidence a correct click set gave was 1.72 on the
-// generated tuning subjects and 1.74 on Colin27 (Segmentation.md, "Points
+// generated tuning subjects and 1.71 on Colin27 (Segmentation.md, "Points
 // read in the wrong convention"): refusing correct points costs a user more
 // than the misread ones this bar lets through. Strength alone does not
 // separate them: a putamen's or a thalamus's faint boundary can be a third as
