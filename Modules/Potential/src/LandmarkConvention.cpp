@@ -16,8 +16,8 @@ namespace {
 
 // The edges at one reading of the points. Each point's strongest edge is
 // looked for within `reach` of it, so the smoothed gradient is computed on
-// that small box alone (smoothedGradientIn): the points' whole box, smoothed
-// for each of the three readings, was a tenth of the caudate demo's command.
+// that small box alone (smoothedGradientIn): a few dozen voxels a point,
+// where the points' whole box holds tens of thousands for each reading.
 ReadingEdges edgesAt(const Volume& image, const MatrixX3& points, double sigma, double reach) {
   for (Eigen::Index p = 0; p < points.rows(); ++p)
     if (!image.geometry.covers(points.row(p).transpose())) return {};

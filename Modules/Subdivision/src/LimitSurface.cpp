@@ -998,8 +998,8 @@ struct SurfaceState::Impl {
   // One subpatch at a time, not whole levels: where most elements are
   // special and hold few points, filling all three children costs more than
   // it saves. And only the slots used are allocated: a tessellation touches
-  // a few of an element's 36, and all 36 for each of a dense triangle mesh's
-  // 448,128 special elements were 6 GB.
+  // a few of an element's 36, and a scan's triangle mesh has a special
+  // element on every face (448,128 for 75,408 triangles: 6 GB at 36 each).
   static constexpr int kSlots = 3 * kCachedLevels;
   using Grid = Eigen::Matrix<double, 16, 3>;
   struct Cache {
