@@ -992,9 +992,9 @@ struct SurfaceState::Impl {
   // Per special element: the grid points of each subpatch a point has needed
   // at this state (slot 3 (level - 1) + child - 1; slot kSlots: the vertex
   // masks and the structure's vertices), each filled once under `mutex`. A
-  // slot's grid is allocated when first filled and not moved until the
-  // next reset(): a reader that sees ready[slot] set may read it without
-  // the lock.
+  // slot's grid is allocated the first time it is filled and kept, never
+  // moved (reset() only marks it to be filled again): a reader that sees
+  // ready[slot] set may read it without the lock.
   // One subpatch at a time, not whole levels: where most elements are
   // special and hold few points, filling all three children costs more than
   // it saves. And only the slots used are allocated: a tessellation touches

@@ -20,7 +20,7 @@ std::vector<Vector3> smoothedGradient(const Volume& image, double sigma);
 // (repeated beyond the image's faces, as the recursive filters' boundary
 // does). Its cost is the box's and not the image's: for the gradient near a
 // few points. It agrees with smoothedGradient to within 1.5 % of the
-// gradient's largest magnitude (ImageFilters' unit test, on Colin27).
+// gradient's largest magnitude (SmoothedGradientUnitTest, on Colin27).
 std::vector<Vector3> smoothedGradientIn(const Volume& image, double sigma, const std::array<int, 3>& first,
                                         const std::array<int, 3>& size);
 
