@@ -9,7 +9,6 @@
 #include <vtkFieldData.h>
 #include <vtkIntArray.h>
 #include <vtkNew.h>
-#include <vtkOBJReader.h>
 #include <vtkPLYReader.h>
 #include <vtkPolyDataReader.h>
 #include <vtkSTLReader.h>
@@ -22,6 +21,7 @@
 
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
+#include "dynsub/MeshIO.h"
 #include "dynsub/VtkErrors.h"
 
 namespace dynsub {
@@ -83,6 +83,29 @@ void addFarDistance(vtkPolyData* polyData, const std::string& name, double far) 
 
 namespace {
 
+// The polygons of an OBJ file read by DynSub's own reader.
+vtkSmartPointer<vtkPolyData> toPolyData(const PolygonData& data, const std::string& path) {
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(data.points.rows());
+  for (Eigen::Index i = 0; i < data.points.rows(); ++i)
+    points->SetPoint(i, data.points(i, 0), data.points(i, 1), data.points(i, 2));
+  vtkNew<vtkCellArray> polygons;
+  for (size_t f = 0; f < data.faces.size(); ++f) {
+    polygons->InsertNextCell(static_cast<vtkIdType>(data.faces[f].size()));
+    for (const int corner : data.faces[f]) {
+      if (corner >= data.points.rows())
+        throw Error(path, "face " + std::to_string(f + 1) + " uses vertex " + std::to_string(corner + 1) +
+                              ", but the file has " + std::to_string(data.points.rows()) + " vertices");
+      polygons->InsertCellPoint(corner);
+    }
+  }
+  auto polyData = vtkSmartPointer<vtkPolyData>::New();
+  polyData->SetPoints(points);
+  polyData->SetPolys(polygons);
+  return polyData;
+}
+
 // `reader`'s file name is set.
 vtkSmartPointer<vtkPolyData> readWith(vtkAlgorithm* reader, const std::string& path) {
   VtkErrors errors;
@@ -112,9 +135,12 @@ vtkSmartPointer<vtkPolyData> readSurfacePolyData(const std::string& path) {
     vtkNew<vtkPolyDataReader> reader;
     reader->SetFileName(path.c_str());
     polyData = readWith(reader.GetPointer(), path);
-  } else if (extension == ".obj" || extension == ".ply" || extension == ".stl") {
+  } else if (extension == ".obj") {
+    // DynSub's own OBJ reader: VTK's reads "v nan 1 0" as the origin without
+    // a word, where this one names the line.
+    polyData = toPolyData(readPolygonData(path), path);
+  } else if (extension == ".ply" || extension == ".stl") {
     vtkSmartPointer<vtkAbstractPolyDataReader> reader;
-    if (extension == ".obj") reader = vtkSmartPointer<vtkOBJReader>::New();
     if (extension == ".ply") reader = vtkSmartPointer<vtkPLYReader>::New();
     if (extension == ".stl") reader = vtkSmartPointer<vtkSTLReader>::New();
     reader->SetFileName(path.c_str());

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <csignal>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -203,6 +204,48 @@ TEST(SurfaceWriter, ObjPlyStlReadBack) {
   stlReader->SetFileName(stl.c_str());
   stlReader->Update();
   expectTriangles(stlReader->GetOutput(), "STL");
+}
+
+// readSurfacePolyData reads OBJ with DynSub's own reader: the written
+// surface comes back with its exact doubles, and a vertex VTK's OBJ reader
+// would take as the origin ("v nan 1 0") is refused with its line.
+TEST(SurfacePolyData, ReadsObjExactlyAndRefusesBadRecords) {
+  const dynsub::TriangleSurface surface = cubeSurface();
+  const std::string obj = scratch("exact.obj");
+  dynsub::writeTriangleSurface(surface, obj);
+  const vtkSmartPointer<vtkPolyData> read = dynsub::readSurfacePolyData(obj);
+  ASSERT_EQ(read->GetNumberOfPoints(), surface.points.rows());
+  ASSERT_EQ(read->GetNumberOfPolys(), static_cast<vtkIdType>(surface.triangles.size()));
+  for (vtkIdType i = 0; i < read->GetNumberOfPoints(); ++i) {
+    double p[3];
+    read->GetPoint(i, p);
+    for (int a = 0; a < 3; ++a) ASSERT_EQ(p[a], surface.points(i, a)) << "point " << i;
+  }
+  vtkNew<vtkIdList> ids;
+  read->GetCellPoints(7, ids);
+  ASSERT_EQ(ids->GetNumberOfIds(), 3);
+  for (int k = 0; k < 3; ++k) EXPECT_EQ(ids->GetId(k), surface.triangles[7][k]);
+
+  const std::string tetrahedron = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  auto refused = [&](const std::string& name, const std::string& text) {
+    const std::string path = scratch(name);
+    { std::ofstream(path) << text; }
+    try {
+      dynsub::readSurfacePolyData(path);
+    } catch (const dynsub::Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(read without an error)");
+  };
+  std::string withNan = tetrahedron;
+  withNan.replace(withNan.find("v 0 1 0"), 7, "v nan 1 0");
+  EXPECT_NE(refused("nan.obj", withNan).find("nan.obj: point 2 has a non-finite coordinate"), std::string::npos)
+      << refused("nan.obj", withNan);
+  std::string withText = tetrahedron;
+  withText.replace(withText.find("v 0 1 0"), 7, "v 0x 1 0");
+  EXPECT_NE(refused("text.obj", withText).find("line 3: '0x' is not a number"), std::string::npos);
+  EXPECT_NE(refused("range.obj", tetrahedron + "f 1 2 9\n").find("face 5 uses vertex 9, but the file has 4 vertices"),
+            std::string::npos);
 }
 
 TEST(SurfaceWriter, BadTargetsLeaveNoFile) {

@@ -24,7 +24,8 @@ std::string farName(const std::string& scalars);
 // Adds `far` as the one-value field array farName(name).
 void addFarDistance(vtkPolyData* polyData, const std::string& name, double far);
 
-// Reads a triangle surface (.vtp, .vtk, .obj, .ply or .stl, by extension). Throws
+// Reads a triangle surface (.vtp, .vtk, .obj, .ply or .stl, by extension; .obj
+// through DynSub's own reader, MeshIO.h, which names a bad record's line). Throws
 // dynsub::Error naming the file when it is missing, unreadable, has no
 // triangles, or has non-finite coordinates.
 vtkSmartPointer<vtkPolyData> readSurfacePolyData(const std::string& path);
