@@ -468,6 +468,7 @@ void run(Arguments& a) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  dynsub::removeTemporariesOnInterrupt();
   Arguments arguments;
   const slicer::Module module = describe(arguments);
   // Slicer reads the descriptor from stdout, which must start with "<?xml".

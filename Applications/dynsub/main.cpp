@@ -11,6 +11,7 @@
 #include "dynsub/Error.h"
 
 int main(int argc, char** argv) {
+  dynsub::removeTemporariesOnInterrupt();
   CLI::App app{
       "DynSub: dynamic Catmull-Clark subdivision surfaces for segmenting 3D medical images and "
       "recovering shapes.\n"

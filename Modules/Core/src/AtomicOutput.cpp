@@ -6,11 +6,15 @@
 
 #include <algorithm>
 #include <cctype>
+#include <csignal>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <mutex>
 #include <string>
 #include <system_error>
+#include <thread>
+#include <vector>
 
 #include "dynsub/Error.h"
 
@@ -22,7 +26,66 @@ namespace {
 
 std::string temporaryPrefix(long pid) { return ".tmp-" + std::to_string(pid) + "-"; }
 
+// The temporaries in progress. Never destroyed: the interrupt's thread may
+// use it while the process exits.
+struct Temporaries {
+  std::mutex mutex;
+  std::vector<std::string> paths;
+};
+
+Temporaries& temporaries() {
+  static Temporaries* const all = new Temporaries;
+  return *all;
+}
+
+sigset_t interruptSignals() {
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGHUP);
+  return signals;
+}
+
 }  // namespace
+
+void trackTemporary(const std::string& path) {
+  Temporaries& all = temporaries();
+  const std::lock_guard<std::mutex> lock(all.mutex);
+  all.paths.push_back(path);
+}
+
+void untrackTemporary(const std::string& path) {
+  Temporaries& all = temporaries();
+  const std::lock_guard<std::mutex> lock(all.mutex);
+  const auto last = std::find(all.paths.rbegin(), all.paths.rend(), path);
+  if (last != all.paths.rend()) all.paths.erase(std::next(last).base());
+}
+
+void removeTemporariesOnInterrupt() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    const sigset_t signals = interruptSignals();
+    pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+    std::thread([signals] {
+      int signal = 0;
+      while (sigwait(&signals, &signal) != 0) {
+      }
+      Temporaries& all = temporaries();
+      // Held to the end: an output begun after this is not begun at all.
+      all.mutex.lock();
+      std::error_code ignored;
+      for (auto path = all.paths.rbegin(); path != all.paths.rend(); ++path) fs::remove_all(*path, ignored);
+      // End as the signal would have ended the process without this.
+      std::signal(signal, SIG_DFL);
+      sigset_t only;
+      sigemptyset(&only);
+      sigaddset(&only, signal);
+      pthread_sigmask(SIG_UNBLOCK, &only, nullptr);
+      raise(signal);
+    }).detach();
+  });
+}
 
 std::string temporaryName(const std::string& name) { return temporaryPrefix(::getpid()) + name; }
 
@@ -61,13 +124,16 @@ AtomicOutput::AtomicOutput(std::string target) : target_(std::move(target)) {
   // The process id keeps two concurrent runs from sharing a temporary file; the
   // name ends with the target's file name, so writers still see its extension.
   temporary_ = (path.parent_path() / (prefix + name)).string();
+  trackTemporary(temporary_);
 }
 
 AtomicOutput::~AtomicOutput() {
-  if (!committed_ && temporary_ != target_) {
+  if (temporary_ == target_) return;
+  if (!committed_) {
     std::error_code ignored;
     fs::remove(temporary_, ignored);
   }
+  untrackTemporary(temporary_);
 }
 
 void AtomicOutput::commit() {

@@ -49,6 +49,7 @@ OutputSet::OutputSet(std::filesystem::path dir) : dir_(std::move(dir)) {
   std::filesystem::remove_all(staging_, error);
   if (!std::filesystem::create_directory(staging_, error))
     throw Error(dir_.string(), "cannot be created: " + (error ? error.message() : staging_.string() + " exists"));
+  trackTemporary(staging_.string());
 }
 
 // Two runs writing to one directory at once take turns: each holds a lock on
@@ -70,6 +71,7 @@ OutputSet::~OutputSet() {
     std::error_code ignored;
     std::filesystem::remove_all(staging_, ignored);
   }
+  if (!staging_.empty()) untrackTemporary(staging_.string());
   if (lock_ >= 0) ::close(lock_);  // releases the lock
 }
 

@@ -75,6 +75,11 @@ bool launchPrivateXServer(LaunchedServer& server, std::string* why) {
   const pid_t parent = getpid();
   const pid_t pid = fork();
   if (pid == 0) {  // only async-signal-safe calls until exec
+    // Signals this process blocks (AtomicOutput.h's interrupt) are not
+    // blocked in Xvfb: the SIGTERM below must end it.
+    sigset_t none;
+    sigemptyset(&none);
+    sigprocmask(SIG_SETMASK, &none, nullptr);
     prctl(PR_SET_PDEATHSIG, SIGTERM);
     if (getppid() != parent) _exit(1);
     close(fds[0]);

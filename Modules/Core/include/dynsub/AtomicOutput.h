@@ -4,10 +4,12 @@
 // target by commit(). If commit() is never called (an exception, a failed
 // check), the destructor removes the temporary file and the target is untouched.
 //
-// The temporary file is ".tmp-<pid>-<name>". A run killed by a signal that
-// cannot be caught (SIGKILL, a scheduler's hard limit) leaves its temporary
-// files behind; the next output of the same name removes those whose process
-// is gone (the sweep), so a rerun of the job cleans up after the killed one.
+// The temporary file is ".tmp-<pid>-<name>". A program that called
+// removeTemporariesOnInterrupt() removes its temporaries when interrupted
+// (Ctrl-C, SIGTERM, SIGHUP). A run killed by a signal that cannot be caught
+// (SIGKILL, a scheduler's hard limit) leaves them behind; the next output of
+// the same name removes those whose process is gone (the sweep), so a rerun
+// of the job cleans up after the killed one.
 // A target that is already this process's temporary file (a writer given the
 // path of an enclosing output) is written in place: the enclosing output
 // removes it or makes it appear.
@@ -38,6 +40,21 @@ class AtomicOutput {
   std::string temporary_;
   bool committed_ = false;
 };
+
+// Makes SIGINT, SIGTERM and SIGHUP remove this process's outputs in progress
+// (AtomicOutput's temporary files, OutputSet's folders) before the process
+// ends by the signal as it would have without this. Call it first in main,
+// before any thread starts: the signals are blocked in every thread and
+// taken by one thread of their own, which may do what a signal handler may
+// not (remove a folder). A child process inherits the blocked signals: a
+// program that starts one unblocks them in it (Figures.cpp, FigureDisplay.cpp).
+void removeTemporariesOnInterrupt();
+
+// Temporaries that an interrupt removes (removeTemporariesOnInterrupt): a
+// file or folder from when it is made to when it is moved into place or
+// removed. AtomicOutput and OutputSet keep theirs here.
+void trackTemporary(const std::string& path);
+void untrackTemporary(const std::string& path);
 
 // This process's temporary name for `name`: ".tmp-<pid>-<name>".
 std::string temporaryName(const std::string& name);
