@@ -1,6 +1,9 @@
 #include "dynsub/Lattice.h"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
 #include <map>
 #include <set>
 
@@ -15,6 +18,53 @@ std::vector<int> sortedUnique(std::vector<int> v) {
   std::sort(v.begin(), v.end());
   v.erase(std::unique(v.begin(), v.end()), v.end());
   return v;
+}
+
+// The volume the closed shell `shell` of faces encloses, by the divergence
+// theorem with its faces oriented alike: each edge run once each way, which
+// the first face's orientation fixes up to sign. NaN when no such orientation
+// exists (a shell like a Klein bottle's).
+double enclosedVolume(const MatrixX3& points, const std::vector<std::vector<int>>& faces,
+                      const std::vector<std::vector<int>>& faceEdges, const std::vector<int>& shell) {
+  // Each run of an edge by one of the shell's faces: the edge, the face (its
+  // place in the shell), and whether it runs from the lower-numbered point.
+  // The shell is closed, so sorted by edge they come in pairs.
+  std::vector<std::array<int, 3>> runs;
+  for (std::size_t k = 0; k < shell.size(); ++k) {
+    const std::vector<int>& loop = faces[shell[k]];
+    for (std::size_t i = 0; i < loop.size(); ++i)
+      runs.push_back({faceEdges[shell[k]][i], static_cast<int>(k), loop[i] < loop[(i + 1) % loop.size()] ? 1 : 0});
+  }
+  std::sort(runs.begin(), runs.end());
+  std::vector<int> sign(shell.size(), 0);
+  sign[0] = 1;
+  // Faces alike run their shared edge opposite ways. A few passes reach every
+  // face of a cell.
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (std::size_t r = 0; r + 1 < runs.size(); r += 2) {
+      const int a = runs[r][1], b = runs[r + 1][1];
+      const int relation = runs[r][2] != runs[r + 1][2] ? 1 : -1;  // sign[b] = relation * sign[a]
+      if (sign[a] != 0 && sign[b] != 0) {
+        if (sign[b] != relation * sign[a]) return std::numeric_limits<double>::quiet_NaN();
+      } else if (sign[a] != 0 || sign[b] != 0) {
+        if (sign[a] == 0)
+          sign[a] = relation * sign[b];
+        else
+          sign[b] = relation * sign[a];
+        changed = true;
+      }
+    }
+  }
+  double sixTimes = 0;
+  for (std::size_t k = 0; k < shell.size(); ++k) {
+    const std::vector<int>& loop = faces[shell[k]];
+    const Vector3 first = points.row(loop[0]).transpose();
+    for (std::size_t i = 1; i + 1 < loop.size(); ++i)
+      sixTimes += sign[k] * first.dot(Vector3(points.row(loop[i]).transpose())
+                                          .cross(Vector3(points.row(loop[i + 1]).transpose())));
+  }
+  return std::abs(sixTimes) / 6;
 }
 
 }  // namespace
@@ -33,6 +83,9 @@ Lattice Lattice::fromCells(MatrixX3 points, std::vector<std::vector<int>> faces,
   // A face of no area has no normal to extrude along and makes a cell of no
   // volume; judged as MeshCheck judges a control mesh's faces.
   const double minimumArea = degenerateArea(points);
+  // A cell of no volume (its faces folded into one plane) is refused alike,
+  // at the same relative scale.
+  const double minimumVolume = std::pow(minimumArea, 1.5);
   Lattice l;
   l.points_ = std::move(points);
   l.faces_ = std::move(faces);
@@ -83,6 +136,10 @@ Lattice Lattice::fromCells(MatrixX3 points, std::vector<std::vector<int>> faces,
                                 " of its faces (expected 2)");
       l.cellEdges_[c].push_back(e);
     }
+    const double volume = enclosedVolume(l.points_, l.faces_, l.faceEdges_, shell);
+    if (std::isnan(volume))
+      throw Error(source, name + "'s faces cannot be oriented alike: it has no inside and no outside");
+    if (!(volume > minimumVolume)) throw Error(source, name + " is flat: it encloses no volume");
     l.cellPoints_[c] = sortedUnique(l.cellPoints_[c]);
   }
   for (int f = 0; f < faceCount; ++f) {

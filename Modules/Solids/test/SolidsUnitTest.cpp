@@ -288,5 +288,36 @@ TEST_F(LatticeFiles, InvalidLatticesAreNamed) {
   EXPECT_NE(message(file("line.lattice", line)).find("face 0 is degenerate"), std::string::npos);
 }
 
+// A cell must enclose a volume, though each of its faces has an area: a
+// hexahedron whose top is its bottom moved sideways within their plane is
+// refused, and so is a closed shell with no inside (the real projective
+// plane's six-point triangulation). The upright cube is a unit of volume.
+TEST(Lattice, RefusesCellsWithNoVolume) {
+  const std::vector<std::vector<int>> hexahedron = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                                    {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  MatrixX3 points = regularLattice(1, 1, 1).points();
+  EXPECT_NO_THROW(Lattice::fromCells(points, hexahedron, {{0, 1, 2, 3, 4, 5}}, "cube.lattice"));
+  for (int p = 4; p < 8; ++p) points.row(p) = points.row(p - 4) + Eigen::RowVector3d(0.5, 0.5, 0);
+  std::string flat = "(accepted)";
+  try {
+    Lattice::fromCells(points, hexahedron, {{0, 1, 2, 3, 4, 5}}, "flat.lattice");
+  } catch (const Error& e) {
+    flat = e.what();
+  }
+  EXPECT_NE(flat.find("flat.lattice: cell 0 is flat: it encloses no volume"), std::string::npos) << flat;
+
+  MatrixX3 six(6, 3);
+  six << 0, 0, 0, 1, 0, 0.2, 0.3, 1, 0.1, -0.7, 0.6, 0.4, -0.6, -0.8, 0.3, 0.4, -0.9, 1.1;
+  const std::vector<std::vector<int>> plane = {{0, 1, 2}, {0, 2, 3}, {0, 3, 4}, {0, 4, 5}, {0, 5, 1},
+                                               {1, 2, 4}, {2, 3, 5}, {3, 4, 1}, {4, 5, 2}, {5, 1, 3}};
+  std::string noInside = "(accepted)";
+  try {
+    Lattice::fromCells(six, plane, {{0, 1, 2, 3, 4, 5, 6, 7, 8, 9}}, "plane.lattice");
+  } catch (const Error& e) {
+    noInside = e.what();
+  }
+  EXPECT_NE(noInside.find("plane.lattice: cell 0's faces cannot be oriented alike"), std::string::npos) << noInside;
+}
+
 }  // namespace
 }  // namespace dynsub
