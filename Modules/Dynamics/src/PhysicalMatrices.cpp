@@ -175,7 +175,7 @@ ElementIntegrals integrate(const LimitSurface& surface, int element, const Assem
   const SharedPieces shared = surface.sharedPieces(element, options.levels);
   auto found = cache.find(shared.key);
   if (found == cache.end()) found = cache.emplace(shared.key, integratePieces(*shared.pieces, true, options)).first;
-  return mapIntegrals(found->second, *shared.map, surface.elementColumns(element));
+  return mapIntegrals(found->second, shared.map, surface.elementColumns(element));
 }
 
 }  // namespace

@@ -214,10 +214,15 @@ struct LimitSurface::Impl {
     // isolation): the column of each slot, so that a point's weights are the
     // B-spline basis itself; else slotColumn[0] = -1.
     std::array<int, 16> slotColumn{-1};
-    // Special: the structure of its neighbourhood (index into `structures`)
-    // and the blend of its columns each neighbourhood vertex is (rows).
+    // Special: the structure of its neighbourhood (index into `structures`),
+    // and the base vertex each neighbourhood vertex is. The structure map
+    // (neighbourhood vertices by columns) is their rows of `isolation`:
+    // mapColumns holds where each of those rows' weights falls in `columns`,
+    // row after row. Kept as indices into `isolation` rather than as a dense
+    // map: a scan's triangle mesh has a special element on every face.
     int structure = -1;
-    Eigen::MatrixXd structureMap;
+    std::vector<int> mapVertices;
+    std::vector<int> mapColumns;
   };
   // A special element's masks at its extraordinary vertex over its columns;
   // a structure's (below) also its subpatches, level by level.
@@ -250,7 +255,7 @@ struct LimitSurface::Impl {
   std::vector<std::unique_ptr<Special>> specials;
   // One special per neighbourhood structure, over the neighbourhood's own
   // vertices (identity weights): what every special element of that
-  // structure is, up to its structureMap. Few: after isolation a structure
+  // structure is, up to its structure map. Few: after isolation a structure
   // is a valence (and whether at a boundary).
   std::map<std::vector<int>, int> structureIndex;
   std::vector<std::unique_ptr<Special>> structures;
@@ -288,6 +293,30 @@ struct LimitSurface::Impl {
     std::sort(columns.begin(), columns.end());
     columns.erase(std::unique(columns.begin(), columns.end()), columns.end());
     return columns;
+  }
+  // Calls visit(k, c, w) for each weight of a special element's structure
+  // map: its neighbourhood vertex k is, in part, w times its column c. Row by
+  // row, each row's columns in increasing order.
+  template <class Visit>
+  void forEachMapWeight(const Element& element, Visit&& visit) const {
+    const int* column = element.mapColumns.data();
+    for (size_t k = 0; k < element.mapVertices.size(); ++k)
+      for (SparseMatrix::InnerIterator it(isolation, element.mapVertices[k]); it; ++it)
+        visit(static_cast<Eigen::Index>(k), *column++, it.value());
+  }
+  Eigen::MatrixXd structureMap(const Element& element) const {
+    Eigen::MatrixXd map = Eigen::MatrixXd::Zero(element.mapVertices.size(), element.columns.size());
+    forEachMapWeight(element, [&](Eigen::Index k, int c, double w) { map(k, c) = w; });
+    return map;
+  }
+  // The positions of a special element's neighbourhood vertices (the
+  // structure map applied to the control points), into out.
+  template <class Out>
+  void neighbourhoodPoints(const Element& element, const MatrixX3& controlPoints, Out& out) const {
+    out.setZero(element.mapVertices.size(), 3);
+    forEachMapWeight(element, [&](Eigen::Index k, int c, double w) {
+      out.row(k) += w * controlPoints.row(element.columns[c]);
+    });
   }
   Eigen::RowVectorXd rowOver(const std::vector<int>& columns, int baseVertex) const {
     Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(columns.size());
@@ -388,11 +417,16 @@ struct LimitSurface::Impl {
     }
     local.topology = structureTopologies[found->second];
     element.structure = found->second;
-    element.structureMap = local.weights;
+    element.mapVertices = neighbourhood.parentVertex;
+    for (const int b : element.mapVertices)
+      for (SparseMatrix::InnerIterator it(isolation, b); it; ++it)
+        element.mapColumns.push_back(
+            static_cast<int>(std::lower_bound(columns.begin(), columns.end(), static_cast<int>(it.col())) -
+                             columns.begin()));
     element.columns = columns;
     element.special = static_cast<int>(specials.size());
     // The element keeps only its masks. Its subpatches are its
-    // structure's times structureMap: subdivision is linear, and a structure's
+    // structure's times its structure map: subdivision is linear, and a structure's
     // displacements from its limit point, times the blends, are the element's
     // (the blends' rows sum to 1). Tabulated per element they would take
     // memory, and time to fault it in, for every special element rather than
@@ -518,7 +552,7 @@ struct LimitSurface::Impl {
 
   // Where a point of a special element lies: the regular subpatch (grid rows
   // of displacements over its structure's neighbourhood vertices; times the
-  // element's structureMap, over its columns), its own parameters and
+  // element's structure map, over its columns), its own parameters and
   // d(patch parameters)/d(element u, v); no patch at the extraordinary corner.
   struct SubpatchPoint {
     const GridMatrix* patch = nullptr;  // null: the point is the extraordinary vertex
@@ -614,7 +648,6 @@ struct LimitSurface::Impl {
       const int count = rows == 6 ? 6 : rows == 3 ? 3 : 1;
       const Eigen::Matrix<double, 6, 16> basis = detail::bsplineWeights(at.u, at.v);
       const GridMatrix& patch = *at.patch;
-      const Eigen::MatrixXd& map = element.structureMap;
       const Eigen::Index m = patch.cols();
       Eigen::Matrix<double, 6, Eigen::Dynamic> local(6, m);
       for (Eigen::Index k = 0; k < m; ++k) {
@@ -624,13 +657,10 @@ struct LimitSurface::Impl {
           local(r, k) = sum;
         }
       }
-      for (Eigen::Index c = 0; c < map.cols(); ++c) {
-        for (int r = 0; r < count; ++r) {
-          double sum = local(r, 0) * map(0, c);
-          for (Eigen::Index k = 1; k < m; ++k) sum += local(r, k) * map(k, c);
-          w(r, c) = sum;
-        }
-      }
+      w.topRows(count).setZero();
+      forEachMapWeight(element, [&](Eigen::Index k, int c, double weight) {
+        for (int r = 0; r < count; ++r) w(r, c) += local(r, k) * weight;
+      });
       w.row(0) += special.vertexMasks.row(0);  // the patch holds displacements from the limit point
     }
     applyChainRule(w, at.jacobian, rows);
@@ -670,8 +700,8 @@ struct LimitSurface::Impl {
     if (!at.patch) {
       result.topRows(3) = masks;
     } else {
-      Eigen::Matrix<double, Eigen::Dynamic, 3> local(element.structureMap.rows(), 3);
-      blend(element.structureMap, element.columns, controlPoints, local);  // the structure's vertices
+      Eigen::Matrix<double, Eigen::Dynamic, 3> local;
+      neighbourhoodPoints(element, controlPoints, local);
       grid.noalias() = *at.patch * local;
       result = detail::bsplineWeights(at.u, at.v) * grid;
       result.row(0) += masks.row(0);
@@ -1006,7 +1036,7 @@ struct SurfaceState::Impl {
     std::array<std::atomic<bool>, kSlots + 1> ready{};
     std::mutex mutex;
     Eigen::Matrix<double, 3, 3> masks;               // limit position and tangents at the vertex
-    Eigen::Matrix<double, Eigen::Dynamic, 3> local;  // the structure's vertices (structureMap's blends)
+    Eigen::Matrix<double, Eigen::Dynamic, 3> local;  // the element's neighbourhood vertices
     std::array<std::unique_ptr<Grid>, kSlots> grids;
   };
   std::unique_ptr<Cache[]> caches;
@@ -1055,8 +1085,7 @@ LimitSample SurfaceState::evaluate(const ElementPoint& point) const {
     const std::lock_guard<std::mutex> lock(cache.mutex);
     if (!cache.ready[Impl::kSlots].load(std::memory_order_relaxed)) {
       LimitSurface::Impl::blend(special.vertexMasks, special.columns, p, cache.masks);
-      cache.local.resize(element.structureMap.rows(), 3);
-      LimitSurface::Impl::blend(element.structureMap, element.columns, p, cache.local);
+      s.neighbourhoodPoints(element, p, cache.local);
       cache.ready[Impl::kSlots].store(true, std::memory_order_release);
     }
     if (!cache.ready[slot].load(std::memory_order_relaxed)) {
@@ -1103,7 +1132,7 @@ ElementPieces LimitSurface::elementPieces(int element, int levels) const {
   ElementPieces result;
   result.columns = e.columns;
   for (const BsplinePiece& piece : shared.pieces->pieces) {
-    result.pieces.push_back(BsplinePiece{piece.grid * *shared.map, s.specials[e.special]->vertexMasks.row(0),
+    result.pieces.push_back(BsplinePiece{piece.grid * shared.map, s.specials[e.special]->vertexMasks.row(0),
                                          piece.size, piece.swapped});
   }
   return result;
@@ -1122,7 +1151,7 @@ SharedPieces LimitSurface::sharedPieces(int element, int levels) const {
     found = s.structurePieces.emplace(key, s.piecesOf(*s.structures[e.structure], e.corner, levels)).first;
   }
   // A std::map's elements never move: the pointer stays valid as others are added.
-  return SharedPieces{(e.structure * 4 + e.corner) * 61 + levels, &found->second, &e.structureMap};
+  return SharedPieces{(e.structure * 4 + e.corner) * 61 + levels, &found->second, s.structureMap(e)};
 }
 
 SparseMatrix LimitSurface::controlVertexLimitOperator() const {

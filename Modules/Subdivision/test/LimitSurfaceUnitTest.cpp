@@ -478,11 +478,11 @@ TEST(LimitSurface, SpecialElementsAreTheirStructuresPiecesMapped) {
         const dynsub::ElementPieces own = surface.elementPieces(e, levels);
         const dynsub::SharedPieces shared = surface.sharedPieces(e, levels);
         ASSERT_EQ(shared.pieces->pieces.size(), own.pieces.size()) << name;
-        ASSERT_EQ(shared.map->cols(), static_cast<Eigen::Index>(own.columns.size())) << name;
+        ASSERT_EQ(shared.map.cols(), static_cast<Eigen::Index>(own.columns.size())) << name;
         for (size_t k = 0; k < own.pieces.size(); ++k) {
           const dynsub::BsplinePiece& piece = shared.pieces->pieces[k];
-          const Eigen::MatrixXd grid = piece.grid * *shared.map;
-          const Eigen::RowVectorXd offset = piece.offset * *shared.map;
+          const Eigen::MatrixXd grid = piece.grid * shared.map;
+          const Eigen::RowVectorXd offset = piece.offset * shared.map;
           // The same sums in another order: rounding of the entries' size
           // (they shrink like the subdominant eigenvalue^level), plus that of
           // the level-0 weights (<= 1), whose row sums' rounding subdivision

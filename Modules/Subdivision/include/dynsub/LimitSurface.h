@@ -118,7 +118,7 @@ struct ElementPieces {
 struct SharedPieces {
   int key = -1;                           // equal keys, equal `pieces`
   const ElementPieces* pieces = nullptr;  // over the neighbourhood's vertices (columns 0..n-1); owned by the surface
-  const Eigen::MatrixXd* map = nullptr;   // neighbourhood vertices by the element's columns
+  Eigen::MatrixXd map;                    // neighbourhood vertices by the element's columns
 };
 
 // Rows: points; columns: control vertices; s = J * p for each coordinate.
