@@ -1017,7 +1017,11 @@ struct SurfaceState::Impl {
   static constexpr int kCachedLevels = 12;
   const LimitSurface* surface = nullptr;
   MatrixX3 controlPoints;
-  SparseMatrix patchOperator;
+  // Built when first asked for: a tessellation needs only the grids, and on
+  // a scan's mesh the operator takes a gigabyte.
+  mutable std::once_flag patchOperatorOnce;
+  mutable std::atomic<bool> patchOperatorBuilt{false};
+  mutable SparseMatrix patchOperator;
   MatrixX3 grids;  // patchOperator * controlPoints
   // Per special element: the grid points of each subpatch a point has needed
   // at this state (slot 3 (level - 1) + child - 1; slot kSlots: the vertex
@@ -1044,7 +1048,6 @@ struct SurfaceState::Impl {
 
 SurfaceState::SurfaceState(const LimitSurface& surface) : impl_(std::make_unique<Impl>()) {
   impl_->surface = &surface;
-  impl_->patchOperator = surface.patchOperator();
   impl_->caches = std::make_unique<Impl::Cache[]>(surface.impl_->specials.size());
 }
 
@@ -1053,13 +1056,48 @@ SurfaceState::~SurfaceState() = default;
 void SurfaceState::reset(const MatrixX3& controlPoints) {
   checkPoints(controlPoints, impl_->surface->controlVertexCount());
   impl_->controlPoints = controlPoints;
-  impl_->grids = applyOperator(impl_->patchOperator, controlPoints);
+  // patchOperator() * controlPoints: by the operator once it is built (its
+  // rows are contiguous), else element by element from their grids, the
+  // same sums in the same order.
+  if (impl_->patchOperatorBuilt.load(std::memory_order_acquire)) {
+    applyOperator(impl_->patchOperator, controlPoints, impl_->grids);
+  } else {
+    const LimitSurface::Impl& s = *impl_->surface->impl_;
+    impl_->grids.resize(16 * static_cast<Eigen::Index>(s.elements.size()), 3);
+    const double* x = controlPoints.data();
+    const double* y = x + controlPoints.rows();
+    const double* z = y + controlPoints.rows();
+    for (size_t e = 0; e < s.elements.size(); ++e) {
+      const LimitSurface::Impl::Element& element = s.elements[e];
+      double sum[16][3] = {};
+      if (element.type == ElementType::Normal) {
+        for (size_t c = 0; c < element.columns.size(); ++c) {
+          const int column = element.columns[c];
+          const double* weights = &element.grid(0, static_cast<Eigen::Index>(c));
+          for (int slot = 0; slot < 16; ++slot) {
+            if (weights[slot] == 0.0) continue;
+            sum[slot][0] += weights[slot] * x[column];
+            sum[slot][1] += weights[slot] * y[column];
+            sum[slot][2] += weights[slot] * z[column];
+          }
+        }
+      }
+      for (int slot = 0; slot < 16; ++slot)
+        for (int a = 0; a < 3; ++a) impl_->grids(16 * static_cast<Eigen::Index>(e) + slot, a) = sum[slot][a];
+    }
+  }
   for (size_t i = 0; i < impl_->surface->impl_->specials.size(); ++i) {
     for (std::atomic<bool>& r : impl_->caches[i].ready) r.store(false, std::memory_order_relaxed);
   }
 }
 
-const SparseMatrix& SurfaceState::patchOperator() const { return impl_->patchOperator; }
+const SparseMatrix& SurfaceState::patchOperator() const {
+  std::call_once(impl_->patchOperatorOnce, [this] {
+    impl_->patchOperator = impl_->surface->patchOperator();
+    impl_->patchOperatorBuilt.store(true, std::memory_order_release);
+  });
+  return impl_->patchOperator;
+}
 
 const MatrixX3& SurfaceState::grids() const { return impl_->grids; }
 

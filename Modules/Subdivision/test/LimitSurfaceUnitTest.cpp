@@ -4,12 +4,15 @@
 #include <cmath>
 #include <numeric>
 #include <random>
+#include <string>
 #include <thread>
+#include <utility>
 
 #include <gtest/gtest.h>
 
 #include "PatchRules.h"
 #include "TestMeshes.h"
+#include "dynsub/ApplyOperator.h"
 #include "dynsub/CatmullClark.h"
 #include "dynsub/Error.h"
 #include "dynsub/LimitSurface.h"
@@ -505,6 +508,27 @@ TEST(LimitSurface, SpecialElementsAreTheirStructuresPiecesMapped) {
     if (name == "cube98") {
       EXPECT_LE(keys.size(), 8u);
     }
+  }
+}
+
+// SurfaceState's grids are patchOperator() times the control points to the
+// bit, whether it computes them from the elements (before the operator is
+// asked for) or by the operator (after): the same sums in the same order.
+TEST(SurfaceState, GridsAreThePatchOperatorsProductBeforeAndAfterItIsBuilt) {
+  for (const auto& [name, mesh] : {std::pair<std::string, dynsub::ControlMesh>{"cube98", dynsub::makeCube98()},
+                                   {"pyramid", dynsub::testing::makePyramid()}}) {
+    const LimitSurface surface(mesh);
+    dynsub::SurfaceState state(surface);
+    dynsub::MatrixX3 controlPoints = mesh.points();
+    controlPoints.col(1).array() += 0.1 * controlPoints.col(0).array().square();
+    state.reset(controlPoints);
+    const dynsub::MatrixX3 fromElements = state.grids();
+    const dynsub::MatrixX3 expected = dynsub::applyOperator(surface.patchOperator(), controlPoints);
+    ASSERT_EQ(fromElements.rows(), 16 * surface.elementCount()) << name;
+    EXPECT_TRUE((fromElements.array() == expected.array()).all()) << name;
+    EXPECT_EQ(state.patchOperator().nonZeros(), surface.patchOperator().nonZeros()) << name;
+    state.reset(controlPoints);
+    EXPECT_TRUE((state.grids().array() == expected.array()).all()) << name;
   }
 }
 

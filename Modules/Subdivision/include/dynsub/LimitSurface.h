@@ -227,9 +227,9 @@ class SurfaceState {
   ~SurfaceState();
   void reset(const MatrixX3& controlPoints);
   LimitSample evaluate(const ElementPoint& point) const;
-  // The surface's patchOperator(), built once, and patchOperator() times the
-  // control points of the last reset(): rows 16 e .. 16 e + 15 are normal
-  // element e's grid points.
+  // The surface's patchOperator(), built the first time it is asked for
+  // (thread-safe), and patchOperator() times the control points of the last
+  // reset(): rows 16 e .. 16 e + 15 are normal element e's grid points.
   const SparseMatrix& patchOperator() const;
   const MatrixX3& grids() const;
 
