@@ -61,8 +61,9 @@ double enclosedVolume(const MatrixX3& points, const std::vector<std::vector<int>
     const std::vector<int>& loop = faces[shell[k]];
     const Vector3 first = points.row(loop[0]).transpose();
     for (std::size_t i = 1; i + 1 < loop.size(); ++i)
-      sixTimes += sign[k] * first.dot(Vector3(points.row(loop[i]).transpose())
-                                          .cross(Vector3(points.row(loop[i + 1]).transpose())));
+      sixTimes +=
+          sign[k] *
+          first.dot(Vector3(points.row(loop[i]).transpose()).cross(Vector3(points.row(loop[i + 1]).transpose())));
   }
   return std::abs(sixTimes) / 6;
 }

@@ -314,9 +314,8 @@ struct LimitSurface::Impl {
   template <class Out>
   void neighbourhoodPoints(const Element& element, const MatrixX3& controlPoints, Out& out) const {
     out.setZero(element.mapVertices.size(), 3);
-    forEachMapWeight(element, [&](Eigen::Index k, int c, double w) {
-      out.row(k) += w * controlPoints.row(element.columns[c]);
-    });
+    forEachMapWeight(element,
+                     [&](Eigen::Index k, int c, double w) { out.row(k) += w * controlPoints.row(element.columns[c]); });
   }
   Eigen::RowVectorXd rowOver(const std::vector<int>& columns, int baseVertex) const {
     Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(columns.size());
@@ -420,9 +419,8 @@ struct LimitSurface::Impl {
     element.mapVertices = neighbourhood.parentVertex;
     for (const int b : element.mapVertices)
       for (SparseMatrix::InnerIterator it(isolation, b); it; ++it)
-        element.mapColumns.push_back(
-            static_cast<int>(std::lower_bound(columns.begin(), columns.end(), static_cast<int>(it.col())) -
-                             columns.begin()));
+        element.mapColumns.push_back(static_cast<int>(
+            std::lower_bound(columns.begin(), columns.end(), static_cast<int>(it.col())) - columns.begin()));
     element.columns = columns;
     element.special = static_cast<int>(specials.size());
     // The element keeps only its masks. Its subpatches are its
@@ -1170,8 +1168,8 @@ ElementPieces LimitSurface::elementPieces(int element, int levels) const {
   ElementPieces result;
   result.columns = e.columns;
   for (const BsplinePiece& piece : shared.pieces->pieces) {
-    result.pieces.push_back(BsplinePiece{piece.grid * shared.map, s.specials[e.special]->vertexMasks.row(0),
-                                         piece.size, piece.swapped});
+    result.pieces.push_back(
+        BsplinePiece{piece.grid * shared.map, s.specials[e.special]->vertexMasks.row(0), piece.size, piece.swapped});
   }
   return result;
 }
