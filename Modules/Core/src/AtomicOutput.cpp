@@ -68,8 +68,8 @@ void removeTemporariesOnInterrupt() {
     const sigset_t signals = interruptSignals();
     pthread_sigmask(SIG_BLOCK, &signals, nullptr);
     std::thread([signals] {
-      int signal = 0;
-      while (sigwait(&signals, &signal) != 0) {
+      int received = 0;
+      while (sigwait(&signals, &received) != 0) {
       }
       Temporaries& all = temporaries();
       // Held to the end: an output begun after this is not begun at all.
@@ -77,12 +77,12 @@ void removeTemporariesOnInterrupt() {
       std::error_code ignored;
       for (auto path = all.paths.rbegin(); path != all.paths.rend(); ++path) fs::remove_all(*path, ignored);
       // End as the signal would have ended the process without this.
-      std::signal(signal, SIG_DFL);
+      std::signal(received, SIG_DFL);
       sigset_t only;
       sigemptyset(&only);
-      sigaddset(&only, signal);
+      sigaddset(&only, received);
       pthread_sigmask(SIG_UNBLOCK, &only, nullptr);
-      raise(signal);
+      raise(received);
     }).detach();
   });
 }
