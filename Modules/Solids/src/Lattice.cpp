@@ -56,14 +56,13 @@ double enclosedVolume(const MatrixX3& points, const std::vector<std::vector<int>
       }
     }
   }
+  // Each face's cone from the origin: its first point dotted with its Newell
+  // normal is six times the cone's signed volume (the normal's two terms at
+  // that point are perpendicular to it, which leaves the face's fan).
   double sixTimes = 0;
   for (std::size_t k = 0; k < shell.size(); ++k) {
     const std::vector<int>& loop = faces[shell[k]];
-    const Vector3 first = points.row(loop[0]).transpose();
-    for (std::size_t i = 1; i + 1 < loop.size(); ++i)
-      sixTimes +=
-          sign[k] *
-          first.dot(Vector3(points.row(loop[i]).transpose()).cross(Vector3(points.row(loop[i + 1]).transpose())));
+    sixTimes += sign[k] * Vector3(points.row(loop[0]).transpose()).dot(newellNormal(points, loop));
   }
   return std::abs(sixTimes) / 6;
 }

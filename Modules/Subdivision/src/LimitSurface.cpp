@@ -1056,32 +1056,21 @@ void SurfaceState::reset(const MatrixX3& controlPoints) {
   impl_->controlPoints = controlPoints;
   // patchOperator() * controlPoints: by the operator once it is built (its
   // rows are contiguous), else element by element from their grids, the
-  // same sums in the same order.
+  // same products in the same order (the operator leaves out the grids'
+  // zeros, which add nothing).
   if (impl_->patchOperatorBuilt.load(std::memory_order_acquire)) {
     applyOperator(impl_->patchOperator, controlPoints, impl_->grids);
   } else {
     const LimitSurface::Impl& s = *impl_->surface->impl_;
     impl_->grids.resize(16 * static_cast<Eigen::Index>(s.elements.size()), 3);
-    const double* x = controlPoints.data();
-    const double* y = x + controlPoints.rows();
-    const double* z = y + controlPoints.rows();
+    Eigen::Matrix<double, 16, 3> grid;
     for (size_t e = 0; e < s.elements.size(); ++e) {
       const LimitSurface::Impl::Element& element = s.elements[e];
-      double sum[16][3] = {};
-      if (element.type == ElementType::Normal) {
-        for (size_t c = 0; c < element.columns.size(); ++c) {
-          const int column = element.columns[c];
-          const double* weights = &element.grid(0, static_cast<Eigen::Index>(c));
-          for (int slot = 0; slot < 16; ++slot) {
-            if (weights[slot] == 0.0) continue;
-            sum[slot][0] += weights[slot] * x[column];
-            sum[slot][1] += weights[slot] * y[column];
-            sum[slot][2] += weights[slot] * z[column];
-          }
-        }
-      }
-      for (int slot = 0; slot < 16; ++slot)
-        for (int a = 0; a < 3; ++a) impl_->grids(16 * static_cast<Eigen::Index>(e) + slot, a) = sum[slot][a];
+      if (element.type == ElementType::Normal)
+        LimitSurface::Impl::blend(element.grid, element.columns, controlPoints, grid);
+      else
+        grid.setZero();  // the operator's rows of a special element are empty
+      impl_->grids.middleRows<16>(16 * static_cast<Eigen::Index>(e)) = grid;
     }
   }
   for (size_t i = 0; i < impl_->surface->impl_->specials.size(); ++i) {
