@@ -1,5 +1,6 @@
 #include "dynsub/AtomicOutput.h"
 
+#include <fcntl.h>
 #include <signal.h>
 #include <sys/statvfs.h>
 #include <unistd.h>
@@ -38,13 +39,34 @@ Temporaries& temporaries() {
   return *all;
 }
 
+constexpr int kInterruptSignals[] = {SIGINT, SIGTERM, SIGHUP};
+
 sigset_t interruptSignals() {
   sigset_t signals;
   sigemptyset(&signals);
-  sigaddset(&signals, SIGINT);
-  sigaddset(&signals, SIGTERM);
-  sigaddset(&signals, SIGHUP);
+  for (const int signal : kInterruptSignals) sigaddset(&signals, signal);
   return signals;
+}
+
+// The interrupt's pipe: the handler writes the signal's number, the cleanup
+// thread reads it.
+int interruptPipe[2] = {-1, -1};
+pid_t interruptOwner = 0;
+
+void forwardInterrupt(int signal) {
+  if (getpid() != interruptOwner) {  // a forked child before its exec
+    std::signal(signal, SIG_DFL);
+    raise(signal);
+    return;
+  }
+  const int savedErrno = errno;
+  const unsigned char number = static_cast<unsigned char>(signal);
+  if (write(interruptPipe[1], &number, 1) != 1) {
+    // The pipe cannot be written: end by the signal without the cleanup.
+    std::signal(signal, SIG_DFL);
+    raise(signal);
+  }
+  errno = savedErrno;
 }
 
 }  // namespace
@@ -65,23 +87,36 @@ void untrackTemporary(const std::string& path) {
 void removeTemporariesOnInterrupt() {
   static std::once_flag once;
   std::call_once(once, [] {
+    // Without a pipe (no file descriptor left) an interrupt ends the process
+    // as usual, and the next run of the same outputs sweeps what it left.
+    if (pipe2(interruptPipe, O_CLOEXEC) != 0) return;
+    interruptOwner = getpid();
+    // Threads started from here on block the signals, so that their system
+    // calls are not interrupted; the cleanup thread below takes them. A thread
+    // that a library started before this (a BLAS thread pool) does not block
+    // them, and the handler there forwards the signal all the same.
     const sigset_t signals = interruptSignals();
     pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+    struct sigaction action = {};
+    action.sa_handler = forwardInterrupt;
+    action.sa_mask = signals;
+    action.sa_flags = SA_RESTART;
+    for (const int signal : kInterruptSignals) sigaction(signal, &action, nullptr);
     std::thread([signals] {
-      int received = 0;
-      while (sigwait(&signals, &received) != 0) {
+      pthread_sigmask(SIG_UNBLOCK, &signals, nullptr);
+      unsigned char received = 0;
+      ssize_t count = 0;
+      while ((count = read(interruptPipe[0], &received, 1)) < 0 && errno == EINTR) {
       }
+      if (count != 1) return;
       Temporaries& all = temporaries();
       // Held to the end: an output begun after this is not begun at all.
       all.mutex.lock();
       std::error_code ignored;
       for (auto path = all.paths.rbegin(); path != all.paths.rend(); ++path) fs::remove_all(*path, ignored);
-      // End as the signal would have ended the process without this.
+      // End as the signal would have ended the process without this. This
+      // thread does not block it, so raise() delivers it here.
       std::signal(received, SIG_DFL);
-      sigset_t only;
-      sigemptyset(&only);
-      sigaddset(&only, received);
-      pthread_sigmask(SIG_UNBLOCK, &only, nullptr);
       raise(received);
     }).detach();
   });

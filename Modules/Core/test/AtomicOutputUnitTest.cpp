@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "dynsub/AtomicOutput.h"
@@ -302,44 +303,56 @@ TEST(OutputSet, TheNextRunRemovesTheFolderOfAKilledRun) {
 // Interrupted (Ctrl-C, a scheduler's SIGTERM, a closed terminal's SIGHUP), a
 // process that called removeTemporariesOnInterrupt removes its outputs in
 // progress, a file and a new directory's folder with files in it, keeps what
-// it had committed, and ends by the signal.
+// it had committed, and ends by the signal. Also when the signal lands on a
+// thread that was running before the call and does not block it, as a BLAS
+// library's thread pool started when the library was loaded.
 TEST(AtomicOutput, AnInterruptRemovesOutputsInProgress) {
-  for (const int signal : {SIGINT, SIGTERM, SIGHUP}) {
-    const fs::path dir = freshDirectory("atomic-interrupt");
-    int ready[2];
-    ASSERT_EQ(pipe(ready), 0);
-    const pid_t child = fork();
-    ASSERT_GE(child, 0);
-    if (child == 0) {
-      close(ready[0]);
-      dynsub::removeTemporariesOnInterrupt();
-      {
-        dynsub::AtomicOutput done((dir / "done.obj").string());
-        std::ofstream(done.temporaryPath()) << "v 0 0 0\n";
-        done.commit();
+  for (const bool earlierThread : {false, true})
+    for (const int signal : {SIGINT, SIGTERM, SIGHUP}) {
+      const std::string which = "signal " + std::to_string(signal) + (earlierThread ? " to an earlier thread" : "");
+      const fs::path dir = freshDirectory("atomic-interrupt");
+      int ready[2];
+      ASSERT_EQ(pipe(ready), 0);
+      const pid_t child = fork();
+      ASSERT_GE(child, 0);
+      if (child == 0) {
+        close(ready[0]);
+        std::thread earlier;
+        if (earlierThread)
+          earlier = std::thread([] {
+            for (;;) pause();
+          });
+        dynsub::removeTemporariesOnInterrupt();
+        {
+          dynsub::AtomicOutput done((dir / "done.obj").string());
+          std::ofstream(done.temporaryPath()) << "v 0 0 0\n";
+          done.commit();
+        }
+        dynsub::AtomicOutput file((dir / "surface.obj").string());
+        std::ofstream(file.temporaryPath()) << "v 0 0 0\n";
+        dynsub::OutputSet set(dir / "run");
+        std::ofstream(set.add("report.json")) << "{}";
+        fs::create_directory(set.writingDirectory() / "structure");
+        std::ofstream(set.writingDirectory() / "structure" / "labelmap.nii.gz") << "half";
+        if (write(ready[1], "r", 1) != 1) _exit(3);
+        if (earlierThread) pthread_kill(earlier.native_handle(), signal);
+        for (;;) pause();
       }
-      dynsub::AtomicOutput file((dir / "surface.obj").string());
-      std::ofstream(file.temporaryPath()) << "v 0 0 0\n";
-      dynsub::OutputSet set(dir / "run");
-      std::ofstream(set.add("report.json")) << "{}";
-      fs::create_directory(set.writingDirectory() / "structure");
-      std::ofstream(set.writingDirectory() / "structure" / "labelmap.nii.gz") << "half";
-      if (write(ready[1], "r", 1) != 1) _exit(3);
-      for (;;) pause();
+      close(ready[1]);
+      char byte = 0;
+      ASSERT_EQ(read(ready[0], &byte, 1), 1) << "the child did not get as far as its outputs";
+      close(ready[0]);
+      if (!earlierThread) {
+        ASSERT_EQ(kill(child, signal), 0);
+      }
+      int status = 0;
+      ASSERT_EQ(waitpid(child, &status, 0), child);
+      ASSERT_TRUE(WIFSIGNALED(status)) << which << ": the child exited with " << WEXITSTATUS(status);
+      EXPECT_EQ(WTERMSIG(status), signal) << which;
+      std::vector<std::string> left;
+      for (const auto& entry : fs::directory_iterator(dir)) left.push_back(entry.path().filename().string());
+      EXPECT_EQ(left, std::vector<std::string>{"done.obj"}) << which;
     }
-    close(ready[1]);
-    char byte = 0;
-    ASSERT_EQ(read(ready[0], &byte, 1), 1) << "the child did not get as far as its outputs";
-    close(ready[0]);
-    ASSERT_EQ(kill(child, signal), 0);
-    int status = 0;
-    ASSERT_EQ(waitpid(child, &status, 0), child);
-    ASSERT_TRUE(WIFSIGNALED(status)) << "signal " << signal << ": the child exited with " << WEXITSTATUS(status);
-    EXPECT_EQ(WTERMSIG(status), signal);
-    std::vector<std::string> left;
-    for (const auto& entry : fs::directory_iterator(dir)) left.push_back(entry.path().filename().string());
-    EXPECT_EQ(left, std::vector<std::string>{"done.obj"}) << "signal " << signal;
-  }
 }
 
 TEST(AtomicOutput, MissingDirectoryIsNamed) {

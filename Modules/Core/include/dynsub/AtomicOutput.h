@@ -43,11 +43,13 @@ class AtomicOutput {
 
 // Makes SIGINT, SIGTERM and SIGHUP remove this process's outputs in progress
 // (AtomicOutput's temporary files, OutputSet's folders) before the process
-// ends by the signal as it would have without this. Call it first in main,
-// before any thread starts: the signals are blocked in every thread and
-// taken by one thread of their own, which may do what a signal handler may
-// not (remove a folder). A child process inherits the blocked signals: a
-// program that starts one unblocks them in it (Figures.cpp, FigureDisplay.cpp).
+// ends by the signal as it would have without this. Call it first in main.
+// A handler passes the signal through a pipe to one thread of its own, which
+// may do what a signal handler may not (remove a folder). Threads started
+// after the call block the signals, so that only that thread or a thread a
+// library started earlier takes them. A child process inherits the blocked
+// signals: a program that starts one unblocks them in it (Figures.cpp,
+// FigureDisplay.cpp).
 void removeTemporariesOnInterrupt();
 
 // Temporaries that an interrupt removes (removeTemporariesOnInterrupt): a
