@@ -54,19 +54,17 @@ int interruptPipe[2] = {-1, -1};
 pid_t interruptOwner = 0;
 
 void forwardInterrupt(int signal) {
-  if (getpid() != interruptOwner) {  // a forked child before its exec
-    std::signal(signal, SIG_DFL);
-    raise(signal);
-    return;
+  // Not in a forked child before its exec, which is not the pipe's owner.
+  if (getpid() == interruptOwner) {
+    const int savedErrno = errno;
+    const unsigned char number = static_cast<unsigned char>(signal);
+    const bool passed = write(interruptPipe[1], &number, 1) == 1;
+    errno = savedErrno;
+    if (passed) return;
   }
-  const int savedErrno = errno;
-  const unsigned char number = static_cast<unsigned char>(signal);
-  if (write(interruptPipe[1], &number, 1) != 1) {
-    // The pipe cannot be written: end by the signal without the cleanup.
-    std::signal(signal, SIG_DFL);
-    raise(signal);
-  }
-  errno = savedErrno;
+  // End by the signal without the cleanup (delivered when this returns).
+  std::signal(signal, SIG_DFL);
+  raise(signal);
 }
 
 }  // namespace
