@@ -50,7 +50,7 @@ void SimulationArguments::addOptions(CLI::App& command, const SimulationOptions&
   values = defaults;
   scheme = toString(defaults.integrator.scheme);
   solver = toString(defaults.integrator.solver);
-  command.add_option("--max-level", values.maxLevel, "Global refinements allowed (0-6)")
+  command.add_option("--max-level", values.maxLevel, "Refinement levels allowed (0-6)")
       ->default_val(defaults.maxLevel)
       ->check(CLI::Range(0, 6));
   command.add_option("--scheme", scheme,

@@ -9,8 +9,8 @@
 #include "CommandLine.h"
 #include "Commands.h"
 #include "EarlierRuns.h"
+#include "dynsub/Deformation.h"
 #include "dynsub/Error.h"
-#include "dynsub/ForceModel.h"
 #include "dynsub/MeshIO.h"
 #include "dynsub/ModelOutputs.h"
 #include "dynsub/SpringFile.h"
@@ -19,21 +19,24 @@ namespace dynsub::app {
 
 namespace {
 
-struct DeformOptions {
+struct DeformArguments {
   std::string mesh;
   std::string springs;
   std::string out;
   double stiffness = 10.0;
   bool fixBoundary = false;
+  std::string refinement = "local";
+  DeformationOptions deformation;
   SimulationArguments simulation;
 };
 
-void runDeform(DeformOptions o) {
+void runDeform(DeformArguments o) {
   const ControlMesh mesh = readControlMesh(o.mesh);
   const SpringFile springs = readSpringFile(o.springs, o.stiffness);
   const std::filesystem::path dir(o.out);
   prepareOutputDirectory(dir);
-  SimulationOptions options = o.simulation.apply(o.simulation.values);
+  o.deformation.simulation = o.simulation.apply(o.simulation.values);
+  o.deformation.localRefinement = o.refinement == "local";
 
   std::vector<int> fixed;
   if (o.fixBoundary) {
@@ -43,12 +46,12 @@ void runDeform(DeformOptions o) {
     }
     if (fixed.empty()) throw Error(o.mesh, "--fix-boundary was given, but the mesh is closed");
   }
-  SpringForceModel model(springs.targets, springs.stiffness, SpringForceModel::Attach::NearestAtLevelStart);
   ProgressLine line;
-  const SimulationResult result = simulate(mesh, {&model}, fixed, options, nullptr, line.callback());
+  const DeformationResult result =
+      deformSurface(mesh, springs.targets, springs.stiffness, fixed, o.deformation, line.callback());
   line.finish();
 
-  const Eigen::VectorXd& lengths = model.lengths();
+  const Eigen::VectorXd& lengths = result.springLengths;
   double seconds = 0.0;
   for (const LevelSummary& l : result.levels) seconds += l.seconds;
 
@@ -58,33 +61,45 @@ void runDeform(DeformOptions o) {
   report.set("springs", springs.targets.rows());
   report.set("fixed_control_vertices", fixed.size());
   report.set("control_vertices", result.mesh.vertexCount());
+  report.set("free_control_points", result.levels.back().freeControlPoints);
   report.set("levels", result.levels.back().level);
   report.set("iterations", result.steps);
   report.set("equilibrium", result.levels.back().converged);
+  report.set("max_distance_percent", result.maxDistancePercent);
+  report.set("tolerance_percent", o.deformation.tolerancePercent);
+  report.set("tolerance_met", result.toleranceMet);
+  report.set("diameter_mm", result.diameter);
   report.set("max_spring_length_mm", lengths.size() ? lengths.maxCoeff() : 0.0);
   report.set("mean_spring_length_mm", lengths.size() ? lengths.mean() : 0.0);
   report.set("seconds", seconds);
   std::vector<Report> levels;
-  for (const LevelSummary& l : result.levels) levels.push_back(levelReport(l, -1, -1));
+  for (std::size_t i = 0; i < result.levels.size(); ++i) {
+    Report level = levelReport(result.levels[i], -1, -1);
+    if (i < result.levelDistancesPercent.size()) level.set("max_distance_percent", result.levelDistancesPercent[i]);
+    levels.push_back(level);
+  }
   report.set("per_level", levels);
-  Report parameters = simulationReport(options);
+  Report parameters = simulationReport(o.deformation.simulation);
   parameters.set("default_spring_stiffness", o.stiffness);
   parameters.set("fix_boundary", o.fixBoundary);
+  parameters.set("refinement", result.localRefinement ? "local" : "global");
   report.set("parameters", parameters);
 
   writeModelOutputs(dir, result.mesh, outputSurface(result.mesh), report,
                     [&dir](OutputSet& outputs) { retireEarlierRun(outputs, dir); });
   std::cout << std::fixed << std::setprecision(3) << "deformed " << o.mesh << " with " << springs.targets.rows()
             << " springs: " << (result.levels.back().converged ? "equilibrium" : "step limit reached") << " after "
-            << result.steps << " steps, " << std::setprecision(2) << seconds << " s; largest spring length "
-            << std::setprecision(3) << (lengths.size() ? lengths.maxCoeff() : 0.0) << " mm\n"
+            << result.steps << " steps, " << std::setprecision(2) << seconds << " s; farthest target "
+            << std::setprecision(3) << result.maxDistancePercent << " % of the model's diameter ("
+            << result.levels.back().level << " refinement(s), " << result.mesh.vertexCount() << " control vertices"
+            << (result.toleranceMet ? ")" : "; above the tolerance)") << "\n"
             << "wrote " << (dir / kSurfaceFile).string() << ", control_mesh.obj, report.json\n";
 }
 
 }  // namespace
 
 void addDeformCommand(CLI::App& app) {
-  auto o = std::make_shared<DeformOptions>();
+  auto o = std::make_shared<DeformArguments>();
   CLI::App* command = app.add_subcommand(
       "deform",
       "Model a surface by pulling on it: springs from points in space attach to the nearest points of the "
@@ -99,13 +114,21 @@ void addDeformCommand(CLI::App& app) {
       ->default_val(o->stiffness)
       ->check(positiveNumber());
   command->add_flag("--fix-boundary", o->fixBoundary, "Hold the boundary control vertices of an open mesh in place");
-  SimulationOptions defaults;
-  defaults.maxLevel = 0;
-  // Springs held at their attachments are linear: the static scheme's first
-  // Newton step is the exact equilibrium (residual 1e-14 where first-order
-  // time steps stop at 1e-2 after ~300 steps; Documentation/Performance.md).
-  defaults.integrator.scheme = IntegrationScheme::Static;
-  o->simulation.addOptions(*command, defaults);
+  command
+      ->add_option("--tolerance", o->deformation.tolerancePercent,
+                   "Largest distance from a spring's target to the surface at which refinement (up to --max-level) "
+                   "stops, in percent of the diameter of the smallest sphere enclosing the control mesh and the "
+                   "targets")
+      ->default_val(o->deformation.tolerancePercent)
+      ->check(positiveNumber());
+  command
+      ->add_option("--refinement", o->refinement,
+                   "local: a level's faces near the targets still farther than the tolerance are refined and their "
+                   "new points move, while elsewhere the refined mesh keeps the coarser level's shape (the static "
+                   "scheme without --fix-boundary; otherwise every face); global: every face, as the papers do")
+      ->default_val("local")
+      ->check(CLI::IsMember({"local", "global"}));
+  o->simulation.addOptions(*command, DeformationOptions::defaultSimulation());
   command->callback([o] { runDeform(*o); });
 }
 

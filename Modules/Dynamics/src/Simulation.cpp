@@ -627,6 +627,26 @@ SparseMatrix refinedBasis(const Topology& coarse, const SparseMatrix& subdivisio
 
 }  // namespace
 
+std::vector<int> grownFaces(const Topology& mesh, const std::vector<int>& faces, int rings) {
+  std::vector<bool> chosen(mesh.faceCount(), faces.empty());
+  for (int f : faces) chosen[f] = true;
+  for (int ring = 0; ring < rings && !faces.empty(); ++ring) {
+    std::vector<bool> grown = chosen;
+    for (int f = 0; f < mesh.faceCount(); ++f) {
+      if (!chosen[f]) continue;
+      for (int v : mesh.face(f)) {
+        for (int g : mesh.vertexFaces(v)) grown[g] = true;
+      }
+    }
+    chosen = std::move(grown);
+  }
+  std::vector<int> result;
+  for (int f = 0; f < mesh.faceCount(); ++f) {
+    if (chosen[f]) result.push_back(f);
+  }
+  return result;
+}
+
 SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceModel*>& forces,
                           const std::vector<int>& fixed, const SimulationOptions& options, const AcceptFit& accept,
                           const ProgressCallback& progress, const RefineRegion& region) {

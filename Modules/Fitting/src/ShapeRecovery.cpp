@@ -66,28 +66,6 @@ double largestBias(const Eigen::VectorXd& signedDistances, const Eigen::MatrixXi
   return bias;
 }
 
-// `faces` and every face within `rings` rings of them (sharing a vertex);
-// every face of the mesh when `faces` is empty.
-std::vector<int> grownFaces(const Topology& mesh, const std::vector<int>& faces, int rings) {
-  std::vector<bool> chosen(mesh.faceCount(), faces.empty());
-  for (int f : faces) chosen[f] = true;
-  for (int ring = 0; ring < rings && !faces.empty(); ++ring) {
-    std::vector<bool> grown = chosen;
-    for (int f = 0; f < mesh.faceCount(); ++f) {
-      if (!chosen[f]) continue;
-      for (int v : mesh.face(f)) {
-        for (int g : mesh.vertexFaces(v)) grown[g] = true;
-      }
-    }
-    chosen = std::move(grown);
-  }
-  std::vector<int> result;
-  for (int f = 0; f < mesh.faceCount(); ++f) {
-    if (chosen[f]) result.push_back(f);
-  }
-  return result;
-}
-
 // Springs from the surface to the data: at each quadrature point of the
 // surface, a spring of stiffness `stiffness` x its parametric area to the
 // nearest data point, found again at every evaluation. The data springs pull

@@ -221,6 +221,11 @@ using ProgressCallback = std::function<void(const Progress&)>;
 // mesh is free.
 using RefineRegion = std::function<std::vector<int>(const Topology& mesh)>;
 
+// `faces` and every face within `rings` rings of them (sharing a vertex);
+// every face of the mesh when `faces` is empty: a RefineRegion's answer
+// from the faces where a fit is refused.
+std::vector<int> grownFaces(const Topology& mesh, const std::vector<int>& faces, int rings);
+
 // forces are not owned. fixed: control vertices of the initial mesh that do not
 // move (they keep their numbers through refinement); not with `region`.
 // Throws dynsub::Error on bad options or unrecoverable divergence.

@@ -1,0 +1,66 @@
+#pragma once
+// Modeling by forces (TVCG §4.1, Fig. 6): springs from points in space to
+// the nearest points of the limit surface pull it to a new equilibrium.
+//
+// The surface is refined while a target is farther from it than the
+// tolerance, up to the simulation's maxLevel, and only where: the faces that
+// hold such a target's nearest surface point, and kRefineRings rings around
+// them, get new free control points (RefineRegion, Simulation.h); elsewhere
+// the refined mesh follows the coarser level. A pull on a few points then
+// adds detail where they pull, not over the whole surface, as global
+// refinement (`localRefinement` false, as the papers do) would. The distance
+// is measured, as the fit's error is, to the nearest point of the exact
+// limit surface, in percent of the diameter of the smallest sphere enclosing
+// the initial control points and the targets: a unit-free tolerance, and a
+// single target still has a model to measure against.
+#include <memory>
+#include <vector>
+
+#include "dynsub/ControlMesh.h"
+#include "dynsub/Simulation.h"
+
+namespace dynsub {
+
+// A refinement must bring the farthest target at least this share closer,
+// or refinement ends there with the tolerance unmet: the springs' pull is
+// then balanced by the surface's elasticity, which a finer mesh does not
+// weaken (its energy does not depend on the level; elasticityPerLevel 1),
+// and a finer level would cost four times the control vertices for nothing.
+constexpr double kLeastRefinementGain = 0.1;
+
+struct DeformationOptions {
+  // The largest distance from a target to the surface that ends refinement,
+  // percent of the diameter (see above).
+  double tolerancePercent = 1.0;
+  // Refine only near the targets still too far (the static scheme only, and
+  // not with fixed control vertices); false: every face.
+  bool localRefinement = true;
+  SimulationOptions simulation = defaultSimulation();
+
+  // The static scheme, no refinement.
+  static SimulationOptions defaultSimulation();
+  // Whether refinement is local for these fixed control vertices.
+  bool refinesLocally(const std::vector<int>& fixed) const;
+};
+
+struct DeformationResult {
+  ControlMesh mesh;
+  std::shared_ptr<const LimitSurface> surface;  // mesh's limit surface
+  std::vector<LevelSummary> levels;
+  int steps = 0;
+  double diameter = 0;             // mm, the tolerance's reference length
+  double maxDistancePercent = 0;   // the farthest target from the final surface
+  bool toleranceMet = false;
+  bool localRefinement = false;    // whether the refinement was local
+  Eigen::VectorXd springLengths;   // mm, each spring's at its last evaluation
+  std::vector<double> levelDistancesPercent;  // the farthest target, at each level's end
+};
+
+// targets: #springs x 3 (mm); stiffness: one per spring (N/mm), > 0. fixed:
+// control vertices of `initial` that do not move. Throws dynsub::Error on bad
+// input or unrecoverable divergence.
+DeformationResult deformSurface(const ControlMesh& initial, const MatrixX3& targets, const Eigen::VectorXd& stiffness,
+                                const std::vector<int>& fixed, const DeformationOptions& options,
+                                const ProgressCallback& progress = nullptr);
+
+}  // namespace dynsub
