@@ -63,8 +63,7 @@ DeformationResult deformSurface(const ControlMesh& initial, const MatrixX3& targ
     const double distance = measure(surface, points);
     const bool gained = result.levelDistancesPercent.empty() ||
                         distance < (1.0 - kLeastRefinementGain) * result.levelDistancesPercent.back();
-    const bool refine =
-        distance > options.tolerancePercent && gained && when != FitAsk::LastLevelLooseRule;
+    const bool refine = distance > options.tolerancePercent && gained && when != FitAsk::LastLevelLooseRule;
     if (refine || when == FitAsk::LevelEnd) result.levelDistancesPercent.push_back(distance);
     return refine ? FitVerdict::Refine : FitVerdict::Settle;
   };

@@ -48,11 +48,11 @@ struct DeformationResult {
   std::shared_ptr<const LimitSurface> surface;  // mesh's limit surface
   std::vector<LevelSummary> levels;
   int steps = 0;
-  double diameter = 0;             // mm, the tolerance's reference length
-  double maxDistancePercent = 0;   // the farthest target from the final surface
+  double diameter = 0;            // mm, the tolerance's reference length
+  double maxDistancePercent = 0;  // the farthest target from the final surface
   bool toleranceMet = false;
-  bool localRefinement = false;    // whether the refinement was local
-  Eigen::VectorXd springLengths;   // mm, each spring's at its last evaluation
+  bool localRefinement = false;               // whether the refinement was local
+  Eigen::VectorXd springLengths;              // mm, each spring's at its last evaluation
   std::vector<double> levelDistancesPercent;  // the farthest target, at each level's end
 };
 
