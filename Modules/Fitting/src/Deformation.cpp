@@ -43,24 +43,20 @@ DeformationResult deformSurface(const ControlMesh& initial, const MatrixX3& targ
   // The faces, of the level last measured, that hold a target's nearest
   // surface point farther than the tolerance.
   std::vector<int> facesToRefine;
-  const auto measure = [&](const LimitSurface& surface, const MatrixX3& points) {
-    std::vector<ClosestPoint> nearest;
-    const FitError e = measureFitError(surface, points, targets, result.diameter, nullptr, &nearest);
-    facesToRefine.clear();
-    for (const ClosestPoint& c : nearest) {
-      if (100.0 * c.distance / result.diameter > options.tolerancePercent)
-        facesToRefine.push_back(surface.elementControlFace(c.point.element));
-    }
-    result.maxDistancePercent = e.maxPercent;
-    return e.maxPercent;
-  };
   // Each level runs to its equilibrium (one or two Newton steps: the springs
   // are linear within a level), and is refined if a target is still too far.
   // A refinement that brings the farthest target less than
-  // kLeastRefinementGain closer ends the refinement (see the header).
+  // kLeastRefinementGain closer ends the refinement (see the header). Every
+  // level's distance is recorded once, where the level ends: refused at the
+  // looser rule, or at its end, which the last level always reaches (its
+  // looser rule is never refused), so the last one recorded is the final
+  // surface's.
   const AcceptFit accept = [&](const LimitSurface& surface, const MatrixX3& points, FitAsk when) {
     if (when == FitAsk::Step) return FitVerdict::Settle;
-    const double distance = measure(surface, points);
+    std::vector<ClosestPoint> nearest;
+    const double distance = measureFitError(surface, points, targets, result.diameter, nullptr, &nearest).maxPercent;
+    if (result.localRefinement)
+      facesToRefine = facesFartherThan(surface, nearest, result.diameter, options.tolerancePercent);
     const bool gained = result.levelDistancesPercent.empty() ||
                         distance < (1.0 - kLeastRefinementGain) * result.levelDistancesPercent.back();
     const bool refine = distance > options.tolerancePercent && gained && when != FitAsk::LastLevelLooseRule;
@@ -76,9 +72,9 @@ DeformationResult deformSurface(const ControlMesh& initial, const MatrixX3& targ
   result.surface = std::move(simulation.surface);
   result.levels = std::move(simulation.levels);
   result.steps = simulation.steps;
-  // Measured again on the final mesh, whichever state the last verdict was
-  // asked at.
-  measure(*result.surface, result.mesh.points());
+  if (result.levelDistancesPercent.size() != result.levels.size())
+    throw Error("internal: a deformation's level ended without its distance measured");
+  result.maxDistancePercent = result.levelDistancesPercent.back();
   result.toleranceMet = result.maxDistancePercent <= options.tolerancePercent;
   result.springLengths = springs.lengths();
   return result;

@@ -141,6 +141,16 @@ FitError measureFitError(const LimitSurface& surface, const MatrixX3& controlPoi
   return error;
 }
 
+std::vector<int> facesFartherThan(const LimitSurface& surface, const std::vector<ClosestPoint>& nearest,
+                                  double diameter, double tolerancePercent) {
+  std::vector<int> faces;
+  for (const ClosestPoint& c : nearest) {
+    // The same percentage as a fit's max error.
+    if (100.0 * c.distance / diameter > tolerancePercent) faces.push_back(surface.elementControlFace(c.point.element));
+  }
+  return faces;
+}
+
 FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const FitOptions& options,
                         const ProgressCallback& progress) {
   const auto started = std::chrono::steady_clock::now();
@@ -204,12 +214,7 @@ FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const 
     // On noisy data a level is refused by its bias, which no one point's
     // distance locates: refined everywhere.
     if (options.refinesLocally() && !result.noiseLimited) {
-      for (const ClosestPoint& c : nearest) {
-        // The same percentage as the verdict's max error.
-        if (100.0 * c.distance / diameter > options.tolerancePercent) {
-          facesToRefine.push_back(surface.elementControlFace(c.point.element));
-        }
-      }
+      facesToRefine = facesFartherThan(surface, nearest, diameter, options.tolerancePercent);
     }
     return e;
   };

@@ -158,6 +158,12 @@ FitError measureFitError(const LimitSurface& surface, const MatrixX3& controlPoi
                          double diameter, const Eigen::MatrixXi* neighbours = nullptr,
                          std::vector<ClosestPoint>* nearest = nullptr);
 
+// The control faces (with repeats) that hold a point's nearest surface point,
+// of `nearest` (measureFitError's), farther than tolerancePercent of
+// `diameter`: where a local refinement (RefineRegion) starts.
+std::vector<int> facesFartherThan(const LimitSurface& surface, const std::vector<ClosestPoint>& nearest,
+                                  double diameter, double tolerancePercent);
+
 // `initial` must be closed. Throws dynsub::Error on bad input or divergence.
 FitResult fitPointCloud(const MatrixX3& data, const ControlMesh& initial, const FitOptions& options,
                         const ProgressCallback& progress = nullptr);
