@@ -113,7 +113,9 @@ void addDeformCommand(CLI::App& app) {
   command->add_option("--stiffness", o->stiffness, "Stiffness of springs that do not give one, N/mm")
       ->default_val(o->stiffness)
       ->check(positiveNumber());
-  command->add_flag("--fix-boundary", o->fixBoundary, "Hold the boundary control vertices of an open mesh in place");
+  command->add_flag("--fix-boundary", o->fixBoundary,
+                    "Hold the boundary of an open mesh in place: its control vertices, and after refinement their new "
+                    "boundary points");
   command
       ->add_option("--tolerance", o->deformation.tolerancePercent,
                    "Largest distance from a spring's target to the surface at which refinement (up to --max-level) "
@@ -125,7 +127,7 @@ void addDeformCommand(CLI::App& app) {
       ->add_option("--refinement", o->refinement,
                    "local: a level's faces near the targets still farther than the tolerance are refined and their "
                    "new points move, while elsewhere the refined mesh keeps the coarser level's shape (the static "
-                   "scheme without --fix-boundary; otherwise every face); global: every face, as the papers do")
+                   "scheme; otherwise every face); global: every face, as the papers do")
       ->default_val("local")
       ->check(CLI::IsMember({"local", "global"}));
   o->simulation.addOptions(*command, DeformationOptions::defaultSimulation());

@@ -167,6 +167,19 @@ for name in surface.vtp control_mesh.obj report.json; do check "deform writes $n
 crown=$(awk '$1 == "v" { n++ } n == 41 { print $4; exit }' "$work/hat/control_mesh.obj")  # vertex 41: the centre
 check "the crown rises (z = $crown)" awk -v z="$crown" 'BEGIN { exit !(z > 0.7) }'
 check "the brim stays" grep -q "^v -1 -1 0$" "$work/hat/control_mesh.obj"
+# Refined twice near the crown, the brim still stays: every point within
+# 0.03 of the rim (the level's spacing is 0.0625) is on it, at z = 0.
+"$DYNSUB" deform "$DATA/Meshes/sheet.obj" --springs "$DATA/Deform/sheet_hat.springs" --fix-boundary \
+  --max-level 2 --tolerance 0.1 --out "$work/hat2" >/dev/null 2>&1
+check "the brim stays through local refinement" python3 -c "
+import json, sys
+r = json.load(open(sys.argv[1] + '/report.json'))
+assert r['levels'] == 2 and r['parameters']['refinement'] == 'local', r
+assert r['free_control_points'] < r['control_vertices'] / 2, r
+rim = [v for v in (list(map(float, l.split()[1:4])) for l in open(sys.argv[1] + '/control_mesh.obj')
+       if l.startswith('v ')) if max(abs(v[0]), abs(v[1])) > 0.97]
+assert len(rim) == 128 and all(v[2] == 0 and max(abs(v[0]), abs(v[1])) == 1 for v in rim), rim
+" "$work/hat2"
 "$DYNSUB" deform "$DATA/Meshes/torus.obj" --springs "$DATA/Deform/torus_pull.springs" --out "$work/torus" >/dev/null 2>&1
 check "deform pulls the torus" test -s "$work/torus/report.json"
 # Refinement up to --max-level while a target is farther than the tolerance,

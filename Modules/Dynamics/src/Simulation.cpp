@@ -578,6 +578,41 @@ bool independentOffRows(const SparseMatrix& m, const std::vector<int>& rows) {
   return pivots.minCoeff() > 1e-12 * pivots.cwiseAbs().maxCoeff();
 }
 
+// The rows of `m` that have nonzeros, all in the columns marked in `columns`.
+std::vector<bool> rowsWithin(const SparseMatrix& m, const std::vector<bool>& columns) {
+  std::vector<bool> within(m.rows(), false);
+  for (Eigen::Index row = 0; row < m.outerSize(); ++row) {
+    bool any = false, all = true;
+    for (SparseMatrix::InnerIterator it(m, row); it; ++it) {
+      if (it.value() == 0.0) continue;
+      any = true;
+      all = all && columns[it.col()];
+    }
+    within[row] = any && all;
+  }
+  return within;
+}
+
+// The points of the mesh refined by `subdivision` that stay where they are
+// (the fixed control vertices of simulate, Simulation.h): the held points of
+// the coarse mesh, which keep their numbers, and every refined point that the
+// held points alone determine (an open mesh's held boundary: its refined
+// vertex and edge points).
+std::vector<bool> heldRefinedRows(const SparseMatrix& subdivision, const std::vector<bool>& held) {
+  std::vector<bool> rows = rowsWithin(subdivision, held);
+  for (size_t v = 0; v < held.size(); ++v) rows[v] = rows[v] || held[v];
+  return rows;
+}
+
+// The indices marked in `mask`.
+std::vector<int> marked(const std::vector<bool>& mask) {
+  std::vector<int> indices;
+  for (int i = 0; i < static_cast<int>(mask.size()); ++i) {
+    if (mask[i]) indices.push_back(i);
+  }
+  return indices;
+}
+
 // The free basis after `coarse` is refined (RefineRegion): the free points
 // before, carried by the subdivision matrix A (A T, or A itself where every
 // point was free), then one new free point per edge point and face point of
@@ -589,8 +624,15 @@ bool independentOffRows(const SparseMatrix& m, const std::vector<int>& rows) {
 // There a direction of the free points would move nothing and the Newton
 // systems T^T (K + H) T would be singular, so the step is refined globally
 // instead. Empty (every point free) when the refinement is global.
+// heldPoints: the free points that do not move; heldRows: the refined mesh's
+// points that must not move (heldRefinedRows). An edge or face point that the
+// held points alone determine gets no free point of its own, so that it stays;
+// a held row that a free point would move (an interior vertex held alone: its
+// vertex point blends its free neighbours) cannot stay under a basis, and the
+// step is refined globally instead.
 SparseMatrix refinedBasis(const Topology& coarse, const SparseMatrix& subdivision, const SparseMatrix& basis,
-                          const std::vector<int>& faces) {
+                          const std::vector<int>& faces, const std::vector<bool>& heldPoints,
+                          const std::vector<bool>& heldRows) {
   std::vector<bool> refined(coarse.faceCount(), false);
   for (int f : faces) {
     if (f < 0 || f >= coarse.faceCount()) throw Error("internal: a face to refine does not exist");
@@ -603,14 +645,18 @@ SparseMatrix refinedBasis(const Topology& coarse, const SparseMatrix& subdivisio
   for (int f = 0; f < coarse.faceCount(); ++f) {
     for (int k = 0; refined[f] && k < coarse.faceSize(f); ++k) freeEdge[coarse.faceEdge(f, k)] = true;
   }
+  const SparseMatrix carried = basis.size() == 0 ? subdivision : SparseMatrix(subdivision * basis);
+  const std::vector<bool> determined = rowsWithin(carried, heldPoints);
+  for (int row = 0; row < static_cast<int>(heldRows.size()); ++row) {
+    if (heldRows[row] && !determined[row]) return SparseMatrix();
+  }
   std::vector<int> newPoints;
   for (int e = 0; e < edges; ++e) {
-    if (freeEdge[e]) newPoints.push_back(vertices + e);
+    if (freeEdge[e] && !determined[vertices + e]) newPoints.push_back(vertices + e);
   }
   for (int f = 0; f < coarse.faceCount(); ++f) {
-    if (refined[f]) newPoints.push_back(vertices + edges + f);
+    if (refined[f] && !determined[vertices + edges + f]) newPoints.push_back(vertices + edges + f);
   }
-  const SparseMatrix carried = basis.size() == 0 ? subdivision : SparseMatrix(subdivision * basis);
   if (!independentOffRows(carried, newPoints)) return SparseMatrix();
   std::vector<Triplet> entries;
   entries.reserve(static_cast<size_t>(carried.nonZeros()) + newPoints.size());
@@ -658,8 +704,14 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
     }
   }
   const bool local = region && options.integrator.scheme == IntegrationScheme::Static;
-  if (local && !fixed.empty()) throw Error("internal: local refinement with fixed control vertices");
   SimulationResult result;
+  // The mesh's points that do not move, and the free points that do not
+  // (the same while every point is free; the carried free points keep their
+  // numbers under a basis).
+  std::vector<bool> heldRows(initial.vertexCount(), false);
+  for (int v : fixed) heldRows[v] = true;
+  std::vector<bool> heldPoints = heldRows;
+  std::vector<int> fixedPoints = fixed;
   ControlMesh mesh = initial;
   SparseMatrix freeBasis;                           // LevelModel::freeBasis of the next level
   MatrixX3 freePoints = mesh.points();              // and its free points
@@ -719,8 +771,9 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
       const bool coarse =
           accept && (!lastLevel || relaxed < options.relaxations) && options.equilibrium.coarseLevelFactor > 1.0;
       LevelEnd end = LevelEnd::Equilibrium;
-      const MatrixX3 points = runLevel(model, forces, fixed, options, asked, coarse, timeStep, progress, summary, end);
-      summary.residual = equilibriumResidual(model, forces, points, fixed);
+      const MatrixX3 points =
+          runLevel(model, forces, fixedPoints, options, asked, coarse, timeStep, progress, summary, end);
+      summary.residual = equilibriumResidual(model, forces, points, fixedPoints);
       mesh.setPoints(meshPoints(freeBasis, points));
       freePoints = points;
       result.steps += summary.steps;
@@ -742,9 +795,15 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
       break;
     }
     SubdividedMesh refined = subdivide(mesh);
-    if (local) freeBasis = refinedBasis(mesh.topology(), refined.subdivisionMatrix, freeBasis, region(mesh.topology()));
+    heldRows = heldRefinedRows(refined.subdivisionMatrix, heldRows);
+    if (local) {
+      freeBasis = refinedBasis(mesh.topology(), refined.subdivisionMatrix, freeBasis, region(mesh.topology()),
+                               heldPoints, heldRows);
+    }
     if (freeBasis.size() == 0) {
       freePoints = refined.mesh.points();
+      heldPoints = heldRows;
+      fixedPoints = marked(heldPoints);
     } else {
       // The free points carried keep their values; the new ones are the new
       // edge and face points' offsets from where subdivision puts them: zero
@@ -752,6 +811,7 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
       MatrixX3 start = MatrixX3::Zero(freeBasis.cols(), 3);
       start.topRows(freePoints.rows()) = freePoints;
       freePoints = std::move(start);
+      heldPoints.resize(freeBasis.cols(), false);  // the new points move
     }
     mesh = std::move(refined.mesh);
   }

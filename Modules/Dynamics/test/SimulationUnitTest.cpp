@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -174,6 +175,68 @@ TEST(StaticScheme, LocalRefinementFreesTheNamedFacesPoints) {
     EXPECT_EQ(result.levels[1].stabilizerUpdates, 0) << mesh.vertexCount();
     EXPECT_EQ(result.surface->controlVertexCount(), result.mesh.vertexCount());
   }
+}
+
+// The flat sheet's boundary held, its centre pulled up by springs, refined
+// twice: every boundary point of the final mesh stays on the square's rim at
+// z = 0 (the boundary's new vertex and edge points are determined by the held
+// ones alone), globally, and locally with the pulled faces named, which frees
+// fewer points. A vertex held alone inside the sheet cannot stay under a free
+// basis (its vertex point blends free neighbours): a local step there is taken
+// globally, and the vertex stays where the refinement put it.
+TEST(StaticScheme, HeldPointsStayHeldThroughRefinement) {
+  const ControlMesh sheet = makeSheet81();
+  std::vector<int> boundary;
+  for (int v = 0; v < sheet.vertexCount(); ++v) {
+    if (sheet.topology().isBoundaryVertex(v)) boundary.push_back(v);
+  }
+  MatrixX3 targets(5, 3);
+  targets << 0, 0, 0.9, 0.25, 0, 0.8, -0.25, 0, 0.8, 0, 0.25, 0.8, 0, -0.25, 0.8;
+  const AcceptFit refineTwice = [](const LimitSurface&, const MatrixX3&, FitAsk when) {
+    return when == FitAsk::LevelEnd ? FitVerdict::Refine : FitVerdict::Settle;
+  };
+  const int centreVertex = 40;  // (0, 0); vertices keep their numbers through refinement
+  // The faces at the centre and a ring around them: a quarter of the sheet's
+  // side at level 0, 3/8 of it at level 1.
+  const RefineRegion centre = [&](const Topology& mesh) { return grownFaces(mesh, mesh.vertexFaces(centreVertex), 1); };
+  int freeGlobal = 0, freeLocal = 0;
+  for (const bool local : {false, true}) {
+    SpringForceModel springs(targets, Eigen::VectorXd::Constant(targets.rows(), 20.0),
+                             SpringForceModel::Attach::NearestAtLevelStart);
+    const SimulationResult result =
+        simulate(sheet, {&springs}, boundary, relaxingOptions(2, 0), refineTwice, nullptr, local ? centre : nullptr);
+    ASSERT_EQ(result.levels.size(), 3u);
+    const MatrixX3& points = result.mesh.points();
+    int rim = 0;
+    for (int v = 0; v < result.mesh.vertexCount(); ++v) {
+      if (!result.mesh.topology().isBoundaryVertex(v)) continue;
+      ++rim;
+      // Subdivision's weights on held points (sums of a few binary
+      // fractions): exact up to rounding.
+      EXPECT_NEAR(points(v, 2), 0.0, 1e-12) << v;
+      EXPECT_NEAR(std::max(std::abs(points(v, 0)), std::abs(points(v, 1))), 1.0, 1e-12) << v;
+    }
+    EXPECT_EQ(rim, 128);
+    EXPECT_GT(points.col(2).maxCoeff(), 0.5);  // the centre rose toward the springs (z 0.8-0.9)
+    (local ? freeLocal : freeGlobal) = result.levels.back().freeControlPoints;
+  }
+  EXPECT_EQ(freeGlobal, 1089);
+  EXPECT_LT(freeLocal, freeGlobal / 2);
+
+  const auto holdCentre = [&](int maxLevel) {
+    SpringForceModel springs(targets, Eigen::VectorXd::Constant(targets.rows(), 20.0),
+                             SpringForceModel::Attach::NearestAtLevelStart);
+    return simulate(sheet, {&springs}, {centreVertex}, relaxingOptions(maxLevel, 0), refineTwice, nullptr, centre);
+  };
+  const SimulationResult held = holdCentre(1);
+  ASSERT_EQ(held.levels.size(), 2u);
+  EXPECT_EQ(held.levels[1].freeControlPoints, held.levels[1].controlVertices);
+  // Where level 0's equilibrium (the same run stopped there) subdivides it
+  // to; each level's equilibrium is one exact Newton step of linear springs,
+  // so the two runs agree to rounding.
+  const MatrixX3 start = subdivide(holdCentre(0).mesh).mesh.points();
+  EXPECT_LT((held.mesh.points().row(centreVertex) - start.row(centreVertex)).norm(), 1e-9);
+  EXPECT_GT(start(centreVertex, 2), 0.1);  // lifted by its neighbours, then held
 }
 
 // A result whose level was relaxed says so in its origin, and a refit from it

@@ -22,8 +22,8 @@ SimulationOptions DeformationOptions::defaultSimulation() {
   return o;
 }
 
-bool DeformationOptions::refinesLocally(const std::vector<int>& fixed) const {
-  return localRefinement && fixed.empty() && simulation.integrator.scheme == IntegrationScheme::Static;
+bool DeformationOptions::refinesLocally() const {
+  return localRefinement && simulation.integrator.scheme == IntegrationScheme::Static;
 }
 
 DeformationResult deformSurface(const ControlMesh& initial, const MatrixX3& targets, const Eigen::VectorXd& stiffness,
@@ -37,7 +37,7 @@ DeformationResult deformSurface(const ControlMesh& initial, const MatrixX3& targ
   extent << initial.points(), targets;
   result.diameter = 2.0 * smallestEnclosingSphere(extent).radius;
   if (!(result.diameter > 0)) throw Error("the control mesh and the springs' targets are all one point");
-  result.localRefinement = options.refinesLocally(fixed);
+  result.localRefinement = options.refinesLocally();
 
   SpringForceModel springs(targets, stiffness, SpringForceModel::Attach::NearestAtLevelStart);
   // The faces, of the level last measured, that hold a target's nearest

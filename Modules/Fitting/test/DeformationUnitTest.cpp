@@ -108,12 +108,11 @@ TEST(Deformation, ReportsAnUnmetToleranceWithoutRefinement) {
   EXPECT_EQ(r.springLengths.size(), bumpTargets().rows());
 }
 
-TEST(Deformation, FixedControlVerticesRefineGlobally) {
+TEST(Deformation, RefinesLocallyUnderTheStaticSchemeOnly) {
   DeformationOptions options;
-  EXPECT_TRUE(options.refinesLocally({}));
-  EXPECT_FALSE(options.refinesLocally({0}));
+  EXPECT_TRUE(options.refinesLocally());
   options.simulation.integrator.scheme = IntegrationScheme::FirstOrder;
-  EXPECT_FALSE(options.refinesLocally({}));
+  EXPECT_FALSE(options.refinesLocally());
 }
 
 TEST(Deformation, RefusesBadOptions) {

@@ -227,7 +227,12 @@ using RefineRegion = std::function<std::vector<int>(const Topology& mesh)>;
 std::vector<int> grownFaces(const Topology& mesh, const std::vector<int>& faces, int rings);
 
 // forces are not owned. fixed: control vertices of the initial mesh that do not
-// move (they keep their numbers through refinement); not with `region`.
+// move. They keep their numbers through refinement, and each refinement holds
+// as well every new point that the held points alone determine: an open
+// mesh's held boundary stays held, its new vertex and edge points included.
+// With `region`, a held point that a free point would move (an interior vertex
+// held alone: its vertex point blends its neighbours) makes that refinement
+// global.
 // Throws dynsub::Error on bad options or unrecoverable divergence.
 SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceModel*>& forces,
                           const std::vector<int>& fixed, const SimulationOptions& options,

@@ -32,15 +32,15 @@ struct DeformationOptions {
   // The largest distance from a target to the surface that ends refinement,
   // percent of the diameter (see above).
   double tolerancePercent = 1.0;
-  // Refine only near the targets still too far (the static scheme only, and
-  // not with fixed control vertices); false: every face.
+  // Refine only near the targets still too far (the static scheme only);
+  // false: every face.
   bool localRefinement = true;
   SimulationOptions simulation = defaultSimulation();
 
   // The static scheme, no refinement.
   static SimulationOptions defaultSimulation();
-  // Whether refinement is local for these fixed control vertices.
-  bool refinesLocally(const std::vector<int>& fixed) const;
+  // Whether refinement is local.
+  bool refinesLocally() const;
 };
 
 struct DeformationResult {
