@@ -26,6 +26,7 @@ struct DeformArguments {
   double stiffness = 10.0;
   bool fixBoundary = false;
   std::string refinement = "local";
+  std::string restShape = "initial";
   DeformationOptions deformation;
   SimulationArguments simulation;
 };
@@ -37,6 +38,7 @@ void runDeform(DeformArguments o) {
   prepareOutputDirectory(dir);
   o.deformation.simulation = o.simulation.apply(o.simulation.values);
   o.deformation.localRefinement = o.refinement == "local";
+  o.deformation.simulation.restShape = o.restShape == "initial";
 
   std::vector<int> fixed;
   if (o.fixBoundary) {
@@ -83,6 +85,7 @@ void runDeform(DeformArguments o) {
   parameters.set("default_spring_stiffness", o.stiffness);
   parameters.set("fix_boundary", o.fixBoundary);
   parameters.set("refinement", result.localRefinement ? "local" : "global");
+  parameters.set("rest_shape", o.restShape);
   report.set("parameters", parameters);
 
   writeModelOutputs(dir, result.mesh, outputSurface(result.mesh), report,
@@ -130,6 +133,13 @@ void addDeformCommand(CLI::App& app) {
                    "scheme; otherwise every face); global: every face, as the papers do")
       ->default_val("local")
       ->check(CLI::IsMember({"local", "global"}));
+  command
+      ->add_option("--rest-shape", o->restShape,
+                   "initial: the surface's elasticity resists departing from the input mesh's shape, so only the "
+                   "pulled region gives; none: it resists any stretch and bend, as the papers' model does, and a "
+                   "closed surface pulled in one place shrinks elsewhere unless springs anchor it")
+      ->default_val("initial")
+      ->check(CLI::IsMember({"initial", "none"}));
   o->simulation.addOptions(*command, DeformationOptions::defaultSimulation());
   command->callback([o] { runDeform(*o); });
 }

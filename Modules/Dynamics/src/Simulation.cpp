@@ -125,6 +125,28 @@ void acceptState(const std::vector<ForceModel*>& forces) {
   for (ForceModel* f : forces) f->acceptState();
 }
 
+// The elasticity's pull toward a rest shape r (SimulationOptions::restShape):
+// the energy 1/2 (p - r)^T K (p - r) is 1/2 p^T K p less (K r)^T p, plus a
+// constant, so r adds the constant force K r.
+class RestShapeForce final : public ForceModel {
+ public:
+  // K and r of a level, over its free points.
+  void set(const SymmetricMatrix& stiffness, const MatrixX3& rest) {
+    force_ = stiffness * rest;
+    restEnergy_ = 0.5 * (force_.array() * rest.array()).sum();
+  }
+  void beginLevel(const LimitSurface&, const SurfaceQuadrature&, const MatrixX3&) override {}
+  MatrixX3 generalizedForce(const MatrixX3& controlPoints, double& potential) override {
+    potential += restEnergy_ - (force_.array() * controlPoints.array()).sum();
+    return force_;
+  }
+  bool hasPotential() const override { return true; }
+
+ private:
+  MatrixX3 force_;
+  double restEnergy_ = 0;
+};
+
 // The equilibrium rule of Simulation.h over a sliding window of steps.
 class EquilibriumWindow {
  public:
@@ -712,6 +734,11 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
   for (int v : fixed) heldRows[v] = true;
   std::vector<bool> heldPoints = heldRows;
   std::vector<int> fixedPoints = fixed;
+  // The rest shape over the free points, and the forces with its pull.
+  MatrixX3 restPoints = initial.points();
+  RestShapeForce rest;
+  std::vector<ForceModel*> allForces = forces;
+  if (options.restShape) allForces.push_back(&rest);
   ControlMesh mesh = initial;
   SparseMatrix freeBasis;                           // LevelModel::freeBasis of the next level
   MatrixX3 freePoints = mesh.points();              // and its free points
@@ -771,9 +798,10 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
       const bool coarse =
           accept && (!lastLevel || relaxed < options.relaxations) && options.equilibrium.coarseLevelFactor > 1.0;
       LevelEnd end = LevelEnd::Equilibrium;
+      if (options.restShape) rest.set(model.matrices.stiffness, restPoints);
       const MatrixX3 points =
-          runLevel(model, forces, fixedPoints, options, asked, coarse, timeStep, progress, summary, end);
-      summary.residual = equilibriumResidual(model, forces, points, fixedPoints);
+          runLevel(model, allForces, fixedPoints, options, asked, coarse, timeStep, progress, summary, end);
+      summary.residual = equilibriumResidual(model, allForces, points, fixedPoints);
       mesh.setPoints(meshPoints(freeBasis, points));
       freePoints = points;
       result.steps += summary.steps;
@@ -796,12 +824,14 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
     }
     SubdividedMesh refined = subdivide(mesh);
     heldRows = heldRefinedRows(refined.subdivisionMatrix, heldRows);
+    const MatrixX3 restMesh = refined.subdivisionMatrix * meshPoints(freeBasis, restPoints);
     if (local) {
       freeBasis = refinedBasis(mesh.topology(), refined.subdivisionMatrix, freeBasis, region(mesh.topology()),
                                heldPoints, heldRows);
     }
     if (freeBasis.size() == 0) {
       freePoints = refined.mesh.points();
+      restPoints = restMesh;
       heldPoints = heldRows;
       fixedPoints = marked(heldPoints);
     } else {
@@ -812,6 +842,9 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
       start.topRows(freePoints.rows()) = freePoints;
       freePoints = std::move(start);
       heldPoints.resize(freeBasis.cols(), false);  // the new points move
+      MatrixX3 restStart = MatrixX3::Zero(freeBasis.cols(), 3);
+      restStart.topRows(restPoints.rows()) = restPoints;
+      restPoints = std::move(restStart);
     }
     mesh = std::move(refined.mesh);
   }

@@ -239,6 +239,58 @@ TEST(StaticScheme, HeldPointsStayHeldThroughRefinement) {
   EXPECT_GT(start(centreVertex, 2), 0.1);  // lifted by its neighbours, then held
 }
 
+// With a rest shape (SimulationOptions::restShape) the elasticity holds the
+// initial shape: springs already met move nothing, before refinement and
+// after it, global or local (the rest shape is carried as the points are).
+// The torus stretched along x and lifted on one side (Data/Deform's
+// torus_pull) keeps its tube, where without a rest shape the tension
+// flattens it to a ribbon.
+TEST(StaticScheme, ARestShapeHoldsTheSurfaceWhereNothingPulls) {
+  const ControlMesh torus = makeTorus32();
+  const AcceptFit refineOnce = [](const LimitSurface&, const MatrixX3&, FitAsk when) {
+    return when == FitAsk::LevelEnd ? FitVerdict::Refine : FitVerdict::Settle;
+  };
+  const RefineRegion firstFace = [](const Topology&) { return std::vector<int>{0}; };
+  SimulationOptions options = relaxingOptions(1, 0);
+  options.elasticityPerLevel = 1.0;
+  options.restShape = true;
+  const MatrixX3 met = tessellate(LimitSurface(torus), torus.points(), 1).points;
+  const MatrixX3 refined = subdivide(torus).mesh.points();
+  for (const bool local : {false, true}) {
+    SpringForceModel springs(met, Eigen::VectorXd::Constant(met.rows(), 1.0),
+                             SpringForceModel::Attach::NearestAtLevelStart);
+    const SimulationResult result =
+        simulate(torus, {&springs}, {}, options, refineOnce, nullptr, local ? firstFace : nullptr);
+    ASSERT_EQ(result.levels.size(), 2u);
+    EXPECT_LT((result.mesh.points() - refined).cwiseAbs().maxCoeff(), 1e-9) << local;
+  }
+
+  MatrixX3 pull(4, 3);
+  pull << 2.0, 0, 0, -2.0, 0, 0, 0, 1.2, 0.8, 0, -1.2, -0.8;
+  Eigen::VectorXd stiffness(4);
+  stiffness << 10, 10, 5, 5;
+  // The tube's height where the ring is stretched (near y = 0, x < 0); 2/3
+  // on the initial limit surface.
+  const auto tubeHeight = [&](bool restShape) {
+    SpringForceModel springs(pull, stiffness, SpringForceModel::Attach::NearestAtLevelStart);
+    SimulationOptions o;
+    o.integrator.scheme = IntegrationScheme::Static;
+    o.restShape = restShape;
+    const SimulationResult result = simulate(torus, {&springs}, {}, o);
+    const MatrixX3 p = tessellate(*result.surface, result.mesh.points(), 8).points;
+    double low = 0.0, high = 0.0;
+    for (Eigen::Index i = 0; i < p.rows(); ++i) {
+      if (std::abs(p(i, 1)) < 0.05 && p(i, 0) < 0.0) {
+        low = std::min(low, p(i, 2));
+        high = std::max(high, p(i, 2));
+      }
+    }
+    return high - low;
+  };
+  EXPECT_GT(tubeHeight(true), 0.6);   // 0.71 measured
+  EXPECT_LT(tubeHeight(false), 0.2);  // 0.06 measured
+}
+
 // A result whose level was relaxed says so in its origin, and a refit from it
 // continues at the relaxed elasticity with only the relaxations left: with
 // none left, a Relax verdict ends the refit at its one level, where a fresh

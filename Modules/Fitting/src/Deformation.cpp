@@ -19,6 +19,10 @@ SimulationOptions DeformationOptions::defaultSimulation() {
   // after 262).
   o.integrator.scheme = IntegrationScheme::Static;
   o.maxLevel = 0;
+  // Modeling changes a shape where it is pulled: without a rest shape the
+  // tension would shrink the rest of a closed model (the torus pull flattens
+  // its tube to a tenth of its height; Dynamics.md).
+  o.restShape = true;
   return o;
 }
 

@@ -20,7 +20,8 @@ namespace {
 // on each face (where the limit surface is the face's plane, x, y or z =
 // +-1), less the top's centre; and 69 targets over the middle of the top,
 // raised into a Gaussian bump 0.25 high and 0.1 wide. Without the anchors
-// the surface's tension would shrink the cube onto the bump.
+// the springs, far stiffer than the surface, would pull the coarse cube,
+// which cannot form so narrow a bump, into a wild shape.
 MatrixX3 bumpTargets() {
   std::vector<Vector3> points;
   for (int axis = 0; axis < 3; ++axis) {

@@ -93,6 +93,12 @@ struct SimulationOptions {
   // earlier fit had reached; every point of its mesh is free (a local
   // refinement's free basis is not carried). The default is a fresh start.
   LevelOrigin origin;
+  // The shape the surface's elasticity holds: false, none (the papers'
+  // model: tension and rigidity resist any stretch and bend, so a closed
+  // surface that forces pull in one place shrinks everywhere else); true, the
+  // initial mesh's (its energy is that of the departure p - p0, p0 the
+  // initial control points, carried through refinement as the points are).
+  bool restShape = false;
   // Tension and rigidity at level g are multiplied by elasticityPerLevel^g.
   // 1 keeps the physics of the initial model (the energy of a surface does not
   // depend on the level); < 1 lets each refinement trade smoothing for detail.

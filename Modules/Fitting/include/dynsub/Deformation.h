@@ -37,7 +37,7 @@ struct DeformationOptions {
   bool localRefinement = true;
   SimulationOptions simulation = defaultSimulation();
 
-  // The static scheme, no refinement.
+  // The static scheme, no refinement, the initial shape at rest.
   static SimulationOptions defaultSimulation();
   // Whether refinement is local.
   bool refinesLocally() const;
