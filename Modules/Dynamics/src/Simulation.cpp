@@ -32,8 +32,10 @@ double quadraticForm(const SymmetricMatrix& a, const MatrixX3& x) {
   return (x.array() * applyOperator(a, x).array()).sum();
 }
 
-double relativeChange(double energy, double last) {
-  return std::abs(energy - last) / std::max({std::abs(energy), std::abs(last), 1e-300});
+// |energy - last| relative to the larger of the two, or to `floor` where
+// both are smaller (LevelModel::energyFloor).
+double relativeChange(double energy, double last, double floor) {
+  return std::abs(energy - last) / std::max({std::abs(energy), std::abs(last), floor, 1e-300});
 }
 
 // Everything a level is built on: the surface of its control mesh and the
@@ -53,6 +55,13 @@ struct LevelModel {
   // (RefineRegion; #mesh vertices by #free), or empty: every point free.
   // The surface, the matrices and the states are over the free points.
   SparseMatrix freeBasis{};
+  // 1/2 r^T K r of the rest shape r (SimulationOptions::restShape; 0 without
+  // one): the size of the terms that cancel in the energy 1/2 (p - r)^T K
+  // (p - r) as it is summed. Near the rest shape the energy is rounding of
+  // that size, whose changes are no rise and no divergence, and are measured
+  // against energyFloor rather than against the energy.
+  double restEnergy = 0;
+  double energyFloor = 0;  // 1e-9 restEnergy: well above the sum's rounding
 };
 
 // The mesh's points at free points `points` (LevelModel::freeBasis).
@@ -141,6 +150,7 @@ class RestShapeForce final : public ForceModel {
     return force_;
   }
   bool hasPotential() const override { return true; }
+  double restEnergy() const { return restEnergy_; }
 
  private:
   MatrixX3 force_;
@@ -293,7 +303,7 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
     const MatrixX3 velocity = (points - previous) / timeStep;
     const double energy = 0.5 * quadraticForm(model.matrices.mass, velocity) +
                           0.5 * quadraticForm(model.matrices.stiffness, points) + potential;
-    if (step == 1) firstEnergy = std::abs(energy);
+    if (step == 1) firstEnergy = std::max(std::abs(energy), model.restEnergy);
     if (!std::isfinite(energy) || std::abs(energy) > 1e3 * std::max(firstEnergy, 1e-300)) return LevelEnd::Diverged;
     if (step > 1) {
       // The forces were just evaluated at `points`: a fit met there ends here.
@@ -301,7 +311,7 @@ LevelEnd runTimeSteps(const LevelModel& model, const std::vector<ForceModel*>& f
         summary.energy = energy;
         return LevelEnd::Met;
       }
-      const double change = relativeChange(energy, lastEnergy);
+      const double change = relativeChange(energy, lastEnergy, model.energyFloor);
       const double shape = stepMotion.measure(
           previous, points, change, asked ? options.equilibrium.energyTolerance : loose.energyTolerance);
       const bool still = window.settled(change, shape);
@@ -437,7 +447,7 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
         if (!std::isfinite(trialEnergy)) continue;
         evaluated = true;
         // Rounding of the energy's sum must not count as a rise.
-        accepted = !lineSearch || trialEnergy <= energy + 1e-12 * std::abs(energy);
+        accepted = !lineSearch || trialEnergy <= energy + 1e-12 * (std::abs(energy) + model.restEnergy);
         if (accepted && !isotropic) lastLength = tried;
         // The next length is the lowest point of the parabola through the
         // energy here, its slope here and the energy at the rejected length,
@@ -459,7 +469,7 @@ LevelEnd runStaticSteps(const LevelModel& model, const std::vector<ForceModel*>&
       return finish(lineSearch && evaluated ? LevelEnd::Equilibrium : LevelEnd::Diverged);
     }
     const double motion = (trial - points).rowwise().norm().maxCoeff();
-    const double change = relativeChange(trialEnergy, energy);
+    const double change = relativeChange(trialEnergy, energy, model.energyFloor);
     acceptState(forces);
     previous = std::move(points);
     points = std::move(trial);
@@ -627,7 +637,7 @@ std::vector<bool> heldRefinedRows(const SparseMatrix& subdivision, const std::ve
 }
 
 // The indices marked in `mask`.
-std::vector<int> marked(const std::vector<bool>& mask) {
+std::vector<int> indicesOf(const std::vector<bool>& mask) {
   std::vector<int> indices;
   for (int i = 0; i < static_cast<int>(mask.size()); ++i) {
     if (mask[i]) indices.push_back(i);
@@ -646,15 +656,15 @@ std::vector<int> marked(const std::vector<bool>& mask) {
 // There a direction of the free points would move nothing and the Newton
 // systems T^T (K + H) T would be singular, so the step is refined globally
 // instead. Empty (every point free) when the refinement is global.
-// heldPoints: the free points that do not move; heldRows: the refined mesh's
-// points that must not move (heldRefinedRows). An edge or face point that the
-// held points alone determine gets no free point of its own, so that it stays;
-// a held row that a free point would move (an interior vertex held alone: its
-// vertex point blends its free neighbours) cannot stay under a basis, and the
-// step is refined globally instead.
+// heldFreePoints: the free points that do not move; heldMeshPoints: the
+// refined mesh's points that must not move (heldRefinedRows). An edge or face
+// point that the held points alone determine gets no free point of its own,
+// so that it stays; a held mesh point that a free point would move (an
+// interior vertex held alone: its vertex point blends its free neighbours)
+// cannot stay under a basis, and the step is refined globally instead.
 SparseMatrix refinedBasis(const Topology& coarse, const SparseMatrix& subdivision, const SparseMatrix& basis,
-                          const std::vector<int>& faces, const std::vector<bool>& heldPoints,
-                          const std::vector<bool>& heldRows) {
+                          const std::vector<int>& faces, const std::vector<bool>& heldFreePoints,
+                          const std::vector<bool>& heldMeshPoints) {
   std::vector<bool> refined(coarse.faceCount(), false);
   for (int f : faces) {
     if (f < 0 || f >= coarse.faceCount()) throw Error("internal: a face to refine does not exist");
@@ -668,9 +678,9 @@ SparseMatrix refinedBasis(const Topology& coarse, const SparseMatrix& subdivisio
     for (int k = 0; refined[f] && k < coarse.faceSize(f); ++k) freeEdge[coarse.faceEdge(f, k)] = true;
   }
   const SparseMatrix carried = basis.size() == 0 ? subdivision : SparseMatrix(subdivision * basis);
-  const std::vector<bool> determined = rowsWithin(carried, heldPoints);
-  for (int row = 0; row < static_cast<int>(heldRows.size()); ++row) {
-    if (heldRows[row] && !determined[row]) return SparseMatrix();
+  const std::vector<bool> determined = rowsWithin(carried, heldFreePoints);
+  for (int row = 0; row < static_cast<int>(heldMeshPoints.size()); ++row) {
+    if (heldMeshPoints[row] && !determined[row]) return SparseMatrix();
   }
   std::vector<int> newPoints;
   for (int e = 0; e < edges; ++e) {
@@ -730,10 +740,10 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
   // The mesh's points that do not move, and the free points that do not
   // (the same while every point is free; the carried free points keep their
   // numbers under a basis).
-  std::vector<bool> heldRows(initial.vertexCount(), false);
-  for (int v : fixed) heldRows[v] = true;
-  std::vector<bool> heldPoints = heldRows;
-  std::vector<int> fixedPoints = fixed;
+  std::vector<bool> heldMeshPoints(initial.vertexCount(), false);
+  for (int v : fixed) heldMeshPoints[v] = true;
+  std::vector<bool> heldFreePoints = heldMeshPoints;
+  std::vector<int> fixedPoints = fixed;  // indicesOf(heldFreePoints), as the solvers take them
   // The rest shape over the free points, and the forces with its pull.
   MatrixX3 restPoints = initial.points();
   RestShapeForce rest;
@@ -792,13 +802,17 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
       LevelSummary summary;
       summary.level = level;
       summary.controlVertices = mesh.vertexCount();
-      summary.freeControlPoints = static_cast<int>(freePoints.rows());
+      summary.freeControlPoints = static_cast<int>(freePoints.rows() - fixedPoints.size());
       summary.elasticity = model.elasticity;
       // A level that will be refined or relaxed may end at a looser rule.
       const bool coarse =
           accept && (!lastLevel || relaxed < options.relaxations) && options.equilibrium.coarseLevelFactor > 1.0;
       LevelEnd end = LevelEnd::Equilibrium;
-      if (options.restShape) rest.set(model.matrices.stiffness, restPoints);
+      if (options.restShape) {
+        rest.set(model.matrices.stiffness, restPoints);
+        model.restEnergy = rest.restEnergy();
+        model.energyFloor = 1e-9 * model.restEnergy;
+      }
       const MatrixX3 points =
           runLevel(model, allForces, fixedPoints, options, asked, coarse, timeStep, progress, summary, end);
       summary.residual = equilibriumResidual(model, allForces, points, fixedPoints);
@@ -823,17 +837,18 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
       break;
     }
     SubdividedMesh refined = subdivide(mesh);
-    heldRows = heldRefinedRows(refined.subdivisionMatrix, heldRows);
-    const MatrixX3 restMesh = refined.subdivisionMatrix * meshPoints(freeBasis, restPoints);
+    heldMeshPoints = heldRefinedRows(refined.subdivisionMatrix, heldMeshPoints);
+    const MatrixX3 restMesh =
+        options.restShape ? MatrixX3(refined.subdivisionMatrix * meshPoints(freeBasis, restPoints)) : MatrixX3();
     if (local) {
       freeBasis = refinedBasis(mesh.topology(), refined.subdivisionMatrix, freeBasis, region(mesh.topology()),
-                               heldPoints, heldRows);
+                               heldFreePoints, heldMeshPoints);
     }
     if (freeBasis.size() == 0) {
       freePoints = refined.mesh.points();
-      restPoints = restMesh;
-      heldPoints = heldRows;
-      fixedPoints = marked(heldPoints);
+      if (options.restShape) restPoints = restMesh;
+      heldFreePoints = heldMeshPoints;
+      fixedPoints = indicesOf(heldFreePoints);
     } else {
       // The free points carried keep their values; the new ones are the new
       // edge and face points' offsets from where subdivision puts them: zero
@@ -841,10 +856,12 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
       MatrixX3 start = MatrixX3::Zero(freeBasis.cols(), 3);
       start.topRows(freePoints.rows()) = freePoints;
       freePoints = std::move(start);
-      heldPoints.resize(freeBasis.cols(), false);  // the new points move
-      MatrixX3 restStart = MatrixX3::Zero(freeBasis.cols(), 3);
-      restStart.topRows(restPoints.rows()) = restPoints;
-      restPoints = std::move(restStart);
+      heldFreePoints.resize(freeBasis.cols(), false);  // the new points move
+      if (options.restShape) {
+        MatrixX3 restStart = MatrixX3::Zero(freeBasis.cols(), 3);
+        restStart.topRows(restPoints.rows()) = restPoints;
+        restPoints = std::move(restStart);
+      }
     }
     mesh = std::move(refined.mesh);
   }

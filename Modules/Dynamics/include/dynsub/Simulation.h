@@ -127,8 +127,8 @@ struct SimulationOptions {
 struct LevelSummary {
   int level = 0;  // global refinements of the initial control mesh
   int controlVertices = 0;
-  // The control points that move (RefineRegion): controlVertices unless the
-  // refinement was local.
+  // The control points that move: controlVertices less the fixed ones, or
+  // fewer where the refinement was local (RefineRegion).
   int freeControlPoints = 0;
   // The factor on tension and rigidity: elasticityPerLevel^(level + relaxations run).
   double elasticity = 1.0;
@@ -233,9 +233,12 @@ using RefineRegion = std::function<std::vector<int>(const Topology& mesh)>;
 std::vector<int> grownFaces(const Topology& mesh, const std::vector<int>& faces, int rings);
 
 // forces are not owned. fixed: control vertices of the initial mesh that do not
-// move. They keep their numbers through refinement, and each refinement holds
-// as well every new point that the held points alone determine: an open
-// mesh's held boundary stays held, its new vertex and edge points included.
+// move within a level. They keep their numbers through refinement, which
+// puts each where the subdivision rules do (an interior one's vertex point
+// blends its neighbours, so it moves with them; a boundary one's blends boundary
+// points alone, so it stays where those are held too), and each refinement holds as well every
+// new point that the held points alone determine: an open mesh's held
+// boundary stays where it is, its new vertex and edge points included.
 // With `region`, a held point that a free point would move (an interior vertex
 // held alone: its vertex point blends its neighbours) makes that refinement
 // global.
