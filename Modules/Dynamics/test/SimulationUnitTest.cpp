@@ -196,7 +196,7 @@ TEST(StaticScheme, HeldPointsStayHeldThroughRefinement) {
     return when == FitAsk::LevelEnd ? FitVerdict::Refine : FitVerdict::Settle;
   };
   const int centreVertex = 40;  // (0, 0); vertices keep their numbers through refinement
-  const int cornerVertex = 0;  // (-1, -1)
+  const int cornerVertex = 0;   // (-1, -1)
   // The faces at the centre and at a corner, and a ring around them: the
   // corner's reach the boundary, whose new points the held ones determine.
   const RefineRegion centre = [&](const Topology& mesh) {
