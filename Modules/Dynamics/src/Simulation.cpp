@@ -561,6 +561,10 @@ MatrixX3 runLevel(const LevelModel& model, const std::vector<ForceModel*>& force
 
 }  // namespace
 
+bool takesRefineRegion(const SimulationOptions& options) {
+  return options.integrator.scheme == IntegrationScheme::Static;
+}
+
 void checkSimulationOptions(const SimulationOptions& o) {
   checkMaterial(o.material);
   const EquilibriumOptions& e = o.equilibrium;
@@ -735,7 +739,7 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
                   std::to_string(initial.vertexCount()) + ")");
     }
   }
-  const bool local = region && options.integrator.scheme == IntegrationScheme::Static;
+  const bool local = region && takesRefineRegion(options);
   SimulationResult result;
   // The mesh's points that do not move, and the free points that do not
   // (the same while every point is free; the carried free points keep their
@@ -743,7 +747,6 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
   std::vector<bool> heldMeshPoints(initial.vertexCount(), false);
   for (int v : fixed) heldMeshPoints[v] = true;
   std::vector<bool> heldFreePoints = heldMeshPoints;
-  std::vector<int> fixedPoints = fixed;  // indicesOf(heldFreePoints), as the solvers take them
   // The rest shape over the free points, and the forces with its pull.
   MatrixX3 restPoints = initial.points();
   RestShapeForce rest;
@@ -780,6 +783,7 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
     // A level refused as close is first run on with weaker elasticity
     // (relaxations), then refined.
     LevelModel& model = *built;
+    const std::vector<int> fixedPoints = indicesOf(heldFreePoints);  // as the solvers take them
     const bool lastLevel = level >= options.maxLevel;
     FitVerdict verdict = FitVerdict::Settle;  // the last one asked of this level
     const AcceptFit asked =
@@ -848,7 +852,6 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
       freePoints = refined.mesh.points();
       if (options.restShape) restPoints = restMesh;
       heldFreePoints = heldMeshPoints;
-      fixedPoints = indicesOf(heldFreePoints);
     } else {
       // The free points carried keep their values; the new ones are the new
       // edge and face points' offsets from where subdivision puts them: zero

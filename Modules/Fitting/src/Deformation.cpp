@@ -26,9 +26,7 @@ SimulationOptions DeformationOptions::defaultSimulation() {
   return o;
 }
 
-bool DeformationOptions::refinesLocally() const {
-  return localRefinement && simulation.integrator.scheme == IntegrationScheme::Static;
-}
+bool DeformationOptions::refinesLocally() const { return localRefinement && takesRefineRegion(simulation); }
 
 DeformationResult deformSurface(const ControlMesh& initial, const MatrixX3& targets, const Eigen::VectorXd& stiffness,
                                 const std::vector<int>& fixed, const DeformationOptions& options,

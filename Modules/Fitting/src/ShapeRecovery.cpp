@@ -40,9 +40,7 @@ SimulationOptions FitOptions::defaultSimulation() {
   return o;
 }
 
-bool FitOptions::refinesLocally() const {
-  return localRefinement && simulation.integrator.scheme == IntegrationScheme::Static;
-}
+bool FitOptions::refinesLocally() const { return localRefinement && takesRefineRegion(simulation); }
 
 double noiseReach(Eigen::Index points) {
   return std::sqrt(2.0 * std::log(static_cast<double>(std::max<Eigen::Index>(points, 2))));

@@ -221,7 +221,8 @@ using ProgressCallback = std::function<void(const Progress&)>;
 // point of the refined mesh stays where subdivision puts it from the free
 // points before, so away from those faces the surface keeps the coarser
 // level's shape and freedom (the level is solved for the free points alone,
-// over LimitSurface.h's free basis). Used by the static scheme only; without
+// over LimitSurface.h's free basis). Used by the static scheme only
+// (takesRefineRegion); without
 // it, when every face is named on a mesh whose points are all free, or where
 // the free points would not stay independent, every point of the refined
 // mesh is free.
@@ -247,6 +248,10 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
                           const std::vector<int>& fixed, const SimulationOptions& options,
                           const AcceptFit& accept = nullptr, const ProgressCallback& progress = nullptr,
                           const RefineRegion& region = nullptr);
+
+// Whether simulate refines locally when given a RefineRegion: under the static
+// scheme only (see above).
+bool takesRefineRegion(const SimulationOptions& options);
 
 void checkSimulationOptions(const SimulationOptions& options);
 
