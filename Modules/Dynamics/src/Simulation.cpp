@@ -640,6 +640,14 @@ std::vector<bool> heldRefinedRows(const SparseMatrix& subdivision, const std::ve
   return rows;
 }
 
+// `points` followed by zero rows, up to `rows` in all: free points carried
+// into a refined basis, whose new columns are offsets (refinedBasis).
+MatrixX3 withNewOffsets(const MatrixX3& points, Eigen::Index rows) {
+  MatrixX3 padded = MatrixX3::Zero(rows, 3);
+  padded.topRows(points.rows()) = points;
+  return padded;
+}
+
 // The indices marked in `mask`.
 std::vector<int> indicesOf(const std::vector<bool>& mask) {
   std::vector<int> indices;
@@ -855,16 +863,10 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
     } else {
       // The free points carried keep their values; the new ones are the new
       // edge and face points' offsets from where subdivision puts them: zero
-      // at the start.
-      MatrixX3 start = MatrixX3::Zero(freeBasis.cols(), 3);
-      start.topRows(freePoints.rows()) = freePoints;
-      freePoints = std::move(start);
+      // at the start, and in the rest shape.
+      freePoints = withNewOffsets(freePoints, freeBasis.cols());
+      if (options.restShape) restPoints = withNewOffsets(restPoints, freeBasis.cols());
       heldFreePoints.resize(freeBasis.cols(), false);  // the new points move
-      if (options.restShape) {
-        MatrixX3 restStart = MatrixX3::Zero(freeBasis.cols(), 3);
-        restStart.topRows(restPoints.rows()) = restPoints;
-        restPoints = std::move(restStart);
-      }
     }
     mesh = std::move(refined.mesh);
   }
