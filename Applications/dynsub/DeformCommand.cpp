@@ -1,8 +1,10 @@
 // dynsub deform: modeling by forces (TVCG §4.1, Fig. 6): springs from points in
 // space to the nearest points of the limit surface pull it to a new equilibrium.
+#include <algorithm>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <sstream>
 
 #include <CLI/CLI.hpp>
 
@@ -74,13 +76,30 @@ void runDeform(DeformArguments o) {
   report.set("max_spring_length_mm", lengths.size() ? lengths.maxCoeff() : 0.0);
   report.set("mean_spring_length_mm", lengths.size() ? lengths.mean() : 0.0);
   report.set("seconds", seconds);
+  report.set("turned_over_percent", result.turnedOverPercent);
   std::vector<Report> levels;
   for (std::size_t i = 0; i < result.levels.size(); ++i) {
     Report level = levelReport(result.levels[i], -1, -1);
-    if (i < result.levelDistancesPercent.size()) level.set("max_distance_percent", result.levelDistancesPercent[i]);
+    level.set("max_distance_percent", result.levelDistancesPercent[i]);
+    level.set("turned_over_percent", result.levelTurnedOverPercent[i]);
     levels.push_back(level);
   }
   report.set("per_level", levels);
+  std::vector<std::string> warnings;
+  const auto worst = std::max_element(result.levelTurnedOverPercent.begin(), result.levelTurnedOverPercent.end());
+  if (*worst > 0.0) {
+    const int level = result.levels[worst - result.levelTurnedOverPercent.begin()].level;
+    std::ostringstream text;
+    text << std::setprecision(3) << *worst << " % of the surface turned over at level " << level
+         << " (its normals point against the input's): it folded through itself or turned inside out";
+    if (level < result.levels.back().level) text << ", and the finer levels started from that shape";
+    text << ". The springs ask for a shape the control mesh cannot form against its elasticity";
+    if (!o.deformation.simulation.restShape) text << ", which shrinks a surface without a rest shape";
+    text << ": lower --stiffness, add springs that hold the rest of the surface"
+         << (o.deformation.simulation.restShape ? "" : ", or keep the input's shape (--rest-shape initial)");
+    warnings.push_back(text.str());
+  }
+  report.set("warnings", warnings);
   Report parameters = simulationReport(o.deformation.simulation);
   parameters.set("default_spring_stiffness", o.stiffness);
   parameters.set("fix_boundary", o.fixBoundary);
@@ -97,6 +116,7 @@ void runDeform(DeformArguments o) {
             << result.levels.back().level << " refinement(s), " << result.mesh.vertexCount() << " control vertices"
             << (result.toleranceMet ? ")" : "; above the tolerance)") << "\n"
             << "wrote " << (dir / kSurfaceFile).string() << ", control_mesh.obj, report.json\n";
+  for (const std::string& warning : warnings) std::cerr << "warning: " << warning << '\n';
 }
 
 }  // namespace

@@ -1,7 +1,9 @@
 #include "dynsub/Deformation.h"
 
+#include <algorithm>
 #include <cmath>
 
+#include "dynsub/CatmullClark.h"
 #include "dynsub/ClosestPoint.h"
 #include "dynsub/EnclosingSphere.h"
 #include "dynsub/Error.h"
@@ -28,6 +30,39 @@ SimulationOptions DeformationOptions::defaultSimulation() {
 
 bool DeformationOptions::refinesLocally() const { return localRefinement && takesRefineRegion(simulation); }
 
+namespace {
+// Samples of the turned-over measure: a fold a tenth of a coarse element
+// across still takes several.
+constexpr int kTurnedOverSamples = 4096;
+}  // namespace
+
+double turnedOverAreaPercent(const LimitSurface& before, const MatrixX3& beforePoints, const LimitSurface& after,
+                             const MatrixX3& afterPoints) {
+  if (before.elementCount() != after.elementCount())
+    throw Error("internal: surfaces of different meshes compared for turned-over area");
+  SurfaceState initialState(before), finalState(after);
+  initialState.reset(beforePoints);
+  finalState.reset(afterPoints);
+  // An n x n midpoint grid on each element, n such that the surface has about
+  // kTurnedOverSamples points or more at any level, each weighted by the
+  // input's area element.
+  const int elements = before.elementCount();
+  const int n = std::clamp(static_cast<int>(std::ceil(std::sqrt(double(kTurnedOverSamples) / elements))), 1, 16);
+  double area = 0.0, turned = 0.0;
+  for (int element = 0; element < elements; ++element) {
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j < n; ++j) {
+        const ElementPoint point{element, (i + 0.5) / n, (j + 0.5) / n};
+        const LimitSample initial = initialState.evaluate(point);
+        const double weight = initial.du.cross(initial.dv).norm();
+        area += weight;
+        if (initial.normal.dot(finalState.evaluate(point).normal) < 0.0) turned += weight;
+      }
+    }
+  }
+  return area > 0.0 ? 100.0 * turned / area : 0.0;
+}
+
 DeformationResult deformSurface(const ControlMesh& initial, const MatrixX3& targets, const Eigen::VectorXd& stiffness,
                                 const std::vector<int>& fixed, const DeformationOptions& options,
                                 const ProgressCallback& progress) {
@@ -45,6 +80,8 @@ DeformationResult deformSurface(const ControlMesh& initial, const MatrixX3& targ
   // The faces, of the level last measured, that hold a target's nearest
   // surface point farther than the tolerance.
   std::vector<int> facesToRefine;
+  ControlMesh inputAtLevel = initial;
+  std::unique_ptr<LimitSurface> inputSurface;  // inputAtLevel's
   // Each level runs to its equilibrium (one or two Newton steps: the springs
   // are linear within a level), and is refined if a target is still too far.
   // A refinement that brings the farthest target less than
@@ -62,7 +99,20 @@ DeformationResult deformSurface(const ControlMesh& initial, const MatrixX3& targ
     const bool gained = result.levelDistancesPercent.empty() ||
                         distance < (1.0 - kLeastRefinementGain) * result.levelDistancesPercent.back();
     const bool refine = distance > options.tolerancePercent && gained && when != FitAsk::LastLevelLooseRule;
-    if (refine || when == FitAsk::LevelEnd) result.levelDistancesPercent.push_back(distance);
+    if (refine || when == FitAsk::LevelEnd) {
+      result.levelDistancesPercent.push_back(distance);
+      // The input surface at this level's elements: every refinement, local
+      // ones too, subdivides the whole mesh.
+      while (LimitSurface::elementCountOf(inputAtLevel) < surface.elementCount()) {
+        inputAtLevel = subdivide(inputAtLevel).mesh;
+        inputSurface.reset();
+      }
+      // A level without a free basis is a surface of the input's mesh itself.
+      const bool sameMesh = surface.controlVertexCount() == inputAtLevel.vertexCount();
+      if (!sameMesh && !inputSurface) inputSurface = std::make_unique<LimitSurface>(inputAtLevel);
+      result.levelTurnedOverPercent.push_back(
+          turnedOverAreaPercent(sameMesh ? surface : *inputSurface, inputAtLevel.points(), surface, points));
+    }
     return refine ? FitVerdict::Refine : FitVerdict::Settle;
   };
   RefineRegion region;
@@ -74,11 +124,13 @@ DeformationResult deformSurface(const ControlMesh& initial, const MatrixX3& targ
   result.surface = std::move(simulation.surface);
   result.levels = std::move(simulation.levels);
   result.steps = simulation.steps;
-  if (result.levelDistancesPercent.size() != result.levels.size())
+  if (result.levelDistancesPercent.size() != result.levels.size() ||
+      result.levelTurnedOverPercent.size() != result.levels.size())
     throw Error("internal: a deformation's level ended without its distance measured");
   result.maxDistancePercent = result.levelDistancesPercent.back();
   result.toleranceMet = result.maxDistancePercent <= options.tolerancePercent;
   result.springLengths = springs.lengths();
+  result.turnedOverPercent = result.levelTurnedOverPercent.back();
   return result;
 }
 

@@ -3,7 +3,8 @@
 // the targets still too far, to the tolerance,
 // with fewer free points than global refinement needs; soft springs, which
 // no finer mesh brings closer, end the refinement early; without refinement
-// the tolerance is reported unmet; bad options are refused.
+// the tolerance is reported unmet; a surface the springs fold through itself
+// is reported; bad options are refused.
 #include <cmath>
 #include <vector>
 
@@ -11,6 +12,7 @@
 
 #include "dynsub/Deformation.h"
 #include "dynsub/Error.h"
+#include "dynsub/LimitSurface.h"
 #include "dynsub/StandardMeshes.h"
 
 namespace dynsub {
@@ -22,9 +24,9 @@ namespace {
 // raised into a Gaussian bump 0.25 high and 0.1 wide. Without the anchors
 // the springs, far stiffer than the surface, would pull the coarse cube,
 // which cannot form so narrow a bump, into a wild shape.
-MatrixX3 bumpTargets() {
+MatrixX3 bumpTargets(bool anchored = true) {
   std::vector<Vector3> points;
-  for (int axis = 0; axis < 3; ++axis) {
+  for (int axis = 0; axis < 3 && anchored; ++axis) {
     for (double side : {-1.0, 1.0}) {
       for (double u : {-0.5, 0.0, 0.5}) {
         for (double w : {-0.5, 0.0, 0.5}) {
@@ -49,8 +51,8 @@ MatrixX3 bumpTargets() {
   return targets;
 }
 
-DeformationResult deformCube(double stiffness, int maxLevel, bool local) {
-  const MatrixX3 targets = bumpTargets();
+DeformationResult deformCube(double stiffness, int maxLevel, bool local, bool anchored = true) {
+  const MatrixX3 targets = bumpTargets(anchored);
   DeformationOptions options;
   options.tolerancePercent = 0.5;
   options.localRefinement = local;
@@ -87,6 +89,27 @@ TEST(Deformation, RefinesOnlyNearTheTargetsUntilTheToleranceIsMet) {
   EXPECT_EQ(local.mesh.vertexCount(), global.mesh.vertexCount());
   EXPECT_EQ(global.levels.back().freeControlPoints, global.mesh.vertexCount());
   EXPECT_LT(local.levels.back().freeControlPoints, global.levels.back().freeControlPoints / 4);
+  // Nothing turned over at any level (0 measured).
+  for (const DeformationResult* r : {&local, &global}) {
+    ASSERT_EQ(r->levelTurnedOverPercent.size(), r->levels.size());
+    for (double percent : r->levelTurnedOverPercent) EXPECT_EQ(percent, 0.0);
+  }
+}
+
+TEST(Deformation, ReportsASurfaceTurnedOver) {
+  // Without the anchors, springs of 1000 N/mm against tension 0.1 fold the
+  // coarse cube through itself to meet a bump it cannot form (6.7 % of its
+  // area turned over measured; the top's control points at z 3.9, the bottom
+  // risen above z = 0.97). 1 % leaves room for the solver's rounding and
+  // fails if the fold goes unseen. Springs of 10 N/mm only bow the top.
+  const DeformationResult folded = deformCube(1000.0, 0, true, false);
+  EXPECT_GT(folded.turnedOverPercent, 1.0);
+  EXPECT_EQ(folded.levelTurnedOverPercent.back(), folded.turnedOverPercent);
+  EXPECT_EQ(deformCube(10.0, 0, true, false).turnedOverPercent, 0.0);
+  // The measure itself: a surface against itself turns nothing over.
+  const ControlMesh cube = makeCube98();
+  const LimitSurface surface(cube);
+  EXPECT_EQ(turnedOverAreaPercent(surface, cube.points(), surface, cube.points()), 0.0);
 }
 
 TEST(Deformation, EndsRefinementThatBringsTheTargetsNoCloser) {

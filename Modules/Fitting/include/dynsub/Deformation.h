@@ -54,7 +54,25 @@ struct DeformationResult {
   bool localRefinement = false;               // whether the refinement was local
   Eigen::VectorXd springLengths;              // mm, each spring's at its last evaluation
   std::vector<double> levelDistancesPercent;  // the farthest target, at each level's end
+  // The share of the input surface's area, percent, whose normal the final
+  // surface turns against itself (their dot product < 0, compared at the same
+  // parameters): the surface has folded through itself or turned inside out.
+  // Springs far stiffer than the elasticity on a level too coarse to form
+  // their shape do that (an unanchored bump on the cube); so does a closed
+  // surface shrinking without a rest shape, and a pull that bends a region
+  // over by more than 90 degrees reads here too. A turned-over level also
+  // misleads the next one, whose springs attach to the nearest points of it.
+  double turnedOverPercent = 0;
+  std::vector<double> levelTurnedOverPercent;  // the same, at each level's end
 };
+
+// The share (percent) of the area of surface `before` (at its control points
+// beforePoints) whose normal `after` reverses, compared on a midpoint grid of
+// each element, with 4096 points or more over the surface. The two surfaces
+// are of one mesh's elements; `after` may be over a free basis (Simulation.h's
+// RefineRegion).
+double turnedOverAreaPercent(const LimitSurface& before, const MatrixX3& beforePoints, const LimitSurface& after,
+                             const MatrixX3& afterPoints);
 
 // targets: #springs x 3 (mm); stiffness: one per spring (N/mm), > 0. fixed:
 // control vertices of `initial` that do not move. Throws dynsub::Error on bad
