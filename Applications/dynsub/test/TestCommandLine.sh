@@ -176,6 +176,7 @@ import json, sys
 r = json.load(open(sys.argv[1] + '/report.json'))
 assert r['levels'] == 2 and r['parameters']['refinement'] == 'local', r
 assert r['free_control_points'] < r['control_vertices'] / 2, r
+assert [l.get('refinement') for l in r['per_level']] == [None, 'local', 'local'], r['per_level']
 rim = [v for v in (list(map(float, l.split()[1:4])) for l in open(sys.argv[1] + '/control_mesh.obj')
        if l.startswith('v ')) if max(abs(v[0]), abs(v[1])) > 0.97]
 assert len(rim) == 128 and all(v[2] == 0 and max(abs(v[0]), abs(v[1])) == 1 for v in rim), rim

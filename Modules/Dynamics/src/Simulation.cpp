@@ -815,6 +815,7 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
       summary.level = level;
       summary.controlVertices = mesh.vertexCount();
       summary.freeControlPoints = static_cast<int>(freePoints.rows() - fixedPoints.size());
+      summary.localRefinement = freeBasis.size() != 0;
       summary.elasticity = model.elasticity;
       // A level that will be refined or relaxed may end at a looser rule.
       const bool coarse =

@@ -224,6 +224,8 @@ TEST(StaticScheme, HeldPointsStayHeldThroughRefinement) {
     EXPECT_EQ(rim, 128);
     EXPECT_GT(points.col(2).maxCoeff(), 0.5);  // the centre rose toward the springs (z 0.8-0.9)
     (local ? freeLocal : freeGlobal) = result.levels.back().freeControlPoints;
+    EXPECT_FALSE(result.levels[0].localRefinement);
+    for (int level = 1; level < 3; ++level) EXPECT_EQ(result.levels[level].localRefinement, local) << level;
   }
   EXPECT_EQ(freeGlobal, 1089 - 128);  // every point but the boundary's
   EXPECT_LT(freeLocal, freeGlobal / 2);
@@ -236,6 +238,7 @@ TEST(StaticScheme, HeldPointsStayHeldThroughRefinement) {
   const SimulationResult held = holdCentre(1);
   ASSERT_EQ(held.levels.size(), 2u);
   EXPECT_EQ(held.levels[1].freeControlPoints, held.levels[1].controlVertices - 1);
+  EXPECT_FALSE(held.levels[1].localRefinement);  // asked for, and refined globally instead
   // Where level 0's equilibrium (the same run stopped there) subdivides it
   // to; each level's equilibrium is one exact Newton step of linear springs,
   // so the two runs agree to rounding.

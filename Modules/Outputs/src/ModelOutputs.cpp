@@ -43,6 +43,9 @@ Report levelReport(const LevelSummary& l, double maxErrorPercent, double rmsErro
   r.set("level", l.level);
   r.set("control_vertices", l.controlVertices);
   r.set("free_control_points", l.freeControlPoints);
+  // How the level came from the one before: what was done, which can be
+  // global where local was asked for (Simulation.h).
+  if (l.level > 0) r.set("refinement", l.localRefinement ? "local" : "global");
   r.set("elasticity", l.elasticity);
   r.set("iterations", l.steps);
   r.set("equilibrium", l.converged && !l.met);

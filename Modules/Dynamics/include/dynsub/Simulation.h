@@ -130,6 +130,10 @@ struct LevelSummary {
   // The control points that move: controlVertices less the fixed ones, or
   // fewer where the refinement was local (RefineRegion).
   int freeControlPoints = 0;
+  // The level moved over a free basis (local refinement). False where it was
+  // not asked for, and where simulate refined globally instead (see
+  // RefineRegion and simulate).
+  bool localRefinement = false;
   // The factor on tension and rigidity: elasticityPerLevel^(level + relaxations run).
   double elasticity = 1.0;
   int steps = 0;

@@ -51,7 +51,9 @@ struct DeformationResult {
   double diameter = 0;            // mm, the tolerance's reference length
   double maxDistancePercent = 0;  // the farthest target from the final surface
   bool toleranceMet = false;
-  bool localRefinement = false;               // whether the refinement was local
+  // Whether local refinement was asked for and the scheme takes it; each
+  // level's LevelSummary::localRefinement says whether it was done.
+  bool localRefinement = false;
   Eigen::VectorXd springLengths;              // mm, each spring's at its last evaluation
   std::vector<double> levelDistancesPercent;  // the farthest target, at each level's end
   // The share of the input surface's area, percent, whose normal the final
