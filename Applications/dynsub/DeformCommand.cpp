@@ -1,6 +1,5 @@
 // dynsub deform: modeling by forces (TVCG §4.1, Fig. 6): springs from points in
 // space to the nearest points of the limit surface pull it to a new equilibrium.
-#include <algorithm>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -86,17 +85,27 @@ void runDeform(DeformArguments o) {
   }
   report.set("per_level", levels);
   std::vector<std::string> warnings;
-  const auto worst = std::max_element(result.levelTurnedOverPercent.begin(), result.levelTurnedOverPercent.end());
-  if (*worst > 0.0) {
-    const int level = result.levels[worst - result.levelTurnedOverPercent.begin()].level;
+  for (const int restart : result.restarts) {
     std::ostringstream text;
-    text << std::setprecision(3) << *worst << " % of the surface turned over at level " << level
-         << " (its normals point against the input's): it folded through itself or turned inside out";
-    if (level < result.levels.back().level) text << ", and the finer levels started from that shape";
-    text << ". The springs ask for a shape the control mesh cannot form against its elasticity";
+    text << std::setprecision(3) << result.levelTurnedOverPercent[restart - 1]
+         << " % of the surface turned over at level " << result.levels[restart - 1].level
+         << " (its normals point against the input's); the deformation started "
+         << "again from the input mesh refined to level " << result.levels[restart].level;
+    warnings.push_back(text.str());
+  }
+  if (result.turnedOverPercent > 0.0) {
+    std::ostringstream text;
+    text << std::setprecision(3) << result.turnedOverPercent << " % of the surface turned over (its normals point "
+         << "against the input's): it folded through itself or turned inside out. The springs ask for a shape the "
+         << "control mesh cannot form against its elasticity";
     if (!o.deformation.simulation.restShape) text << ", which shrinks a surface without a rest shape";
-    text << ": lower --stiffness, add springs that hold the rest of the surface"
-         << (o.deformation.simulation.restShape ? "" : ", or keep the input's shape (--rest-shape initial)");
+    std::vector<std::string> fixes{"lower --stiffness", "add springs that hold the rest of the surface"};
+    if (!o.deformation.simulation.restShape) fixes.push_back("keep the input's shape (--rest-shape initial)");
+    if (result.restarts.empty()) fixes.push_back("allow a finer level (--max-level)");
+    text << ": ";
+    for (std::size_t i = 0; i < fixes.size(); ++i) {
+      text << (i == 0 ? "" : i + 1 < fixes.size() ? ", " : " or ") << fixes[i];
+    }
     warnings.push_back(text.str());
   }
   report.set("warnings", warnings);

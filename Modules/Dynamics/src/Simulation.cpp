@@ -717,6 +717,15 @@ SparseMatrix refinedBasis(const Topology& coarse, const SparseMatrix& subdivisio
 
 }  // namespace
 
+std::vector<int> refinedFixedVertices(const SparseMatrix& subdivision, const std::vector<int>& fixed) {
+  std::vector<bool> held(subdivision.cols(), false);
+  for (int v : fixed) {
+    if (v < 0 || v >= subdivision.cols()) throw Error("internal: a fixed control vertex does not exist");
+    held[v] = true;
+  }
+  return indicesOf(heldRefinedRows(subdivision, held));
+}
+
 std::vector<int> grownFaces(const Topology& mesh, const std::vector<int>& faces, int rings) {
   std::vector<bool> chosen(mesh.faceCount(), faces.empty());
   for (int f : faces) chosen[f] = true;

@@ -245,6 +245,18 @@ TEST(StaticScheme, HeldPointsStayHeldThroughRefinement) {
   const MatrixX3 start = subdivide(holdCentre(0).mesh).mesh.points();
   EXPECT_LT((held.mesh.points().row(centreVertex) - start.row(centreVertex)).norm(), 1e-9);
   EXPECT_GT(start(centreVertex, 2), 0.1);  // lifted by its neighbours, then held
+
+  // The rule as a caller sees it: the held boundary's refinement is the
+  // refined sheet's boundary (64 of 289 points), and a vertex held alone
+  // inside holds only itself.
+  const SubdividedMesh refined = subdivide(sheet);
+  std::vector<int> refinedBoundary;
+  for (int v = 0; v < refined.mesh.vertexCount(); ++v) {
+    if (refined.mesh.topology().isBoundaryVertex(v)) refinedBoundary.push_back(v);
+  }
+  EXPECT_EQ(refinedBoundary.size(), 64u);
+  EXPECT_EQ(refinedFixedVertices(refined.subdivisionMatrix, boundary), refinedBoundary);
+  EXPECT_EQ(refinedFixedVertices(refined.subdivisionMatrix, {centreVertex}), std::vector<int>{centreVertex});
 }
 
 // With a rest shape (SimulationOptions::restShape) the elasticity holds the

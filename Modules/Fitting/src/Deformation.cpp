@@ -80,8 +80,20 @@ DeformationResult deformSurface(const ControlMesh& initial, const MatrixX3& targ
   // The faces, of the level last measured, that hold a target's nearest
   // surface point farther than the tolerance.
   std::vector<int> facesToRefine;
+  // The input refined to the level last measured, its surface (when that
+  // level's is over a free basis), its held vertices, and its level.
   ControlMesh inputAtLevel = initial;
-  std::unique_ptr<LimitSurface> inputSurface;  // inputAtLevel's
+  std::unique_ptr<LimitSurface> inputSurface;
+  std::vector<int> heldAtLevel = fixed;
+  int inputLevel = 0;
+  const auto refineInput = [&] {
+    SubdividedMesh refined = subdivide(inputAtLevel);
+    heldAtLevel = refinedFixedVertices(refined.subdivisionMatrix, heldAtLevel);
+    inputAtLevel = std::move(refined.mesh);
+    inputSurface.reset();
+    ++inputLevel;
+  };
+  bool turnedOver = false;  // the run ended at a level that turned over, with a finer one allowed
   // Each level runs to its equilibrium (one or two Newton steps: the springs
   // are linear within a level), and is refined if a target is still too far.
   // A refinement that brings the farthest target less than
@@ -99,31 +111,44 @@ DeformationResult deformSurface(const ControlMesh& initial, const MatrixX3& targ
     const bool gained = result.levelDistancesPercent.empty() ||
                         distance < (1.0 - kLeastRefinementGain) * result.levelDistancesPercent.back();
     const bool refine = distance > options.tolerancePercent && gained && when != FitAsk::LastLevelLooseRule;
-    if (refine || when == FitAsk::LevelEnd) {
-      result.levelDistancesPercent.push_back(distance);
-      // The input surface at this level's elements: every refinement, local
-      // ones too, subdivides the whole mesh.
-      while (LimitSurface::elementCountOf(inputAtLevel) < surface.elementCount()) {
-        inputAtLevel = subdivide(inputAtLevel).mesh;
-        inputSurface.reset();
-      }
-      // A level without a free basis is a surface of the input's mesh itself.
-      const bool sameMesh = surface.controlVertexCount() == inputAtLevel.vertexCount();
-      if (!sameMesh && !inputSurface) inputSurface = std::make_unique<LimitSurface>(inputAtLevel);
-      result.levelTurnedOverPercent.push_back(
-          turnedOverAreaPercent(sameMesh ? surface : *inputSurface, inputAtLevel.points(), surface, points));
-    }
+    if (!refine && when != FitAsk::LevelEnd) return FitVerdict::Settle;
+    result.levelDistancesPercent.push_back(distance);
+    // Every refinement, local ones too, subdivides the whole mesh.
+    while (LimitSurface::elementCountOf(inputAtLevel) < surface.elementCount()) refineInput();
+    // A level without a free basis is a surface of the input's mesh itself.
+    const bool sameMesh = surface.controlVertexCount() == inputAtLevel.vertexCount();
+    if (!sameMesh && !inputSurface) inputSurface = std::make_unique<LimitSurface>(inputAtLevel);
+    const double turned =
+        turnedOverAreaPercent(sameMesh ? surface : *inputSurface, inputAtLevel.points(), surface, points);
+    result.levelTurnedOverPercent.push_back(turned);
+    // A fold is no shape to refine (the next level's springs would attach
+    // to it): the run ends here and starts again below.
+    turnedOver = turned > 0.0 && inputLevel < options.simulation.maxLevel;
+    if (turnedOver) return FitVerdict::Stop;
     return refine ? FitVerdict::Refine : FitVerdict::Settle;
   };
   RefineRegion region;
   if (result.localRefinement) {
     region = [&](const Topology& mesh) { return grownFaces(mesh, facesToRefine, kRefineRings); };
   }
-  SimulationResult simulation = simulate(initial, {&springs}, fixed, options.simulation, accept, progress, region);
-  result.mesh = std::move(simulation.mesh);
-  result.surface = std::move(simulation.surface);
-  result.levels = std::move(simulation.levels);
-  result.steps = simulation.steps;
+  ControlMesh start = initial;
+  std::vector<int> held = fixed;
+  SimulationOptions simulationOptions = options.simulation;
+  for (;;) {
+    SimulationResult simulation = simulate(start, {&springs}, held, simulationOptions, accept, progress, region);
+    result.mesh = std::move(simulation.mesh);
+    result.surface = std::move(simulation.surface);
+    result.levels.insert(result.levels.end(), simulation.levels.begin(), simulation.levels.end());
+    result.steps += simulation.steps;
+    if (!turnedOver) break;
+    // Start again from the input refined past the level that turned over,
+    // where the springs attach to the input's surface, as at level 0.
+    refineInput();
+    result.restarts.push_back(static_cast<int>(result.levels.size()));
+    start = inputAtLevel;
+    held = heldAtLevel;
+    simulationOptions.origin = {inputLevel, simulation.origin.isolation, 0};
+  }
   if (result.levelDistancesPercent.size() != result.levels.size() ||
       result.levelTurnedOverPercent.size() != result.levels.size())
     throw Error("internal: a deformation's level ended without its distance measured");

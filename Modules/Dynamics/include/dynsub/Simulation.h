@@ -253,6 +253,12 @@ SimulationResult simulate(const ControlMesh& initial, const std::vector<ForceMod
                           const AcceptFit& accept = nullptr, const ProgressCallback& progress = nullptr,
                           const RefineRegion& region = nullptr);
 
+// The control vertices that simulate holds after a refinement (subdivision:
+// the refined mesh's points from the coarse ones), `fixed` holding the coarse
+// mesh's: the fixed ones, which keep their numbers, and every refined point
+// that they alone determine. Sorted.
+std::vector<int> refinedFixedVertices(const SparseMatrix& subdivision, const std::vector<int>& fixed);
+
 // Whether simulate refines locally when given a RefineRegion: under the static
 // scheme only (see above).
 bool takesRefineRegion(const SimulationOptions& options);

@@ -62,10 +62,13 @@ struct DeformationResult {
   // Springs far stiffer than the elasticity on a level too coarse to form
   // their shape do that (an unanchored bump on the cube); so does a closed
   // surface shrinking without a rest shape, and a pull that bends a region
-  // over by more than 90 degrees reads here too. A turned-over level also
-  // misleads the next one, whose springs attach to the nearest points of it.
+  // over by more than 90 degrees reads here too.
   double turnedOverPercent = 0;
   std::vector<double> levelTurnedOverPercent;  // the same, at each level's end
+  // The levels (indices into `levels`) that started again from the input
+  // mesh refined to them, because the level before turned over (see
+  // deformSurface).
+  std::vector<int> restarts;
 };
 
 // The share (percent) of the area of surface `before` (at its control points
@@ -76,6 +79,12 @@ struct DeformationResult {
 double turnedOverAreaPercent(const LimitSurface& before, const MatrixX3& beforePoints, const LimitSurface& after,
                              const MatrixX3& afterPoints);
 
+// A level that turns over, with a finer level allowed, is not refined: the
+// deformation starts again from the input mesh refined once past it, whose
+// finer surface can form more of what the springs ask. Its springs attach to
+// the input's surface, as at level 0, where the fold's refinement would have
+// attached some of them to its wrong side.
+//
 // targets: #springs x 3 (mm); stiffness: one per spring (N/mm), > 0. fixed:
 // control vertices of `initial` that do not move. Throws dynsub::Error on bad
 // input or unrecoverable divergence.
