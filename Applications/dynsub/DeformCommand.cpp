@@ -1,5 +1,6 @@
 // dynsub deform: modeling by forces (TVCG §4.1, Fig. 6): springs from points in
 // space to the nearest points of the limit surface pull it to a new equilibrium.
+#include <algorithm>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -79,6 +80,9 @@ void runDeform(DeformArguments o) {
   std::vector<Report> levels;
   for (std::size_t i = 0; i < result.levels.size(); ++i) {
     Report level = levelReport(result.levels[i], -1, -1);
+    // Not refined from the level before: started again (DeformationResult::restarts).
+    if (std::find(result.restarts.begin(), result.restarts.end(), static_cast<int>(i)) != result.restarts.end())
+      level.set("refinement", "restarted");
     level.set("max_distance_percent", result.levelDistancesPercent[i]);
     level.set("turned_over_percent", result.levelTurnedOverPercent[i]);
     levels.push_back(level);
@@ -89,20 +93,23 @@ void runDeform(DeformArguments o) {
     std::ostringstream text;
     text << std::setprecision(3) << result.levelTurnedOverPercent[restart - 1]
          << " % of the surface turned over at level " << result.levels[restart - 1].level
-         << " (its normals point against the input's); the deformation started "
-         << "again from the input mesh refined to level " << result.levels[restart].level;
+         << " (its normals point against the input's); the deformation started again from the input mesh refined "
+         << "to level " << result.levels[restart].level;
     warnings.push_back(text.str());
   }
   if (result.turnedOverPercent > 0.0) {
     std::ostringstream text;
     text << std::setprecision(3) << result.turnedOverPercent << " % of the surface turned over (its normals point "
-         << "against the input's): it folded through itself or turned inside out. The springs ask for a shape the "
-         << "control mesh cannot form against its elasticity";
+         << "against the input's): it folded through itself, where the springs ask for a shape the control mesh "
+         << "cannot form against its elasticity";
     if (!o.deformation.simulation.restShape) text << ", which shrinks a surface without a rest shape";
     std::vector<std::string> fixes{"lower --stiffness", "add springs that hold the rest of the surface"};
     if (!o.deformation.simulation.restShape) fixes.push_back("keep the input's shape (--rest-shape initial)");
-    if (result.restarts.empty()) fixes.push_back("allow a finer level (--max-level)");
-    text << ": ";
+    // A finer level helps where the fold comes from a level too coarse,
+    // which a restart has not already tried.
+    if (result.restarts.empty() && result.levels.back().level >= o.deformation.simulation.maxLevel)
+      fixes.push_back("allow a finer level (--max-level)");
+    text << ". Fixes: ";
     for (std::size_t i = 0; i < fixes.size(); ++i) {
       text << (i == 0 ? "" : i + 1 < fixes.size() ? ", " : " or ") << fixes[i];
     }

@@ -229,6 +229,7 @@ import json, sys
 r = json.load(open(sys.argv[1] + '/report.json'))
 assert r['tolerance_met'] and r['turned_over_percent'] == 0 and len(r['warnings']) == 1, r
 assert r['per_level'][0]['turned_over_percent'] > 5 and r['per_level'][1]['level'] == 1, r['per_level']
+assert r['per_level'][1]['refinement'] == 'restarted', r['per_level']
 z = [float(l.split()[3]) for l in open(sys.argv[1] + '/control_mesh.obj') if l.startswith('v ')]
 assert min(z) < -0.9 and max(z) < 1.6, (min(z), max(z))
 " "$work/bump_only"

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "dynsub/CatmullClark.h"
 #include "dynsub/ClosestPoint.h"
@@ -80,12 +81,16 @@ DeformationResult deformSurface(const ControlMesh& initial, const MatrixX3& targ
   // The faces, of the level last measured, that hold a target's nearest
   // surface point farther than the tolerance.
   std::vector<int> facesToRefine;
+  // The level the next verdict is asked of, and the farthest target's
+  // distance at the level before it (none before a run's first level).
+  int level = options.simulation.origin.level;
+  double previousDistance = std::numeric_limits<double>::infinity();
   // The input refined to the level last measured, its surface (when that
   // level's is over a free basis), its held vertices, and its level.
   ControlMesh inputAtLevel = initial;
   std::unique_ptr<LimitSurface> inputSurface;
   std::vector<int> heldAtLevel = fixed;
-  int inputLevel = 0;
+  int inputLevel = level;
   const auto refineInput = [&] {
     SubdividedMesh refined = subdivide(inputAtLevel);
     heldAtLevel = refinedFixedVertices(refined.subdivisionMatrix, heldAtLevel);
@@ -108,13 +113,15 @@ DeformationResult deformSurface(const ControlMesh& initial, const MatrixX3& targ
     const double distance = measureFitError(surface, points, targets, result.diameter, nullptr, &nearest).maxPercent;
     if (result.localRefinement)
       facesToRefine = facesFartherThan(surface, nearest, result.diameter, options.tolerancePercent);
-    const bool gained = result.levelDistancesPercent.empty() ||
-                        distance < (1.0 - kLeastRefinementGain) * result.levelDistancesPercent.back();
+    const bool gained = distance < (1.0 - kLeastRefinementGain) * previousDistance;
     const bool refine = distance > options.tolerancePercent && gained && when != FitAsk::LastLevelLooseRule;
     if (!refine && when != FitAsk::LevelEnd) return FitVerdict::Settle;
     result.levelDistancesPercent.push_back(distance);
+    previousDistance = distance;
     // Every refinement, local ones too, subdivides the whole mesh.
-    while (LimitSurface::elementCountOf(inputAtLevel) < surface.elementCount()) refineInput();
+    while (inputLevel < level) refineInput();
+    if (LimitSurface::elementCountOf(inputAtLevel) != surface.elementCount())
+      throw Error("internal: a deformation's level is not its input refined as often");
     // A level without a free basis is a surface of the input's mesh itself.
     const bool sameMesh = surface.controlVertexCount() == inputAtLevel.vertexCount();
     if (!sameMesh && !inputSurface) inputSurface = std::make_unique<LimitSurface>(inputAtLevel);
@@ -123,8 +130,9 @@ DeformationResult deformSurface(const ControlMesh& initial, const MatrixX3& targ
     result.levelTurnedOverPercent.push_back(turned);
     // A fold is no shape to refine (the next level's springs would attach
     // to it): the run ends here and starts again below.
-    turnedOver = turned > 0.0 && inputLevel < options.simulation.maxLevel;
+    turnedOver = turned >= kRestartTurnedOverPercent && level < options.simulation.maxLevel;
     if (turnedOver) return FitVerdict::Stop;
+    if (refine) ++level;
     return refine ? FitVerdict::Refine : FitVerdict::Settle;
   };
   RefineRegion region;
@@ -145,9 +153,11 @@ DeformationResult deformSurface(const ControlMesh& initial, const MatrixX3& targ
     // where the springs attach to the input's surface, as at level 0.
     refineInput();
     result.restarts.push_back(static_cast<int>(result.levels.size()));
+    level = inputLevel;
+    previousDistance = std::numeric_limits<double>::infinity();
     start = inputAtLevel;
     held = heldAtLevel;
-    simulationOptions.origin = {inputLevel, simulation.origin.isolation, 0};
+    simulationOptions.origin = {level, simulation.origin.isolation, 0};
   }
   if (result.levelDistancesPercent.size() != result.levels.size() ||
       result.levelTurnedOverPercent.size() != result.levels.size())

@@ -28,6 +28,13 @@ namespace dynsub {
 // and a finer level would cost four times the control vertices for nothing.
 constexpr double kLeastRefinementGain = 0.1;
 
+// A level whose surface turns this share of its area over (percent;
+// DeformationResult::turnedOverPercent), with a finer level allowed, is not
+// refined but started again finer (deformSurface). A smaller fold is kept
+// and reported: a pull may bend a small region over by more than 90 degrees,
+// and a restart frees every point of its level, as global refinement does.
+constexpr double kRestartTurnedOverPercent = 1.0;
+
 struct DeformationOptions {
   // The largest distance from a target to the surface that ends refinement,
   // percent of the diameter (see above).
@@ -58,7 +65,7 @@ struct DeformationResult {
   std::vector<double> levelDistancesPercent;  // the farthest target, at each level's end
   // The share of the input surface's area, percent, whose normal the final
   // surface turns against itself (their dot product < 0, compared at the same
-  // parameters): the surface has folded through itself or turned inside out.
+  // parameters): the surface has folded through itself.
   // Springs far stiffer than the elasticity on a level too coarse to form
   // their shape do that (an unanchored bump on the cube); so does a closed
   // surface shrinking without a rest shape, and a pull that bends a region
@@ -67,23 +74,24 @@ struct DeformationResult {
   std::vector<double> levelTurnedOverPercent;  // the same, at each level's end
   // The levels (indices into `levels`) that started again from the input
   // mesh refined to them, because the level before turned over (see
-  // deformSurface).
+  // deformSurface); every point of such a level is free.
   std::vector<int> restarts;
 };
 
 // The share (percent) of the area of surface `before` (at its control points
-// beforePoints) whose normal `after` reverses, compared on a midpoint grid of
-// each element, with 4096 points or more over the surface. The two surfaces
-// are of one mesh's elements; `after` may be over a free basis (Simulation.h's
-// RefineRegion).
+// beforePoints) whose normal `after` reverses, compared on an n x n midpoint
+// grid of each element, n = ceil(sqrt(4096 / elements)) up to 16. The two
+// surfaces are of one mesh's elements; `after` may be over a free basis
+// (Simulation.h's RefineRegion).
 double turnedOverAreaPercent(const LimitSurface& before, const MatrixX3& beforePoints, const LimitSurface& after,
                              const MatrixX3& afterPoints);
 
-// A level that turns over, with a finer level allowed, is not refined: the
-// deformation starts again from the input mesh refined once past it, whose
-// finer surface can form more of what the springs ask. Its springs attach to
-// the input's surface, as at level 0, where the fold's refinement would have
-// attached some of them to its wrong side.
+// A level that turns kRestartTurnedOverPercent or more over, with a finer
+// level allowed, is not refined: its refinement's springs would attach to the
+// fold's nearest points, some on its wrong side. The deformation starts again
+// from the input mesh refined once past it, whose finer surface can form more
+// of what the springs ask, with the springs attached to the input's surface as
+// at level 0, and the refinement's gain measured from there on.
 //
 // targets: #springs x 3 (mm); stiffness: one per spring (N/mm), > 0. fixed:
 // control vertices of `initial` that do not move. Throws dynsub::Error on bad
