@@ -3,7 +3,14 @@
 // with OpenSubdiv's LimitStencilTable (adaptive, isolation level 10, double) on
 // the same points: 4 x 4 interior points per face, including the special
 // elements. Reported: points per second (items/s).
+// The *Triangles pair builds the same for a scan-like control mesh, a sphere
+// of triangles (an icosahedron split 3-5 times: 642, 2562, 10242 vertices),
+// one point per parametric face: every vertex of it is extraordinary, so it
+// needs two isolating subdivisions and half its elements are special.
 //   build/bin/LimitOperatorBenchmark --benchmark_min_time=1
+#include <array>
+#include <cmath>
+#include <map>
 #include <memory>
 
 #include <benchmark/benchmark.h>
@@ -23,6 +30,44 @@ dynsub::ControlMesh cubeAtLevel(int level) {
   dynsub::ControlMesh mesh = dynsub::makeCube98();
   for (int i = 0; i < level; ++i) mesh = dynsub::subdivide(mesh).mesh;
   return mesh;
+}
+
+// The icosahedron with each triangle split into four `splits` times, its
+// vertices on the unit sphere.
+dynsub::ControlMesh triangleSphere(int splits) {
+  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
+  std::vector<dynsub::Vector3> points = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                                         {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<std::array<int, 3>> triangles = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                                               {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                                               {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                                               {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+  for (int split = 0; split < splits; ++split) {
+    std::map<std::pair<int, int>, int> midpoints;
+    const auto midpoint = [&](int a, int b) {
+      const auto [it, added] = midpoints.try_emplace({std::min(a, b), std::max(a, b)}, static_cast<int>(points.size()));
+      if (added) points.push_back(0.5 * (points[a] + points[b]));
+      return it->second;
+    };
+    std::vector<std::array<int, 3>> finer;
+    for (const auto& [a, b, c] : triangles) {
+      const int ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
+      finer.insert(finer.end(), {{a, ab, ca}, {ab, b, bc}, {ca, bc, c}, {ab, bc, ca}});
+    }
+    triangles = std::move(finer);
+  }
+  dynsub::MatrixX3 positions(static_cast<Eigen::Index>(points.size()), 3);
+  for (size_t i = 0; i < points.size(); ++i) positions.row(static_cast<Eigen::Index>(i)) = points[i].normalized();
+  std::vector<dynsub::Polygon> faces;
+  for (const auto& [a, b, c] : triangles) faces.push_back({a, b, c});
+  return dynsub::ControlMesh::fromPolygons(positions, faces);
+}
+
+// One point per parametric face (three per triangle), at its middle.
+std::vector<dynsub::SurfacePoint> parametricFaceMiddles(const dynsub::LimitSurface& surface) {
+  std::vector<dynsub::SurfacePoint> points;
+  for (int f = 0; f < surface.parametricFaceCount(); ++f) points.push_back({f, 0.5, 0.5});
+  return points;
 }
 
 std::vector<dynsub::SurfacePoint> samples(int faces) {
@@ -124,10 +169,47 @@ void OpenSubdivApplyStencils(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * points.size());
 }
 
+void DynSubBuildOperatorsTriangles(benchmark::State& state) {
+  const dynsub::ControlMesh mesh = triangleSphere(static_cast<int>(state.range(0)));
+  const std::vector<dynsub::SurfacePoint> points = parametricFaceMiddles(dynsub::LimitSurface(mesh));
+  for (auto _ : state) {
+    const dynsub::LimitSurface surface(mesh);
+    dynsub::LimitOperators ops = surface.operators(points, 1);
+    benchmark::DoNotOptimize(ops.J.nonZeros());
+  }
+  state.SetItemsProcessed(state.iterations() * points.size());
+  state.counters["control_vertices"] = mesh.vertexCount();
+}
+
+void OpenSubdivBuildStencilsTriangles(benchmark::State& state) {
+  const dynsub::ControlMesh mesh = triangleSphere(static_cast<int>(state.range(0)));
+  const std::vector<dynsub::SurfacePoint> points = parametricFaceMiddles(dynsub::LimitSurface(mesh));
+  std::vector<double> s(points.size(), 0.5), t(points.size(), 0.5);
+  Far::LimitStencilTableFactoryReal<double>::LocationArrayVec locations;
+  for (size_t i = 0; i < points.size(); ++i) {
+    Far::LimitStencilTableFactoryReal<double>::LocationArray location;
+    location.ptexIdx = points[i].face;
+    location.numLocations = 1;
+    location.s = &s[i];
+    location.t = &t[i];
+    locations.push_back(location);
+  }
+  for (auto _ : state) {
+    auto refiner = dynsub::testing::openSubdivRefiner(mesh);
+    refiner->RefineAdaptive(Far::TopologyRefiner::AdaptiveOptions(10));
+    std::unique_ptr<const Far::LimitStencilTableReal<double>> table(
+        Far::LimitStencilTableFactoryReal<double>::Create(*refiner, locations));
+    benchmark::DoNotOptimize(table->GetNumStencils());
+  }
+  state.SetItemsProcessed(state.iterations() * points.size());
+}
+
 BENCHMARK(DynSubBuildOperators)->DenseRange(0, 3)->Unit(benchmark::kMillisecond);
 BENCHMARK(OpenSubdivBuildStencils)->DenseRange(0, 3)->Unit(benchmark::kMillisecond);
 BENCHMARK(DynSubApplyOperators)->DenseRange(0, 3)->Unit(benchmark::kMicrosecond);
 BENCHMARK(OpenSubdivApplyStencils)->DenseRange(0, 3)->Unit(benchmark::kMicrosecond);
+BENCHMARK(DynSubBuildOperatorsTriangles)->DenseRange(3, 5)->Unit(benchmark::kMillisecond);
+BENCHMARK(OpenSubdivBuildStencilsTriangles)->DenseRange(3, 5)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

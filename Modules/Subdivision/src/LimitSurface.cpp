@@ -284,14 +284,26 @@ struct LimitSurface::Impl {
     return special.deepest;
   }
 
-  // Control-vertex columns and dense weights of a set of base-mesh stencils.
-  std::vector<int> columnsOf(const std::vector<int>& baseVertices) const {
+  // The control-vertex columns that a set of base vertices blend, sorted.
+  // Each column is taken once, as first met (columnMark holds the call that
+  // last met it), so that only the distinct ones are sorted: after two
+  // isolating steps a base vertex blends a dozen or more control vertices,
+  // and an element's base vertices share most of them.
+  std::vector<int> columnMark;
+  int columnCall = 0;
+  std::vector<int> columnsOf(const std::vector<int>& baseVertices) {
+    if (columnMark.size() != static_cast<size_t>(controlVertexCount)) columnMark.assign(controlVertexCount, -1);
+    ++columnCall;
     std::vector<int> columns;
     for (int b : baseVertices) {
-      for (SparseMatrix::InnerIterator it(isolation, b); it; ++it) columns.push_back(static_cast<int>(it.col()));
+      for (SparseMatrix::InnerIterator it(isolation, b); it; ++it) {
+        const int c = static_cast<int>(it.col());
+        if (columnMark[c] == columnCall) continue;
+        columnMark[c] = columnCall;
+        columns.push_back(c);
+      }
     }
     std::sort(columns.begin(), columns.end());
-    columns.erase(std::unique(columns.begin(), columns.end()), columns.end());
     return columns;
   }
   // Calls visit(k, c, w) for each weight of a special element's structure
@@ -317,13 +329,14 @@ struct LimitSurface::Impl {
     forEachMapWeight(element,
                      [&](Eigen::Index k, int c, double w) { out.row(k) += w * controlPoints.row(element.columns[c]); });
   }
-  Eigen::RowVectorXd rowOver(const std::vector<int>& columns, int baseVertex) const {
-    Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(columns.size());
+  // Adds `weight` times a base vertex's blend of control vertices to `row`,
+  // a row over `columns` (which hold the blend's columns).
+  template <class Row>
+  void addRowOver(const std::vector<int>& columns, int baseVertex, double weight, Row&& row) const {
     for (SparseMatrix::InnerIterator it(isolation, baseVertex); it; ++it) {
       const auto position = std::lower_bound(columns.begin(), columns.end(), static_cast<int>(it.col()));
-      row(position - columns.begin()) += it.value();
+      row(position - columns.begin()) += weight * it.value();
     }
-    return row;
   }
 
   void buildNormal(Element& element, int face) {
@@ -336,7 +349,7 @@ struct LimitSurface::Impl {
     element.columns = columnsOf(baseVertices);
     element.grid.setZero(16, element.columns.size());
     for (int s = 0; s < 16; ++s) {
-      for (const auto& [v, w] : grid[s]) element.grid.row(s) += w * rowOver(element.columns, v);
+      for (const auto& [v, w] : grid[s]) addRowOver(element.columns, v, w, element.grid.row(s));
     }
     if (element.columns.size() != 16) return;
     for (int s = 0; s < 16; ++s) {
@@ -388,18 +401,13 @@ struct LimitSurface::Impl {
     const int x = base.face(face)[element.corner];
     detail::Neighbourhood neighbourhood = detail::extractNeighbourhood(base, x, face);
     const std::vector<int> columns = columnsOf(neighbourhood.parentVertex);
-    LocalMesh local;
-    local.weights.resize(neighbourhood.parentVertex.size(), columns.size());
-    for (size_t i = 0; i < neighbourhood.parentVertex.size(); ++i) {
-      local.weights.row(i) = rowOver(columns, neighbourhood.parentVertex[i]);
-    }
-    local.face = neighbourhood.face;
+    const int localFace = neighbourhood.face;
 
     // The structure: neighbourhoods are numbered by their structure
     // (extractNeighbourhood), so equal ones have equal polygons, and share
     // one Topology (a mesh of triangles has a special element on every
     // face, each of whose topologies would otherwise be built and kept).
-    std::vector<int> key{local.face};
+    std::vector<int> key{localFace};
     for (const Polygon& polygon : neighbourhood.faces) {
       key.push_back(-static_cast<int>(polygon.size()));
       key.insert(key.end(), polygon.begin(), polygon.end());
@@ -411,12 +419,14 @@ struct LimitSurface::Impl {
       std::vector<int> vertices(n);
       for (int i = 0; i < n; ++i) vertices[i] = i;
       structures.push_back(
-          makeSpecial(LocalMesh{structureTopologies.back(), Eigen::MatrixXd::Identity(n, n), local.face},
+          makeSpecial(LocalMesh{structureTopologies.back(), Eigen::MatrixXd::Identity(n, n), localFace},
                       std::move(vertices), true));
     }
-    local.topology = structureTopologies[found->second];
     element.structure = found->second;
-    element.mapVertices = neighbourhood.parentVertex;
+    element.mapVertices = std::move(neighbourhood.parentVertex);
+    size_t weights = 0;
+    for (const int b : element.mapVertices) weights += static_cast<size_t>(isolation.row(b).nonZeros());
+    element.mapColumns.reserve(weights);
     for (const int b : element.mapVertices)
       for (SparseMatrix::InnerIterator it(isolation, b); it; ++it)
         element.mapColumns.push_back(static_cast<int>(
@@ -429,6 +439,26 @@ struct LimitSurface::Impl {
     // (the blends' rows sum to 1). Tabulated per element they would take
     // memory, and time to fault it in, for every special element rather than
     // for the few structures.
+    if (!base.isBoundaryVertex(x)) {
+      // At an interior vertex the masks are linear in the blends too: the
+      // structure's masks times the structure map.
+      auto owned = std::make_unique<Special>();
+      owned->columns = columns;
+      owned->vertexMasks.setZero(3, static_cast<Eigen::Index>(columns.size()));
+      const Eigen::Matrix<double, 3, Eigen::Dynamic>& masks = structures[element.structure]->vertexMasks;
+      forEachMapWeight(element,
+                       [&](Eigen::Index k, int c, double w) { owned->vertexMasks.col(c) += w * masks.col(k); });
+      specials.push_back(std::move(owned));
+      return;
+    }
+    // At a boundary vertex the cross-boundary tangent is found from the
+    // blends' own eigen-terms (setBoundaryTangents), so from their weights.
+    LocalMesh local;
+    local.topology = structureTopologies[element.structure];
+    local.face = localFace;
+    local.weights.setZero(static_cast<Eigen::Index>(element.mapVertices.size()),
+                          static_cast<Eigen::Index>(columns.size()));
+    forEachMapWeight(element, [&](Eigen::Index k, int c, double w) { local.weights(k, c) += w; });
     specials.push_back(makeSpecial(std::move(local), columns, false));
   }
 

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <unordered_map>
 
 #include "dynsub/CatmullClark.h"
 #include "dynsub/Error.h"
@@ -256,15 +255,17 @@ Neighbourhood extractNeighbourhood(const Topology& topology, int x, int f) {
 
   Neighbourhood result;
   result.face = 0;
-  std::unordered_map<int, int> localIndex;
   result.faces.reserve(order.size());
   for (const auto& [g, first] : order) {
     Polygon polygon = topology.face(g);
     std::rotate(polygon.begin(), polygon.begin() + first, polygon.end());
     for (int& v : polygon) {
-      const auto [it, added] = localIndex.emplace(v, static_cast<int>(result.parentVertex.size()));
-      if (added) result.parentVertex.push_back(v);
-      v = it->second;
+      // A neighbourhood has a few dozen vertices: a scan finds one sooner
+      // than a hash map is built.
+      const auto it = std::find(result.parentVertex.begin(), result.parentVertex.end(), v);
+      const int local = static_cast<int>(it - result.parentVertex.begin());
+      if (it == result.parentVertex.end()) result.parentVertex.push_back(v);
+      v = local;
     }
     result.faces.push_back(std::move(polygon));
   }
