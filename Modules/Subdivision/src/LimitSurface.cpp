@@ -284,14 +284,15 @@ struct LimitSurface::Impl {
     return special.deepest;
   }
 
-  // The control-vertex columns that a set of base vertices blend, sorted.
-  // Each column is taken once, as first met (columnMark holds the call that
-  // last met it), so that only the distinct ones are sorted: after two
-  // isolating steps a base vertex blends a dozen or more control vertices,
-  // and an element's base vertices share most of them.
+  // The control-vertex columns that a set of base vertices blend, sorted;
+  // for the constructor alone, which builds one element at a time (the marks
+  // are shared scratch). Each column is taken once, as first met
+  // (columnMark holds the call that last met it), so that only the distinct
+  // ones are sorted: after two isolating steps a base vertex blends a dozen
+  // or more control vertices, and an element's base vertices share most of them.
   std::vector<int> columnMark;
   int columnCall = 0;
-  std::vector<int> columnsOf(const std::vector<int>& baseVertices) {
+  std::vector<int> gatherColumns(const std::vector<int>& baseVertices) {
     if (columnMark.size() != static_cast<size_t>(controlVertexCount)) columnMark.assign(controlVertexCount, -1);
     ++columnCall;
     std::vector<int> columns;
@@ -346,7 +347,7 @@ struct LimitSurface::Impl {
     for (const SmallStencil& s : grid) {
       for (const auto& [v, w] : s) baseVertices.push_back(v);
     }
-    element.columns = columnsOf(baseVertices);
+    element.columns = gatherColumns(baseVertices);
     element.grid.setZero(16, element.columns.size());
     for (int s = 0; s < 16; ++s) {
       for (const auto& [v, w] : grid[s]) addRowOver(element.columns, v, w, element.grid.row(s));
@@ -400,7 +401,7 @@ struct LimitSurface::Impl {
   void buildSpecial(Element& element, int face) {
     const int x = base.face(face)[element.corner];
     detail::Neighbourhood neighbourhood = detail::extractNeighbourhood(base, x, face);
-    const std::vector<int> columns = columnsOf(neighbourhood.parentVertex);
+    const std::vector<int> columns = gatherColumns(neighbourhood.parentVertex);
     const int localFace = neighbourhood.face;
 
     // The structure: neighbourhoods are numbered by their structure
@@ -424,9 +425,9 @@ struct LimitSurface::Impl {
     }
     element.structure = found->second;
     element.mapVertices = std::move(neighbourhood.parentVertex);
-    size_t weights = 0;
-    for (const int b : element.mapVertices) weights += static_cast<size_t>(isolation.row(b).nonZeros());
-    element.mapColumns.reserve(weights);
+    size_t entries = 0;
+    for (const int b : element.mapVertices) entries += static_cast<size_t>(isolation.row(b).nonZeros());
+    element.mapColumns.reserve(entries);
     for (const int b : element.mapVertices)
       for (SparseMatrix::InnerIterator it(isolation, b); it; ++it)
         element.mapColumns.push_back(static_cast<int>(
@@ -451,8 +452,9 @@ struct LimitSurface::Impl {
       specials.push_back(std::move(owned));
       return;
     }
-    // At a boundary vertex the cross-boundary tangent is found from the
-    // blends' own eigen-terms (setBoundaryTangents), so from their weights.
+    // At a boundary vertex the cross-boundary tangent keeps the eigen-terms
+    // that are large in these blends (setBoundaryTangents), a choice that is
+    // not linear in them: so it is found from the element's own weights.
     LocalMesh local;
     local.topology = structureTopologies[element.structure];
     local.face = localFace;
