@@ -108,16 +108,17 @@ void DynSubApplyOperators(benchmark::State& state) {
 
 Far::LimitStencilTableFactoryReal<double>::LocationArrayVec locationsOf(const std::vector<dynsub::SurfacePoint>& points,
                                                                         std::vector<double>& s, std::vector<double>& t) {
-  // Points come 16 per face, so one location array per face.
+  // One location array per run of points on one face.
   for (const auto& p : points) {
     s.push_back(p.u);
     t.push_back(p.v);
   }
   Far::LimitStencilTableFactoryReal<double>::LocationArrayVec locations;
-  for (size_t first = 0; first < points.size(); first += 16) {
+  for (size_t first = 0, end = 0; first < points.size(); first = end) {
+    for (end = first + 1; end < points.size() && points[end].face == points[first].face;) ++end;
     Far::LimitStencilTableFactoryReal<double>::LocationArray location;
     location.ptexIdx = points[first].face;
-    location.numLocations = 16;
+    location.numLocations = static_cast<int>(end - first);
     location.s = &s[first];
     location.t = &t[first];
     locations.push_back(location);
@@ -125,9 +126,9 @@ Far::LimitStencilTableFactoryReal<double>::LocationArrayVec locationsOf(const st
   return locations;
 }
 
-void OpenSubdivBuildStencils(benchmark::State& state) {
-  const dynsub::ControlMesh mesh = cubeAtLevel(static_cast<int>(state.range(0)));
-  const std::vector<dynsub::SurfacePoint> points = samples(mesh.faceCount());
+// OpenSubdiv's adaptive refinement and limit stencils for the points, timed.
+void timeOpenSubdivBuild(benchmark::State& state, const dynsub::ControlMesh& mesh,
+                         const std::vector<dynsub::SurfacePoint>& points) {
   std::vector<double> s, t;
   const auto locations = locationsOf(points, s, t);
   for (auto _ : state) {
@@ -138,6 +139,11 @@ void OpenSubdivBuildStencils(benchmark::State& state) {
     benchmark::DoNotOptimize(table->GetNumStencils());
   }
   state.SetItemsProcessed(state.iterations() * points.size());
+}
+
+void OpenSubdivBuildStencils(benchmark::State& state) {
+  const dynsub::ControlMesh mesh = cubeAtLevel(static_cast<int>(state.range(0)));
+  timeOpenSubdivBuild(state, mesh, samples(mesh.faceCount()));
 }
 
 void OpenSubdivApplyStencils(benchmark::State& state) {
@@ -183,25 +189,7 @@ void DynSubBuildOperatorsTriangles(benchmark::State& state) {
 
 void OpenSubdivBuildStencilsTriangles(benchmark::State& state) {
   const dynsub::ControlMesh mesh = triangleSphere(static_cast<int>(state.range(0)));
-  const std::vector<dynsub::SurfacePoint> points = parametricFaceMiddles(dynsub::LimitSurface(mesh));
-  std::vector<double> s(points.size(), 0.5), t(points.size(), 0.5);
-  Far::LimitStencilTableFactoryReal<double>::LocationArrayVec locations;
-  for (size_t i = 0; i < points.size(); ++i) {
-    Far::LimitStencilTableFactoryReal<double>::LocationArray location;
-    location.ptexIdx = points[i].face;
-    location.numLocations = 1;
-    location.s = &s[i];
-    location.t = &t[i];
-    locations.push_back(location);
-  }
-  for (auto _ : state) {
-    auto refiner = dynsub::testing::openSubdivRefiner(mesh);
-    refiner->RefineAdaptive(Far::TopologyRefiner::AdaptiveOptions(10));
-    std::unique_ptr<const Far::LimitStencilTableReal<double>> table(
-        Far::LimitStencilTableFactoryReal<double>::Create(*refiner, locations));
-    benchmark::DoNotOptimize(table->GetNumStencils());
-  }
-  state.SetItemsProcessed(state.iterations() * points.size());
+  timeOpenSubdivBuild(state, mesh, parametricFaceMiddles(dynsub::LimitSurface(mesh)));
 }
 
 BENCHMARK(DynSubBuildOperators)->DenseRange(0, 3)->Unit(benchmark::kMillisecond);
