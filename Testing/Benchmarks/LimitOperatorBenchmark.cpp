@@ -78,9 +78,9 @@ std::vector<dynsub::SurfacePoint> samples(int faces) {
   return points;
 }
 
-void DynSubBuildOperators(benchmark::State& state) {
-  const dynsub::ControlMesh mesh = cubeAtLevel(static_cast<int>(state.range(0)));
-  const std::vector<dynsub::SurfacePoint> points = samples(mesh.faceCount());
+// DynSub's limit surface and operators for the points, timed.
+void timeDynSubBuild(benchmark::State& state, const dynsub::ControlMesh& mesh,
+                     const std::vector<dynsub::SurfacePoint>& points) {
   for (auto _ : state) {
     const dynsub::LimitSurface surface(mesh);
     dynsub::LimitOperators ops = surface.operators(points, 1);  // J, J_u, J_v, as OpenSubdiv builds
@@ -88,6 +88,11 @@ void DynSubBuildOperators(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations() * points.size());
   state.counters["control_vertices"] = mesh.vertexCount();
+}
+
+void DynSubBuildOperators(benchmark::State& state) {
+  const dynsub::ControlMesh mesh = cubeAtLevel(static_cast<int>(state.range(0)));
+  timeDynSubBuild(state, mesh, samples(mesh.faceCount()));
 }
 
 void DynSubApplyOperators(benchmark::State& state) {
@@ -177,14 +182,7 @@ void OpenSubdivApplyStencils(benchmark::State& state) {
 
 void DynSubBuildOperatorsTriangles(benchmark::State& state) {
   const dynsub::ControlMesh mesh = triangleSphere(static_cast<int>(state.range(0)));
-  const std::vector<dynsub::SurfacePoint> points = parametricFaceMiddles(dynsub::LimitSurface(mesh));
-  for (auto _ : state) {
-    const dynsub::LimitSurface surface(mesh);
-    dynsub::LimitOperators ops = surface.operators(points, 1);
-    benchmark::DoNotOptimize(ops.J.nonZeros());
-  }
-  state.SetItemsProcessed(state.iterations() * points.size());
-  state.counters["control_vertices"] = mesh.vertexCount();
+  timeDynSubBuild(state, mesh, parametricFaceMiddles(dynsub::LimitSurface(mesh)));
 }
 
 void OpenSubdivBuildStencilsTriangles(benchmark::State& state) {

@@ -200,6 +200,36 @@ int quadrant(double u, double v) {
   return v < 0.5 ? 1 : 2;
 }
 
+// The control-vertex columns that sets of base vertices blend (rows of the
+// isolation matrix), sorted; one per construction, which builds its elements
+// one at a time. Each column is taken once, as first met (mark_ holds the
+// call that last met it), so that only the distinct ones are sorted: after
+// two isolating steps a base vertex blends a dozen or more control vertices,
+// and an element's base vertices share most of them.
+class ColumnGatherer {
+ public:
+  explicit ColumnGatherer(const SparseMatrix& isolation) : isolation_(isolation), mark_(isolation.cols(), -1) {}
+  std::vector<int> operator()(const std::vector<int>& baseVertices) {
+    ++call_;
+    std::vector<int> columns;
+    for (int b : baseVertices) {
+      for (SparseMatrix::InnerIterator it(isolation_, b); it; ++it) {
+        const int c = static_cast<int>(it.col());
+        if (mark_[c] == call_) continue;
+        mark_[c] = call_;
+        columns.push_back(c);
+      }
+    }
+    std::sort(columns.begin(), columns.end());
+    return columns;
+  }
+
+ private:
+  const SparseMatrix& isolation_;
+  std::vector<int> mark_;
+  int call_ = 0;
+};
+
 }  // namespace
 
 struct LimitSurface::Impl {
@@ -284,29 +314,6 @@ struct LimitSurface::Impl {
     return special.deepest;
   }
 
-  // The control-vertex columns that a set of base vertices blend, sorted;
-  // for the constructor alone, which builds one element at a time (the marks
-  // are shared scratch). Each column is taken once, as first met
-  // (columnMark holds the call that last met it), so that only the distinct
-  // ones are sorted: after two isolating steps a base vertex blends a dozen
-  // or more control vertices, and an element's base vertices share most of them.
-  std::vector<int> columnMark;
-  int columnCall = 0;
-  std::vector<int> gatherColumns(const std::vector<int>& baseVertices) {
-    if (columnMark.size() != static_cast<size_t>(controlVertexCount)) columnMark.assign(controlVertexCount, -1);
-    ++columnCall;
-    std::vector<int> columns;
-    for (int b : baseVertices) {
-      for (SparseMatrix::InnerIterator it(isolation, b); it; ++it) {
-        const int c = static_cast<int>(it.col());
-        if (columnMark[c] == columnCall) continue;
-        columnMark[c] = columnCall;
-        columns.push_back(c);
-      }
-    }
-    std::sort(columns.begin(), columns.end());
-    return columns;
-  }
   // Calls visit(k, c, w) for each weight of a special element's structure
   // map: its neighbourhood vertex k is, in part, w times its column c. Row by
   // row, each row's columns in increasing order.
@@ -340,7 +347,7 @@ struct LimitSurface::Impl {
     }
   }
 
-  void buildNormal(Element& element, int face) {
+  void buildNormal(Element& element, int face, ColumnGatherer& gatherColumns) {
     std::array<SmallStencil, 16> grid;
     if (!detail::gatherRegularPatch(base, face, grid)) throw Error("internal: normal element is not regular");
     std::vector<int> baseVertices;
@@ -398,7 +405,7 @@ struct LimitSurface::Impl {
     return owned;
   }
 
-  void buildSpecial(Element& element, int face) {
+  void buildSpecial(Element& element, int face, ColumnGatherer& gatherColumns) {
     const int x = base.face(face)[element.corner];
     detail::Neighbourhood neighbourhood = detail::extractNeighbourhood(base, x, face);
     const std::vector<int> columns = gatherColumns(neighbourhood.parentVertex);
@@ -816,6 +823,7 @@ LimitSurface::LimitSurface(const ControlMesh& mesh, const SparseMatrix& freeBasi
   s.isolation.makeCompressed();
 
   s.elements.resize(s.base.faceCount());
+  ColumnGatherer gatherColumns(s.isolation);
   for (int f = 0; f < s.base.faceCount(); ++f) {
     Impl::Element& element = s.elements[f];
     element.controlFace = controlFaceOf[f];
@@ -823,10 +831,10 @@ LimitSurface::LimitSurface(const ControlMesh& mesh, const SparseMatrix& freeBasi
       if (!s.base.isRegularVertex(s.base.face(f)[k])) element.corner = k;
     }
     if (element.corner < 0) {
-      s.buildNormal(element, f);
+      s.buildNormal(element, f, gatherColumns);
     } else {
       element.type = ElementType::Special;
-      s.buildSpecial(element, f);
+      s.buildSpecial(element, f, gatherColumns);
     }
   }
 }
