@@ -115,6 +115,11 @@ void runDeform(DeformArguments o) {
     }
     warnings.push_back(text.str());
   }
+  const TriangleSurface surface = outputSurface(result.mesh);
+  const SelfIntersection crossing = findSelfIntersections(surface);
+  const std::string crossingWarning = selfIntersectionWarning(crossing, "");
+  if (!crossingWarning.empty()) warnings.push_back(crossingWarning);
+  report.set("self_intersection", selfIntersectionReport(crossing));
   report.set("warnings", warnings);
   Report parameters = simulationReport(o.deformation.simulation);
   parameters.set("default_spring_stiffness", o.stiffness);
@@ -123,8 +128,7 @@ void runDeform(DeformArguments o) {
   parameters.set("rest_shape", o.restShape);
   report.set("parameters", parameters);
 
-  writeModelOutputs(dir, result.mesh, outputSurface(result.mesh), report,
-                    [&dir](OutputSet& outputs) { retireEarlierRun(outputs, dir); });
+  writeModelOutputs(dir, result.mesh, surface, report, [&dir](OutputSet& outputs) { retireEarlierRun(outputs, dir); });
   std::cout << std::fixed << std::setprecision(3) << "deformed " << o.mesh << " with " << springs.targets.rows()
             << " springs: " << (result.levels.back().converged ? "equilibrium" : "step limit reached") << " after "
             << result.steps << " steps, " << std::setprecision(2) << seconds << " s; farthest target "

@@ -7,6 +7,10 @@
 // of triangles (an icosahedron split 3-5 times: 642, 2562, 10242 vertices),
 // one point per parametric face: every vertex of it is extraordinary, so it
 // needs two isolating subdivisions and half its elements are special.
+// Tessellate and FindSelfIntersections: the output tessellation of the cube
+// at levels 0-2 (8 x 8 squares per face; level 1 gives the 49,152 triangles of
+// a segmented structure), and the search for its crossing triangles that
+// every model-moving command runs on it, side by side.
 //   build/bin/LimitOperatorBenchmark --benchmark_min_time=1
 #include <array>
 #include <cmath>
@@ -20,6 +24,7 @@
 #include "dynsub/ApplyOperator.h"
 #include "dynsub/CatmullClark.h"
 #include "dynsub/LimitSurface.h"
+#include "dynsub/SelfIntersection.h"
 #include "dynsub/StandardMeshes.h"
 
 namespace {
@@ -190,12 +195,32 @@ void OpenSubdivBuildStencilsTriangles(benchmark::State& state) {
   timeOpenSubdivBuild(state, mesh, parametricFaceMiddles(dynsub::LimitSurface(mesh)));
 }
 
+void Tessellate(benchmark::State& state) {
+  const dynsub::ControlMesh mesh = cubeAtLevel(static_cast<int>(state.range(0)));
+  const dynsub::LimitSurface surface(mesh);
+  for (auto _ : state)
+    benchmark::DoNotOptimize(dynsub::tessellate(surface, mesh.points(), dynsub::kOutputSegments).points.data());
+}
+
+void FindSelfIntersections(benchmark::State& state) {
+  const dynsub::ControlMesh mesh = cubeAtLevel(static_cast<int>(state.range(0)));
+  const dynsub::TriangleSurface tessellation =
+      dynsub::tessellate(dynsub::LimitSurface(mesh), mesh.points(), dynsub::kOutputSegments);
+  for (auto _ : state) {
+    const dynsub::SelfIntersection found = dynsub::findSelfIntersections(tessellation);
+    if (found.trianglePairs != 0) state.SkipWithError("the cube's limit surface crosses itself");
+  }
+  state.counters["triangles"] = static_cast<double>(tessellation.triangles.size());
+}
+
 BENCHMARK(DynSubBuildOperators)->DenseRange(0, 3)->Unit(benchmark::kMillisecond);
 BENCHMARK(OpenSubdivBuildStencils)->DenseRange(0, 3)->Unit(benchmark::kMillisecond);
 BENCHMARK(DynSubApplyOperators)->DenseRange(0, 3)->Unit(benchmark::kMicrosecond);
 BENCHMARK(OpenSubdivApplyStencils)->DenseRange(0, 3)->Unit(benchmark::kMicrosecond);
 BENCHMARK(DynSubBuildOperatorsTriangles)->DenseRange(3, 5)->Unit(benchmark::kMillisecond);
 BENCHMARK(OpenSubdivBuildStencilsTriangles)->DenseRange(3, 5)->Unit(benchmark::kMillisecond);
+BENCHMARK(Tessellate)->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
+BENCHMARK(FindSelfIntersections)->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -1,5 +1,7 @@
 #include "dynsub/ModelOutputs.h"
 
+#include <iomanip>
+#include <sstream>
 #include <string>
 
 #include "dynsub/Error.h"
@@ -63,6 +65,30 @@ Report levelReport(const LevelSummary& l, double maxErrorPercent, double rmsErro
   r.set("equilibrium_residual", l.residual);
   r.set("seconds", l.seconds);
   return r;
+}
+
+Report selfIntersectionReport(const SelfIntersection& found) {
+  Report r;
+  r.set("triangle_pairs", found.trianglePairs);
+  r.set("area_percent", found.areaPercent);
+  if (found.trianglePairs > 0) r.set("bounds_mm", std::vector<Vector3>{found.boundsMin, found.boundsMax});
+  return r;
+}
+
+std::string selfIntersectionWarning(const SelfIntersection& found, const std::string& space) {
+  if (found.trianglePairs == 0) return "";
+  const auto point = [](const Vector3& p) {
+    std::ostringstream text;
+    text << std::fixed << std::setprecision(1) << "(" << p.x() << ", " << p.y() << ", " << p.z() << ")";
+    return text.str();
+  };
+  std::ostringstream text;
+  text << "the surface passes through itself: " << found.trianglePairs << " pairs of its triangles cross, over "
+       << std::fixed << std::setprecision(2) << found.areaPercent << " % of its area, between "
+       << point(found.boundsMin) << " and " << point(found.boundsMax) << " mm" << (space.empty() ? "" : " ") << space
+       << ". There it bounds no solid, and a mask filled from it (as segment's labelmap is) leaves out what two "
+          "of its sheets enclose: look at the result there";
+  return text.str();
 }
 
 TriangleSurface outputSurface(const ControlMesh& mesh) { return outputSurface(mesh, LimitSurface(mesh)); }

@@ -9,6 +9,7 @@
 
 #include "dynsub/OutputSet.h"
 #include "dynsub/Report.h"
+#include "dynsub/SelfIntersection.h"
 #include "dynsub/Simulation.h"
 #include "dynsub/SurfaceWriter.h"
 
@@ -18,6 +19,14 @@ namespace dynsub {
 Report simulationReport(const SimulationOptions& options);
 // One entry of report.json's "per_level"; the fit errors are left out when negative.
 Report levelReport(const LevelSummary& level, double maxErrorPercent, double rmsErrorPercent);
+
+// report.json's "self_intersection": how many pairs of the written surface's
+// triangles cross (SelfIntersection.h), their share of its area and their
+// bounding box.
+Report selfIntersectionReport(const SelfIntersection& found);
+// The warning that the written surface passes through itself, or "" when it
+// does not; `space` names its coordinates ("LPS", or "" for a scan's own).
+std::string selfIntersectionWarning(const SelfIntersection& found, const std::string& space);
 
 // The limit surface as the programs write it (outputSegments, Tessellation.h).
 // Throws dynsub::Error if the control points are not finite.

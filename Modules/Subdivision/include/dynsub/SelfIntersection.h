@@ -1,0 +1,30 @@
+#pragma once
+// Where a tessellated surface passes through itself. A fitted surface can: a
+// landmark or an edge may pull one part of it through another, and then
+// surface.vtp is no longer the boundary of a solid (tools that need one, such
+// as a mesh boolean or a thickness measure, refuse it or go wrong) and the
+// labelmap, filled by the even-odd rule (Voxelize.h), leaves out what two
+// sheets enclose twice.
+//
+// Two triangles cross when an edge of one passes through the other. Pairs
+// that share a sample are not tested: neighbours meet along their common edge
+// or corner by construction, so a fold narrower than one triangle around a
+// sample is not seen. Samples that coincide (a sharp crease's two sides,
+// written once per side: Tessellation.h) count as shared.
+#include <vector>
+
+#include "dynsub/Tessellation.h"
+
+namespace dynsub {
+
+struct SelfIntersection {
+  int trianglePairs = 0;       // pairs of triangles that cross
+  std::vector<int> triangles;  // the triangles in those pairs, ascending
+  double areaPercent = 0.0;    // their share of the surface's area
+  // Their bounding box (mm); zero when there are none.
+  Vector3 boundsMin = Vector3::Zero(), boundsMax = Vector3::Zero();
+};
+
+SelfIntersection findSelfIntersections(const TriangleSurface& surface);
+
+}  // namespace dynsub
