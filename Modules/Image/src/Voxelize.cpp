@@ -46,7 +46,14 @@ Mask voxelizeSurface(const MatrixX3& points, const std::vector<std::array<int, 3
 
   Mask mask{grid, std::vector<std::uint8_t>(grid.voxelCount(), 0)};
   const int rowsJ = grid.size[1], rowsK = grid.size[2];
-  std::vector<std::vector<double>> crossings(static_cast<std::size_t>(rowsJ) * rowsK);
+  // Where each row crosses the surface, and which way: +1 or -1 by the sign of
+  // the triangle's normal along the row.
+  struct Crossing {
+    double at;
+    int sense;
+    bool operator<(const Crossing& other) const { return at < other.at; }
+  };
+  std::vector<std::vector<Crossing>> crossings(static_cast<std::size_t>(rowsJ) * rowsK);
   // The row through voxel centres (j, k) is shifted by this much, see the header.
   const double shiftJ = 1.0e-6, shiftK = 1.7e-6;
 
@@ -67,20 +74,30 @@ Mask voxelizeSurface(const MatrixX3& points, const std::vector<std::array<int, 3
         const double s = (y * (c[2] - a[2]) - (c[1] - a[1]) * z) / det;
         const double r = ((b[1] - a[1]) * z - y * (b[2] - a[2])) / det;
         if (s < 0 || r < 0 || s + r > 1) continue;
-        crossings[static_cast<std::size_t>(k) * rowsJ + j].push_back(a[0] + s * (b[0] - a[0]) + r * (c[0] - a[0]));
+        crossings[static_cast<std::size_t>(k) * rowsJ + j].push_back(
+            {a[0] + s * (b[0] - a[0]) + r * (c[0] - a[0]), det > 0 ? 1 : -1});
       }
   }
 
   for (int k = 0; k < rowsK; ++k)
     for (int j = 0; j < rowsJ; ++j) {
       auto& row = crossings[static_cast<std::size_t>(k) * rowsJ + j];
-      // A closed surface is crossed an even number of times; an odd count means a
-      // crossing was lost at a tangency, and the row is left out rather than filled wrongly.
-      if (row.size() % 2 != 0) continue;
+      // A closed surface winds around each point a whole number of times, so a
+      // row's senses sum to 0; any other sum means a crossing was lost at a
+      // tangency, and the row is left out rather than filled wrongly.
+      int total = 0;
+      for (const Crossing& c : row) total += c.sense;
+      if (total != 0) continue;
       std::sort(row.begin(), row.end());
-      for (std::size_t c = 0; c + 1 < row.size(); c += 2) {
-        const int first = std::max(0, static_cast<int>(std::ceil(row[c])));
-        const int last = std::min(grid.size[0] - 1, static_cast<int>(std::floor(row[c + 1])));
+      // Inside where the surface winds around the voxel's centre (the nonzero
+      // rule): where two sheets of a surface that passes through itself
+      // overlap, it winds twice, and the even-odd rule would leave that out.
+      int winding = 0;
+      for (std::size_t c = 0; c + 1 < row.size(); ++c) {
+        winding += row[c].sense;
+        if (winding == 0) continue;
+        const int first = std::max(0, static_cast<int>(std::ceil(row[c].at)));
+        const int last = std::min(grid.size[0] - 1, static_cast<int>(std::floor(row[c + 1].at)));
         for (int i = first; i <= last; ++i) mask.voxels[grid.offset(i, j, k)] = 1;
       }
     }

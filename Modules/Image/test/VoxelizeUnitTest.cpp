@@ -69,6 +69,46 @@ TEST(Voxelize, SphereOnAnAnisotropicRotatedGrid) {
   EXPECT_NEAR(volume / exact, 1.0, 0.02);
 }
 
+// A surface that passes through itself: two spheres overlapping, as one
+// triangle set. The surface winds twice around the lens they share, which is
+// inside (the nonzero rule; the even-odd rule would leave it out). Turned
+// inward, the spheres give the same mask.
+TEST(Voxelize, WhereASurfaceOverlapsItselfIsInside) {
+  const ImageGeometry g = grid({48, 40, 24}, Vector3(0.6, 0.8, 1.5), Vector3(-14, -15, -16), skewDirection());
+  const Vector3 a = g.toPhysical(Vector3(18.5, 19.5, 11.5)), b = a + Vector3(6, 3, 2);
+  const double radius = 8.0;
+  MatrixX3 first, second;
+  std::vector<std::array<int, 3>> firstTriangles, secondTriangles;
+  uvSphere(a, radius, first, firstTriangles);
+  uvSphere(b, radius, second, secondTriangles);
+  MatrixX3 points(first.rows() + second.rows(), 3);
+  points << first, second;
+  std::vector<std::array<int, 3>> triangles = firstTriangles;
+  const int shift = static_cast<int>(first.rows());
+  for (const auto& t : secondTriangles) triangles.push_back({t[0] + shift, t[1] + shift, t[2] + shift});
+  std::vector<std::array<int, 3>> inward = triangles;
+  for (auto& t : inward) std::swap(t[1], t[2]);
+  const Mask mask = voxelizeSurface(points, triangles, g);
+  EXPECT_EQ(voxelizeSurface(points, inward, g).voxels, mask.voxels);
+  // 0.02 mm: the polygons' distance from their spheres, as above.
+  long long lens = 0;
+  for (int k = 0; k < g.size[2]; ++k)
+    for (int j = 0; j < g.size[1]; ++j)
+      for (int i = 0; i < g.size[0]; ++i) {
+        const Vector3 x = g.toPhysical(Vector3(i, j, k));
+        const double near = std::min((x - a).norm(), (x - b).norm()), far = std::max((x - a).norm(), (x - b).norm());
+        const bool set = mask.voxels[g.offset(i, j, k)];
+        if (near < radius - 0.02) {
+          ASSERT_TRUE(set) << i << ' ' << j << ' ' << k;
+        }
+        if (near > radius + 0.02) {
+          ASSERT_FALSE(set) << i << ' ' << j << ' ' << k;
+        }
+        lens += far < radius - 0.02;
+      }
+  EXPECT_GT(lens, 500);  // the lens holds enough voxel centres to be tested
+}
+
 TEST(Voxelize, OpenSurfaceIsRefused) {
   const ImageGeometry g = grid({20, 20, 20}, Vector3::Ones(), Vector3::Zero(), Matrix3::Identity());
   MatrixX3 points;

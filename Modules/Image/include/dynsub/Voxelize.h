@@ -3,10 +3,12 @@
 // voxel is inside when its centre is. Each row of voxels along the grid's
 // first axis is a line in physical space; the surface's crossings of that line
 // (computed in continuous index space, where the line is axis-aligned, so any
-// direction matrix and spacing are handled exactly) are sorted, and the
-// voxels between the 1st and 2nd, 3rd and 4th, ... crossings are set
-// (even-odd rule). The rows are offset by 1e-6 voxel so that no row passes
-// exactly through a triangle edge or vertex.
+// direction matrix and spacing are handled exactly) are sorted, each with the
+// way the surface faces there, and the voxels around which the surface winds
+// are set (the nonzero rule: where a surface that passes through itself
+// overlaps itself, inside as well, which the even-odd rule would leave out;
+// for a surface that does not, the two rules agree). The rows are offset by
+// 1e-6 voxel so that no row passes exactly through a triangle edge or vertex.
 #include <array>
 #include <vector>
 
