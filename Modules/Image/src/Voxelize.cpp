@@ -84,14 +84,13 @@ Mask voxelizeSurface(const MatrixX3& points, const std::vector<std::array<int, 3
       auto& row = crossings[static_cast<std::size_t>(k) * rowsJ + j];
       // A closed surface winds around each point a whole number of times, so a
       // row's senses sum to 0; any other sum means a crossing was lost at a
-      // tangency, and the row is left out rather than filled wrongly.
+      // tangency or counted twice on a shared edge, and the row is left out
+      // rather than filled wrongly.
       int total = 0;
       for (const Crossing& c : row) total += c.sense;
       if (total != 0) continue;
       std::sort(row.begin(), row.end());
-      // Inside where the surface winds around the voxel's centre (the nonzero
-      // rule): where two sheets of a surface that passes through itself
-      // overlap, it winds twice, and the even-odd rule would leave that out.
+      // Inside where the surface winds around the voxel's centre (the nonzero rule, Voxelize.h).
       int winding = 0;
       for (std::size_t c = 0; c + 1 < row.size(); ++c) {
         winding += row[c].sense;

@@ -86,8 +86,8 @@ std::string selfIntersectionWarning(const SelfIntersection& found, const std::st
   text << "the surface passes through itself: " << found.trianglePairs << " pairs of its triangles cross, over "
        << std::fixed << std::setprecision(2) << found.areaPercent << " % of its area, between "
        << point(found.boundsMin) << " and " << point(found.boundsMax) << " mm" << (space.empty() ? "" : " ") << space
-       << ". There it bounds no solid: a tool that needs one (a mesh boolean, a thickness measure, a mask filled "
-          "by the even-odd rule) goes wrong there. Look at the result there";
+       << ": there it bounds no solid, and tools that need one (a mesh boolean, a thickness measure, a mask "
+          "filled by the even-odd rule) go wrong; look at the result in that box";
   return text.str();
 }
 

@@ -5,9 +5,10 @@
 // (computed in continuous index space, where the line is axis-aligned, so any
 // direction matrix and spacing are handled exactly) are sorted, each with the
 // way the surface faces there, and the voxels around which the surface winds
-// are set (the nonzero rule: where a surface that passes through itself
-// overlaps itself, inside as well, which the even-odd rule would leave out;
-// for a surface that does not, the two rules agree). The rows are offset by
+// any number of times but 0 are set (the nonzero rule). Where a surface that
+// passes through itself overlaps itself it winds twice, inside too, which the
+// even-odd rule would leave out; for a consistently oriented surface that
+// does not cross itself (a model's), the two rules agree. The rows are offset by
 // 1e-6 voxel so that no row passes exactly through a triangle edge or vertex.
 #include <array>
 #include <vector>

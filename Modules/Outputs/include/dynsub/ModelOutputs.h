@@ -25,7 +25,7 @@ Report levelReport(const LevelSummary& level, double maxErrorPercent, double rms
 // bounding box.
 Report selfIntersectionReport(const SelfIntersection& found);
 // The warning that the written surface passes through itself, or "" when it
-// does not; `space` names its coordinates ("LPS", or "" for a scan's own).
+// does not; `space` names its coordinates ("LPS", or "" for the input's own).
 std::string selfIntersectionWarning(const SelfIntersection& found, const std::string& space);
 
 // The limit surface as the programs write it (outputSegments, Tessellation.h).

@@ -3,8 +3,8 @@
 // landmark or an edge may pull one part of it through another, and then
 // surface.vtp is no longer the boundary of a solid: tools that need one, such
 // as a mesh boolean, a thickness measure or a mask filled by the even-odd
-// rule, refuse it or go wrong there. (DynSub's own labelmap is filled by the
-// nonzero rule, Voxelize.h, which counts what two sheets enclose as inside.)
+// rule, refuse it or go wrong there. DynSub's own labelmap is filled by the
+// nonzero rule (Voxelize.h), which counts what two sheets enclose as inside.
 //
 // Two triangles cross when an edge of one passes through the other. Pairs
 // that share a sample are not tested: neighbours meet along their common edge
