@@ -116,10 +116,7 @@ void runDeform(DeformArguments o) {
     warnings.push_back(text.str());
   }
   const TriangleSurface surface = outputSurface(result.mesh);
-  const SelfIntersection crossing = findSelfIntersections(surface);
-  const std::string crossingWarning = selfIntersectionWarning(crossing, "");
-  if (!crossingWarning.empty()) warnings.push_back(crossingWarning);
-  report.set("self_intersection", selfIntersectionReport(crossing));
+  report.set("self_intersection", selfIntersectionReport(surface, "", warnings));
   report.set("warnings", warnings);
   Report parameters = simulationReport(o.deformation.simulation);
   parameters.set("default_spring_stiffness", o.stiffness);

@@ -185,9 +185,7 @@ void runFit(FitCommandOptions o) {
   if (coverage.uncoveredFraction > kUncoveredWarning && (dataGenus < 0 || dataGenus == initial.genus())) {
     warnings.push_back(uncoveredWarning(coverage, o.points, diameter, o.fit.surfaceSprings > 0.0));
   }
-  const SelfIntersection crossing = findSelfIntersections(surface);
-  const std::string crossingWarning = selfIntersectionWarning(crossing, "");
-  if (!crossingWarning.empty()) warnings.push_back(crossingWarning);
+  const Report crossing = selfIntersectionReport(surface, "", warnings);
 
   Report report;
   report.set("input", o.points);
@@ -217,7 +215,7 @@ void runFit(FitCommandOptions o) {
   coverageReport.set("uncovered_area_percent", 100.0 * coverage.uncoveredFraction);
   coverageReport.set("gap_spacings", kCoverageSpacings);
   report.set("surface_coverage", coverageReport);
-  report.set("self_intersection", selfIntersectionReport(crossing));
+  report.set("self_intersection", crossing);
   if (!o.reference.empty()) {
     const FitError e = measureFitError(*result.surface, result.mesh.points(), reference, diameter);
     Report against;

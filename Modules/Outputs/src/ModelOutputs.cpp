@@ -9,6 +9,7 @@
 #include "dynsub/MeshCheck.h"
 #include "dynsub/MeshIO.h"
 #include "dynsub/ParallelFor.h"
+#include "dynsub/SelfIntersection.h"
 
 namespace dynsub {
 
@@ -67,16 +68,14 @@ Report levelReport(const LevelSummary& l, double maxErrorPercent, double rmsErro
   return r;
 }
 
-Report selfIntersectionReport(const SelfIntersection& found) {
+Report selfIntersectionReport(const TriangleSurface& surface, const std::string& space,
+                              std::vector<std::string>& warnings) {
+  const SelfIntersection found = findSelfIntersections(surface);
   Report r;
   r.set("triangle_pairs", found.trianglePairs);
   r.set("area_percent", found.areaPercent);
-  if (found.trianglePairs > 0) r.set("bounds_mm", std::vector<Vector3>{found.boundsMin, found.boundsMax});
-  return r;
-}
-
-std::string selfIntersectionWarning(const SelfIntersection& found, const std::string& space) {
-  if (found.trianglePairs == 0) return "";
+  if (found.trianglePairs == 0) return r;
+  r.set("bounds_mm", std::vector<Vector3>{found.boundsMin, found.boundsMax});
   const auto point = [](const Vector3& p) {
     std::ostringstream text;
     text << std::fixed << std::setprecision(1) << "(" << p.x() << ", " << p.y() << ", " << p.z() << ")";
@@ -88,7 +87,8 @@ std::string selfIntersectionWarning(const SelfIntersection& found, const std::st
        << point(found.boundsMin) << " and " << point(found.boundsMax) << " mm" << (space.empty() ? "" : " ") << space
        << ": there it bounds no solid, and tools that need one (a mesh boolean, a thickness measure, a mask "
           "filled by the even-odd rule) go wrong; look at the result in that box";
-  return text.str();
+  warnings.push_back(text.str());
+  return r;
 }
 
 TriangleSurface outputSurface(const ControlMesh& mesh) { return outputSurface(mesh, LimitSurface(mesh)); }

@@ -481,9 +481,7 @@ SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& in, const 
     const std::vector<std::string> seed = seedWarnings(*outcome.seed);
     outcome.warnings.insert(outcome.warnings.begin(), seed.begin(), seed.end());
   }
-  const SelfIntersection crossing = findSelfIntersections(result.surface);
-  const std::string crossingWarning = selfIntersectionWarning(crossing, "LPS");
-  if (!crossingWarning.empty()) outcome.warnings.push_back(crossingWarning);
+  const Report crossing = selfIntersectionReport(result.surface, "LPS", outcome.warnings);
   const TrustEvidence evidence = trustEvidence(image, in, outcome);
   outcome.trust = measureTrust(result.surface, result.volume, evidence);
   outcome.trustFlags = trustFlags(outcome.trust, evidence);
@@ -538,7 +536,7 @@ SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& in, const 
   report.set("surface_volume_mm3", result.volume);
   report.set("surface_outside_region", result.outsideRegion);
   if (std::isfinite(result.surfaceOnEdges)) report.set("surface_on_edges", result.surfaceOnEdges);
-  report.set("self_intersection", selfIntersectionReport(crossing));
+  report.set("self_intersection", crossing);
   report.set("warnings", outcome.warnings);
   report.set("trust", trustReport(outcome.trust, outcome.trustFlags));
   std::vector<Report> residuals;

@@ -9,7 +9,6 @@
 
 #include "dynsub/OutputSet.h"
 #include "dynsub/Report.h"
-#include "dynsub/SelfIntersection.h"
 #include "dynsub/Simulation.h"
 #include "dynsub/SurfaceWriter.h"
 
@@ -20,13 +19,13 @@ Report simulationReport(const SimulationOptions& options);
 // One entry of report.json's "per_level"; the fit errors are left out when negative.
 Report levelReport(const LevelSummary& level, double maxErrorPercent, double rmsErrorPercent);
 
-// report.json's "self_intersection": how many pairs of the written surface's
-// triangles cross (SelfIntersection.h), their share of its area and their
-// bounding box.
-Report selfIntersectionReport(const SelfIntersection& found);
-// The warning that the written surface passes through itself, or "" when it
-// does not; `space` names its coordinates ("LPS", or "" for the input's own).
-std::string selfIntersectionWarning(const SelfIntersection& found, const std::string& space);
+// report.json's "self_intersection" for the surface a command writes: how
+// many pairs of its triangles cross (SelfIntersection.h), their share of its
+// area and their bounding box. Where it crosses itself, a warning that names
+// the box is added to `warnings`; `space` names the coordinates ("LPS", or ""
+// for the input's own).
+Report selfIntersectionReport(const TriangleSurface& surface, const std::string& space,
+                              std::vector<std::string>& warnings);
 
 // The limit surface as the programs write it (outputSegments, Tessellation.h).
 // Throws dynsub::Error if the control points are not finite.
