@@ -73,12 +73,26 @@ SelfIntersection findSelfIntersections(const TriangleSurface& surface) {
     return std::uint64_t(cell.x()) | std::uint64_t(cell.y()) << 10 | std::uint64_t(cell.z()) << 20;
   };
 
-  // (cell << 32 | triangle) for every cell a triangle's box meets, sorted by cell.
+  // (cell << 32 | triangle) for every cell a triangle's box meets, sorted by
+  // cell. A triangle whose box meets more than kLongCells cells is long: where
+  // a few long triangles lie among many short ones (a stretched element), the
+  // cells are the short ones' size and a long one's box could meet up to 1001^3
+  // of them, so long triangles are kept out of the grid and tested against
+  // every triangle whose box they meet instead. The grid then holds at most
+  // kLongCells entries a triangle; an even tessellation puts about 3 a triangle.
+  constexpr std::int64_t kLongCells = 64;
   std::vector<std::uint64_t> entries;
   entries.reserve(3 * static_cast<std::size_t>(count));
+  std::vector<int> longOnes;
+  std::vector<char> isLong(count, 0);
   for (int t = 0; t < count; ++t) {
     const Eigen::Vector3i first = cellOf(triangles[t].low), last = cellOf(triangles[t].high);
     triangles[t].firstCell = first;
+    if ((last - first + Eigen::Vector3i::Ones()).cast<std::int64_t>().prod() > kLongCells) {
+      longOnes.push_back(t);
+      isLong[t] = 1;
+      continue;
+    }
     for (int z = first.z(); z <= last.z(); ++z)
       for (int y = first.y(); y <= last.y(); ++y)
         for (int x = first.x(); x <= last.x(); ++x) entries.push_back(cellNumber({x, y, z}) << 32 | std::uint64_t(t));
@@ -113,6 +127,13 @@ SelfIntersection findSelfIntersections(const TriangleSurface& surface) {
     }
     return false;
   };
+  // Whether triangles a and b, whose boxes meet, cross.
+  auto crosses = [&](int a, int b) {
+    const Triangle& ta = triangles[a];
+    const Triangle& tb = triangles[b];
+    if (shareACorner(a, b) || oneSide(ta, tb) || oneSide(tb, ta)) return false;
+    return edgeThrough(ta, tb) || edgeThrough(tb, ta);
+  };
 
   // The cells in two halves, one per thread where there are two: the pairs
   // each finds, in the cell that holds the low corner of their boxes'
@@ -136,13 +157,17 @@ SelfIntersection findSelfIntersections(const TriangleSurface& surface) {
         for (std::size_t j = i + 1; j < members.size(); ++j) {
           const Triangle& b = triangles[members[j]];
           if (!boxesMeet(a, b) || cellNumber(a.firstCell.cwiseMax(b.firstCell)) != cell) continue;
-          if (shareACorner(members[i], members[j]) || oneSide(a, b) || oneSide(b, a)) continue;
-          if (edgeThrough(a, b) || edgeThrough(b, a)) found[half].push_back({members[i], members[j]});
+          if (crosses(members[i], members[j])) found[half].push_back({members[i], members[j]});
         }
       }
       begin = end;
     }
   });
+  // Each long triangle against every other triangle, a pair of long ones once.
+  for (int a : longOnes)
+    for (int b = 0; b < count; ++b)
+      if (b != a && !(isLong[b] && b < a) && boxesMeet(triangles[a], triangles[b]) && crosses(a, b))
+        found[0].push_back({a, b});
 
   std::vector<char> crossing(count, 0);
   for (const auto& pairs : found) {

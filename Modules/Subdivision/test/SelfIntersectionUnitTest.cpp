@@ -123,6 +123,46 @@ TEST(SelfIntersection, FindsExactlyTheTrianglesAlongACrossingLine) {
   EXPECT_NEAR(found.areaPercent, 100.0 * (0.1 + 0.02 * vertical) / 2.96, 1e-9);
 }
 
+// A long triangle through a fine grid far smaller than it: the grid's
+// 9,800 triangles (70 x 70 squares of 1e-4 on z = 0.0035) make the cells about
+// a thousandth of the box, whose 1000^3 cells the long triangle's box meets.
+// It crosses the grid along a line: exactly the grid triangles with corners on
+// both sides of that line cross it, each in one pair.
+TEST(SelfIntersection, FindsALongTriangleThroughAFineGrid) {
+  TriangleSurface s;
+  s.points.resize(0, 3);
+  const double height = 0.0035;
+  addGrid(s, 70, [&](double u, double v) { return dynsub::Vector3(0.007 * u, 0.007 * v, height); });
+  const int grid = static_cast<int>(s.triangles.size());
+  // The line through q along d (no grid sample on it), and a direction w out of
+  // the grid's plane: the triangle's corners at (-2, -1), (2, -1) and (0, 1.5)
+  // in (d, w), so that its section by z = height runs 1.2 along d each way, far
+  // past the grid.
+  const dynsub::Vector3 q(0.00313, 0.00171, height), d(0.8, 0.6, 0.0), w(-0.18, 0.24, 1.0);
+  const int first = static_cast<int>(s.points.rows());
+  s.points.conservativeResize(first + 3, 3);
+  s.points.row(first) = q - 2.0 * d - w;
+  s.points.row(first + 1) = q + 2.0 * d - w;
+  s.points.row(first + 2) = q + 1.5 * w;
+  s.triangles.push_back({first, first + 1, first + 2});
+
+  std::vector<int> expected;
+  for (int t = 0; t < grid; ++t) {
+    double low = 1e300, high = -1e300;
+    for (int k = 0; k < 3; ++k) {
+      const dynsub::Vector3 offset = s.points.row(s.triangles[t][k]).transpose() - q;
+      const double side = offset.x() * d.y() - offset.y() * d.x();
+      low = std::min(low, side), high = std::max(high, side);
+    }
+    if (low < 0.0 && high > 0.0) expected.push_back(t);
+  }
+  ASSERT_GT(expected.size(), 100u);
+  const dynsub::SelfIntersection found = dynsub::findSelfIntersections(s);
+  EXPECT_EQ(found.trianglePairs, static_cast<int>(expected.size()));
+  expected.push_back(grid);
+  EXPECT_EQ(found.triangles, expected);
+}
+
 TEST(SelfIntersection, AnEmptySurfaceHasNone) {
   TriangleSurface s;
   s.points.resize(0, 3);
