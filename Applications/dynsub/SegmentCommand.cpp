@@ -69,10 +69,10 @@ std::vector<int> parseLabelValues(const std::string& text) {
     } catch (const std::exception&) {
       used = 0;
     }
-    if (used == 0 || used != item.size()) throw Error("--reference-label " + text + ": expected N[,M...] (integers)");
+    if (used == 0 || used != item.size()) throw UsageError("--reference-label " + text + ": expected N[,M...] (integers)");
     values.push_back(value);
   }
-  if (values.empty()) throw Error("--reference-label " + text + ": expected N[,M...] (integers)");
+  if (values.empty()) throw UsageError("--reference-label " + text + ": expected N[,M...] (integers)");
   return values;
 }
 
@@ -159,9 +159,9 @@ std::string firstStart(const Arguments& o) { return o.init.empty() ? "auto" : o.
 void runSegmentOne(const Arguments& o, const LandmarkSource* landmarks) {
   // Every input is read and checked before anything is written.
   if (!o.reference.empty() && o.referenceLabels.empty())
-    throw Error("--reference needs --reference-label N[,M...]: the label value(s) of the structure");
+    throw UsageError("--reference needs --reference-label N[,M...]: the label value(s) of the structure");
   if (o.inside.size() > 1)
-    throw Error("--inside is given " + std::to_string(o.inside.size()) +
+    throw UsageError("--inside is given " + std::to_string(o.inside.size()) +
                 " times for one structure: give one click inside it");
   SegmentInputs inputs;
   inputs.start = parseSegmentStart(firstStart(o), "--init");
@@ -179,11 +179,11 @@ void runSegmentOne(const Arguments& o, const LandmarkSource* landmarks) {
   if (!o.inside.empty()) inputs.inside = parsePoint(o.inside.front(), "--inside");
   if (inputs.start.kind == SegmentStart::Kind::Atlas) {
     if (o.atlasLabel.empty())
-      throw Error("--init atlas needs --atlas-label N[,M...] or a name from the atlas's table (e.g. Caudate_L)");
+      throw UsageError("--init atlas needs --atlas-label N[,M...] or a name from the atlas's table (e.g. Caudate_L)");
     inputs.atlas = std::make_shared<const Atlas>(readAtlas(o.atlas, o.atlasLabels));
     inputs.atlasLabels = atlasLabelValues(*inputs.atlas, o.atlasLabel.front());
   } else if (!o.atlasLabel.empty()) {
-    throw Error("--atlas-label serves an atlas start: add --init atlas");
+    throw UsageError("--atlas-label serves an atlas start: add --init atlas");
   }
   checkSegmentInputs(inputs, o.parameters);
   // The reference is needed only to score the result, and reading it
@@ -242,38 +242,38 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
   if (each) {
     for (const std::string& start : o.init)
       if (start == "atlas")
-        throw Error(
+        throw UsageError(
             "--init atlas starts every structure from the atlas: give it once, with an --atlas-label per "
             "structure");
   } else if (!atlas && first != "auto") {
-    throw Error("--init " + first +
+    throw UsageError("--init " + first +
                 ": give an --init per structure (the point lists' in their order, then any "
                 "structures without landmarks), or start them all from their landmarks (auto) or from the atlas "
                 "(--init atlas, an --atlas-label per structure)");
   }
-  if (!atlas && !o.atlasLabel.empty()) throw Error("--atlas-label serves an atlas start: add --init atlas");
+  if (!atlas && !o.atlasLabel.empty()) throw UsageError("--atlas-label serves an atlas start: add --init atlas");
   const std::size_t n = atlas ? o.atlasLabel.size() : std::max(sources.size(), o.init.size());
   if (atlas && !sources.empty() && sources.size() != n)
-    throw Error("--init atlas with --landmarks: give an --atlas-label per point list, in their order (" +
+    throw UsageError("--init atlas with --landmarks: give an --atlas-label per point list, in their order (" +
                 std::to_string(sources.size()) + " lists, " + std::to_string(n) + " atlas labels)");
   if (each && o.init.size() < sources.size())
-    throw Error("--init is given " + std::to_string(o.init.size()) + " times for " + std::to_string(sources.size()) +
+    throw UsageError("--init is given " + std::to_string(o.init.size()) + " times for " + std::to_string(sources.size()) +
                 " point lists: give one per structure, or one for all");
   if (!atlas && !o.inside.empty())
     throw Error(
         "--inside serves an atlas start (--init atlas); to start a structure from one click alone, give "
         "it --init seed:x,y,z");
   if (!o.inside.empty() && o.inside.size() != n)
-    throw Error("--inside is given " + std::to_string(o.inside.size()) + " times for " + std::to_string(n) +
+    throw UsageError("--inside is given " + std::to_string(o.inside.size()) + " times for " + std::to_string(n) +
                 " atlas structures: give a click inside each, in the order of --atlas-label, or none");
   if (!atlas && sources.size() < n && o.names.empty())
     throw Error("structures without landmarks need names: give a --name per structure, in the order of --init");
   const std::string order = atlas ? "--atlas-label" : each ? "--init" : "--landmarks";
   if (!o.names.empty() && o.names.size() != n)
-    throw Error("--name is given " + std::to_string(o.names.size()) + " times for " + std::to_string(n) +
+    throw UsageError("--name is given " + std::to_string(o.names.size()) + " times for " + std::to_string(n) +
                 " structures (one per " + order + "): name each structure, or none");
   if (!o.reference.empty() && o.referenceLabels.size() != n)
-    throw Error("--reference needs one --reference-label N[,M...] per structure, in the order of " + order + " (" +
+    throw UsageError("--reference needs one --reference-label N[,M...] per structure, in the order of " + order + " (" +
                 std::to_string(n) + " structures, " + std::to_string(o.referenceLabels.size()) + " given)");
   const std::shared_ptr<const Atlas> atlasData =
       atlas ? std::make_shared<const Atlas>(readAtlas(o.atlas, o.atlasLabels)) : nullptr;

@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "CommandLine.h"
 #include "Commands.h"
 #include "EarlierRuns.h"
 #include "dynsub/Error.h"
@@ -178,26 +179,33 @@ void addSolidCommand(CLI::App& app) {
   sculpt->add_option("--level", so->settings.levels, "Subdivisions carrying the mass points")
       ->default_val(so->settings.levels)
       ->check(CLI::Range(0, 4));
-  sculpt->add_option("--time-step", so->settings.timeStep, "Time step, s")->default_val(so->settings.timeStep);
+  sculpt->add_option("--time-step", so->settings.timeStep, "Time step, s")
+      ->default_val(so->settings.timeStep)
+      ->check(positiveNumber());
   sculpt->add_option("--scheme", so->scheme, "Integration: semi-implicit (Euler) or explicit (the paper's)")
       ->default_val(so->scheme)
       ->check(CLI::IsMember({"semi-implicit", "explicit"}));
   sculpt->add_option("--mass", so->settings.material.mass, "Mass per mass point")
-      ->default_val(so->settings.material.mass);
+      ->default_val(so->settings.material.mass)
+      ->check(positiveNumber());
   sculpt->add_option("--damping", so->settings.material.damping, "Damping per mass point, N s/mm")
-      ->default_val(so->settings.material.damping);
+      ->default_val(so->settings.material.damping)
+      ->check(nonNegativeNumber());
   sculpt->add_option("--stiffness", so->settings.material.springStiffness, "Normal springs, N/mm")
-      ->default_val(so->settings.material.springStiffness);
+      ->default_val(so->settings.material.springStiffness)
+      ->check(positiveNumber());
   sculpt->add_option("--virtual-stiffness", so->settings.material.virtualStiffness,
                      "Virtual (angle) springs, N/mm")
-      ->default_val(so->settings.material.virtualStiffness);
+      ->default_val(so->settings.material.virtualStiffness)
+      ->check(positiveNumber());
   sculpt->add_option("--rope-stiffness", so->settings.ropeStiffness, "The rope, N/mm")
-      ->default_val(so->settings.ropeStiffness);
+      ->default_val(so->settings.ropeStiffness)
+      ->check(positiveNumber());
   sculpt->add_flag("!--no-figures", so->figure,
                    "Do not render sculpted.png (rendering needs an X display; without DISPLAY a private Xvfb is started)");
   sculpt->callback([so, sculpt] {
     if (!so->script.empty() && sculpt->count("--out") == 0)
-      throw Error("--out DIR is required with --script (where the sculpted solid is written)");
+      throw UsageError("--out DIR is required with --script (where the sculpted solid is written)");
     runSculpt(*so);
   });
 

@@ -23,7 +23,7 @@ void runSubject(const Arguments& arguments) {
   SubjectSettings settings;
   for (const std::string& setting : arguments.settings) {
     const auto equals = setting.find('=');
-    if (equals == std::string::npos) throw Error("--set", "expected KEY=VALUE, got '" + setting + "'");
+    if (equals == std::string::npos) throw UsageError("--set", "expected KEY=VALUE, got '" + setting + "'");
     setSubjectSetting(settings, setting.substr(0, equals), setting.substr(equals + 1));
   }
   checkSubjectSettings(settings);

@@ -648,9 +648,9 @@ expect_error "solid sculpt: extruding an interior face" 1 "line 2 (extrude 5): f
   "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" --script "$work/interior.sculpt" --out "$work/s31"
 expect_error "solid sculpt: a missing script" 1 "none.sculpt: no such file" "$work/s32" \
   "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" --script "$work/none.sculpt" --out "$work/s32"
-expect_error "solid sculpt: --script without --out" 1 "--out DIR is required" "$work/sculpted" \
+expect_error "solid sculpt: --script without --out" 2 "--out DIR is required" "$work/sculpted" \
   "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" --script "$DATA/Solids/arm.sculpt"
-expect_error "solid sculpt: NaN stiffness" 1 "stiffnesses must be finite" "$work/s33" \
+expect_error "solid sculpt: NaN stiffness" 2 "--stiffness: nan is not a finite number > 0" "$work/s33" \
   "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" --script "$DATA/Solids/arm.sculpt" --stiffness nan \
   --out "$work/s33"
 expect_error "solid sculpt: a bad lattice" 1 "uses point 99" "$work/s34" \
@@ -711,10 +711,18 @@ assert t['trusted'] and t['atlas_outline_distance_mm'] < 4.5 and 0.7 < t['volume
 "
 expect_error "segment --init atlas: a misspelt label" 1 "did you mean 'Putamen_L'" "$work/s43" \
   "$DYNSUB" segment "$work/subject/image.nii.gz" --init atlas --atlas-label Putamn_L --out "$work/s43"
-expect_error "segment --init atlas: no label" 1 "needs --atlas-label" "$work/s44" \
+expect_error "segment --init atlas: no label" 2 "needs --atlas-label" "$work/s44" \
   "$DYNSUB" segment "$work/subject/image.nii.gz" --init atlas --out "$work/s44"
 expect_error "segment --inside without an atlas start" 1 "serves an atlas start" "$work/s45" \
   "$DYNSUB" segment "$work/subject/image.nii.gz" --init sphere:22,-8,4,5 --inside=22,-8,4 --out "$work/s45"
+expect_error "segment --init seed: a NaN coordinate" 2 "expected seed:x,y,z" "$work/s47" \
+  "$DYNSUB" segment "$work/subject/image.nii.gz" --init seed:nan,-8,4 --out "$work/s47"
+printf 'x,y,z\n' >"$work/empty.csv"
+expect_error "segment: a landmark file with no points" 1 "empty.csv: no landmarks" "$work/s48" \
+  "$DYNSUB" segment "$work/subject/image.nii.gz" --landmarks "$work/empty.csv" --out "$work/s48"
+mkdir -p "$work/folder.mrk.json"
+expect_error "segment: a folder given as landmarks" 1 "folder.mrk.json: is a directory" "$work/s49" \
+  "$DYNSUB" segment "$work/subject/image.nii.gz" --landmarks "$work/folder.mrk.json" --out "$work/s49"
 expect_error "segment --init atlas: a label map off the template's grid" 1 "not on its template's grid" "$work/s46" \
   "$DYNSUB" segment "$work/subject/image.nii.gz" --init atlas --atlas-label 73 --atlas-labels "$mri/ch2better.nii.gz" \
   --out "$work/s46"

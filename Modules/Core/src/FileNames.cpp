@@ -20,4 +20,13 @@ void requireExisting(const std::string& path) {
   if (!std::filesystem::exists(path, ignored)) throw Error(path, "no such file or directory");
 }
 
+std::ifstream openForReading(const std::string& path, std::ios::openmode mode) {
+  std::error_code ignored;
+  if (!std::filesystem::exists(path, ignored)) throw Error(path, "no such file");
+  if (std::filesystem::is_directory(path, ignored)) throw Error(path, "is a directory, not a file");
+  std::ifstream in(path, mode);
+  if (!in) throw Error(path, "cannot open the file for reading");
+  return in;
+}
+
 }  // namespace dynsub

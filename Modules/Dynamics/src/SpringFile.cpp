@@ -1,19 +1,17 @@
 #include "dynsub/SpringFile.h"
 
-#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <vector>
 
 #include "dynsub/Error.h"
+#include "dynsub/FileNames.h"
 #include "dynsub/TextFields.h"
 
 namespace dynsub {
 
 SpringFile readSpringFile(const std::string& path, double defaultStiffness) {
-  std::ifstream in(path);
-  if (!std::filesystem::exists(path)) throw Error(path, "no such file");
-  if (!in) throw Error(path, "cannot be opened");
+  std::ifstream in = openForReading(path);
   std::vector<Eigen::Vector4d> rows;
   std::string line;
   int number = 0;

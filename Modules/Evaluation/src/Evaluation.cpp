@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "dynsub/Error.h"
+#include "dynsub/FileNames.h"
 #include "dynsub/ImageIO.h"
 #include "dynsub/Metrics.h"
 #include "dynsub/SegmentImage.h"
@@ -147,8 +148,7 @@ void requireKnownKeys(const nlohmann::json& object, std::initializer_list<const 
 }  // namespace
 
 EvaluationPlan readEvaluationPlan(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw Error(path, "cannot open the evaluation plan");
+  std::ifstream in = openForReading(path);
   nlohmann::json j;
   try {
     in >> j;
@@ -206,6 +206,7 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
             throw Error(path, where + ": subject " + std::to_string(list.back()) +
                                   " is in two splits (tuning and test subjects must be disjoint)");
         }
+        if (list.empty()) throw Error(path, where + ": split '" + split + "' has no subjects");
         cohort.subjects.emplace_back(split, list);
       }
       plan.cohorts.push_back(cohort);

@@ -110,6 +110,8 @@ TEST(EvaluationPlan, CohortsWithSharedSubjectsUnknownSplitsOrBadSettingsAreRefus
             std::string::npos);
   EXPECT_NE(cohortError(start + R"("subjects": {"training": [1]}})").find("unknown split 'training'"),
             std::string::npos);
+  EXPECT_NE(cohortError(start + R"("subjects": {"tuning": [1], "test": []}})").find("split 'test' has no subjects"),
+            std::string::npos);
   EXPECT_NE(cohortError(start + R"("settings": {"noise": 2}, "subjects": {"test": [1]}})").find("unknown setting"),
             std::string::npos);
   EXPECT_NE(cohortError(start + R"("settings": {"warp_mm": 40}, "subjects": {"test": [1]}})").find("fold"),

@@ -199,8 +199,7 @@ namespace {
 // or .csv.
 std::vector<LandmarkList> readAllLists(const std::string& path) {
   const Format format = formatOf(path);
-  std::ifstream in(path);
-  if (!in) throw Error(path, "no such file or not readable");
+  std::ifstream in = openForReading(path);
   if (format == Format::MarkupsJson) return readMarkupsJson(path, in);
   LandmarkList list;
   list.landmarks = format == Format::Fcsv ? readFcsv(path, in, list.stated) : readCsv(path, in);

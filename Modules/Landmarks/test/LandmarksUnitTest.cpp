@@ -129,6 +129,8 @@ TEST(Landmarks, BadFilesAreRefusedWithTheirName) {
     }
   };
   expectError(scratch("none.csv"), "no such file");
+  std::filesystem::create_directories(scratch("folder.mrk.json"));
+  expectError(scratch("folder.mrk.json"), "is a directory");
   std::ofstream(scratch("points.txt").string()) << "1 2 3\n";
   expectError(scratch("points.txt"), "unknown landmark format");
   std::ofstream(scratch("nan.csv").string()) << "x,y,z\n1,2,3\n4,nan,6\n";

@@ -1,6 +1,7 @@
 #include "dynsub/ControlMesh.h"
 
 #include <numeric>
+#include <sstream>
 
 #include "dynsub/Error.h"
 #include "dynsub/MeshCheck.h"
@@ -36,11 +37,20 @@ void ControlMesh::setCreases(const std::vector<Crease>& creases, const std::stri
   Topology topology = *topology_;
   std::vector<double> sharpness(topology.edgeCount());
   for (int e = 0; e < topology.edgeCount(); ++e) sharpness[e] = topology.edgeSharpness(e);
+  // An edge tagged twice with two sharpnesses is a contradiction, not an
+  // override: which tag a reader keeps differs from tool to tool.
+  std::vector<char> tagged(topology.edgeCount(), 0);
   for (const Crease& crease : creases) {
     const std::string edge = "crease (" + std::to_string(crease.a) + ", " + std::to_string(crease.b) + ")";
     const bool inRange = crease.a >= 0 && crease.b >= 0 && crease.a < vertexCount() && crease.b < vertexCount();
     const int e = inRange ? topology.findEdge(crease.a, crease.b) : -1;
     if (e < 0) throw Error(source, edge + " is not an edge of the mesh (vertices are numbered from 0)");
+    if (tagged[e] && sharpness[e] != crease.sharpness) {
+      std::ostringstream both;
+      both << sharpness[e] << " and " << crease.sharpness;
+      throw Error(source, edge + " is tagged twice, with sharpness " + both.str() + ": tag each edge once");
+    }
+    tagged[e] = 1;
     sharpness[e] = crease.sharpness;
   }
   topology.setEdgeSharpness(std::move(sharpness), source);

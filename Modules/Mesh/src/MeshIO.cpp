@@ -18,16 +18,6 @@ namespace dynsub {
 
 namespace {
 
-
-std::ifstream openForReading(const std::string& path) {
-  std::error_code error;
-  if (!std::filesystem::exists(path, error)) throw Error(path, "no such file");
-  if (std::filesystem::is_directory(path, error)) throw Error(path, "is a directory, not a mesh file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path, "cannot open the file for reading");
-  return in;
-}
-
 MatrixX3 toMatrix(const std::vector<Vector3>& points) {
   MatrixX3 result(points.size(), 3);
   for (size_t i = 0; i < points.size(); ++i) result.row(i) = points[i].transpose();
@@ -76,7 +66,7 @@ Crease parseCreaseTag(std::istringstream& record, const std::string& path, int l
 }
 
 PolygonData readObj(const std::string& path) {
-  std::ifstream in = openForReading(path);
+  std::ifstream in = openForReading(path, std::ios::binary);
   std::vector<Vector3> points;
   PolygonData data;
   std::string text;
@@ -132,7 +122,7 @@ std::vector<std::string> nextOffRecord(std::istream& in, const std::string& path
 }
 
 PolygonData readOff(const std::string& path) {
-  std::ifstream in = openForReading(path);
+  std::ifstream in = openForReading(path, std::ios::binary);
   int line = 0;
   std::vector<std::string> tokens = nextOffRecord(in, path, line, "the OFF header");
   // COFF, NOFF, STOFF, ...: per-vertex colours, normals or texture
@@ -173,6 +163,14 @@ PolygonData readOff(const std::string& path) {
       face.push_back(static_cast<int>(index));
     }
     data.faces.push_back(std::move(face));
+  }
+  // A record past the announced faces means the counts are wrong, and what
+  // they leave out would be lost silently.
+  for (std::string text; std::getline(in, text);) {
+    ++line;
+    if (text.substr(0, text.find('#')).find_first_not_of(" \t\r") != std::string::npos)
+      throw Error(path, "line " + std::to_string(line) + ": more records than the " + std::to_string(vertexCount) +
+                            " vertices and " + std::to_string(faceCount) + " faces the header announces");
   }
   return data;
 }
@@ -261,7 +259,7 @@ class PlyValueReader {
 };
 
 PolygonData readPly(const std::string& path) {
-  std::ifstream in = openForReading(path);
+  std::ifstream in = openForReading(path, std::ios::binary);
   std::string text;
   if (!std::getline(in, text) || text.substr(0, 3) != "ply") throw Error(path, "not a PLY file (no 'ply' magic line)");
   std::string format;

@@ -126,6 +126,13 @@ TEST(MeshIO, BrokenFilesAreNamed) {
   const std::string truncated = scratch("truncated.off").string();
   writeText(truncated, "OFF\n4 1 0\n0 0 0\n1 0 0\n");
   expectError(truncated, "truncated");
+  // A face past the header's count would be dropped unseen.
+  const std::string extra = scratch("extra.off").string();
+  writeText(extra, "OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 1 3\n");
+  expectError(extra, "line 8: more records than the 4 vertices and 1 faces");
+  const std::string directory = scratch("folder.obj").string();
+  std::filesystem::create_directories(directory);
+  expectError(directory, "is a directory");
   const std::string truncatedPly = scratch("truncated.ply").string();
   writeText(truncatedPly, "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
                           "property float y\nproperty float z\nend_header\n\x01\x02");
@@ -173,6 +180,7 @@ TEST(MeshIO, BadCreaseTagsAreNamed) {
       {"t crease 2/1/0 4 5 nan\n", "has sharpness nan"},
       {"t crease 2/1/0 4 5 5\n", "semi-sharp creases up to 4"},
       {"t crease 2/1/0 3 4 10\n", "a dart"},
+      {"t crease 2/1/0 4 5 1\nt crease 2/1/0 5 4 2\n", "crease (5, 4) is tagged twice, with sharpness 1 and 2"},
       // Two sharp creases at the centre with one face between them.
       {"t crease 2/1/0 1 4 10\nt crease 2/1/0 4 5 10\n", "single face on one side"},
   };

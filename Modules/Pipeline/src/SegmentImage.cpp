@@ -30,8 +30,8 @@ std::vector<double> numbersAfter(const std::string& value, std::size_t prefix, i
   const std::string message = option + " " + value + ": expected " + expected + " (LPS mm)";
   for (int i = 0; i < count; ++i)
     if (!(in >> v[i]) || !std::isfinite(v[i]) || (i + 1 < count && (!(in >> comma) || comma != ',')))
-      throw Error(message);
-  if (in >> comma) throw Error(message);
+      throw UsageError(message);
+  if (in >> comma) throw UsageError(message);
   return v;
 }
 
@@ -377,7 +377,8 @@ void checkStart(const SegmentInputs& in) {
     throw Error("an atlas start needs the structure's labels in the atlas (--atlas-label)");
   if (in.start.kind != SegmentStart::Kind::FromLandmarks || in.landmarks.size() >= 4) return;
   const std::string alternatives = "give at least 4 on the structure's boundary, or start from one click inside it";
-  if (in.landmarks.empty()) throw Error("no landmarks to build the initial model from: " + alternatives);
+  const std::string none = "no landmarks to build the initial model from: " + alternatives;
+  if (in.landmarks.empty()) throw in.landmarkSource.empty() ? Error(none) : Error(in.landmarkSource, none);
   throw Error(in.landmarkSource, std::to_string(in.landmarks.size()) +
                                      " landmarks are too few to outline a structure: " + alternatives);
 }

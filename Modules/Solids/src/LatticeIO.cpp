@@ -24,9 +24,7 @@ namespace {
 // Lines without comments and blank lines, with their numbers.
 class LatticeReader {
  public:
-  explicit LatticeReader(const std::string& path) : path_(path), in_(path) {
-    if (!in_) throw Error(path, "no such file or it cannot be read");
-  }
+  explicit LatticeReader(const std::string& path) : path_(path), in_(openForReading(path)) {}
 
   std::istringstream next(const char* expecting) {
     std::string line;
@@ -37,6 +35,17 @@ class LatticeReader {
       return std::istringstream(line);
     }
     throw Error(path_, "the file ends early: expected " + std::string(expecting));
+  }
+
+  // Refuses a line with data after the last item the counts announce: the
+  // counts are then wrong, and what they leave out would be lost silently.
+  void expectEnd(const std::string& last) {
+    std::string line;
+    while (std::getline(in_, line)) {
+      ++number_;
+      const auto first = line.find_first_not_of(" \t\r");
+      if (first != std::string::npos && line[first] != '#') fail("more data after " + last);
+    }
   }
 
   [[noreturn]] void fail(const std::string& message) const {
@@ -105,6 +114,7 @@ Lattice readLattice(const std::string& path) {
   const int c = reader.count("cells");
   std::vector<std::vector<int>> cells(c);
   for (auto& cell : cells) cell = reader.indexList("cell");
+  reader.expectEnd("the " + std::to_string(c) + " cells the file announces");
   return Lattice::fromCells(std::move(points), std::move(faces), std::move(cells), path);
 }
 

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "dynsub/Error.h"
+#include "dynsub/FileNames.h"
 #include "dynsub/TextFields.h"
 
 namespace dynsub {
@@ -161,8 +162,7 @@ std::function<void(Sculpture&)> parseAction(Words& w) {
 }  // namespace
 
 std::vector<SculptAction> readSculptScript(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw Error(path, "no such file or it cannot be read");
+  std::ifstream in = openForReading(path);
   std::vector<SculptAction> actions;
   std::string text;
   int line = 0;

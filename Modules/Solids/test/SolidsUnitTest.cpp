@@ -264,6 +264,9 @@ TEST_F(LatticeFiles, InvalidLatticesAreNamed) {
   // A cell missing a face is open.
   std::string open = std::string(text).replace(text.find("4 0 1 2 3"), 9, "3 0 1 2");
   EXPECT_NE(message(file("open.lattice", open)).find("fewer than 4 faces"), std::string::npos);
+  // A cell past the announced count would be dropped unseen.
+  EXPECT_NE(message(file("extra.lattice", text + "4 0 1 2 3\n")).find("line 14: more data after the 1 cells"),
+            std::string::npos);
   EXPECT_THROW(Lattice::fromCells(regularLattice(1, 1, 1).points(),
                                   {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}},
                                   {{0, 1, 2, 3, 4}}),

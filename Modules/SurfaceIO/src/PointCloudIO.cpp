@@ -40,8 +40,7 @@ bool parseXyz(std::string line, const std::string& separators, Vector3& point) {
 }
 
 MatrixX3 readText(const std::string& path, bool csv) {
-  std::ifstream in(path);
-  if (!in) throw Error(path, "cannot be opened");
+  std::ifstream in = openForReading(path);
   std::vector<Vector3> points;
   std::string line;
   int number = 0;

@@ -15,6 +15,14 @@ class Error : public std::runtime_error {
   Error(const std::string& source, const std::string& message);
 };
 
+// An option's value that cannot be used (malformed, or not fitting the other
+// options), found after the command line was parsed: the programs exit with 2
+// for it, as for the values their parser refuses, and 1 for other errors.
+class UsageError : public Error {
+ public:
+  using Error::Error;
+};
+
 // An Error about landmarks given as points (outside the image, on no edge):
 // a caller that read them from a file catches it to name the file.
 class LandmarkError : public Error {

@@ -1,5 +1,6 @@
 #pragma once
 // Small helpers on file names shared by the readers and writers.
+#include <fstream>
 #include <string>
 
 namespace dynsub {
@@ -10,5 +11,10 @@ std::string lowerCaseExtension(const std::string& path);
 // Throws dynsub::Error naming `path` ("no such file or directory") unless it
 // exists, as a file or a directory (a DICOM series).
 void requireExisting(const std::string& path);
+
+// `path` opened for reading. Throws dynsub::Error naming it when it does not
+// exist, is a directory (which std::ifstream opens, and fails on only at the
+// first read, with a message that names no file) or cannot be opened.
+std::ifstream openForReading(const std::string& path, std::ios::openmode mode = std::ios::in);
 
 }  // namespace dynsub
