@@ -493,12 +493,9 @@ int main(int argc, char** argv) {
     const std::string hint = dynsub::app::didYouMean(app, std::vector<std::string>(argv + 1, argv + argc));
     if (!hint.empty()) std::cerr << "DynSubSegment: " << hint << '\n';
     return 2;
-  } catch (const dynsub::UsageError& error) {
-    std::cerr << "DynSubSegment: error: " << error.what() << '\n';
-    return 2;
   } catch (const dynsub::Error& error) {
     std::cerr << "DynSubSegment: error: " << dynsub::withoutTemporaryPrefix(error.what()) << '\n';
-    return 1;
+    return dynamic_cast<const dynsub::UsageError*>(&error) ? 2 : 1;
   } catch (const std::exception& error) {
     std::cerr << "DynSubSegment: unexpected error: " << error.what() << '\n';
     return 1;

@@ -69,7 +69,8 @@ std::vector<int> parseLabelValues(const std::string& text) {
     } catch (const std::exception&) {
       used = 0;
     }
-    if (used == 0 || used != item.size()) throw UsageError("--reference-label " + text + ": expected N[,M...] (integers)");
+    if (used == 0 || used != item.size())
+      throw UsageError("--reference-label " + text + ": expected N[,M...] (integers)");
     values.push_back(value);
   }
   if (values.empty()) throw UsageError("--reference-label " + text + ": expected N[,M...] (integers)");
@@ -162,7 +163,7 @@ void runSegmentOne(const Arguments& o, const LandmarkSource* landmarks) {
     throw UsageError("--reference needs --reference-label N[,M...]: the label value(s) of the structure");
   if (o.inside.size() > 1)
     throw UsageError("--inside is given " + std::to_string(o.inside.size()) +
-                " times for one structure: give one click inside it");
+                     " times for one structure: give one click inside it");
   SegmentInputs inputs;
   inputs.start = parseSegmentStart(firstStart(o), "--init");
   // One structure's values, as N[,M...] or as several values (71 72).
@@ -247,34 +248,34 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
             "structure");
   } else if (!atlas && first != "auto") {
     throw UsageError("--init " + first +
-                ": give an --init per structure (the point lists' in their order, then any "
-                "structures without landmarks), or start them all from their landmarks (auto) or from the atlas "
-                "(--init atlas, an --atlas-label per structure)");
+                     ": give an --init per structure (the point lists' in their order, then any "
+                     "structures without landmarks), or start them all from their landmarks (auto) or from the atlas "
+                     "(--init atlas, an --atlas-label per structure)");
   }
   if (!atlas && !o.atlasLabel.empty()) throw UsageError("--atlas-label serves an atlas start: add --init atlas");
   const std::size_t n = atlas ? o.atlasLabel.size() : std::max(sources.size(), o.init.size());
   if (atlas && !sources.empty() && sources.size() != n)
     throw UsageError("--init atlas with --landmarks: give an --atlas-label per point list, in their order (" +
-                std::to_string(sources.size()) + " lists, " + std::to_string(n) + " atlas labels)");
+                     std::to_string(sources.size()) + " lists, " + std::to_string(n) + " atlas labels)");
   if (each && o.init.size() < sources.size())
-    throw UsageError("--init is given " + std::to_string(o.init.size()) + " times for " + std::to_string(sources.size()) +
-                " point lists: give one per structure, or one for all");
+    throw UsageError("--init is given " + std::to_string(o.init.size()) + " times for " +
+                     std::to_string(sources.size()) + " point lists: give one per structure, or one for all");
   if (!atlas && !o.inside.empty())
-    throw Error(
+    throw UsageError(
         "--inside serves an atlas start (--init atlas); to start a structure from one click alone, give "
         "it --init seed:x,y,z");
   if (!o.inside.empty() && o.inside.size() != n)
     throw UsageError("--inside is given " + std::to_string(o.inside.size()) + " times for " + std::to_string(n) +
-                " atlas structures: give a click inside each, in the order of --atlas-label, or none");
+                     " atlas structures: give a click inside each, in the order of --atlas-label, or none");
   if (!atlas && sources.size() < n && o.names.empty())
-    throw Error("structures without landmarks need names: give a --name per structure, in the order of --init");
+    throw UsageError("structures without landmarks need names: give a --name per structure, in the order of --init");
   const std::string order = atlas ? "--atlas-label" : each ? "--init" : "--landmarks";
   if (!o.names.empty() && o.names.size() != n)
     throw UsageError("--name is given " + std::to_string(o.names.size()) + " times for " + std::to_string(n) +
-                " structures (one per " + order + "): name each structure, or none");
+                     " structures (one per " + order + "): name each structure, or none");
   if (!o.reference.empty() && o.referenceLabels.size() != n)
     throw UsageError("--reference needs one --reference-label N[,M...] per structure, in the order of " + order + " (" +
-                std::to_string(n) + " structures, " + std::to_string(o.referenceLabels.size()) + " given)");
+                     std::to_string(n) + " structures, " + std::to_string(o.referenceLabels.size()) + " given)");
   const std::shared_ptr<const Atlas> atlasData =
       atlas ? std::make_shared<const Atlas>(readAtlas(o.atlas, o.atlasLabels)) : nullptr;
   std::vector<StructureInputs> structures = structuresToSegment(o.image, sources, atlasData, o.atlasLabel);

@@ -39,12 +39,9 @@ int main(int argc, char** argv) {
     const std::string hint = dynsub::app::didYouMean(app, std::vector<std::string>(argv + 1, argv + argc));
     if (!hint.empty()) std::cerr << "dynsub: " << hint << '\n';
     return 2;
-  } catch (const dynsub::UsageError& error) {
-    std::cerr << "dynsub: error: " << error.what() << '\n';
-    return 2;
   } catch (const dynsub::Error& error) {
     std::cerr << "dynsub: error: " << dynsub::withoutTemporaryPrefix(error.what()) << '\n';
-    return 1;
+    return dynamic_cast<const dynsub::UsageError*>(&error) ? 2 : 1;
   } catch (const std::exception& error) {
     std::cerr << "dynsub: unexpected error: " << error.what() << '\n';
     return 1;

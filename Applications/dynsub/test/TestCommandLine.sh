@@ -713,7 +713,7 @@ expect_error "segment --init atlas: a misspelt label" 1 "did you mean 'Putamen_L
   "$DYNSUB" segment "$work/subject/image.nii.gz" --init atlas --atlas-label Putamn_L --out "$work/s43"
 expect_error "segment --init atlas: no label" 2 "needs --atlas-label" "$work/s44" \
   "$DYNSUB" segment "$work/subject/image.nii.gz" --init atlas --out "$work/s44"
-expect_error "segment --inside without an atlas start" 1 "serves an atlas start" "$work/s45" \
+expect_error "segment --inside without an atlas start" 2 "serves an atlas start" "$work/s45" \
   "$DYNSUB" segment "$work/subject/image.nii.gz" --init sphere:22,-8,4,5 --inside=22,-8,4 --out "$work/s45"
 expect_error "segment --init seed: a NaN coordinate" 2 "expected seed:x,y,z" "$work/s47" \
   "$DYNSUB" segment "$work/subject/image.nii.gz" --init seed:nan,-8,4 --out "$work/s47"

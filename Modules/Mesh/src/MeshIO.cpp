@@ -106,9 +106,9 @@ PolygonData readObj(const std::string& path) {
   return data;
 }
 
-// Reads the next non-empty, non-comment line of an OFF file as tokens.
-std::vector<std::string> nextOffRecord(std::istream& in, const std::string& path, int& line,
-                                       const char* expected) {
+// The next non-empty, non-comment line of an OFF file as tokens; empty at the
+// end of the file.
+std::vector<std::string> readOffRecord(std::istream& in, int& line) {
   std::string text;
   while (std::getline(in, text)) {
     ++line;
@@ -118,7 +118,14 @@ std::vector<std::string> nextOffRecord(std::istream& in, const std::string& path
     for (std::string token; record >> token;) tokens.push_back(token);
     if (!tokens.empty()) return tokens;
   }
-  throw Error(path, std::string("the file ends before ") + expected + " (truncated?)");
+  return {};
+}
+
+// As readOffRecord, where the file must go on.
+std::vector<std::string> nextOffRecord(std::istream& in, const std::string& path, int& line, const char* expected) {
+  std::vector<std::string> tokens = readOffRecord(in, line);
+  if (tokens.empty()) throw Error(path, std::string("the file ends before ") + expected + " (truncated?)");
+  return tokens;
 }
 
 PolygonData readOff(const std::string& path) {
@@ -166,12 +173,9 @@ PolygonData readOff(const std::string& path) {
   }
   // A record past the announced faces means the counts are wrong, and what
   // they leave out would be lost silently.
-  for (std::string text; std::getline(in, text);) {
-    ++line;
-    if (text.substr(0, text.find('#')).find_first_not_of(" \t\r") != std::string::npos)
-      throw Error(path, "line " + std::to_string(line) + ": more records than the " + std::to_string(vertexCount) +
-                            " vertices and " + std::to_string(faceCount) + " faces the header announces");
-  }
+  if (!readOffRecord(in, line).empty())
+    throw Error(path, "line " + std::to_string(line) + ": more records than the " + std::to_string(vertexCount) +
+                          " vertices and " + std::to_string(faceCount) + " faces the header announces");
   return data;
 }
 

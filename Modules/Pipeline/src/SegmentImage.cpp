@@ -371,10 +371,11 @@ SegmentOptions optionsFor(const SegmentInputs& in, const SegmentParameters& para
 
 void checkStart(const SegmentInputs& in) {
   if (in.inside && in.start.kind != SegmentStart::Kind::Atlas)
-    throw Error("--inside serves an atlas start (--init atlas); to start from one click alone, use --init "
-                "seed:x,y,z");
+    throw UsageError(
+        "--inside serves an atlas start (--init atlas); to start from one click alone, use --init "
+        "seed:x,y,z");
   if (in.start.kind == SegmentStart::Kind::Atlas && (!in.atlas || in.atlasLabels.empty()))
-    throw Error("an atlas start needs the structure's labels in the atlas (--atlas-label)");
+    throw UsageError("an atlas start needs the structure's labels in the atlas (--atlas-label)");
   if (in.start.kind != SegmentStart::Kind::FromLandmarks || in.landmarks.size() >= 4) return;
   const std::string alternatives = "give at least 4 on the structure's boundary, or start from one click inside it";
   const std::string none = "no landmarks to build the initial model from: " + alternatives;

@@ -28,24 +28,15 @@ class LatticeReader {
 
   std::istringstream next(const char* expecting) {
     std::string line;
-    while (std::getline(in_, line)) {
-      ++number_;
-      const auto first = line.find_first_not_of(" \t\r");
-      if (first == std::string::npos || line[first] == '#') continue;
-      return std::istringstream(line);
-    }
-    throw Error(path_, "the file ends early: expected " + std::string(expecting));
+    if (!nextDataLine(line)) throw Error(path_, "the file ends early: expected " + std::string(expecting));
+    return std::istringstream(line);
   }
 
   // Refuses a line with data after the last item the counts announce: the
   // counts are then wrong, and what they leave out would be lost silently.
   void expectEnd(const std::string& last) {
     std::string line;
-    while (std::getline(in_, line)) {
-      ++number_;
-      const auto first = line.find_first_not_of(" \t\r");
-      if (first != std::string::npos && line[first] != '#') fail("more data after " + last);
-    }
+    if (nextDataLine(line)) fail("more data after " + last);
   }
 
   [[noreturn]] void fail(const std::string& message) const {
@@ -83,6 +74,16 @@ class LatticeReader {
   }
 
  private:
+  // The next line that is neither blank nor a comment; false at the end of the file.
+  bool nextDataLine(std::string& line) {
+    while (std::getline(in_, line)) {
+      ++number_;
+      const auto first = line.find_first_not_of(" \t\r");
+      if (first != std::string::npos && line[first] != '#') return true;
+    }
+    return false;
+  }
+
   std::string path_;
   std::ifstream in_;
   int number_ = 0;
