@@ -12,6 +12,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "dynsub/Error.h"
 #include "dynsub/TextFields.h"
 
 namespace dynsub::app {
@@ -96,7 +97,11 @@ SimulationOptions SimulationArguments::apply(SimulationOptions base) const {
   base.material.tensionU = base.material.tensionV = values.material.tensionU;
   base.material.rigidityUU = base.material.rigidityVV = values.material.rigidityUU;
   base.material.rigidityUV = 2.0 * values.material.rigidityUU;
-  checkSimulationOptions(base);
+  try {
+    checkSimulationOptions(base);  // options that do not fit together (first-order without damping)
+  } catch (const Error& error) {
+    throw UsageError(error.what());
+  }
   return base;
 }
 

@@ -45,6 +45,7 @@ struct FitCommandOptions {
 
 ControlMesh chooseInitialModel(const FitCommandOptions& o, const MatrixX3& data) {
   ControlMesh mesh;
+  const bool shape = o.init == "auto" || o.init == "sphere" || o.init == "torus";
   if (o.init == "auto" || o.init == "sphere") {
     mesh = initialModel(data, InitialShape::Sphere);
   } else if (o.init == "torus") {
@@ -57,11 +58,15 @@ ControlMesh chooseInitialModel(const FitCommandOptions& o, const MatrixX3& data)
     }
   }
   if (o.genus >= 0 && mesh.genus() != o.genus) {
-    throw Error(o.init == "auto" ? std::string("--init auto") : o.init,
-                "the initial model has genus " + std::to_string(mesh.genus()) + " but --genus " +
-                    std::to_string(o.genus) + " was asked for" +
-                    (o.genus == 1 ? " (use --init torus or a control mesh of genus 1)"
-                                  : " (give a control mesh of that genus with --init MESH)"));
+    const std::string problem = "the initial model has genus " + std::to_string(mesh.genus()) + " but --genus " +
+                                std::to_string(o.genus) + " was asked for" +
+                                (o.genus == 0   ? " (use --init sphere)"
+                                 : o.genus == 1 ? " (use --init torus or a control mesh of genus 1)"
+                                                : " (give a control mesh of that genus with --init MESH)");
+    // A built-in shape of the wrong genus is two options that do not fit
+    // together; a mesh file of the wrong genus is that file's problem.
+    if (shape) throw UsageError("--init " + o.init, problem);
+    throw Error(o.init, problem);
   }
   return mesh;
 }

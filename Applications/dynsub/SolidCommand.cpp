@@ -105,6 +105,8 @@ void runSculpt(const SculptOptions& options) {
   SculptOptions o = options;
   o.settings.scheme = o.scheme == "explicit" ? SolidScheme::PaperExplicit : SolidScheme::SemiImplicit;
   const Lattice lattice = readLattice(o.lattice);
+  // An --out that cannot be a directory is said before any sculpting.
+  prepareOutputDirectory(o.out);
   Report report;
   report.set("lattice", o.lattice);
   if (o.script.empty()) {

@@ -114,7 +114,14 @@ expect_error "a point beyond 1e9 mm" 1 "far.xyz: point 1 (1e+300, 1e+300, 1e+300
 printf '0 0 0\n1e-300 0 0\n0 1e-300 0\n0 0 1e-300\n' >"$work/tiny.xyz"
 expect_error "points within 1e-6 mm" 1 "tiny.xyz: the points span only 1e-300 mm" "$work/o4c" \
   "$DYNSUB" fit "$work/tiny.xyz" --out "$work/o4c"
-expect_error "wrong genus" 1 "genus" "$work/o5" "$DYNSUB" fit "$work/sphere.xyz" --init torus --genus 0 --out "$work/o5"
+expect_error "a built-in model of the wrong genus" 2 "--init torus: the initial model has genus 1 but --genus 0" \
+  "$work/o5" "$DYNSUB" fit "$work/sphere.xyz" --init torus --genus 0 --out "$work/o5"
+expect_error "a control mesh of the wrong genus" 1 "torus.obj: the initial model has genus 1 but --genus 0" \
+  "$work/o5" "$DYNSUB" fit "$work/sphere.xyz" --init "$DATA/Meshes/torus.obj" --genus 0 --out "$work/o5"
+# A vertex whose areas overflow: named as such, not as a degenerate face.
+printf 'v 0 0 0\nv 1e300 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\n' >"$work/far.obj"
+expect_error "a vertex beyond 1e9 mm" 1 "far.obj: vertex 1 (1e+300, 0, 0) lies beyond" "$work/o5b.vtp" \
+  "$DYNSUB" limit "$work/far.obj" --out "$work/o5b.vtp"
 expect_error "open initial model" 1 "closed" "$work/o6" \
   "$DYNSUB" fit "$work/sphere.xyz" --init "$DATA/Meshes/sheet.obj" --out "$work/o6"
 expect_error "missing point cloud" 1 "no such file" "$work/o7" "$DYNSUB" fit "$work/none.xyz" --out "$work/o7"
@@ -170,6 +177,9 @@ for name in surface.vtp control_mesh.obj report.json; do check "deform writes $n
 crown=$(awk '$1 == "v" { n++ } n == 41 { print $4; exit }' "$work/hat/control_mesh.obj")  # vertex 41: the centre
 check "the crown rises (z = $crown)" awk -v z="$crown" 'BEGIN { exit !(z > 0.7) }'
 check "the brim stays" grep -q "^v -1 -1 0$" "$work/hat/control_mesh.obj"
+expect_error "deform: first-order steps without damping" 2 "first-order integration needs a damping > 0" \
+  "$work/hat0" "$DYNSUB" deform "$DATA/Meshes/sheet.obj" --springs "$DATA/Deform/sheet_hat.springs" \
+  --scheme first-order --damping 0 --out "$work/hat0"
 # Refined twice near the crown, the brim still stays: every point within
 # 0.03 of the rim (the level's spacing is 0.0625) is on it, at z = 0.
 "$DYNSUB" deform "$DATA/Meshes/sheet.obj" --springs "$DATA/Deform/sheet_hat.springs" --fix-boundary \
@@ -531,9 +541,19 @@ expect_error "a result of no voxel" 1 "speck.csv: the result encloses no voxel o
 expect_error "negative end pressure" 2 "end-pressure" "$work/s13" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --end-pressure -0.1 \
   --out "$work/s13"
-expect_error "NaN edge threshold" 1 "edge_low (--edge-low) must be in 0..10, got nan" "$work/s9" \
+expect_error "NaN edge threshold" 2 "edge_low (--edge-low) must be in 0..10, got nan" "$work/s9" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --edge-low nan \
   --out "$work/s9"
+expect_error "edge thresholds the wrong way round" 2 "must satisfy 0 <= low <= high" "$work/s9b" \
+  "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --edge-low 5 \
+  --edge-high 1 --out "$work/s9b"
+expect_error "an atlas label list ending in a comma" 2 "--atlas-label Caudate_L,: an empty label" "$work/s9c" \
+  "$DYNSUB" segment "$mri/ch2.nii.gz" --init atlas --atlas-label Caudate_L, --out "$work/s9c"
+# Stopped by the step limit, the surface had not settled: the run says so.
+"$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --max-steps 20 \
+  --no-figures --out "$work/s9d" >/dev/null 2>"$work/s9d.err"
+check "a segmentation stopped by --max-steps warns that it was still moving" \
+  grep -q "still moving when the last level reached its step limit (--max-steps 20)" "$work/s9d.err"
 # The MRI cut to half its bytes: the gzip stream ends early (ITK alone read
 # the missing voxels as zeros).
 head -c 1700000 "$mri/ch2.nii.gz" >"$work/cut.nii.gz"
@@ -590,7 +610,7 @@ expect_error "unknown landmark format" 1 "unknown landmark format" "$work/s3" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/points.txt" --out "$work/s3"
 expect_error "init outside the image" 1 "outside the image" "$work/s4" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:900,0,0,10 --out "$work/s4"
-expect_error "NaN image force" 1 "image_force (--image-force) must be in" "$work/s5" \
+expect_error "NaN image force" 2 "image_force (--image-force) must be in" "$work/s5" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:-10,10,10,5 --image-force nan --out "$work/s5"
 expect_error "negative landmark tolerance" 2 "landmark-tolerance: Value -1 not in range" "$work/s8" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:-10,10,10,5 --landmark-tolerance -1 --out "$work/s8"
@@ -648,6 +668,10 @@ expect_error "solid sculpt: extruding an interior face" 1 "line 2 (extrude 5): f
   "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" --script "$work/interior.sculpt" --out "$work/s31"
 expect_error "solid sculpt: a missing script" 1 "none.sculpt: no such file" "$work/s32" \
   "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" --script "$work/none.sculpt" --out "$work/s32"
+# An --out that cannot be a directory is refused before the script runs.
+expect_error "solid sculpt: --out is a file" 1 "exists and is not a directory" "$work/s32b/sculpted.vtu" \
+  "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" --script "$DATA/Solids/arm.sculpt" --out "$work/three.xyz"
+check "solid sculpt: --out is a file, and no action ran" test ! -s "$work/stdout"
 expect_error "solid sculpt: --script without --out" 2 "--out DIR is required" "$work/sculpted" \
   "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" --script "$DATA/Solids/arm.sculpt"
 expect_error "solid sculpt: NaN stiffness" 2 "--stiffness: nan is not a finite number > 0" "$work/s33" \

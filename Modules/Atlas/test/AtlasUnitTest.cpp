@@ -55,8 +55,9 @@ TEST(Atlas, NamesAndValuesSelectLabels) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("did you mean 'Caudate_L'"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(atlasLabelValues(atlas, "71,,72"), Error);
-  EXPECT_THROW(atlasLabelValues(atlas, "7.5"), Error);
+  EXPECT_THROW(atlasLabelValues(atlas, "71,,72"), UsageError);
+  EXPECT_THROW(atlasLabelValues(atlas, "Caudate_L,"), UsageError);
+  EXPECT_THROW(atlasLabelValues(atlas, "7.5"), UsageError);
   // The calcarine cortex lies outside the cropped box: no voxel has it.
   EXPECT_THROW(atlasLabelValues(atlas, "Calcarine_L"), Error);
 }

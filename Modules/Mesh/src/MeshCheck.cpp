@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 #include <numeric>
+#include <sstream>
 #include <string>
 #include <tuple>
 
@@ -57,6 +58,13 @@ void checkPolygonMesh(const MatrixX3& points, const std::vector<std::vector<int>
   for (int v = 0; v < vertexCount; ++v) {
     if (!points.row(v).allFinite()) {
       throw Error(source, "vertex " + std::to_string(v) + " has a coordinate that is NaN or infinite");
+    }
+    // Areas of such coordinates overflow, and every face would look degenerate.
+    if (points.row(v).cwiseAbs().maxCoeff() > kLargestCoordinate) {
+      std::ostringstream message;
+      message << "vertex " << v << " (" << points(v, 0) << ", " << points(v, 1) << ", " << points(v, 2)
+              << ") lies beyond " << kLargestCoordinate << " mm of the origin; coordinates are in mm";
+      throw Error(source, message.str());
     }
   }
   const double minimumArea = degenerateArea(points);

@@ -397,9 +397,8 @@ void checkRanges(const SegmentParameters& parameters) {
   }
 }
 
-}  // namespace
-
-SegmentOptions segmentOptions(const SegmentParameters& parameters, bool pointsOnBoundary) {
+// segmentOptions(), its errors as found.
+SegmentOptions checkedOptions(const SegmentParameters& parameters, bool pointsOnBoundary) {
   checkRanges(parameters);
   checkSeedOptions(parameters.seed);
   checkAtlasRegistrationOptions(parameters.registration);
@@ -416,6 +415,16 @@ SegmentOptions segmentOptions(const SegmentParameters& parameters, bool pointsOn
   m.rigidityUV = 2 * m.rigidityUU;
   checkSegmentOptions(o);
   return o;
+}
+
+}  // namespace
+
+SegmentOptions segmentOptions(const SegmentParameters& parameters, bool pointsOnBoundary) {
+  try {
+    return checkedOptions(parameters, pointsOnBoundary);
+  } catch (const Error& error) {
+    throw UsageError(error.what());  // every value here is an option someone gave
+  }
 }
 
 void checkSegmentParameters(const SegmentParameters& parameters) {

@@ -178,6 +178,8 @@ void checkStructures(const std::vector<StructureInputs>& structures, const Segme
       throw Error("structure name '" + s.name + "' is given twice: name each structure once (--name)");
     try {
       checkSegmentInputs(s.inputs, parameters);
+    } catch (const UsageError& error) {
+      throw UsageError("structure " + s.name, error.what());
     } catch (const Error& error) {
       throw Error("structure " + s.name, error.what());
     }

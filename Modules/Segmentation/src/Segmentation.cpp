@@ -383,6 +383,14 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
             << " % of the surface left the region of interest, where no image force holds it: it has "
                "probably leaked (add landmarks where it escaped, or raise --margin)";
     result.warnings.push_back(warning.str());
+    warning.str("");
+  }
+  // A surface still moving when the steps ran out is where it happened to
+  // be, not where the forces balance.
+  if (!result.levels.empty() && !result.levels.back().converged) {
+    warning << "the surface was still moving when the last level reached its step limit (--max-steps "
+            << options.simulation.equilibrium.maxSteps << "): check the result, or raise --max-steps";
+    result.warnings.push_back(warning.str());
   }
   return result;
 }

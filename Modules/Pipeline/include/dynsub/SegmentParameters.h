@@ -102,9 +102,9 @@ std::string toText(const ParameterValue& value);
 // The evolution's options: `parameters.segment` with --edge-low/--edge-high
 // given to the reference they are fractions of (the landmarks' when
 // `pointsOnBoundary` and the reference is the landmarks, else the image's)
-// and one tension and one rigidity for every direction. Throws dynsub::Error
+// and one tension and one rigidity for every direction. Throws UsageError
 // for a value outside its row's range and for impossible options
-// (checkSegmentOptions, checkSeedOptions).
+// (checkSegmentOptions, checkSeedOptions): they are options someone gave.
 SegmentOptions segmentOptions(const SegmentParameters& parameters, bool pointsOnBoundary);
 // Whether segmentOptions() would accept the parameters whatever the inputs
 // (a plan's, before any run).

@@ -9,9 +9,9 @@
 
 namespace dynsub {
 
-// The coordinates (mm) and the extent of a point cloud checkPointCloud
-// accepts: a kilometre-scale survey to a nanometre one.
-constexpr double kLargestCoordinate = 1e9, kSmallestSpan = 1e-6;
+// The smallest extent (mm) of a point cloud checkPointCloud accepts: a
+// nanometre-scale scan.
+constexpr double kSmallestSpan = 1e-6;
 
 // Checks a point cloud read from `source`: at least 4 points, finite
 // coordinates within kLargestCoordinate of the origin, a span of at least
