@@ -544,7 +544,7 @@ expect_error "negative end pressure" 2 "end-pressure" "$work/s13" \
 expect_error "NaN edge threshold" 2 "edge_low (--edge-low) must be in 0..10, got nan" "$work/s9" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --edge-low nan \
   --out "$work/s9"
-expect_error "edge thresholds the wrong way round" 2 "must satisfy 0 <= low <= high" "$work/s9b" \
+expect_error "edge thresholds the wrong way round" 2 "edge_low (--edge-low) is 5 and edge_high (--edge-high) 1" "$work/s9b" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --edge-low 5 \
   --edge-high 1 --out "$work/s9b"
 expect_error "an atlas label list ending in a comma" 2 "--atlas-label Caudate_L,: an empty label" "$work/s9c" \

@@ -409,6 +409,14 @@ SegmentOptions checkedOptions(const SegmentParameters& parameters, bool pointsOn
       edges.reference == EdgeReference::Landmarks && pointsOnBoundary ? edges.ofLandmarks : edges.ofImage;
   if (parameters.edgeLow) thresholds.low = *parameters.edgeLow;
   if (parameters.edgeHigh) thresholds.high = *parameters.edgeHigh;
+  // Said here, where it is known which was given and of which reference.
+  if (thresholds.low > thresholds.high)
+    throw Error("edge_low (--edge-low) is " + number(thresholds.low) + (parameters.edgeLow ? "" : " (its default)") +
+                " and edge_high (--edge-high) " + number(thresholds.high) +
+                (parameters.edgeHigh ? "" : " (its default)") +
+                ": the low threshold must not exceed the high one (both are fractions of " +
+                (&thresholds == &edges.ofLandmarks ? "the landmarks' median gradient)"
+                                                    : "the image's 99th-percentile gradient)"));
   Material& m = o.simulation.material;
   m.tensionV = m.tensionU;
   m.rigidityVV = m.rigidityUU;
