@@ -339,7 +339,8 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
   result.outsideRegion = static_cast<double>(outside) / std::max<Eigen::Index>(triangles.points.rows(), 1);
   std::ostringstream warning;
   warning << std::fixed << std::setprecision(0);
-  if (result.volume < kCollapsedBelow * result.initialVolume) {
+  const bool collapsed = result.volume < kCollapsedBelow * result.initialVolume;
+  if (collapsed) {
     warning << "the surface shrank to " << 100 * result.volume / result.initialVolume
             << " % of the initial model's volume: it has probably collapsed (give more landmarks, or start "
                "closer to the structure's boundary)";
@@ -386,8 +387,9 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
     warning.str("");
   }
   // A surface still moving when the steps ran out is where it happened to
-  // be, not where the forces balance.
-  if (!result.levels.empty() && !result.levels.back().converged) {
+  // be, not where the forces balance. (A collapsing one is said above: more
+  // steps would not help it.)
+  if (!collapsed && !result.levels.empty() && !result.levels.back().converged) {
     warning << "the surface was still moving when the last level reached its step limit (--max-steps "
             << options.simulation.equilibrium.maxSteps << "): check the result, or raise --max-steps";
     result.warnings.push_back(warning.str());
