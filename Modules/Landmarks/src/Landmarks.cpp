@@ -1,5 +1,6 @@
 #include "dynsub/Landmarks.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <fstream>
@@ -218,11 +219,19 @@ std::vector<Landmark> readLandmarks(const std::string& path, CoordinateSystem* s
 }
 
 std::vector<LandmarkList> readLandmarkLists(const std::string& path) {
-  std::vector<LandmarkList> lists = readAllLists(path), withPoints;
-  for (LandmarkList& list : lists)
-    if (!list.landmarks.empty()) withPoints.push_back(std::move(list));
-  if (withPoints.empty()) withPoints.push_back(lists.empty() ? LandmarkList() : lists.front());
-  return withPoints;
+  std::vector<LandmarkList> lists = readAllLists(path);
+  const auto empty = [](const LandmarkList& list) { return list.landmarks.empty(); };
+  if (lists.empty()) return {LandmarkList()};
+  if (std::all_of(lists.begin(), lists.end(), empty)) return {lists.front()};
+  // Skipped, a list without points would leave its structure out, and the
+  // lists after it would take the wrong --name and --reference-label.
+  const auto gap = std::find_if(lists.begin(), lists.end(), empty);
+  if (gap != lists.end())
+    throw Error(path, "point list " + std::to_string(gap - lists.begin() + 1) +
+                          (gap->name.empty() ? "" : " ('" + gap->name + "')") +
+                          " holds no point, beside lists that do: place its structure's points, or delete the "
+                          "empty list");
+  return lists;
 }
 
 void writeLandmarks(const std::vector<Landmark>& landmarks, const std::string& path, CoordinateSystem system) {

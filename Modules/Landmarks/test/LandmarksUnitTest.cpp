@@ -62,7 +62,6 @@ TEST(Landmarks, AMarkupsFileGivesEachPointListOnItsOwn) {
   std::ofstream(json.string()) << R"({"markups": [
     {"name": "Caudate L", "coordinateSystem": "LPS", "controlPoints": [
       {"label": "c1", "position": [1.0, 2.0, 3.0]}, {"label": "c2", "position": [4.0, 5.0, 6.0]}]},
-    {"name": "empty", "controlPoints": []},
     {"coordinateSystem": "RAS", "controlPoints": [{"label": "p1", "position": [10.0, 20.0, 30.0]}]}]})";
   const std::vector<LandmarkList> lists = readLandmarkLists(json.string());
   ASSERT_EQ(lists.size(), 2u);
@@ -84,6 +83,21 @@ TEST(Landmarks, AMarkupsFileGivesEachPointListOnItsOwn) {
   ASSERT_EQ(one.size(), 1u);
   EXPECT_EQ(one[0].name, "");
   EXPECT_EQ(one[0].landmarks.size(), 3u);
+
+  // An empty list beside lists with points would drop its structure and
+  // shift the names and labels given to those after it: it is refused.
+  const fs::path gap = scratch("gap.mrk.json");
+  std::ofstream(gap.string()) << R"({"markups": [
+    {"name": "Caudate L", "controlPoints": []},
+    {"name": "Putamen L", "controlPoints": [{"label": "p1", "position": [10.0, 20.0, 30.0]}]}]})";
+  try {
+    readLandmarkLists(gap.string());
+    FAIL() << "an empty list beside one with points was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("gap.mrk.json: point list 1 ('Caudate L') holds no point"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 // A scene's markups file may hold a ruler or a box beside the point lists:

@@ -41,9 +41,9 @@ struct LandmarkList {
   CoordinateSystem stated = CoordinateSystem::LPS;  // the system the file says its values are in
   std::vector<Landmark> landmarks;                  // LPS mm
 };
-// The file's lists that hold a point, in order (one list for .fcsv and
-// .csv; the first list when none holds a point): a markups file may hold
-// one list per structure. Throws as readLandmarks.
+// The file's lists, in order (one list for .fcsv and .csv; the first list
+// when none holds a point): a markups file may hold one list per structure.
+// Throws as readLandmarks, and for an empty list beside lists with points.
 std::vector<LandmarkList> readLandmarkLists(const std::string& path);
 
 // Format by extension (.mrk.json, .fcsv, .csv); `system` applies to .mrk.json
