@@ -1,6 +1,7 @@
 #include "dynsub/MeshIO.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -262,6 +263,14 @@ class PlyValueReader {
   bool swap_;
 };
 
+// "8 vertex, 6 face": the header's counts, for errors.
+std::string elementCounts(const std::vector<PlyElement>& elements) {
+  std::string counts;
+  for (const PlyElement& element : elements)
+    counts += (counts.empty() ? "" : ", ") + std::to_string(element.count) + " " + element.name;
+  return counts;
+}
+
 PolygonData readPly(const std::string& path) {
   std::ifstream in = openForReading(path, std::ios::binary);
   std::string text;
@@ -359,6 +368,12 @@ PolygonData readPly(const std::string& path) {
     }
   }
   if (!sawVertices) throw Error(path, "the PLY file has no vertex element");
+  // Records past the header's counts (a face more than announced) would be
+  // dropped without a word, as in the OFF reader; a final newline is not one.
+  for (char c; in.get(c);)
+    if (!std::isspace(static_cast<unsigned char>(c)))
+      throw Error(path, "the file goes on after the elements its PLY header announces (" + elementCounts(elements) +
+                            "): a count in the header is wrong");
   return data;
 }
 

@@ -137,6 +137,28 @@ TEST(MeshIO, BrokenFilesAreNamed) {
   writeText(truncatedPly, "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
                           "property float y\nproperty float z\nend_header\n\x01\x02");
   expectError(truncatedPly, "truncated");
+  // Likewise in PLY, ASCII or binary (a trailing newline is no record).
+  const std::string plyHeader =
+      "element vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  const std::string extraPly = scratch("extra.ply").string();
+  writeText(extraPly, "ply\nformat ascii 1.0\n" + plyHeader + "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 1 3\n");
+  expectError(extraPly, "goes on after the elements its PLY header announces (4 vertex, 1 face)");
+  std::string binary = "ply\nformat binary_little_endian 1.0\n" + plyHeader;
+  const float corners[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+  binary.append(reinterpret_cast<const char*>(corners), sizeof corners);
+  const auto face = [&binary](std::int32_t a, std::int32_t b, std::int32_t c) {
+    binary += '\x03';
+    for (const std::int32_t v : {a, b, c}) binary.append(reinterpret_cast<const char*>(&v), sizeof v);
+  };
+  face(0, 1, 2);
+  const std::string oneFace = scratch("one_face.ply").string();
+  writeText(oneFace, binary + "\n");
+  EXPECT_EQ(dynsub::readPolygonData(oneFace).faces.size(), 1u);
+  face(0, 1, 3);
+  const std::string extraBinary = scratch("extra_binary.ply").string();
+  writeText(extraBinary, binary);
+  expectError(extraBinary, "goes on after the elements");
   const std::string empty = scratch("empty.obj").string();
   writeText(empty, "");
   expectError(empty, "no vertices");
