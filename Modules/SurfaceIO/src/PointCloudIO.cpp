@@ -1,7 +1,10 @@
 #include "dynsub/PointCloudIO.h"
 
+#include <array>
+#include <cctype>
 #include <cerrno>
 #include <cstdlib>
+#include <optional>
 #include <filesystem>
 #include <iterator>
 #include <string>
@@ -25,18 +28,53 @@ namespace dynsub {
 
 namespace {
 
-// Parses the first three numbers of a line split at `separators`; false if
-// the line has fewer than three fields or a field is not a number.
-bool parseXyz(std::string line, const std::string& separators, Vector3& point) {
-  for (char& c : line) {
-    if (separators.find(c) != std::string::npos) c = ' ';
+// A line's fields: a CSV's between its separators (",;" or a tab; an empty
+// field counts), a text file's between runs of blanks. Trimmed of blanks and
+// quotes.
+std::vector<std::string> fieldsOf(const std::string& line, bool csv) {
+  std::vector<std::string> fields;
+  if (csv) {
+    std::string field;
+    for (const char c : line) {
+      if (c == ',' || c == ';' || c == '\t') {
+        fields.push_back(field);
+        field.clear();
+      } else {
+        field += c;
+      }
+    }
+    fields.push_back(field);
+  } else {
+    std::istringstream in(line);
+    for (std::string field; in >> field;) fields.push_back(field);
   }
-  std::istringstream in(line);
-  std::string field;
-  for (int i = 0; i < 3; ++i) {
-    if (!(in >> field) || !parseNumber(field, point(i))) return false;
+  for (std::string& f : fields) {
+    const auto begin = f.find_first_not_of(" \t\r\""), end = f.find_last_not_of(" \t\r\"");
+    f = begin == std::string::npos ? std::string() : f.substr(begin, end - begin + 1);
   }
-  return true;
+  return fields;
+}
+
+// The columns of x, y and z named by a CSV's first line, or nullopt when it
+// names none of them. Named in part, or over more than three columns
+// without the names, the columns cannot be told: an error.
+std::optional<std::array<std::size_t, 3>> namedColumns(const std::vector<std::string>& names,
+                                                        const std::string& path, int line) {
+  std::array<std::size_t, 3> columns{};
+  int found = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    const std::string wanted(1, "xyz"[axis]);
+    for (std::size_t c = 0; c < names.size(); ++c)
+      if (names[c] == wanted || names[c] == std::string(1, static_cast<char>(std::toupper(wanted[0])))) {
+        columns[axis] = c;
+        ++found;
+        break;
+      }
+  }
+  if (found == 3) return columns;
+  if (found == 0 && names.size() == 3) return std::nullopt;
+  throw Error(path, "line " + std::to_string(line) + ": the header does not name the coordinates' columns x, y and z (" +
+                        std::to_string(names.size()) + " columns): name them so");
 }
 
 MatrixX3 readText(const std::string& path, bool csv) {
@@ -45,15 +83,21 @@ MatrixX3 readText(const std::string& path, bool csv) {
   std::string line;
   int number = 0;
   bool header = csv;
+  std::array<std::size_t, 3> columns{0, 1, 2};
   while (std::getline(in, line)) {
     ++number;
     const size_t comment = line.find('#');
     if (comment != std::string::npos) line.erase(comment);
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    const std::vector<std::string> fields = fieldsOf(line, csv);
     Vector3 p;
-    if (!parseXyz(line, csv ? ",;\t\r" : " \t\r", p)) {
+    bool numbers = true;
+    for (int axis = 0; axis < 3 && numbers; ++axis)
+      numbers = columns[axis] < fields.size() && parseNumber(fields[columns[axis]], p(axis));
+    if (!numbers) {
       if (header) {  // a first line of column names
         header = false;
+        if (const auto named = namedColumns(fields, path, number)) columns = *named;
         continue;
       }
       throw Error(path, "line " + std::to_string(number) + ": expected three numbers x y z");

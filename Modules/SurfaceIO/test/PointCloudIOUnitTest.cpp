@@ -65,6 +65,31 @@ TEST(PointCloudIO, PointFilesAreNotMeshVertices) {
   }
 }
 
+// A CSV's header names its columns: the coordinates are read from the
+// columns it names x, y and z, wherever they are (pandas writes an index
+// column first); three unnamed columns are x, y, z in order; more columns
+// without the names are refused rather than guessed.
+TEST(PointCloudIO, ACsvHeaderNamesTheCoordinatesColumns) {
+  const dynsub::MatrixX3 indexed =
+      dynsub::readPointCloud(writeText("pandas.csv", ",x,y,z\n0,1,2,3\n1,4,5,6\n2,7,8,9\n3,1,1,2\n")).points;
+  ASSERT_EQ(indexed.rows(), 4);
+  EXPECT_EQ(indexed.row(1), Eigen::RowVector3d(4, 5, 6));
+  const dynsub::MatrixX3 reordered =
+      dynsub::readPointCloud(writeText("zyx.csv", "\"Z\";\"Y\";\"X\"\n3;2;1\n6;5;4\n9;8;7\n2;1;1\n")).points;
+  EXPECT_EQ(reordered.row(0), Eigen::RowVector3d(1, 2, 3));
+  const dynsub::MatrixX3 unnamed =
+      dynsub::readPointCloud(writeText("abc.csv", "a,b,c\n1,2,3\n4,5,6\n7,8,9\n1,1,2\n")).points;
+  EXPECT_EQ(unnamed.row(0), Eigen::RowVector3d(1, 2, 3));
+  try {
+    dynsub::readPointCloud(writeText("four.csv", "id,px,py,pz\n0,1,2,3\n1,4,5,6\n2,7,8,9\n3,1,1,2\n"));
+    FAIL() << "four unnamed columns were read";
+  } catch (const dynsub::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("four.csv: line 1: the header does not name the coordinates' columns"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 int genusOf(const std::string& path) { return dynsub::closedMeshGenus(dynsub::readPointCloud(path), path); }
 
 // A fit warns when its model's genus is not the scan's (FitCommand.cpp), so
