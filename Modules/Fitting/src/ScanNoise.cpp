@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <tuple>
+#include <vector>
 
 #include <Eigen/Eigenvalues>
 
@@ -138,11 +140,10 @@ MatrixX3 withoutRows(const MatrixX3& points, const std::vector<int>& drop) {
   return kept;
 }
 
-ScanNoise estimateScanNoise(const MatrixX3& points) {
-  if (points.rows() <= kNoiseNeighbours) {
-    throw Error("the noise of a scan is measured on at least " + std::to_string(kNoiseNeighbours + 1) +
-                " points; it has " + std::to_string(points.rows()));
-  }
+namespace {
+
+// estimateScanNoise on points that are all distinct.
+ScanNoise estimateOnDistinct(const MatrixX3& points) {
   const Eigen::MatrixXi neighbours = nearestNeighbours(points, kNoiseNeighbours);
   const Eigen::Index n = points.rows();
   Eigen::VectorXd standardized = Eigen::VectorXd::Zero(n), localScale = Eigen::VectorXd::Zero(n);
@@ -192,6 +193,42 @@ ScanNoise estimateScanNoise(const MatrixX3& points) {
                      std::abs(standardized(i)) > 0.5 * spacing;
     if (isolated || off) noise.outliers.push_back(static_cast<int>(i));
   }
+  return noise;
+}
+
+}  // namespace
+
+ScanNoise estimateScanNoise(const MatrixX3& points) {
+  if (points.rows() <= kNoiseNeighbours) {
+    throw Error("the noise of a scan is measured on at least " + std::to_string(kNoiseNeighbours + 1) +
+                " points; it has " + std::to_string(points.rows()));
+  }
+  // Copies of one point (a file written twice, overlapping scans merged)
+  // would be one another's nearest neighbours: every local quadric would fit
+  // them exactly, the scatter would come out near 0, and clean points would
+  // be set aside as outliers. Each position counts once.
+  const Eigen::Index n = points.rows();
+  std::vector<Eigen::Index> order(static_cast<size_t>(n));
+  for (Eigen::Index i = 0; i < n; ++i) order[static_cast<size_t>(i)] = i;
+  const auto less = [&points](Eigen::Index a, Eigen::Index b) {
+    return std::tie(points(a, 0), points(a, 1), points(a, 2)) < std::tie(points(b, 0), points(b, 1), points(b, 2));
+  };
+  std::sort(order.begin(), order.end(), less);
+  std::vector<int> distinctOf(static_cast<size_t>(n));
+  std::vector<Eigen::Index> firsts;
+  for (size_t k = 0; k < order.size(); ++k) {
+    if (k == 0 || points.row(order[k]) != points.row(order[k - 1])) firsts.push_back(order[k]);
+    distinctOf[static_cast<size_t>(order[k])] = static_cast<int>(firsts.size()) - 1;
+  }
+  if (static_cast<Eigen::Index>(firsts.size()) == n) return estimateOnDistinct(points);
+  // Too few distinct points to measure: no noise, and none set aside.
+  if (static_cast<Eigen::Index>(firsts.size()) <= kNoiseNeighbours) return ScanNoise{};
+  ScanNoise noise = estimateOnDistinct(points(firsts, Eigen::all));
+  std::vector<char> outlier(firsts.size(), 0);
+  for (const int d : noise.outliers) outlier[static_cast<size_t>(d)] = 1;
+  noise.outliers.clear();
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (outlier[static_cast<size_t>(distinctOf[static_cast<size_t>(i)])]) noise.outliers.push_back(static_cast<int>(i));
   return noise;
 }
 

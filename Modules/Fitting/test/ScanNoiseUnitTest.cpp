@@ -2,7 +2,9 @@
 // and outliers are known: the noise is measured to within the spread of a
 // median over a few thousand points, outliers scattered about the shape are
 // found, and clean, curved, sparsely sampled points are not called outliers.
+#include <algorithm>
 #include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -125,6 +127,31 @@ TEST(ScanNoise, FindsScatteredOutliers) {
   EXPECT_GE(found, 86) << "of 90 outliers";
   EXPECT_LE(wrong, 15) << "of 3000 surface points";
   EXPECT_NEAR(noise.sigma, 0.3, 0.03);
+}
+
+// Every point twice or three times (a file written twice, overlapping scans
+// merged) measures as the points once: a copy is not a neighbour whose
+// offset tells noise, and a clean point's copy does not make it an outlier.
+// An outlier's copies are all outliers.
+TEST(ScanNoise, CopiesOfAPointCountOnce) {
+  const MatrixX3 surface = withNoise(ellipsoidPoints(1500, Vector3(50, 50, 50), 22), 0.3, 23);
+  const MatrixX3 outliers = scatteredOff(45, 55, 50, 2.0, 24);
+  MatrixX3 scan(surface.rows() + outliers.rows(), 3);
+  scan << surface, outliers;
+  const ScanNoise once = estimateScanNoise(scan);
+  for (const int copies : {2, 3}) {
+    const ScanNoise copied = estimateScanNoise(scan.replicate(copies, 1));
+    EXPECT_EQ(copied.sigma, once.sigma) << copies << " copies";
+    std::vector<int> expected;
+    for (int k = 0; k < copies; ++k)
+      for (const int i : once.outliers) expected.push_back(i + k * static_cast<int>(scan.rows()));
+    std::sort(expected.begin(), expected.end());
+    EXPECT_EQ(copied.outliers, expected) << copies << " copies";
+  }
+  // Fewer distinct points than a neighbourhood: nothing measured.
+  const ScanNoise few = estimateScanNoise(surface.topRows(10).replicate(3, 1));
+  EXPECT_EQ(few.sigma, 0.0);
+  EXPECT_TRUE(few.outliers.empty());
 }
 
 TEST(ScanNoise, RefusesTooFewPoints) {

@@ -82,6 +82,8 @@ constexpr double kOutlierFactor = 4.0;
 // median over all points.
 constexpr double kIsolationFactor = 3.0;
 
+// Exact copies of a point count once, and are all outliers when it is one;
+// with kNoiseNeighbours or fewer distinct points, no noise and no outliers.
 // Throws dynsub::Error when there are fewer than kNoiseNeighbours + 1 points.
 ScanNoise estimateScanNoise(const MatrixX3& points);
 
