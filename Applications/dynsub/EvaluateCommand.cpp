@@ -301,6 +301,11 @@ void runEvaluate(const EvaluateCommandOptions& o) {
               << (g.failures ? ", " + std::to_string(g.failures) + " failed" : "") << '\n';
   std::cout << runs.size() << " runs in " << std::setprecision(1) << seconds << " s; wrote " << (dir / "runs.csv").string()
             << ", summary.csv, summary.json and dice_*.svg\n";
+  // Some failures are results (a user would have had no segmentation);
+  // all of them say that the plan cannot be run as written.
+  if (!runs.empty() && std::all_of(runs.begin(), runs.end(), [](const EvaluationRun& r) { return !r.error.empty(); }))
+    throw Error(o.plan, "every one of its " + std::to_string(runs.size()) + " runs failed, the first with: " +
+                            runs.front().error + " (runs.csv gives each run's error)");
 }
 
 }  // namespace

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <fstream>
 #include <iostream>
 
@@ -24,13 +25,28 @@ void runSubject(const Arguments& arguments) {
   for (const std::string& setting : arguments.settings) {
     const auto equals = setting.find('=');
     if (equals == std::string::npos) throw UsageError("--set", "expected KEY=VALUE, got '" + setting + "'");
-    setSubjectSetting(settings, setting.substr(0, equals), setting.substr(equals + 1));
+    // An unknown key or a value out of range is a usage error here; the
+    // same checks name the plan when a plan's cohort gives the settings.
+    try {
+      setSubjectSetting(settings, setting.substr(0, equals), setting.substr(equals + 1));
+    } catch (const Error& error) {
+      throw UsageError("--set", error.what());
+    }
   }
-  checkSubjectSettings(settings);
+  try {
+    checkSubjectSettings(settings);
+  } catch (const Error& error) {
+    throw UsageError("--set", error.what());
+  }
   prepareOutputDirectory(arguments.out);
   const Volume image = readVolume(arguments.image);
   const Volume labels = readLabelMap(arguments.labels);
   const Subject subject = makeSubject(image, labels, settings, arguments.seed);
+  // A ground truth with no label scores nothing: say so now, not when a
+  // plan's structures find no voxel.
+  if (std::none_of(subject.labels.voxels.begin(), subject.labels.voxels.end(), [](float v) { return v != 0; }))
+    throw Error(arguments.labels, "no labelled voxel lies within the image " + arguments.image +
+                                      ": the label map is empty or does not overlap the image");
   OutputSet outputs(arguments.out);
   writeVolume(subject.image, outputs.add("image.nii.gz"), VoxelType::Float32);
   writeVolume(subject.labels, outputs.add("labels.nii.gz"), VoxelType::Label16);

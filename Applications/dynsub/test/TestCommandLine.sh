@@ -703,12 +703,19 @@ check "subject records the drawn SNR" grep -q '"snr": 20,' "$work/subject/subjec
   --out "$work/synthesized" >/dev/null
 check "a synthesized subject records its contrast" grep -q '"contrast": "t2"' "$work/synthesized/subject.json"
 check "a synthesized subject shares its seed's anatomy" cmp -s "$work/subject/labels.nii.gz" "$work/synthesized/labels.nii.gz"
-expect_error "subject: an unknown mode" 1 "mode must be 'realistic' or 'synthesized'" "$work/s43" \
+expect_error "subject: an unknown mode" 2 "mode must be 'realistic' or 'synthesized'" "$work/s43" \
   "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --set mode=synthetic --out "$work/s43"
-expect_error "subject: an unknown setting" 1 "unknown setting 'noise'" "$work/s40" \
+expect_error "subject: an unknown setting" 2 "unknown setting 'noise'" "$work/s40" \
   "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --set noise=3 --out "$work/s40"
-expect_error "subject: a warp that could fold" 1 "warp_mm must be" "$work/s41" \
+expect_error "subject: a warp that could fold" 2 "warp_mm must be" "$work/s41" \
   "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --set warp_mm=20 --out "$work/s41"
+/usr/bin/python3 -c "
+import sys, numpy, nibabel
+nibabel.save(nibabel.Nifti1Image(numpy.zeros((8, 8, 8), numpy.int16), numpy.eye(4)), sys.argv[1])" "$work/nolabel.nii.gz"
+expect_error "subject: a label map without labels" 1 "nolabel.nii.gz: no labelled voxel lies within the image" \
+  "$work/s41c" "$DYNSUB" subject "$mri/ch2.nii.gz" "$work/nolabel.nii.gz" --out "$work/s41c"
+expect_error "subject: a range the wrong way round" 2 "snr must be LOW,HIGH with 0 < LOW <= HIGH <= 1000" "$work/s41b" \
+  "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --set snr=30,10 --out "$work/s41b"
 expect_error "subject: missing labels" 1 "nolabels.nii.gz" "$work/s42" \
   "$DYNSUB" subject "$mri/ch2.nii.gz" "$work/nolabels.nii.gz" --out "$work/s42"
 expect_error "subject: an image given as its labels" 1 "image.nii.gz: not a label map" "$work/s44" \

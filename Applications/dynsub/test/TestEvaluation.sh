@@ -138,6 +138,15 @@ bad escaping_name "$(edited "p['splits'][0]['name'] = '../../escaped'")" \
 bad misspelt_key "$(edited "p['protocols'][0]['slice'] = 6")" "a protocol: unknown key 'slice'"
 bad repeated_seed "$(edited "p['splits'][0]['seeds'] = [101, 101]")" "split 'test' lists seed 101 twice"
 bad no_seeds "$(edited "p['splits'][0]['seeds'] = []")" "split 'test' has no seeds"
+# A plan whose every run fails (3 clicks on one slice make no surface) is
+# not a result: the runs are written, with their errors, and the exit is 1.
+edited "p['protocols'] = [dict(p['protocols'][0], slices=1, points_per_slice=3)]; \
+p['splits'][0]['structures'] = ['caudate_left', 'putamen_left']" >"$work/all_fail.json"
+"$DYNSUB" evaluate "$work/all_fail.json" --out "$work/out_all_fail" >"$work/all_fail.log" 2>&1
+check "a plan whose every run fails: exit 1" test $? -eq 1
+check "a plan whose every run fails: the message" grep -q "all_fail.json: every one of its 2 runs failed" \
+  "$work/all_fail.log"
+check "a plan whose every run fails: runs.csv gives the errors" test -s "$work/out_all_fail/runs.csv"
 "$DYNSUB" evaluate "$work/missing.json" --out "$work/out_missing" >"$work/missing.log" 2>&1
 check "missing plan: non-zero exit and the file named" grep -q "missing.json" "$work/missing.log"
 "$DYNSUB" evaluate "$DATA/Evaluation/ci_plan.json" --out "$work/out_keep" --keep-landmarks "$work/no/clicks" \
