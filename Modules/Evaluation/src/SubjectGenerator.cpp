@@ -302,8 +302,10 @@ void checkSubjectSettings(const SubjectSettings& s) {
           "warp_mm must be at least 0 and under 0.4 x warp_spacing_mm, or the deformation may fold");
   require(s.gammaSpread >= 0 && s.gammaSpread <= 1, "gamma_spread must be in 0..1");
   require(s.biasSpread >= 0 && s.biasSpread < 1, "bias_spread must be in 0..1 (below 1)");
-  require(s.blurMm[0] >= 0 && s.blurMm[0] <= s.blurMm[1] && s.blurMm[1] <= 5, "blur_mm must be LOW,HIGH with 0 <= LOW <= HIGH <= 5");
-  require(s.snr[0] > 0 && s.snr[0] <= s.snr[1] && s.snr[1] <= 1000, "snr must be LOW,HIGH with 0 < LOW <= HIGH <= 1000");
+  require(s.blurMm[0] >= 0 && s.blurMm[0] <= s.blurMm[1] && s.blurMm[1] <= 5,
+          "blur_mm must be LOW,HIGH with 0 <= LOW <= HIGH <= 5");
+  require(s.snr[0] > 0 && s.snr[0] <= s.snr[1] && s.snr[1] <= 1000,
+          "snr must be LOW,HIGH with 0 < LOW <= HIGH <= 1000");
   require(s.sourceSnr > 0, "source_snr must be positive");
   require(s.thickFraction >= 0 && s.thickFraction <= 1, "thick_fraction must be in 0..1");
   require(s.thickMm > 0 && s.thickMm <= 10, "thick_mm must be over 0 and at most 10");

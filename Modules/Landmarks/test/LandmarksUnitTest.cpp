@@ -94,8 +94,7 @@ TEST(Landmarks, AMarkupsFileGivesEachPointListOnItsOwn) {
     readLandmarkLists(gap.string());
     FAIL() << "an empty list beside one with points was accepted";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("gap.mrk.json: point list 1 ('Caudate L') holds no point"),
-              std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("gap.mrk.json: point list 1 ('Caudate L') holds no point"), std::string::npos)
         << e.what();
   }
 }

@@ -416,7 +416,7 @@ SegmentOptions checkedOptions(const SegmentParameters& parameters, bool pointsOn
                 (parameters.edgeHigh ? "" : " (its default)") +
                 ": the low threshold must not exceed the high one (both are fractions of " +
                 (&thresholds == &edges.ofLandmarks ? "the landmarks' median gradient)"
-                                                    : "the image's 99th-percentile gradient)"));
+                                                   : "the image's 99th-percentile gradient)"));
   Material& m = o.simulation.material;
   m.tensionV = m.tensionU;
   m.rigidityVV = m.rigidityUU;

@@ -58,8 +58,8 @@ std::vector<std::string> fieldsOf(const std::string& line, bool csv) {
 // The columns of x, y and z named by a CSV's first line, or nullopt when it
 // names none of them. Named in part, or over more than three columns
 // without the names, the columns cannot be told: an error.
-std::optional<std::array<std::size_t, 3>> namedColumns(const std::vector<std::string>& names,
-                                                        const std::string& path, int line) {
+std::optional<std::array<std::size_t, 3>> namedColumns(const std::vector<std::string>& names, const std::string& path,
+                                                       int line) {
   std::array<std::size_t, 3> columns{};
   int found = 0;
   for (int axis = 0; axis < 3; ++axis) {
@@ -73,7 +73,8 @@ std::optional<std::array<std::size_t, 3>> namedColumns(const std::vector<std::st
   }
   if (found == 3) return columns;
   if (found == 0 && names.size() == 3) return std::nullopt;
-  throw Error(path, "line " + std::to_string(line) + ": the header does not name the coordinates' columns x, y and z (" +
+  throw Error(path, "line " + std::to_string(line) +
+                        ": the header does not name the coordinates' columns x, y and z (" +
                         std::to_string(names.size()) + " columns): name them so");
 }
 
