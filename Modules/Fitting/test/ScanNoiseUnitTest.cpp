@@ -62,6 +62,13 @@ TEST(WithoutRows, DropsTheRowsAsked) {
 // Isotropic noise of sigma per coordinate is sigma along the normal. The
 // lower quartile of 3000 |t| has a relative standard error of about 3.3 %;
 // 10 % leaves room for the small curvature the quadrics do not follow.
+// `surface` with `outliers` after it.
+MatrixX3 withOutliers(const MatrixX3& surface, const MatrixX3& outliers) {
+  MatrixX3 scan(surface.rows() + outliers.rows(), 3);
+  scan << surface, outliers;
+  return scan;
+}
+
 TEST(ScanNoise, MeasuresKnownNoiseOnCurvedSurfaces) {
   for (double sigma : {0.1, 0.3}) {
     const ScanNoise sphere = estimateScanNoise(withNoise(ellipsoidPoints(3000, Vector3(50, 50, 50), 7), sigma, 8));
@@ -118,9 +125,7 @@ TEST(ScanNoise, EdgesAndCornersAreNotNoise) {
 // set aside with them.
 TEST(ScanNoise, FindsScatteredOutliers) {
   const MatrixX3 surface = withNoise(ellipsoidPoints(3000, Vector3(50, 50, 50), 13), 0.3, 14);
-  const MatrixX3 outliers = scatteredOff(90, 55, 50, 2.0, 15);
-  MatrixX3 scan(surface.rows() + outliers.rows(), 3);
-  scan << surface, outliers;
+  const MatrixX3 scan = withOutliers(surface, scatteredOff(90, 55, 50, 2.0, 15));
   const ScanNoise noise = estimateScanNoise(scan);
   int found = 0, wrong = 0;
   for (int i : noise.outliers) (i >= surface.rows() ? found : wrong) += 1;
@@ -135,9 +140,7 @@ TEST(ScanNoise, FindsScatteredOutliers) {
 // An outlier's copies are all outliers.
 TEST(ScanNoise, CopiesOfAPointCountOnce) {
   const MatrixX3 surface = withNoise(ellipsoidPoints(1500, Vector3(50, 50, 50), 22), 0.3, 23);
-  const MatrixX3 outliers = scatteredOff(45, 55, 50, 2.0, 24);
-  MatrixX3 scan(surface.rows() + outliers.rows(), 3);
-  scan << surface, outliers;
+  const MatrixX3 scan = withOutliers(surface, scatteredOff(45, 55, 50, 2.0, 24));
   const ScanNoise once = estimateScanNoise(scan);
   for (const int copies : {2, 3}) {
     const ScanNoise copied = estimateScanNoise(scan.replicate(copies, 1));
