@@ -4,9 +4,9 @@
 #include <cctype>
 #include <cerrno>
 #include <cstdlib>
-#include <optional>
 #include <filesystem>
 #include <iterator>
+#include <optional>
 #include <string>
 #include <fstream>
 #include <sstream>
@@ -29,11 +29,10 @@ namespace dynsub {
 namespace {
 
 // A line's fields: a CSV's between its separators (",;" or a tab; an empty
-// field counts), a text file's between runs of blanks. Trimmed of blanks and
-// quotes.
+// field counts), else between runs of blanks. Trimmed of blanks and quotes.
 std::vector<std::string> fieldsOf(const std::string& line, bool csv) {
   std::vector<std::string> fields;
-  if (csv) {
+  if (csv && line.find_first_of(",;\t") != std::string::npos) {
     std::string field;
     for (const char c : line) {
       if (c == ',' || c == ';' || c == '\t') {
@@ -63,9 +62,8 @@ std::optional<std::array<std::size_t, 3>> namedColumns(const std::vector<std::st
   std::array<std::size_t, 3> columns{};
   int found = 0;
   for (int axis = 0; axis < 3; ++axis) {
-    const std::string wanted(1, "xyz"[axis]);
     for (std::size_t c = 0; c < names.size(); ++c)
-      if (names[c] == wanted || names[c] == std::string(1, static_cast<char>(std::toupper(wanted[0])))) {
+      if (names[c].size() == 1 && std::tolower(static_cast<unsigned char>(names[c][0])) == "xyz"[axis]) {
         columns[axis] = c;
         ++found;
         break;

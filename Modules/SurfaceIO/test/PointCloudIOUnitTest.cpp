@@ -80,6 +80,9 @@ TEST(PointCloudIO, ACsvHeaderNamesTheCoordinatesColumns) {
   const dynsub::MatrixX3 unnamed =
       dynsub::readPointCloud(writeText("abc.csv", "a,b,c\n1,2,3\n4,5,6\n7,8,9\n1,1,2\n")).points;
   EXPECT_EQ(unnamed.row(0), Eigen::RowVector3d(1, 2, 3));
+  const dynsub::MatrixX3 blanks =
+      dynsub::readPointCloud(writeText("blanks.csv", "x y z\n1 2 3\n4 5 6\n7 8 9\n1 1 2\n")).points;
+  EXPECT_EQ(blanks.row(3), Eigen::RowVector3d(1, 1, 2));
   try {
     dynsub::readPointCloud(writeText("four.csv", "id,px,py,pz\n0,1,2,3\n1,4,5,6\n2,7,8,9\n3,1,1,2\n"));
     FAIL() << "four unnamed columns were read";
