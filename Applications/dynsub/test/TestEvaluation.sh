@@ -138,6 +138,8 @@ bad escaping_name "$(edited "p['splits'][0]['name'] = '../../escaped'")" \
 bad misspelt_key "$(edited "p['protocols'][0]['slice'] = 6")" "a protocol: unknown key 'slice'"
 bad repeated_seed "$(edited "p['splits'][0]['seeds'] = [101, 101]")" "split 'test' lists seed 101 twice"
 bad no_seeds "$(edited "p['splits'][0]['seeds'] = []")" "split 'test' has no seeds"
+expect_error "an unknown --split" 2 "--split nope: the plan has no such split (its splits: test)" \
+  "$work/out_nope/runs.csv" "$DYNSUB" evaluate "$DATA/Evaluation/ci_plan.json" --split nope --out "$work/out_nope"
 # A plan whose every run fails (3 clicks on one slice make no surface) is
 # not a result: the runs are written, with their errors, and the exit is 1.
 edited "p['protocols'] = [dict(p['protocols'][0], slices=1, points_per_slice=3)]; \

@@ -338,8 +338,12 @@ std::vector<EvaluationRun> runEvaluation(const EvaluationPlan& plan, const Evalu
       splits.push_back(&s);
   for (const std::string& name : options.splits) {
     bool known = false;
-    for (const EvaluationSplit& s : plan.splits) known = known || s.name == name;
-    if (!known) throw Error("the plan has no split '" + name + "'");
+    std::string names;
+    for (const EvaluationSplit& s : plan.splits) {
+      known = known || s.name == name;
+      names += (names.empty() ? "" : ", ") + s.name;
+    }
+    if (!known) throw UsageError("--split " + name, "the plan has no such split (its splits: " + names + ")");
   }
 
   // Every input is read or generated once, before any run: an image, its
