@@ -105,8 +105,9 @@ void runSculpt(const SculptOptions& options) {
   SculptOptions o = options;
   o.settings.scheme = o.scheme == "explicit" ? SolidScheme::PaperExplicit : SolidScheme::SemiImplicit;
   const Lattice lattice = readLattice(o.lattice);
-  // An --out that cannot be a directory is said before any sculpting.
-  prepareOutputDirectory(o.out);
+  // An --out that cannot be a directory is said before a script runs (the
+  // window says it when s saves).
+  if (!o.script.empty()) prepareOutputDirectory(o.out);
   Report report;
   report.set("lattice", o.lattice);
   if (o.script.empty()) {

@@ -30,13 +30,13 @@ void runSubject(const Arguments& arguments) {
     try {
       setSubjectSetting(settings, setting.substr(0, equals), setting.substr(equals + 1));
     } catch (const Error& error) {
-      throw UsageError("--set", error.what());
+      throw UsageError(error.what());
     }
   }
   try {
     checkSubjectSettings(settings);
   } catch (const Error& error) {
-    throw UsageError("--set", error.what());
+    throw UsageError(error.what());
   }
   prepareOutputDirectory(arguments.out);
   const Volume image = readVolume(arguments.image);

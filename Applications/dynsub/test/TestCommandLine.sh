@@ -553,7 +553,7 @@ expect_error "an atlas label list ending in a comma" 2 "--atlas-label Caudate_L,
 "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --max-steps 20 \
   --no-figures --out "$work/s9d" >/dev/null 2>"$work/s9d.err"
 check "a segmentation stopped by --max-steps warns that it was still moving" \
-  grep -q "still moving when the last level reached its step limit (--max-steps 20)" "$work/s9d.err"
+  grep -q "still moving when the last level reached its step limit of 20 steps" "$work/s9d.err"
 # The MRI cut to half its bytes: the gzip stream ends early (ITK alone read
 # the missing voxels as zeros).
 head -c 1700000 "$mri/ch2.nii.gz" >"$work/cut.nii.gz"

@@ -222,15 +222,18 @@ std::vector<LandmarkList> readLandmarkLists(const std::string& path) {
   std::vector<LandmarkList> lists = readAllLists(path);
   const auto empty = [](const LandmarkList& list) { return list.landmarks.empty(); };
   if (lists.empty()) return {LandmarkList()};
-  if (std::all_of(lists.begin(), lists.end(), empty)) return {lists.front()};
-  // Skipped, a list without points would leave its structure out, and the
-  // lists after it would take the wrong --name and --reference-label.
+  const auto filled = std::count_if(lists.begin(), lists.end(), [&](const LandmarkList& l) { return !empty(l); });
+  if (filled == 0) return {lists.front()};
+  // Beside two or more lists of points (several structures), a list without
+  // points, skipped, would leave its structure out, and the lists after it
+  // would take the wrong --name and --reference-label.
   const auto gap = std::find_if(lists.begin(), lists.end(), empty);
-  if (gap != lists.end())
+  if (filled > 1 && gap != lists.end())
     throw Error(path, "point list " + std::to_string(gap - lists.begin() + 1) +
                           (gap->name.empty() ? "" : " ('" + gap->name + "')") +
                           " holds no point, beside lists that do: place its structure's points, or delete the "
                           "empty list");
+  lists.erase(std::remove_if(lists.begin(), lists.end(), empty), lists.end());
   return lists;
 }
 

@@ -84,15 +84,23 @@ TEST(Landmarks, AMarkupsFileGivesEachPointListOnItsOwn) {
   EXPECT_EQ(one[0].name, "");
   EXPECT_EQ(one[0].landmarks.size(), 3u);
 
-  // An empty list beside lists with points would drop its structure and
-  // shift the names and labels given to those after it: it is refused.
+  // Beside one list of points, an empty list is left out (a scene's stray
+  // list); beside several, it would drop its structure and shift the names
+  // and labels given to those after it: it is refused.
+  const fs::path stray = scratch("stray.mrk.json");
+  std::ofstream(stray.string()) << R"({"markups": [{"name": "F", "controlPoints": []},
+    {"name": "Putamen L", "controlPoints": [{"label": "p1", "position": [10.0, 20.0, 30.0]}]}]})";
+  const std::vector<LandmarkList> kept = readLandmarkLists(stray.string());
+  ASSERT_EQ(kept.size(), 1u);
+  EXPECT_EQ(kept[0].name, "Putamen L");
   const fs::path gap = scratch("gap.mrk.json");
   std::ofstream(gap.string()) << R"({"markups": [
     {"name": "Caudate L", "controlPoints": []},
-    {"name": "Putamen L", "controlPoints": [{"label": "p1", "position": [10.0, 20.0, 30.0]}]}]})";
+    {"name": "Putamen L", "controlPoints": [{"label": "p1", "position": [10.0, 20.0, 30.0]}]},
+    {"name": "Thalamus L", "controlPoints": [{"label": "t1", "position": [12.0, 18.0, 8.0]}]}]})";
   try {
     readLandmarkLists(gap.string());
-    FAIL() << "an empty list beside one with points was accepted";
+    FAIL() << "an empty list beside two with points was accepted";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("gap.mrk.json: point list 1 ('Caudate L') holds no point"), std::string::npos)
         << e.what();

@@ -390,8 +390,9 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
   // be, not where the forces balance. (A collapsing one is said above: more
   // steps would not help it.)
   if (!collapsed && !result.levels.empty() && !result.levels.back().converged) {
-    warning << "the surface was still moving when the last level reached its step limit (--max-steps "
-            << options.simulation.equilibrium.maxSteps << "): check the result, or raise --max-steps";
+    warning << "the surface was still moving when the last level reached its step limit of "
+            << options.simulation.equilibrium.maxSteps
+            << " steps (max_steps, --max-steps): check the result, or raise the limit";
     result.warnings.push_back(warning.str());
   }
   return result;

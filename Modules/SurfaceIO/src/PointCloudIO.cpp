@@ -28,14 +28,18 @@ namespace dynsub {
 
 namespace {
 
-// A line's fields: a CSV's between its separators (",;" or a tab; an empty
-// field counts), else between runs of blanks. Trimmed of blanks and quotes.
+// A line's fields: a CSV's between its separator (the first of ',', ';' and
+// a tab that the line holds; an empty field counts), else between runs of
+// blanks. Trimmed of blanks and quotes.
 std::vector<std::string> fieldsOf(const std::string& line, bool csv) {
   std::vector<std::string> fields;
-  if (csv && line.find_first_of(",;\t") != std::string::npos) {
+  char separator = 0;
+  for (const char c : {',', ';', '\t'})
+    if (!separator && line.find(c) != std::string::npos) separator = c;
+  if (csv && separator) {
     std::string field;
     for (const char c : line) {
-      if (c == ',' || c == ';' || c == '\t') {
+      if (c == separator) {
         fields.push_back(field);
         field.clear();
       } else {
@@ -54,23 +58,37 @@ std::vector<std::string> fieldsOf(const std::string& line, bool csv) {
   return fields;
 }
 
-// The columns of x, y and z named by a CSV's first line, or nullopt when it
-// names none of them. Named in part, or over more than three columns
-// without the names, the columns cannot be told: an error.
-std::optional<std::array<std::size_t, 3>> namedColumns(const std::vector<std::string>& names, const std::string& path,
+// Whether a column's name is the coordinate `axis` ('x', 'y' or 'z'): the
+// letter in either case, alone or before a unit or a word ("x_mm", "X [mm]",
+// "X Coordinate").
+bool namesAxis(const std::string& name, char axis) {
+  return !name.empty() && std::tolower(static_cast<unsigned char>(name[0])) == axis &&
+         (name.size() == 1 || !std::isalnum(static_cast<unsigned char>(name[1])));
+}
+
+// The columns of x, y and z named by a CSV's first line, or nullopt for the
+// first three: when it names none of them and its first column is not an
+// index (pandas writes one, unnamed, first). Named in part, the columns
+// cannot be told: an error.
+std::optional<std::array<std::size_t, 3>> namedColumns(std::vector<std::string> names, const std::string& path,
                                                        int line) {
+  // CloudCompare writes "//" before the names.
+  if (!names.empty() && names[0].rfind("//", 0) == 0) names[0].erase(0, 2);
   std::array<std::size_t, 3> columns{};
   int found = 0;
   for (int axis = 0; axis < 3; ++axis) {
     for (std::size_t c = 0; c < names.size(); ++c)
-      if (names[c].size() == 1 && std::tolower(static_cast<unsigned char>(names[c][0])) == "xyz"[axis]) {
+      if (namesAxis(names[c], "xyz"[axis])) {
         columns[axis] = c;
         ++found;
         break;
       }
   }
   if (found == 3) return columns;
-  if (found == 0 && names.size() == 3) return std::nullopt;
+  std::string first = names.empty() ? std::string() : names[0];
+  for (char& c : first) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const bool index = names.size() > 3 && (first.empty() || first == "id" || first == "index");
+  if (found == 0 && !index) return std::nullopt;
   throw Error(path, "line " + std::to_string(line) +
                         ": the header does not name the coordinates' columns x, y and z (" +
                         std::to_string(names.size()) + " columns): name them so");
@@ -85,6 +103,8 @@ MatrixX3 readText(const std::string& path, bool csv) {
   std::array<std::size_t, 3> columns{0, 1, 2};
   while (std::getline(in, line)) {
     ++number;
+    // A byte order mark (Excel's "CSV UTF-8") before the first line.
+    if (number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
     const size_t comment = line.find('#');
     if (comment != std::string::npos) line.erase(comment);
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;

@@ -67,8 +67,8 @@ TEST(PointCloudIO, PointFilesAreNotMeshVertices) {
 
 // A CSV's header names its columns: the coordinates are read from the
 // columns it names x, y and z, wherever they are (pandas writes an index
-// column first); three unnamed columns are x, y, z in order; more columns
-// without the names are refused rather than guessed.
+// column first); columns without those names are x, y, z in order, unless
+// the first is an index, which is refused rather than read as x.
 TEST(PointCloudIO, ACsvHeaderNamesTheCoordinatesColumns) {
   const dynsub::MatrixX3 indexed =
       dynsub::readPointCloud(writeText("pandas.csv", ",x,y,z\n0,1,2,3\n1,4,5,6\n2,7,8,9\n3,1,1,2\n")).points;
@@ -80,12 +80,24 @@ TEST(PointCloudIO, ACsvHeaderNamesTheCoordinatesColumns) {
   const dynsub::MatrixX3 unnamed =
       dynsub::readPointCloud(writeText("abc.csv", "a,b,c\n1,2,3\n4,5,6\n7,8,9\n1,1,2\n")).points;
   EXPECT_EQ(unnamed.row(0), Eigen::RowVector3d(1, 2, 3));
+  // Names with units, Excel's byte order mark, CloudCompare's "//".
+  for (const std::string header : {"x_mm,y_mm,z_mm,label", "\xEF\xBB\xBFX [mm],Y [mm],Z [mm],label", "//X,Y,Z,R"}) {
+    const dynsub::MatrixX3 named =
+        dynsub::readPointCloud(writeText("named.csv", header + "\n1,2,3,9\n4,5,6,9\n7,8,9,9\n1,1,2,9\n")).points;
+    EXPECT_EQ(named.row(0), Eigen::RowVector3d(1, 2, 3)) << header;
+  }
+  // Names with units, Excel's byte order mark, CloudCompare's "//".
+  for (const std::string header : {"x_mm,y_mm,z_mm,label", "\xEF\xBB\xBFX [mm],Y [mm],Z [mm],label", "//X,Y,Z,R"}) {
+    const dynsub::MatrixX3 named =
+        dynsub::readPointCloud(writeText("named.csv", header + "\n1,2,3,9\n4,5,6,9\n7,8,9,9\n1,1,2,9\n")).points;
+    EXPECT_EQ(named.row(0), Eigen::RowVector3d(1, 2, 3)) << header;
+  }
   const dynsub::MatrixX3 blanks =
       dynsub::readPointCloud(writeText("blanks.csv", "x y z\n1 2 3\n4 5 6\n7 8 9\n1 1 2\n")).points;
   EXPECT_EQ(blanks.row(3), Eigen::RowVector3d(1, 1, 2));
   try {
     dynsub::readPointCloud(writeText("four.csv", "id,px,py,pz\n0,1,2,3\n1,4,5,6\n2,7,8,9\n3,1,1,2\n"));
-    FAIL() << "four unnamed columns were read";
+    FAIL() << "an index column was read as x";
   } catch (const dynsub::Error& e) {
     EXPECT_NE(std::string(e.what()).find("four.csv: line 1: the header does not name the coordinates' columns"),
               std::string::npos)

@@ -43,7 +43,8 @@ struct LandmarkList {
 };
 // The file's lists, in order (one list for .fcsv and .csv; the first list
 // when none holds a point): a markups file may hold one list per structure.
-// Throws as readLandmarks, and for an empty list beside lists with points.
+// Throws as readLandmarks, and for an empty list beside two or more lists
+// with points (an empty list beside one is left out).
 std::vector<LandmarkList> readLandmarkLists(const std::string& path);
 
 // Format by extension (.mrk.json, .fcsv, .csv); `system` applies to .mrk.json
