@@ -97,11 +97,7 @@ SimulationOptions SimulationArguments::apply(SimulationOptions base) const {
   base.material.tensionU = base.material.tensionV = values.material.tensionU;
   base.material.rigidityUU = base.material.rigidityVV = values.material.rigidityUU;
   base.material.rigidityUV = 2.0 * values.material.rigidityUU;
-  try {
-    checkSimulationOptions(base);  // options that do not fit together (first-order without damping)
-  } catch (const Error& error) {
-    throw UsageError(error.what());
-  }
+  asUsageError([&] { checkSimulationOptions(base); });  // first-order without damping, say
   return base;
 }
 

@@ -22,22 +22,16 @@ struct Arguments {
 
 void runSubject(const Arguments& arguments) {
   SubjectSettings settings;
-  for (const std::string& setting : arguments.settings) {
-    const auto equals = setting.find('=');
-    if (equals == std::string::npos) throw UsageError("--set", "expected KEY=VALUE, got '" + setting + "'");
-    // An unknown key or a value out of range is a usage error here; the
-    // same checks name the plan when a plan's cohort gives the settings.
-    try {
+  // An unknown key or a value out of range is a usage error here; the same
+  // checks name the plan when a plan's cohort gives the settings.
+  asUsageError([&] {
+    for (const std::string& setting : arguments.settings) {
+      const auto equals = setting.find('=');
+      if (equals == std::string::npos) throw UsageError("--set", "expected KEY=VALUE, got '" + setting + "'");
       setSubjectSetting(settings, setting.substr(0, equals), setting.substr(equals + 1));
-    } catch (const Error& error) {
-      throw UsageError(error.what());
     }
-  }
-  try {
     checkSubjectSettings(settings);
-  } catch (const Error& error) {
-    throw UsageError(error.what());
-  }
+  });
   prepareOutputDirectory(arguments.out);
   const Volume image = readVolume(arguments.image);
   const Volume labels = readLabelMap(arguments.labels);

@@ -428,11 +428,8 @@ SegmentOptions checkedOptions(const SegmentParameters& parameters, bool pointsOn
 }  // namespace
 
 SegmentOptions segmentOptions(const SegmentParameters& parameters, bool pointsOnBoundary) {
-  try {
-    return checkedOptions(parameters, pointsOnBoundary);
-  } catch (const Error& error) {
-    throw UsageError(error.what());  // every value here is an option someone gave
-  }
+  // Every value here is an option someone gave.
+  return asUsageError([&] { return checkedOptions(parameters, pointsOnBoundary); });
 }
 
 void checkSegmentParameters(const SegmentParameters& parameters) {

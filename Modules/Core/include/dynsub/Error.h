@@ -23,6 +23,20 @@ class UsageError : public Error {
   using Error::Error;
 };
 
+// Runs `check` and returns what it returns, an Error it throws rethrown as a
+// UsageError: for checks shared with files (a plan's settings) where the
+// values checked came from the command line.
+template <typename Check>
+decltype(auto) asUsageError(Check&& check) {
+  try {
+    return check();
+  } catch (const UsageError&) {
+    throw;
+  } catch (const Error& error) {
+    throw UsageError(error.what());
+  }
+}
+
 // An Error about landmarks given as points (outside the image, on no edge):
 // a caller that read them from a file catches it to name the file.
 class LandmarkError : public Error {
