@@ -46,10 +46,8 @@ struct FitCommandOptions {
 ControlMesh chooseInitialModel(const FitCommandOptions& o, const MatrixX3& data) {
   ControlMesh mesh;
   const bool shape = o.init == "auto" || o.init == "sphere" || o.init == "torus";
-  if (o.init == "auto" || o.init == "sphere") {
-    mesh = initialModel(data, InitialShape::Sphere);
-  } else if (o.init == "torus") {
-    mesh = initialModel(data, InitialShape::Torus);
+  if (shape) {
+    mesh = initialModel(data, o.init == "torus" ? InitialShape::Torus : InitialShape::Sphere);
   } else {
     mesh = readControlMesh(o.init);
     if (!mesh.isClosed()) {
