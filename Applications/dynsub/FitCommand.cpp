@@ -15,6 +15,7 @@
 #include "EarlierRuns.h"
 #include "FigureOutputs.h"
 #include "dynsub/ClosestPoint.h"
+#include "dynsub/Coordinates.h"
 #include "dynsub/EnclosingSphere.h"
 #include "dynsub/Error.h"
 #include "dynsub/MeshIO.h"
@@ -102,7 +103,7 @@ double statedNoise(const std::string& text) {
   } catch (const std::exception&) {
     used = 0;
   }
-  // A length beyond the largest coordinate a scan may have (InitialModels.h).
+  // A length beyond the largest coordinate a scan may have (Coordinates.h).
   if (used != text.size() || !std::isfinite(value) || value < 0.0 || value > kLargestCoordinate) {
     throw CLI::ValidationError("--noise", "expected auto, measure or a number of mm, 0 to 1e9, got '" + text + "'");
   }

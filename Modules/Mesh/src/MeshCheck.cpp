@@ -4,10 +4,10 @@
 #include <cmath>
 #include <map>
 #include <numeric>
-#include <sstream>
 #include <string>
 #include <tuple>
 
+#include "dynsub/Coordinates.h"
 #include "dynsub/Error.h"
 #include "dynsub/PolygonArea.h"
 #include "dynsub/Topology.h"
@@ -60,12 +60,8 @@ void checkPolygonMesh(const MatrixX3& points, const std::vector<std::vector<int>
       throw Error(source, "vertex " + std::to_string(v) + " has a coordinate that is NaN or infinite");
     }
     // Areas of such coordinates overflow, and every face would look degenerate.
-    if (points.row(v).cwiseAbs().maxCoeff() > kLargestCoordinate) {
-      std::ostringstream message;
-      message << "vertex " << v << " (" << points(v, 0) << ", " << points(v, 1) << ", " << points(v, 2)
-              << ") lies beyond " << kLargestCoordinate << " mm of the origin; coordinates are in mm";
-      throw Error(source, message.str());
-    }
+    const std::string beyond = beyondLargestCoordinate(points.row(v).transpose());
+    if (!beyond.empty()) throw Error(source, "vertex " + std::to_string(v) + " " + beyond);
   }
   const double minimumArea = degenerateArea(points);
 

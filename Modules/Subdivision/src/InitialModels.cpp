@@ -56,12 +56,8 @@ void checkPointCloud(const MatrixX3& points, const std::string& source) {
     if (!points.row(i).allFinite()) throw Error(source, "point " + std::to_string(i + 1) + " is not finite");
     // Squared distances of coordinates near 1e154 overflow, and the test of
     // coincidence below would see NaN.
-    if (points.row(i).cwiseAbs().maxCoeff() > kLargestCoordinate) {
-      std::ostringstream message;
-      message << "point " << i + 1 << " (" << points(i, 0) << ", " << points(i, 1) << ", " << points(i, 2)
-              << ") lies beyond " << kLargestCoordinate << " mm of the origin; coordinates are in mm";
-      throw Error(source, message.str());
-    }
+    const std::string beyond = beyondLargestCoordinate(points.row(i).transpose());
+    if (!beyond.empty()) throw Error(source, "point " + std::to_string(i + 1) + " " + beyond);
   }
   // Likewise, spans below this have squared distances that underflow to 0.
   const double span = (points.colwise().maxCoeff() - points.colwise().minCoeff()).maxCoeff();

@@ -13,9 +13,4 @@ using MatrixX3 = Eigen::Matrix<double, Eigen::Dynamic, 3>;  // N x 3, one point 
 using SparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 using Triplet = Eigen::Triplet<double>;
 
-// The largest coordinate (mm) the readers accept, of a point or a mesh
-// vertex: a kilometre-scale survey fits, and the squares and products of
-// coordinates that distances and areas take stay far from overflow.
-constexpr double kLargestCoordinate = 1e9;
-
 }  // namespace dynsub

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "dynsub/ControlMesh.h"
+#include "dynsub/Coordinates.h"
 #include "dynsub/Types.h"
 
 namespace dynsub {
