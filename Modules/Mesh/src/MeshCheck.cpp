@@ -148,6 +148,13 @@ void checkPolygonMesh(const MatrixX3& points, const std::vector<std::vector<int>
       throw Error(source, "vertex " + std::to_string(v) + " joins " + std::to_string(fans) +
                               " separate fans of faces: the mesh is not manifold there");
     }
+    const size_t faceCount = vertexFaces[v].size();
+    if (faceCount > static_cast<size_t>(kLargestValence)) {
+      throw Error(source, "vertex " + std::to_string(v) + " has " + std::to_string(faceCount) +
+                              " faces around it; at most " + std::to_string(kLargestValence) +
+                              " are supported (the surface's cost near a vertex grows faster than the cube of "
+                              "their number). Remesh it with fewer faces around that vertex");
+    }
   }
 }
 

@@ -1,8 +1,12 @@
 // Unit tests (no rendering): each defect is rejected with a message naming it.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <string>
+
 #include "dynsub/ControlMesh.h"
 #include "dynsub/Error.h"
+#include "dynsub/MeshCheck.h"
 
 namespace {
 
@@ -88,6 +92,36 @@ TEST(MeshCheck, RejectsInconsistentOrientation) {
                  "faces 0 and 2 both run along edge (4, 5)");
   // The edge is named the way the faces run along it.
   expectRejected(gridPoints(3, 3), {{0, 1, 4, 3}, {4, 3, 6, 7}}, "faces 0 and 1 both run along edge (4, 3)");
+}
+
+// A bipyramid: apexes 0 and 1 over a ring of `ring` vertices, each apex with
+// `ring` triangles around it.
+std::vector<Polygon> bipyramidFaces(int ring) {
+  std::vector<Polygon> faces;
+  for (int i = 0; i < ring; ++i) {
+    const int a = 2 + i, b = 2 + (i + 1) % ring;
+    faces.push_back({0, a, b});
+    faces.push_back({1, b, a});
+  }
+  return faces;
+}
+
+MatrixX3 bipyramidPoints(int ring) {
+  MatrixX3 points(ring + 2, 3);
+  points.row(0) << 0, 0, 1;
+  points.row(1) << 0, 0, -1;
+  for (int i = 0; i < ring; ++i) {
+    const double angle = 2.0 * M_PI * i / ring;
+    points.row(2 + i) << std::cos(angle), std::sin(angle), 0;
+  }
+  return points;
+}
+
+TEST(MeshCheck, RejectsVerticesOfMoreFacesThanSupported) {
+  const int most = dynsub::kLargestValence;
+  EXPECT_EQ(ControlMesh::fromPolygons(bipyramidPoints(most), bipyramidFaces(most)).vertexCount(), most + 2);
+  expectRejected(bipyramidPoints(most + 1), bipyramidFaces(most + 1),
+                 "vertex 0 has " + std::to_string(most + 1) + " faces around it; at most " + std::to_string(most));
 }
 
 }  // namespace
