@@ -73,11 +73,15 @@ void checkClickProtocol(const ClickProtocol& p) {
   if (p.pointsPerSlice < 1 || p.pointsPerSlice > 100) throw Error(name + "points per slice must be in 1..100");
   if (!(p.coverageLow > 0 && p.coverageLow <= p.coverageHigh && p.coverageHigh <= 1))
     throw Error(name + "coverage must satisfy 0 < low <= high <= 1");
-  if (!(p.scatter >= 0 && std::isfinite(p.scatter))) throw Error(name + "scatter must be a finite number >= 0 mm");
+  // Beyond this a click's scatter or a mistake's distance exceeds any
+  // structure's size, and the clicks fall outside it, or the image.
+  constexpr double kLargestDistance = 100.0;
+  const std::string range = " must be in 0.." + std::to_string(static_cast<int>(kLargestDistance)) + " mm";
+  if (!(p.scatter >= 0 && p.scatter <= kLargestDistance)) throw Error(name + "scatter" + range);
   if (p.mistakes < 0 || p.mistakes > p.slices * p.pointsPerSlice)
     throw Error(name + "mistakes must be in 0..the number of clicks");
-  if (!(p.mistakeDistance >= 0 && std::isfinite(p.mistakeDistance)))
-    throw Error(name + "the mistake distance must be a finite number >= 0 mm");
+  if (!(p.mistakeDistance >= 0 && p.mistakeDistance <= kLargestDistance))
+    throw Error(name + "the mistake distance" + range);
 }
 
 std::vector<Landmark> expertClicks(const Mask& reference, const ClickProtocol& protocol, unsigned seed) {

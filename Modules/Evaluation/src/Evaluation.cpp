@@ -57,6 +57,51 @@ int optionalWholeNumber(const nlohmann::json& object, const char* key, int fallb
   return static_cast<int>(wholeNumber(object.at(key), where + key, 0, kLargestSetting));
 }
 
+// The plan's values, each of the JSON type its field needs: nlohmann's own
+// conversions would say "[json.exception.type_error.302] type must be
+// string, but is number" without saying where.
+const nlohmann::json& required(const nlohmann::json& object, const char* key, const std::string& where) {
+  if (!object.contains(key)) throw Error(where + " has no '" + key + "'");
+  return object.at(key);
+}
+std::string textOf(const nlohmann::json& value, const std::string& what) {
+  if (!value.is_string()) throw Error(what + " must be a string, got " + value.dump());
+  return value.get<std::string>();
+}
+double realOf(const nlohmann::json& value, const std::string& what) {
+  if (!value.is_number()) throw Error(what + " must be a number, got " + value.dump());
+  return value.get<double>();
+}
+bool flagOf(const nlohmann::json& value, const std::string& what) {
+  if (!value.is_boolean()) throw Error(what + " must be true or false, got " + value.dump());
+  return value.get<bool>();
+}
+const nlohmann::json& listOf(const nlohmann::json& value, const std::string& what) {
+  if (!value.is_array()) throw Error(what + " must be a list, got " + value.dump());
+  return value;
+}
+// `object`'s optional list `key`, empty where it has none.
+nlohmann::json optionalList(const nlohmann::json& object, const char* key, const std::string& where) {
+  return object.contains(key) ? listOf(object.at(key), where + key) : nlohmann::json::array();
+}
+
+// A key given twice in one object: nlohmann keeps the last, silently, where
+// the first may be the one meant.
+nlohmann::json parseWithoutRepeatedKeys(std::istream& in) {
+  std::vector<std::set<std::string>> keys;  // one set per object open
+  const nlohmann::json::parser_callback_t check = [&keys](int, nlohmann::json::parse_event_t event,
+                                                          nlohmann::json& parsed) {
+    using Event = nlohmann::json::parse_event_t;
+    if (event == Event::object_start) keys.emplace_back();
+    if (event == Event::object_end) keys.pop_back();
+    if (event == Event::key && !keys.back().insert(parsed.get<std::string>()).second)
+      throw Error("the key '" + parsed.get<std::string>() + "' is given twice in one object");
+    return true;
+  };
+  // parse reads to the end: anything after the plan's object is an error.
+  return nlohmann::json::parse(in, check);
+}
+
 // A result keeping less than this fraction of the reference's volume has collapsed.
 constexpr double kCollapsedBelowReference = 0.2;
 
@@ -151,42 +196,51 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
   std::ifstream in = openForReading(path);
   nlohmann::json j;
   try {
-    in >> j;
-  } catch (const std::exception& e) {
+    j = parseWithoutRepeatedKeys(in);
+  } catch (const nlohmann::json::exception& e) {
     throw Error(path, std::string("not valid JSON: ") + e.what());
+  } catch (const Error& e) {
+    throw Error(path, e.what());
   }
   const std::filesystem::path base = std::filesystem::absolute(path).parent_path();
   EvaluationPlan plan;
   try {
     requireKnownKeys(j, {"images", "reference", "atlas", "cohorts", "structures", "protocols", "segment", "splits"},
                      "the plan");
-    for (const auto& i : j.value("images", nlohmann::json::array()))
+    for (const auto& i : optionalList(j, "images", "the plan's "))
       requireKnownKeys(i, {"name", "path"}, "an image");
-    for (const auto& c : j.value("cohorts", nlohmann::json::array()))
+    for (const auto& c : optionalList(j, "cohorts", "the plan's "))
       requireKnownKeys(c, {"name", "image", "labels", "settings", "subjects"}, "a cohort");
-    for (const auto& st : j.value("structures", nlohmann::json::array()))
+    for (const auto& st : optionalList(j, "structures", "the plan's "))
       requireKnownKeys(st, {"name", "labels", "orientation"}, "a structure");
-    for (const auto& p : j.value("protocols", nlohmann::json::array()))
+    for (const auto& p : optionalList(j, "protocols", "the plan's "))
       requireKnownKeys(p, {"name", "slices", "points_per_slice", "coverage", "scatter_mm", "mistakes",
                            "mistake_distance_mm", "orientation", "atlas", "clicks", "seed_only", "seed_depth",
                            "format"},
                        "a protocol");
-    for (const auto& sp : j.value("splits", nlohmann::json::array()))
+    for (const auto& sp : optionalList(j, "splits", "the plan's "))
       requireKnownKeys(sp, {"name", "seeds", "structures"}, "a split");
     if (j.contains("atlas")) requireKnownKeys(j.at("atlas"), {"image", "labels"}, "the atlas");
     if (j.contains("images")) {
-      plan.reference = resolve(j.at("reference").get<std::string>(), base);
-      for (const auto& i : j.at("images")) plan.images.push_back({i.at("name"), resolve(i.at("path"), base)});
+      plan.reference = resolve(textOf(required(j, "reference", "the plan, which has images,"), "the reference"), base);
+      for (const auto& i : j.at("images")) {
+        const std::string name = textOf(required(i, "name", "an image"), "an image's name");
+        const std::string where = "image '" + name + "'";
+        plan.images.push_back({name, resolve(textOf(required(i, "path", where), where + ": path"), base)});
+      }
     }
     if (j.contains("atlas")) {
-      plan.atlasImage = resolve(j.at("atlas").at("image").get<std::string>(), base);
-      plan.atlasLabels = resolve(j.at("atlas").at("labels").get<std::string>(), base);
+      const nlohmann::json& atlas = j.at("atlas");
+      plan.atlasImage = resolve(textOf(required(atlas, "image", "the atlas"), "the atlas's image"), base);
+      plan.atlasLabels = resolve(textOf(required(atlas, "labels", "the atlas"), "the atlas's labels"), base);
     }
-    const nlohmann::json cohorts = j.value("cohorts", nlohmann::json::array());
-    for (const auto& c : cohorts) {
-      EvaluationCohort cohort{c.at("name"), resolve(c.at("image"), base), resolve(c.at("labels"), base), {}, {}};
-      const std::string where = "cohort '" + cohort.name + "'";
+    for (const auto& c : optionalList(j, "cohorts", "the plan's ")) {
+      const std::string name = textOf(required(c, "name", "a cohort"), "a cohort's name");
+      const std::string where = "cohort '" + name + "'";
+      EvaluationCohort cohort{name, resolve(textOf(required(c, "image", where), where + ": image"), base),
+                              resolve(textOf(required(c, "labels", where), where + ": labels"), base), {}, {}};
       const nlohmann::json settings = c.value("settings", nlohmann::json::object());
+      if (!settings.is_object()) throw Error(where + ": settings must be an object, got " + settings.dump());
       for (const auto& [key, value] : settings.items()) {
         std::string text;
         if (value.is_array()) {
@@ -198,9 +252,12 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
       }
       checkSubjectSettings(cohort.settings);
       std::set<std::uint64_t> seen;
-      for (const auto& [split, seeds] : c.at("subjects").items()) {
+      const nlohmann::json& subjects = required(c, "subjects", where);
+      if (!subjects.is_object())
+        throw Error(where + ": subjects must be an object of lists by split, got " + subjects.dump());
+      for (const auto& [split, seeds] : subjects.items()) {
         std::vector<std::uint64_t> list;
-        for (const auto& seed : seeds) {
+        for (const auto& seed : listOf(seeds, where + ": split '" + split + "'")) {
           list.push_back(static_cast<std::uint64_t>(wholeNumber(seed, where + ": a subject", 0, kLargestSetting)));
           if (!seen.insert(list.back()).second)
             throw Error(path, where + ": subject " + std::to_string(list.back()) +
@@ -211,40 +268,46 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
       }
       plan.cohorts.push_back(cohort);
     }
-    for (const auto& s : j.at("structures")) {
-      const std::string name = s.at("name");
+    for (const auto& s : optionalList(j, "structures", "the plan's ")) {
+      const std::string name = textOf(required(s, "name", "a structure"), "a structure's name");
+      const std::string where = "structure '" + name + "'";
       std::vector<int> labels;
-      for (const auto& label : s.at("labels"))
-        labels.push_back(static_cast<int>(wholeNumber(label, "structure '" + name + "': a label", 0, kLargestSetting)));
-      plan.structures.push_back({name, labels, axisOf(s.at("orientation"), "structure '" + name + "'")});
+      for (const auto& label : listOf(required(s, "labels", where), where + ": labels"))
+        labels.push_back(static_cast<int>(wholeNumber(label, where + ": a label", 0, kLargestSetting)));
+      plan.structures.push_back(
+          {name, labels, axisOf(textOf(required(s, "orientation", where), where + ": orientation"), where)});
     }
-    for (const auto& p : j.at("protocols")) {
+    for (const auto& p : optionalList(j, "protocols", "the plan's ")) {
       EvaluationProtocol protocol;
       ClickProtocol& c = protocol.clicks;
-      c.name = p.at("name");
-      c.seedOnly = p.value("seed_only", false);
-      c.seedDepth = p.value("seed_depth", c.seedDepth);
+      c.name = textOf(required(p, "name", "a protocol"), "a protocol's name");
       const std::string where = "protocol '" + c.name + "': ";
+      // `p`'s `key` read by `read`, or `fallback` where it has none.
+      const auto optional = [&](const char* key, auto read, auto fallback) {
+        return p.contains(key) ? read(p.at(key), where + key) : fallback;
+      };
+      c.seedOnly = optional("seed_only", flagOf, false);
+      c.seedDepth = optional("seed_depth", realOf, c.seedDepth);
       c.slices = optionalWholeNumber(p, "slices", c.slices, where);
       c.pointsPerSlice = optionalWholeNumber(p, "points_per_slice", c.pointsPerSlice, where);
       if (p.contains("coverage")) {
-        const auto coverage = p.at("coverage").get<std::vector<double>>();
-        if (coverage.size() != 2) throw Error(path, "protocol '" + c.name + "': coverage is [low, high]");
-        c.coverageLow = coverage[0];
-        c.coverageHigh = coverage[1];
+        const nlohmann::json& coverage = listOf(p.at("coverage"), where + "coverage");
+        if (coverage.size() != 2) throw Error(path, where + "coverage is [low, high]");
+        c.coverageLow = realOf(coverage[0], where + "coverage's low");
+        c.coverageHigh = realOf(coverage[1], where + "coverage's high");
       }
-      c.scatter = p.value("scatter_mm", c.scatter);
+      c.scatter = optional("scatter_mm", realOf, c.scatter);
       c.mistakes = optionalWholeNumber(p, "mistakes", c.mistakes, where);
-      c.mistakeDistance = p.value("mistake_distance_mm", c.mistakeDistance);
+      c.mistakeDistance = optional("mistake_distance_mm", realOf, c.mistakeDistance);
       if (p.contains("orientation")) {
         protocol.ownAxis = true;
-        c.axis = axisOf(p.at("orientation"), "protocol '" + c.name + "'");
+        c.axis = axisOf(textOf(p.at("orientation"), where + "orientation"), "protocol '" + c.name + "'");
       }
-      protocol.atlas = p.value("atlas", false);
-      protocol.noClicks = !p.value("clicks", true);
+      protocol.atlas = optional("atlas", flagOf, false);
+      protocol.noClicks = !optional("clicks", flagOf, true);
       if (protocol.noClicks && !protocol.atlas)
         throw Error(path, "protocol '" + c.name + "': only an atlas protocol can do without clicks");
-      protocol.format = p.value("format", protocol.format);
+      protocol.format = optional("format", textOf, protocol.format);
       if (protocol.format != "mrk.json" && protocol.format != "fcsv" && protocol.format != "csv" &&
           protocol.format != "rotate")
         throw Error(path, "protocol '" + c.name + "': format must be mrk.json, fcsv, csv or rotate");
@@ -252,6 +315,8 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
       plan.protocols.push_back(protocol);
     }
     if (j.contains("segment")) {
+      if (!j.at("segment").is_object())
+        throw Error("the plan's segment must be an object of settings, got " + j.at("segment").dump());
       // Settings to compare on the tuning split, by the keys of report.json's
       // "parameters" (SegmentParameters.h); an unknown key is an error, not a
       // silent default.
@@ -271,9 +336,13 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
       }
       checkSegmentParameters(plan.parameters);
     }
-    for (const auto& s : j.at("splits")) {
-      EvaluationSplit split{s.at("name"), s.value("structures", std::vector<std::string>{}), {}};
-      for (const auto& seed : s.at("seeds")) {
+    for (const auto& s : optionalList(j, "splits", "the plan's ")) {
+      const std::string name = textOf(required(s, "name", "a split"), "a split's name");
+      const std::string where = "split '" + name + "'";
+      EvaluationSplit split{name, {}, {}};
+      for (const auto& structure : optionalList(s, "structures", where + ": "))
+        split.structures.push_back(textOf(structure, where + ": a structure"));
+      for (const auto& seed : listOf(required(s, "seeds", where), where + ": seeds")) {
         split.seeds.push_back(static_cast<unsigned>(
             wholeNumber(seed, "split '" + split.name + "': a seed", 0, std::numeric_limits<unsigned>::max())));
         // A seed twice would run the same clicks twice into the same files.

@@ -67,6 +67,42 @@ TEST(EvaluationPlan, FractionsAndNumbersOutOfRangeAreRefused) {
             std::string::npos);
 }
 
+// A value of the wrong JSON type, or a key missing, is named where it is
+// (nlohmann's own text would be "[json.exception.type_error.302] type must
+// be string, but is number").
+TEST(EvaluationPlan, WrongTypesAndMissingKeysAreNamedWhereTheyAre) {
+  EXPECT_NE(errorOf(R"({"name": 6})", "[1]").find("a protocol's name must be a string, got 6"), std::string::npos);
+  EXPECT_NE(errorOf(R"({"slices": 6})", "[1]").find("a protocol has no 'name'"), std::string::npos);
+  EXPECT_NE(errorOf(R"({"name": "six", "scatter_mm": "1"})", "[1]")
+                .find("protocol 'six': scatter_mm must be a number, got \"1\""),
+            std::string::npos);
+  EXPECT_NE(errorOf(R"({"name": "six", "seed_only": 1})", "[1]").find("protocol 'six': seed_only must be true or false"),
+            std::string::npos);
+  EXPECT_NE(errorOf(R"({"name": "six", "coverage": 0.5})", "[1]").find("protocol 'six': coverage must be a list"),
+            std::string::npos);
+  EXPECT_NE(errorOf(R"({"name": "six"})", "7").find("split 'test': seeds must be a list, got 7"), std::string::npos);
+  for (const std::string& e : {errorOf(R"({"name": 6})", "[1]"), errorOf(R"({"name": "six"})", "7")})
+    EXPECT_EQ(e.find("json.exception"), std::string::npos) << e;
+}
+
+// nlohmann would keep the last of a repeated key and stop reading after the
+// plan's object; either may hide what was meant.
+TEST(EvaluationPlan, RepeatedKeysAndTrailingTextAreRefused) {
+  EXPECT_NE(errorOf(R"({"name": "six", "slices": 6, "slices": 3})", "[1]")
+                .find("the key 'slices' is given twice in one object"),
+            std::string::npos);
+  EXPECT_NE(errorOf(R"({"name": "six"})", "[1]}]} {").find("not valid JSON"), std::string::npos);
+}
+
+TEST(EvaluationPlan, ScatterAndMistakeDistancesHaveARange) {
+  EXPECT_NE(errorOf(R"({"name": "six", "scatter_mm": 1e6})", "[1]").find("scatter must be in 0..100 mm"),
+            std::string::npos);
+  EXPECT_NE(errorOf(R"({"name": "six", "mistakes": 1, "mistake_distance_mm": -1})", "[1]")
+                .find("the mistake distance must be in 0..100 mm"),
+            std::string::npos);
+  EXPECT_EQ(errorOf(R"({"name": "six", "scatter_mm": 100})", "[1]"), "");
+}
+
 // A plan of cohorts only, with `cohort` as JSON text (tuning and test splits).
 std::string cohortError(const std::string& cohort, EvaluationPlan* plan = nullptr) {
   const std::string path = (std::filesystem::temp_directory_path() /
