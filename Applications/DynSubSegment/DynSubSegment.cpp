@@ -213,13 +213,17 @@ class SlicerProgress {
   double last_ = -1;
 };
 
+// An output's name is the user's to fix, before anything runs. ".gz" is
+// read with the extension before it (.nii.gz), so that "x.gz" is not
+// taken for a compressed NIfTI file.
 void requireExtension(const std::string& path, const std::vector<std::string>& known, const std::string& what) {
-  const std::string extension = lowerCaseExtension(path);
+  std::string extension = lowerCaseExtension(path);
+  if (extension == ".gz") extension = lowerCaseExtension(std::filesystem::path(path).stem().string()) + extension;
   for (const std::string& k : known)
     if (extension == k) return;
   std::string list;
   for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
-  throw Error(path, "unknown " + what + " format '" + extension + "' (expected " + list + ")");
+  throw UsageError(path, "unknown " + what + " format '" + extension + "' (expected " + list + ")");
 }
 
 // A structure's segment in the .seg.nrrd: its label value, its name (a
@@ -338,13 +342,14 @@ void runTogether(Arguments& a, const Volume& image, const std::vector<LandmarkSo
   const std::string several = std::to_string(n) + " structures, segmented together from their own " +
                               (atlas ? "atlas labels" : "points") + ": ";
   if (atlas && !files.empty() && files.size() != n)
-    throw Error(several + a.landmarks + " holds " + std::to_string(files.size()) +
-                " lists of points; give one atlas label per list, in their order (separated by ';')");
-  if (!a.seeds.empty()) throw Error(several + "add boundary points to the lists of a points file, not as --seed");
-  if (!a.inside.empty()) throw Error(several + "a point inside is one structure's; leave it out");
+    throw UsageError(several + a.landmarks + " holds " + std::to_string(files.size()) +
+                     " lists of points; give one atlas label per list, in their order (separated by ';')");
+  if (!a.seeds.empty())
+    throw UsageError(several + "add boundary points to the lists of a points file, not as --seed");
+  if (!a.inside.empty()) throw UsageError(several + "a point inside is one structure's; leave it out");
   const int lastLabel = a.labelValue + static_cast<int>(n) - 1;
   if (lastLabel > 255)
-    throw Error(several + "their label values " + std::to_string(a.labelValue) + "-" + std::to_string(lastLabel) +
+    throw UsageError(several + "their label values " + std::to_string(a.labelValue) + "-" + std::to_string(lastLabel) +
                 " pass 255; give a smaller --labelValue");
   const std::shared_ptr<const Atlas> atlasData =
       atlas ? std::make_shared<const Atlas>(readAtlas(kDefaultAtlasImage, kDefaultAtlasLabels)) : nullptr;
@@ -429,11 +434,11 @@ void runTogether(Arguments& a, const Volume& image, const std::vector<LandmarkSo
 
 void run(Arguments& a) {
   if (a.labelmap.empty() && a.model.empty() && a.segmentation.empty() && a.report.empty())
-    throw Error("nothing to write: give --labelmap, --model, --segmentation and/or --report");
-  if (!a.labelmap.empty()) requireExtension(a.labelmap, {".nrrd", ".nii", ".gz", ".mha"}, "labelmap");
+    throw UsageError("nothing to write: give --labelmap, --model, --segmentation and/or --report");
+  if (!a.labelmap.empty()) requireExtension(a.labelmap, {".nrrd", ".nii", ".nii.gz", ".mha"}, "labelmap");
   if (!a.model.empty()) requireExtension(a.model, triangleSurfaceExtensions(), "model");
   if (!a.segmentation.empty() && !isSlicerSegmentationName(a.segmentation))
-    throw Error(a.segmentation, "a 3D Slicer segmentation is written as .seg.nrrd");
+    throw UsageError(a.segmentation, "a 3D Slicer segmentation is written as .seg.nrrd");
   if (!a.report.empty()) requireExtension(a.report, {".json"}, "report");
   for (const std::string* path : {&a.labelmap, &a.model, &a.segmentation, &a.report})
     if (!path->empty()) requireWritableDirectoryFor(*path);
@@ -486,6 +491,8 @@ int main(int argc, char** argv) {
     std::vector<std::string> words = slicer::withJoinedPoints(module, argc, argv);
     std::reverse(words.begin(), words.end());  // CLI11 takes a vector last word first
     app.parse(words);
+    if (app.count("--xml") > 0)
+      throw dynsub::UsageError("--xml prints the module's descriptor and takes no other argument");
     run(arguments);
   } catch (const CLI::ParseError& error) {
     const int code = app.exit(error);

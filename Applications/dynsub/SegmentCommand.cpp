@@ -164,6 +164,9 @@ void runSegmentOne(const Arguments& o, const LandmarkSource* landmarks) {
   if (o.inside.size() > 1)
     throw UsageError("--inside is given " + std::to_string(o.inside.size()) +
                      " times for one structure: give one click inside it");
+  if (o.names.size() > 1)
+    throw UsageError("--name is given " + std::to_string(o.names.size()) +
+                     " times for one structure: name each structure segmented together once, or none");
   SegmentInputs inputs;
   inputs.start = parseSegmentStart(firstStart(o), "--init");
   // One structure's values, as N[,M...] or as several values (71 72).
@@ -273,6 +276,9 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
   if (!o.names.empty() && o.names.size() != n)
     throw UsageError("--name is given " + std::to_string(o.names.size()) + " times for " + std::to_string(n) +
                      " structures (one per " + order + "): name each structure, or none");
+  for (const std::string& name : o.names)
+    if (std::count(o.names.begin(), o.names.end(), name) > 1)
+      throw UsageError("--name " + name + " is given twice: name each structure once");
   if (!o.reference.empty() && o.referenceLabels.size() != n)
     throw UsageError("--reference needs one --reference-label N[,M...] per structure, in the order of " + order + " (" +
                      std::to_string(n) + " structures, " + std::to_string(o.referenceLabels.size()) + " given)");

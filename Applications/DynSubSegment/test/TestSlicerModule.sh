@@ -107,9 +107,14 @@ expect_failure "malformed point" 2 "expected x,y,z" --seed 1,2 --labelmap "$work
 expect_failure "NaN point" 2 "expected x,y,z" --seed nan,2,3 --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
 expect_failure "point outside the volume" 1 "outside the image" --seed 500,0,0 "${seeds[@]:2}" \
   --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
-expect_failure "no output asked for" 1 "nothing to write" "${seeds[@]}" "$work/ch2.nrrd"
-expect_failure "unknown labelmap format" 1 "unknown labelmap format" "${seeds[@]}" --labelmap "$work/bad.png" \
+expect_failure "no output asked for" 2 "nothing to write" "${seeds[@]}" "$work/ch2.nrrd"
+expect_failure "unknown labelmap format" 2 "unknown labelmap format" "${seeds[@]}" --labelmap "$work/bad.png" \
   "$work/ch2.nrrd"
+# "x.gz" is no compressed NIfTI name: refused before the run, not after it.
+expect_failure "a labelmap named .gz alone" 2 "unknown labelmap format '.gz'" "${seeds[@]}" \
+  --labelmap "$work/bad.gz" "$work/ch2.nrrd"
+expect_failure "--xml with other arguments" 2 "takes no other argument" --xml "${seeds[@]}" \
+  --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
 expect_failure "model in a missing directory" 1 "no-dir" "${seeds[@]}" --labelmap "$work/bad.nrrd" \
   --model "$work/no-dir/m.vtp" "$work/ch2.nrrd"
 mkdir "$work/folder.vtp"
@@ -178,13 +183,13 @@ grep -v filter- "$work/atlas2.out"; cat "$work/atlas2.err"
 check "two atlas labels: the .seg.nrrd names them by the atlas's table, and holds the labelmap's voxels" \
   "$python" "$here/slicer_module_check.py" segmentation "$work/atlas2.seg.nrrd" "$work/atlas2.nrrd" \
   "Caudate_L=1" "Putamen_L=2"
-expect_failure "three point lists, one atlas label" 1 "give one atlas label per list" \
+expect_failure "three point lists, one atlas label" 2 "give one atlas label per list" \
   --landmarks "$work/lists.mrk.json" --atlasLabel Caudate_L --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
-expect_failure "point lists and --seed" 1 "add boundary points to the lists of a points file, not as --seed" \
+expect_failure "point lists and --seed" 2 "add boundary points to the lists of a points file, not as --seed" \
   --landmarks "$work/lists.mrk.json" "${seeds[@]}" --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
-expect_failure "point lists past label 255" 1 "pass 255" \
+expect_failure "point lists past label 255" 2 "pass 255" \
   --landmarks "$work/lists.mrk.json" --labelValue 255 --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
-expect_failure "a segmentation not .seg.nrrd" 1 "written as .seg.nrrd" "${seeds[@]}" --labelmap "$work/bad.nrrd" \
+expect_failure "a segmentation not .seg.nrrd" 2 "written as .seg.nrrd" "${seeds[@]}" --labelmap "$work/bad.nrrd" \
   --segmentation "$work/bad-seg.nrrd" "$work/ch2.nrrd"
 expect_failure "sigma out of range" 2 "sigma" "${seeds[@]}" --sigma 50 --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
 expect_failure "unknown option" 2 "frobnicate" --frobnicate "$work/ch2.nrrd"

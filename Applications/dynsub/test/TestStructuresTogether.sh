@@ -253,6 +253,11 @@ refused "one name for two structures" "\-\-name is given 1 times" --landmarks "$
 refused "one name for a file of two lists" "\-\-name is given 1 times for 2 structures" --landmarks "$work/two.mrk.json" \
   --name a
 refused "a name twice" "given twice" --landmarks "$caudate" --landmarks "$putamen" --name a --name a
+expect_error "a name twice: a usage error" 2 "\-\-name a is given twice" "$work/refused" \
+  "$DYNSUB" segment "$templates/ch2.nii.gz" --landmarks "$caudate" --landmarks "$putamen" --name a --name a \
+  --out "$work/refused"
+refused "two names for one structure" "\-\-name is given 2 times for one structure" --landmarks "$caudate" --name a \
+  --name b
 refused "a name that is a path" "use letters" --landmarks "$caudate" --landmarks "$putamen" --name a/b --name c
 refused "a name that is one of the run's files" "a file the run writes or removes" --landmarks "$caudate" \
   --landmarks "$putamen" --name a --name surface.vtp
