@@ -27,6 +27,14 @@ inline void inspectHeader(const std::string& path, itk::ImageIOBase& io) {
     voxels *= size;
   }
   filechecks::requireMemoryFor(path, voxels);
+  // ITK would turn a vector or colour voxel into one value (a luminance, or
+  // the first component) without a word.
+  const unsigned components = io.GetNumberOfComponents();
+  if (components > 1) {
+    throw Error(path, "an image of " + std::to_string(components) + " values per voxel (" +
+                          itk::ImageIOBase::GetPixelTypeAsString(io.GetPixelType()) +
+                          "); DynSub reads scalar images: save the channel to segment as an image of its own");
+  }
 }
 
 }  // namespace dynsub::itkbridge

@@ -285,6 +285,26 @@ TEST(HostileImages, NanVoxelsInMetaImageAndNrrdFilesAreRefused) {
   }
 }
 
+// ITK would make one value of each voxel's several (a colour's luminance, a
+// vector's first component); readVolume refuses them, as it does NIfTI's.
+TEST(HostileImages, SeveralValuesPerVoxelAreRefused) {
+  const std::vector<float> voxels = ramp(2 * 4 * 3 * 2, 1.0f);
+  const std::string data(reinterpret_cast<const char*>(voxels.data()), voxels.size() * sizeof(float));
+  std::ofstream(scratch("channels.mha"), std::ios::binary)
+      << "ObjectType = Image\nNDims = 3\nDimSize = 4 3 2\nElementNumberOfChannels = 2\nElementType = MET_FLOAT\n"
+         "ElementDataFile = LOCAL\n"
+      << data;
+  std::ofstream(scratch("channels.nrrd"), std::ios::binary)
+      << "NRRD0004\ntype: float\ndimension: 4\nspace: left-posterior-superior\nsizes: 2 4 3 2\n"
+         "kinds: vector domain domain domain\nspace directions: none (1,0,0) (0,1,0) (0,0,1)\nencoding: raw\n"
+         "endian: little\nspace origin: (0,0,0)\n\n"
+      << data;
+  for (const std::string name : {"channels.mha", "channels.nrrd"}) {
+    const std::string error = readError(scratch(name));
+    EXPECT_NE(error.find(name + ": an image of 2 values per voxel"), std::string::npos) << error;
+  }
+}
+
 TEST(HostileImages, ConstantAndExtremeIntensitiesAreReadExactly) {
   // The ramp goes up to 16 times the scale: 2.4e38 of float's 3.4e38.
   for (const float scale : {0.0f, 1.5e37f, 1e-37f, -1.5e37f}) {
