@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <vector>
@@ -77,6 +78,68 @@ std::vector<unsigned char> readBytes(const std::string& path, std::uintmax_t off
   in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(count));
   if (!in) throw Error(path, "cannot read its voxels");
   return bytes;
+}
+
+// ITK represents an orientation by orthonormal axes. A sform whose axes are
+// not perpendicular (sheared, as for a tilted gantry) it passes over for the
+// qform, and DynSub's outputs carry that: where the two place the image far
+// apart, a viewer that takes the sform (FSL, nibabel) would show the outputs
+// off the input. Refused then, saying by how much.
+template <class Real>
+void requireQformWhereShearedSform(const std::string& path, const Real& real, int version,
+                                   const std::array<std::int64_t, 3>& size) {
+  const int realBytes = version == 1 ? 4 : 8;
+  // sform: rows srow_x, srow_y, srow_z of 4 values each.
+  const int srow = version == 1 ? 280 : 400;
+  double sform[3][4];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) sform[r][c] = real(srow + (4 * r + c) * realBytes);
+  double largestCosine = 0;
+  for (int a = 0; a < 3; ++a)
+    for (int b = a + 1; b < 3; ++b) {
+      double dot = 0, na = 0, nb = 0;
+      for (int r = 0; r < 3; ++r) {
+        dot += sform[r][a] * sform[r][b];
+        na += sform[r][a] * sform[r][a];
+        nb += sform[r][b] * sform[r][b];
+      }
+      largestCosine = std::max(largestCosine, std::abs(dot) / std::sqrt(na * nb));
+    }
+  if (!(largestCosine > 1e-4)) return;  // perpendicular axes: ITK takes the sform
+  // qform: quatern_b, c, d, qoffset_x, y, z, and pixdim[0..3] (qfac, spacing).
+  const int quatern = version == 1 ? 256 : 352, pixdim = version == 1 ? 76 : 104;
+  const double b = real(quatern), c = real(quatern + realBytes), d = real(quatern + 2 * realBytes);
+  const double a = std::sqrt(std::max(0.0, 1.0 - (b * b + c * c + d * d)));
+  const double rotation[3][3] = {{a * a + b * b - c * c - d * d, 2 * (b * c - a * d), 2 * (b * d + a * c)},
+                                 {2 * (b * c + a * d), a * a + c * c - b * b - d * d, 2 * (c * d - a * b)},
+                                 {2 * (b * d - a * c), 2 * (c * d + a * b), a * a + d * d - c * c - b * b}};
+  const double spacing[3] = {real(pixdim + realBytes), real(pixdim + 2 * realBytes),
+                             (real(pixdim) < 0 ? -1.0 : 1.0) * real(pixdim + 3 * realBytes)};
+  // The largest distance between the two placements of a corner voxel.
+  double apart = 0;
+  for (int corner = 0; corner < 8; ++corner) {
+    const double index[3] = {corner & 1 ? size[0] - 1.0 : 0.0, corner & 2 ? size[1] - 1.0 : 0.0,
+                             corner & 4 ? size[2] - 1.0 : 0.0};
+    double squared = 0;
+    for (int r = 0; r < 3; ++r) {
+      double bySform = sform[r][3], byQform = real(quatern + (3 + r) * realBytes);
+      for (int k = 0; k < 3; ++k) {
+        bySform += sform[r][k] * index[k];
+        byQform += rotation[r][k] * spacing[k] * index[k];
+      }
+      squared += (bySform - byQform) * (bySform - byQform);
+    }
+    apart = std::max(apart, std::sqrt(squared));
+  }
+  const double smallestSpacing = std::min({std::abs(spacing[0]), std::abs(spacing[1]), std::abs(spacing[2])});
+  if (!(apart > 0.5 * smallestSpacing)) return;
+  char distance[32];
+  std::snprintf(distance, sizeof distance, "%.1f", apart);
+  throw Error(path, std::string("a NIfTI header whose sform is sheared (its axes are not perpendicular), which ITK "
+                                "cannot represent; its qform, which would be read instead, places the image up to ") +
+                        distance +
+                        " mm elsewhere. Resample the image onto a grid without shear, or set its sform_code to 0 "
+                        "if the qform is the placement meant");
 }
 
 }  // namespace
@@ -181,6 +244,9 @@ DataCheck checkNiftiHeader(const std::string& path) {
   };
   if (qformCode > 0) requireFinite(version == 1 ? 256 : 352, 6, "qform (quatern_b-d, qoffset_x-z)");
   if (sformCode > 0) requireFinite(version == 1 ? 280 : 400, 12, "sform (srow_x, srow_y, srow_z)");
+  std::array<std::int64_t, 3> size{1, 1, 1};
+  for (int a = 0; a < 3 && a < dimensions; ++a) size[a] = dim(a + 1);
+  if (qformCode > 0 && sformCode > 0) requireQformWhereShearedSform(path, real, version, size);
   requireMemoryFor(path, count);
   // vox_offset: a float in NIfTI-1, an integer in NIfTI-2.
   const double offset =
@@ -188,8 +254,6 @@ DataCheck checkNiftiHeader(const std::string& path) {
   if (!(offset >= headerSize) || offset > 1e12)
     throw Error(path, "a NIfTI header whose data offset (vox_offset " + std::to_string(offset) + ") is not after it");
   const auto needed = static_cast<std::uintmax_t>(offset) + count * bytesPerVoxel;
-  std::array<std::int64_t, 3> size{1, 1, 1};
-  for (int a = 0; a < 3 && a < dimensions; ++a) size[a] = dim(a + 1);
   DataCheck checkData = [=] {
     // The whole stream is inflated: a gzip stream cut short or corrupt after
     // the image's bytes is refused too.

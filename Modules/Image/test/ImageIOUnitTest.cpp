@@ -371,6 +371,28 @@ TEST(HostileImages, NonFiniteOrientationsSeriesAndComplexVoxelsAreRefused) {
   EXPECT_NE(error.find("header.nii: a NIfTI image of complex voxels"), std::string::npos) << error;
 }
 
+// A sheared sform is passed over by ITK for the qform: refused where the two
+// place the image more than half a voxel apart, read where they agree, or
+// where the sform is not sheared (ITK then takes the sform).
+TEST(HostileImages, AShearedSformThatTheQformContradictsIsRefused) {
+  const fs::path path = scratch("sheared.nii");
+  // 20 x 20 x 20 voxels of 1 mm; the qform (code 1, identity quaternion, no offset) is the identity.
+  auto write = [&](float shear, float shift) {
+    writeNifti(path, {20, 20, 20}, Vector3(1, 1, 1), ramp(8000, 1.0f));
+    patch(path, 252, std::int16_t{1});
+    patch(path, 280 + 4, shear);  // srow_x[1]: x grows with j
+    patch(path, 280 + 12, shift);  // srow_x[3]
+  };
+  write(0.5f, 0.0f);  // the far corner 9.5 mm apart
+  std::string error = readError(path);
+  EXPECT_NE(error.find("sheared.nii: a NIfTI header whose sform is sheared"), std::string::npos) << error;
+  EXPECT_NE(error.find("places the image up to 9.5 mm elsewhere"), std::string::npos) << error;
+  write(0.02f, 0.0f);  // 0.38 mm apart at most: within half a voxel
+  EXPECT_EQ(readError(path), "");
+  write(0.0f, 5.0f);  // not sheared, 5 mm from the qform: ITK reads the sform
+  EXPECT_EQ(readError(path), "");
+}
+
 TEST(HostileImages, ADegenerateDirectionIsRefused) {
   // NRRD space directions with two parallel axes.
   std::ofstream(scratch("parallel.nrrd"), std::ios::binary)
