@@ -18,6 +18,7 @@
 #include "dynsub/Coordinates.h"
 #include "dynsub/EnclosingSphere.h"
 #include "dynsub/Error.h"
+#include "dynsub/FileNames.h"
 #include "dynsub/MeshIO.h"
 #include "dynsub/ModelOutputs.h"
 #include "dynsub/PointCloudIO.h"
@@ -44,9 +45,35 @@ struct FitCommandOptions {
   FigureOptions figures;
 };
 
+bool isBuiltInShape(const std::string& init) { return init == "auto" || init == "sphere" || init == "torus"; }
+
+std::string genusProblem(int genus, int asked) {
+  return "the initial model has genus " + std::to_string(genus) + " but --genus " + std::to_string(asked) +
+         " was asked for" +
+         (asked == 0   ? " (use --init sphere)"
+          : asked == 1 ? " (use --init torus or a control mesh of genus 1)"
+                       : " (give a control mesh of that genus with --init MESH)");
+}
+
+// --init's value, checked before the scan is read: a built-in shape's genus
+// is known, and a word that names neither a shape nor a mesh file is a typo
+// or a `dynsub mesh` name, not a file of an unknown format.
+void checkInitialModelOption(const FitCommandOptions& o) {
+  if (isBuiltInShape(o.init)) {
+    const int genus = o.init == "torus" ? 1 : 0;
+    // A built-in shape of the wrong genus is two options that do not fit together.
+    if (o.genus >= 0 && genus != o.genus) throw UsageError("--init " + o.init, genusProblem(genus, o.genus));
+    return;
+  }
+  const std::string extension = lowerCaseExtension(o.init);
+  std::error_code ignored;
+  if (extension.empty() && !std::filesystem::exists(o.init, ignored))
+    throw UsageError("--init " + o.init + ": expected auto, sphere, torus or a control mesh file (.obj, .off, .ply)");
+}
+
 ControlMesh chooseInitialModel(const FitCommandOptions& o, const MatrixX3& data) {
   ControlMesh mesh;
-  const bool shape = o.init == "auto" || o.init == "sphere" || o.init == "torus";
+  const bool shape = isBuiltInShape(o.init);
   if (shape) {
     mesh = initialModel(data, o.init == "torus" ? InitialShape::Torus : InitialShape::Sphere);
   } else {
@@ -56,17 +83,9 @@ ControlMesh chooseInitialModel(const FitCommandOptions& o, const MatrixX3& data)
                               " boundary loop(s)");
     }
   }
-  if (o.genus >= 0 && mesh.genus() != o.genus) {
-    const std::string problem = "the initial model has genus " + std::to_string(mesh.genus()) + " but --genus " +
-                                std::to_string(o.genus) + " was asked for" +
-                                (o.genus == 0   ? " (use --init sphere)"
-                                 : o.genus == 1 ? " (use --init torus or a control mesh of genus 1)"
-                                                : " (give a control mesh of that genus with --init MESH)");
-    // A built-in shape of the wrong genus is two options that do not fit
-    // together; a mesh file of the wrong genus is that file's problem.
-    if (shape) throw UsageError("--init " + o.init, problem);
-    throw Error(o.init, problem);
-  }
+  // A built-in shape's genus was checked before the scan was read; a mesh
+  // file of the wrong genus is that file's problem.
+  if (!shape && o.genus >= 0 && mesh.genus() != o.genus) throw Error(o.init, genusProblem(mesh.genus(), o.genus));
   return mesh;
 }
 
@@ -112,6 +131,7 @@ double statedNoise(const std::string& text) {
 
 void runFit(FitCommandOptions o) {
   const double stated = statedNoise(o.noise);
+  checkInitialModelOption(o);
   const PointCloud input = readPointCloud(o.points);
   const MatrixX3& scan = input.points;
   checkPointCloud(scan, o.points);

@@ -116,6 +116,13 @@ expect_error "points within 1e-6 mm" 1 "tiny.xyz: the points span only 1e-300 mm
   "$DYNSUB" fit "$work/tiny.xyz" --out "$work/o4c"
 expect_error "a built-in model of the wrong genus" 2 "--init torus: the initial model has genus 1 but --genus 0" \
   "$work/o5" "$DYNSUB" fit "$work/sphere.xyz" --init torus --genus 0 --out "$work/o5"
+# A built-in shape's genus is checked before the scan is read, and a word
+# that is neither a shape nor a mesh file is named as such.
+printf 'not a scan\n' >"$work/unread.xyz"
+expect_error "a built-in model of the wrong genus, before the scan" 2 "--init torus: the initial model has genus 1" \
+  "$work/o5" "$DYNSUB" fit "$work/unread.xyz" --init torus --genus 0 --out "$work/o5"
+expect_error "an --init that is no shape and no file" 2 "--init sheet: expected auto, sphere, torus or a control mesh" \
+  "$work/o5" "$DYNSUB" fit "$work/sphere.xyz" --init sheet --out "$work/o5"
 expect_error "a control mesh of the wrong genus" 1 "torus.obj: the initial model has genus 1 but --genus 0" \
   "$work/o5" "$DYNSUB" fit "$work/sphere.xyz" --init "$DATA/Meshes/torus.obj" --genus 0 --out "$work/o5"
 # A vertex whose areas overflow: named as such, not as a degenerate face.

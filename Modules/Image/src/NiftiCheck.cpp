@@ -148,7 +148,13 @@ void requireQformWhereShearedSform(const std::string& path, const Real& real, in
 // fills a truncated .nii, or a .nii.gz whose gzip stream is cut short, with
 // zeros without complaint, and allocates whatever the header announces.
 DataCheck checkNiftiHeader(const std::string& path) {
-  const bool gzipped = lowerCaseExtension(path) == ".gz";
+  // Compressed or not by its first bytes, as ITK's reader (zlib) takes a
+  // .nii.gz that is not compressed; it reads a .nii by its name alone.
+  unsigned char magic[2] = {};
+  std::ifstream(path, std::ios::binary).read(reinterpret_cast<char*>(magic), 2);
+  const bool gzipped = magic[0] == 0x1f && magic[1] == 0x8b;
+  if (gzipped && lowerCaseExtension(path) != ".gz")
+    throw Error(path, "compressed with gzip, but named as an uncompressed NIfTI file: name it .nii.gz");
   unsigned char header[540] = {};
   std::uintmax_t got = 0;
   if (gzipped) {

@@ -269,6 +269,20 @@ TEST(HostileImages, GzipMembersAreReadOneAfterAnotherAndACutStreamIsRefused) {
             std::string::npos);
 }
 
+// Compressed or not by the file's first bytes: an uncompressed file named
+// .nii.gz reads as the .nii (ITK's reader takes it too); a compressed one
+// named .nii, which ITK's reader would take for raw bytes, is refused.
+TEST(HostileImages, NiftiCompressionIsTakenFromTheContent) {
+  const std::vector<float> voxels = ramp(5 * 4 * 3, 2.0f);
+  writeNifti(scratch("plain.nii"), {5, 4, 3}, Vector3(1, 1, 1), voxels);
+  fs::copy_file(scratch("plain.nii"), scratch("plain_named.nii.gz"), fs::copy_options::overwrite_existing);
+  EXPECT_EQ(readVolume(scratch("plain_named.nii.gz").string()).voxels, voxels);
+  gzipFile(scratch("plain.nii"), scratch("packed_named.nii"));
+  EXPECT_NE(readError(scratch("packed_named.nii"))
+                .find("packed_named.nii: compressed with gzip, but named as an uncompressed NIfTI file"),
+            std::string::npos);
+}
+
 // ITK keeps NaN in MetaImage and NRRD files; readVolume refuses them there too.
 TEST(HostileImages, NanVoxelsInMetaImageAndNrrdFilesAreRefused) {
   std::vector<float> voxels = ramp(4 * 3 * 2, 1.0f);
