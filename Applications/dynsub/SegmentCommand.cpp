@@ -59,9 +59,11 @@ struct Arguments {
 // "71" or "71,72": a structure's label values in --reference.
 std::vector<int> parseLabelValues(const std::string& text) {
   std::vector<int> values;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
+  // Every item between commas, the empty ones too ("71," and "71,,72" are malformed).
+  for (std::size_t start = 0; start <= text.size();) {
+    const std::size_t comma = std::min(text.find(',', start), text.size());
+    const std::string item = text.substr(start, comma - start);
+    start = comma + 1;
     std::size_t used = 0;
     int value = 0;
     try {

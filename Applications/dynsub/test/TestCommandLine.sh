@@ -556,6 +556,9 @@ expect_error "edge thresholds the wrong way round" 2 "edge_low (--edge-low) is 5
   --edge-high 1 --out "$work/s9b"
 expect_error "an atlas label list ending in a comma" 2 "--atlas-label Caudate_L,: an empty label" "$work/s9c" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --init atlas --atlas-label Caudate_L, --out "$work/s9c"
+expect_error "a reference label list ending in a comma" 2 "--reference-label 71,: expected N" "$work/s9d" \
+  "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" \
+  --reference "$mri/aal.nii.gz" --reference-label 71, --out "$work/s9d"
 # Stopped by the step limit, the surface had not settled: the run says so.
 "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --max-steps 20 \
   --no-figures --out "$work/s9d" >/dev/null 2>"$work/s9d.err"
