@@ -99,6 +99,7 @@ ConvergenceHistory readConvergenceCsv(const std::string& path) {
     history.samples.push_back(s);
   }
   if (!header) throw Error(path, "not a convergence history (no header " + std::string(kHeader) + ")");
+  if (history.samples.empty()) throw Error(path, "a convergence history with no steps (its header alone)");
   return history;
 }
 

@@ -66,6 +66,15 @@ TEST(ConvergenceHistory, CsvRoundTripKeepsUnmeasuredErrors) {
   }
   std::ofstream(path) << "a,b\n";
   EXPECT_THROW(readConvergenceCsv(path), Error);
+  // A header without steps is named as such (the plot would have nothing to draw).
+  std::ofstream(path) << "# fit_error: rms landmark distance (mm)\nlevel,step,energy,fit_error\n";
+  try {
+    readConvergenceCsv(path);
+    FAIL() << "a history without steps was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(path + ": a convergence history with no steps"), std::string::npos)
+        << e.what();
+  }
   std::filesystem::remove(path);
   EXPECT_THROW(readConvergenceCsv(path), Error);
 }
