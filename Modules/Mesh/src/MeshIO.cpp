@@ -70,6 +70,7 @@ PolygonData readObj(const std::string& path) {
   std::ifstream in = openForReading(path, std::ios::binary);
   std::vector<Vector3> points;
   PolygonData data;
+  std::vector<int> faceLines;  // each face's line, to name an index past the last vertex
   std::string text;
   int line = 0;
   while (std::getline(in, text)) {
@@ -99,10 +100,18 @@ PolygonData readObj(const std::string& path) {
         face.push_back(static_cast<int>(resolved));
       }
       data.faces.push_back(std::move(face));
+      faceLines.push_back(line);
     } else if (keyword == "t") {
       data.creases.push_back(parseCreaseTag(record, path, line));
     }
   }
+  // Named here, as the file writes it (from 1), rather than by the mesh
+  // check, which counts vertices and faces from 0.
+  for (std::size_t f = 0; f < data.faces.size(); ++f)
+    for (const int v : data.faces[f])
+      if (v >= static_cast<int>(points.size()))
+        throw Error(path, "line " + std::to_string(faceLines[f]) + ": vertex index " + std::to_string(v + 1) +
+                              " is out of range (the file has " + std::to_string(points.size()) + " vertices)");
   data.points = toMatrix(points);
   return data;
 }

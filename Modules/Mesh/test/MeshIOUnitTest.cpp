@@ -123,6 +123,10 @@ TEST(MeshIO, BrokenFilesAreNamed) {
   const std::string badNumber = scratch("bad.obj").string();
   writeText(badNumber, "v 0 0 0\nv 1 x 0\n");
   expectError(badNumber, "line 2");
+  // An OBJ index past the last vertex is named at its line, as written (from 1).
+  const std::string pastLast = scratch("past_last.obj").string();
+  writeText(pastLast, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 7\n");
+  expectError(pastLast, "line 8: vertex index 7 is out of range (the file has 4 vertices)");
   const std::string truncated = scratch("truncated.off").string();
   writeText(truncated, "OFF\n4 1 0\n0 0 0\n1 0 0\n");
   expectError(truncated, "truncated");
