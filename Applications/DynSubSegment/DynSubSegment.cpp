@@ -344,13 +344,12 @@ void runTogether(Arguments& a, const Volume& image, const std::vector<LandmarkSo
   if (atlas && !files.empty() && files.size() != n)
     throw UsageError(several + a.landmarks + " holds " + std::to_string(files.size()) +
                      " lists of points; give one atlas label per list, in their order (separated by ';')");
-  if (!a.seeds.empty())
-    throw UsageError(several + "add boundary points to the lists of a points file, not as --seed");
+  if (!a.seeds.empty()) throw UsageError(several + "add boundary points to the lists of a points file, not as --seed");
   if (!a.inside.empty()) throw UsageError(several + "a point inside is one structure's; leave it out");
   const int lastLabel = a.labelValue + static_cast<int>(n) - 1;
   if (lastLabel > 255)
     throw UsageError(several + "their label values " + std::to_string(a.labelValue) + "-" + std::to_string(lastLabel) +
-                " pass 255; give a smaller --labelValue");
+                     " pass 255; give a smaller --labelValue");
   const std::shared_ptr<const Atlas> atlasData =
       atlas ? std::make_shared<const Atlas>(readAtlas(kDefaultAtlasImage, kDefaultAtlasLabels)) : nullptr;
   std::vector<StructureInputs> structures = structuresToSegment(a.image, files, atlasData, atlasLabels);

@@ -207,8 +207,7 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
   try {
     requireKnownKeys(j, {"images", "reference", "atlas", "cohorts", "structures", "protocols", "segment", "splits"},
                      "the plan");
-    for (const auto& i : optionalList(j, "images", "the plan's "))
-      requireKnownKeys(i, {"name", "path"}, "an image");
+    for (const auto& i : optionalList(j, "images", "the plan's ")) requireKnownKeys(i, {"name", "path"}, "an image");
     for (const auto& c : optionalList(j, "cohorts", "the plan's "))
       requireKnownKeys(c, {"name", "image", "labels", "settings", "subjects"}, "a cohort");
     for (const auto& st : optionalList(j, "structures", "the plan's "))

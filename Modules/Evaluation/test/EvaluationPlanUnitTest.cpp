@@ -76,8 +76,9 @@ TEST(EvaluationPlan, WrongTypesAndMissingKeysAreNamedWhereTheyAre) {
   EXPECT_NE(errorOf(R"({"name": "six", "scatter_mm": "1"})", "[1]")
                 .find("protocol 'six': scatter_mm must be a number, got \"1\""),
             std::string::npos);
-  EXPECT_NE(errorOf(R"({"name": "six", "seed_only": 1})", "[1]").find("protocol 'six': seed_only must be true or false"),
-            std::string::npos);
+  EXPECT_NE(
+      errorOf(R"({"name": "six", "seed_only": 1})", "[1]").find("protocol 'six': seed_only must be true or false"),
+      std::string::npos);
   EXPECT_NE(errorOf(R"({"name": "six", "coverage": 0.5})", "[1]").find("protocol 'six': coverage must be a list"),
             std::string::npos);
   EXPECT_NE(errorOf(R"({"name": "six"})", "7").find("split 'test': seeds must be a list, got 7"), std::string::npos);

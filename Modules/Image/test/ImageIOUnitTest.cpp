@@ -394,7 +394,7 @@ TEST(HostileImages, AShearedSformThatTheQformContradictsIsRefused) {
   auto write = [&](float shear, float shift) {
     writeNifti(path, {20, 20, 20}, Vector3(1, 1, 1), ramp(8000, 1.0f));
     patch(path, 252, std::int16_t{1});
-    patch(path, 280 + 4, shear);  // srow_x[1]: x grows with j
+    patch(path, 280 + 4, shear);   // srow_x[1]: x grows with j
     patch(path, 280 + 12, shift);  // srow_x[3]
   };
   write(0.5f, 0.0f);  // the far corner 9.5 mm apart
