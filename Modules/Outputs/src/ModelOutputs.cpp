@@ -4,6 +4,7 @@
 #include <sstream>
 #include <string>
 
+#include "dynsub/Coordinates.h"
 #include "dynsub/Error.h"
 #include "dynsub/LimitSurface.h"
 #include "dynsub/MeshCheck.h"
@@ -103,8 +104,15 @@ TriangleSurface outputSurface(const ControlMesh& mesh, const LimitSurface& surfa
 void writeModelOutputs(const std::filesystem::path& dir, const ControlMesh& mesh, const TriangleSurface& surface,
                        const Report& report, const std::function<void(OutputSet&)>& extra,
                        const std::vector<PointScalars>& surfaceScalars, const std::string& space) {
-  // A model the readers refuse (a face of no area: the surface shrank to a
-  // point or a line) is not written as a result.
+  // A model the readers refuse is not written as a result: one that ran
+  // off (a point past the largest coordinate) diverged; one with a face of
+  // no area shrank to a point or a line.
+  for (Eigen::Index v = 0; v < mesh.points().rows(); ++v) {
+    const std::string beyond = beyondLargestCoordinate(mesh.points().row(v).transpose());
+    if (!beyond.empty())
+      throw Error("the model diverged: control vertex " + std::to_string(v) + " " + beyond +
+                  " (lower the time step or the stiffest force; nothing was written)");
+  }
   try {
     checkPolygonMesh(mesh.points(), mesh.faces(), "the resulting control mesh");
   } catch (const Error& error) {
