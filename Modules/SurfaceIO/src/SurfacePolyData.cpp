@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include <vtkCellArray.h>
+#include <vtkCellArrayIterator.h>
 #include <vtkCellData.h>
 #include <vtkDoubleArray.h>
 #include <vtkFieldData.h>
@@ -83,22 +84,18 @@ void addFarDistance(vtkPolyData* polyData, const std::string& name, double far) 
 
 namespace {
 
-// The polygons of an OBJ file read by DynSub's own reader.
-vtkSmartPointer<vtkPolyData> toPolyData(const PolygonData& data, const std::string& path) {
+// The polygons of an OBJ file read by DynSub's own reader (which checks the
+// indices).
+vtkSmartPointer<vtkPolyData> toPolyData(const PolygonData& data) {
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
   points->SetNumberOfPoints(data.points.rows());
   for (Eigen::Index i = 0; i < data.points.rows(); ++i)
     points->SetPoint(i, data.points(i, 0), data.points(i, 1), data.points(i, 2));
   vtkNew<vtkCellArray> polygons;
-  for (size_t f = 0; f < data.faces.size(); ++f) {
-    polygons->InsertNextCell(static_cast<vtkIdType>(data.faces[f].size()));
-    for (const int corner : data.faces[f]) {
-      if (corner >= data.points.rows())
-        throw Error(path, "face " + std::to_string(f + 1) + " uses vertex " + std::to_string(corner + 1) +
-                              ", but the file has " + std::to_string(data.points.rows()) + " vertices");
-      polygons->InsertCellPoint(corner);
-    }
+  for (const Polygon& face : data.faces) {
+    polygons->InsertNextCell(static_cast<vtkIdType>(face.size()));
+    for (const int corner : face) polygons->InsertCellPoint(corner);
   }
   auto polyData = vtkSmartPointer<vtkPolyData>::New();
   polyData->SetPoints(points);
@@ -138,7 +135,7 @@ vtkSmartPointer<vtkPolyData> readSurfacePolyData(const std::string& path) {
   } else if (extension == ".obj") {
     // DynSub's own OBJ reader: VTK's reads "v nan 1 0" as the origin without
     // a word, where this one names the line.
-    polyData = toPolyData(readPolygonData(path), path);
+    polyData = toPolyData(readPolygonData(path));
   } else if (extension == ".ply" || extension == ".stl") {
     vtkSmartPointer<vtkAbstractPolyDataReader> reader;
     if (extension == ".ply") reader = vtkSmartPointer<vtkPLYReader>::New();
@@ -154,6 +151,27 @@ vtkSmartPointer<vtkPolyData> readSurfacePolyData(const std::string& path) {
     polyData->GetPoint(i, p);
     if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
       throw Error(path, "point " + std::to_string(i) + " has a non-finite coordinate");
+  }
+  // VTK's readers keep a cell's point indices as written: one past the
+  // points would be read out of bounds by every filter after.
+  const vtkIdType pointCount = polyData->GetNumberOfPoints();
+  const std::pair<const char*, vtkCellArray*> cellArrays[] = {{"vertex cell", polyData->GetVerts()},
+                                                              {"line", polyData->GetLines()},
+                                                              {"polygon", polyData->GetPolys()},
+                                                              {"triangle strip", polyData->GetStrips()}};
+  for (const auto& [what, cells] : cellArrays) {
+    if (!cells) continue;
+    auto cell = vtk::TakeSmartPointer(cells->NewIterator());
+    for (cell->GoToFirstCell(); !cell->IsDoneWithTraversal(); cell->GoToNextCell()) {
+      vtkIdType size = 0;
+      const vtkIdType* ids = nullptr;
+      cell->GetCurrentCell(size, ids);
+      for (vtkIdType k = 0; k < size; ++k)
+        if (ids[k] < 0 || ids[k] >= pointCount)
+          throw Error(path, std::string(what) + " " + std::to_string(cell->GetCurrentCellId()) + " uses point " +
+                                std::to_string(ids[k]) + ", but the file has " + std::to_string(pointCount) +
+                                " points (both counted from 0)");
+    }
   }
   return polyData;
 }

@@ -244,8 +244,23 @@ TEST(SurfacePolyData, ReadsObjExactlyAndRefusesBadRecords) {
   std::string withText = tetrahedron;
   withText.replace(withText.find("v 0 1 0"), 7, "v 0x 1 0");
   EXPECT_NE(refused("text.obj", withText).find("line 3: '0x' is not a number"), std::string::npos);
-  EXPECT_NE(refused("range.obj", tetrahedron + "f 1 2 9\n").find("face 5 uses vertex 9, but the file has 4 vertices"),
+  EXPECT_NE(refused("range.obj", tetrahedron + "f 1 2 9\n")
+                .find("line 9: vertex index 9 is out of range (the file has 4 vertices)"),
             std::string::npos);
+  // VTK's readers keep an index past the points; every filter after would
+  // read out of bounds.
+  const std::string plyTetrahedron =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 4\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n"
+      "3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 99\n";
+  EXPECT_NE(refused("range.ply", plyTetrahedron).find("range.ply: polygon 3 uses point 99, but the file has 4 points"),
+            std::string::npos)
+      << refused("range.ply", plyTetrahedron);
+  const std::string legacy =
+      "# vtk DataFile Version 3.0\ntetrahedron\nASCII\nDATASET POLYDATA\nPOINTS 4 float\n0 0 0\n1 0 0\n0 1 0\n"
+      "0 0 1\nPOLYGONS 4 16\n3 0 2 1\n3 0 -5 3\n3 1 2 3\n3 0 3 2\n";
+  EXPECT_NE(refused("negative.vtk", legacy).find("negative.vtk: polygon 1 uses point -5"), std::string::npos)
+      << refused("negative.vtk", legacy);
 }
 
 TEST(SurfaceWriter, BadTargetsLeaveNoFile) {
