@@ -439,8 +439,11 @@ void run(Arguments& a) {
   if (!a.segmentation.empty() && !isSlicerSegmentationName(a.segmentation))
     throw UsageError(a.segmentation, "a 3D Slicer segmentation is written as .seg.nrrd");
   if (!a.report.empty()) requireExtension(a.report, {".json"}, "report");
-  for (const std::string* path : {&a.labelmap, &a.model, &a.segmentation, &a.report})
-    if (!path->empty()) requireWritableDirectoryFor(*path);
+  for (const std::string* path : {&a.labelmap, &a.model, &a.segmentation, &a.report}) {
+    if (path->empty()) continue;
+    requireWritableDirectoryFor(*path);
+    for (const std::string& input : {a.image, a.landmarks}) requireNotInput(*path, input);
+  }
   for (const auto& apply : a.afterParsing) apply(a);
 
   SlicerProgress progress(a.parameters.segment.simulation.maxLevel + 1);

@@ -37,6 +37,7 @@ void runDeform(DeformArguments o) {
   const ControlMesh mesh = readControlMesh(o.mesh);
   const SpringFile springs = readSpringFile(o.springs, o.stiffness);
   const std::filesystem::path dir(o.out);
+  requireInputsOutsideRun(dir, {o.mesh, o.springs});
   prepareOutputDirectory(dir);
   o.deformation.simulation = o.simulation.apply(o.simulation.values);
   o.deformation.localRefinement = o.refinement == "local";

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "FigureOutputs.h"
+#include "dynsub/FileNames.h"
 #include "dynsub/ModelOutputs.h"
 #include "dynsub/OutputSet.h"
 #include "dynsub/SegmentStructures.h"
@@ -16,6 +17,11 @@ std::vector<std::string> runFiles() {
   names.insert(names.end(), {kSurfaceFile, kControlMeshFile, kReportFile, kLabelmapFile, kJoinedLabelmap, kJoinedTable,
                              kOutliersFile, kSculptedLattice, kSculptedSolid, kSculptedFigure});
   return names;
+}
+
+void requireInputsOutsideRun(const std::filesystem::path& dir, const std::vector<std::string>& inputs) {
+  for (const std::string& name : runFiles())
+    for (const std::string& input : inputs) requireNotInput((dir / name).string(), input);
 }
 
 void retireEarlierRun(OutputSet& outputs, const std::filesystem::path& dir,

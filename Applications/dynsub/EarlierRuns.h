@@ -31,6 +31,10 @@ constexpr char kSculptedFigure[] = "sculpted.png";
 // files, the ones above, convergence.csv and the figures in each format.
 std::vector<std::string> runFiles();
 
+// Throws UsageError when one of `inputs` is a file of runFiles() in `dir`:
+// the run would overwrite it, or remove it as an earlier run's.
+void requireInputsOutsideRun(const std::filesystem::path& dir, const std::vector<std::string>& inputs);
+
 // Retires every file of runFiles() in `dir` (the set keeps those it
 // writes itself), and the structures' folders an earlier run of several
 // structures left there but those named in `keptFolders`: the folders its

@@ -173,6 +173,7 @@ void runFit(FitCommandOptions o) {
                        "a closed control mesh of genus " + g + " with --init MESH)");
   }
   const std::filesystem::path dir(o.out);
+  requireInputsOutsideRun(dir, {o.points, o.reference, o.init});
   prepareOutputDirectory(dir);
   o.fit.simulation = o.simulation.apply(o.fit.simulation);
   o.figures.prepare();

@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include "Commands.h"
+#include "dynsub/FileNames.h"
 #include "dynsub/LimitSurface.h"
 #include "dynsub/MeshIO.h"
 #include "dynsub/SurfaceWriter.h"
@@ -20,6 +21,7 @@ struct LimitOptions {
 
 void runLimit(const LimitOptions& options) {
   requireTriangleSurfaceTarget(options.out);
+  requireNotInput(options.out, options.mesh);
   const ControlMesh mesh = readControlMesh(options.mesh);
   const LimitSurface surface(mesh);
   const TriangleSurface triangles = tessellate(surface, mesh.points(), options.samplesPerFace);

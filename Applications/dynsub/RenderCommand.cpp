@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "Commands.h"
+#include "EarlierRuns.h"
 #include "FigureOutputs.h"
 #include "dynsub/Error.h"
 #include "dynsub/FigureInputs.h"
@@ -88,6 +89,7 @@ void runRender(const RenderCommandOptions& o) {
   }
 
   const std::filesystem::path dir(o.out);
+  requireInputsOutsideRun(dir, {o.surface, o.image, o.landmarks, o.points, o.outliers, o.convergence, o.controlMesh});
   prepareOutputDirectory(dir);
   OutputSet outputs(dir);
   writeFigures(inputs, o.figures.files(outputs, !o.convergence.empty()));

@@ -208,6 +208,7 @@ void runSegmentOne(const Arguments& o, const LandmarkSource* landmarks) {
     inputs.referenceLabels = referenceLabels;
   }
   const std::filesystem::path dir(o.out);
+  requireInputsOutsideRun(dir, {o.image, landmarks ? landmarks->path : "", o.reference, o.atlas, o.atlasLabels});
   prepareOutputDirectory(dir);
   o.figures.prepare();
 
@@ -320,6 +321,10 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
     }
   }
   const std::filesystem::path dir(o.out);
+  std::vector<std::string> inputs{o.image, o.reference, o.atlas, o.atlasLabels};
+  for (const LandmarkSource& source : sources) inputs.push_back(source.path);
+  requireInputsOutsideRun(dir, inputs);
+  for (const StructureInputs& structure : structures) requireInputsOutsideRun(dir / structure.name, inputs);
   prepareOutputDirectory(dir);
   o.figures.prepare();
 

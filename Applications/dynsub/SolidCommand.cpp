@@ -10,6 +10,7 @@
 #include "Commands.h"
 #include "EarlierRuns.h"
 #include "dynsub/Error.h"
+#include "dynsub/FileNames.h"
 #include "dynsub/LatticeIO.h"
 #include "dynsub/ModelOutputs.h"
 #include "dynsub/OutputSet.h"
@@ -107,7 +108,10 @@ void runSculpt(const SculptOptions& options) {
   const Lattice lattice = readLattice(o.lattice);
   // An --out that cannot be a directory is said before a script runs (the
   // window says it when s saves).
-  if (!o.script.empty()) prepareOutputDirectory(o.out);
+  if (!o.script.empty()) {
+    requireInputsOutsideRun(o.out, {o.lattice, o.script});
+    prepareOutputDirectory(o.out);
+  }
   Report report;
   report.set("lattice", o.lattice);
   if (o.script.empty()) {
@@ -161,6 +165,7 @@ void addSolidCommand(CLI::App& app) {
   subdivide->add_option("--out", o->out, "Output file (.lattice or .vtu)")->required();
   subdivide->callback([o] {
     requireLatticeTarget(o->out);
+    requireNotInput(o->out, o->lattice);
     const Lattice lattice = subdivideSolid(readLattice(o->lattice), o->level).lattice;
     writeLattice(lattice, o->out);
     std::cout << "wrote " << o->out << ": " << lattice.pointCount() << " points, " << lattice.cellCount()

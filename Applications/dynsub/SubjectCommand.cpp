@@ -6,6 +6,7 @@
 
 #include "Commands.h"
 #include "dynsub/Error.h"
+#include "dynsub/FileNames.h"
 #include "dynsub/ImageIO.h"
 #include "dynsub/OutputSet.h"
 #include "dynsub/SubjectGenerator.h"
@@ -32,6 +33,9 @@ void runSubject(const Arguments& arguments) {
     }
     checkSubjectSettings(settings);
   });
+  for (const char* name : {"image.nii.gz", "labels.nii.gz", "subject.json"})
+    for (const std::string& input : {arguments.image, arguments.labels})
+      requireNotInput((std::filesystem::path(arguments.out) / name).string(), input);
   prepareOutputDirectory(arguments.out);
   const Volume image = readVolume(arguments.image);
   const Volume labels = readLabelMap(arguments.labels);

@@ -115,6 +115,10 @@ expect_failure "a labelmap named .gz alone" 2 "unknown labelmap format '.gz'" "$
   --labelmap "$work/bad.gz" "$work/ch2.nrrd"
 expect_failure "--xml with other arguments" 2 "takes no other argument" --xml "${seeds[@]}" \
   --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
+cp "$work/ch2.nrrd" "$work/input_copy.nrrd"
+expect_failure "the labelmap written over the input volume" 2 "is an input of this run too" "${seeds[@]}" \
+  --labelmap "$work/input_copy.nrrd" "$work/input_copy.nrrd"
+check "the input volume is left as it was" cmp -s "$work/ch2.nrrd" "$work/input_copy.nrrd"
 expect_failure "model in a missing directory" 1 "no-dir" "${seeds[@]}" --labelmap "$work/bad.nrrd" \
   --model "$work/no-dir/m.vtp" "$work/ch2.nrrd"
 mkdir "$work/folder.vtp"

@@ -125,6 +125,17 @@ expect_error "an --init that is no shape and no file" 2 "--init sheet: expected 
   "$work/o5" "$DYNSUB" fit "$work/sphere.xyz" --init sheet --out "$work/o5"
 expect_error "a control mesh of the wrong genus" 1 "torus.obj: the initial model has genus 1 but --genus 0" \
   "$work/o5" "$DYNSUB" fit "$work/sphere.xyz" --init "$DATA/Meshes/torus.obj" --genus 0 --out "$work/o5"
+# An output that is an input of the run is refused before anything is
+# written: the run would destroy it (or retire it as an earlier run's).
+cp "$DATA/Meshes/cube.obj" "$work/same.obj"
+expect_error "limit's output is its input" 2 "same.obj: is an input of this run too" "$work/none" \
+  "$DYNSUB" limit "$work/same.obj" --out "$work/same.obj"
+check "limit's input is left as it was" cmp -s "$DATA/Meshes/cube.obj" "$work/same.obj"
+mkdir -p "$work/earlier"
+cp "$DATA/Meshes/cube.obj" "$work/earlier/control_mesh.obj"
+expect_error "deform's input among its run's files" 2 "control_mesh.obj: is an input of this run too" "$work/none" \
+  "$DYNSUB" deform "$work/earlier/control_mesh.obj" --springs "$DATA/Deform/cube_bump.springs" --out "$work/earlier"
+check "deform's input is left as it was" cmp -s "$DATA/Meshes/cube.obj" "$work/earlier/control_mesh.obj"
 # A vertex whose areas overflow: named as such, not as a degenerate face.
 printf 'v 0 0 0\nv 1e300 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\n' >"$work/far.obj"
 expect_error "a vertex beyond 1e9 mm" 1 "far.obj: vertex 1 (1e+300, 0, 0) lies beyond" "$work/o5b.vtp" \

@@ -15,6 +15,14 @@ std::string lowerCaseExtension(const std::string& path) {
   return extension;
 }
 
+void requireNotInput(const std::string& output, const std::string& input) {
+  if (output.empty() || input.empty()) return;
+  std::error_code error;
+  if (std::filesystem::equivalent(output, input, error))
+    throw UsageError(output, "is an input of this run too" + (input == output ? "" : " (" + input + ")") +
+                                 ", which writing it would destroy: give the output another name or directory");
+}
+
 void requireExisting(const std::string& path) {
   std::error_code ignored;
   if (!std::filesystem::exists(path, ignored)) throw Error(path, "no such file or directory");

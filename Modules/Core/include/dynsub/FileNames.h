@@ -17,4 +17,9 @@ void requireExisting(const std::string& path);
 // first read, with a message that names no file) or cannot be opened.
 std::ifstream openForReading(const std::string& path, std::ios::openmode mode = std::ios::in);
 
+// Throws dynsub::UsageError naming `output` when it is the file `input`
+// names, by any path (a link, a relative name): writing the output would
+// destroy that input. Empty names and files that do not exist pass.
+void requireNotInput(const std::string& output, const std::string& input);
+
 }  // namespace dynsub
