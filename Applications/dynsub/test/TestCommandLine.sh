@@ -704,6 +704,12 @@ printf 'rope 2 2 2 to 9 9 9\nrun 50\n' >"$work/wild.sculpt"
 expect_error "solid sculpt: a diverging simulation" 1 "diverged" "$work/s35" \
   "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" --script "$work/wild.sculpt" --rope-stiffness 1e6 \
   --time-step 0.5 --out "$work/s35"
+# A blow-up is caught when its points pass 1e9 mm, before they turn
+# non-finite: 100 steps at this stiffness reach about 1e70 mm.
+printf 'run 100\n' >"$work/run100.sculpt"
+expect_error "solid sculpt: a blow-up still finite" 1 "diverged" "$work/s36" \
+  "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" --script "$work/run100.sculpt" --stiffness 1e5 \
+  --out "$work/s36"
 expect_error "solid sculpt: the window without a display" 1 "needs an X display" "$work/sculpted" \
   env -u DISPLAY "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice"
 env -u DISPLAY PATH=/nonexistent "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" \

@@ -4,6 +4,7 @@
 
 #include <Eigen/SparseCholesky>
 
+#include "dynsub/Coordinates.h"
 #include "dynsub/Error.h"
 
 namespace dynsub {
@@ -177,8 +178,11 @@ void SolidModel::step(double dt, SolidScheme scheme) {
       p.row(i) += dt * v.row(i);
     }
   }
-  if (!p.allFinite() || !v.allFinite())
-    throw Error("the solid's simulation diverged: the time step " + std::to_string(dt) + " s is too large");
+  // A step that overshoots grows the points geometrically; they pass any
+  // coordinate a model may have well before they turn non-finite.
+  if (!p.allFinite() || !v.allFinite() || p.cwiseAbs().maxCoeff() > kLargestCoordinate)
+    throw Error("the solid's simulation diverged: the time step " + std::to_string(dt) +
+                " s is too large for its stiffness and damping");
   p_ = std::move(p);
   v_ = std::move(v);
 }
