@@ -454,11 +454,15 @@ void run(Arguments& a) {
       a.landmarks.empty() ? std::vector<LandmarkSource>{} : landmarkSources({a.landmarks});
   // "Caudate_L;Putamen_L": two structures from the atlas.
   std::vector<std::string> atlasLabels;
-  std::stringstream labels(a.atlasLabel);
-  for (std::string label; std::getline(labels, label, ';');) {
+  // Every item between semicolons, the empty ones too ("Caudate_L;" is malformed).
+  for (std::size_t start = 0; !a.atlasLabel.empty() && start <= a.atlasLabel.size();) {
+    const std::size_t end = std::min(a.atlasLabel.find(';', start), a.atlasLabel.size());
+    std::string label = a.atlasLabel.substr(start, end - start);
+    start = end + 1;
     label.erase(0, label.find_first_not_of(" \t"));
     label.erase(label.find_last_not_of(" \t") + 1);
-    if (!label.empty()) atlasLabels.push_back(label);
+    if (label.empty()) throw UsageError("--atlasLabel " + a.atlasLabel + ": an empty structure between ';'");
+    atlasLabels.push_back(label);
   }
   const std::size_t structures = std::max(files.size(), atlasLabels.size());
   progress.setStructures(static_cast<int>(std::max<std::size_t>(structures, 1)));

@@ -119,6 +119,8 @@ cp "$work/ch2.nrrd" "$work/input_copy.nrrd"
 expect_failure "the labelmap written over the input volume" 2 "is an input of this run too" "${seeds[@]}" \
   --labelmap "$work/input_copy.nrrd" "$work/input_copy.nrrd"
 check "the input volume is left as it was" cmp -s "$work/ch2.nrrd" "$work/input_copy.nrrd"
+expect_failure "an atlas label list ending in ';'" 2 "an empty structure between ';'" --atlasLabel "Caudate_L;" \
+  --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
 expect_failure "model in a missing directory" 1 "no-dir" "${seeds[@]}" --labelmap "$work/bad.nrrd" \
   --model "$work/no-dir/m.vtp" "$work/ch2.nrrd"
 mkdir "$work/folder.vtp"

@@ -567,6 +567,8 @@ expect_error "edge thresholds the wrong way round" 2 "edge_low (--edge-low) is 5
   --edge-high 1 --out "$work/s9b"
 expect_error "an atlas label list ending in a comma" 2 "--atlas-label Caudate_L,: an empty label" "$work/s9c" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --init atlas --atlas-label Caudate_L, --out "$work/s9c"
+expect_error "the atlas's background as a structure" 2 "--atlas-label 0: 0 is the atlas's background" "$work/s9e" \
+  "$DYNSUB" segment "$mri/ch2.nii.gz" --init atlas --atlas-label 0 --out "$work/s9e"
 expect_error "a reference label list ending in a comma" 2 "--reference-label 71,: expected N" "$work/s9d" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" \
   --reference "$mri/aal.nii.gz" --reference-label 71, --out "$work/s9d"

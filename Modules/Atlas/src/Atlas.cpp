@@ -150,6 +150,8 @@ std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec) {
     if (asNumber >> number && asNumber.eof()) {
       if (number != std::floor(number) || std::abs(number) > 32767)
         throw UsageError("--atlas-label " + spec + ": " + item + " is not a label value");
+      // 0 is every label map's background, no structure.
+      if (number == 0) throw UsageError("--atlas-label " + spec + ": 0 is the atlas's background, not a structure");
       values.push_back(static_cast<int>(number));
       continue;
     }

@@ -57,6 +57,7 @@ TEST(Atlas, NamesAndValuesSelectLabels) {
   }
   EXPECT_THROW(atlasLabelValues(atlas, "71,,72"), UsageError);
   EXPECT_THROW(atlasLabelValues(atlas, "Caudate_L,"), UsageError);
+  EXPECT_THROW(atlasLabelValues(atlas, "0"), UsageError);  // the background
   EXPECT_THROW(atlasLabelValues(atlas, "7.5"), UsageError);
   // The calcarine cortex lies outside the cropped box: no voxel has it.
   EXPECT_THROW(atlasLabelValues(atlas, "Calcarine_L"), Error);
