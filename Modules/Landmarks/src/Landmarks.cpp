@@ -74,7 +74,9 @@ bool onStructure(const std::string& path, const std::string& type) {
 std::vector<LandmarkList> readMarkupsJson(const std::string& path, std::ifstream& in) {
   nlohmann::json document;
   try {
-    in >> document;
+    // Read to the end: text after the document (a file pasted twice, a
+    // stray edit) is refused, not ignored.
+    document = nlohmann::json::parse(in);
   } catch (const nlohmann::json::exception& e) {
     throw Error(path, std::string("not valid JSON: ") + e.what());
   }

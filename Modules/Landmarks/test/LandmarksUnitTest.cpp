@@ -2,6 +2,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <string>
 
 #include "ScratchFiles.h"
 #include "dynsub/Error.h"
@@ -160,6 +162,14 @@ TEST(Landmarks, BadFilesAreRefusedWithTheirName) {
   expectError(scratch("noheader.csv"), "x, y and z");
   std::ofstream(scratch("broken.mrk.json").string()) << "{\"markups\": [";
   expectError(scratch("broken.mrk.json"), "JSON");
+  // Text after the document (here the document pasted twice) is refused, not ignored.
+  writeLandmarks(sample(), scratch("twice.mrk.json").string());
+  {
+    std::ifstream in(scratch("twice.mrk.json"));
+    const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    std::ofstream(scratch("twice.mrk.json").string()) << text << text;
+  }
+  expectError(scratch("twice.mrk.json"), "not valid JSON");
   EXPECT_THROW(writeLandmarks(sample(), scratch("no/such/dir/p.csv").string()), Error);
 }
 
