@@ -749,8 +749,10 @@ expect_error "subject: missing labels" 1 "nolabels.nii.gz" "$work/s42" \
   "$DYNSUB" subject "$mri/ch2.nii.gz" "$work/nolabels.nii.gz" --out "$work/s42"
 expect_error "subject: an image given as its labels" 1 "image.nii.gz: not a label map" "$work/s44" \
   "$DYNSUB" subject "$mri/ch2.nii.gz" "$work/subject/image.nii.gz" --out "$work/s44"
-expect_error "subject: a negative seed" 2 "--seed: expected a whole number, 0 or more, got '-1'" "$work/s45" \
-  "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --seed -1 --out "$work/s45"
+expect_error "subject: a negative seed" 2 "--seed: expected a whole number from 0 to 18446744073709551615, got '-1'" \
+  "$work/s45" "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --seed -1 --out "$work/s45"
+expect_error "subject: a seed past 2^64-1" 2 "got '99999999999999999999'" "$work/s45" \
+  "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --seed 99999999999999999999 --out "$work/s45"
 
 # The atlas start on that subject: Colin27 and AAL registered to it, the left
 # putamen carried there by name, with a click inside it.
