@@ -151,9 +151,9 @@ void addDeformCommand(CLI::App& app) {
                       "Spring file: one spring per line, 'x y z' or 'x y z stiffness' (mm, N/mm)")
       ->required();
   command->add_option("--out", o->out, "Output directory (created if missing; its parent must exist)")->required();
-  command->add_option("--stiffness", o->stiffness, "Stiffness of springs that do not give one, N/mm")
+  command->add_option("--stiffness", o->stiffness, "Stiffness of springs that do not give one, N/mm (up to 1e12)")
       ->default_val(o->stiffness)
-      ->check(positiveNumber());
+      ->check(positiveNumber(kLargestSpringStiffness));
   command->add_flag("--fix-boundary", o->fixBoundary,
                     "Hold the boundary of an open mesh in place: its control vertices, and after refinement their new "
                     "boundary points");

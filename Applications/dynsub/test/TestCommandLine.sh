@@ -198,6 +198,18 @@ check "the brim stays" grep -q "^v -1 -1 0$" "$work/hat/control_mesh.obj"
 expect_error "deform: first-order steps without damping" 2 "first-order integration needs a damping > 0" \
   "$work/hat0" "$DYNSUB" deform "$DATA/Meshes/sheet.obj" --springs "$DATA/Deform/sheet_hat.springs" \
   --scheme first-order --damping 0 --out "$work/hat0"
+# Springs past what double precision balances against the surface's own
+# stiffness (a 1e15 N/mm spring ended at a residual of 0.86, called an
+# equilibrium), and points past 1e9 mm, are refused with their line.
+printf '2 0 0 1e15\n-2 0 0 10\n' >"$work/stiff.springs"
+expect_error "deform: a spring stiffer than 1e12 N/mm" 1 "stiff.springs: line 1: stiffness 1e+15 is outside" \
+  "$work/hat1" "$DYNSUB" deform "$DATA/Meshes/torus.obj" --springs "$work/stiff.springs" --out "$work/hat1"
+printf '2 0 0\n1e10 0 0\n' >"$work/far.springs"
+expect_error "deform: a spring's point beyond 1e9 mm" 1 "far.springs: line 2: the spring's point" \
+  "$work/hat1" "$DYNSUB" deform "$DATA/Meshes/torus.obj" --springs "$work/far.springs" --out "$work/hat1"
+expect_error "deform: --stiffness above 1e12" 2 "--stiffness: 1e16 is not a finite number > 0 and <= 1e+12" \
+  "$work/hat1" "$DYNSUB" deform "$DATA/Meshes/torus.obj" --springs "$work/far.springs" --stiffness 1e16 \
+  --out "$work/hat1"
 # Refined twice near the crown, the brim still stays: every point within
 # 0.03 of the rim (the level's spacing is 0.0625) is on it, at z = 0.
 "$DYNSUB" deform "$DATA/Meshes/sheet.obj" --springs "$DATA/Deform/sheet_hat.springs" --fix-boundary \

@@ -4,6 +4,7 @@
 #include <sstream>
 #include <vector>
 
+#include "dynsub/Coordinates.h"
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
 #include "dynsub/TextFields.h"
@@ -37,7 +38,14 @@ SpringFile readSpringFile(const std::string& path, double defaultStiffness) {
     }
     const Eigen::Vector4d row(values[0], values[1], values[2], values.size() == 4 ? values[3] : defaultStiffness);
     if (!row.allFinite()) throw Error(path, "line " + std::to_string(number) + ": a value is not finite");
-    if (!(row(3) > 0.0)) throw Error(path, "line " + std::to_string(number) + ": stiffness must be > 0");
+    const std::string at = "line " + std::to_string(number) + ": ";
+    if (!(row(3) > 0.0 && row(3) <= kLargestSpringStiffness)) {
+      std::ostringstream text;
+      text << "stiffness " << row(3) << " is outside (0, 1e12] N/mm";
+      throw Error(path, at + text.str());
+    }
+    const std::string beyond = beyondLargestCoordinate(row.head<3>());
+    if (!beyond.empty()) throw Error(path, at + "the spring's point " + beyond);
     rows.push_back(row);
   }
   if (rows.empty()) throw Error(path, "has no springs");
