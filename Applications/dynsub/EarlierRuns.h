@@ -31,9 +31,11 @@ constexpr char kSculptedFigure[] = "sculpted.png";
 // files, the ones above, convergence.csv and the figures in each format.
 std::vector<std::string> runFiles();
 
-// Throws UsageError when one of `inputs` is a file of runFiles() in `dir`:
-// the run would overwrite it, or remove it as an earlier run's.
-void requireInputsOutsideRun(const std::filesystem::path& dir, const std::vector<std::string>& inputs);
+// Throws UsageError when one of `inputs` is a file of runFiles() in `dir`,
+// or lies in a structure's folder that retireEarlierRun would remove (those
+// not in `keptFolders`): the run would overwrite it or remove it.
+void requireInputsOutsideRun(const std::filesystem::path& dir, const std::vector<std::string>& inputs,
+                             const std::vector<std::string>& keptFolders = {});
 
 // Retires every file of runFiles() in `dir` (the set keeps those it
 // writes itself), and the structures' folders an earlier run of several

@@ -9,10 +9,10 @@
 #include <vector>
 
 #include "Commands.h"
-#include "EarlierRuns.h"
 #include "FigureOutputs.h"
 #include "dynsub/Error.h"
 #include "dynsub/FigureInputs.h"
+#include "dynsub/FileNames.h"
 #include "dynsub/ImageIO.h"
 #include "dynsub/Landmarks.h"
 #include "dynsub/MeshIO.h"
@@ -89,7 +89,14 @@ void runRender(const RenderCommandOptions& o) {
   }
 
   const std::filesystem::path dir(o.out);
-  requireInputsOutsideRun(dir, {o.surface, o.image, o.landmarks, o.points, o.outliers, o.convergence, o.controlMesh});
+  // render writes only figures: a run's other files, its convergence table
+  // too, may be its inputs.
+  for (const std::string& name : figureOutputNames()) {
+    if (lowerCaseExtension(name) == ".csv") continue;
+    for (const std::string& input :
+         {o.surface, o.image, o.landmarks, o.points, o.outliers, o.convergence, o.controlMesh})
+      requireNotInput((dir / name).string(), input);
+  }
   prepareOutputDirectory(dir);
   OutputSet outputs(dir);
   writeFigures(inputs, o.figures.files(outputs, !o.convergence.empty()));

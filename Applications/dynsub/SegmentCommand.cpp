@@ -75,7 +75,6 @@ std::vector<int> parseLabelValues(const std::string& text) {
       throw UsageError("--reference-label " + text + ": expected N[,M...] (integers)");
     values.push_back(value);
   }
-  if (values.empty()) throw UsageError("--reference-label " + text + ": expected N[,M...] (integers)");
   return values;
 }
 
@@ -175,6 +174,8 @@ void runSegmentOne(const Arguments& o, const LandmarkSource* landmarks) {
   std::vector<int> referenceLabels;
   for (const std::string& values : o.referenceLabels)
     for (const int value : parseLabelValues(values)) referenceLabels.push_back(value);
+  const std::filesystem::path dir(o.out);
+  requireInputsOutsideRun(dir, {o.image, landmarks ? landmarks->path : "", o.reference, o.atlas, o.atlasLabels});
   const Volume image = readVolume(o.image);
   if (landmarks) {
     inputs.landmarks = landmarks->list.landmarks;
@@ -207,8 +208,6 @@ void runSegmentOne(const Arguments& o, const LandmarkSource* landmarks) {
     inputs.referencePath = o.reference;
     inputs.referenceLabels = referenceLabels;
   }
-  const std::filesystem::path dir(o.out);
-  requireInputsOutsideRun(dir, {o.image, landmarks ? landmarks->path : "", o.reference, o.atlas, o.atlasLabels});
   prepareOutputDirectory(dir);
   o.figures.prepare();
 
@@ -308,8 +307,8 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
   const std::vector<std::string> files = runFiles();
   for (const StructureInputs& structure : structures)
     if (std::find(files.begin(), files.end(), structure.name) != files.end())
-      throw Error("structure name '" + structure.name + "' is a file the run writes or removes in " + o.out +
-                  ": give the structure another --name");
+      throw UsageError("structure name '" + structure.name + "' is a file the run writes or removes in " + o.out +
+                       ": give the structure another --name");
   // The references: one labelmap, read once, each structure's labels picked
   // from it before the run.
   std::vector<std::optional<Mask>> references(structures.size());
@@ -323,8 +322,10 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
   const std::filesystem::path dir(o.out);
   std::vector<std::string> inputs{o.image, o.reference, o.atlas, o.atlasLabels};
   for (const LandmarkSource& source : sources) inputs.push_back(source.path);
-  requireInputsOutsideRun(dir, inputs);
-  for (const StructureInputs& structure : structures) requireInputsOutsideRun(dir / structure.name, inputs);
+  std::vector<std::string> names;
+  for (const StructureInputs& structure : structures) names.push_back(structure.name);
+  requireInputsOutsideRun(dir, inputs, names);
+  for (const std::string& name : names) requireInputsOutsideRun(dir / name, inputs);
   prepareOutputDirectory(dir);
   o.figures.prepare();
 
@@ -345,8 +346,6 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
     }
     // What an earlier run into DIR wrote that this one does not: one
     // structure's outputs, a fit's, or other structures' folders.
-    std::vector<std::string> names;
-    for (const StructureInputs& structure : structures) names.push_back(structure.name);
     retireEarlierRun(outputs, dir, names);
     writeVolume(outcome.labels, outputs.add(kJoinedLabelmap), VoxelType::Label16);
     writeLabelTable(structures, outputs.add(kJoinedTable));

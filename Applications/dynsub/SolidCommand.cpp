@@ -108,10 +108,10 @@ void runSculpt(const SculptOptions& options) {
   const Lattice lattice = readLattice(o.lattice);
   // An --out that cannot be a directory is said before a script runs (the
   // window says it when s saves).
-  if (!o.script.empty()) {
-    requireInputsOutsideRun(o.out, {o.lattice, o.script});
-    prepareOutputDirectory(o.out);
-  }
+  // Saved from the window or at the script's end, the sculpture would
+  // replace an input of the same name in --out.
+  requireInputsOutsideRun(o.out, {o.lattice, o.script});
+  if (!o.script.empty()) prepareOutputDirectory(o.out);
   Report report;
   report.set("lattice", o.lattice);
   if (o.script.empty()) {

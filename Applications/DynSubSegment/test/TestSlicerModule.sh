@@ -110,7 +110,7 @@ expect_failure "point outside the volume" 1 "outside the image" --seed 500,0,0 "
 expect_failure "no output asked for" 2 "nothing to write" "${seeds[@]}" "$work/ch2.nrrd"
 expect_failure "unknown labelmap format" 2 "unknown labelmap format" "${seeds[@]}" --labelmap "$work/bad.png" \
   "$work/ch2.nrrd"
-# "x.gz" is no compressed NIfTI name: refused before the run, not after it.
+# "x.gz" is no compressed NIfTI name: refused before the run, as every output name is.
 expect_failure "a labelmap named .gz alone" 2 "unknown labelmap format '.gz'" "${seeds[@]}" \
   --labelmap "$work/bad.gz" "$work/ch2.nrrd"
 expect_failure "--xml with other arguments" 2 "takes no other argument" --xml "${seeds[@]}" \

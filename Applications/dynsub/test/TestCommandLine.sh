@@ -128,14 +128,24 @@ expect_error "a control mesh of the wrong genus" 1 "torus.obj: the initial model
 # An output that is an input of the run is refused before anything is
 # written: the run would destroy it (or retire it as an earlier run's).
 cp "$DATA/Meshes/cube.obj" "$work/same.obj"
-expect_error "limit's output is its input" 2 "same.obj: is an input of this run too" "$work/none" \
+expect_error "limit's output is its input" 2 "same.obj: is an input of this run too" "$work/same.vtp" \
   "$DYNSUB" limit "$work/same.obj" --out "$work/same.obj"
 check "limit's input is left as it was" cmp -s "$DATA/Meshes/cube.obj" "$work/same.obj"
 mkdir -p "$work/earlier"
 cp "$DATA/Meshes/cube.obj" "$work/earlier/control_mesh.obj"
-expect_error "deform's input among its run's files" 2 "control_mesh.obj: is an input of this run too" "$work/none" \
+expect_error "deform's input among its run's files" 2 "control_mesh.obj: is an input of this run too" \
+  "$work/earlier/surface.vtp" \
   "$DYNSUB" deform "$work/earlier/control_mesh.obj" --springs "$DATA/Deform/cube_bump.springs" --out "$work/earlier"
 check "deform's input is left as it was" cmp -s "$DATA/Meshes/cube.obj" "$work/earlier/control_mesh.obj"
+# An earlier run of several structures left a folder the run would remove whole.
+mkdir -p "$work/earlier/caudate"
+printf 'index\tname\tcolor\n1\tcaudate\t#ff0000\n' >"$work/earlier/dseg.tsv"
+printf '{}\n' >"$work/earlier/caudate/report.json"
+cp "$DATA/Meshes/cube.obj" "$work/earlier/caudate/control_mesh.obj"
+expect_error "deform's input in a structure folder the run removes" 2 "an earlier run's structure folder" \
+  "$work/earlier/surface.vtp" "$DYNSUB" deform "$work/earlier/caudate/control_mesh.obj" \
+  --springs "$DATA/Deform/cube_bump.springs" --out "$work/earlier"
+check "deform's input in that folder is left" cmp -s "$DATA/Meshes/cube.obj" "$work/earlier/caudate/control_mesh.obj"
 # A vertex whose areas overflow: named as such, not as a degenerate face.
 printf 'v 0 0 0\nv 1e300 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\n' >"$work/far.obj"
 expect_error "a vertex beyond 1e9 mm" 1 "far.obj: vertex 1 (1e+300, 0, 0) lies beyond" "$work/o5b.vtp" \
@@ -335,6 +345,9 @@ for name in slices.png surface3d.png; do
   check "render redraws fit's $name, coloured by the distance to the scan, pixel for pixel" \
     cmp -s "$work/fitholerendered/$name" "$work/fithole/$name"
 done
+# Redrawn in place, from the run's own files: render writes only figures.
+check "render redraws a run's figures in its own directory" "$DYNSUB" render --surface "$work/fithole/surface.vtp" \
+  --control-mesh "$work/fithole/control_mesh.obj" --convergence "$work/fithole/convergence.csv" --out "$work/fithole"
 # Six points well off the torus (in its hole, 15-17 mm above and below its
 # tube, whose radius is 15 mm) are set aside as outliers: written to
 # outliers.xyz as the very numbers they were read as, and drawn apart from

@@ -41,7 +41,7 @@ SpringFile readSpringFile(const std::string& path, double defaultStiffness) {
     const std::string at = "line " + std::to_string(number) + ": ";
     if (!(row(3) > 0.0 && row(3) <= kLargestSpringStiffness)) {
       std::ostringstream text;
-      text << "stiffness " << row(3) << " is outside (0, 1e12] N/mm";
+      text << "stiffness " << row(3) << " is outside (0, " << kLargestSpringStiffness << "] N/mm";
       throw Error(path, at + text.str());
     }
     const std::string beyond = beyondLargestCoordinate(row.head<3>());

@@ -93,8 +93,8 @@ void readImage(const std::string& path, Geometry& geometry, std::vector<float>& 
     // A 3D scalar image is read by its ImageIO straight into `voxels` (a
     // float file) or through one buffer of its own type: ImageFileReader
     // would add an image of its own and a copy of it into `voxels`, a third
-    // of the segment command's page faults. Other files (2D, 4D, vectors)
-    // go through ImageFileReader, which makes a 3D float image of them.
+    // of the segment command's page faults. Other files (2D, 4D) go through
+    // ImageFileReader, which makes a 3D float image of them.
     if (io->GetNumberOfDimensions() == 3 && io->GetNumberOfComponents() == 1 && readScalarVolume(*io, geometry, voxels))
       return;
     auto reader = itk::ImageFileReader<FloatImage>::New();

@@ -108,13 +108,23 @@ void requireQformWhereShearedSform(const std::string& path, const Real& real, in
   if (!(largestCosine > 1e-4)) return;  // perpendicular axes: ITK takes the sform
   // qform: quatern_b, c, d, qoffset_x, y, z, and pixdim[0..3] (qfac, spacing).
   const int quatern = version == 1 ? 256 : 352, pixdim = version == 1 ? 76 : 104;
-  const double b = real(quatern), c = real(quatern + realBytes), d = real(quatern + 2 * realBytes);
+  // As NIfTI's reference library reads them: b, c, d of a norm above 1 are
+  // normalized (a = 0), and a spacing of 0 or less is taken as 1.
+  double b = real(quatern), c = real(quatern + realBytes), d = real(quatern + 2 * realBytes);
+  const double squared = b * b + c * c + d * d;
+  if (squared > 1.0) {
+    const double norm = std::sqrt(squared);
+    b /= norm;
+    c /= norm;
+    d /= norm;
+  }
   const double a = std::sqrt(std::max(0.0, 1.0 - (b * b + c * c + d * d)));
+  auto positive = [](double spacing) { return spacing > 0 ? spacing : 1.0; };
   const double rotation[3][3] = {{a * a + b * b - c * c - d * d, 2 * (b * c - a * d), 2 * (b * d + a * c)},
                                  {2 * (b * c + a * d), a * a + c * c - b * b - d * d, 2 * (c * d - a * b)},
                                  {2 * (b * d - a * c), 2 * (c * d + a * b), a * a + d * d - c * c - b * b}};
-  const double spacing[3] = {real(pixdim + realBytes), real(pixdim + 2 * realBytes),
-                             (real(pixdim) < 0 ? -1.0 : 1.0) * real(pixdim + 3 * realBytes)};
+  const double spacing[3] = {positive(real(pixdim + realBytes)), positive(real(pixdim + 2 * realBytes)),
+                             (real(pixdim) < 0 ? -1.0 : 1.0) * positive(real(pixdim + 3 * realBytes))};
   // The largest distance between the two placements of a corner voxel.
   double apart = 0;
   for (int corner = 0; corner < 8; ++corner) {
