@@ -199,6 +199,15 @@ void runSegmentOne(const Arguments& o, const LandmarkSource* landmarks) {
   // runs, and its errors (a missing file at once) still come before any
   // output is written.
   std::shared_future<Mask> reference;
+  // The thread reads `image` and `referenceLabels`: whatever ends this run,
+  // an error included, it ends before they are destroyed (`inputs`, declared
+  // before them, keeps a copy of the future).
+  struct WaitForReference {
+    const std::shared_future<Mask>& future;
+    ~WaitForReference() {
+      if (future.valid()) future.wait();
+    }
+  } waitForReference{reference};
   if (!o.reference.empty()) {
     requireExisting(o.reference);  // before the segmentation; its other errors come with its reading
     reference = std::async(std::launch::async, [&o, &image, &referenceLabels] {
