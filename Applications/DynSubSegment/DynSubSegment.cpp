@@ -34,6 +34,7 @@
 #include "dynsub/SegmentImage.h"
 #include "dynsub/SegmentStructures.h"
 #include "dynsub/SurfaceWriter.h"
+#include "dynsub/TextFields.h"
 
 namespace {
 
@@ -454,16 +455,12 @@ void run(Arguments& a) {
       a.landmarks.empty() ? std::vector<LandmarkSource>{} : landmarkSources({a.landmarks});
   // "Caudate_L;Putamen_L": two structures from the atlas.
   std::vector<std::string> atlasLabels;
-  // Every item between semicolons, the empty ones too ("Caudate_L;" is malformed).
-  for (std::size_t start = 0; !a.atlasLabel.empty() && start <= a.atlasLabel.size();) {
-    const std::size_t end = std::min(a.atlasLabel.find(';', start), a.atlasLabel.size());
-    std::string label = a.atlasLabel.substr(start, end - start);
-    start = end + 1;
-    label.erase(0, label.find_first_not_of(" \t"));
-    label.erase(label.find_last_not_of(" \t") + 1);
-    if (label.empty()) throw UsageError("--atlasLabel " + a.atlasLabel + ": an empty structure between ';'");
-    atlasLabels.push_back(label);
-  }
+  if (!a.atlasLabel.empty())
+    for (const std::string& written : splitItems(a.atlasLabel, ';')) {  // "Caudate_L;" has an empty item
+      const std::string label = trimmed(written);
+      if (label.empty()) throw UsageError("--atlasLabel " + a.atlasLabel + ": an empty structure between ';'");
+      atlasLabels.push_back(label);
+    }
   const std::size_t structures = std::max(files.size(), atlasLabels.size());
   progress.setStructures(static_cast<int>(std::max<std::size_t>(structures, 1)));
   if (structures > 1) {

@@ -132,6 +132,8 @@ double statedNoise(const std::string& text) {
 void runFit(FitCommandOptions o) {
   const double stated = statedNoise(o.noise);
   checkInitialModelOption(o);
+  const std::filesystem::path dir(o.out);
+  requireInputsOutsideRun(dir, {o.points, o.reference, o.init});
   const PointCloud input = readPointCloud(o.points);
   const MatrixX3& scan = input.points;
   checkPointCloud(scan, o.points);
@@ -172,8 +174,6 @@ void runFit(FitCommandOptions o) {
                        std::to_string(initial.genus()) + ": " + why + " (give " + builtIn +
                        "a closed control mesh of genus " + g + " with --init MESH)");
   }
-  const std::filesystem::path dir(o.out);
-  requireInputsOutsideRun(dir, {o.points, o.reference, o.init});
   prepareOutputDirectory(dir);
   o.fit.simulation = o.simulation.apply(o.fit.simulation);
   o.figures.prepare();

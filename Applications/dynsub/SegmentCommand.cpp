@@ -30,6 +30,7 @@
 #include "dynsub/SegmentImage.h"
 #include "dynsub/SegmentStructures.h"
 #include "dynsub/SurfaceWriter.h"
+#include "dynsub/TextFields.h"
 
 namespace dynsub::app {
 
@@ -59,11 +60,7 @@ struct Arguments {
 // "71" or "71,72": a structure's label values in --reference.
 std::vector<int> parseLabelValues(const std::string& text) {
   std::vector<int> values;
-  // Every item between commas, the empty ones too ("71," and "71,,72" are malformed).
-  for (std::size_t start = 0; start <= text.size();) {
-    const std::size_t comma = std::min(text.find(',', start), text.size());
-    const std::string item = text.substr(start, comma - start);
-    start = comma + 1;
+  for (const std::string& item : splitItems(text, ',')) {  // "71," and "71,,72" have an empty item
     std::size_t used = 0;
     int value = 0;
     try {

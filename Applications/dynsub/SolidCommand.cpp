@@ -106,10 +106,9 @@ void runSculpt(const SculptOptions& options) {
   SculptOptions o = options;
   o.settings.scheme = o.scheme == "explicit" ? SolidScheme::PaperExplicit : SolidScheme::SemiImplicit;
   const Lattice lattice = readLattice(o.lattice);
-  // An --out that cannot be a directory is said before a script runs (the
-  // window says it when s saves).
   // Saved from the window or at the script's end, the sculpture would
-  // replace an input of the same name in --out.
+  // replace an input of the same name in --out. An --out that cannot be a
+  // directory is said before a script runs (the window says it when s saves).
   requireInputsOutsideRun(o.out, {o.lattice, o.script});
   if (!o.script.empty()) prepareOutputDirectory(o.out);
   Report report;

@@ -136,14 +136,9 @@ Atlas readAtlas(const std::string& imagePath, const std::string& labelsPath) {
 
 std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec) {
   std::vector<int> values;
-  // getline reads no empty item after a last comma.
-  const std::size_t last = spec.find_last_not_of(" \t");
-  if (last != std::string::npos && spec[last] == ',') throw UsageError("--atlas-label " + spec + ": an empty label");
-  std::stringstream items(spec);
-  std::string item;
-  while (std::getline(items, item, ',')) {
-    item.erase(0, item.find_first_not_of(" \t"));
-    item.erase(item.find_last_not_of(" \t") + 1);
+  if (spec.empty()) throw UsageError("--atlas-label: no label given");
+  for (const std::string& written : splitItems(spec, ',')) {
+    const std::string item = trimmed(written);
     if (item.empty()) throw UsageError("--atlas-label " + spec + ": an empty label");
     double number = 0;
     std::istringstream asNumber(item);
@@ -169,7 +164,6 @@ std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec) {
     });
     throw Error(atlas.labelsPath, "no label named '" + item + "' (did you mean '" + nearest->second + "'?)");
   }
-  if (values.empty()) throw UsageError("--atlas-label: no label given");
   for (int value : values)
     if (selectLabels(atlas.labels, {value}).count() == 0)
       throw Error(atlas.labelsPath, "no voxel has the label " + std::to_string(value));

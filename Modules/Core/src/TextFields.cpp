@@ -16,6 +16,21 @@ bool parseNumber(const std::string& field, double& value) {
   }
 }
 
+std::vector<std::string> splitItems(const std::string& text, char separator) {
+  std::vector<std::string> items;
+  for (std::size_t start = 0; start <= text.size();) {
+    const std::size_t end = std::min(text.find(separator, start), text.size());
+    items.push_back(text.substr(start, end - start));
+    start = end + 1;
+  }
+  return items;
+}
+
+std::string trimmed(const std::string& text) {
+  const std::size_t first = text.find_first_not_of(" \t");
+  return first == std::string::npos ? std::string() : text.substr(first, text.find_last_not_of(" \t") + 1 - first);
+}
+
 std::size_t editDistance(const std::string& a, const std::string& b) {
   const auto lower = [](unsigned char c) { return static_cast<char>(std::tolower(c)); };
   std::vector<std::size_t> row(b.size() + 1);

@@ -23,5 +23,18 @@ TEST(TextFields, NearestWordNamesOnlyASlip) {
   EXPECT_EQ(nearestWord("xyz", commands), "");
 }
 
+// The label lists' parsers rest on it: an empty item is kept, so that "71,"
+// is refused rather than read as 71.
+TEST(TextFields, SplitItemsKeepsEmptyItemsAsWritten) {
+  using Items = std::vector<std::string>;
+  EXPECT_EQ(splitItems("71, 72", ','), (Items{"71", " 72"}));
+  EXPECT_EQ(splitItems("71,", ','), (Items{"71", ""}));
+  EXPECT_EQ(splitItems("71,,72", ','), (Items{"71", "", "72"}));
+  EXPECT_EQ(splitItems("", ';'), (Items{""}));
+  EXPECT_EQ(trimmed(" Caudate_L \t"), "Caudate_L");
+  EXPECT_EQ(trimmed(" \t "), "");
+}
+
 }  // namespace
 }  // namespace dynsub
+

@@ -10,6 +10,14 @@ namespace dynsub {
 // "inf" included: callers decide about finiteness); `value` receives it.
 bool parseNumber(const std::string& field, double& value);
 
+// Every item of `text` between `separator`s, as written, the empty ones too
+// ("71," is "71" and "", where std::getline would give "71" alone); one
+// empty item for an empty text.
+std::vector<std::string> splitItems(const std::string& text, char separator);
+
+// `text` without the blanks and tabs at its ends.
+std::string trimmed(const std::string& text);
+
 // Levenshtein's distance, case-insensitive.
 std::size_t editDistance(const std::string& a, const std::string& b);
 
