@@ -37,16 +37,7 @@ std::vector<std::string> fieldsOf(const std::string& line, bool csv) {
   for (const char c : {',', ';', '\t'})
     if (!separator && line.find(c) != std::string::npos) separator = c;
   if (csv && separator) {
-    std::string field;
-    for (const char c : line) {
-      if (c == separator) {
-        fields.push_back(field);
-        field.clear();
-      } else {
-        field += c;
-      }
-    }
-    fields.push_back(field);
+    fields = splitItems(line, separator);
   } else {
     std::istringstream in(line);
     for (std::string field; in >> field;) fields.push_back(field);
