@@ -19,6 +19,7 @@
 #include <iostream>
 #include <list>
 #include <memory>
+#include <new>
 #include <sstream>
 
 #include <CLI/CLI.hpp>
@@ -506,6 +507,9 @@ int main(int argc, char** argv) {
   } catch (const dynsub::Error& error) {
     std::cerr << "DynSubSegment: error: " << dynsub::withoutTemporaryPrefix(error.what()) << '\n';
     return dynamic_cast<const dynsub::UsageError*>(&error) ? 2 : 1;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "DynSubSegment: error: out of memory: the run needed more than this machine (or its limit) gives\n";
+    return 1;
   } catch (const std::exception& error) {
     std::cerr << "DynSubSegment: unexpected error: " << error.what() << '\n';
     return 1;

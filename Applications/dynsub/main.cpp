@@ -2,6 +2,7 @@
 // subdivision surfaces. Exit codes: 0 success, 1 an error in the input or the
 // run (the message names the file and problem), 2 a usage error.
 #include <iostream>
+#include <new>
 
 #include <CLI/CLI.hpp>
 
@@ -42,6 +43,11 @@ int main(int argc, char** argv) {
   } catch (const dynsub::Error& error) {
     std::cerr << "dynsub: error: " << dynsub::withoutTemporaryPrefix(error.what()) << '\n';
     return dynamic_cast<const dynsub::UsageError*>(&error) ? 2 : 1;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "dynsub: error: out of memory: the run needed more than this machine (or its limit, ulimit -v) "
+                 "gives. An output's size grows as the square or the cube of --samples-per-face and of --level: a "
+                 "smaller value needs far less\n";
+    return 1;
   } catch (const std::exception& error) {
     std::cerr << "dynsub: unexpected error: " << error.what() << '\n';
     return 1;

@@ -100,9 +100,9 @@ expect_failure() {
   check "$name: no temporary file" test -z "$(ls -A "$work" | grep '^\.tmp')"
 }
 expect_failure "missing volume" 1 "no-such.nrrd" "${seeds[@]}" --labelmap "$work/bad.nrrd" "$work/no-such.nrrd"
-expect_failure "three points" 1 "--seed: 3 landmarks are too few" --seed 1,2,3 --seed 4,5,6 --seed 7,8,9 \
+expect_failure "three points" 2 "--seed: 3 landmarks are too few" --seed 1,2,3 --seed 4,5,6 --seed 7,8,9 \
   --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
-expect_failure "no points" 1 "no landmarks to build the initial model from" --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
+expect_failure "no points" 2 "no landmarks to build the initial model from" --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
 expect_failure "malformed point" 2 "expected x,y,z" --seed 1,2 --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
 expect_failure "NaN point" 2 "expected x,y,z" --seed nan,2,3 --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
 expect_failure "point outside the volume" 1 "outside the image" --seed 500,0,0 "${seeds[@]:2}" \

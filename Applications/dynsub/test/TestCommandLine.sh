@@ -30,10 +30,10 @@ printf 'v 0 0 0\nv 1 nan 0\n' >"$work/nan.obj"
 expect_error "unparsable number" 1 "nan.obj" "$work/c.vtp" "$DYNSUB" limit "$work/nan.obj" --out "$work/c.vtp"
 : >"$work/empty.obj"
 expect_error "empty mesh" 1 "no vertices" "$work/d.vtp" "$DYNSUB" limit "$work/empty.obj" --out "$work/d.vtp"
-expect_error "unknown output format" 1 "unknown surface format" "$work/e.xyz" \
+expect_error "unknown output format" 2 "unknown surface format" "$work/e.xyz" \
   "$DYNSUB" limit "$DATA/Meshes/cube.obj" --out "$work/e.xyz"
 # The output's name is checked before the mesh is read and its limit evaluated.
-expect_error "unknown output format, before the work" 1 "unknown surface format" "$work/e.xyz" \
+expect_error "unknown output format, before the work" 2 "unknown surface format" "$work/e.xyz" \
   "$DYNSUB" limit "$work/none.obj" --out "$work/e.xyz"
 expect_error "a missing output directory, before the work" 1 "does not exist" "$work/no/f.vtp" \
   "$DYNSUB" limit "$work/none.obj" --out "$work/no/f.vtp"
@@ -41,8 +41,17 @@ expect_error "missing output directory" 1 "does not exist" "$work/no/f.vtp" \
   "$DYNSUB" limit "$DATA/Meshes/cube.obj" --out "$work/no/f.vtp"
 expect_error "impossible sample count" 2 "samples-per-face" "$work/g.vtp" \
   "$DYNSUB" limit "$DATA/Meshes/cube.obj" --samples-per-face 0 --out "$work/g.vtp"
+# 1024 samples per face on the kitten's 3088 elements would be 6.5e9
+# triangles: refused before any is made, with the largest count that fits.
+expect_error "more triangles than a surface can number" 1 "use at most 589 samples per face" "$work/g2.vtp" \
+  "$DYNSUB" limit "$DATA/Meshes/kitten_genus1.obj" --samples-per-face 1024 --out "$work/g2.vtp"
+# Memory running out is said in words, with the options that set the size
+# (level 6 needs about 6 GB; here 2 GB of address space are allowed).
+expect_error "out of memory" 1 "out of memory" "$work/g3.lattice" \
+  bash -c 'ulimit -v 2000000 && exec "$0" "$@"' "$DYNSUB" solid subdivide "$DATA/Solids/cube3.lattice" --level 6 \
+  --out "$work/g3.lattice"
 expect_error "unknown standard mesh" 2 "NAME" "$work/h.obj" "$DYNSUB" mesh sphere --out "$work/h.obj"
-expect_error "a standard mesh under another extension" 1 "c.off: the control mesh is written as OBJ" "$work/c.off" \
+expect_error "a standard mesh under another extension" 2 "c.off: the control mesh is written as OBJ" "$work/c.off" \
   "$DYNSUB" mesh cube --out "$work/c.off"
 expect_error "a misspelt command" 2 "did you mean 'segment'" "$work/i" "$DYNSUB" segmnet x.nii.gz --out "$work/i"
 expect_error "a misspelt option" 2 "did you mean '--landmarks'" "$work/j" \
@@ -685,7 +694,7 @@ sed 's/^6 0 1 2 3 4 5$/5 0 1 2 3 4/' "$DATA/Solids/cube3.lattice" >"$work/open.l
 expect_error "solid: a cell that is not closed" 1 "cell 0 is not closed" "$work/o20.lattice" \
   "$DYNSUB" solid subdivide "$work/open.lattice" --out "$work/o20.lattice"
 # The output's name is checked before the lattice is read and subdivided.
-expect_error "solid: an unknown output format, before the work" 1 "unknown lattice format" "$work/o20" \
+expect_error "solid: an unknown output format, before the work" 2 "unknown lattice format" "$work/o20" \
   "$DYNSUB" solid subdivide "$work/none.lattice" --out "$work/o20"
 sed 's/^4 0 3 4 1$/4 0 3 4 99/' "$DATA/Solids/cube3.lattice" >"$work/range.lattice"
 expect_error "solid: a point index out of range" 1 "uses point 99" "$work/o21.vtu" \
@@ -807,6 +816,8 @@ expect_error "segment --init seed: a NaN coordinate" 2 "expected seed:x,y,z" "$w
 printf 'x,y,z\n' >"$work/empty.csv"
 expect_error "segment: a landmark file with no points" 1 "empty.csv: no landmarks" "$work/s48" \
   "$DYNSUB" segment "$work/subject/image.nii.gz" --landmarks "$work/empty.csv" --out "$work/s48"
+expect_error "segment: nothing to start from" 2 "no landmarks to build the initial model from" "$work/s48b" \
+  "$DYNSUB" segment "$work/subject/image.nii.gz" --out "$work/s48b"
 mkdir -p "$work/folder.mrk.json"
 expect_error "segment: a folder given as landmarks" 1 "folder.mrk.json: is a directory" "$work/s49" \
   "$DYNSUB" segment "$work/subject/image.nii.gz" --landmarks "$work/folder.mrk.json" --out "$work/s49"

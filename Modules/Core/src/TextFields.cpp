@@ -31,6 +31,10 @@ std::string trimmed(const std::string& text) {
   return first == std::string::npos ? std::string() : text.substr(first, text.find_last_not_of(" \t") + 1 - first);
 }
 
+std::string withoutByteOrderMark(const std::string& line) {
+  return line.rfind("\xEF\xBB\xBF", 0) == 0 ? line.substr(3) : line;
+}
+
 std::size_t editDistance(const std::string& a, const std::string& b) {
   const auto lower = [](unsigned char c) { return static_cast<char>(std::tolower(c)); };
   std::vector<std::size_t> row(b.size() + 1);

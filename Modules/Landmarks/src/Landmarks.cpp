@@ -50,11 +50,30 @@ std::vector<std::string> splitCsv(const std::string& line) {
   return fields;
 }
 
+// A column named twice would leave which of the two holds the value to
+// chance (the reader took the last).
+void requireDistinctColumns(const std::string& path, int line, const std::vector<std::string>& columns) {
+  for (std::size_t c = 0; c < columns.size(); ++c)
+    for (std::size_t d = c + 1; d < columns.size(); ++d)
+      if (!columns[c].empty() && columns[c] == columns[d])
+        throw Error(path, "line " + std::to_string(line) + ": the column '" + columns[c] + "' is named twice");
+}
+
 double finiteNumber(const std::string& text, const std::string& path, int line) {
   double value = 0;
   if (!parseNumber(text, value) || !std::isfinite(value))
     throw Error(path, "line " + std::to_string(line) + ": '" + text + "' is not a finite number");
   return value;
+}
+
+// The string `key` of a JSON object, or `fallback` when it has none: another
+// JSON type (a number for a label) is an error that says where.
+std::string textField(const nlohmann::json& object, const std::string& key, const std::string& fallback,
+                      const std::string& path, const std::string& where) {
+  if (!object.contains(key)) return fallback;
+  const nlohmann::json& value = object[key];
+  if (!value.is_string()) throw Error(path, where + ": \"" + key + "\" must be a string, got " + value.dump());
+  return value.get<std::string>();
 }
 
 // Whether a markup's control points are points on a structure: a point
@@ -83,35 +102,54 @@ std::vector<LandmarkList> readMarkupsJson(const std::string& path, std::ifstream
   if (!document.contains("markups") || !document["markups"].is_array())
     throw Error(path, "no \"markups\" list (not a 3D Slicer markups file)");
   std::vector<LandmarkList> lists;
-  // A field of another JSON type than the format's (a number for a label, a
-  // markup that is not an object) makes nlohmann::json throw: the file is
-  // malformed, and the message names the file.
-  try {
-    for (const auto& markup : document["markups"]) {
-      if (!onStructure(path, markup.value("type", "Fiducial"))) continue;
-      const std::string system = markup.value("coordinateSystem", "LPS");
-      if (system != "LPS" && system != "RAS") throw Error(path, "unknown coordinateSystem \"" + system + "\"");
-      if (markup.contains("coordinateUnits") && markup["coordinateUnits"] != "mm")
-        throw Error(path, "coordinateUnits must be mm");
-      LandmarkList& list = lists.emplace_back();
-      list.name = markup.value("name", "");
-      list.stated = system == "RAS" ? CoordinateSystem::RAS : CoordinateSystem::LPS;
-      if (!markup.contains("controlPoints")) continue;
-      int index = 0;
-      for (const auto& point : markup["controlPoints"]) {
-        ++index;
-        if (point.value("positionStatus", "defined") != "defined") continue;
-        const auto& position = point.contains("position") ? point["position"] : nlohmann::json();
-        if (!position.is_array() || position.size() != 3 || !position[0].is_number() || !position[1].is_number() ||
-            !position[2].is_number())
-          throw Error(path, "control point " + std::to_string(index) + " has no [x, y, z] position");
-        Vector3 p(position[0].get<double>(), position[1].get<double>(), position[2].get<double>());
-        if (!p.allFinite()) throw Error(path, "control point " + std::to_string(index) + " is not finite");
-        list.landmarks.push_back({point.value("label", "F-" + std::to_string(index)), system == "RAS" ? flipXY(p) : p});
-      }
+  std::vector<std::string> leftOut;  // the types of the markups that give no landmarks
+  int markupNumber = 0;
+  for (const auto& markup : document["markups"]) {
+    const std::string where = "markup " + std::to_string(++markupNumber);
+    if (!markup.is_object()) throw Error(path, where + " is not a JSON object");
+    const std::string type = textField(markup, "type", "Fiducial", path, where);
+    if (!onStructure(path, type)) {
+      leftOut.push_back(type);
+      continue;
     }
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(path, std::string("a malformed 3D Slicer markups file: ") + e.what());
+    const std::string system = textField(markup, "coordinateSystem", "LPS", path, where);
+    if (system != "LPS" && system != "RAS") throw Error(path, "unknown coordinateSystem \"" + system + "\"");
+    if (textField(markup, "coordinateUnits", "mm", path, where) != "mm")
+      throw Error(path, "coordinateUnits must be mm");
+    LandmarkList& list = lists.emplace_back();
+    list.name = textField(markup, "name", "", path, where);
+    list.stated = system == "RAS" ? CoordinateSystem::RAS : CoordinateSystem::LPS;
+    if (!markup.contains("controlPoints")) continue;
+    if (!markup["controlPoints"].is_array()) throw Error(path, where + ": \"controlPoints\" must be a list");
+    int index = 0;
+    for (const auto& point : markup["controlPoints"]) {
+      const std::string pointWhere = "control point " + std::to_string(++index);
+      if (!point.is_object()) throw Error(path, pointWhere + " is not a JSON object");
+      // Slicer's three states: a point placed, one being placed, and a
+      // name waiting for its point (both left out).
+      const std::string status = textField(point, "positionStatus", "defined", path, pointWhere);
+      if (status != "defined" && status != "preview" && status != "undefined")
+        throw Error(path, pointWhere + ": unknown positionStatus \"" + status +
+                              "\" (expected defined, preview or undefined)");
+      if (status != "defined") continue;
+      const auto& position = point.contains("position") ? point["position"] : nlohmann::json();
+      if (!position.is_array() || position.size() != 3 || !position[0].is_number() || !position[1].is_number() ||
+          !position[2].is_number())
+        throw Error(path, pointWhere + " has no [x, y, z] position");
+      Vector3 p(position[0].get<double>(), position[1].get<double>(), position[2].get<double>());
+      if (!p.allFinite()) throw Error(path, pointWhere + " is not finite");
+      list.landmarks.push_back(
+          {textField(point, "label", "F-" + std::to_string(index), path, pointWhere), system == "RAS" ? flipXY(p) : p});
+    }
+  }
+  // A file of measurements and regions alone (an ROI box, a plane) holds no
+  // landmark: say so, rather than that the file has none.
+  if (lists.empty() && !leftOut.empty()) {
+    std::string types;
+    for (const std::string& type : leftOut) types += (types.empty() ? "" : ", ") + type;
+    throw Error(path, "no point list or curve: its markups (" + types +
+                          ") are measurements or regions, which give no landmarks. Place the points as a point "
+                          "list (Slicer's Markups, 'Point List')");
   }
   return lists;
 }
@@ -123,6 +161,7 @@ std::vector<Landmark> readFcsv(const std::string& path, std::ifstream& in, Coord
   int number = 0;
   while (std::getline(in, line)) {
     ++number;
+    if (number == 1) line = withoutByteOrderMark(line);
     if (line.empty() || line == "\r") continue;
     if (line[0] == '#') {
       const auto equals = line.find('=');
@@ -137,6 +176,7 @@ std::vector<Landmark> readFcsv(const std::string& path, std::ifstream& in, Coord
           throw Error(path, "line " + std::to_string(number) + ": unknown coordinate system '" + value + "'");
       } else if (key.find("columns") != std::string::npos) {
         columns = splitCsv(line.substr(equals + 1));
+        requireDistinctColumns(path, number, columns);
       }
       continue;
     }
@@ -164,6 +204,7 @@ std::vector<Landmark> readCsv(const std::string& path, std::ifstream& in) {
   std::vector<std::string> header;
   while (header.empty() && std::getline(in, line)) {
     ++number;
+    if (number == 1) line = withoutByteOrderMark(line);
     if (!line.empty() && line != "\r") header = splitCsv(line);
   }
   int x = -1, y = -1, z = -1, label = -1;
@@ -176,11 +217,21 @@ std::vector<Landmark> readCsv(const std::string& path, std::ifstream& in) {
     if (name == "label") label = static_cast<int>(c);
   }
   if (x < 0 || y < 0 || z < 0) throw Error(path, "the first line must name the columns x, y and z (LPS mm)");
+  std::vector<std::string> lowerCaseHeader = header;
+  for (std::string& name : lowerCaseHeader)
+    for (char& ch : name) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  requireDistinctColumns(path, number, lowerCaseHeader);
   std::vector<Landmark> landmarks;
   while (std::getline(in, line)) {
     ++number;
     if (line.empty() || line == "\r") continue;
     const auto fields = splitCsv(line);
+    // A row of more values than the header has columns is a point whose
+    // values may have shifted (a stray comma, a decimal comma): which three
+    // are x, y and z cannot be known.
+    if (fields.size() > header.size())
+      throw Error(path, "line " + std::to_string(number) + ": " + std::to_string(fields.size()) +
+                            " fields, but the first line names " + std::to_string(header.size()) + " columns");
     if (static_cast<int>(fields.size()) <= std::max({x, y, z}))
       throw Error(path, "line " + std::to_string(number) + ": too few fields");
     landmarks.push_back({label >= 0 && label < static_cast<int>(fields.size()) ? fields[label] : "",
@@ -192,6 +243,14 @@ std::vector<Landmark> readCsv(const std::string& path, std::ifstream& in) {
 
 std::string labelOf(const std::vector<Landmark>& landmarks, std::size_t i) {
   return landmarks[i].label.empty() ? "F-" + std::to_string(i + 1) : landmarks[i].label;
+}
+
+// A label as a field of a .csv or .fcsv row: quoted when it holds a comma,
+// so that the row keeps its columns (the readers take no quote inside a
+// field: one becomes ').
+std::string csvField(std::string label) {
+  std::replace(label.begin(), label.end(), '"', '\'');
+  return label.find(',') == std::string::npos ? label : '"' + label + '"';
 }
 
 }  // namespace
@@ -280,14 +339,14 @@ void writeLandmarks(const std::vector<Landmark>& landmarks, const std::string& p
           << "\n# columns = id,x,y,z,ow,ox,oy,oz,vis,sel,lock,label,desc,associatedNodeID\n";
       for (std::size_t i = 0; i < landmarks.size(); ++i) {
         const Vector3 p = stored(landmarks[i]);
-        out << i + 1 << ',' << p.x() << ',' << p.y() << ',' << p.z() << ",0,0,0,1,1,1,0," << labelOf(landmarks, i)
-            << ",,\n";
+        out << i + 1 << ',' << p.x() << ',' << p.y() << ',' << p.z() << ",0,0,0,1,1,1,0,"
+            << csvField(labelOf(landmarks, i)) << ",,\n";
       }
     } else {
       out << "x,y,z,label\n";
       for (std::size_t i = 0; i < landmarks.size(); ++i) {
         const Vector3 p = stored(landmarks[i]);
-        out << p.x() << ',' << p.y() << ',' << p.z() << ',' << labelOf(landmarks, i) << '\n';
+        out << p.x() << ',' << p.y() << ',' << p.z() << ',' << csvField(labelOf(landmarks, i)) << '\n';
       }
     }
     out.close();

@@ -171,6 +171,50 @@ TEST(Landmarks, BadFilesAreRefusedWithTheirName) {
   }
   expectError(scratch("twice.mrk.json"), "not valid JSON");
   EXPECT_THROW(writeLandmarks(sample(), scratch("no/such/dir/p.csv").string()), Error);
+
+  // A column named twice, and a row of more values than the header's
+  // columns: which values are x, y and z is not known.
+  std::ofstream(scratch("twox.csv").string()) << "x,y,z,X\n1,2,3,4\n";
+  expectError(scratch("twox.csv"), "the column 'x' is named twice");
+  std::ofstream(scratch("fourvalues.csv").string()) << "x,y,z\n1,2,3\n1,5,2,3\n";
+  expectError(scratch("fourvalues.csv"), "line 3: 4 fields, but the first line names 3 columns");
+  std::ofstream(scratch("twox.fcsv").string()) << "# columns = id,x,y,z,x\n1,2,3,4,5\n";
+  expectError(scratch("twox.fcsv"), "the column 'x' is named twice");
+  // A markups file's fields of the wrong JSON type and states it does not have.
+  std::ofstream(scratch("numberlabel.mrk.json").string())
+      << R"({"markups": [{"type": "Fiducial", "controlPoints": [{"position": [1, 2, 3], "label": 5}]}]})";
+  expectError(scratch("numberlabel.mrk.json"), "control point 1: \"label\" must be a string, got 5");
+  std::ofstream(scratch("status.mrk.json").string())
+      << R"({"markups": [{"type": "Fiducial", "controlPoints": [{"position": [1, 2, 3], "positionStatus": "bogus"}]}]})";
+  expectError(scratch("status.mrk.json"), "unknown positionStatus \"bogus\"");
+  std::ofstream(scratch("notobject.mrk.json").string()) << R"({"markups": [7]})";
+  expectError(scratch("notobject.mrk.json"), "markup 1 is not a JSON object");
+  // Regions and measurements alone: said to be what they are.
+  std::ofstream(scratch("box.mrk.json").string())
+      << R"({"markups": [{"type": "ROI", "controlPoints": [{"position": [1, 2, 3]}]}, {"type": "Plane"}]})";
+  expectError(scratch("box.mrk.json"), "its markups (ROI, Plane) are measurements or regions");
+}
+
+TEST(Landmarks, SpreadsheetFilesAreRead) {
+  // Excel's "CSV UTF-8" starts with a byte order mark.
+  const fs::path csv = scratch("excel.csv");
+  std::ofstream(csv.string()) << "\xEF\xBB\xBFX,Y,Z,Label\n-12,10,12,head\n-14,12,10\n";
+  const std::vector<Landmark> read = readLandmarks(csv.string());
+  ASSERT_EQ(read.size(), 2u);
+  EXPECT_EQ(read[0].position, Vector3(-12, 10, 12));
+  EXPECT_EQ(read[0].label, "head");
+  // A label with a comma keeps its row's columns through a round trip, and a
+  // point that is not placed yet (Slicer's "undefined") is left out.
+  for (const std::string name : {"comma.csv", "comma.fcsv", "comma.mrk.json"}) {
+    writeLandmarks({{"head, left", Vector3(1, 2, 3)}}, scratch(name).string());
+    const std::vector<Landmark> back = readLandmarks(scratch(name).string());
+    ASSERT_EQ(back.size(), 1u) << name;
+    EXPECT_EQ(back[0].label, "head, left") << name;
+  }
+  const fs::path pending = scratch("pending.mrk.json");
+  std::ofstream(pending.string()) << R"({"markups": [{"type": "Fiducial", "controlPoints": [
+      {"position": [1, 2, 3]}, {"position": [0, 0, 0], "positionStatus": "undefined"}]}]})";
+  EXPECT_EQ(readLandmarks(pending.string()).size(), 1u);
 }
 
 }  // namespace

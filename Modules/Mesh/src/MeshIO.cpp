@@ -406,7 +406,7 @@ ControlMesh readControlMesh(const std::string& path) {
 void writeObj(const ControlMesh& mesh, const std::string& path) {
   // OBJ is the one format written; under another name it would be read back as that format.
   if (lowerCaseExtension(path) != ".obj")
-    throw Error(path, "the control mesh is written as OBJ: give the file the extension .obj");
+    throw UsageError(path, "the control mesh is written as OBJ: give the file the extension .obj");
   AtomicOutput output(path);
   {
     std::ofstream out(output.temporaryPath());

@@ -379,9 +379,13 @@ void checkStart(const SegmentInputs& in) {
   if (in.start.kind != SegmentStart::Kind::FromLandmarks || in.landmarks.size() >= 4) return;
   const std::string alternatives = "give at least 4 on the structure's boundary, or start from one click inside it";
   const std::string none = "no landmarks to build the initial model from: " + alternatives;
-  if (in.landmarks.empty()) throw in.landmarkSource.empty() ? Error(none) : Error(in.landmarkSource, none);
-  throw Error(in.landmarkSource, std::to_string(in.landmarks.size()) +
-                                     " landmarks are too few to outline a structure: " + alternatives);
+  const std::string tooFew =
+      std::to_string(in.landmarks.size()) + " landmarks are too few to outline a structure: " + alternatives;
+  // Points given by flags (--seed), or none at all, are the command line's
+  // fault: a usage error. A file's are the file's.
+  if (in.landmarkSource.empty()) throw UsageError(none);
+  if (in.landmarkSource.rfind("--", 0) == 0) throw UsageError(in.landmarkSource, in.landmarks.empty() ? none : tooFew);
+  throw Error(in.landmarkSource, in.landmarks.empty() ? none : tooFew);
 }
 
 }  // namespace

@@ -183,7 +183,7 @@ void writeVtu(const Lattice& l, const std::string& path, const std::string& name
 void requireLatticeTarget(const std::string& path) {
   const std::string extension = lowerCaseExtension(path);
   if (extension != ".lattice" && extension != ".vtu")
-    throw Error(path, "unknown lattice format '" + extension + "' (expected .lattice or .vtu)");
+    throw UsageError(path, "unknown lattice format '" + extension + "' (expected .lattice or .vtu)");
   requireWritableDirectoryFor(path);
 }
 

@@ -1,6 +1,10 @@
 #include "dynsub/Tessellation.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
 
 #include "dynsub/Error.h"
 #include "dynsub/Topology.h"
@@ -17,6 +21,15 @@ TriangleSurface tessellate(const LimitSurface& surface, const MatrixX3& controlP
     throw Error("samples per face must be between 1 and 1024, got " + std::to_string(n));
   }
   const Topology& base = surface.baseTopology();
+  // Samples and triangles are numbered by int, as in the surface files'
+  // indices: a finer grid than that holds is refused rather than wrapped.
+  const std::int64_t triangleCount = std::int64_t{2} * base.faceCount() * n * n;
+  if (triangleCount > std::numeric_limits<int>::max()) {
+    const int largest = static_cast<int>(std::sqrt(std::numeric_limits<int>::max() / (2.0 * base.faceCount())));
+    throw Error(std::to_string(n) + " samples per face on " + std::to_string(base.faceCount()) + " elements make " +
+                std::to_string(triangleCount) + " triangles, more than one surface can number (2^31 - 1): use at most " +
+                std::to_string(largest) + " samples per face");
+  }
   // Sample numbering: base vertices, then n-1 per base edge (from its first
   // vertex), then (n-1)^2 per element interior.
   const int edgeBase = base.vertexCount();

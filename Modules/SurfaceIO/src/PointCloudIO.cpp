@@ -94,8 +94,7 @@ MatrixX3 readText(const std::string& path, bool csv) {
   std::array<std::size_t, 3> columns{0, 1, 2};
   while (std::getline(in, line)) {
     ++number;
-    // A byte order mark (Excel's "CSV UTF-8") before the first line.
-    if (number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
+    if (number == 1) line = withoutByteOrderMark(line);
     const size_t comment = line.find('#');
     if (comment != std::string::npos) line.erase(comment);
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;

@@ -166,7 +166,7 @@ void requireTriangleSurfaceTarget(const std::string& path) {
   const std::string extension = lowerCaseExtension(path);
   const std::vector<std::string> known = triangleSurfaceExtensions();
   if (std::find(known.begin(), known.end(), extension) == known.end()) {
-    throw Error(path, "unknown surface format '" + extension + "' (expected .vtp, .vtk, .obj, .ply or .stl)");
+    throw UsageError(path, "unknown surface format '" + extension + "' (expected .vtp, .vtk, .obj, .ply or .stl)");
   }
   requireWritableDirectoryFor(path);
 }

@@ -18,6 +18,10 @@ std::vector<std::string> splitItems(const std::string& text, char separator);
 // `text` without the blanks and tabs at its ends.
 std::string trimmed(const std::string& text);
 
+// `line` without the UTF-8 byte order mark that spreadsheets ("CSV UTF-8")
+// write before a file's first line.
+std::string withoutByteOrderMark(const std::string& line);
+
 // Levenshtein's distance, case-insensitive.
 std::size_t editDistance(const std::string& a, const std::string& b);
 
