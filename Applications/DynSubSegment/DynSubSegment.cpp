@@ -291,7 +291,7 @@ void runOne(Arguments& a, const Volume& image, const LandmarkSource* file, Slice
   if (!a.atlasLabel.empty()) {
     in.start = parseSegmentStart("atlas", "--init");
     in.atlas = std::make_shared<const Atlas>(readAtlas(kDefaultAtlasImage, kDefaultAtlasLabels));
-    in.atlasLabels = atlasLabelValues(*in.atlas, a.atlasLabel);
+    in.atlasLabels = atlasLabelValues(*in.atlas, a.atlasLabel, "--atlasLabel");
     if (!a.inside.empty()) in.inside = parsePoint(a.inside, "--inside");
   } else if (!a.inside.empty()) {
     in.start.kind = SegmentStart::Kind::Seed;
@@ -354,7 +354,7 @@ void runTogether(Arguments& a, const Volume& image, const std::vector<LandmarkSo
                      " pass 255; give a smaller --labelValue");
   const std::shared_ptr<const Atlas> atlasData =
       atlas ? std::make_shared<const Atlas>(readAtlas(kDefaultAtlasImage, kDefaultAtlasLabels)) : nullptr;
-  std::vector<StructureInputs> structures = structuresToSegment(a.image, files, atlasData, atlasLabels);
+  std::vector<StructureInputs> structures = structuresToSegment(a.image, files, atlasData, atlasLabels, "--atlasLabel");
   // A list of one point is a click inside its structure, as one point is for
   // one structure: the start of a structure without an atlas label, the click
   // that places its atlas label otherwise.

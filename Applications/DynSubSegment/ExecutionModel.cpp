@@ -9,6 +9,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "CommandLine.h"
 #include "dynsub/TextFields.h"
 
 namespace dynsub::slicer {
@@ -38,8 +39,9 @@ std::string defaultOf(const Parameter& p) {
 }
 
 // The numbers in a word of a point ("[-16.5," or "19.0," or "1,2,3"), or
-// nothing when a part of it is not a number.
+// nothing when a part of it is not a number, or is missing ("17.5,,21").
 std::optional<std::vector<std::string>> pointNumbers(const std::string& word) {
+  if (word.find(",,") != std::string::npos) return std::nullopt;
   std::string text = word;
   for (char& c : text)
     if (c == '[' || c == ']' || c == '(' || c == ')' || c == ',') c = ' ';
@@ -150,7 +152,8 @@ void addOptions(CLI::App& app, const Module& module) {
       if (p.index >= 0) option->required();
       if (!p.choices.empty()) option->check(CLI::IsMember(p.choices));
       if (!p.minimum.empty() && !p.maximum.empty())
-        option->check(CLI::Range(std::stod(p.minimum), std::stod(p.maximum)));
+        option->check(dynsub::app::numberBetween(std::stod(p.minimum), std::stod(p.maximum),
+                                                 std::holds_alternative<int*>(p.target)));
       const std::string value = defaultOf(p);
       if (!value.empty() && !std::holds_alternative<bool*>(p.target)) option->default_str(value);
     }

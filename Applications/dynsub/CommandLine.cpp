@@ -39,6 +39,21 @@ CLI::Validator numberCheck(std::string name, bool zeroAllowed, double largest) {
 
 }  // namespace
 
+CLI::Validator numberBetween(double low, double high, bool whole) {
+  std::ostringstream range, shown;
+  range << low << " and " << high;
+  shown << (whole ? "INT" : "FLOAT") << " in [" << low << " - " << high << "]";
+  return CLI::Validator(
+      [low, high, whole, range = range.str()](std::string& text) -> std::string {
+        double value = 0;
+        if (!parseNumber(text, value) || std::isnan(value)) return text + " is not a number";
+        if (whole && value != std::floor(value)) return text + " is not a whole number";
+        if (value < low || value > high) return text + " is not between " + range;
+        return std::string();
+      },
+      shown.str());
+}
+
 CLI::Validator positiveNumber(double largest) { return numberCheck("a finite number > 0", false, largest); }
 CLI::Validator nonNegativeNumber(double largest) { return numberCheck("a finite number >= 0", true, largest); }
 
@@ -53,7 +68,7 @@ void SimulationArguments::addOptions(CLI::App& command, const SimulationOptions&
   solver = toString(defaults.integrator.solver);
   command.add_option("--max-level", values.maxLevel, "Refinement levels allowed (0-6)")
       ->default_val(defaults.maxLevel)
-      ->check(CLI::Range(0, 6));
+      ->check(numberBetween(0, 6, true));
   command.add_option("--scheme", scheme,
                      "How the equilibrium is reached: static (Newton steps on K p = f_p), or time integration, "
                      "first-order (massless, TVCG eq. 32) or second-order (eq. 31)")
@@ -68,7 +83,7 @@ void SimulationArguments::addOptions(CLI::App& command, const SimulationOptions&
       ->check(positiveNumber(kLargestMaterialValue));
   command.add_option("--max-steps", values.equilibrium.maxSteps, "Step limit per level")
       ->default_val(defaults.equilibrium.maxSteps)
-      ->check(CLI::Range(1, 1000000));
+      ->check(numberBetween(1, 1000000, true));
   command.add_option("--mass", values.material.mass, "Mass density mu, kg per unit parametric area")
       ->default_val(defaults.material.mass)
       ->check(nonNegativeNumber(kLargestMaterialValue));
@@ -115,15 +130,19 @@ void addSegmentParameterOptions(CLI::App& command, SegmentParameters& parameters
                     row.flag(), [p, set = access.set](const std::string& v) { set(*p, v); }, help)
                 ->check(CLI::IsMember(access.names));
           } else if constexpr (std::is_same_v<A, Parameter::OptionalReal>) {
-            return command.add_option_function<double>(
-                row.flag(), [p, access](double v) { access(*p) = v; }, help);
-          } else {
+            return command
+                .add_option_function<double>(
+                    row.flag(), [p, access](double v) { access(*p) = v; }, help)
+                ->check(numberBetween(row.low, row.high, false));
+          } else if constexpr (std::is_same_v<A, Parameter::Switch>) {
             return command.add_option(row.flag(), access(parameters), help);
+          } else {
+            using Value = std::remove_reference_t<decltype(access(parameters))>;
+            return command.add_option(row.flag(), access(parameters), help)
+                ->check(numberBetween(row.low, row.high, std::is_integral_v<Value>));
           }
         },
         row.value);
-    if (!std::holds_alternative<Parameter::Switch>(row.value) && !std::holds_alternative<Parameter::Choice>(row.value))
-      option->check(CLI::Range(row.low, row.high));
     if (!std::holds_alternative<Parameter::OptionalReal>(row.value)) option->default_str(shown);
     option->group(row.group);
   }

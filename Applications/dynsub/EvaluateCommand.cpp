@@ -15,6 +15,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "CommandLine.h"
 #include "Commands.h"
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
@@ -322,7 +323,7 @@ void addEvaluateCommand(CLI::App& app) {
   command->add_option("PLAN", o->plan, "Evaluation plan (.json)")->required();
   command->add_option("--out", o->out, "Output directory (created if missing; its parent must exist)")->required();
   command->add_option("--split", o->splits, "Run only these splits of the plan (repeatable; default: all)");
-  command->add_option("--jobs", o->jobs, "Runs at once")->default_val(2)->check(CLI::Range(1, 64));
+  command->add_option("--jobs", o->jobs, "Runs at once")->default_val(2)->check(numberBetween(1, 64, true));
   command->add_option(
       "--keep-landmarks", o->keepLandmarks,
       "Keep each run's landmark file in this directory (named split_image_structure_protocol_seed; created if "

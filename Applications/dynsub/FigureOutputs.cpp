@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "CommandLine.h"
 #include "dynsub/Error.h"
 #include "dynsub/FigureInputs.h"
 #include "dynsub/OutputSet.h"
@@ -54,7 +55,7 @@ void FigureOptions::addStyleOptions(CLI::App& command) {
                   "Pixels per inch of the figures at their nominal size (slices 12 x 8 in, 3D view 8 x 8 in, "
                   "convergence 9 x 5 in); text, lines and dots grow with it. 100 gives 1200 x 800 pixels of slices, "
                   "300 a print-quality 3600 x 2400")
-      ->check(CLI::Range(kMinFigureDpi, kMaxFigureDpi))
+      ->check(numberBetween(kMinFigureDpi, kMaxFigureDpi, false))
       ->default_str("100");
 }
 

@@ -354,7 +354,7 @@ void addFitCommand(CLI::App& app) {
                       "(the 32-vertex torus, for genus 1), or a closed control mesh file of the data's genus")
       ->default_val("auto");
   command->add_option("--genus", o->genus, "Genus the data is known to have; the initial model must match")
-      ->check(CLI::Range(0, 100));
+      ->check(numberBetween(0, 100, true));
   command->add_option("--tolerance", o->fit.tolerancePercent, "Max error to reach, in percent")
       ->default_val(1.0)
       ->check(positiveNumber());
@@ -408,7 +408,7 @@ void addFitCommand(CLI::App& app) {
                    "Times a level whose fit is refused within twice the tolerance is run on with its tension and "
                    "rigidity weakened 4-fold more, before it is refined")
       ->default_val(FitOptions::defaultSimulation().relaxations)
-      ->check(CLI::Range(0, 6));
+      ->check(numberBetween(0, 6, true));
   o->figures.addOptions(*command);
   command->callback([o] { runFit(*o); });
 }

@@ -43,7 +43,8 @@ std::vector<LandmarkSource> landmarkSources(const std::vector<std::string>& file
 
 std::vector<StructureInputs> structuresToSegment(const std::string& image, const std::vector<LandmarkSource>& sources,
                                                  const std::shared_ptr<const Atlas>& atlas,
-                                                 const std::vector<std::string>& atlasLabels) {
+                                                 const std::vector<std::string>& atlasLabels,
+                                                 const std::string& atlasOption) {
   const std::size_t n = atlas ? atlasLabels.size() : sources.size();
   std::vector<StructureInputs> structures;
   for (std::size_t s = 0; s < n; ++s) {
@@ -59,7 +60,7 @@ std::vector<StructureInputs> structuresToSegment(const std::string& image, const
     if (atlas) {
       in.start = parseSegmentStart("atlas", "--init");
       in.atlas = atlas;
-      in.atlasLabels = atlasLabelValues(*atlas, atlasLabels[s]);
+      in.atlasLabels = atlasLabelValues(*atlas, atlasLabels[s], atlasOption);
       if (sources.empty()) structure.name = asStructureName(atlasStructureName(*atlas, in.atlasLabels, atlasLabels[s]));
     }
     structures.push_back(std::move(structure));

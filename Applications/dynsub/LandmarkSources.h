@@ -35,9 +35,11 @@ std::vector<LandmarkSource> landmarkSources(const std::vector<std::string>& file
 // atlas, its labels (atlasLabelValues's form), each paired with the list of
 // the same place when there are lists (the caller checks that the counts
 // agree). A structure is named by its list, else by the atlas
-// (atlasStructureName, made a structure's name). Throws as atlasLabelValues.
+// (atlasStructureName, made a structure's name). Throws as atlasLabelValues,
+// naming `atlasOption`, the flag the labels came from.
 std::vector<StructureInputs> structuresToSegment(const std::string& image, const std::vector<LandmarkSource>& sources,
                                                  const std::shared_ptr<const Atlas>& atlas,
-                                                 const std::vector<std::string>& atlasLabels);
+                                                 const std::vector<std::string>& atlasLabels,
+                                                 const std::string& atlasOption);
 
 }  // namespace dynsub::app

@@ -2,6 +2,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "CommandLine.h"
 #include "Commands.h"
 #include "dynsub/FileNames.h"
 #include "dynsub/LimitSurface.h"
@@ -56,7 +57,7 @@ void addLimitCommand(CLI::App& app) {
   command->add_option("--samples-per-face", options->samplesPerFace,
                       "N: parameter squares along each side of an element (1 to 1024)")
       ->default_val(8)
-      ->check(CLI::Range(1, 1024));
+      ->check(numberBetween(1, 1024, true));
   command->callback([options] { runLimit(*options); });
 }
 

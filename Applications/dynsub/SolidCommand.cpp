@@ -151,7 +151,7 @@ void addSolidCommand(CLI::App& app) {
   // would be overwritten by that subcommand's default.
   auto statsOptions = std::make_shared<SolidOptions>();
   stats->add_option("LATTICE", statsOptions->lattice, "Control lattice (.lattice)")->required();
-  stats->add_option("--level", statsOptions->level, "Subdivisions")->default_val(0)->check(CLI::Range(0, 6));
+  stats->add_option("--level", statsOptions->level, "Subdivisions")->default_val(0)->check(numberBetween(0, 6, true));
   stats->callback([statsOptions] {
     const Lattice lattice = subdivideSolid(readLattice(statsOptions->lattice), statsOptions->level).lattice;
     std::cout << countsReport(lattice).text(-1);
@@ -160,7 +160,7 @@ void addSolidCommand(CLI::App& app) {
   CLI::App* subdivide = solid->add_subcommand(
       "subdivide", "Subdivide a lattice L times and write it (.lattice, or .vtu for ParaView)");
   subdivide->add_option("LATTICE", o->lattice, "Control lattice (.lattice)")->required();
-  subdivide->add_option("--level", o->level, "Subdivisions")->default_val(1)->check(CLI::Range(0, 6));
+  subdivide->add_option("--level", o->level, "Subdivisions")->default_val(1)->check(numberBetween(0, 6, true));
   subdivide->add_option("--out", o->out, "Output file (.lattice or .vtu)")->required();
   subdivide->callback([o] {
     requireLatticeTarget(o->out);
@@ -185,7 +185,7 @@ void addSolidCommand(CLI::App& app) {
       ->default_val(so->out);
   sculpt->add_option("--level", so->settings.levels, "Subdivisions carrying the mass points")
       ->default_val(so->settings.levels)
-      ->check(CLI::Range(0, 4));
+      ->check(numberBetween(0, 4, true));
   sculpt->add_option("--time-step", so->settings.timeStep, "Time step, s")
       ->default_val(so->settings.timeStep)
       ->check(positiveNumber());

@@ -50,6 +50,10 @@ expect_error "more triangles than a surface can number" 1 "use at most 589 sampl
 expect_error "out of memory" 1 "out of memory" "$work/g3.lattice" \
   bash -c 'ulimit -v 2000000 && exec "$0" "$@"' "$DYNSUB" solid subdivide "$DATA/Solids/cube3.lattice" --level 6 \
   --out "$work/g3.lattice"
+expect_error "a word for a count" 2 "samples-per-face: abc is not a number" "$work/g4.vtp" \
+  "$DYNSUB" limit "$DATA/Meshes/cube.obj" --samples-per-face abc --out "$work/g4.vtp"
+expect_error "a fraction for a count" 2 "samples-per-face: 2.5 is not a whole number" "$work/g4.vtp" \
+  "$DYNSUB" limit "$DATA/Meshes/cube.obj" --samples-per-face 2.5 --out "$work/g4.vtp"
 expect_error "unknown standard mesh" 2 "NAME" "$work/h.obj" "$DYNSUB" mesh sphere --out "$work/h.obj"
 expect_error "a standard mesh under another extension" 2 "c.off: the control mesh is written as OBJ" "$work/c.off" \
   "$DYNSUB" mesh cube --out "$work/c.off"
@@ -593,7 +597,7 @@ expect_error "a result of no voxel" 1 "speck.csv: the result encloses no voxel o
 expect_error "negative end pressure" 2 "end-pressure" "$work/s13" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --end-pressure -0.1 \
   --out "$work/s13"
-expect_error "NaN edge threshold" 2 "edge_low (--edge-low) must be in 0..10, got nan" "$work/s9" \
+expect_error "NaN edge threshold" 2 "--edge-low: nan is not a number" "$work/s9" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --edge-low nan \
   --out "$work/s9"
 expect_error "edge thresholds the wrong way round" 2 "edge_low (--edge-low) is 5 and edge_high (--edge-high) 1" "$work/s9b" \
@@ -667,9 +671,9 @@ expect_error "unknown landmark format" 1 "unknown landmark format" "$work/s3" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/points.txt" --out "$work/s3"
 expect_error "init outside the image" 1 "outside the image" "$work/s4" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:900,0,0,10 --out "$work/s4"
-expect_error "NaN image force" 2 "image_force (--image-force) must be in" "$work/s5" \
+expect_error "NaN image force" 2 "image-force: nan is not a number" "$work/s5" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:-10,10,10,5 --image-force nan --out "$work/s5"
-expect_error "negative landmark tolerance" 2 "landmark-tolerance: Value -1 not in range" "$work/s8" \
+expect_error "negative landmark tolerance" 2 "landmark-tolerance: -1 is not between 0 and" "$work/s8" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:-10,10,10,5 --landmark-tolerance -1 --out "$work/s8"
 expect_error "reference label absent" 1 "no voxel" "$work/s6" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:-10,10,10,5 --reference "$mri/aal.nii.gz" \

@@ -134,19 +134,19 @@ Atlas readAtlas(const std::string& imagePath, const std::string& labelsPath) {
   return atlas;
 }
 
-std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec) {
+std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec, const std::string& option) {
   std::vector<int> values;
-  if (spec.empty()) throw UsageError("--atlas-label: no label given");
+  if (spec.empty()) throw UsageError(option + ": no label given");
   for (const std::string& written : splitItems(spec, ',')) {
     const std::string item = trimmed(written);
-    if (item.empty()) throw UsageError("--atlas-label " + spec + ": an empty label");
+    if (item.empty()) throw UsageError(option + " " + spec + ": an empty label");
     double number = 0;
     std::istringstream asNumber(item);
     if (asNumber >> number && asNumber.eof()) {
       if (number != std::floor(number) || std::abs(number) > 32767)
-        throw UsageError("--atlas-label " + spec + ": " + item + " is not a label value");
+        throw UsageError(option + " " + spec + ": " + item + " is not a label value");
       // 0 is every label map's background, no structure.
-      if (number == 0) throw UsageError("--atlas-label " + spec + ": 0 is the atlas's background, not a structure");
+      if (number == 0) throw UsageError(option + " " + spec + ": 0 is the atlas's background, not a structure");
       values.push_back(static_cast<int>(number));
       continue;
     }
@@ -157,7 +157,7 @@ std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec) {
       continue;
     }
     if (atlas.names.empty())
-      throw Error(atlas.labelsPath, "no table of label names beside it: give --atlas-label as numbers, not '" +
+      throw Error(atlas.labelsPath, "no table of label names beside it: give " + option + " as numbers, not '" +
                                         item + "'");
     const auto nearest = std::min_element(atlas.names.begin(), atlas.names.end(), [&](const auto& a, const auto& b) {
       return editDistance(a.second, item) < editDistance(b.second, item);

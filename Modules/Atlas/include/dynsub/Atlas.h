@@ -44,8 +44,10 @@ Atlas readAtlas(const std::string& imagePath, const std::string& labelsPath);
 
 // "71", "71,72", "Caudate_L" or "Caudate_L,Caudate_R": the label values.
 // Throws dynsub::Error for a name the table does not hold (naming the
-// nearest), or a value no voxel of the label map has.
-std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec);
+// nearest), or a value no voxel of the label map has. `option` is the flag
+// the spec came from, for messages.
+std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec,
+                                  const std::string& option = "--atlas-label");
 
 // What a structure given as `spec`, of label values `values`
 // (atlasLabelValues's), is called: the table's name when it is one value the
