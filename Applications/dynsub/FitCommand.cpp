@@ -24,6 +24,7 @@
 #include "dynsub/PointCloudIO.h"
 #include "dynsub/ScanNoise.h"
 #include "dynsub/ShapeRecovery.h"
+#include "dynsub/SpringFile.h"
 #include "dynsub/SurfaceCoverage.h"
 #include "dynsub/SurfaceWriter.h"
 
@@ -129,6 +130,10 @@ double statedNoise(const std::string& text) {
   return value;
 }
 
+// Surface springs a thousand times the useful 0.1 (their help): beyond it
+// they outweigh the data, and the fit drifts from the scan.
+constexpr double kLargestSurfaceSprings = 100.0;
+
 void runFit(FitCommandOptions o) {
   const double stated = statedNoise(o.noise);
   checkInitialModelOption(o);
@@ -137,6 +142,14 @@ void runFit(FitCommandOptions o) {
   const PointCloud input = readPointCloud(o.points);
   const MatrixX3& scan = input.points;
   checkPointCloud(scan, o.points);
+  // A noise wider than the scan itself is a slip (a value meant in another
+  // unit): the fit would take every point's scatter for noise and stop at once.
+  const double extent = (scan.colwise().maxCoeff() - scan.colwise().minCoeff()).norm();
+  if (stated > extent) {
+    std::ostringstream message;
+    message << "--noise " << o.noise << ": more than the whole scan, " << extent << " mm across its bounding box";
+    throw UsageError(o.points, message.str());
+  }
   const MatrixX3 reference = o.reference.empty() ? MatrixX3() : readPointCloud(o.reference).points;
   if (!o.reference.empty()) checkPointCloud(reference, o.reference);
   // A mesh's vertices are where its maker put the surface: their scatter
@@ -355,13 +368,13 @@ void addFitCommand(CLI::App& app) {
       ->default_val("auto");
   command->add_option("--genus", o->genus, "Genus the data is known to have; the initial model must match")
       ->check(numberBetween(0, 100, true));
-  command->add_option("--tolerance", o->fit.tolerancePercent, "Max error to reach, in percent")
+  command->add_option("--tolerance", o->fit.tolerancePercent, "Max error to reach, in percent of the diameter")
       ->default_val(1.0)
-      ->check(positiveNumber());
+      ->check(positiveNumber(100.0));
   command->add_option("--data-stiffness", o->fit.dataStiffness,
                       "Spring stiffness of the data, N/mm per unit parametric area, shared by all points")
       ->default_val(o->fit.dataStiffness)
-      ->check(positiveNumber());
+      ->check(positiveNumber(kLargestSpringStiffness));
   command
       ->add_option("--springs-per-element", o->fit.springsPerElement,
                    "Data springs that pull a level, per element of its surface: a fixed random sample of the "
@@ -394,7 +407,7 @@ void addFitCommand(CLI::App& app) {
                    "nearest to onto the scan; 0.1 removed most of those the coverage warning reported on clouds of "
                    "CGAL's meshes, in 0.8-1.5 times the time")
       ->default_val(0.0)
-      ->check(nonNegativeNumber());
+      ->check(nonNegativeNumber(kLargestSurfaceSprings));
   command->add_flag("--to-equilibrium", o->fit.toEquilibrium,
                     "Run the last level on to its equilibrium, as the papers do; by default the fit ends at the "
                     "first step where the tolerance is met");

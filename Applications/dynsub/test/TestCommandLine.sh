@@ -114,6 +114,16 @@ sys.exit(0 if ok else 1)" "$work/fitgenus/report.json" "$work/fitgenus1/report.j
 
 printf '1 2 3\n4 5 6\n7 8 9.5\n' >"$work/three.xyz"
 expect_error "too few points" 1 "at least 4" "$work/o1" "$DYNSUB" fit "$work/three.xyz" --out "$work/o1"
+# Values no fit can mean: a tolerance past the whole diameter, surface
+# springs that outweigh the data, a noise wider than the scan.
+expect_error "fit: a tolerance of more than 100 %" 2 "tolerance: 1e9 is not a finite number > 0 and <= 100" \
+  "$work/o1" "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --tolerance 1e9 --out "$work/o1"
+expect_error "fit: surface springs past 100" 2 "surface-springs: 1e30 is not" "$work/o1" \
+  "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --surface-springs 1e30 --out "$work/o1"
+expect_error "fit: a noise wider than the scan" 2 "--noise 1e9: more than the whole scan" "$work/o1" \
+  "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --noise 1e9 --out "$work/o1"
+expect_error "fit: a NaN figure resolution" 2 "figure-dpi: nan is not a number" "$work/o1" \
+  "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --figure-dpi nan --out "$work/o1"
 printf '0 0 0\n1 0 0\n0 1 0\n0 0 nan\n1 1 1\n' >"$work/nan.xyz"
 expect_error "NaN coordinate" 1 "nan.xyz" "$work/o2" "$DYNSUB" fit "$work/nan.xyz" --out "$work/o2"
 printf '1 1 1\n1 1 1\n1 1 1\n1 1 1\n1 1 1\n' >"$work/same.xyz"

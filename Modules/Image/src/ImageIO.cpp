@@ -55,6 +55,16 @@ Volume readVolume(const std::string& path) {
   const ImageGeometry& g = volume.geometry;
   if (!g.direction.allFinite() || !(std::abs(g.direction.determinant()) > 1e-6))
     throw Error(path, "singular direction matrix");
+  // Axes at right angles, of unit length, as ITK's filters and every output
+  // format's header take them: a sheared or scaled matrix (as a header may
+  // hold one) would place the results elsewhere in each viewer.
+  const double skew = (g.direction.transpose() * g.direction - Matrix3::Identity()).cwiseAbs().maxCoeff();
+  if (skew > 1e-3) {
+    std::ostringstream message;
+    message << "the direction matrix is not orthonormal (its axes' dot products and lengths are off by up to "
+            << skew << "): DynSub needs axes at right angles, of unit length; resample the image onto such a grid";
+    throw Error(path, message.str());
+  }
   if (!g.origin.allFinite()) throw Error(path, "the origin is not finite");
   if (!(g.spacing.minCoeff() > 0)) throw Error(path, "spacing must be positive");
   // Options, tolerances and reports are in mm, chosen for voxels of tenths of

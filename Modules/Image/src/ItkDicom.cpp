@@ -118,6 +118,10 @@ FloatImage::Pointer readSeries(const std::string& directory) {
     throw Error(directory, "directory holds " + std::to_string(series.size()) + " DICOM series; give one series");
   const std::vector<std::string> files = names->GetFileNames(series.front());
   requireWholeSeries(files, dicomFiles);
+  // A colour or vector series is refused as such a file is (the series
+  // reader would make one value of each voxel's several).
+  auto header = itk::GDCMImageIO::New();
+  inspectHeader(files.front(), *header);
   auto reader = itk::ImageSeriesReader<FloatImage>::New();
   reader->SetImageIO(itk::GDCMImageIO::New());
   reader->SetFileNames(files);

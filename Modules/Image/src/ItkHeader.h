@@ -27,6 +27,17 @@ inline void inspectHeader(const std::string& path, itk::ImageIOBase& io) {
     voxels *= size;
   }
   filechecks::requireMemoryFor(path, voxels);
+  // ITK reads the first volume of a series of them (a 4D image) into a 3D
+  // image without a word.
+  std::string sizes;
+  bool beyond3D = false;
+  for (unsigned a = 0; a < io.GetNumberOfDimensions(); ++a) {
+    sizes += (a ? " x " : "") + std::to_string(io.GetDimensions(a));
+    beyond3D = beyond3D || (a >= 3 && io.GetDimensions(a) > 1);
+  }
+  if (beyond3D)
+    throw Error(path, "a " + std::to_string(io.GetNumberOfDimensions()) + "D image (" + sizes +
+                          " voxels); DynSub reads 3D images: save the volume to segment as an image of its own");
   // ITK would turn a vector or colour voxel into one value (a luminance, or
   // the first component) without a word.
   const unsigned components = io.GetNumberOfComponents();

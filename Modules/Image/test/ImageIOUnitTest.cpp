@@ -319,6 +319,34 @@ TEST(HostileImages, SeveralValuesPerVoxelAreRefused) {
   }
 }
 
+// ITK reads a 4D file's first volume, and keeps a sheared or scaled direction
+// matrix as written: both refused, naming what the file holds.
+TEST(HostileImages, FourDimensionsAndAxesNotAtRightAnglesAreRefused) {
+  const std::vector<float> voxels = ramp(4 * 3 * 2 * 2, 1.0f);
+  const std::string data(reinterpret_cast<const char*>(voxels.data()), voxels.size() * sizeof(float));
+  std::ofstream(scratch("fourd.mha"), std::ios::binary)
+      << "ObjectType = Image\nNDims = 4\nDimSize = 4 3 2 2\nElementType = MET_FLOAT\nElementDataFile = LOCAL\n"
+      << data;
+  EXPECT_NE(readError(scratch("fourd.mha")).find("fourd.mha: a 4D image (4 x 3 x 2 x 2 voxels)"), std::string::npos)
+      << readError(scratch("fourd.mha"));
+  const std::string volume = data.substr(0, data.size() / 2);
+  for (const std::string matrix : {"1 0 0 0.5 1 0 0 0 1", "2 0 0 0 2 0 0 0 2"}) {
+    std::ofstream(scratch("skewed.mha"), std::ios::binary)
+        << "ObjectType = Image\nNDims = 3\nTransformMatrix = " << matrix
+        << "\nDimSize = 4 3 2\nElementType = MET_FLOAT\nElementDataFile = LOCAL\n"
+        << volume;
+    EXPECT_NE(readError(scratch("skewed.mha")).find("skewed.mha: the direction matrix is not orthonormal"),
+              std::string::npos)
+        << matrix << ": " << readError(scratch("skewed.mha"));
+  }
+  // A rotation written to 6 decimals reads.
+  std::ofstream(scratch("rotated.mha"), std::ios::binary)
+      << "ObjectType = Image\nNDims = 3\nTransformMatrix = 0.866025 0.5 0 -0.5 0.866025 0 0 0 1"
+      << "\nDimSize = 4 3 2\nElementType = MET_FLOAT\nElementDataFile = LOCAL\n"
+      << volume;
+  EXPECT_EQ(readError(scratch("rotated.mha")), "");
+}
+
 TEST(HostileImages, ConstantAndExtremeIntensitiesAreReadExactly) {
   // The ramp goes up to 16 times the scale: 2.4e38 of float's 3.4e38.
   for (const float scale : {0.0f, 1.5e37f, 1e-37f, -1.5e37f}) {

@@ -57,32 +57,38 @@ bool namesAxis(const std::string& name, char axis) {
          (name.size() == 1 || !std::isalnum(static_cast<unsigned char>(name[1])));
 }
 
-// The columns of x, y and z named by a CSV's first line, or nullopt for the
-// first three: when it names none of them and its first column is not an
-// index (pandas writes one, unnamed, first). Named in part, the columns
-// cannot be told: an error.
+// The columns of x, y and z named by a CSV's first line (or, as 3D Slicer
+// exports points, l, p and s: the same LPS axes), or nullopt for the first
+// three when the line names three columns alone, none of them an axis. With
+// more columns, or an axis named in part or twice, which hold the
+// coordinates cannot be told: an error.
 std::optional<std::array<std::size_t, 3>> namedColumns(std::vector<std::string> names, const std::string& path,
                                                        int line) {
   // CloudCompare writes "//" before the names.
   if (!names.empty() && names[0].rfind("//", 0) == 0) names[0].erase(0, 2);
-  std::array<std::size_t, 3> columns{};
-  int found = 0;
-  for (int axis = 0; axis < 3; ++axis) {
-    for (std::size_t c = 0; c < names.size(); ++c)
-      if (namesAxis(names[c], "xyz"[axis])) {
-        columns[axis] = c;
-        ++found;
-        break;
-      }
+  const auto error = [&](const std::string& what) {
+    return Error(path, "line " + std::to_string(line) + ": " + what);
+  };
+  for (const char* axes : {"xyz", "lps"}) {
+    std::array<std::size_t, 3> columns{};
+    int found = 0;
+    for (int axis = 0; axis < 3; ++axis) {
+      int named = 0;
+      for (std::size_t c = 0; c < names.size(); ++c)
+        if (namesAxis(names[c], axes[axis])) {
+          if (named++ == 0) columns[axis] = c;
+        }
+      if (named > 1) throw error(std::string("the header names the column ") + axes[axis] + " twice");
+      found += named;
+    }
+    if (found == 3) return columns;
+    if (found > 0 && axes[0] == 'x')
+      throw error("the header does not name all the coordinates' columns x, y and z (" +
+                  std::to_string(names.size()) + " columns): name them so");
   }
-  if (found == 3) return columns;
-  std::string first = names.empty() ? std::string() : names[0];
-  for (char& c : first) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  const bool index = names.size() > 3 && (first.empty() || first == "id" || first == "index");
-  if (found == 0 && !index) return std::nullopt;
-  throw Error(path, "line " + std::to_string(line) +
-                        ": the header does not name the coordinates' columns x, y and z (" +
-                        std::to_string(names.size()) + " columns): name them so");
+  if (names.size() == 3) return std::nullopt;
+  throw error("the header names no columns x, y and z among its " + std::to_string(names.size()) +
+              ", so which hold the coordinates cannot be told: name them so");
 }
 
 MatrixX3 readText(const std::string& path, bool csv) {
@@ -92,6 +98,10 @@ MatrixX3 readText(const std::string& path, bool csv) {
   int number = 0;
   bool header = csv;
   std::array<std::size_t, 3> columns{0, 1, 2};
+  // The header's count of fields, else the first point's: a line of more
+  // (a stray separator, a decimal comma) has values that may have shifted.
+  std::size_t width = 0;
+  std::string widthFrom = "the first point has ";
   while (std::getline(in, line)) {
     ++number;
     if (number == 1) line = withoutByteOrderMark(line);
@@ -107,11 +117,17 @@ MatrixX3 readText(const std::string& path, bool csv) {
       if (header) {  // a first line of column names
         header = false;
         if (const auto named = namedColumns(fields, path, number)) columns = *named;
+        width = fields.size();
+        widthFrom = "the header names ";
         continue;
       }
       throw Error(path, "line " + std::to_string(number) + ": expected three numbers x y z");
     }
     header = false;
+    if (width == 0) width = fields.size();
+    if (fields.size() > width)
+      throw Error(path, "line " + std::to_string(number) + ": " + std::to_string(fields.size()) + " values, where " + widthFrom +
+                            std::to_string(width));
     points.push_back(p);
   }
   if (points.empty()) throw Error(path, "has no points");

@@ -66,9 +66,11 @@ TEST(PointCloudIO, PointFilesAreNotMeshVertices) {
 }
 
 // A CSV's header names its columns: the coordinates are read from the
-// columns it names x, y and z, wherever they are (pandas writes an index
-// column first); columns without those names are x, y, z in order, unless
-// the first is an index, which is refused rather than read as x.
+// columns it names x, y and z (or l, p and s, as 3D Slicer exports points),
+// wherever they are (pandas writes an index column first); three columns
+// without those names are x, y, z in order. More columns without them, an
+// axis named twice, and a row longer than the header are refused rather
+// than read with the values shifted.
 TEST(PointCloudIO, ACsvHeaderNamesTheCoordinatesColumns) {
   const dynsub::MatrixX3 indexed =
       dynsub::readPointCloud(writeText("pandas.csv", ",x,y,z\n0,1,2,3\n1,4,5,6\n2,7,8,9\n3,1,1,2\n")).points;
@@ -86,21 +88,33 @@ TEST(PointCloudIO, ACsvHeaderNamesTheCoordinatesColumns) {
         dynsub::readPointCloud(writeText("named.csv", header + "\n1,2,3,9\n4,5,6,9\n7,8,9,9\n1,1,2,9\n")).points;
     EXPECT_EQ(named.row(0), Eigen::RowVector3d(1, 2, 3)) << header;
   }
-  // Names with units, Excel's byte order mark, CloudCompare's "//".
-  for (const std::string header : {"x_mm,y_mm,z_mm,label", "\xEF\xBB\xBFX [mm],Y [mm],Z [mm],label", "//X,Y,Z,R"}) {
-    const dynsub::MatrixX3 named =
-        dynsub::readPointCloud(writeText("named.csv", header + "\n1,2,3,9\n4,5,6,9\n7,8,9,9\n1,1,2,9\n")).points;
-    EXPECT_EQ(named.row(0), Eigen::RowVector3d(1, 2, 3)) << header;
-  }
   const dynsub::MatrixX3 blanks =
       dynsub::readPointCloud(writeText("blanks.csv", "x y z\n1 2 3\n4 5 6\n7 8 9\n1 1 2\n")).points;
   EXPECT_EQ(blanks.row(3), Eigen::RowVector3d(1, 1, 2));
+  const dynsub::MatrixX3 slicer = dynsub::readPointCloud(
+      writeText("slicer.csv", "label,l,p,s,defined\nF-1,1,2,3,1\nF-2,4,5,6,1\nF-3,7,8,9,1\nF-4,1,1,2,1\n")).points;
+  EXPECT_EQ(slicer.row(1), Eigen::RowVector3d(4, 5, 6));
+  const std::pair<std::string, std::string> refused[] = {
+      {"id,px,py,pz\n0,1,2,3\n1,4,5,6\n2,7,8,9\n3,1,1,2\n", "line 1: the header names no columns x, y and z among its 4"},
+      {"label,r,a,s\n1,1,2,3\n2,4,5,6\n3,7,8,9\n4,1,1,2\n", "line 1: the header names no columns x, y and z among its 4"},
+      {"x,y,w\n1,2,3\n4,5,6\n7,8,9\n1,1,2\n", "line 1: the header does not name all the coordinates' columns"},
+      {"x,y,z,x\n1,2,3,4\n4,5,6,7\n7,8,9,1\n1,1,2,1\n", "line 1: the header names the column x twice"},
+      {"x,y,z\n1,2,3\n4,5,6,7\n7,8,9\n1,1,2\n", "line 3: 4 values, where the header names 3"},
+  };
+  for (const auto& [text, message] : refused) {
+    try {
+      dynsub::readPointCloud(writeText("refused.csv", text));
+      FAIL() << text << " was read";
+    } catch (const dynsub::Error& e) {
+      EXPECT_NE(std::string(e.what()).find("refused.csv: " + message), std::string::npos) << e.what();
+    }
+  }
+  // Without a header, the first point sets the row's width.
   try {
-    dynsub::readPointCloud(writeText("four.csv", "id,px,py,pz\n0,1,2,3\n1,4,5,6\n2,7,8,9\n3,1,1,2\n"));
-    FAIL() << "an index column was read as x";
+    dynsub::readPointCloud(writeText("rows.xyz", "1 2 3\n4 5 6\n7 8 9 1\n1 1 2\n"));
+    FAIL() << "a row of four values was read";
   } catch (const dynsub::Error& e) {
-    EXPECT_NE(std::string(e.what()).find("four.csv: line 1: the header does not name the coordinates' columns"),
-              std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("rows.xyz: line 3: 4 values, where the first point has 3"), std::string::npos)
         << e.what();
   }
 }
