@@ -83,6 +83,7 @@ ControlMesh chooseInitialModel(const FitCommandOptions& o, const MatrixX3& data)
       throw Error(o.init, "the initial model must be closed, but it has " + std::to_string(mesh.boundaryLoopCount()) +
                               " boundary loop(s)");
     }
+    requireOutwardFacing(mesh, o.init);
   }
   // A built-in shape's genus was checked before the scan was read; a mesh
   // file of the wrong genus is that file's problem.

@@ -152,7 +152,9 @@ TEST(Deformation, StartsAgainPastALevelThatTurnedOver) {
     EXPECT_LE(r.levels.back().level, maxLevel);
     // Level 2 turns 16.7 % over (measured): with level 3 allowed, it starts
     // again there.
-    if (maxLevel == 3) EXPECT_GE(r.restarts.size(), 1u);
+    if (maxLevel == 3) {
+      EXPECT_GE(r.restarts.size(), 1u);
+    }
   }
 }
 

@@ -123,6 +123,25 @@ int ControlMesh::genus() const {
   return (2 * pieceCount() - eulerCharacteristic() - boundaryLoopCount()) / 2;
 }
 
+double enclosedVolume(const ControlMesh& mesh) {
+  const MatrixX3& p = mesh.points();
+  double sixTimes = 0;
+  for (const Polygon& face : mesh.faces())
+    for (std::size_t k = 1; k + 1 < face.size(); ++k)
+      sixTimes += p.row(face[0]).dot(p.row(face[k]).cross(p.row(face[k + 1])));
+  return sixTimes / 6.0;
+}
+
+void requireOutwardFacing(const ControlMesh& mesh, const std::string& source) {
+  const double volume = enclosedVolume(mesh);
+  if (volume >= 0) return;
+  std::ostringstream message;
+  message << "the control mesh faces inward (the volume it encloses is " << volume
+          << " mm^3 as its faces are ordered): reverse the order of every face's vertices (MeshLab: Invert Faces "
+             "Orientation; Blender: Flip Normals)";
+  throw Error(source, message.str());
+}
+
 void ControlMesh::setPoints(const MatrixX3& points) {
   if (points.rows() != vertexCount()) {
     throw Error("ControlMesh::setPoints: got " + std::to_string(points.rows()) +

@@ -2,6 +2,9 @@
 // topology and orientation, and the copies in Data/Meshes are identical.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
+#include "dynsub/Error.h"
 #include "dynsub/MeshIO.h"
 #include "dynsub/StandardMeshes.h"
 
@@ -14,18 +17,6 @@ int countValence(const dynsub::ControlMesh& mesh, int valence) {
   return count;
 }
 
-// Signed volume by the divergence theorem (fan triangulation of each face):
-// positive when faces are oriented outward.
-double signedVolume(const dynsub::ControlMesh& mesh) {
-  const dynsub::MatrixX3 p = mesh.points();
-  double volume = 0;
-  for (const dynsub::Polygon& face : mesh.faces()) {
-    for (size_t k = 1; k + 1 < face.size(); ++k) {
-      volume += p.row(face[0]).dot(p.row(face[k]).cross(p.row(face[k + 1]))) / 6.0;
-    }
-  }
-  return volume;
-}
 
 TEST(StandardMeshes, CubeHasThePapersCounts) {
   const dynsub::ControlMesh cube = dynsub::makeCube98();
@@ -35,7 +26,7 @@ TEST(StandardMeshes, CubeHasThePapersCounts) {
   EXPECT_EQ(countValence(cube, 4), 90);
   EXPECT_TRUE(cube.isClosed());
   EXPECT_EQ(cube.genus(), 0);
-  EXPECT_NEAR(signedVolume(cube), 8.0, 1e-12);
+  EXPECT_NEAR(dynsub::enclosedVolume(cube), 8.0, 1e-12);
 }
 
 TEST(StandardMeshes, TorusAndSheet) {
@@ -43,12 +34,29 @@ TEST(StandardMeshes, TorusAndSheet) {
   EXPECT_EQ(torus.vertexCount(), 32);
   EXPECT_EQ(torus.faceCount(), 32);
   EXPECT_EQ(torus.genus(), 1);
-  EXPECT_GT(signedVolume(torus), 0.0);
+  EXPECT_GT(dynsub::enclosedVolume(torus), 0.0);
   const dynsub::ControlMesh sheet = dynsub::makeSheet81();
   EXPECT_EQ(sheet.vertexCount(), 81);
   EXPECT_EQ(sheet.faceCount(), 64);
   EXPECT_EQ(sheet.boundaryLoopCount(), 1);
   EXPECT_EQ(countValence(sheet, 2), 4);
+}
+
+// A mesh whose faces all turn inward encloses a negative volume, and is
+// refused as an initial model, naming its file.
+TEST(StandardMeshes, AMeshFacingInwardIsRefused) {
+  const dynsub::ControlMesh cube = dynsub::makeCube98();
+  std::vector<dynsub::Polygon> reversed = cube.faces();
+  for (dynsub::Polygon& face : reversed) std::reverse(face.begin(), face.end());
+  const dynsub::ControlMesh inward = dynsub::ControlMesh::fromPolygons(cube.points(), reversed);
+  EXPECT_NEAR(dynsub::enclosedVolume(inward), -8.0, 1e-12);
+  EXPECT_NO_THROW(dynsub::requireOutwardFacing(cube, "cube.obj"));
+  try {
+    dynsub::requireOutwardFacing(inward, "inward.obj");
+    FAIL() << "a mesh facing inward was taken";
+  } catch (const dynsub::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("inward.obj: the control mesh faces inward"), std::string::npos) << e.what();
+  }
 }
 
 // A cube and a torus side by side: two pieces whose genera add up (the Euler

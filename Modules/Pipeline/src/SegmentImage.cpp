@@ -206,6 +206,7 @@ ControlMesh chooseStart(const Volume& image, const SegmentInputs& in, const Segm
     case SegmentStart::Kind::Mesh: {
       ControlMesh mesh = readControlMesh(in.start.meshPath);
       if (!mesh.isClosed()) throw Error(in.start.meshPath, "the initial model must be a closed control mesh");
+      requireOutwardFacing(mesh, in.start.meshPath);
       return mesh;
     }
   }

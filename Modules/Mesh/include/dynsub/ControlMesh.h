@@ -70,4 +70,13 @@ class ControlMesh {
   std::shared_ptr<const Topology> topology_;
 };
 
+// The volume a closed mesh's polygons enclose (mm^3), signed: positive when
+// they face outward by the right-hand rule, negative when they face inward.
+double enclosedVolume(const ControlMesh& mesh);
+
+// Throws dynsub::Error naming `source` when closed `mesh` faces inward: its
+// forces (a pressure, an inflation) would push the wrong way, and its results
+// would be inside out in every viewer.
+void requireOutwardFacing(const ControlMesh& mesh, const std::string& source);
+
 }  // namespace dynsub
