@@ -273,6 +273,7 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
       std::vector<int> labels;
       for (const auto& label : listOf(required(s, "labels", where), where + ": labels"))
         labels.push_back(static_cast<int>(wholeNumber(label, where + ": a label", 0, kLargestSetting)));
+      if (labels.empty()) throw Error(path, where + " has no labels");
       plan.structures.push_back(
           {name, labels, axisOf(textOf(required(s, "orientation", where), where + ": orientation"), where)});
     }
@@ -341,6 +342,9 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
       EvaluationSplit split{name, {}, {}};
       for (const auto& structure : optionalList(s, "structures", where + ": "))
         split.structures.push_back(textOf(structure, where + ": a structure"));
+      // Left out, the key means every structure; an empty list is a slip.
+      if (s.contains("structures") && split.structures.empty())
+        throw Error(path, where + " lists no structures (leave \"structures\" out for all of them)");
       for (const auto& seed : listOf(required(s, "seeds", where), where + ": seeds")) {
         split.seeds.push_back(static_cast<unsigned>(
             wholeNumber(seed, "split '" + split.name + "': a seed", 0, std::numeric_limits<unsigned>::max())));
@@ -371,6 +375,27 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
       for (const EvaluationSplit& s : plan.splits) known = known || s.name == split;
       if (!known) throw Error(path, "cohort '" + cohort.name + "' names unknown split '" + split + "'");
     }
+  // On a plan's images every split runs: two splits that share a click seed
+  // and a structure would run the same clicks, and a tuning figure would be
+  // reported again as a test one.
+  if (!plan.images.empty())
+    for (std::size_t a = 0; a < plan.splits.size(); ++a)
+      for (std::size_t b = a + 1; b < plan.splits.size(); ++b) {
+        const EvaluationSplit &first = plan.splits[a], &second = plan.splits[b];
+        for (const EvaluationStructure& structure : plan.structures) {
+          const auto runs = [&](const EvaluationSplit& split) {
+            return split.structures.empty() || std::find(split.structures.begin(), split.structures.end(),
+                                                         structure.name) != split.structures.end();
+          };
+          if (!runs(first) || !runs(second)) continue;
+          for (unsigned seed : first.seeds)
+            if (std::find(second.seeds.begin(), second.seeds.end(), seed) != second.seeds.end())
+              throw Error(path, "splits '" + first.name + "' and '" + second.name + "' share seed " +
+                                    std::to_string(seed) + " for structure '" + structure.name +
+                                    "': on the plan's images they would run the same clicks (each split's seeds "
+                                    "must be its own)");
+        }
+      }
   // Names make the runs' file names and the summary's groups: each once, and
   // each a plain file name (no '/' or "..": nothing is written outside the
   // directories asked for).

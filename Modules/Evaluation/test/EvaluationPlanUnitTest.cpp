@@ -95,6 +95,18 @@ TEST(EvaluationPlan, RepeatedKeysAndTrailingTextAreRefused) {
   EXPECT_NE(errorOf(R"({"name": "six"})", "[1]}]} {").find("not valid JSON"), std::string::npos);
 }
 
+// On a plan's images every split runs: a seed two splits share for one
+// structure would score the same clicks as tuning and as test. An empty
+// list of a split's structures is a slip, not "all".
+TEST(EvaluationPlan, SplitsSharingClicksOrListingNoStructureAreRefused) {
+  EXPECT_NE(errorOf(R"({"name": "six"})", R"([1, 2]}, {"name": "tuning", "seeds": [2])")
+                .find("splits 'test' and 'tuning' share seed 2 for structure 'caudate_left'"),
+            std::string::npos);
+  EXPECT_EQ(errorOf(R"({"name": "six"})", R"([1, 2]}, {"name": "tuning", "seeds": [3])"), "");
+  EXPECT_NE(errorOf(R"({"name": "six"})", R"([1], "structures": [])").find("split 'test' lists no structures"),
+            std::string::npos);
+}
+
 TEST(EvaluationPlan, ScatterAndMistakeDistancesHaveARange) {
   EXPECT_NE(errorOf(R"({"name": "six", "scatter_mm": 1e6})", "[1]").find("scatter must be in 0..100 mm"),
             std::string::npos);
