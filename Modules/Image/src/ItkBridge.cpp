@@ -106,7 +106,7 @@ void readImage(const std::string& path, Geometry& geometry, std::vector<float>& 
     const float* buffer = image->GetBufferPointer();
     voxels.assign(buffer, buffer + countOf(geometry));
   } catch (const itk::ExceptionObject& e) {
-    throw Error(path, std::string("cannot read image: ") + e.GetDescription());
+    throw Error(path, "cannot read image: " + readableItkMessage(e.GetDescription()));
   }
 }
 

@@ -154,7 +154,7 @@ void readDicom(const std::string& path, Geometry& geometry, std::vector<float>& 
     const float* buffer = image->GetBufferPointer();
     voxels.assign(buffer, buffer + countOf(geometry));
   } catch (const itk::ExceptionObject& e) {
-    throw Error(path, std::string("cannot read image: ") + e.GetDescription());
+    throw Error(path, "cannot read image: " + readableItkMessage(e.GetDescription()));
   }
 }
 

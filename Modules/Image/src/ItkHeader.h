@@ -3,6 +3,7 @@
 // image file's header that ItkBridge.cpp and ItkDicom.cpp make before ITK
 // reads its voxels.
 #include <cstdint>
+#include <sstream>
 #include <string>
 
 #include <itkImageIOBase.h>
@@ -11,6 +12,35 @@
 #include "dynsub/Error.h"
 
 namespace dynsub::itkbridge {
+
+// An ITK exception's description as a reason a person can read: without the
+// "itk::ERROR: NrrdImageIO(0x55...): Read: Error reading FILE:" preamble, and
+// of a reading library's chain of "[nrrd] function: trouble reading" lines,
+// the lines that say what is wrong ("couldn't open \"x.raw\" for reading"),
+// joined by "; ".
+inline std::string readableItkMessage(const std::string& description) {
+  std::istringstream lines(description);
+  std::string line, reasons;
+  bool first = true;
+  while (std::getline(lines, line)) {
+    if (first) {
+      first = false;
+      // The preamble ends at its last ": " when the line names no reason after it.
+      const bool preamble = line.find("ERROR: ") != std::string::npos && line.back() == ':';
+      if (preamble) continue;
+    }
+    // "[nrrd] _nrrdEncodingRaw_read: fread got only ..." -> "fread got only ..."
+    if (!line.empty() && line[0] == '[') {
+      const auto tag = line.find("] ");
+      const auto colon = tag == std::string::npos ? std::string::npos : line.find(": ", tag);
+      line = colon == std::string::npos ? std::string() : line.substr(colon + 2);
+    }
+    while (!line.empty() && (line.back() == ' ' || line.back() == ':')) line.pop_back();
+    if (line.empty() || line == "trouble" || line.rfind("trouble reading", 0) == 0) continue;
+    reasons += (reasons.empty() ? "" : "; ") + line;
+  }
+  return reasons.empty() ? description : reasons;
+}
 
 // After the project's own checks of the file (FileChecks.h), made by
 // readVolume before it calls a library's readImage: `io` reads the header of

@@ -347,6 +347,22 @@ TEST(HostileImages, FourDimensionsAndAxesNotAtRightAnglesAreRefused) {
   EXPECT_EQ(readError(scratch("rotated.mha")), "");
 }
 
+// The reading library's reason, without ITK's preamble (its class, an
+// address) and the chain of "trouble reading" lines around it.
+TEST(HostileImages, ALibrarysReasonIsGivenWithoutItsPreamble) {
+  std::ofstream(scratch("detached.nhdr"))
+      << "NRRD0004\ntype: float\ndimension: 3\nspace: left-posterior-superior\nsizes: 4 3 2\n"
+         "space directions: (1,0,0) (0,1,0) (0,0,1)\nencoding: raw\nendian: little\nspace origin: (0,0,0)\n"
+         "data file: nothere.raw\n";
+  const std::string error = readError(scratch("detached.nhdr"));
+  EXPECT_NE(error.find("detached.nhdr: cannot read image: "), std::string::npos) << error;
+  EXPECT_NE(error.find("couldn't open \""), std::string::npos) << error;
+  EXPECT_NE(error.find("nothere.raw\" (data file 1 of 1) for reading"), std::string::npos) << error;
+  EXPECT_EQ(error.find("ERROR"), std::string::npos) << error;
+  EXPECT_EQ(error.find("trouble reading"), std::string::npos) << error;
+  EXPECT_EQ(error.find('\n'), std::string::npos) << error;
+}
+
 TEST(HostileImages, ConstantAndExtremeIntensitiesAreReadExactly) {
   // The ramp goes up to 16 times the scale: 2.4e38 of float's 3.4e38.
   for (const float scale : {0.0f, 1.5e37f, 1e-37f, -1.5e37f}) {
