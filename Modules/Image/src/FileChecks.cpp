@@ -84,6 +84,7 @@ DataCheck checkImageHeader(const std::string& path) {
   const std::string extension = lowerCaseExtension(path);
   if (isNiftiName(path)) return checkNiftiHeader(path);
   if (extension == ".mha" || extension == ".mhd") checkMetaImageFile(path);
+  if (extension == ".nrrd") checkNrrdFile(path);
   return [] {};
 }
 

@@ -55,6 +55,12 @@ inline void checkNiftiFile(const std::string& path) { checkNiftiHeader(path)(); 
 // compressed. Throws dynsub::Error naming the file that falls short.
 void checkMetaImageFile(const std::string& path);
 
+// A NRRD file (.nrrd) with its raw data after the header: the data is no
+// longer than its sizes and type announce (ITK would read the first bytes
+// as the image). Throws dynsub::Error naming the file; other encodings and
+// detached data are left to ITK, which reports data that falls short.
+void checkNrrdFile(const std::string& path);
+
 // Whether the file's name says NIfTI: .nii or .nii.gz (any case).
 bool isNiftiName(const std::string& path);
 

@@ -38,7 +38,7 @@ void checkMetaImageFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path, "cannot be opened");
   std::string line, dataFile, elementType;
-  bool compressed = false;
+  bool compressed = false, headerSize = false;
   std::uintmax_t compressedSize = 0, channels = 1;
   std::vector<std::int64_t> size;
   long long dimensions = -1;
@@ -72,6 +72,7 @@ void checkMetaImageFile(const std::string& path) {
       if (n < 0) throw Error(path, "MetaImage CompressedDataSize is negative");
       compressedSize = static_cast<std::uintmax_t>(n);
     }
+    if (key == "HeaderSize") headerSize = true;
     if (key == "ElementDataFile") dataFile = value;
   }
   if (dataFile.empty()) throw Error(path, "a MetaImage header without ElementDataFile");
@@ -110,6 +111,12 @@ void checkMetaImageFile(const std::string& path) {
   if (available < needed)
     throw Error(source, "truncated: " + std::to_string(available) + " bytes of data, the header announces " +
                             std::to_string(needed));
+  // More raw data than announced: the header's DimSize or ElementType is not
+  // the data's, and ITK would read its first bytes as the image. (A
+  // HeaderSize skips bytes before the data, which are then not counted here.)
+  if (!compressed && !headerSize && available > needed)
+    throw Error(source, std::to_string(available) + " bytes of data, where the header announces " +
+                            std::to_string(needed) + ": its DimSize or ElementType does not describe the data");
 }
 
 }  // namespace dynsub::filechecks

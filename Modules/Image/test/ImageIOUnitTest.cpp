@@ -347,6 +347,30 @@ TEST(HostileImages, FourDimensionsAndAxesNotAtRightAnglesAreRefused) {
   EXPECT_EQ(readError(scratch("rotated.mha")), "");
 }
 
+// A header that announces less data than the file holds: ITK reads the
+// first bytes as the image and drops the rest.
+TEST(HostileImages, MoreDataThanTheHeaderAnnouncesIsRefused) {
+  const std::vector<float> voxels = ramp(4 * 3 * 3, 1.0f);
+  const std::string data(reinterpret_cast<const char*>(voxels.data()), voxels.size() * sizeof(float));
+  std::ofstream(scratch("extra.mha"), std::ios::binary)
+      << "ObjectType = Image\nNDims = 3\nDimSize = 4 3 2\nElementType = MET_FLOAT\nElementDataFile = LOCAL\n"
+      << data;
+  std::ofstream(scratch("extra.nrrd"), std::ios::binary)
+      << "NRRD0004\ntype: float\ndimension: 3\nspace: left-posterior-superior\nsizes: 4 3 2\n"
+         "space directions: (1,0,0) (0,1,0) (0,0,1)\nencoding: raw\nendian: little\nspace origin: (0,0,0)\n\n"
+      << data;
+  for (const std::string name : {"extra.mha", "extra.nrrd"}) {
+    const std::string error = readError(scratch(name));
+    EXPECT_NE(error.find(name + ": 144 bytes of data, where the header announces 96"), std::string::npos) << error;
+  }
+  // The data the header announces, to the byte, reads.
+  std::ofstream(scratch("exact.nrrd"), std::ios::binary)
+      << "NRRD0004\ntype: float\ndimension: 3\nspace: left-posterior-superior\nsizes: 4 3 3\n"
+         "space directions: (1,0,0) (0,1,0) (0,0,1)\nencoding: raw\nendian: little\nspace origin: (0,0,0)\n\n"
+      << data;
+  EXPECT_EQ(readError(scratch("exact.nrrd")), "");
+}
+
 // The reading library's reason, without ITK's preamble (its class, an
 // address) and the chain of "trouble reading" lines around it.
 TEST(HostileImages, ALibrarysReasonIsGivenWithoutItsPreamble) {
