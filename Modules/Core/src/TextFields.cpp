@@ -31,6 +31,11 @@ std::string trimmed(const std::string& text) {
   return first == std::string::npos ? std::string() : text.substr(first, text.find_last_not_of(" \t") + 1 - first);
 }
 
+std::string withoutLibraryTag(const std::string& message) {
+  const std::size_t end = message.find("] ");
+  return message.rfind('[', 0) == 0 && end != std::string::npos ? message.substr(end + 2) : message;
+}
+
 std::string withoutByteOrderMark(const std::string& line) {
   return line.rfind("\xEF\xBB\xBF", 0) == 0 ? line.substr(3) : line;
 }

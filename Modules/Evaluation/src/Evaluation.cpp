@@ -20,6 +20,7 @@
 #include "dynsub/SegmentImage.h"
 #include "dynsub/SegmentStructures.h"
 #include "dynsub/SubjectGenerator.h"
+#include "dynsub/TextFields.h"
 
 namespace dynsub {
 
@@ -198,7 +199,7 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
   try {
     j = parseWithoutRepeatedKeys(in);
   } catch (const nlohmann::json::exception& e) {
-    throw Error(path, std::string("not valid JSON: ") + e.what());
+    throw Error(path, "not valid JSON: " + withoutLibraryTag(e.what()));
   } catch (const Error& e) {
     throw Error(path, e.what());
   }
@@ -361,7 +362,7 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
       plan.splits.push_back(split);
     }
   } catch (const nlohmann::json::exception& e) {
-    throw Error(path, std::string("not an evaluation plan: ") + e.what());
+    throw Error(path, "not an evaluation plan: " + withoutLibraryTag(e.what()));
   } catch (const Error& e) {
     const std::string message = e.what();
     throw Error(message.rfind(path, 0) == 0 ? message : path + ": " + message);

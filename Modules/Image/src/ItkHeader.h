@@ -25,9 +25,12 @@ inline std::string readableItkMessage(const std::string& description) {
   while (std::getline(lines, line)) {
     if (first) {
       first = false;
-      // The preamble ends at its last ": " when the line names no reason after it.
-      const bool preamble = line.find("ERROR: ") != std::string::npos && line.back() == ':';
-      if (preamble) continue;
+      // "itk::ERROR: NrrdImageIO(0x55...): " goes; what follows stays unless
+      // it only announces the lines after it ("Read: Error reading x.nrrd:").
+      const auto error = line.find("ERROR: ");
+      const auto address = error == std::string::npos ? std::string::npos : line.find("): ", error);
+      if (address != std::string::npos) line = line.substr(address + 3);
+      if (!line.empty() && line.back() == ':') continue;
     }
     // "[nrrd] _nrrdEncodingRaw_read: fread got only ..." -> "fread got only ..."
     if (!line.empty() && line[0] == '[') {

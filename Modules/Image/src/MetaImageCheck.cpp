@@ -2,10 +2,12 @@
 #include "FileChecks.h"
 
 #include <cerrno>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <utility>
 #include <vector>
 
 #include "dynsub/Error.h"
@@ -42,6 +44,9 @@ void checkMetaImageFile(const std::string& path) {
   std::uintmax_t compressedSize = 0, channels = 1;
   std::vector<std::int64_t> size;
   long long dimensions = -1;
+  // The placement's fields as written, checked once NDims is known (MetaIO
+  // fails on a value that is not a number, then reports the file missing).
+  std::vector<std::pair<std::string, std::string>> placement;
   auto whole = [&](const std::string& key, const std::string& value) {
     char* end = nullptr;
     errno = 0;
@@ -73,11 +78,29 @@ void checkMetaImageFile(const std::string& path) {
       compressedSize = static_cast<std::uintmax_t>(n);
     }
     if (key == "HeaderSize") headerSize = true;
+    if (key == "ElementSpacing" || key == "Offset" || key == "Origin" || key == "Position" || key == "CenterOfRotation" ||
+        key == "TransformMatrix" || key == "Rotation" || key == "Orientation")
+      placement.emplace_back(key, value);
     if (key == "ElementDataFile") dataFile = value;
   }
   if (dataFile.empty()) throw Error(path, "a MetaImage header without ElementDataFile");
   if (dimensions < 1 || dimensions > 10)
     throw Error(path, "a MetaImage header with NDims " + std::to_string(dimensions) + " (1 to 10 are read)");
+  for (const auto& [key, value] : placement) {
+    std::istringstream fields(value);
+    std::size_t count = 0;
+    for (std::string field; fields >> field; ++count) {
+      char* end = nullptr;
+      const double number = std::strtod(field.c_str(), &end);
+      if (*end != '\0' || !std::isfinite(number))
+        throw Error(path, "MetaImage " + key + " holds '" + field + "', not a finite number");
+    }
+    const bool matrix = key == "TransformMatrix" || key == "Rotation" || key == "Orientation";
+    const std::size_t expected = static_cast<std::size_t>(matrix ? dimensions * dimensions : dimensions);
+    if (count != expected)
+      throw Error(path, "MetaImage " + key + " has " + std::to_string(count) + " values for NDims " +
+                            std::to_string(dimensions) + " (expected " + std::to_string(expected) + ")");
+  }
   if (static_cast<long long>(size.size()) != dimensions)
     throw Error(path, "MetaImage DimSize has " + std::to_string(size.size()) + " sizes for NDims " +
                           std::to_string(dimensions));

@@ -339,6 +339,19 @@ TEST(HostileImages, FourDimensionsAndAxesNotAtRightAnglesAreRefused) {
               std::string::npos)
         << matrix << ": " << readError(scratch("skewed.mha"));
   }
+  // A placement field that is not a number, or of the wrong count: MetaIO
+  // fails on it and then reports the file missing.
+  for (const auto& [field, message] : std::vector<std::pair<std::string, std::string>>{
+           {"ElementSpacing = nan 1 1", "ElementSpacing holds 'nan', not a finite number"},
+           {"TransformMatrix = 1 0 0 0 1", "TransformMatrix has 5 values for NDims 3 (expected 9)"},
+           {"Offset = 0 0", "Offset has 2 values for NDims 3 (expected 3)"}}) {
+    std::ofstream(scratch("placed.mha"), std::ios::binary)
+        << "ObjectType = Image\nNDims = 3\n" << field
+        << "\nDimSize = 4 3 2\nElementType = MET_FLOAT\nElementDataFile = LOCAL\n"
+        << volume;
+    EXPECT_NE(readError(scratch("placed.mha")).find("placed.mha: MetaImage " + message), std::string::npos)
+        << readError(scratch("placed.mha"));
+  }
   // A rotation written to 6 decimals reads.
   std::ofstream(scratch("rotated.mha"), std::ios::binary)
       << "ObjectType = Image\nNDims = 3\nTransformMatrix = 0.866025 0.5 0 -0.5 0.866025 0 0 0 1"

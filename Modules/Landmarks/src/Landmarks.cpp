@@ -97,7 +97,7 @@ std::vector<LandmarkList> readMarkupsJson(const std::string& path, std::ifstream
     // stray edit) is refused, not ignored.
     document = nlohmann::json::parse(in);
   } catch (const nlohmann::json::exception& e) {
-    throw Error(path, std::string("not valid JSON: ") + e.what());
+    throw Error(path, "not valid JSON: " + withoutLibraryTag(e.what()));
   }
   if (!document.contains("markups") || !document["markups"].is_array())
     throw Error(path, "no \"markups\" list (not a 3D Slicer markups file)");

@@ -161,7 +161,7 @@ TEST(Landmarks, BadFilesAreRefusedWithTheirName) {
   std::ofstream(scratch("noheader.csv").string()) << "1,2,3\n";
   expectError(scratch("noheader.csv"), "x, y and z");
   std::ofstream(scratch("broken.mrk.json").string()) << "{\"markups\": [";
-  expectError(scratch("broken.mrk.json"), "JSON");
+  expectError(scratch("broken.mrk.json"), "not valid JSON: parse error at line 1");
   // Text after the document (here the document pasted twice) is refused, not ignored.
   writeLandmarks(sample(), scratch("twice.mrk.json").string());
   {

@@ -20,9 +20,10 @@
 
 #include "dynsub/ControlMesh.h"
 #include "dynsub/Error.h"
-#include "dynsub/TextFields.h"
 #include "dynsub/FileNames.h"
 #include "dynsub/MeshIO.h"
+#include "dynsub/TextFields.h"
+#include "dynsub/VtkErrors.h"
 
 namespace dynsub {
 
@@ -163,7 +164,10 @@ PointCloud readVtp(const std::string& path) {
   vtkNew<vtkXMLPolyDataReader> reader;
   if (!reader->CanReadFile(path.c_str())) throw Error(path, "is not a VTK XML polydata file");
   reader->SetFileName(path.c_str());
+  VtkErrors errors;
+  errors.watch(reader);
   reader->Update();
+  if (!errors.first().empty()) throw Error(path, "VTK could not read the points: " + errors.reason());
   if (reader->GetErrorCode() != 0) throw Error(path, "could not be read (truncated or corrupt?)");
   vtkPolyData* data = reader->GetOutput();
   if (!data || !data->GetPoints() || data->GetNumberOfPoints() == 0) throw Error(path, "has no points");

@@ -108,11 +108,7 @@ vtkSmartPointer<vtkPolyData> readWith(vtkAlgorithm* reader, const std::string& p
   VtkErrors errors;
   errors.watch(reader);
   reader->Update();
-  if (!errors.first().empty()) {
-    // The first line is enough: VTK's messages carry source locations after it.
-    const std::string first = errors.first().substr(0, errors.first().find('\n'));
-    throw Error(path, "VTK could not read the surface: " + first);
-  }
+  if (!errors.first().empty()) throw Error(path, "VTK could not read the surface: " + errors.reason());
   auto polyData = vtkSmartPointer<vtkPolyData>::New();
   polyData->ShallowCopy(vtkPolyData::SafeDownCast(reader->GetOutputDataObject(0)));
   return polyData;

@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -46,6 +47,30 @@ TEST(PointCloudIO, SurfaceFilesAreMeshVertices) {
     EXPECT_EQ(cloud.points.rows(), surface.points.rows()) << extension;
     EXPECT_TRUE(cloud.meshVertices) << extension;
   }
+}
+
+// A .vtp cut short: one error that names the file and VTK's reason, and
+// nothing of VTK's own log on stderr (its XML parser's line, an executive's
+// dump).
+TEST(PointCloudIO, ATruncatedVtpIsRefusedInOneMessage) {
+  const dynsub::ControlMesh cube = dynsub::makeCube98();
+  const dynsub::LimitSurface limit(cube);
+  const std::string whole = scratch("whole.vtp");
+  dynsub::writeTriangleSurface(dynsub::tessellate(limit, cube.points(), 2), whole);
+  std::ifstream in(whole, std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string cut = writeText("cut.vtp", text.substr(0, text.size() / 2));
+  testing::internal::CaptureStderr();
+  std::string error;
+  try {
+    dynsub::readPointCloud(cut);
+  } catch (const dynsub::Error& e) {
+    error = e.what();
+  }
+  const std::string printed = testing::internal::GetCapturedStderr();
+  EXPECT_NE(error.find("cut.vtp: VTK could not read the points: "), std::string::npos) << error;
+  EXPECT_EQ(error.find("0x"), std::string::npos) << error;
+  EXPECT_EQ(printed, "");
 }
 
 TEST(PointCloudIO, PointFilesAreNotMeshVertices) {

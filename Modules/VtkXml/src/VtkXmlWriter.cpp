@@ -30,12 +30,7 @@ void writeVtkXml(vtkDataObject* data, const std::string& path, const std::string
   writer->EncodeAppendedDataOff();
   writer->SetCompressorTypeToLZ4();
   if (writer->Write() != 1 || writer->GetErrorCode() != 0) {
-    // The reason is what follows VTK's source location, class and address.
-    std::string message = errors.first();
-    const std::size_t reason = message.rfind("): ");
-    if (reason != std::string::npos) message.erase(0, reason + 3);
-    while (!message.empty() && (message.back() == '\n' || message.back() == ' ')) message.pop_back();
-    throw writeFailure(name, withoutTemporaryPrefix(message));
+    throw writeFailure(name, withoutTemporaryPrefix(errors.reason()));
   }
 }
 

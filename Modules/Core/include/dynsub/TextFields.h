@@ -18,6 +18,11 @@ std::vector<std::string> splitItems(const std::string& text, char separator);
 // `text` without the blanks and tabs at its ends.
 std::string trimmed(const std::string& text);
 
+// A library's message without the tag it starts with: "[json.exception.
+// parse_error.101] parse error at line 1, column 13: ..." -> "parse error at
+// line 1, column 13: ...".
+std::string withoutLibraryTag(const std::string& message);
+
 // `line` without the UTF-8 byte order mark that spreadsheets ("CSV UTF-8")
 // write before a file's first line.
 std::string withoutByteOrderMark(const std::string& line);
