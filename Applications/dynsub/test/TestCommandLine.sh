@@ -329,6 +329,15 @@ mri=/usr/share/mricron/templates
   --reference "$mri/aal.nii.gz" --reference-label 71 --out "$work/caudate" >"$work/stdout" 2>&1
 check "segment succeeds" test $? -eq 0
 cp "$work/stdout" "$work/caudate.out"  # later checks write $work/stdout again
+# A start 8 mm across inside clicks 40 mm long moves by more than its size
+# in a step until the step is about 4 ms (Simulation.h): it is reached by
+# halving, not refused as a divergence.
+"$DYNSUB" mesh cube --out "$work/cube98.obj" >/dev/null
+awk '$1 == "v" { printf "v %.17g %.17g %.17g\n", 15.36 + 4 * $2, -1.5 + 4 * $3, 15.97 + 4 * $4; next } { print }' \
+  "$work/cube98.obj" >"$work/small_start.obj"
+"$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --init "$work/small_start.obj" \
+  --no-figures --out "$work/small_start" >"$work/stdout" 2>&1
+check "segment from a small --init mesh among far clicks succeeds" test $? -eq 0
 for name in surface.vtp control_mesh.obj labelmap.nii.gz report.json convergence.csv slices.png surface3d.png \
   convergence.png; do
   check "segment writes $name" test -s "$work/caudate/$name"

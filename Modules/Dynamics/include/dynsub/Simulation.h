@@ -109,7 +109,11 @@ struct SimulationOptions {
   // and plate hold it off data it could reach (the faces of a cube bow in),
   // and refining costs four times the control vertices.
   int relaxations = 0;
-  int maxTimeStepHalvings = 8;
+  // 12 takes segment's 4 s step to 1 ms: a start a few mm across pulled by
+  // landmarks 20 mm away (a small --init mesh in a caudate's clicks) moves
+  // by more than its size in a step until about 4 ms. A divergence shows in
+  // a level's first steps, so each restart costs a few steps.
+  int maxTimeStepHalvings = 12;
   // Steps of falling energy after which a halved time step is doubled again
   // (see above; 0: a halved step stays halved). Chosen on the evaluation's
   // tuning split; only simulations in which a level diverged are affected
