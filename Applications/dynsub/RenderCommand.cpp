@@ -5,6 +5,7 @@
 #include <iostream>
 #include <memory>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -66,7 +67,21 @@ void runRender(const RenderCommandOptions& o) {
     image = std::make_unique<Volume>(readVolume(o.image));
     inputs.image = image.get();
   }
-  if (!o.landmarks.empty()) inputs.landmarks = landmarkPositions(readLandmarks(o.landmarks));
+  if (!o.landmarks.empty()) {
+    const std::vector<Landmark> landmarks = readLandmarks(o.landmarks);
+    // Drawn on the image's slices, a landmark outside the image would be
+    // left out of the figure without a word.
+    for (std::size_t i = 0; image && i < landmarks.size(); ++i) {
+      const Vector3& p = landmarks[i].position;
+      if (image->geometry.covers(p)) continue;
+      std::ostringstream message;
+      message << "landmark " << i + 1 << (landmarks[i].label.empty() ? "" : " ('" + landmarks[i].label + "')")
+              << " at (" << p.x() << ", " << p.y() << ", " << p.z() << ") mm LPS lies outside the image " << o.image
+              << " (are the landmarks for another image?)";
+      throw Error(o.landmarks, message.str());
+    }
+    inputs.landmarks = landmarkPositions(landmarks);
+  }
   const auto readDrawnPoints = [](const std::string& path) {
     MatrixX3 points = readPointCloud(path).points;
     if (!points.allFinite()) throw Error(path, "a point is not a finite number");

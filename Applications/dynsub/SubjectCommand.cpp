@@ -1,7 +1,9 @@
 #include <algorithm>
-#include <limits>
 #include <fstream>
 #include <iostream>
+#include <limits>
+#include <set>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
@@ -27,10 +29,14 @@ void runSubject(const Arguments& arguments) {
   // An unknown key or a value out of range is a usage error here; the same
   // checks name the plan when a plan's cohort gives the settings.
   asUsageError([&] {
+    std::set<std::string> given;
     for (const std::string& setting : arguments.settings) {
       const auto equals = setting.find('=');
       if (equals == std::string::npos) throw UsageError("--set", "expected KEY=VALUE, got '" + setting + "'");
-      setSubjectSetting(settings, setting.substr(0, equals), setting.substr(equals + 1));
+      const std::string key = setting.substr(0, equals);
+      // The last would win without a word, and the subject be another than meant.
+      if (!given.insert(key).second) throw UsageError("--set", key + " is set twice");
+      setSubjectSetting(settings, key, setting.substr(equals + 1));
     }
     checkSubjectSettings(settings);
   });

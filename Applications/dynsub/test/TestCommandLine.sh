@@ -512,6 +512,10 @@ check "render --figure-coordinates RAS: the same surface figure" \
   cmp -s "$work/rendered_ras/surface3d.png" "$work/caudate/surface3d.png"
 check "render --figure-coordinates RAS: other slice captions" \
   test -s "$work/rendered_ras/slices.png" -a -n "$(cmp "$work/rendered_ras/slices.png" "$work/caudate/slices.png")"
+printf 'x,y,z\n-12,10,12\n400,10,12\n' >"$work/far_landmarks.csv"
+expect_error "render: a landmark outside the image" 1 "landmark 2 at (400, 10, 12) mm LPS lies outside the image" \
+  "$work/r0b" "$DYNSUB" render --surface "$work/caudate/surface.vtp" --image "$mri/ch2.nii.gz" \
+  --landmarks "$work/far_landmarks.csv" --out "$work/r0b"
 expect_error "render: unknown coordinate system" 2 "figure-coordinates" "$work/r0" \
   "$DYNSUB" render --surface "$work/caudate/surface.vtp" --figure-coordinates xyz --out "$work/r0"
 expect_error "render: missing surface" 1 "no such file" "$work/r1" \
@@ -793,6 +797,10 @@ expect_error "subject: an unknown mode" 2 "mode must be 'realistic' or 'synthesi
   "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --set mode=synthetic --out "$work/s43"
 expect_error "subject: an unknown setting" 2 "unknown setting 'noise'" "$work/s40" \
   "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --set noise=3 --out "$work/s40"
+expect_error "subject: a setting given twice" 2 "--set: snr is set twice" "$work/s41b" \
+  "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --set snr=20 --set snr=30 --out "$work/s41b"
+expect_error "subject: an empty structure label" 2 "structure_labels must be a number, got '71,'" "$work/s41c" \
+  "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --set structure_labels=71, --out "$work/s41c"
 expect_error "subject: a warp that could fold" 2 "warp_mm must be" "$work/s41" \
   "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --set warp_mm=20 --out "$work/s41"
 /usr/bin/python3 -c "

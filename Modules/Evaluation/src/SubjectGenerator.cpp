@@ -267,8 +267,7 @@ void setSubjectSetting(SubjectSettings& s, const std::string& key, const std::st
   }
   if (key == "structure_labels") {
     s.structureLabels.clear();
-    std::stringstream list(value);
-    for (std::string item; std::getline(list, item, ',');) {
+    for (const std::string& item : splitItems(value, ',')) {
       const double label = number(item);
       if (label < 1 || label > 65535 || label != std::floor(label))
         throw Error("subject settings", "structure_labels must be whole numbers in 1..65535, got '" + item + "'");
