@@ -7,6 +7,7 @@
 // the looser rule; local refinement frees points only where the data ask.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -38,9 +39,20 @@ TEST(PointCloudChecks, RefuseDegenerateData) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("flat.xyz: all points lie on a plane"), std::string::npos) << e.what();
   }
-  MatrixX3 line(10, 3);
-  for (int i = 0; i < 10; ++i) line.row(i) << i, 2 * i, -i;
-  EXPECT_THROW(checkPointCloud(line, "line.xyz"), Error);
+  // A line whose points were written to 6 significant digits is still a line.
+  MatrixX3 line(500, 3);
+  for (int i = 0; i < 500; ++i)
+    for (int a = 0; a < 3; ++a) {
+      char written[32];
+      std::snprintf(written, sizeof written, "%g", 0.0200401 * i * (a + 1));
+      line(i, a) = std::stod(written);
+    }
+  try {
+    checkPointCloud(line, "line.xyz");
+    FAIL() << "collinear points were accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("line.xyz: all points lie on a line"), std::string::npos) << e.what();
+  }
   EXPECT_NO_THROW(checkPointCloud(MatrixX3::Random(10, 3), "fine.xyz"));
 }
 

@@ -78,9 +78,11 @@ void checkPointCloud(const MatrixX3& points, const std::string& source) {
 int spannedDimensions(const MatrixX3& points) {
   const Principal p = principalAxes(points);
   if (!(p.variances(0) > 0.0)) return 0;
-  // Relative to the largest spread; 1e-12 of the variance is 1e-6 of the size.
-  if (p.variances(1) <= 1e-12 * p.variances(0)) return 1;
-  if (p.variances(2) <= 1e-12 * p.variances(0)) return 2;
+  // Relative to the largest spread: 1e-10 of the variance is 1e-5 of the
+  // size, above the rounding of coordinates written to 6 digits (a line so
+  // written scatters by up to 1e-6 of its length).
+  if (p.variances(1) <= 1e-10 * p.variances(0)) return 1;
+  if (p.variances(2) <= 1e-10 * p.variances(0)) return 2;
   return 3;
 }
 
