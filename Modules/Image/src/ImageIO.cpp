@@ -53,6 +53,19 @@ Volume readVolume(const std::string& path) {
       throw Error(path, "not a 3D image (" + std::to_string(volume.geometry.size[a]) + " voxel(s) along axis " +
                             std::to_string(a) + ")");
   const ImageGeometry& g = volume.geometry;
+  if (!g.origin.allFinite()) throw Error(path, "the origin is not finite");
+  // Options, tolerances and reports are in mm, chosen for voxels of tenths of
+  // a mm to a few mm: a spacing far outside that is a broken header (or a
+  // file in other units) that would give meaningless results.
+  if (!(g.spacing.minCoeff() >= kSmallestSpacing && g.spacing.maxCoeff() <= kLargestSpacing)) {
+    std::ostringstream message;
+    message << "voxel spacing " << g.spacing.x() << " x " << g.spacing.y() << " x " << g.spacing.z() << " mm ";
+    if (!(g.spacing.minCoeff() > 0))
+      message << "is not positive";
+    else
+      message << "is outside the " << kSmallestSpacing << " to " << kLargestSpacing << " mm DynSub works with";
+    throw Error(path, message.str());
+  }
   if (!g.direction.allFinite() || !(std::abs(g.direction.determinant()) > 1e-6))
     throw Error(path, "singular direction matrix");
   // Axes at right angles, of unit length, as ITK's filters and every output
@@ -63,17 +76,6 @@ Volume readVolume(const std::string& path) {
     std::ostringstream message;
     message << "the direction matrix is not orthonormal (its axes' dot products and lengths are off by up to "
             << skew << "): DynSub needs axes at right angles, of unit length; resample the image onto such a grid";
-    throw Error(path, message.str());
-  }
-  if (!g.origin.allFinite()) throw Error(path, "the origin is not finite");
-  if (!(g.spacing.minCoeff() > 0)) throw Error(path, "spacing must be positive");
-  // Options, tolerances and reports are in mm, chosen for voxels of tenths of
-  // a mm to a few mm: a spacing far outside that is a broken header (or a
-  // file in other units) that would give meaningless results.
-  if (!(g.spacing.minCoeff() >= kSmallestSpacing && g.spacing.maxCoeff() <= kLargestSpacing)) {
-    std::ostringstream message;
-    message << "voxel spacing " << g.spacing.x() << " x " << g.spacing.y() << " x " << g.spacing.z()
-            << " mm is outside the " << kSmallestSpacing << " to " << kLargestSpacing << " mm DynSub works with";
     throw Error(path, message.str());
   }
   // NaN or infinite intensities would spread through the smoothing into every
