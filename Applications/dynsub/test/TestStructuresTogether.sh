@@ -253,6 +253,15 @@ refused "one name for two structures" "\-\-name is given 1 times" --landmarks "$
 refused "one name for a file of two lists" "\-\-name is given 1 times for 2 structures" --landmarks "$work/two.mrk.json" \
   --name a
 refused "a name twice" "given twice" --landmarks "$caudate" --landmarks "$putamen" --name a --name a
+# Lists whose names differ in characters a folder's name does not keep.
+/usr/bin/python3 -c "
+import json, sys
+c, p = (json.load(open(f)) for f in sys.argv[1:3])
+c['markups'][0]['name'], p['markups'][0]['name'] = 'Noyau caud\u00e9', 'Noyau caud\u00e8'
+c['markups'].append(p['markups'][0])
+json.dump(c, open(sys.argv[3], 'w'))" "$caudate" "$putamen" "$work/accents.mrk.json"
+refused "names alike once made folder names" "two structures are named 'Noyau_caud__'" \
+  --landmarks "$work/accents.mrk.json"
 expect_error "a name twice: a usage error" 2 "\-\-name a is given twice" "$work/refused" \
   "$DYNSUB" segment "$templates/ch2.nii.gz" --landmarks "$caudate" --landmarks "$putamen" --name a --name a \
   --out "$work/refused"

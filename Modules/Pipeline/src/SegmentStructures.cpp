@@ -175,7 +175,9 @@ void checkStructures(const std::vector<StructureInputs>& structures, const Segme
       throw Error("structure name '" + s.name +
                   "': use letters, digits, '_', '-' and '.' only (it names the structure's output folder)");
     if (!names.insert(s.name).second)
-      throw Error("structure name '" + s.name + "' is given twice: name each structure once (--name)");
+      throw Error("two structures are named '" + s.name +
+                  "' (a list's name makes its folder's, each character other than a letter, a digit, '_', '-' "
+                  "and '.' made '_'): give each structure a --name");
     try {
       checkSegmentInputs(s.inputs, parameters);
     } catch (const UsageError& error) {
