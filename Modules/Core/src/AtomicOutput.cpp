@@ -192,11 +192,12 @@ std::string withoutTemporaryPrefix(const std::string& text) {
 Error writeFailure(const std::string& path, const std::string& detail) {
   const int saved = errno;
   std::string reason;
-  // A full file system is named as such whatever the writer reported.
+  // A full file system is named as such whatever the writer reported (a
+  // pseudo file system, /proc say, has no blocks at all, and is not full).
   fs::path directory = fs::path(path).parent_path();
   if (directory.empty()) directory = ".";
   struct statvfs space {};
-  if (::statvfs(directory.c_str(), &space) == 0 && space.f_bavail == 0)
+  if (::statvfs(directory.c_str(), &space) == 0 && space.f_blocks > 0 && space.f_bavail == 0)
     reason = std::strerror(ENOSPC);
   else if (!detail.empty())
     reason = detail;
