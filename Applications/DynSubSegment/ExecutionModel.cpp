@@ -39,18 +39,24 @@ std::string defaultOf(const Parameter& p) {
 }
 
 // The numbers in a word of a point ("[-16.5," or "19.0," or "1,2,3"), or
-// nothing when a part of it is not a number, or is missing ("17.5,,21").
+// nothing when a part of it is not a number, or is missing ("17.5,,21",
+// ",17.5,21": only the comma that ends a word, before the next, may have
+// nothing after it).
 std::optional<std::vector<std::string>> pointNumbers(const std::string& word) {
-  if (word.find(",,") != std::string::npos) return std::nullopt;
   std::string text = word;
   for (char& c : text)
-    if (c == '[' || c == ']' || c == '(' || c == ')' || c == ',') c = ' ';
-  std::istringstream in(text);
+    if (c == '[' || c == ']' || c == '(' || c == ')') c = ' ';
+  const std::vector<std::string> items = dynsub::splitItems(text, ',');
   std::vector<std::string> numbers;
-  for (std::string part; in >> part;) {
-    double value = 0;
-    if (!dynsub::parseNumber(part, value)) return std::nullopt;
-    numbers.push_back(part);
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    std::istringstream in(items[i]);
+    std::size_t found = 0;
+    for (std::string part; in >> part; ++found) {
+      double value = 0;
+      if (!dynsub::parseNumber(part, value)) return std::nullopt;
+      numbers.push_back(part);
+    }
+    if (found == 0 && i + 1 < items.size()) return std::nullopt;
   }
   return numbers;
 }

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <iomanip>
 #include <sstream>
 #include <variant>
 
@@ -37,17 +38,27 @@ CLI::Validator numberCheck(std::string name, bool zeroAllowed, double largest) {
       zeroAllowed ? "NUMBER>=0" : "NUMBER>0");
 }
 
+// Whether `text` is a whole number as written in base 10: a sign, then
+// digits without a leading 0. CLI11 stores an integer option through
+// strtoll in base 0, which reads "010" as octal 8 and "0x10" as 16; such
+// text is refused rather than checked as one value and stored as another.
+bool decimalWholeNumber(const std::string& text) {
+  const std::size_t digits = !text.empty() && (text[0] == '+' || text[0] == '-') ? 1 : 0;
+  if (digits == text.size() || (text[digits] == '0' && text.size() > digits + 1)) return false;
+  return std::all_of(text.begin() + digits, text.end(), [](char c) { return c >= '0' && c <= '9'; });
+}
+
 }  // namespace
 
 CLI::Validator numberBetween(double low, double high, bool whole) {
   std::ostringstream range, shown;
-  range << low << " and " << high;
-  shown << (whole ? "INT" : "FLOAT") << " in [" << low << " - " << high << "]";
+  range << std::setprecision(15) << low << " and " << high;
+  shown << std::setprecision(15) << (whole ? "INT" : "FLOAT") << " in [" << low << " - " << high << "]";
   return CLI::Validator(
       [low, high, whole, range = range.str()](std::string& text) -> std::string {
         double value = 0;
         if (!parseNumber(text, value) || std::isnan(value)) return text + " is not a number";
-        if (whole && value != std::floor(value)) return text + " is not a whole number";
+        if (whole && !decimalWholeNumber(text)) return text + " is not a whole number (write it in digits, as 12)";
         if (value < low || value > high) return text + " is not between " + range;
         return std::string();
       },

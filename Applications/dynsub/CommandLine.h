@@ -36,11 +36,10 @@ void addSegmentParameterOptions(CLI::App& command, SegmentParameters& parameters
 CLI::Validator positiveNumber(double largest = std::numeric_limits<double>::infinity());
 CLI::Validator nonNegativeNumber(double largest = std::numeric_limits<double>::infinity());
 
-// A check for a number from `low` to `high`, a whole one when `whole`, whose
-// refusals say what is wrong: "--samples-per-face: abc is not a number", "2.5
-// is not a whole number", "2000 is not between 1 and 1024" (CLI11's Range
-// says "Value abc not in range" of a word, and "Could not convert" of a
-// fraction for an integer).
+// A check for a number from `low` to `high`, a whole one in decimal digits
+// when `whole`, whose refusals say what is wrong: "--samples-per-face: abc
+// is not a number", "2.5 is not a whole number", "2000 is not between 1 and
+// 1024".
 CLI::Validator numberBetween(double low, double high, bool whole);
 
 // For a usage error: "did you mean 'segment'?" for a command that is not one

@@ -4,6 +4,7 @@
 
 #include "CommandLine.h"
 #include "Commands.h"
+#include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
 #include "dynsub/LimitSurface.h"
 #include "dynsub/MeshIO.h"
@@ -25,6 +26,9 @@ void runLimit(const LimitOptions& options) {
   requireNotInput(options.out, options.mesh);
   const ControlMesh mesh = readControlMesh(options.mesh);
   const LimitSurface surface(mesh);
+  // The option's value is at fault: a usage error.
+  if (const std::string tooFine = tessellationTooFine(surface, options.samplesPerFace); !tooFine.empty())
+    throw UsageError(options.mesh, tooFine);
   const TriangleSurface triangles = tessellate(surface, mesh.points(), options.samplesPerFace);
   writeTriangleSurface(triangles, options.out);
   int special = 0;

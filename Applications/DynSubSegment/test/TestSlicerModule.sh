@@ -108,6 +108,8 @@ expect_failure "a word for the label value" 2 "labelValue: abc is not a number" 
   --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
 expect_failure "a point with a coordinate missing" 2 "expected x,y,z" --seed 17.5,,21,21 --labelmap "$work/bad.nrrd" \
   "$work/ch2.nrrd"
+expect_failure "a point with its first coordinate missing" 2 "expected x,y,z" --seed ,17.5,21,21 \
+  --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
 expect_failure "NaN point" 2 "expected x,y,z" --seed nan,2,3 --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
 expect_failure "point outside the volume" 1 "outside the image" --seed 500,0,0 "${seeds[@]:2}" \
   --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"

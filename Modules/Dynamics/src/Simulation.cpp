@@ -8,6 +8,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <string>
 
 #include <Eigen/SparseCholesky>
@@ -521,8 +522,10 @@ MatrixX3 runLevel(const LevelModel& model, const std::vector<ForceModel*>& force
   double regrowCeiling = std::max(timeStep, options.integrator.timeStep);
   for (int halvings = 0;; ++halvings) {
     if (halvings > options.maxTimeStepHalvings) {
-      throw Error("the simulation diverged at level " + std::to_string(model.level) + " even with time step " +
-                  std::to_string(timeStep * 2.0) + " s (try a smaller --time-step or softer forces)");
+      std::ostringstream message;
+      message << "the simulation diverged at level " << model.level << " even with time step " << timeStep * 2.0
+              << " s (try a smaller --time-step or softer forces)";
+      throw Error(message.str());
     }
     const double startStep = timeStep;
     for (ForceModel* f : forces) f->beginLevel(*model.surface, model.quadrature, model.start);

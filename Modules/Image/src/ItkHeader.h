@@ -47,9 +47,10 @@ inline std::string readableItkMessage(const std::string& description) {
 
 // After the project's own checks of the file (FileChecks.h), made by
 // readVolume before it calls a library's readImage: `io` reads the header of
-// `path`, and an image too large for memory is refused before it is allocated
-// (the number of dimensions is checked by readVolume, for files and DICOM
-// series alike).
+// `path`; an image too large for memory is refused before it is allocated,
+// and one of more than three dimensions or of several values per voxel
+// before ITK would make one 3D scalar image of it (readVolume refuses fewer
+// than three).
 inline void inspectHeader(const std::string& path, itk::ImageIOBase& io) {
   io.SetFileName(path);
   io.ReadImageInformation();

@@ -40,7 +40,7 @@ void checkMetaImageFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path, "cannot be opened");
   std::string line, dataFile, elementType;
-  bool compressed = false, headerSize = false;
+  bool compressed = false, headerSize = false, binary = true;
   std::uintmax_t compressedSize = 0, channels = 1;
   std::vector<std::int64_t> size;
   long long dimensions = -1;
@@ -78,6 +78,7 @@ void checkMetaImageFile(const std::string& path) {
       compressedSize = static_cast<std::uintmax_t>(n);
     }
     if (key == "HeaderSize") headerSize = true;
+    if (key == "BinaryData") binary = value != "False" && value != "false";
     if (key == "ElementSpacing" || key == "Offset" || key == "Origin" || key == "Position" || key == "CenterOfRotation" ||
         key == "TransformMatrix" || key == "Rotation" || key == "Orientation")
       placement.emplace_back(key, value);
@@ -130,6 +131,8 @@ void checkMetaImageFile(const std::string& path) {
   } else {
     return;
   }
+  // Data written as text has no size to check here.
+  if (!binary) return;
   const std::uintmax_t needed = compressed ? compressedSize : *voxelBytes;
   if (available < needed)
     throw Error(source, "truncated: " + std::to_string(available) + " bytes of data, the header announces " +

@@ -50,8 +50,7 @@ std::vector<std::string> splitCsv(const std::string& line) {
   return fields;
 }
 
-// A column named twice would leave which of the two holds the value to
-// chance (the reader took the last).
+// A column named twice leaves which of the two holds the value to chance.
 void requireDistinctColumns(const std::string& path, int line, const std::vector<std::string>& columns) {
   for (std::size_t c = 0; c < columns.size(); ++c)
     for (std::size_t d = c + 1; d < columns.size(); ++d)
@@ -114,8 +113,12 @@ std::vector<LandmarkList> readMarkupsJson(const std::string& path, std::ifstream
     }
     const std::string system = textField(markup, "coordinateSystem", "LPS", path, where);
     if (system != "LPS" && system != "RAS") throw Error(path, "unknown coordinateSystem \"" + system + "\"");
-    if (textField(markup, "coordinateUnits", "mm", path, where) != "mm")
-      throw Error(path, "coordinateUnits must be mm");
+    // Slicer writes a unit's name, or (schema 1.0.3) a list of its forms
+    // whose first is the name: ["mm", "UCUM", "millimeter"].
+    const nlohmann::json units = markup.contains("coordinateUnits") ? markup["coordinateUnits"] : nlohmann::json("mm");
+    const nlohmann::json& unit = units.is_array() && !units.empty() ? units[0] : units;
+    if (!unit.is_string() || unit.get<std::string>() != "mm")
+      throw Error(path, where + ": coordinateUnits must be mm, got " + units.dump());
     LandmarkList& list = lists.emplace_back();
     list.name = textField(markup, "name", "", path, where);
     list.stated = system == "RAS" ? CoordinateSystem::RAS : CoordinateSystem::LPS;
@@ -225,7 +228,9 @@ std::vector<Landmark> readCsv(const std::string& path, std::ifstream& in) {
   while (std::getline(in, line)) {
     ++number;
     if (line.empty() || line == "\r") continue;
-    const auto fields = splitCsv(line);
+    std::vector<std::string> fields = splitCsv(line);
+    // A separator that ends a row adds no value.
+    while (fields.size() > header.size() && fields.back().empty()) fields.pop_back();
     // A row of more values than the header has columns is a point whose
     // values may have shifted (a stray comma, a decimal comma): which three
     // are x, y and z cannot be known.

@@ -199,6 +199,8 @@ TEST(Landmarks, SpreadsheetFilesAreRead) {
   // Excel's "CSV UTF-8" starts with a byte order mark.
   const fs::path csv = scratch("excel.csv");
   std::ofstream(csv.string()) << "\xEF\xBB\xBFX,Y,Z,Label\n-12,10,12,head\n-14,12,10\n";
+  std::ofstream(scratch("trailing.csv").string()) << "x,y,z\n1,2,3,\n4,5,6\n";
+  EXPECT_EQ(readLandmarks(scratch("trailing.csv").string()).size(), 2u);
   const std::vector<Landmark> read = readLandmarks(csv.string());
   ASSERT_EQ(read.size(), 2u);
   EXPECT_EQ(read[0].position, Vector3(-12, 10, 12));
@@ -211,6 +213,11 @@ TEST(Landmarks, SpreadsheetFilesAreRead) {
     ASSERT_EQ(back.size(), 1u) << name;
     EXPECT_EQ(back[0].label, "head, left") << name;
   }
+  // Slicer's schema 1.0.3 also writes the unit as a list of its forms.
+  const fs::path units = scratch("units.mrk.json");
+  std::ofstream(units.string()) << R"({"markups": [{"type": "Fiducial", "coordinateUnits": ["mm", "UCUM", "millimeter"],
+      "controlPoints": [{"position": [1, 2, 3]}]}]})";
+  EXPECT_EQ(readLandmarks(units.string()).size(), 1u);
   const fs::path pending = scratch("pending.mrk.json");
   std::ofstream(pending.string()) << R"({"markups": [{"type": "Fiducial", "controlPoints": [
       {"position": [1, 2, 3]}, {"position": [0, 0, 0], "positionStatus": "undefined"}]}]})";

@@ -15,21 +15,25 @@ int outputSegments(const LimitSurface& surface) {
   return std::max(2, kOutputSegments >> surface.isolationLevels());
 }
 
+std::string tessellationTooFine(const LimitSurface& surface, int segmentsPerElement) {
+  // Samples and triangles are numbered by int, as in the surface files'
+  // indices: a finer grid than that holds is refused rather than wrapped.
+  const int elements = surface.baseTopology().faceCount();
+  const std::int64_t n = segmentsPerElement, triangles = 2 * elements * n * n;
+  if (triangles <= std::numeric_limits<int>::max()) return "";
+  const int largest = static_cast<int>(std::sqrt(std::numeric_limits<int>::max() / (2.0 * elements)));
+  return std::to_string(n) + " samples per face on " + std::to_string(elements) + " elements make " +
+         std::to_string(triangles) + " triangles, more than one surface can number (2^31 - 1): use at most " +
+         std::to_string(largest) + " samples per face";
+}
+
 TriangleSurface tessellate(const LimitSurface& surface, const MatrixX3& controlPoints, int segmentsPerElement) {
   const int n = segmentsPerElement;
   if (n < 1 || n > 1024) {
     throw Error("samples per face must be between 1 and 1024, got " + std::to_string(n));
   }
+  if (const std::string tooFine = tessellationTooFine(surface, n); !tooFine.empty()) throw Error(tooFine);
   const Topology& base = surface.baseTopology();
-  // Samples and triangles are numbered by int, as in the surface files'
-  // indices: a finer grid than that holds is refused rather than wrapped.
-  const std::int64_t triangleCount = std::int64_t{2} * base.faceCount() * n * n;
-  if (triangleCount > std::numeric_limits<int>::max()) {
-    const int largest = static_cast<int>(std::sqrt(std::numeric_limits<int>::max() / (2.0 * base.faceCount())));
-    throw Error(std::to_string(n) + " samples per face on " + std::to_string(base.faceCount()) + " elements make " +
-                std::to_string(triangleCount) + " triangles, more than one surface can number (2^31 - 1): use at most " +
-                std::to_string(largest) + " samples per face");
-  }
   // Sample numbering: base vertices, then n-1 per base edge (from its first
   // vertex), then (n-1)^2 per element interior.
   const int edgeBase = base.vertexCount();

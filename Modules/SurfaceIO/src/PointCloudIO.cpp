@@ -1,10 +1,12 @@
 #include "dynsub/PointCloudIO.h"
 
+#include <algorithm>
 #include <array>
 #include <cctype>
 #include <cerrno>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <iterator>
 #include <optional>
 #include <string>
@@ -30,15 +32,25 @@ namespace dynsub {
 namespace {
 
 // A line's fields: a CSV's between its separator (the first of ',', ';' and
-// a tab that the line holds; an empty field counts), else between runs of
-// blanks. Trimmed of blanks and quotes.
+// a tab that the line holds; an empty field counts, a separator inside
+// double quotes does not split), else between runs of blanks. Trimmed of
+// blanks and quotes; empty fields at the line's end (a separator ending it)
+// dropped.
 std::vector<std::string> fieldsOf(const std::string& line, bool csv) {
   std::vector<std::string> fields;
   char separator = 0;
   for (const char c : {',', ';', '\t'})
     if (!separator && line.find(c) != std::string::npos) separator = c;
   if (csv && separator) {
-    fields = splitItems(line, separator);
+    bool quoted = false;
+    fields.emplace_back();
+    for (const char c : line) {
+      if (c == '"') quoted = !quoted;
+      if (c == separator && !quoted)
+        fields.emplace_back();
+      else
+        fields.back() += c;
+    }
   } else {
     std::istringstream in(line);
     for (std::string field; in >> field;) fields.push_back(field);
@@ -47,6 +59,7 @@ std::vector<std::string> fieldsOf(const std::string& line, bool csv) {
     const auto begin = f.find_first_not_of(" \t\r\""), end = f.find_last_not_of(" \t\r\"");
     f = begin == std::string::npos ? std::string() : f.substr(begin, end - begin + 1);
   }
+  while (fields.size() > 1 && fields.back().empty()) fields.pop_back();
   return fields;
 }
 
@@ -58,35 +71,58 @@ bool namesAxis(const std::string& name, char axis) {
          (name.size() == 1 || !std::isalnum(static_cast<unsigned char>(name[1])));
 }
 
+// The column of `names` that names `axis` (namesAxis), -1 when none; of
+// several, the one named by the letter alone or in mm ("x" or "x_mm" beside
+// "x_vox"), else an error.
+int columnOf(const std::vector<std::string>& names, char axis, const std::function<Error(std::string)>& error) {
+  std::vector<int> matches, preferred;
+  for (std::size_t c = 0; c < names.size(); ++c) {
+    if (!namesAxis(names[c], axis)) continue;
+    matches.push_back(static_cast<int>(c));
+    std::string lower = names[c];
+    for (char& ch : lower) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    if (lower.size() == 1 || lower.find("mm") != std::string::npos) preferred.push_back(static_cast<int>(c));
+  }
+  if (matches.size() == 1) return matches[0];
+  if (matches.empty()) return -1;
+  if (preferred.size() == 1) return preferred[0];
+  throw error(std::string("the header names ") + std::to_string(matches.size()) + " columns " + axis +
+              ", so which holds the coordinate cannot be told: name one x, y or z alone");
+}
+
 // The columns of x, y and z named by a CSV's first line (or, as 3D Slicer
 // exports points, l, p and s: the same LPS axes), or nullopt for the first
 // three when the line names three columns alone, none of them an axis. With
-// more columns, or an axis named in part or twice, which hold the
-// coordinates cannot be told: an error.
+// more columns, or the axes named in part, which hold the coordinates cannot
+// be told: an error; so are RAS columns (r, a, s), which would need x and y
+// negated.
 std::optional<std::array<std::size_t, 3>> namedColumns(std::vector<std::string> names, const std::string& path,
                                                        int line) {
   // CloudCompare writes "//" before the names.
   if (!names.empty() && names[0].rfind("//", 0) == 0) names[0].erase(0, 2);
-  const auto error = [&](const std::string& what) {
+  const std::function<Error(std::string)> error = [&](const std::string& what) {
     return Error(path, "line " + std::to_string(line) + ": " + what);
   };
-  for (const char* axes : {"xyz", "lps"}) {
-    std::array<std::size_t, 3> columns{};
-    int found = 0;
-    for (int axis = 0; axis < 3; ++axis) {
-      int named = 0;
-      for (std::size_t c = 0; c < names.size(); ++c)
-        if (namesAxis(names[c], axes[axis])) {
-          if (named++ == 0) columns[axis] = c;
-        }
-      if (named > 1) throw error(std::string("the header names the column ") + axes[axis] + " twice");
-      found += named;
-    }
-    if (found == 3) return columns;
-    if (found > 0 && axes[0] == 'x')
-      throw error("the header does not name all the coordinates' columns x, y and z (" +
-                  std::to_string(names.size()) + " columns): name them so");
-  }
+  const auto columnsNamed = [&](const char* axes) {
+    std::array<int, 3> columns{};
+    for (int axis = 0; axis < 3; ++axis) columns[axis] = columnOf(names, axes[axis], error);
+    return columns;
+  };
+  const auto count = [](const std::array<int, 3>& columns) {
+    return std::count_if(columns.begin(), columns.end(), [](int c) { return c >= 0; });
+  };
+  const std::array<int, 3> xyz = columnsNamed("xyz");
+  const std::array<int, 3> lps = count(xyz) == 0 ? columnsNamed("lps") : std::array<int, 3>{-1, -1, -1};
+  const std::array<int, 3> named = count(xyz) > 0 ? xyz : lps;
+  if (count(named) == 3) return std::array<std::size_t, 3>{static_cast<std::size_t>(named[0]),
+                                                         static_cast<std::size_t>(named[1]),
+                                                         static_cast<std::size_t>(named[2])};
+  if (count(xyz) == 0 && count(columnsNamed("ras")) == 3)
+    throw error("the columns r, a and s are RAS coordinates, and DynSub reads LPS: negate r and a and name the "
+                "columns x, y and z (or export the points in LPS)");
+  if (count(named) > 0)
+    throw error("the header does not name all the coordinates' columns x, y and z (" + std::to_string(names.size()) +
+                " columns): name them so");
   if (names.size() == 3) return std::nullopt;
   throw error("the header names no columns x, y and z among its " + std::to_string(names.size()) +
               ", so which hold the coordinates cannot be told: name them so");

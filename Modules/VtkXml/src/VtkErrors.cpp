@@ -6,13 +6,29 @@
 #include <vtkExecutive.h>
 #include <vtkLogger.h>
 
+#include <mutex>
 #include <sstream>
 
 namespace dynsub {
 
-VtkErrors::VtkErrors()
-    : command_(vtkSmartPointer<vtkCallbackCommand>::New()), stderrVerbosity_(vtkLogger::GetCurrentVerbosityCutoff()) {
-  vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
+namespace {
+
+// The VtkErrors alive, and the stderr verbosity the first found (DynSub
+// logs to no file, so VTK's cutoff is stderr's), given back by the last.
+std::mutex quietMutex;
+int quietCount = 0;
+vtkLogger::Verbosity quietSaved = vtkLogger::VERBOSITY_OFF;
+
+}  // namespace
+
+VtkErrors::VtkErrors() : command_(vtkSmartPointer<vtkCallbackCommand>::New()) {
+  {
+    const std::lock_guard<std::mutex> lock(quietMutex);
+    if (quietCount++ == 0) {
+      quietSaved = vtkLogger::GetCurrentVerbosityCutoff();
+      vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
+    }
+  }
   command_->SetClientData(this);
   command_->SetCallback([](vtkObject*, unsigned long, void* client, void* text) {
     auto* self = static_cast<VtkErrors*>(client);
@@ -21,7 +37,10 @@ VtkErrors::VtkErrors()
 }
 
 VtkErrors::~VtkErrors() {
-  vtkLogger::SetStderrVerbosity(static_cast<vtkLogger::Verbosity>(stderrVerbosity_));
+  for (const auto& [object, tag] : watched_)
+    if (object) object->RemoveObserver(tag);
+  const std::lock_guard<std::mutex> lock(quietMutex);
+  if (--quietCount == 0) vtkLogger::SetStderrVerbosity(quietSaved);
 }
 
 std::string VtkErrors::reason() const {
@@ -39,8 +58,9 @@ std::string VtkErrors::reason() const {
 }
 
 void VtkErrors::watch(vtkAlgorithm* algorithm) {
-  algorithm->AddObserver(vtkCommand::ErrorEvent, command_);
-  algorithm->GetExecutive()->AddObserver(vtkCommand::ErrorEvent, command_);
+  watched_.emplace_back(algorithm, algorithm->AddObserver(vtkCommand::ErrorEvent, command_));
+  vtkExecutive* executive = algorithm->GetExecutive();
+  watched_.emplace_back(executive, executive->AddObserver(vtkCommand::ErrorEvent, command_));
 }
 
 }  // namespace dynsub

@@ -5,6 +5,7 @@
 // a closed, consistently oriented triangle mesh (normals point where s_u x s_v
 // points: outward for an outward-oriented control mesh).
 #include <array>
+#include <string>
 #include <vector>
 
 #include "dynsub/LimitSurface.h"
@@ -29,7 +30,13 @@ constexpr int kOutputSegments = 8;
 // isolation, and as slow to compress and write.
 int outputSegments(const LimitSurface& surface);
 
-// N = segmentsPerElement >= 1. Throws dynsub::Error for N < 1 or N > 1024.
+// Why `segmentsPerElement` squares per element of `surface` are more than
+// one surface can number (its triangles past 2^31 - 1), with the largest
+// count that fits; empty when they are not.
+std::string tessellationTooFine(const LimitSurface& surface, int segmentsPerElement);
+
+// N = segmentsPerElement >= 1. Throws dynsub::Error for N < 1 or N > 1024,
+// or for a grid tessellationTooFine refuses.
 TriangleSurface tessellate(const LimitSurface& surface, const MatrixX3& controlPoints, int segmentsPerElement);
 
 }  // namespace dynsub

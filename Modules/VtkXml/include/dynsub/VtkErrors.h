@@ -2,15 +2,20 @@
 // VTK reports a failure (a file it cannot read or write) as error events of
 // the object and of its pipeline's executive, printed to stderr when nobody
 // listens. A VtkErrors listens instead and keeps the first message, for an
-// error that names the file. While it lives, VTK's log prints nothing to
-// stderr: the objects inside a reader (its XML parser), which it cannot
-// listen to, would print their own part of the failure it reports.
+// error that names the file. While one lives (on any thread), VTK's log
+// prints nothing to stderr: the objects inside a reader (its XML parser),
+// which it cannot listen to, would print their own part of the failure it
+// reports.
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <vtkSmartPointer.h>
+#include <vtkWeakPointer.h>
 
 class vtkAlgorithm;
 class vtkCallbackCommand;
+class vtkObject;
 
 namespace dynsub {
 
@@ -34,7 +39,8 @@ class VtkErrors {
  private:
   std::string first_;
   vtkSmartPointer<vtkCallbackCommand> command_;
-  int stderrVerbosity_;  // vtkLogger's, given back on destruction
+  // What it listens to, with the observers' tags, removed on destruction.
+  std::vector<std::pair<vtkWeakPointer<vtkObject>, unsigned long>> watched_;
 };
 
 }  // namespace dynsub
