@@ -372,8 +372,9 @@ void addFitCommand(CLI::App& app) {
   command->add_option("--tolerance", o->fit.tolerancePercent, "Max error to reach, in percent of the diameter")
       ->default_val(1.0)
       ->check(positiveNumber(100.0));
-  command->add_option("--data-stiffness", o->fit.dataStiffness,
-                      "Spring stiffness of the data, N/mm per unit parametric area, shared by all points")
+  command
+      ->add_option("--data-stiffness", o->fit.dataStiffness,
+                   "Spring stiffness of the data, N/mm per unit parametric area, shared by all points")
       ->default_val(o->fit.dataStiffness)
       ->check(positiveNumber(kLargestSpringStiffness));
   command

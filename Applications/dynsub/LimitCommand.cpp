@@ -58,8 +58,9 @@ void addLimitCommand(CLI::App& app) {
   command->add_option("MESH", options->mesh, "Control mesh (.obj, .off or .ply), closed or with boundaries")
       ->required();
   command->add_option("--out", options->out, "Output surface file (.vtp, .vtk, .obj, .ply or .stl)")->required();
-  command->add_option("--samples-per-face", options->samplesPerFace,
-                      "N: parameter squares along each side of an element (1 to 1024)")
+  command
+      ->add_option("--samples-per-face", options->samplesPerFace,
+                   "N: parameter squares along each side of an element (1 to 1024)")
       ->default_val(8)
       ->check(numberBetween(1, 1024, true));
   command->callback([options] { runLimit(*options); });

@@ -292,7 +292,8 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
                      std::to_string(n) + " structures, " + std::to_string(o.referenceLabels.size()) + " given)");
   const std::shared_ptr<const Atlas> atlasData =
       atlas ? std::make_shared<const Atlas>(readAtlas(o.atlas, o.atlasLabels)) : nullptr;
-  std::vector<StructureInputs> structures = structuresToSegment(o.image, sources, atlasData, o.atlasLabel, "--atlas-label");
+  std::vector<StructureInputs> structures =
+      structuresToSegment(o.image, sources, atlasData, o.atlasLabel, "--atlas-label");
   structures.resize(n);  // those without landmarks after the lists
   for (std::size_t s = 0; s < n; ++s) {
     StructureInputs& structure = structures[s];

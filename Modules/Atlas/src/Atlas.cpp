@@ -157,8 +157,8 @@ std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec, c
       continue;
     }
     if (atlas.names.empty())
-      throw Error(atlas.labelsPath, "no table of label names beside it: give " + option + " as numbers, not '" +
-                                        item + "'");
+      throw Error(atlas.labelsPath,
+                  "no table of label names beside it: give " + option + " as numbers, not '" + item + "'");
     const auto nearest = std::min_element(atlas.names.begin(), atlas.names.end(), [&](const auto& a, const auto& b) {
       return editDistance(a.second, item) < editDistance(b.second, item);
     });

@@ -74,8 +74,8 @@ Volume readVolume(const std::string& path) {
   const double skew = (g.direction.transpose() * g.direction - Matrix3::Identity()).cwiseAbs().maxCoeff();
   if (skew > 1e-3) {
     std::ostringstream message;
-    message << "the direction matrix is not orthonormal (its axes' dot products and lengths are off by up to "
-            << skew << "): DynSub needs axes at right angles, of unit length; resample the image onto such a grid";
+    message << "the direction matrix is not orthonormal (its axes' dot products and lengths are off by up to " << skew
+            << "): DynSub needs axes at right angles, of unit length; resample the image onto such a grid";
     throw Error(path, message.str());
   }
   // NaN or infinite intensities would spread through the smoothing into every

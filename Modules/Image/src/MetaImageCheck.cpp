@@ -79,8 +79,8 @@ void checkMetaImageFile(const std::string& path) {
     }
     if (key == "HeaderSize") headerSize = true;
     if (key == "BinaryData") binary = value != "False" && value != "false";
-    if (key == "ElementSpacing" || key == "Offset" || key == "Origin" || key == "Position" || key == "CenterOfRotation" ||
-        key == "TransformMatrix" || key == "Rotation" || key == "Orientation")
+    if (key == "ElementSpacing" || key == "Offset" || key == "Origin" || key == "Position" ||
+        key == "CenterOfRotation" || key == "TransformMatrix" || key == "Rotation" || key == "Orientation")
       placement.emplace_back(key, value);
     if (key == "ElementDataFile") dataFile = value;
   }

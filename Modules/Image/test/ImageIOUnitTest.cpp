@@ -346,8 +346,8 @@ TEST(HostileImages, FourDimensionsAndAxesNotAtRightAnglesAreRefused) {
            {"TransformMatrix = 1 0 0 0 1", "TransformMatrix has 5 values for NDims 3 (expected 9)"},
            {"Offset = 0 0", "Offset has 2 values for NDims 3 (expected 3)"}}) {
     std::ofstream(scratch("placed.mha"), std::ios::binary)
-        << "ObjectType = Image\nNDims = 3\n" << field
-        << "\nDimSize = 4 3 2\nElementType = MET_FLOAT\nElementDataFile = LOCAL\n"
+        << "ObjectType = Image\nNDims = 3\n"
+        << field << "\nDimSize = 4 3 2\nElementType = MET_FLOAT\nElementDataFile = LOCAL\n"
         << volume;
     EXPECT_NE(readError(scratch("placed.mha")).find("placed.mha: MetaImage " + message), std::string::npos)
         << readError(scratch("placed.mha"));

@@ -132,8 +132,8 @@ std::vector<LandmarkList> readMarkupsJson(const std::string& path, std::ifstream
       // name waiting for its point (both left out).
       const std::string status = textField(point, "positionStatus", "defined", path, pointWhere);
       if (status != "defined" && status != "preview" && status != "undefined")
-        throw Error(path, pointWhere + ": unknown positionStatus \"" + status +
-                              "\" (expected defined, preview or undefined)");
+        throw Error(
+            path, pointWhere + ": unknown positionStatus \"" + status + "\" (expected defined, preview or undefined)");
       if (status != "defined") continue;
       const auto& position = point.contains("position") ? point["position"] : nlohmann::json();
       if (!position.is_array() || position.size() != 3 || !position[0].is_number() || !position[1].is_number() ||

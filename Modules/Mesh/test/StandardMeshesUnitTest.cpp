@@ -17,7 +17,6 @@ int countValence(const dynsub::ControlMesh& mesh, int valence) {
   return count;
 }
 
-
 TEST(StandardMeshes, CubeHasThePapersCounts) {
   const dynsub::ControlMesh cube = dynsub::makeCube98();
   EXPECT_EQ(cube.vertexCount(), 98);

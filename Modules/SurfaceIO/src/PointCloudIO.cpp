@@ -114,12 +114,13 @@ std::optional<std::array<std::size_t, 3>> namedColumns(std::vector<std::string> 
   const std::array<int, 3> xyz = columnsNamed("xyz");
   const std::array<int, 3> lps = count(xyz) == 0 ? columnsNamed("lps") : std::array<int, 3>{-1, -1, -1};
   const std::array<int, 3> named = count(xyz) > 0 ? xyz : lps;
-  if (count(named) == 3) return std::array<std::size_t, 3>{static_cast<std::size_t>(named[0]),
-                                                         static_cast<std::size_t>(named[1]),
-                                                         static_cast<std::size_t>(named[2])};
+  if (count(named) == 3)
+    return std::array<std::size_t, 3>{static_cast<std::size_t>(named[0]), static_cast<std::size_t>(named[1]),
+                                      static_cast<std::size_t>(named[2])};
   if (count(xyz) == 0 && count(columnsNamed("ras")) == 3)
-    throw error("the columns r, a and s are RAS coordinates, and DynSub reads LPS: negate r and a and name the "
-                "columns x, y and z (or export the points in LPS)");
+    throw error(
+        "the columns r, a and s are RAS coordinates, and DynSub reads LPS: negate r and a and name the "
+        "columns x, y and z (or export the points in LPS)");
   if (count(named) > 0)
     throw error("the header does not name all the coordinates' columns x, y and z (" + std::to_string(names.size()) +
                 " columns): name them so");
@@ -163,8 +164,8 @@ MatrixX3 readText(const std::string& path, bool csv) {
     header = false;
     if (width == 0) width = fields.size();
     if (fields.size() > width)
-      throw Error(path, "line " + std::to_string(number) + ": " + std::to_string(fields.size()) + " values, where " + widthFrom +
-                            std::to_string(width));
+      throw Error(path, "line " + std::to_string(number) + ": " + std::to_string(fields.size()) + " values, where " +
+                            widthFrom + std::to_string(width));
     points.push_back(p);
   }
   if (points.empty()) throw Error(path, "has no points");

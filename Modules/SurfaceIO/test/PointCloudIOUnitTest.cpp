@@ -116,21 +116,28 @@ TEST(PointCloudIO, ACsvHeaderNamesTheCoordinatesColumns) {
   const dynsub::MatrixX3 blanks =
       dynsub::readPointCloud(writeText("blanks.csv", "x y z\n1 2 3\n4 5 6\n7 8 9\n1 1 2\n")).points;
   EXPECT_EQ(blanks.row(3), Eigen::RowVector3d(1, 1, 2));
-  const dynsub::MatrixX3 slicer = dynsub::readPointCloud(
-      writeText("slicer.csv", "label,l,p,s,defined\nF-1,1,2,3,1\nF-2,4,5,6,1\nF-3,7,8,9,1\nF-4,1,1,2,1\n")).points;
+  const dynsub::MatrixX3 slicer =
+      dynsub::readPointCloud(
+          writeText("slicer.csv", "label,l,p,s,defined\nF-1,1,2,3,1\nF-2,4,5,6,1\nF-3,7,8,9,1\nF-4,1,1,2,1\n"))
+          .points;
   EXPECT_EQ(slicer.row(1), Eigen::RowVector3d(4, 5, 6));
   // Of two columns of an axis, the one in mm; a quoted label with a comma
   // and a separator ending a row add no column.
-  const dynsub::MatrixX3 inMm = dynsub::readPointCloud(
-      writeText("units.csv", "x_vox,y_vox,z_vox,x_mm,y_mm,z_mm\n9,9,9,1,2,3\n9,9,9,4,5,6\n9,9,9,7,8,9\n9,9,9,1,1,2\n"))
-                                   .points;
+  const dynsub::MatrixX3 inMm =
+      dynsub::readPointCloud(
+          writeText("units.csv",
+                    "x_vox,y_vox,z_vox,x_mm,y_mm,z_mm\n9,9,9,1,2,3\n9,9,9,4,5,6\n9,9,9,7,8,9\n9,9,9,1,1,2\n"))
+          .points;
   EXPECT_EQ(inMm.row(0), Eigen::RowVector3d(1, 2, 3));
-  const dynsub::MatrixX3 quoted = dynsub::readPointCloud(
-      writeText("quoted.csv", "x,y,z,label\n1,2,3,\"left, anterior\"\n4,5,6,b\n7,8,9,\n1,1,2,\n")).points;
+  const dynsub::MatrixX3 quoted =
+      dynsub::readPointCloud(
+          writeText("quoted.csv", "x,y,z,label\n1,2,3,\"left, anterior\"\n4,5,6,b\n7,8,9,\n1,1,2,\n"))
+          .points;
   ASSERT_EQ(quoted.rows(), 4);
   EXPECT_EQ(quoted.row(3), Eigen::RowVector3d(1, 1, 2));
   const std::pair<std::string, std::string> refused[] = {
-      {"id,px,py,pz\n0,1,2,3\n1,4,5,6\n2,7,8,9\n3,1,1,2\n", "line 1: the header names no columns x, y and z among its 4"},
+      {"id,px,py,pz\n0,1,2,3\n1,4,5,6\n2,7,8,9\n3,1,1,2\n",
+       "line 1: the header names no columns x, y and z among its 4"},
       {"label,r,a,s\n1,1,2,3\n2,4,5,6\n3,7,8,9\n4,1,1,2\n", "line 1: the columns r, a and s are RAS coordinates"},
       {"r,a,s\n1,2,3\n4,5,6\n7,8,9\n1,1,2\n", "line 1: the columns r, a and s are RAS coordinates"},
       {"x,y,w\n1,2,3\n4,5,6\n7,8,9\n1,1,2\n", "line 1: the header does not name all the coordinates' columns"},
