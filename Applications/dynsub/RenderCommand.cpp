@@ -5,7 +5,6 @@
 #include <iostream>
 #include <memory>
 #include <set>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -19,6 +18,7 @@
 #include "dynsub/MeshIO.h"
 #include "dynsub/OutputSet.h"
 #include "dynsub/PointCloudIO.h"
+#include "dynsub/Segmentation.h"
 
 namespace dynsub::app {
 
@@ -71,14 +71,10 @@ void runRender(const RenderCommandOptions& o) {
     const std::vector<Landmark> landmarks = readLandmarks(o.landmarks);
     // Drawn on the image's slices, a landmark outside the image would be
     // left out of the figure without a word.
-    for (std::size_t i = 0; image && i < landmarks.size(); ++i) {
-      const Vector3& p = landmarks[i].position;
-      if (image->geometry.covers(p)) continue;
-      std::ostringstream message;
-      message << "landmark " << i + 1 << (landmarks[i].label.empty() ? "" : " ('" + landmarks[i].label + "')")
-              << " at (" << p.x() << ", " << p.y() << ", " << p.z() << ") mm LPS lies outside the image " << o.image
-              << " (are the landmarks for another image?)";
-      throw Error(o.landmarks, message.str());
+    try {
+      if (image) requireLandmarksInside(image->geometry, landmarks);
+    } catch (const LandmarkError& error) {
+      throw Error(o.landmarks, std::string(error.what()) + " " + o.image + " (are the landmarks for another image?)");
     }
     inputs.landmarks = landmarkPositions(landmarks);
   }

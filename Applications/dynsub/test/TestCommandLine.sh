@@ -513,7 +513,7 @@ check "render --figure-coordinates RAS: the same surface figure" \
 check "render --figure-coordinates RAS: other slice captions" \
   test -s "$work/rendered_ras/slices.png" -a -n "$(cmp "$work/rendered_ras/slices.png" "$work/caudate/slices.png")"
 printf 'x,y,z\n-12,10,12\n400,10,12\n' >"$work/far_landmarks.csv"
-expect_error "render: a landmark outside the image" 1 "landmark 2 at (400, 10, 12) mm LPS lies outside the image" \
+expect_error "render: a landmark outside the image" 1 "landmark 2 of 2 at (400, 10, 12) mm LPS lies outside the image" \
   "$work/r0b" "$DYNSUB" render --surface "$work/caudate/surface.vtp" --image "$mri/ch2.nii.gz" \
   --landmarks "$work/far_landmarks.csv" --out "$work/r0b"
 expect_error "render: unknown coordinate system" 2 "figure-coordinates" "$work/r0" \

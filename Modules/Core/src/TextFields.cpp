@@ -26,6 +26,21 @@ std::vector<std::string> splitItems(const std::string& text, char separator) {
   return items;
 }
 
+std::vector<std::string> splitCsvFields(const std::string& line, char separator) {
+  std::vector<std::string> fields(1);
+  bool quoted = false;
+  for (const char c : line) {
+    if (c == '"')
+      quoted = !quoted;
+    else if (c == separator && !quoted)
+      fields.emplace_back();
+    else if (c != '\r')
+      fields.back() += c;
+  }
+  for (std::string& field : fields) field = trimmed(field);
+  return fields;
+}
+
 std::string trimmed(const std::string& text) {
   const std::size_t first = text.find_first_not_of(" \t");
   return first == std::string::npos ? std::string() : text.substr(first, text.find_last_not_of(" \t") + 1 - first);
@@ -34,6 +49,12 @@ std::string trimmed(const std::string& text) {
 std::string withoutLibraryTag(const std::string& message) {
   const std::size_t end = message.find("] ");
   return message.rfind('[', 0) == 0 && end != std::string::npos ? message.substr(end + 2) : message;
+}
+
+std::string afterObjectAddress(const std::string& line) {
+  const std::size_t address = line.find("(0x");
+  const std::size_t end = address == std::string::npos ? std::string::npos : line.find("): ", address);
+  return end == std::string::npos ? line : line.substr(end + 3);
 }
 
 std::string withoutByteOrderMark(const std::string& line) {

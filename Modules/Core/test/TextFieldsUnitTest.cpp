@@ -35,6 +35,22 @@ TEST(TextFields, SplitItemsKeepsEmptyItemsAsWritten) {
   EXPECT_EQ(trimmed(" \t "), "");
 }
 
+// The landmark and point-cloud readers split CSV lines with it.
+TEST(TextFields, SplitCsvFieldsKeepsQuotedSeparators) {
+  using Fields = std::vector<std::string>;
+  EXPECT_EQ(splitCsvFields("1, 2,\"left, anterior\"\r", ','), (Fields{"1", "2", "left, anterior"}));
+  EXPECT_EQ(splitCsvFields("1;2;", ';'), (Fields{"1", "2", ""}));
+  EXPECT_EQ(splitCsvFields("", ','), (Fields{""}));
+}
+
+// ITK's and VTK's messages name the object that failed by its address.
+TEST(TextFields, AfterObjectAddressKeepsTheReason) {
+  EXPECT_EQ(afterObjectAddress("vtkXMLDataParser (0x55bb834416e0): Error parsing XML"), "Error parsing XML");
+  EXPECT_EQ(afterObjectAddress("itk::ERROR: NrrdImageIO(0x5561): Read: Error reading x.nrrd:"),
+            "Read: Error reading x.nrrd:");
+  EXPECT_EQ(afterObjectAddress("no object (here): named"), "no object (here): named");
+}
+
 }  // namespace
 }  // namespace dynsub
 

@@ -10,6 +10,7 @@
 
 #include "FileChecks.h"
 #include "dynsub/Error.h"
+#include "dynsub/TextFields.h"
 
 namespace dynsub::itkbridge {
 
@@ -27,9 +28,7 @@ inline std::string readableItkMessage(const std::string& description) {
       first = false;
       // "itk::ERROR: NrrdImageIO(0x55...): " goes; what follows stays unless
       // it only announces the lines after it ("Read: Error reading x.nrrd:").
-      const auto error = line.find("ERROR: ");
-      const auto address = error == std::string::npos ? std::string::npos : line.find("): ", error);
-      if (address != std::string::npos) line = line.substr(address + 3);
+      line = afterObjectAddress(line);
       if (!line.empty() && line.back() == ':') continue;
     }
     // "[nrrd] _nrrdEncodingRaw_read: fread got only ..." -> "fread got only ..."

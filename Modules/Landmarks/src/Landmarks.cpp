@@ -29,27 +29,6 @@ Format formatOf(const std::string& path) {
 // RAS <-> LPS is its own inverse.
 Vector3 flipXY(const Vector3& p) { return Vector3(-p.x(), -p.y(), p.z()); }
 
-std::vector<std::string> splitCsv(const std::string& line) {
-  std::vector<std::string> fields;
-  std::string field;
-  bool quoted = false;
-  for (char c : line) {
-    if (c == '"')
-      quoted = !quoted;
-    else if (c == ',' && !quoted) {
-      fields.push_back(field);
-      field.clear();
-    } else if (c != '\r')
-      field += c;
-  }
-  fields.push_back(field);
-  for (auto& f : fields) {
-    const auto begin = f.find_first_not_of(" \t"), end = f.find_last_not_of(" \t");
-    f = begin == std::string::npos ? std::string() : f.substr(begin, end - begin + 1);
-  }
-  return fields;
-}
-
 // A column named twice leaves which of the two holds the value to chance.
 void requireDistinctColumns(const std::string& path, int line, const std::vector<std::string>& columns) {
   for (std::size_t c = 0; c < columns.size(); ++c)
@@ -169,7 +148,7 @@ std::vector<Landmark> readFcsv(const std::string& path, std::ifstream& in, Coord
     if (line[0] == '#') {
       const auto equals = line.find('=');
       if (equals == std::string::npos) continue;
-      const std::string key = line.substr(0, equals), value = splitCsv(line.substr(equals + 1))[0];
+      const std::string key = line.substr(0, equals), value = splitCsvFields(line.substr(equals + 1), ',')[0];
       if (key.find("CoordinateSystem") != std::string::npos) {
         if (value == "LPS" || value == "1")
           system = CoordinateSystem::LPS;
@@ -178,12 +157,12 @@ std::vector<Landmark> readFcsv(const std::string& path, std::ifstream& in, Coord
         else
           throw Error(path, "line " + std::to_string(number) + ": unknown coordinate system '" + value + "'");
       } else if (key.find("columns") != std::string::npos) {
-        columns = splitCsv(line.substr(equals + 1));
+        columns = splitCsvFields(line.substr(equals + 1), ',');
         requireDistinctColumns(path, number, columns);
       }
       continue;
     }
-    const auto fields = splitCsv(line);
+    const auto fields = splitCsvFields(line, ',');
     auto column = [&](const std::string& name) -> int {
       for (std::size_t c = 0; c < columns.size(); ++c)
         if (columns[c] == name) return static_cast<int>(c);
@@ -208,27 +187,25 @@ std::vector<Landmark> readCsv(const std::string& path, std::ifstream& in) {
   while (header.empty() && std::getline(in, line)) {
     ++number;
     if (number == 1) line = withoutByteOrderMark(line);
-    if (!line.empty() && line != "\r") header = splitCsv(line);
+    if (!line.empty() && line != "\r") header = splitCsvFields(line, ',');
   }
+  // Column names in any case: X, Label.
+  for (std::string& name : header)
+    for (char& ch : name) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
   int x = -1, y = -1, z = -1, label = -1;
   for (std::size_t c = 0; c < header.size(); ++c) {
-    std::string name = header[c];
-    for (char& ch : name) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-    if (name == "x") x = static_cast<int>(c);
-    if (name == "y") y = static_cast<int>(c);
-    if (name == "z") z = static_cast<int>(c);
-    if (name == "label") label = static_cast<int>(c);
+    if (header[c] == "x") x = static_cast<int>(c);
+    if (header[c] == "y") y = static_cast<int>(c);
+    if (header[c] == "z") z = static_cast<int>(c);
+    if (header[c] == "label") label = static_cast<int>(c);
   }
   if (x < 0 || y < 0 || z < 0) throw Error(path, "the first line must name the columns x, y and z (LPS mm)");
-  std::vector<std::string> lowerCaseHeader = header;
-  for (std::string& name : lowerCaseHeader)
-    for (char& ch : name) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-  requireDistinctColumns(path, number, lowerCaseHeader);
+  requireDistinctColumns(path, number, header);
   std::vector<Landmark> landmarks;
   while (std::getline(in, line)) {
     ++number;
     if (line.empty() || line == "\r") continue;
-    std::vector<std::string> fields = splitCsv(line);
+    std::vector<std::string> fields = splitCsvFields(line, ',');
     // A separator that ends a row adds no value.
     while (fields.size() > header.size() && fields.back().empty()) fields.pop_back();
     // A row of more values than the header has columns is a point whose

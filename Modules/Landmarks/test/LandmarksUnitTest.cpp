@@ -151,17 +151,18 @@ TEST(Landmarks, BadFilesAreRefusedWithTheirName) {
       EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
     }
   };
+  // `text` written as the scratch file `name`.
+  auto written = [](const std::string& name, const std::string& text) {
+    std::ofstream(scratch(name).string()) << text;
+    return scratch(name);
+  };
   expectError(scratch("none.csv"), "no such file");
   std::filesystem::create_directories(scratch("folder.mrk.json"));
   expectError(scratch("folder.mrk.json"), "is a directory");
-  std::ofstream(scratch("points.txt").string()) << "1 2 3\n";
-  expectError(scratch("points.txt"), "unknown landmark format");
-  std::ofstream(scratch("nan.csv").string()) << "x,y,z\n1,2,3\n4,nan,6\n";
-  expectError(scratch("nan.csv"), "line 3");
-  std::ofstream(scratch("noheader.csv").string()) << "1,2,3\n";
-  expectError(scratch("noheader.csv"), "x, y and z");
-  std::ofstream(scratch("broken.mrk.json").string()) << "{\"markups\": [";
-  expectError(scratch("broken.mrk.json"), "not valid JSON: parse error at line 1");
+  expectError(written("points.txt", "1 2 3\n"), "unknown landmark format");
+  expectError(written("nan.csv", "x,y,z\n1,2,3\n4,nan,6\n"), "line 3");
+  expectError(written("noheader.csv", "1,2,3\n"), "x, y and z");
+  expectError(written("broken.mrk.json", "{\"markups\": ["), "not valid JSON: parse error at line 1");
   // Text after the document (here the document pasted twice) is refused, not ignored.
   writeLandmarks(sample(), scratch("twice.mrk.json").string());
   {
@@ -174,25 +175,25 @@ TEST(Landmarks, BadFilesAreRefusedWithTheirName) {
 
   // A column named twice, and a row of more values than the header's
   // columns: which values are x, y and z is not known.
-  std::ofstream(scratch("twox.csv").string()) << "x,y,z,X\n1,2,3,4\n";
-  expectError(scratch("twox.csv"), "the column 'x' is named twice");
-  std::ofstream(scratch("fourvalues.csv").string()) << "x,y,z\n1,2,3\n1,5,2,3\n";
-  expectError(scratch("fourvalues.csv"), "line 3: 4 fields, but the first line names 3 columns");
-  std::ofstream(scratch("twox.fcsv").string()) << "# columns = id,x,y,z,x\n1,2,3,4,5\n";
-  expectError(scratch("twox.fcsv"), "the column 'x' is named twice");
+  expectError(written("twox.csv", "x,y,z,X\n1,2,3,4\n"), "the column 'x' is named twice");
+  expectError(written("fourvalues.csv", "x,y,z\n1,2,3\n1,5,2,3\n"),
+              "line 3: 4 fields, but the first line names 3 columns");
+  expectError(written("twox.fcsv", "# columns = id,x,y,z,x\n1,2,3,4,5\n"), "the column 'x' is named twice");
   // A markups file's fields of the wrong JSON type and states it does not have.
-  std::ofstream(scratch("numberlabel.mrk.json").string())
-      << R"({"markups": [{"type": "Fiducial", "controlPoints": [{"position": [1, 2, 3], "label": 5}]}]})";
-  expectError(scratch("numberlabel.mrk.json"), "control point 1: \"label\" must be a string, got 5");
-  std::ofstream(scratch("status.mrk.json").string())
-      << R"({"markups": [{"type": "Fiducial", "controlPoints": [{"position": [1, 2, 3], "positionStatus": "bogus"}]}]})";
-  expectError(scratch("status.mrk.json"), "unknown positionStatus \"bogus\"");
-  std::ofstream(scratch("notobject.mrk.json").string()) << R"({"markups": [7]})";
-  expectError(scratch("notobject.mrk.json"), "markup 1 is not a JSON object");
+  expectError(written("numberlabel.mrk.json",
+                      R"({"markups": [{"type": "Fiducial", "controlPoints": [{"position": [1, 2, 3], "label": 5}]}]})"),
+              "control point 1: \"label\" must be a string, got 5");
+  expectError(
+      written(
+          "status.mrk.json",
+          R"({"markups": [{"type": "Fiducial", "controlPoints": [{"position": [1, 2, 3], "positionStatus": "bogus"}]}]})"),
+      "unknown positionStatus \"bogus\"");
+  expectError(written("notobject.mrk.json", R"({"markups": [7]})"), "markup 1 is not a JSON object");
   // Regions and measurements alone: said to be what they are.
-  std::ofstream(scratch("box.mrk.json").string())
-      << R"({"markups": [{"type": "ROI", "controlPoints": [{"position": [1, 2, 3]}]}, {"type": "Plane"}]})";
-  expectError(scratch("box.mrk.json"), "its markups (ROI, Plane) are measurements or regions");
+  expectError(
+      written("box.mrk.json",
+              R"({"markups": [{"type": "ROI", "controlPoints": [{"position": [1, 2, 3]}]}, {"type": "Plane"}]})"),
+      "its markups (ROI, Plane) are measurements or regions");
 }
 
 TEST(Landmarks, SpreadsheetFilesAreRead) {

@@ -190,12 +190,7 @@ bool limitSurfaceInside(const ControlMesh& mesh, const ImageGeometry& grid) {
   return true;
 }
 
-SegmentationRegion::SegmentationRegion(const Volume& image, const std::vector<Landmark>& landmarks,
-                                       const ControlMesh& initial, const SegmentOptions& options,
-                                       const std::vector<Landmark>& alsoCover) {
-  checkSegmentOptions(options);
-  if (!initial.isClosed()) throw Error("the initial model must be a closed control mesh");
-  const ImageGeometry& grid = image.geometry;
+void requireLandmarksInside(const ImageGeometry& grid, const std::vector<Landmark>& landmarks) {
   for (std::size_t i = 0; i < landmarks.size(); ++i)
     if (!grid.covers(landmarks[i].position)) {
       const Vector3& p = landmarks[i].position;
@@ -205,6 +200,15 @@ SegmentationRegion::SegmentationRegion(const Volume& image, const std::vector<La
               << p.y() << ", " << p.z() << ") mm LPS lies outside the image";
       throw LandmarkError(message.str());
     }
+}
+
+SegmentationRegion::SegmentationRegion(const Volume& image, const std::vector<Landmark>& landmarks,
+                                       const ControlMesh& initial, const SegmentOptions& options,
+                                       const std::vector<Landmark>& alsoCover) {
+  checkSegmentOptions(options);
+  if (!initial.isClosed()) throw Error("the initial model must be a closed control mesh");
+  const ImageGeometry& grid = image.geometry;
+  requireLandmarksInside(grid, landmarks);
   if (!limitSurfaceInside(initial, grid)) throw Error("the initial model reaches outside the image");
   const MatrixX3 start = limitPoints(initial, 2);
 

@@ -42,15 +42,7 @@ std::vector<std::string> fieldsOf(const std::string& line, bool csv) {
   for (const char c : {',', ';', '\t'})
     if (!separator && line.find(c) != std::string::npos) separator = c;
   if (csv && separator) {
-    bool quoted = false;
-    fields.emplace_back();
-    for (const char c : line) {
-      if (c == '"') quoted = !quoted;
-      if (c == separator && !quoted)
-        fields.emplace_back();
-      else
-        fields.back() += c;
-    }
+    fields = splitCsvFields(line, separator);
   } else {
     std::istringstream in(line);
     for (std::string field; in >> field;) fields.push_back(field);

@@ -9,6 +9,8 @@
 #include <mutex>
 #include <sstream>
 
+#include "dynsub/TextFields.h"
+
 namespace dynsub {
 
 namespace {
@@ -47,10 +49,7 @@ std::string VtkErrors::reason() const {
   std::istringstream lines(first_);
   for (std::string line; std::getline(lines, line);) {
     if (line.empty() || line.rfind("ERROR: In ", 0) == 0 || line.rfind("Warning: In ", 0) == 0) continue;
-    // "vtkXMLDataParser (0x55bb834416e0): Error parsing ..." -> "Error parsing ..."
-    const auto address = line.find(" (0x");
-    const auto end = address == std::string::npos ? std::string::npos : line.find("): ", address);
-    if (line.rfind("vtk", 0) == 0 && end != std::string::npos) line = line.substr(end + 3);
+    line = afterObjectAddress(line);  // "vtkXMLDataParser (0x55...): Error parsing ..."
     while (!line.empty() && (line.back() == ' ' || line.back() == '\r')) line.pop_back();
     if (!line.empty()) return line;
   }

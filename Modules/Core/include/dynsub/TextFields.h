@@ -15,6 +15,12 @@ bool parseNumber(const std::string& field, double& value);
 // empty item for an empty text.
 std::vector<std::string> splitItems(const std::string& text, char separator);
 
+// The fields of a CSV line between `separator`s, as spreadsheets write them:
+// a separator inside double quotes does not split ("left, anterior"), the
+// quotes and carriage returns are dropped, and each field is trimmed of
+// blanks and tabs at its ends.
+std::vector<std::string> splitCsvFields(const std::string& line, char separator);
+
 // `text` without the blanks and tabs at its ends.
 std::string trimmed(const std::string& text);
 
@@ -22,6 +28,11 @@ std::string trimmed(const std::string& text);
 // parse_error.101] parse error at line 1, column 13: ..." -> "parse error at
 // line 1, column 13: ...".
 std::string withoutLibraryTag(const std::string& message);
+
+// `line` after the object a library's message names by its address
+// ("vtkXMLDataParser (0x55d0...): ", "itk::ERROR: NrrdImageIO(0x55d0...): "),
+// or as written when it names none.
+std::string afterObjectAddress(const std::string& line);
 
 // `line` without the UTF-8 byte order mark that spreadsheets ("CSV UTF-8")
 // write before a file's first line.

@@ -102,6 +102,10 @@ struct SegmentResult {
 constexpr double kCollapsedBelow = 0.5;
 constexpr double kLeakedAbove = 0.05;
 
+// Throws LandmarkError ("landmark 2 of 36 ('F-2') at (x, y, z) mm LPS lies
+// outside the image") for the first landmark `grid` does not cover.
+void requireLandmarksInside(const ImageGeometry& grid, const std::vector<Landmark>& landmarks);
+
 // The image side of a segmentation: the region of interest cropped from the
 // image and its edge field (EdgePotential.h), with the time each took.
 // segment() builds one per call; an interactive refit keeps it and reuses it
