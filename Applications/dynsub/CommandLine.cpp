@@ -6,7 +6,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <iomanip>
 #include <sstream>
 #include <variant>
@@ -20,24 +19,6 @@ namespace dynsub::app {
 
 namespace {
 
-CLI::Validator numberCheck(std::string name, bool zeroAllowed, double largest) {
-  if (std::isfinite(largest)) {
-    std::ostringstream bound;
-    bound << " and <= " << largest;
-    name += bound.str();
-  }
-  return CLI::Validator(
-      [name, zeroAllowed, largest](std::string& text) -> std::string {
-        char* end = nullptr;
-        const double value = std::strtod(text.c_str(), &end);
-        const bool number = !text.empty() && end == text.c_str() + text.size() && std::isfinite(value);
-        return number && (value > 0.0 || (zeroAllowed && value == 0.0)) && value <= largest
-                   ? std::string()
-                   : text + " is not " + name;
-      },
-      zeroAllowed ? "NUMBER>=0" : "NUMBER>0");
-}
-
 // Whether `text` is a whole number as written in base 10: a sign, then
 // digits without a leading 0. CLI11 stores an integer option through
 // strtoll in base 0, which reads "010" as octal 8 and "0x10" as 16; such
@@ -48,25 +29,43 @@ bool decimalWholeNumber(const std::string& text) {
   return std::all_of(text.begin() + digits, text.end(), [](char c) { return c >= '0' && c <= '9'; });
 }
 
-}  // namespace
+// `value` as written in a message: in full up to 7 characters (1024, 0.001),
+// in short scientific form beyond (1e+12).
+std::string shortNumber(double value) {
+  std::ostringstream full, brief;
+  full << std::setprecision(15) << value;
+  brief << value;
+  return full.str().size() <= 7 ? full.str() : brief.str();
+}
 
-CLI::Validator numberBetween(double low, double high, bool whole) {
-  std::ostringstream range, shown;
-  range << std::setprecision(15) << low << " and " << high;
-  shown << std::setprecision(15) << (whole ? "INT" : "FLOAT") << " in [" << low << " - " << high << "]";
+// The one check behind every numeric option: `text` read by parseNumber,
+// then held to [low, high] (or (low, high] when `lowIncluded` is false), and
+// to decimal digits when `whole`.
+CLI::Validator numberCheck(double low, bool lowIncluded, double high, bool whole) {
+  const bool closed = lowIncluded && std::isfinite(high);
+  std::string range = closed ? "between " + shortNumber(low) + " and " + shortNumber(high)
+                             : std::string("a finite number ") + (lowIncluded ? ">= " : "> ") + shortNumber(low);
+  if (!closed && std::isfinite(high)) range += " and <= " + shortNumber(high);
+  const std::string shown = std::string(whole ? "INT" : "FLOAT") +
+                            (std::isfinite(high) ? std::string(" in ") + (lowIncluded ? "[" : "(") + shortNumber(low) +
+                                                       " - " + shortNumber(high) + "]"
+                                                 : (lowIncluded ? ">=" : ">") + shortNumber(low));
   return CLI::Validator(
-      [low, high, whole, range = range.str()](std::string& text) -> std::string {
+      [low, lowIncluded, high, whole, range](std::string& text) -> std::string {
         double value = 0;
         if (!parseNumber(text, value) || std::isnan(value)) return text + " is not a number";
         if (whole && !decimalWholeNumber(text)) return text + " is not a whole number (write it in digits, as 12)";
-        if (value < low || value > high) return text + " is not between " + range;
-        return std::string();
+        const bool inside = std::isfinite(value) && (lowIncluded ? value >= low : value > low) && value <= high;
+        return inside ? std::string() : text + " is not " + range;
       },
-      shown.str());
+      shown);
 }
 
-CLI::Validator positiveNumber(double largest) { return numberCheck("a finite number > 0", false, largest); }
-CLI::Validator nonNegativeNumber(double largest) { return numberCheck("a finite number >= 0", true, largest); }
+}  // namespace
+
+CLI::Validator numberBetween(double low, double high, bool whole) { return numberCheck(low, true, high, whole); }
+CLI::Validator positiveNumber(double largest) { return numberCheck(0.0, false, largest, false); }
+CLI::Validator nonNegativeNumber(double largest) { return numberCheck(0.0, true, largest, false); }
 
 // The material's densities and the time step end where the segmentation's
 // table ends theirs (SegmentParameters.cpp): far beyond any useful value, and

@@ -30,17 +30,14 @@ struct SimulationArguments {
 // the parsing.
 void addSegmentParameterOptions(CLI::App& command, SegmentParameters& parameters);
 
-// Checks for a finite number > 0 and >= 0, at most `largest`, whose refusals
-// read "--tolerance: -1 is not a finite number > 0" (CLI11's PositiveNumber
-// and NonNegativeNumber print the largest double as their range's end).
+// Checks for a number on the command line, each refusal saying what is
+// wrong: "--samples-per-face: abc is not a number", "2.5 is not a whole
+// number", "2000 is not between 1 and 1024", "-1 is not a finite number > 0".
+// A whole number is taken in decimal digits only.
+CLI::Validator numberBetween(double low, double high, bool whole);
+// Finite, > 0 (or >= 0) and at most `largest`.
 CLI::Validator positiveNumber(double largest = std::numeric_limits<double>::infinity());
 CLI::Validator nonNegativeNumber(double largest = std::numeric_limits<double>::infinity());
-
-// A check for a number from `low` to `high`, a whole one in decimal digits
-// when `whole`, whose refusals say what is wrong: "--samples-per-face: abc
-// is not a number", "2.5 is not a whole number", "2000 is not between 1 and
-// 1024".
-CLI::Validator numberBetween(double low, double high, bool whole);
 
 // For a usage error: "did you mean 'segment'?" for a command that is not one
 // of `app`'s subcommands, or "did you mean '--landmarks'?" for a long option
