@@ -45,6 +45,16 @@ expect_error "impossible sample count" 2 "samples-per-face" "$work/g.vtp" \
 # triangles: refused before any is made, with the largest count that fits.
 expect_error "more triangles than a surface can number" 2 "use at most 589 samples per face" "$work/g2.vtp" \
   "$DYNSUB" limit "$DATA/Meshes/kitten_genus1.obj" --samples-per-face 1024 --out "$work/g2.vtp"
+# A surface that would not fit in memory (here 700 MB of address space) is
+# refused before any work, with the finest that fits; that one is written.
+expect_error "a surface larger than memory" 2 "samples per face need about .* GiB" "$work/g5.vtp" \
+  bash -c 'ulimit -v 700000 && exec "$0" "$@"' "$DYNSUB" limit "$DATA/Meshes/cube.obj" --samples-per-face 1024 \
+  --out "$work/g5.vtp"
+finest=$(sed -n 's/.*use at most \([0-9]*\) samples per face.*/\1/p' "$work/stderr")
+check "the finest surface said to fit ($finest) is written under the same limit" \
+  bash -c 'ulimit -v 700000 && exec "$0" "$@"' "$DYNSUB" limit "$DATA/Meshes/cube.obj" --samples-per-face "$finest" \
+  --out "$work/g5.vtp"
+rm -f "$work/g5.vtp"
 # Memory running out is said in words, with the options that set the size
 # (level 6 needs about 6 GB; here 2 GB of address space are allowed).
 expect_error "out of memory" 1 "out of memory" "$work/g3.lattice" \

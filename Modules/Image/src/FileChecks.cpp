@@ -3,7 +3,6 @@
 #include "FileChecks.h"
 
 #include <libdeflate.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <fstream>
@@ -14,6 +13,7 @@
 
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
+#include "dynsub/Memory.h"
 
 namespace dynsub::filechecks {
 
@@ -68,15 +68,13 @@ std::vector<unsigned char> inflateGzipFile(const std::string& path, std::uintmax
 }
 
 void requireMemoryFor(const std::string& path, std::uintmax_t voxels) {
-  const long pages = sysconf(_SC_PHYS_PAGES), pageSize = sysconf(_SC_PAGE_SIZE);
-  if (pages <= 0 || pageSize <= 0) return;  // unknown: left to the allocator
-  const auto memory = static_cast<std::uintmax_t>(pages) * static_cast<std::uintmax_t>(pageSize);
+  const MemoryLimit memory = usableMemory();
+  if (memory.bytes == 0) return;  // unknown: left to the allocator
   const auto needed = checkedProduct(voxels, sizeof(float));
-  if (!needed || *needed > memory) {
-    auto gib = [](long double bytes) { return std::to_string(static_cast<long long>(bytes / (1 << 30))); };
+  if (!needed || *needed > memory.bytes) {
     throw Error(path, "the header announces " + std::to_string(voxels) + " voxels, " +
-                          (needed ? gib(*needed) : std::string("over 2^64 bytes")) + " GiB as float, more than " +
-                          "this machine's " + gib(memory) + " GiB of memory");
+                          (needed ? gibibytes(*needed) : std::string("over 2^64 bytes")) + " as float, more than " +
+                          memory.what + " (" + gibibytes(memory.bytes) + ")");
   }
 }
 

@@ -27,6 +27,17 @@ std::string tessellationTooFine(const LimitSurface& surface, int segmentsPerElem
          std::to_string(largest) + " samples per face";
 }
 
+TessellationSize tessellationSize(const LimitSurface& surface, int segmentsPerElement) {
+  const Topology& base = surface.baseTopology();
+  const std::uint64_t n = segmentsPerElement, faces = base.faceCount();
+  TessellationSize size;
+  size.samples = base.vertexCount() + base.edgeCount() * (n - 1) + faces * (n - 1) * (n - 1);
+  size.triangles = 2 * faces * n * n;
+  size.bytes = size.samples * (2 * sizeof(Vector3) + sizeof(char)) +
+               size.triangles * (sizeof(std::array<int, 3>) + sizeof(int) + sizeof(ElementType));
+  return size;
+}
+
 TriangleSurface tessellate(const LimitSurface& surface, const MatrixX3& controlPoints, int segmentsPerElement) {
   const int n = segmentsPerElement;
   if (n < 1 || n > 1024) {
@@ -69,6 +80,10 @@ TriangleSurface tessellate(const LimitSurface& surface, const MatrixX3& controlP
   result.points.setZero(sampleCount, 3);
   result.normals.setZero(sampleCount, 3);
   std::vector<char> done(sampleCount, 0);
+  const std::size_t triangleCount = 2 * static_cast<std::size_t>(base.faceCount()) * n * n;
+  result.triangles.reserve(triangleCount);
+  result.triangleElement.reserve(triangleCount);
+  result.triangleType.reserve(triangleCount);
   for (int f = 0; f < base.faceCount(); ++f) {
     for (int j = 0; j <= n; ++j) {
       for (int i = 0; i <= n; ++i) {

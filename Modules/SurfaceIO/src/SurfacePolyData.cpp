@@ -48,13 +48,15 @@ vtkSmartPointer<vtkPolyData> toPolyData(const TriangleSurface& surface) {
                            3 * static_cast<vtkIdType>(surface.triangles.size()));
   vtkNew<vtkUnsignedCharArray> type;
   type->SetName("ElementType");
+  type->SetNumberOfValues(static_cast<vtkIdType>(surface.triangles.size()));
   vtkNew<vtkIntArray> element;
   element->SetName("Element");
+  element->SetNumberOfValues(static_cast<vtkIdType>(surface.triangles.size()));
   for (size_t t = 0; t < surface.triangles.size(); ++t) {
     const vtkIdType ids[3] = {surface.triangles[t][0], surface.triangles[t][1], surface.triangles[t][2]};
     triangles->InsertNextCell(3, ids);
-    type->InsertNextValue(static_cast<unsigned char>(surface.triangleType[t]));
-    element->InsertNextValue(surface.triangleElement[t]);
+    type->SetValue(static_cast<vtkIdType>(t), static_cast<unsigned char>(surface.triangleType[t]));
+    element->SetValue(static_cast<vtkIdType>(t), surface.triangleElement[t]);
   }
   auto polyData = vtkSmartPointer<vtkPolyData>::New();
   polyData->SetPoints(points);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <utility>
 
 #include <vtkFieldData.h>
 #include <vtkNew.h>
@@ -40,13 +41,32 @@ void writeVtp(const TriangleSurface& surface, const std::string& path, const std
   writeVtkXml(data, path, name);
 }
 
-// Writes `bytes` to `path`, a new file; errors name `name`.
-void writeFile(const std::string& path, const std::string& name, const std::string& bytes) {
-  std::ofstream out(path, std::ios::binary);
-  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  out.close();
-  if (!out) throw writeFailure(name);
-}
+// A new file at `path` written through `bytes` a block at a time, so that
+// a surface of a billion triangles is not held a second time as its file's
+// text; errors name `name`.
+class FileBlocks {
+ public:
+  FileBlocks(const std::string& path, std::string name) : out_(path, std::ios::binary), name_(std::move(name)) {}
+  std::string bytes;
+  // Passes `bytes` on to the file once they fill a block.
+  void spill() {
+    if (bytes.size() >= kBlock) write();
+  }
+  void close() {
+    write();
+    out_.close();
+    if (!out_) throw writeFailure(name_);
+  }
+
+ private:
+  static constexpr std::size_t kBlock = 1 << 20;
+  void write() {
+    out_.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    bytes.clear();
+  }
+  std::ofstream out_;
+  std::string name_;
+};
 
 // The shortest text that reads back as exactly `value`.
 void appendNumber(std::string& text, double value) {
@@ -56,8 +76,9 @@ void appendNumber(std::string& text, double value) {
 }
 
 // Wavefront OBJ: vertices, their normals, and triangles that use both (1-based).
-std::string objText(const TriangleSurface& surface) {
-  std::string text = "# written by DynSub\n";
+void writeObjText(const TriangleSurface& surface, FileBlocks& file) {
+  std::string& text = file.bytes;
+  text = "# written by DynSub\n";
   for (const auto* rows : {&surface.points, &surface.normals}) {
     const char* tag = rows == &surface.points ? "v" : "vn";
     for (Eigen::Index i = 0; i < rows->rows(); ++i) {
@@ -67,14 +88,18 @@ std::string objText(const TriangleSurface& surface) {
         appendNumber(text, (*rows)(i, a));
       }
       text += '\n';
+      file.spill();
     }
   }
   for (const auto& t : surface.triangles) {
     text += 'f';
-    for (int p : t) text += ' ' + std::to_string(p + 1) + "//" + std::to_string(p + 1);
+    for (int p : t) {
+      const std::string index = std::to_string(p + 1);
+      text += ' ' + index + "//" + index;
+    }
     text += '\n';
+    file.spill();
   }
-  return text;
 }
 
 enum class ByteOrder { Little, Big };
@@ -91,8 +116,9 @@ void appendBinary(std::string& bytes, T value, ByteOrder order = ByteOrder::Litt
 
 // Binary little-endian PLY: float positions and normals (as VTK's PLY writer
 // gives them), and each triangle as a list of three ints.
-std::string plyBytes(const TriangleSurface& surface) {
-  std::string bytes = "ply\nformat binary_little_endian 1.0\ncomment written by DynSub\nelement vertex " +
+void writePlyBytes(const TriangleSurface& surface, FileBlocks& file) {
+  std::string& bytes = file.bytes;
+  bytes = "ply\nformat binary_little_endian 1.0\ncomment written by DynSub\nelement vertex " +
                       std::to_string(surface.points.rows()) +
                       "\nproperty float x\nproperty float y\nproperty float z\n"
                       "property float nx\nproperty float ny\nproperty float nz\nelement face " +
@@ -101,18 +127,20 @@ std::string plyBytes(const TriangleSurface& surface) {
   for (Eigen::Index i = 0; i < surface.points.rows(); ++i) {
     for (int a = 0; a < 3; ++a) appendBinary(bytes, static_cast<float>(surface.points(i, a)));
     for (int a = 0; a < 3; ++a) appendBinary(bytes, static_cast<float>(surface.normals(i, a)));
+    file.spill();
   }
   for (const auto& t : surface.triangles) {
     appendBinary(bytes, static_cast<uint8_t>(3));
     for (int p : t) appendBinary(bytes, static_cast<int32_t>(p));
+    file.spill();
   }
-  return bytes;
 }
 
 // Binary STL: an 80-byte header, the triangle count, then each triangle's
 // unit normal (from its corners, as STL readers expect) and corners in floats.
-std::string stlBytes(const TriangleSurface& surface, const std::string& path) {
-  std::string bytes = "DynSub binary STL";
+void writeStlBytes(const TriangleSurface& surface, const std::string& path, FileBlocks& file) {
+  std::string& bytes = file.bytes;
+  bytes = "DynSub binary STL";
   bytes.resize(80, ' ');
   if (surface.triangles.size() > 0xffffffffu)
     throw Error(path, "more triangles than a binary STL file can count (4 294 967 295); nothing written");
@@ -127,38 +155,54 @@ std::string stlBytes(const TriangleSurface& surface, const std::string& path) {
     for (int p : t)
       for (int k = 0; k < 3; ++k) appendBinary(bytes, static_cast<float>(surface.points(p, k)));
     appendBinary(bytes, static_cast<uint16_t>(0));
+    file.spill();
   }
-  return bytes;
 }
 
 // Legacy VTK polydata, binary (big-endian, as the format has it): float
 // positions, triangles, and the normals and point data as point arrays.
 // 3D Slicer reads the coordinate system from "SPACE=" in the title line.
-std::string legacyVtkBytes(const TriangleSurface& surface, const std::vector<PointScalars>& scalars,
-                           const std::string& space) {
+void writeLegacyVtkBytes(const TriangleSurface& surface, const std::vector<PointScalars>& scalars,
+                         const std::string& space, FileBlocks& file) {
   const auto n = surface.points.rows();
   const std::size_t triangles = surface.triangles.size();
-  std::string bytes = "# vtk DataFile Version 4.2\nDynSub surface" + (space.empty() ? "" : " SPACE=" + space) +
+  std::string& bytes = file.bytes;
+  bytes = "# vtk DataFile Version 4.2\nDynSub surface" + (space.empty() ? "" : " SPACE=" + space) +
                       "\nBINARY\nDATASET POLYDATA\nPOINTS " + std::to_string(n) + " float\n";
-  for (Eigen::Index i = 0; i < n; ++i)
+  for (Eigen::Index i = 0; i < n; ++i) {
     for (int a = 0; a < 3; ++a) appendBinary(bytes, static_cast<float>(surface.points(i, a)), ByteOrder::Big);
+    file.spill();
+  }
   bytes += "\nPOLYGONS " + std::to_string(triangles) + " " + std::to_string(4 * triangles) + "\n";
   for (const auto& t : surface.triangles) {
     appendBinary(bytes, static_cast<int32_t>(3), ByteOrder::Big);
     for (int p : t) appendBinary(bytes, static_cast<int32_t>(p), ByteOrder::Big);
+    file.spill();
   }
   bytes += "\nPOINT_DATA " + std::to_string(n) + "\nNORMALS Normals float\n";
-  for (Eigen::Index i = 0; i < n; ++i)
+  for (Eigen::Index i = 0; i < n; ++i) {
     for (int a = 0; a < 3; ++a) appendBinary(bytes, static_cast<float>(surface.normals(i, a)), ByteOrder::Big);
+    file.spill();
+  }
   for (const PointScalars& s : scalars) {
     bytes += "\nSCALARS " + s.name + " float 1\nLOOKUP_TABLE default\n";
-    for (Eigen::Index i = 0; i < n; ++i) appendBinary(bytes, static_cast<float>(s.values[i]), ByteOrder::Big);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      appendBinary(bytes, static_cast<float>(s.values[i]), ByteOrder::Big);
+      file.spill();
+    }
   }
   bytes += '\n';
-  return bytes;
 }
 
 }  // namespace
+
+std::uint64_t surfaceWriterBytes(const std::string& path, std::uint64_t points, std::uint64_t triangles) {
+  if (lowerCaseExtension(path) != ".vtp") return 0;
+  // toPolyData's arrays: positions and normals in doubles; 32-bit corners
+  // and offsets, the element type and the element; and the XML writer's
+  // blocks, about 10 bytes a triangle (measured by peak resident memory).
+  return points * 6 * sizeof(double) + triangles * (4 * sizeof(std::int32_t) + 1 + sizeof(int) + 10);
+}
 
 std::vector<std::string> triangleSurfaceExtensions() { return {".vtp", ".vtk", ".obj", ".ply", ".stl"}; }
 
@@ -188,28 +232,28 @@ void writeTriangleSurface(const TriangleSurface& surface, const std::string& pat
   AtomicOutput output(path);
   if (extension == ".vtp") {
     writeVtp(surface, output.temporaryPath(), path, scalars, space);
-  } else if (extension == ".vtk") {
-    writeFile(output.temporaryPath(), path, legacyVtkBytes(surface, scalars, space));
-  } else if (extension == ".obj") {
-    writeFile(output.temporaryPath(), path, objText(surface));
-  } else if (extension == ".ply") {
-    writeFile(output.temporaryPath(), path, plyBytes(surface));
   } else {
-    writeFile(output.temporaryPath(), path, stlBytes(surface, path));
+    FileBlocks file(output.temporaryPath(), path);
+    if (extension == ".vtk") writeLegacyVtkBytes(surface, scalars, space, file);
+    if (extension == ".obj") writeObjText(surface, file);
+    if (extension == ".ply") writePlyBytes(surface, file);
+    if (extension == ".stl") writeStlBytes(surface, path, file);
+    file.close();
   }
   output.commit();
 }
 
 void writePointCloudXyz(const MatrixX3& points, const std::string& path) {
-  std::string text;
+  AtomicOutput output(path);
+  FileBlocks file(output.temporaryPath(), path);
   for (Eigen::Index p = 0; p < points.rows(); ++p) {
     for (int c = 0; c < 3; ++c) {
-      appendNumber(text, points(p, c));
-      text += c < 2 ? ' ' : '\n';
+      appendNumber(file.bytes, points(p, c));
+      file.bytes += c < 2 ? ' ' : '\n';
     }
+    file.spill();
   }
-  AtomicOutput output(path);
-  writeFile(output.temporaryPath(), path, text);
+  file.close();
   output.commit();
 }
 

@@ -5,6 +5,7 @@
 // a closed, consistently oriented triangle mesh (normals point where s_u x s_v
 // points: outward for an outward-oriented control mesh).
 #include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,14 @@ int outputSegments(const LimitSurface& surface);
 // one surface can number (its triangles past 2^31 - 1), with the largest
 // count that fits; empty when they are not.
 std::string tessellationTooFine(const LimitSurface& surface, int segmentsPerElement);
+
+// The samples and triangles of `segmentsPerElement` squares per element of
+// `surface`, and the bytes tessellate() holds for them: each sample's point
+// and normal, each triangle's corners, element and type.
+struct TessellationSize {
+  std::uint64_t samples = 0, triangles = 0, bytes = 0;
+};
+TessellationSize tessellationSize(const LimitSurface& surface, int segmentsPerElement);
 
 // N = segmentsPerElement >= 1. Throws dynsub::Error for N < 1 or N > 1024,
 // or for a grid tessellationTooFine refuses.

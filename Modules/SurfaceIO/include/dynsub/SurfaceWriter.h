@@ -7,6 +7,7 @@
 //   .obj  Wavefront OBJ with vertex normals;  .ply  binary PLY (float
 //         positions and normals);  .stl  binary STL.
 // Coordinates are written as given (mm). The file appears complete or not at all.
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,11 @@ constexpr char kScanDistanceScalars[] = "scan_distance_mm";
 // finite, or a far distance that is negative or not finite.
 void writeTriangleSurface(const TriangleSurface& surface, const std::string& path,
                           const std::vector<PointScalars>& scalars = {}, const std::string& space = "");
+
+// The memory writeTriangleSurface takes besides the surface, for `points` and
+// `triangles` written to `path`: a .vtp goes through a copy in VTK's arrays;
+// the other formats stream to the file.
+std::uint64_t surfaceWriterBytes(const std::string& path, std::uint64_t points, std::uint64_t triangles);
 
 // The extensions writeTriangleSurface accepts, with the dot (".vtp", ...).
 std::vector<std::string> triangleSurfaceExtensions();
