@@ -12,6 +12,7 @@
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
 #include "dynsub/LatticeIO.h"
+#include "dynsub/Memory.h"
 #include "dynsub/ModelOutputs.h"
 #include "dynsub/OutputSet.h"
 #include "dynsub/Report.h"
@@ -46,13 +47,32 @@ struct SculptOptions {
   bool figure = true;
 };
 
-Report countsReport(const Lattice& lattice) {
+Report countsReport(const LatticeCounts& counts) {
   Report r;
-  r.set("points", lattice.pointCount());
-  r.set("edges", lattice.edgeCount());
-  r.set("faces", lattice.faceCount());
-  r.set("cells", lattice.cellCount());
+  r.set("points", counts.points);
+  r.set("edges", counts.edges);
+  r.set("faces", counts.faces);
+  r.set("cells", counts.cells);
   return r;
+}
+
+Report countsReport(const Lattice& lattice) { return countsReport(refinedCounts(lattice, 0)); }
+
+// Refining `levels` times takes about 3 KiB a refined cell (peak resident
+// memory of `solid subdivide` on the three Table 1 lattices at levels 4 and
+// 5: 2.8-3.0 KiB), the cells growing eightfold a level. More than memory
+// holds is refused before any work, with the level that fits; a tenth is
+// kept for what the estimate leaves out.
+void requireMemoryForLevels(const Lattice& lattice, int levels, const std::string& path) {
+  const MemoryLimit memory = usableMemory();
+  auto needed = [&](int level) { return 3.0L * 1024 * refinedCounts(lattice, level).cells; };
+  auto fits = [&](int level) { return 1.1L * needed(level) <= memory.bytes; };
+  if (memory.bytes == 0 || fits(levels)) return;
+  int largest = levels;
+  while (largest > 0 && !fits(largest)) --largest;
+  throw UsageError(path, std::to_string(levels) + " levels need about " + gibibytes(needed(levels)) +
+                             ", more than " + memory.what + " (" + gibibytes(memory.bytes) + "): use at most --level " +
+                             std::to_string(largest));
 }
 
 // DIR/sculpted.lattice (the control lattice, to sculpt on later),
@@ -153,8 +173,7 @@ void addSolidCommand(CLI::App& app) {
   stats->add_option("LATTICE", statsOptions->lattice, "Control lattice (.lattice)")->required();
   stats->add_option("--level", statsOptions->level, "Subdivisions")->default_val(0)->check(numberBetween(0, 6, true));
   stats->callback([statsOptions] {
-    const Lattice lattice = subdivideSolid(readLattice(statsOptions->lattice), statsOptions->level).lattice;
-    std::cout << countsReport(lattice).text(-1);
+    std::cout << countsReport(refinedCounts(readLattice(statsOptions->lattice), statsOptions->level)).text(-1);
   });
 
   CLI::App* subdivide = solid->add_subcommand(
@@ -165,7 +184,9 @@ void addSolidCommand(CLI::App& app) {
   subdivide->callback([o] {
     requireLatticeTarget(o->out);
     requireNotInput(o->out, o->lattice);
-    const Lattice lattice = subdivideSolid(readLattice(o->lattice), o->level).lattice;
+    const Lattice control = readLattice(o->lattice);
+    requireMemoryForLevels(control, o->level, o->lattice);
+    const Lattice lattice = subdivideSolid(control, o->level).lattice;
     writeLattice(lattice, o->out);
     std::cout << "wrote " << o->out << ": " << lattice.pointCount() << " points, " << lattice.cellCount()
               << " cells\n";

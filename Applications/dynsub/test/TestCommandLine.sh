@@ -55,11 +55,23 @@ check "the finest surface said to fit ($finest) is written under the same limit"
   bash -c 'ulimit -v 700000 && exec "$0" "$@"' "$DYNSUB" limit "$DATA/Meshes/cube.obj" --samples-per-face "$finest" \
   --out "$work/g5.vtp"
 rm -f "$work/g5.vtp"
-# Memory running out is said in words, with the options that set the size
-# (level 6 needs about 6 GB; here 2 GB of address space are allowed).
-expect_error "out of memory" 1 "out of memory" "$work/g3.lattice" \
+# So is a subdivided solid (level 6 of cube3 needs about 6 GB; here 2 GB of
+# address space are allowed), and its counts are printed without building it.
+expect_error "a solid larger than memory" 2 "6 levels need about .* use at most --level 5" "$work/g3.lattice" \
   bash -c 'ulimit -v 2000000 && exec "$0" "$@"' "$DYNSUB" solid subdivide "$DATA/Solids/cube3.lattice" --level 6 \
   --out "$work/g3.lattice"
+check "the level said to fit is written under the same limit" \
+  bash -c 'ulimit -v 2000000 && exec "$0" "$@" >/dev/null' "$DYNSUB" solid subdivide "$DATA/Solids/cube3.lattice" \
+  --level 5 --out "$work/g3.lattice"
+rm -f "$work/g3.lattice"
+check "solid stats counts level 6 within the same limit" bash -c 'ulimit -v 2000000 && exec "$0" "$@" | \
+  grep -q "\"cells\":2097152"' "$DYNSUB" solid stats "$DATA/Solids/cube3.lattice" --level 6
+# Memory running out where no estimate is made is said in words, with the
+# options that set the size (sculpting cube4 at level 4 takes 1.25 GB; here
+# 1 GB of address space is allowed).
+expect_error "out of memory" 1 "out of memory" "$work/g3" \
+  bash -c 'ulimit -v 1000000 && exec "$0" "$@"' "$DYNSUB" solid sculpt "$DATA/Solids/cube4.lattice" \
+  --script "$DATA/Solids/arm.sculpt" --level 4 --no-figures --out "$work/g3"
 expect_error "a word for a count" 2 "samples-per-face: abc is not a number" "$work/g4.vtp" \
   "$DYNSUB" limit "$DATA/Meshes/cube.obj" --samples-per-face abc --out "$work/g4.vtp"
 expect_error "a fraction for a count" 2 "samples-per-face: 2.5 is not a whole number" "$work/g4.vtp" \

@@ -1,5 +1,6 @@
 #include "dynsub/SolidSubdivision.h"
 
+#include <algorithm>
 #include <map>
 
 #include "dynsub/Error.h"
@@ -235,6 +236,46 @@ SolidRefinement subdivideSolid(const Lattice& lattice, int levels) {
     result.cellOrigin = std::move(next.cellOrigin);
   }
   return result;
+}
+
+LatticeCounts refinedCounts(const Lattice& lattice, int levels) {
+  LatticeCounts n{static_cast<std::uint64_t>(lattice.pointCount()), static_cast<std::uint64_t>(lattice.edgeCount()),
+                  static_cast<std::uint64_t>(lattice.faceCount()), static_cast<std::uint64_t>(lattice.cellCount())};
+  // Sums over faces of their points, and over cells of their faces and edges.
+  std::uint64_t faceCorners = 0, cellFaces = 0, cellEdges = 0;
+  for (const auto& face : lattice.faces()) faceCorners += face.size();
+  for (const auto& cell : lattice.cells()) cellFaces += cell.size();
+  // (cell, corner) pairs by the number k of the cell's edges at the corner.
+  std::map<std::uint64_t, std::uint64_t> corners;
+  for (int c = 0; c < lattice.cellCount(); ++c) {
+    cellEdges += lattice.cellEdges()[c].size();
+    for (int p : lattice.cellPoints()[c]) {
+      const auto& edges = lattice.cellEdges()[c];
+      ++corners[std::count_if(edges.begin(), edges.end(), [&](int e) {
+        return lattice.edges()[e][0] == p || lattice.edges()[e][1] == p;
+      })];
+    }
+  }
+  for (int level = 0; level < levels; ++level) {
+    LatticeCounts next;
+    next.points = n.points + n.edges + n.faces + n.cells;
+    next.edges = 2 * n.edges + faceCorners + cellFaces;
+    next.faces = faceCorners + cellEdges;
+    next.cells = 0;
+    std::map<std::uint64_t, std::uint64_t> nextCorners;
+    cellFaces = cellEdges = 0;
+    for (const auto& [k, count] : corners) {
+      next.cells += count;
+      cellFaces += 2 * k * count;
+      cellEdges += 4 * k * count;
+      nextCorners[k] += 2 * count;
+      nextCorners[3] += 2 * k * count;
+    }
+    faceCorners = 4 * next.faces;
+    corners = nextCorners;
+    n = next;
+  }
+  return n;
 }
 
 }  // namespace dynsub

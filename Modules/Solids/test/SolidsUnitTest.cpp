@@ -51,6 +51,34 @@ TEST(SolidSubdivision, ReproducesTable1Counts) {
   expectCounts(subdivideSolid(holes, 2).lattice, {1900, 5040, 4416, 1280}, "Cube w/ holes, level 2");
 }
 
+// refinedCounts agrees with the lattices subdivideSolid builds, on the cubes
+// and on cells other than hexahedra: a pyramid (a corner of 4 edges) and a
+// tetrahedron.
+TEST(SolidSubdivision, CountsFromIncidencesAgreeWithTheRefinedLattices) {
+  MatrixX3 pyramidPoints(5, 3);
+  pyramidPoints << 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0, 0.5, 0.5, 1;
+  MatrixX3 tetrahedronPoints(4, 3);
+  tetrahedronPoints << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+  const std::vector<std::pair<std::string, Lattice>> lattices = {
+      {"cube3", regularLattice(2, 2, 2)},
+      {"holes", regularLattice(3, 3, 3, 1.0, {13, 4, 22, 10, 16, 12, 14})},
+      {"pyramid", Lattice::fromCells(pyramidPoints, {{0, 3, 2, 1}, {0, 1, 4}, {1, 2, 4}, {2, 3, 4}, {3, 0, 4}},
+                                     {{0, 1, 2, 3, 4}})},
+      {"tetrahedron",
+       Lattice::fromCells(tetrahedronPoints, {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {2, 0, 3}}, {{0, 1, 2, 3}})}};
+  for (const auto& [name, lattice] : lattices) {
+    for (int level = 0; level <= 3; ++level) {
+      const Counts built = countsOf(subdivideSolid(lattice, level).lattice);
+      const LatticeCounts counted = refinedCounts(lattice, level);
+      const std::string what = name + ", level " + std::to_string(level);
+      EXPECT_EQ(counted.points, static_cast<std::uint64_t>(built.points)) << what;
+      EXPECT_EQ(counted.edges, static_cast<std::uint64_t>(built.edges)) << what;
+      EXPECT_EQ(counted.faces, static_cast<std::uint64_t>(built.faces)) << what;
+      EXPECT_EQ(counted.cells, static_cast<std::uint64_t>(built.cells)) << what;
+    }
+  }
+}
+
 // The uniform tri-cubic B-spline's refinement along one axis: a fine point at
 // even index 2i is (p[i-1] + 6 p[i] + p[i+1]) / 8, at odd index 2i + 1 it is
 // (p[i] + p[i+1]) / 2.

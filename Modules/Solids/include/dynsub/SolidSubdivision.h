@@ -30,6 +30,8 @@
 // point, cell point, face point) inside the cell; each point of a cell gives a
 // new cell. Counts: P' = P + E + F + C, F' = sum n_f + sum_c E_c,
 // C' = sum_c P_c.
+#include <cstdint>
+
 #include "dynsub/Lattice.h"
 
 namespace dynsub {
@@ -46,5 +48,15 @@ struct SolidRefinement {
 SolidRefinement subdivideSolid(const Lattice& lattice);
 // `levels` >= 0 refinements; A is their product (#points at the last level x #points).
 SolidRefinement subdivideSolid(const Lattice& lattice, int levels);
+
+// The counts of `levels` refinements of `lattice`, from its incidences
+// alone. A cell's corner where k of its edges meet refines into a cell of
+// 2k + 2 points, 4k edges and 2k faces, two of whose corners have k edges and
+// the rest 3; so the counts of (cell, corner) pairs by k carry the sums above
+// from level to level, and a level 6 is counted without building it.
+struct LatticeCounts {
+  std::uint64_t points = 0, edges = 0, faces = 0, cells = 0;
+};
+LatticeCounts refinedCounts(const Lattice& lattice, int levels);
 
 }  // namespace dynsub
