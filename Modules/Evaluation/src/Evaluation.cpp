@@ -9,6 +9,7 @@
 #include <map>
 #include <mutex>
 #include <set>
+#include <tuple>
 #include <thread>
 
 #include <nlohmann/json.hpp>
@@ -234,6 +235,11 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
       plan.atlasImage = resolve(textOf(required(atlas, "image", "the atlas"), "the atlas's image"), base);
       plan.atlasLabels = resolve(textOf(required(atlas, "labels", "the atlas"), "the atlas's labels"), base);
     }
+    // Where each subject was drawn: a seed draws the same anatomy from the
+    // same image and labels whatever the other settings, so it may serve one
+    // split only, across cohorts too (the versions of one subject in several
+    // cohorts, at 1 mm and in thick slices say, stay in one split).
+    std::map<std::tuple<std::string, std::string, std::uint64_t>, std::pair<std::string, std::string>> drawnIn;
     for (const auto& c : optionalList(j, "cohorts", "the plan's ")) {
       const std::string name = textOf(required(c, "name", "a cohort"), "a cohort's name");
       const std::string where = "cohort '" + name + "'";
@@ -251,7 +257,6 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
         setSubjectSetting(cohort.settings, key, text);
       }
       checkSubjectSettings(cohort.settings);
-      std::set<std::uint64_t> seen;
       const nlohmann::json& subjects = required(c, "subjects", where);
       if (!subjects.is_object())
         throw Error(where + ": subjects must be an object of lists by split, got " + subjects.dump());
@@ -259,9 +264,15 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
         std::vector<std::uint64_t> list;
         for (const auto& seed : listOf(seeds, where + ": split '" + split + "'")) {
           list.push_back(static_cast<std::uint64_t>(wholeNumber(seed, where + ": a subject", 0, kLargestSetting)));
-          if (!seen.insert(list.back()).second)
-            throw Error(path, where + ": subject " + std::to_string(list.back()) +
-                                  " is in two splits (tuning and test subjects must be disjoint)");
+          const auto [earlier, first] = drawnIn.try_emplace({cohort.image, cohort.labels, list.back()}, name, split);
+          if (first || (earlier->second.second == split && earlier->second.first != name)) continue;
+          const std::string subject = "subject " + std::to_string(list.back());
+          if (earlier->second.first == name)
+            throw Error(path, where + ": " + subject + " is in two splits (tuning and test subjects must be disjoint)");
+          throw Error(path, where + ": " + subject + " is in split '" + split + "', and cohort '" +
+                                earlier->second.first + "' draws it from the same image and labels in split '" +
+                                earlier->second.second + "': a seed draws the same anatomy, so tuning and test " +
+                                "subjects would not be disjoint");
         }
         if (list.empty()) throw Error(path, where + ": split '" + split + "' has no subjects");
         cohort.subjects.emplace_back(split, list);
