@@ -95,8 +95,8 @@ void checkPolygonMesh(const MatrixX3& points, const std::vector<std::vector<int>
         }
       }
     }
-    if (0.5 * newellNormal(points, face).norm() <= minimumArea) {
-      throw Error(source, faceName + " is degenerate: its area is zero");
+    if (const std::string noArea = noAreaReason(points, face, minimumArea); !noArea.empty()) {
+      throw Error(source, faceName + " is degenerate: " + noArea);
     }
     for (size_t k = 0; k < face.size(); ++k) {
       const int a = face[k];

@@ -102,8 +102,8 @@ Lattice Lattice::fromCells(MatrixX3 points, std::vector<std::vector<int>> faces,
       if (p < 0 || p >= n)
         throw Error(source, name + " uses point " + std::to_string(p) + ", but the lattice has " + std::to_string(n));
     if (sortedUnique(loop).size() != loop.size()) throw Error(source, name + " repeats a point");
-    if (!(0.5 * newellNormal(l.points_, loop).norm() > minimumArea))
-      throw Error(source, name + " is degenerate: its area is zero");
+    if (const std::string noArea = noAreaReason(l.points_, loop, minimumArea); !noArea.empty())
+      throw Error(source, name + " is degenerate: " + noArea);
     for (std::size_t i = 0; i < loop.size(); ++i) {
       const int a = std::min(loop[i], loop[(i + 1) % loop.size()]), b = std::max(loop[i], loop[(i + 1) % loop.size()]);
       auto [it, added] = edgeIndex.try_emplace({a, b}, static_cast<int>(l.edges_.size()));

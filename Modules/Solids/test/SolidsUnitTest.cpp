@@ -317,6 +317,11 @@ TEST_F(LatticeFiles, InvalidLatticesAreNamed) {
   EXPECT_NE(message(file("same.lattice", same)).find("face 0 is degenerate: its area is zero"), std::string::npos);
   std::string line = std::string(text).replace(text.find("0 1 0\n0 0 1"), 5, "2 0 0");
   EXPECT_NE(message(file("line.lattice", line)).find("face 0 is degenerate"), std::string::npos);
+  // A mistyped coordinate far from the rest: the faces have an area, which
+  // is none beside the lattice's extent.
+  std::string far = std::string(text).replace(text.find("1 0 0"), 5, "1e6 0 0");
+  EXPECT_NE(message(file("far.lattice", far)).find("is a point far from the others"), std::string::npos)
+      << message(file("far.lattice", far));
 }
 
 // A cell must enclose a volume, though each of its faces has an area: a
