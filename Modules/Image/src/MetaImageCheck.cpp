@@ -1,11 +1,16 @@
 // MetaImage files: the checks made before ITK reads them (FileChecks.h).
 #include "FileChecks.h"
 
+#include <libdeflate.h>
+
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <algorithm>
 #include <fstream>
 #include <map>
+#include <memory>
+#include <new>
 #include <sstream>
 #include <utility>
 #include <vector>
@@ -120,9 +125,10 @@ void checkMetaImageFile(const std::string& path) {
   if (!voxelBytes) throw Error(path, "a MetaImage header whose size does not fit in 64 bits");
   std::uintmax_t available = 0;
   std::string source = path;
+  std::streamoff dataStart = 0;
   if (dataFile == "LOCAL") {
-    const std::streamoff at = in.tellg();
-    available = at < 0 ? 0 : fs::file_size(path) - static_cast<std::uintmax_t>(at);
+    dataStart = std::max<std::streamoff>(in.tellg(), 0);
+    available = fs::file_size(path) - static_cast<std::uintmax_t>(dataStart);
   } else if (dataFile.find_first_of("% ") == std::string::npos && dataFile != "LIST") {
     source = (fs::path(path).parent_path() / dataFile).string();
     std::error_code error;
@@ -143,6 +149,35 @@ void checkMetaImageFile(const std::string& path) {
   if (!compressed && !headerSize && available > needed)
     throw Error(source, std::to_string(available) + " bytes of data, where the header announces " +
                             std::to_string(needed) + ": its DimSize or ElementType does not describe the data");
+  // Compressed data must inflate to exactly the voxels' bytes: on a corrupt
+  // stream MetaIO prints "Uncompress failed" and ITK returns whatever image
+  // it got. (Without CompressedDataSize the stream runs to the file's end.)
+  if (compressed && !headerSize) {
+    std::vector<unsigned char> packed(static_cast<std::size_t>(compressedSize ? compressedSize : available));
+    std::ifstream data(source, std::ios::binary);
+    data.seekg(dataStart);
+    data.read(reinterpret_cast<char*>(packed.data()), static_cast<std::streamsize>(packed.size()));
+    if (!data) throw Error(source, "its compressed data cannot be read");
+    // Deflate inflates at most kLargestDeflateRatio-fold: a header that
+    // announces more is refused before a buffer of its size is allocated.
+    if (*voxelBytes / kLargestDeflateRatio > packed.size())
+      throw Error(source, "corrupt header: " + std::to_string(packed.size()) + " bytes of compressed data cannot hold the " +
+                              std::to_string(*voxelBytes) + " bytes it announces");
+    const std::unique_ptr<libdeflate_decompressor, void (*)(libdeflate_decompressor*)> decompressor(
+        libdeflate_alloc_decompressor(), &libdeflate_free_decompressor);
+    if (!decompressor) throw std::bad_alloc();
+    std::vector<unsigned char> voxels(static_cast<std::size_t>(*voxelBytes));
+    std::size_t inflated = 0;
+    const auto result = libdeflate_zlib_decompress(decompressor.get(), packed.data(), packed.size(), voxels.data(),
+                                                   voxels.size(), &inflated);
+    if (result != LIBDEFLATE_SUCCESS || inflated != voxels.size())
+      throw Error(source, std::string("corrupt compressed data: it ") +
+                              (result == LIBDEFLATE_INSUFFICIENT_SPACE ? "inflates to more than"
+                               : result == LIBDEFLATE_SUCCESS          ? "inflates to " + std::to_string(inflated) +
+                                                                    " bytes, not"
+                                                                      : "is not a complete zlib stream of") +
+                              " the " + std::to_string(*voxelBytes) + " bytes the header announces");
+  }
 }
 
 }  // namespace dynsub::filechecks

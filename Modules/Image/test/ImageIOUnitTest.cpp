@@ -360,6 +360,39 @@ TEST(HostileImages, FourDimensionsAndAxesNotAtRightAnglesAreRefused) {
   EXPECT_EQ(readError(scratch("rotated.mha")), "");
 }
 
+// A compressed MetaImage whose stream is damaged, or whose header announces
+// fewer voxels than the stream holds: MetaIO prints "Uncompress failed" and
+// ITK returns an image regardless. Pseudo-random voxels, as above.
+TEST(HostileImages, CorruptCompressedMetaImageDataIsRefused) {
+  Mask big{grid({40, 40, 40}, Vector3::Ones(), Vector3::Zero(), Matrix3::Identity()), {}};
+  big.voxels.resize(big.geometry.voxelCount());
+  unsigned state = 1;
+  for (auto& voxel : big.voxels) voxel = ((state = state * 1103515245u + 12345u) >> 16) & 1u;
+  const fs::path packed = scratch("packed.mha");
+  writeMask(big, packed.string());
+  std::string bytes;
+  {
+    std::ifstream in(packed, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const std::size_t data = bytes.find("ElementDataFile = LOCAL\n") + 24;
+  std::string damaged = bytes;
+  for (std::size_t at = data + 100; at < data + 110; ++at) damaged[at] = static_cast<char>(~damaged[at]);
+  std::ofstream(scratch("damaged.mha"), std::ios::binary) << damaged;
+  std::string error = readError(scratch("damaged.mha"));
+  // Damage may end the stream early or late: only the verdict is certain.
+  EXPECT_NE(error.find("damaged.mha: corrupt compressed data: it "), std::string::npos) << error;
+  EXPECT_NE(error.find(" the 64000 bytes the header announces"), std::string::npos) << error;
+  std::string shorter = bytes;
+  shorter.replace(shorter.find("DimSize = 40 40 40"), 18, "DimSize = 40 40 39");
+  std::ofstream(scratch("shorter.mha"), std::ios::binary) << shorter;
+  error = readError(scratch("shorter.mha"));
+  EXPECT_NE(error.find("shorter.mha: corrupt compressed data: it inflates to more than the 62400 bytes"),
+            std::string::npos)
+      << error;
+  EXPECT_EQ(readError(scratch("packed.mha")), "");
+}
+
 // A header that announces less data than the file holds: ITK reads the
 // first bytes as the image and drops the rest.
 TEST(HostileImages, MoreDataThanTheHeaderAnnouncesIsRefused) {
