@@ -17,9 +17,10 @@
 
 namespace dynsub::filechecks {
 
-std::vector<unsigned char> inflateGzipFile(const std::string& path, std::uintmax_t expected) {
+std::vector<unsigned char> inflateGzipFile(const std::string& path, std::uintmax_t expected, std::uintmax_t start) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path, "cannot be opened");
+  in.seekg(static_cast<std::streamoff>(start));
   const std::vector<unsigned char> packed{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   if (in.bad()) throw Error(path, "cannot be read");
   auto corrupt = [&](const std::string& why) {

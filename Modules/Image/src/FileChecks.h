@@ -20,11 +20,13 @@ inline std::optional<std::uintmax_t> checkedProduct(std::uintmax_t a, std::uintm
   return result;
 }
 
-// The bytes a gzip file inflates to, in one piece (libdeflate). `expected`
-// is the size its contents announce; more than four times as much is refused
-// rather than allocated. Throws dynsub::Error naming the file when its
-// stream is cut short or corrupt.
-std::vector<unsigned char> inflateGzipFile(const std::string& path, std::uintmax_t expected);
+// The bytes a gzip file (from byte `start` on: a NRRD's data follows its
+// header) inflates to, in one piece (libdeflate). `expected` is the size its
+// contents announce; more than four times as much is refused rather than
+// allocated. Throws dynsub::Error naming the file when its stream is cut
+// short or corrupt.
+std::vector<unsigned char> inflateGzipFile(const std::string& path, std::uintmax_t expected,
+                                           std::uintmax_t start = 0);
 
 // Throws dynsub::Error when an image of `voxels` voxels would not fit in this
 // machine's memory as float (a corrupt or hostile header), before anything

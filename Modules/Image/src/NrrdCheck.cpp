@@ -59,11 +59,13 @@ void checkNrrdFile(const std::string& path) {
       detachedOrSkipped = true;
   }
   const int bytes = nrrdTypeBytes(type);
-  if (!in || encoding != "raw" || detachedOrSkipped || bytes == 0 || voxels == 0) return;
-  const std::streamoff at = in.tellg();
-  const std::uintmax_t available = fs::file_size(path) - static_cast<std::uintmax_t>(at);
+  const bool gzip = encoding == "gzip" || encoding == "gz";
+  if (!in || !(encoding == "raw" || gzip) || detachedOrSkipped || bytes == 0 || voxels == 0) return;
+  const auto at = static_cast<std::uintmax_t>(in.tellg());
   std::uintmax_t needed = 0;
   if (__builtin_mul_overflow(voxels, static_cast<std::uintmax_t>(bytes), &needed)) return;
+  // Gzip data (3D Slicer's default) is inflated to be measured.
+  const std::uintmax_t available = gzip ? inflateGzipFile(path, needed, at).size() : fs::file_size(path) - at;
   // Less is ITK's to report (it reads that far); more would be read as the
   // image's first bytes, the rest dropped.
   if (available > needed)

@@ -405,7 +405,17 @@ TEST(HostileImages, MoreDataThanTheHeaderAnnouncesIsRefused) {
       << "NRRD0004\ntype: float\ndimension: 3\nspace: left-posterior-superior\nsizes: 4 3 2\n"
          "space directions: (1,0,0) (0,1,0) (0,0,1)\nencoding: raw\nendian: little\nspace origin: (0,0,0)\n\n"
       << data;
-  for (const std::string name : {"extra.mha", "extra.nrrd"}) {
+  // The same data gzip-encoded, as 3D Slicer writes NRRD: measured inflated.
+  std::ofstream(scratch("extra.raw"), std::ios::binary) << data;
+  gzipFile(scratch("extra.raw"), scratch("extra.raw.gz"));
+  {
+    std::ifstream in(scratch("extra.raw.gz"), std::ios::binary);
+    std::ofstream(scratch("extragz.nrrd"), std::ios::binary)
+        << "NRRD0004\ntype: float\ndimension: 3\nspace: left-posterior-superior\nsizes: 4 3 2\n"
+           "space directions: (1,0,0) (0,1,0) (0,0,1)\nencoding: gzip\nendian: little\nspace origin: (0,0,0)\n\n"
+        << in.rdbuf();
+  }
+  for (const std::string name : {"extra.mha", "extra.nrrd", "extragz.nrrd"}) {
     const std::string error = readError(scratch(name));
     EXPECT_NE(error.find(name + ": 144 bytes of data, where the header announces 96"), std::string::npos) << error;
   }
