@@ -37,9 +37,10 @@ void requireMemoryFor(const LimitSurface& surface, const LimitOptions& options) 
   int largest = options.samplesPerFace;
   while (largest > 1 && !fits(largest)) --largest;
   throw UsageError(options.mesh, std::to_string(options.samplesPerFace) + " samples per face need about " +
-                                     gibibytes(needed(options.samplesPerFace)) + " for the surface and its writing, more than " +
-                                     memory.what + " (" + gibibytes(memory.bytes) + "): use at most " +
-                                     std::to_string(largest) + " samples per face");
+                                     gibibytes(needed(options.samplesPerFace)) +
+                                     " for the surface and its writing, more than " + memory.what + " (" +
+                                     gibibytes(memory.bytes) + "): use at most " + std::to_string(largest) +
+                                     " samples per face");
 }
 
 void runLimit(const LimitOptions& options) {

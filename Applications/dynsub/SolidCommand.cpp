@@ -70,8 +70,8 @@ void requireMemoryForLevels(const Lattice& lattice, int levels, const std::strin
   if (memory.bytes == 0 || fits(levels)) return;
   int largest = levels;
   while (largest > 0 && !fits(largest)) --largest;
-  throw UsageError(path, std::to_string(levels) + " levels need about " + gibibytes(needed(levels)) +
-                             ", more than " + memory.what + " (" + gibibytes(memory.bytes) + "): use at most --level " +
+  throw UsageError(path, std::to_string(levels) + " levels need about " + gibibytes(needed(levels)) + ", more than " +
+                             memory.what + " (" + gibibytes(memory.bytes) + "): use at most --level " +
                              std::to_string(largest));
 }
 

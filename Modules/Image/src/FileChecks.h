@@ -25,8 +25,7 @@ inline std::optional<std::uintmax_t> checkedProduct(std::uintmax_t a, std::uintm
 // contents announce; more than four times as much is refused rather than
 // allocated. Throws dynsub::Error naming the file when its stream is cut
 // short or corrupt.
-std::vector<unsigned char> inflateGzipFile(const std::string& path, std::uintmax_t expected,
-                                           std::uintmax_t start = 0);
+std::vector<unsigned char> inflateGzipFile(const std::string& path, std::uintmax_t expected, std::uintmax_t start = 0);
 
 // Throws dynsub::Error when an image of `voxels` voxels would not fit in this
 // machine's memory as float (a corrupt or hostile header), before anything

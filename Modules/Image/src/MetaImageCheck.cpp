@@ -161,8 +161,9 @@ void checkMetaImageFile(const std::string& path) {
     // Deflate inflates at most kLargestDeflateRatio-fold: a header that
     // announces more is refused before a buffer of its size is allocated.
     if (*voxelBytes / kLargestDeflateRatio > packed.size())
-      throw Error(source, "corrupt header: " + std::to_string(packed.size()) + " bytes of compressed data cannot hold the " +
-                              std::to_string(*voxelBytes) + " bytes it announces");
+      throw Error(source, "corrupt header: " + std::to_string(packed.size()) +
+                              " bytes of compressed data cannot hold the " + std::to_string(*voxelBytes) +
+                              " bytes it announces");
     const std::unique_ptr<libdeflate_decompressor, void (*)(libdeflate_decompressor*)> decompressor(
         libdeflate_alloc_decompressor(), &libdeflate_free_decompressor);
     if (!decompressor) throw std::bad_alloc();
@@ -171,12 +172,12 @@ void checkMetaImageFile(const std::string& path) {
     const auto result = libdeflate_zlib_decompress(decompressor.get(), packed.data(), packed.size(), voxels.data(),
                                                    voxels.size(), &inflated);
     if (result != LIBDEFLATE_SUCCESS || inflated != voxels.size())
-      throw Error(source, std::string("corrupt compressed data: it ") +
-                              (result == LIBDEFLATE_INSUFFICIENT_SPACE ? "inflates to more than"
-                               : result == LIBDEFLATE_SUCCESS          ? "inflates to " + std::to_string(inflated) +
-                                                                    " bytes, not"
-                                                                      : "is not a complete zlib stream of") +
-                              " the " + std::to_string(*voxelBytes) + " bytes the header announces");
+      throw Error(source,
+                  std::string("corrupt compressed data: it ") +
+                      (result == LIBDEFLATE_INSUFFICIENT_SPACE ? "inflates to more than"
+                       : result == LIBDEFLATE_SUCCESS ? "inflates to " + std::to_string(inflated) + " bytes, not"
+                                                      : "is not a complete zlib stream of") +
+                      " the " + std::to_string(*voxelBytes) + " bytes the header announces");
   }
 }
 

@@ -61,8 +61,9 @@ TEST(MeshCheck, RejectsBadFaces) {
   // square no area beside the whole's extent: said so, not "area is zero".
   MatrixX3 far = gridPoints(3, 2);
   far.row(5) << 0.0, 0.0, 1e6;
-  expectRejected(far, {{0, 1, 4, 3}, {1, 2, 5, 4}}, "face 0 is degenerate: its area, 1, is below 1e-12 of the square "
-                                                     "of the whole's extent, 1e+06: is a point far from the others");
+  expectRejected(far, {{0, 1, 4, 3}, {1, 2, 5, 4}},
+                 "face 0 is degenerate: its area, 1, is below 1e-12 of the square "
+                 "of the whole's extent, 1e+06: is a point far from the others");
 }
 
 TEST(MeshCheck, RejectsNonFiniteCoordinates) {

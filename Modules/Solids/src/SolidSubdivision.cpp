@@ -251,9 +251,8 @@ LatticeCounts refinedCounts(const Lattice& lattice, int levels) {
     cellEdges += lattice.cellEdges()[c].size();
     for (int p : lattice.cellPoints()[c]) {
       const auto& edges = lattice.cellEdges()[c];
-      ++corners[std::count_if(edges.begin(), edges.end(), [&](int e) {
-        return lattice.edges()[e][0] == p || lattice.edges()[e][1] == p;
-      })];
+      ++corners[std::count_if(edges.begin(), edges.end(),
+                              [&](int e) { return lattice.edges()[e][0] == p || lattice.edges()[e][1] == p; })];
     }
   }
   for (int level = 0; level < levels; ++level) {

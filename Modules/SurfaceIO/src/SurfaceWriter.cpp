@@ -119,11 +119,10 @@ void appendBinary(std::string& bytes, T value, ByteOrder order = ByteOrder::Litt
 void writePlyBytes(const TriangleSurface& surface, FileBlocks& file) {
   std::string& bytes = file.bytes;
   bytes = "ply\nformat binary_little_endian 1.0\ncomment written by DynSub\nelement vertex " +
-                      std::to_string(surface.points.rows()) +
-                      "\nproperty float x\nproperty float y\nproperty float z\n"
-                      "property float nx\nproperty float ny\nproperty float nz\nelement face " +
-                      std::to_string(surface.triangles.size()) +
-                      "\nproperty list uchar int vertex_indices\nend_header\n";
+          std::to_string(surface.points.rows()) +
+          "\nproperty float x\nproperty float y\nproperty float z\n"
+          "property float nx\nproperty float ny\nproperty float nz\nelement face " +
+          std::to_string(surface.triangles.size()) + "\nproperty list uchar int vertex_indices\nend_header\n";
   for (Eigen::Index i = 0; i < surface.points.rows(); ++i) {
     for (int a = 0; a < 3; ++a) appendBinary(bytes, static_cast<float>(surface.points(i, a)));
     for (int a = 0; a < 3; ++a) appendBinary(bytes, static_cast<float>(surface.normals(i, a)));
@@ -168,7 +167,7 @@ void writeLegacyVtkBytes(const TriangleSurface& surface, const std::vector<Point
   const std::size_t triangles = surface.triangles.size();
   std::string& bytes = file.bytes;
   bytes = "# vtk DataFile Version 4.2\nDynSub surface" + (space.empty() ? "" : " SPACE=" + space) +
-                      "\nBINARY\nDATASET POLYDATA\nPOINTS " + std::to_string(n) + " float\n";
+          "\nBINARY\nDATASET POLYDATA\nPOINTS " + std::to_string(n) + " float\n";
   for (Eigen::Index i = 0; i < n; ++i) {
     for (int a = 0; a < 3; ++a) appendBinary(bytes, static_cast<float>(surface.points(i, a)), ByteOrder::Big);
     file.spill();
