@@ -26,7 +26,7 @@ struct LimitOptions {
 // before any work, with the finest that would: a surface of billions of
 // triangles otherwise runs for minutes before the allocator fails. A tenth
 // is kept for what the estimate leaves out (the program, the allocator).
-void requireMemoryFor(const LimitSurface& surface, const LimitOptions& options) {
+void requireMemoryForSurface(const LimitSurface& surface, const LimitOptions& options) {
   const MemoryLimit memory = usableMemory();
   auto needed = [&](int n) {
     const TessellationSize size = tessellationSize(surface, n);
@@ -51,7 +51,7 @@ void runLimit(const LimitOptions& options) {
   // The option's value is at fault: a usage error.
   if (const std::string tooFine = tessellationTooFine(surface, options.samplesPerFace); !tooFine.empty())
     throw UsageError(options.mesh, tooFine);
-  requireMemoryFor(surface, options);
+  requireMemoryForSurface(surface, options);
   const TriangleSurface triangles = tessellate(surface, mesh.points(), options.samplesPerFace);
   writeTriangleSurface(triangles, options.out);
   int special = 0;
