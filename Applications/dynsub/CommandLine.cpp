@@ -53,7 +53,9 @@ CLI::Validator numberCheck(double low, bool lowIncluded, double high, bool whole
   return CLI::Validator(
       [low, lowIncluded, high, whole, range](std::string& text) -> std::string {
         double value = 0;
-        if (!parseNumber(text, value) || std::isnan(value)) return text + " is not a number";
+        // Decimal notation only: strtod also reads " 5", hexadecimal "0x10" and "0x1p3".
+        const bool decimal = !text.empty() && text.find_first_not_of("0123456789+-.eE") == std::string::npos;
+        if (!decimal || !parseNumber(text, value) || std::isnan(value)) return text + " is not a number";
         if (whole && !decimalWholeNumber(text)) return text + " is not a whole number (write it in digits, as 12)";
         const bool inside = std::isfinite(value) && (lowIncluded ? value >= low : value > low) && value <= high;
         return inside ? std::string() : text + " is not " + range;

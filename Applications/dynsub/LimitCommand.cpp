@@ -22,36 +22,25 @@ struct LimitOptions {
   int samplesPerFace = 8;
 };
 
-// A tessellation that would not fit in memory with its writing is refused
-// before any work, with the finest that would: a surface of billions of
-// triangles otherwise runs for minutes before the allocator fails. A tenth
-// is kept for what the estimate leaves out (the program, the allocator).
-void requireMemoryForSurface(const LimitSurface& surface, const LimitOptions& options) {
-  const MemoryLimit memory = usableMemory();
-  auto needed = [&](int n) {
-    const TessellationSize size = tessellationSize(surface, n);
-    return size.bytes + surfaceWriterBytes(options.out, size.samples, size.triangles);
-  };
-  auto fits = [&](int n) { return 1.1L * needed(n) <= memory.bytes; };
-  if (memory.bytes == 0 || fits(options.samplesPerFace)) return;
-  int largest = options.samplesPerFace;
-  while (largest > 1 && !fits(largest)) --largest;
-  throw UsageError(options.mesh, std::to_string(options.samplesPerFace) + " samples per face need about " +
-                                     gibibytes(needed(options.samplesPerFace)) +
-                                     " for the surface and its writing, more than " + memory.what + " (" +
-                                     gibibytes(memory.bytes) + "): use at most " + std::to_string(largest) +
-                                     " samples per face");
-}
-
 void runLimit(const LimitOptions& options) {
   requireTriangleSurfaceTarget(options.out);
   requireNotInput(options.out, options.mesh);
   const ControlMesh mesh = readControlMesh(options.mesh);
   const LimitSurface surface(mesh);
   // The option's value is at fault: a usage error.
+  // Refused before any work, the memory first (its finest size is the
+  // smaller on any machine of less than about 200 GB): a surface of billions
+  // of triangles otherwise runs for minutes before the allocator fails.
+  requireMemoryForSize(
+      options.samplesPerFace, 1,
+      [&](int n) {
+        const TessellationSize size = tessellationSize(surface, n);
+        return static_cast<long double>(size.bytes + surfaceWriterBytes(options.out, size.samples, size.triangles));
+      },
+      options.mesh, std::to_string(options.samplesPerFace) + " samples per face (the surface and its writing)",
+      "--samples-per-face");
   if (const std::string tooFine = tessellationTooFine(surface, options.samplesPerFace); !tooFine.empty())
     throw UsageError(options.mesh, tooFine);
-  requireMemoryForSurface(surface, options);
   const TriangleSurface triangles = tessellate(surface, mesh.points(), options.samplesPerFace);
   writeTriangleSurface(triangles, options.out);
   int special = 0;

@@ -58,23 +58,6 @@ Report countsReport(const LatticeCounts& counts) {
 
 Report countsReport(const Lattice& lattice) { return countsReport(refinedCounts(lattice, 0)); }
 
-// Refining `levels` times takes about 3 KiB a refined cell (peak resident
-// memory of `solid subdivide` on the three Table 1 lattices at levels 4 and
-// 5: 2.8-3.0 KiB), the cells growing eightfold a level. More than memory
-// holds is refused before any work, with the level that fits; a tenth is
-// kept for what the estimate leaves out.
-void requireMemoryForLevels(const Lattice& lattice, int levels, const std::string& path) {
-  const MemoryLimit memory = usableMemory();
-  auto needed = [&](int level) { return 3.0L * 1024 * refinedCounts(lattice, level).cells; };
-  auto fits = [&](int level) { return 1.1L * needed(level) <= memory.bytes; };
-  if (memory.bytes == 0 || fits(levels)) return;
-  int largest = levels;
-  while (largest > 0 && !fits(largest)) --largest;
-  throw UsageError(path, std::to_string(levels) + " levels need about " + gibibytes(needed(levels)) + ", more than " +
-                             memory.what + " (" + gibibytes(memory.bytes) + "): use at most --level " +
-                             std::to_string(largest));
-}
-
 // DIR/sculpted.lattice (the control lattice, to sculpt on later),
 // DIR/sculpted.vtu (the subdivided solid where the mass points are),
 // DIR/sculpted.png (SolidView's figure, with a display) and DIR/report.json,
@@ -185,7 +168,12 @@ void addSolidCommand(CLI::App& app) {
     requireLatticeTarget(o->out);
     requireNotInput(o->out, o->lattice);
     const Lattice control = readLattice(o->lattice);
-    requireMemoryForLevels(control, o->level, o->lattice);
+    // A refined cell takes up to 3.4 KiB at its peak (`solid subdivide` of
+    // the three Table 1 lattices and of prisms and pyramids at levels 4 and
+    // 5: 2.75-3.4 KiB), and the cells grow eightfold a level.
+    requireMemoryForSize(
+        o->level, 0, [&](int level) { return 3.5L * 1024 * refinedCounts(control, level).cells; }, o->lattice,
+        std::to_string(o->level) + " levels", "--level");
     const Lattice lattice = subdivideSolid(control, o->level).lattice;
     writeLattice(lattice, o->out);
     std::cout << "wrote " << o->out << ": " << lattice.pointCount() << " points, " << lattice.cellCount()

@@ -81,16 +81,17 @@ void addSubjectCommand(CLI::App& app) {
       "and subject.json (what was drawn).");
   command->add_option("IMAGE", arguments->image, "The source image (NIfTI, NRRD, MetaImage or DICOM)")->required();
   command->add_option("LABELS", arguments->labels, "Its label map (integer labels, any grid)")->required();
-  // Digits only, and at most 2^64-1: the unsigned reader takes "-1" as
-  // 2^64-1 and a longer number as 2^64-1 too, other seeds than the one given.
+  // Digits only, without a leading 0, and at most 2^64-1: the unsigned
+  // reader takes "-1" and a longer number as 2^64-1, and "010" as octal 8,
+  // other seeds than the one given.
   command->add_option("--seed", arguments->seed, "The subject's seed (a whole number, 0 to 2^64-1)")
       ->default_val(1)
       ->check([](const std::string& text) {
-        const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+        const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos &&
+                            (text.size() == 1 || text[0] != '0');
         const std::string largest = std::to_string(std::numeric_limits<std::uint64_t>::max());
-        const std::string number = digits ? text.substr(std::min(text.find_first_not_of('0'), text.size() - 1)) : "";
-        const bool fits = digits && (number.size() < largest.size() ||
-                                     (number.size() == largest.size() && number <= largest));
+        const bool fits = digits && (text.size() < largest.size() ||
+                                     (text.size() == largest.size() && text <= largest));
         return fits ? std::string() : "expected a whole number from 0 to " + largest + ", got '" + text + "'";
       });
   command->add_option("--set", arguments->settings,

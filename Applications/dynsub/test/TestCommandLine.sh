@@ -42,15 +42,17 @@ expect_error "missing output directory" 1 "does not exist" "$work/no/f.vtp" \
 expect_error "impossible sample count" 2 "samples-per-face" "$work/g.vtp" \
   "$DYNSUB" limit "$DATA/Meshes/cube.obj" --samples-per-face 0 --out "$work/g.vtp"
 # 1024 samples per face on the kitten's 3088 elements would be 6.5e9
-# triangles: refused before any is made, with the largest count that fits.
-expect_error "more triangles than a surface can number" 2 "use at most 589 samples per face" "$work/g2.vtp" \
+# triangles, 660 GiB: refused before any is made, with the largest count
+# that fits.
+expect_error "more triangles than memory holds" 2 "use at most --samples-per-face" "$work/g2.vtp" \
   "$DYNSUB" limit "$DATA/Meshes/kitten_genus1.obj" --samples-per-face 1024 --out "$work/g2.vtp"
 # A surface that would not fit in memory (here 700 MB of address space) is
 # refused before any work, with the finest that fits; that one is written.
-expect_error "a surface larger than memory" 2 "samples per face need about .* GiB" "$work/g5.vtp" \
+expect_error "a surface larger than memory" 2 "samples per face (the surface and its writing) need about .* GiB" \
+  "$work/g5.vtp" \
   bash -c 'ulimit -v 700000 && exec "$0" "$@"' "$DYNSUB" limit "$DATA/Meshes/cube.obj" --samples-per-face 1024 \
   --out "$work/g5.vtp"
-finest=$(sed -n 's/.*use at most \([0-9]*\) samples per face.*/\1/p' "$work/stderr")
+finest=$(sed -n 's/.*use at most --samples-per-face \([0-9]*\).*/\1/p' "$work/stderr")
 check "the finest surface said to fit ($finest) is written under the same limit" \
   bash -c 'ulimit -v 700000 && exec "$0" "$@"' "$DYNSUB" limit "$DATA/Meshes/cube.obj" --samples-per-face "$finest" \
   --out "$work/g5.vtp"
@@ -140,6 +142,8 @@ expect_error "too few points" 1 "at least 4" "$work/o1" "$DYNSUB" fit "$work/thr
 # springs that outweigh the data, a noise wider than the scan.
 expect_error "fit: a tolerance of more than 100 %" 2 "tolerance: 1e9 is not a finite number > 0 and <= 100" \
   "$work/o1" "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --tolerance 1e9 --out "$work/o1"
+expect_error "fit: a hexadecimal tolerance" 2 "tolerance: 0x1p3 is not a number" \
+  "$work/o1" "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --tolerance 0x1p3 --out "$work/o1"
 expect_error "fit: surface springs past 100" 2 "surface-springs: 1e30 is not" "$work/o1" \
   "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --surface-springs 1e30 --out "$work/o1"
 expect_error "fit: a noise wider than the scan" 2 "--noise 1e9: more than the whole scan" "$work/o1" \
@@ -840,6 +844,8 @@ expect_error "subject: a negative seed" 2 "--seed: expected a whole number from 
   "$work/s45" "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --seed -1 --out "$work/s45"
 expect_error "subject: a seed past 2^64-1" 2 "got '99999999999999999999'" "$work/s45" \
   "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --seed 99999999999999999999 --out "$work/s45"
+expect_error "subject: a seed with a leading 0 (read as octal)" 2 "got '010'" "$work/s45" \
+  "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --seed 010 --out "$work/s45"
 
 # The atlas start on that subject: Colin27 and AAL registered to it, the left
 # putamen carried there by name, with a click inside it.

@@ -5,6 +5,8 @@
 
 #include <cstdio>
 
+#include "dynsub/Error.h"
+
 namespace dynsub {
 
 MemoryLimit usableMemory() {
@@ -36,6 +38,21 @@ std::string gibibytes(long double bytes) {
   char text[32];
   std::snprintf(text, sizeof text, "%.1Lf GiB", bytes / (1u << 30));
   return text;
+}
+
+void requireMemoryForSize(int size, int smallest, const std::function<long double(int)>& estimate,
+                          const std::string& path, const std::string& what, const std::string& option) {
+  const MemoryLimit memory = usableMemory();
+  const auto needed = [&](int n) { return 1.1L * estimate(n) + 160.0L * (1 << 20); };
+  if (memory.bytes == 0 || needed(size) <= memory.bytes) return;
+  int largest = size;
+  while (largest > smallest && needed(largest) > memory.bytes) --largest;
+  const std::string advice =
+      needed(largest) <= memory.bytes
+          ? "use at most " + option + " " + std::to_string(largest)
+          : "even " + option + " " + std::to_string(smallest) + " needs about " + gibibytes(needed(smallest));
+  throw UsageError(path, what + " need about " + gibibytes(needed(size)) + ", more than " + memory.what + " (" +
+                             gibibytes(memory.bytes) + "): " + advice);
 }
 
 }  // namespace dynsub

@@ -235,11 +235,21 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
       plan.atlasImage = resolve(textOf(required(atlas, "image", "the atlas"), "the atlas's image"), base);
       plan.atlasLabels = resolve(textOf(required(atlas, "labels", "the atlas"), "the atlas's labels"), base);
     }
-    // Where each subject was drawn: a seed draws the same anatomy from the
-    // same image and labels whatever the other settings, so it may serve one
-    // split only, across cohorts too (the versions of one subject in several
-    // cohorts, at 1 mm and in thick slices say, stay in one split).
-    std::map<std::tuple<std::string, std::string, std::uint64_t>, std::pair<std::string, std::string>> drawnIn;
+    // Where each subject was drawn. A seed draws the same anatomy whatever
+    // the other settings, so from the same image or the same labels (one
+    // file, by whatever path) it serves one split only, across cohorts too;
+    // the versions of one subject in several cohorts (at 1 mm and in thick
+    // slices, say) stay in one split.
+    struct Drawn {
+      std::string cohort, split, image, labels;
+      std::uint64_t seed;
+    };
+    std::vector<Drawn> drawn;
+    const auto sameFile = [](const std::string& a, const std::string& b) {
+      std::error_code error;
+      const bool same = std::filesystem::equivalent(a, b, error);
+      return error ? std::filesystem::weakly_canonical(a, error) == std::filesystem::weakly_canonical(b, error) : same;
+    };
     for (const auto& c : optionalList(j, "cohorts", "the plan's ")) {
       const std::string name = textOf(required(c, "name", "a cohort"), "a cohort's name");
       const std::string where = "cohort '" + name + "'";
@@ -264,15 +274,22 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
         std::vector<std::uint64_t> list;
         for (const auto& seed : listOf(seeds, where + ": split '" + split + "'")) {
           list.push_back(static_cast<std::uint64_t>(wholeNumber(seed, where + ": a subject", 0, kLargestSetting)));
-          const auto [earlier, first] = drawnIn.try_emplace({cohort.image, cohort.labels, list.back()}, name, split);
-          if (first || (earlier->second.second == split && earlier->second.first != name)) continue;
           const std::string subject = "subject " + std::to_string(list.back());
-          if (earlier->second.first == name)
-            throw Error(path, where + ": " + subject + " is in two splits (tuning and test subjects must be disjoint)");
-          throw Error(path, where + ": " + subject + " is in split '" + split + "', and cohort '" +
-                                earlier->second.first + "' draws it from the same image and labels in split '" +
-                                earlier->second.second + "': a seed draws the same anatomy, so tuning and test " +
-                                "subjects would not be disjoint");
+          for (const Drawn& earlier : drawn) {
+            if (earlier.seed != list.back()) continue;
+            if (earlier.cohort == name)
+              throw Error(path, where + ": " + subject + " is listed twice" +
+                                    (earlier.split == split ? " in split '" + split + "'"
+                                                            : " (in splits '" + earlier.split + "' and '" + split +
+                                                                  "': tuning and test subjects must be disjoint)"));
+            const bool image = sameFile(earlier.image, cohort.image), labels = sameFile(earlier.labels, cohort.labels);
+            if (earlier.split != split && (image || labels))
+              throw Error(path, where + ": " + subject + " is in split '" + split + "', and cohort '" +
+                                    earlier.cohort + "' draws it from the same " + (image ? "image" : "labels") +
+                                    " in split '" + earlier.split + "': a seed draws the same anatomy, so tuning and " +
+                                    "test subjects would not be disjoint");
+          }
+          drawn.push_back({name, split, cohort.image, cohort.labels, list.back()});
         }
         if (list.empty()) throw Error(path, where + ": split '" + split + "' has no subjects");
         cohort.subjects.emplace_back(split, list);

@@ -155,19 +155,24 @@ TEST(EvaluationPlan, CohortsTakeSettingsAndSubjectsPerSplit) {
 
 TEST(EvaluationPlan, CohortsWithSharedSubjectsUnknownSplitsOrBadSettingsAreRefused) {
   const std::string start = R"({"name": "noisy", "image": "ch2.nii.gz", "labels": "aal.nii.gz", )";
-  EXPECT_NE(cohortError(start + R"("subjects": {"tuning": [1, 2], "test": [2]}})").find("subject 2 is in two splits"),
+  EXPECT_NE(cohortError(start + R"("subjects": {"tuning": [1, 2], "test": [2]}})").find("subject 2 is listed twice (in splits 't"),
             std::string::npos);
-  // Across cohorts: a seed draws the same anatomy from the same image and
-  // labels, so it stays in one split; another image's subject 2 is another.
-  const std::string thick = R"(, {"name": "thick", "image": "ch2.nii.gz", "labels": "aal.nii.gz",
+  // Across cohorts: a seed draws the same anatomy from the same image or
+  // labels (by whatever path), so it stays in one split; another image's
+  // and labels' subject 2 is another.
+  const std::string thick = R"(, {"name": "thick", "image": "./ch2.nii.gz", "labels": "aal.nii.gz",
       "settings": {"thick_fraction": 1}, )";
   const std::string tuning = start + R"("subjects": {"tuning": [1, 2]}})";
   EXPECT_NE(cohortError(tuning + thick + R"("subjects": {"test": [2]}})")
                 .find("cohort 'thick': subject 2 is in split 'test', and cohort 'noisy' draws it from the same image "
-                      "and labels in split 'tuning'"),
+                      "in split 'tuning'"),
             std::string::npos);
   EXPECT_EQ(cohortError(tuning + thick + R"("subjects": {"tuning": [2]}})"), "");
-  EXPECT_EQ(cohortError(tuning + R"(, {"name": "other", "image": "t2.nii.gz", "labels": "aal.nii.gz",
+  EXPECT_NE(cohortError(tuning + R"(, {"name": "other", "image": "t2.nii.gz", "labels": "x/../aal.nii.gz",
+      "subjects": {"test": [2]}})")
+                .find("draws it from the same labels in split 'tuning'"),
+            std::string::npos);
+  EXPECT_EQ(cohortError(tuning + R"(, {"name": "other", "image": "t2.nii.gz", "labels": "hammers.nii.gz",
       "subjects": {"test": [2]}})"),
             "");
   EXPECT_NE(cohortError(start + R"("subjects": {"training": [1]}})").find("unknown split 'training'"),

@@ -50,6 +50,24 @@ TEST(Tessellation, CountsAndBounds) {
   EXPECT_EQ(t.points.rows(), 32 * 4 * 4);  // a closed quad grid: one sample per square
   EXPECT_THROW(dynsub::tessellate(surface, torus.points(), 0), dynsub::Error);
   EXPECT_THROW(dynsub::tessellate(surface, torus.points(), 1025), dynsub::Error);
+  // The size estimate agrees with what is made: each sample's point and
+  // normal and a flag, each triangle's corners, element and type.
+  const dynsub::TessellationSize size = dynsub::tessellationSize(surface, 4);
+  EXPECT_EQ(size.samples, static_cast<std::uint64_t>(t.points.rows()));
+  EXPECT_EQ(size.triangles, t.triangles.size());
+  EXPECT_EQ(size.bytes, size.samples * 49 + size.triangles * 20);
+}
+
+// Past 2^31 - 1 triangles the samples and triangles cannot be numbered:
+// refused with the largest count that fits (on 32 elements, 5792 would make
+// 2,147,024,896 triangles and 5793 2,147,766,336).
+TEST(Tessellation, GridsPastWhatIntCanNumberAreRefused) {
+  const dynsub::ControlMesh torus = dynsub::testing::makeBumpyTorus();
+  const dynsub::LimitSurface surface(torus);
+  EXPECT_EQ(dynsub::tessellationTooFine(surface, 5792), "");
+  EXPECT_EQ(dynsub::tessellationTooFine(surface, 5793),
+            "5793 samples per face on 32 elements make 2147766336 triangles, more than one surface can number "
+            "(2^31 - 1): use at most 5792 samples per face");
 }
 
 }  // namespace
