@@ -90,8 +90,8 @@ void addSubjectCommand(CLI::App& app) {
         const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos &&
                             (text.size() == 1 || text[0] != '0');
         const std::string largest = std::to_string(std::numeric_limits<std::uint64_t>::max());
-        const bool fits = digits && (text.size() < largest.size() ||
-                                     (text.size() == largest.size() && text <= largest));
+        const bool fits =
+            digits && (text.size() < largest.size() || (text.size() == largest.size() && text <= largest));
         return fits ? std::string() : "expected a whole number from 0 to " + largest + ", got '" + text + "'";
       });
   command->add_option("--set", arguments->settings,

@@ -47,10 +47,9 @@ void requireMemoryForSize(int size, int smallest, const std::function<long doubl
   if (memory.bytes == 0 || needed(size) <= memory.bytes) return;
   int largest = size;
   while (largest > smallest && needed(largest) > memory.bytes) --largest;
-  const std::string advice =
-      needed(largest) <= memory.bytes
-          ? "use at most " + option + " " + std::to_string(largest)
-          : "even " + option + " " + std::to_string(smallest) + " needs about " + gibibytes(needed(smallest));
+  const std::string advice = needed(largest) <= memory.bytes ? "use at most " + option + " " + std::to_string(largest)
+                                                             : "even " + option + " " + std::to_string(smallest) +
+                                                                   " needs about " + gibibytes(needed(smallest));
   throw UsageError(path, what + " need about " + gibibytes(needed(size)) + ", more than " + memory.what + " (" +
                              gibibytes(memory.bytes) + "): " + advice);
 }

@@ -284,9 +284,9 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
                                                                   "': tuning and test subjects must be disjoint)"));
             const bool image = sameFile(earlier.image, cohort.image), labels = sameFile(earlier.labels, cohort.labels);
             if (earlier.split != split && (image || labels))
-              throw Error(path, where + ": " + subject + " is in split '" + split + "', and cohort '" +
-                                    earlier.cohort + "' draws it from the same " + (image ? "image" : "labels") +
-                                    " in split '" + earlier.split + "': a seed draws the same anatomy, so tuning and " +
+              throw Error(path, where + ": " + subject + " is in split '" + split + "', and cohort '" + earlier.cohort +
+                                    "' draws it from the same " + (image ? "image" : "labels") + " in split '" +
+                                    earlier.split + "': a seed draws the same anatomy, so tuning and " +
                                     "test subjects would not be disjoint");
           }
           drawn.push_back({name, split, cohort.image, cohort.labels, list.back()});

@@ -155,7 +155,8 @@ TEST(EvaluationPlan, CohortsTakeSettingsAndSubjectsPerSplit) {
 
 TEST(EvaluationPlan, CohortsWithSharedSubjectsUnknownSplitsOrBadSettingsAreRefused) {
   const std::string start = R"({"name": "noisy", "image": "ch2.nii.gz", "labels": "aal.nii.gz", )";
-  EXPECT_NE(cohortError(start + R"("subjects": {"tuning": [1, 2], "test": [2]}})").find("subject 2 is listed twice (in splits 't"),
+  EXPECT_NE(cohortError(start + R"("subjects": {"tuning": [1, 2], "test": [2]}})")
+                .find("subject 2 is listed twice (in splits 't"),
             std::string::npos);
   // Across cohorts: a seed draws the same anatomy from the same image or
   // labels (by whatever path), so it stays in one split; another image's
