@@ -27,7 +27,6 @@ void runLimit(const LimitOptions& options) {
   requireNotInput(options.out, options.mesh);
   const ControlMesh mesh = readControlMesh(options.mesh);
   const LimitSurface surface(mesh);
-  // The option's value is at fault: a usage error.
   // Refused before any work, the memory first (its finest size is the
   // smaller on any machine of less than about 200 GB): a surface of billions
   // of triangles otherwise runs for minutes before the allocator fails.
@@ -39,6 +38,7 @@ void runLimit(const LimitOptions& options) {
       },
       options.mesh, std::to_string(options.samplesPerFace) + " samples per face (the surface and its writing)",
       "--samples-per-face");
+  // The option's value is at fault: a usage error.
   if (const std::string tooFine = tessellationTooFine(surface, options.samplesPerFace); !tooFine.empty())
     throw UsageError(options.mesh, tooFine);
   const TriangleSurface triangles = tessellate(surface, mesh.points(), options.samplesPerFace);

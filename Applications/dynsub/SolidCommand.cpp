@@ -56,7 +56,12 @@ Report countsReport(const LatticeCounts& counts) {
   return r;
 }
 
-Report countsReport(const Lattice& lattice) { return countsReport(refinedCounts(lattice, 0)); }
+Report countsReport(const Lattice& lattice) {
+  return countsReport(LatticeCounts{static_cast<std::uint64_t>(lattice.pointCount()),
+                                    static_cast<std::uint64_t>(lattice.edgeCount()),
+                                    static_cast<std::uint64_t>(lattice.faceCount()),
+                                    static_cast<std::uint64_t>(lattice.cellCount())});
+}
 
 // DIR/sculpted.lattice (the control lattice, to sculpt on later),
 // DIR/sculpted.vtu (the subdivided solid where the mass points are),

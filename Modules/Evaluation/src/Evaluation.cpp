@@ -9,7 +9,6 @@
 #include <map>
 #include <mutex>
 #include <set>
-#include <tuple>
 #include <thread>
 
 #include <nlohmann/json.hpp>

@@ -19,10 +19,10 @@ std::string tessellationTooFine(const LimitSurface& surface, int segmentsPerElem
   // Samples and triangles are numbered by int, as in the surface files'
   // indices: a finer grid than that holds is refused rather than wrapped.
   const int elements = surface.baseTopology().faceCount();
-  const std::int64_t n = segmentsPerElement, triangles = 2 * elements * n * n;
-  if (triangles <= std::numeric_limits<int>::max()) return "";
+  const std::uint64_t triangles = tessellationSize(surface, segmentsPerElement).triangles;
+  if (triangles <= static_cast<std::uint64_t>(std::numeric_limits<int>::max())) return "";
   const int largest = static_cast<int>(std::sqrt(std::numeric_limits<int>::max() / (2.0 * elements)));
-  return std::to_string(n) + " samples per face on " + std::to_string(elements) + " elements make " +
+  return std::to_string(segmentsPerElement) + " samples per face on " + std::to_string(elements) + " elements make " +
          std::to_string(triangles) + " triangles, more than one surface can number (2^31 - 1): use at most " +
          std::to_string(largest) + " samples per face";
 }
@@ -80,7 +80,7 @@ TriangleSurface tessellate(const LimitSurface& surface, const MatrixX3& controlP
   result.points.setZero(sampleCount, 3);
   result.normals.setZero(sampleCount, 3);
   std::vector<char> done(sampleCount, 0);
-  const std::size_t triangleCount = 2 * static_cast<std::size_t>(base.faceCount()) * n * n;
+  const std::size_t triangleCount = tessellationSize(surface, n).triangles;
   result.triangles.reserve(triangleCount);
   result.triangleElement.reserve(triangleCount);
   result.triangleType.reserve(triangleCount);
