@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <iomanip>
 #include <sstream>
 #include <variant>
@@ -38,7 +39,7 @@ std::string shortNumber(double value) {
   return full.str().size() <= 7 ? full.str() : brief.str();
 }
 
-// The one check behind every numeric option: `text` read by parseNumber,
+// The one check behind every numeric option: `text` read by strtod,
 // then held to [low, high] (or (low, high] when `lowIncluded` is false), and
 // to decimal digits when `whole`.
 CLI::Validator numberCheck(double low, bool lowIncluded, double high, bool whole) {
@@ -52,13 +53,17 @@ CLI::Validator numberCheck(double low, bool lowIncluded, double high, bool whole
                                                  : (lowIncluded ? ">=" : ">") + shortNumber(low));
   return CLI::Validator(
       [low, lowIncluded, high, whole, range](std::string& text) -> std::string {
-        double value = 0;
+        const std::string quoted = "'" + text + "'";
         // Decimal notation only: strtod also reads " 5", hexadecimal "0x10" and "0x1p3".
         const bool decimal = !text.empty() && text.find_first_not_of("0123456789+-.eE") == std::string::npos;
-        if (!decimal || !parseNumber(text, value) || std::isnan(value)) return text + " is not a number";
-        if (whole && !decimalWholeNumber(text)) return text + " is not a whole number (write it in digits, as 12)";
+        char* end = nullptr;
+        // A number too small for a double (1e-999) is read as strtod rounds it (0);
+        // one too large (1e999) as infinite, which no range holds.
+        const double value = decimal ? std::strtod(text.c_str(), &end) : 0.0;
+        if (!decimal || *end != '\0' || std::isnan(value)) return quoted + " is not a number";
+        if (whole && !decimalWholeNumber(text)) return quoted + " is not a whole number (write it in digits, as 12)";
         const bool inside = std::isfinite(value) && (lowIncluded ? value >= low : value > low) && value <= high;
-        return inside ? std::string() : text + " is not " + range;
+        return inside ? std::string() : quoted + " is not " + range;
       },
       shown);
 }

@@ -104,7 +104,7 @@ expect_failure "three points" 2 "--seed: 3 landmarks are too few" --seed 1,2,3 -
   --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
 expect_failure "no points" 2 "no landmarks to build the initial model from" --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
 expect_failure "malformed point" 2 "expected x,y,z" --seed 1,2 --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
-expect_failure "a word for the label value" 2 "labelValue: abc is not a number" --labelValue abc --seed 1,2,3 \
+expect_failure "a word for the label value" 2 "labelValue: 'abc' is not a number" --labelValue abc --seed 1,2,3 \
   --labelmap "$work/bad.nrrd" "$work/ch2.nrrd"
 expect_failure "a point with a coordinate missing" 2 "expected x,y,z" --seed 17.5,,21,21 --labelmap "$work/bad.nrrd" \
   "$work/ch2.nrrd"

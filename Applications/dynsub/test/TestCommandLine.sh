@@ -74,9 +74,9 @@ check "solid stats counts level 6 within the same limit" bash -c 'ulimit -v 2000
 expect_error "out of memory" 1 "out of memory" "$work/g3" \
   bash -c 'ulimit -v 1000000 && exec "$0" "$@"' "$DYNSUB" solid sculpt "$DATA/Solids/cube4.lattice" \
   --script "$DATA/Solids/arm.sculpt" --level 4 --no-figures --out "$work/g3"
-expect_error "a word for a count" 2 "samples-per-face: abc is not a number" "$work/g4.vtp" \
+expect_error "a word for a count" 2 "samples-per-face: 'abc' is not a number" "$work/g4.vtp" \
   "$DYNSUB" limit "$DATA/Meshes/cube.obj" --samples-per-face abc --out "$work/g4.vtp"
-expect_error "a fraction for a count" 2 "samples-per-face: 2.5 is not a whole number" "$work/g4.vtp" \
+expect_error "a fraction for a count" 2 "samples-per-face: '2.5' is not a whole number" "$work/g4.vtp" \
   "$DYNSUB" limit "$DATA/Meshes/cube.obj" --samples-per-face 2.5 --out "$work/g4.vtp"
 expect_error "unknown standard mesh" 2 "NAME" "$work/h.obj" "$DYNSUB" mesh sphere --out "$work/h.obj"
 expect_error "a standard mesh under another extension" 2 "c.off: the control mesh is written as OBJ" "$work/c.off" \
@@ -140,15 +140,19 @@ printf '1 2 3\n4 5 6\n7 8 9.5\n' >"$work/three.xyz"
 expect_error "too few points" 1 "at least 4" "$work/o1" "$DYNSUB" fit "$work/three.xyz" --out "$work/o1"
 # Values no fit can mean: a tolerance past the whole diameter, surface
 # springs that outweigh the data, a noise wider than the scan.
-expect_error "fit: a tolerance of more than 100 %" 2 "tolerance: 1e9 is not a finite number > 0 and <= 100" \
+expect_error "fit: a tolerance of more than 100 %" 2 "tolerance: '1e9' is not a finite number > 0 and <= 100" \
   "$work/o1" "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --tolerance 1e9 --out "$work/o1"
-expect_error "fit: a hexadecimal tolerance" 2 "tolerance: 0x1p3 is not a number" \
+expect_error "fit: a hexadecimal tolerance" 2 "tolerance: '0x1p3' is not a number" \
   "$work/o1" "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --tolerance 0x1p3 --out "$work/o1"
-expect_error "fit: surface springs past 100" 2 "surface-springs: 1e30 is not" "$work/o1" \
+expect_error "fit: a tolerance too large for a double" 2 "tolerance: '1e999' is not a finite number > 0" \
+  "$work/o1" "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --tolerance 1e999 --out "$work/o1"
+expect_error "fit: an empty tolerance" 2 "tolerance: '' is not a number" \
+  "$work/o1" "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --tolerance "" --out "$work/o1"
+expect_error "fit: surface springs past 100" 2 "surface-springs: '1e30' is not" "$work/o1" \
   "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --surface-springs 1e30 --out "$work/o1"
 expect_error "fit: a noise wider than the scan" 2 "--noise 1e9: more than the whole scan" "$work/o1" \
   "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --noise 1e9 --out "$work/o1"
-expect_error "fit: a NaN figure resolution" 2 "figure-dpi: nan is not a number" "$work/o1" \
+expect_error "fit: a NaN figure resolution" 2 "figure-dpi: 'nan' is not a number" "$work/o1" \
   "$DYNSUB" fit "$DATA/PointClouds/torus.xyz" --figure-dpi nan --out "$work/o1"
 printf '0 0 0\n1 0 0\n0 1 0\n0 0 nan\n1 1 1\n' >"$work/nan.xyz"
 expect_error "NaN coordinate" 1 "nan.xyz" "$work/o2" "$DYNSUB" fit "$work/nan.xyz" --out "$work/o2"
@@ -204,7 +208,7 @@ expect_error "open initial model" 1 "closed" "$work/o6" \
 expect_error "missing point cloud" 1 "no such file" "$work/o7" "$DYNSUB" fit "$work/none.xyz" --out "$work/o7"
 printf 'x y z\n' >"$work/words.xyz"
 expect_error "malformed point cloud" 1 "line 1" "$work/o8" "$DYNSUB" fit "$work/words.xyz" --out "$work/o8"
-expect_error "impossible tolerance" 2 "tolerance: -1 is not a finite number > 0" "$work/o9" \
+expect_error "impossible tolerance" 2 "tolerance: '-1' is not a finite number > 0" "$work/o9" \
   "$DYNSUB" fit "$work/sphere.xyz" --tolerance -1 --out "$work/o9"
 expect_error "negative springs per element" 2 "springs-per-element" "$work/o9b" \
   "$DYNSUB" fit "$work/sphere.xyz" --springs-per-element -1 --out "$work/o9b"
@@ -266,7 +270,7 @@ expect_error "deform: a spring stiffer than 1e12 N/mm" 1 "stiff.springs: line 1:
 printf '2 0 0\n1e10 0 0\n' >"$work/far.springs"
 expect_error "deform: a spring's point beyond 1e9 mm" 1 "far.springs: line 2: the spring's point" \
   "$work/hat1" "$DYNSUB" deform "$DATA/Meshes/torus.obj" --springs "$work/far.springs" --out "$work/hat1"
-expect_error "deform: --stiffness above 1e12" 2 "--stiffness: 1e16 is not a finite number > 0 and <= 1e+12" \
+expect_error "deform: --stiffness above 1e12" 2 "--stiffness: '1e16' is not a finite number > 0 and <= 1e+12" \
   "$work/hat1" "$DYNSUB" deform "$DATA/Meshes/torus.obj" --springs "$work/far.springs" --stiffness 1e16 \
   --out "$work/hat1"
 # Refined twice near the crown, the brim still stays: every point within
@@ -646,7 +650,7 @@ expect_error "a result of no voxel" 1 "speck.csv: the result encloses no voxel o
 expect_error "negative end pressure" 2 "end-pressure" "$work/s13" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --end-pressure -0.1 \
   --out "$work/s13"
-expect_error "NaN edge threshold" 2 "--edge-low: nan is not a number" "$work/s9" \
+expect_error "NaN edge threshold" 2 "--edge-low: 'nan' is not a number" "$work/s9" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --edge-low nan \
   --out "$work/s9"
 expect_error "edge thresholds the wrong way round" 2 "edge_low (--edge-low) is 5 and edge_high (--edge-high) 1" "$work/s9b" \
@@ -720,9 +724,9 @@ expect_error "unknown landmark format" 1 "unknown landmark format" "$work/s3" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/points.txt" --out "$work/s3"
 expect_error "init outside the image" 1 "outside the image" "$work/s4" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:900,0,0,10 --out "$work/s4"
-expect_error "NaN image force" 2 "image-force: nan is not a number" "$work/s5" \
+expect_error "NaN image force" 2 "image-force: 'nan' is not a number" "$work/s5" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:-10,10,10,5 --image-force nan --out "$work/s5"
-expect_error "negative landmark tolerance" 2 "landmark-tolerance: -1 is not between 0 and" "$work/s8" \
+expect_error "negative landmark tolerance" 2 "landmark-tolerance: '-1' is not between 0 and" "$work/s8" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:-10,10,10,5 --landmark-tolerance -1 --out "$work/s8"
 expect_error "reference label absent" 1 "no voxel" "$work/s6" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --init sphere:-10,10,10,5 --reference "$mri/aal.nii.gz" \
@@ -784,7 +788,7 @@ expect_error "solid sculpt: --out is a file" 1 "exists and is not a directory" "
 check "solid sculpt: --out is a file, and no action ran" test ! -s "$work/stdout"
 expect_error "solid sculpt: --script without --out" 2 "--out DIR is required" "$work/sculpted" \
   "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" --script "$DATA/Solids/arm.sculpt"
-expect_error "solid sculpt: NaN stiffness" 2 "--stiffness: nan is not a number" "$work/s33" \
+expect_error "solid sculpt: NaN stiffness" 2 "--stiffness: 'nan' is not a number" "$work/s33" \
   "$DYNSUB" solid sculpt "$DATA/Solids/cube3.lattice" --script "$DATA/Solids/arm.sculpt" --stiffness nan \
   --out "$work/s33"
 expect_error "solid sculpt: a bad lattice" 1 "uses point 99" "$work/s34" \
