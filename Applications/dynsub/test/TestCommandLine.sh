@@ -201,7 +201,7 @@ expect_error "deform's input in a structure folder the run removes" 2 "an earlie
 check "deform's input in that folder is left" cmp -s "$DATA/Meshes/cube.obj" "$work/earlier/caudate/control_mesh.obj"
 # A vertex whose areas overflow: named as such, not as a degenerate face.
 printf 'v 0 0 0\nv 1e300 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\n' >"$work/far.obj"
-expect_error "a vertex beyond 1e9 mm" 1 "far.obj: vertex 1 (1e+300, 0, 0) lies beyond" "$work/o5b.vtp" \
+expect_error "a vertex beyond 1e9 mm" 1 "far.obj: vertex 2 (1e+300, 0, 0) lies beyond" "$work/o5b.vtp" \
   "$DYNSUB" limit "$work/far.obj" --out "$work/o5b.vtp"
 expect_error "open initial model" 1 "closed" "$work/o6" \
   "$DYNSUB" fit "$work/sphere.xyz" --init "$DATA/Meshes/sheet.obj" --out "$work/o6"

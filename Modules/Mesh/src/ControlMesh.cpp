@@ -11,8 +11,8 @@ namespace dynsub {
 ControlMesh::ControlMesh() : topology_(std::make_shared<const Topology>()) {}
 
 ControlMesh ControlMesh::fromPolygons(const MatrixX3& points, const std::vector<Polygon>& faces,
-                                      const std::string& source) {
-  checkPolygonMesh(points, faces, source);
+                                      const std::string& source, int firstNumber) {
+  checkPolygonMesh(points, faces, source, firstNumber);
   ControlMesh mesh;
   mesh.points_ = points;
   mesh.topology_ = std::make_shared<const Topology>(static_cast<int>(points.rows()), faces);

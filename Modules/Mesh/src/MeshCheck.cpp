@@ -16,10 +16,6 @@ namespace dynsub {
 
 namespace {
 
-std::string edgeName(int a, int b) {
-  return "(" + std::to_string(a) + ", " + std::to_string(b) + ")";
-}
-
 // Number of fans the faces around one vertex form: faces are in one fan when
 // they are linked through edges incident to the vertex.
 int fanCount(int vertex, const std::vector<int>& incidentFaces,
@@ -50,18 +46,21 @@ int fanCount(int vertex, const std::vector<int>& incidentFaces,
 
 }  // namespace
 
-void checkPolygonMesh(const MatrixX3& points, const std::vector<std::vector<int>>& faces,
-                      const std::string& source) {
+void checkPolygonMesh(const MatrixX3& points, const std::vector<std::vector<int>>& faces, const std::string& source,
+                      int firstNumber) {
+  // A vertex's or a face's number as the file counts them.
+  const auto number = [firstNumber](long long i) { return std::to_string(i + firstNumber); };
+  const auto edgeName = [&number](int a, int b) { return "(" + number(a) + ", " + number(b) + ")"; };
   const int vertexCount = static_cast<int>(points.rows());
   if (vertexCount == 0) throw Error(source, "the mesh has no vertices");
   if (faces.empty()) throw Error(source, "the mesh has no faces");
   for (int v = 0; v < vertexCount; ++v) {
     if (!points.row(v).allFinite()) {
-      throw Error(source, "vertex " + std::to_string(v) + " has a coordinate that is NaN or infinite");
+      throw Error(source, "vertex " + number(v) + " has a coordinate that is NaN or infinite");
     }
     // Areas of such coordinates overflow, and every face would look degenerate.
     const std::string beyond = beyondLargestCoordinate(points.row(v).transpose());
-    if (!beyond.empty()) throw Error(source, "vertex " + std::to_string(v) + " " + beyond);
+    if (!beyond.empty()) throw Error(source, "vertex " + number(v) + " " + beyond);
   }
   const double minimumArea = degenerateArea(points);
 
@@ -76,21 +75,21 @@ void checkPolygonMesh(const MatrixX3& points, const std::vector<std::vector<int>
   std::vector<FaceEdge> faceEdges;
   for (size_t f = 0; f < faces.size(); ++f) {
     const std::vector<int>& face = faces[f];
-    const std::string faceName = "face " + std::to_string(f);
+    const std::string faceName = "face " + number(f);
     if (face.size() < 3) {
       throw Error(source, faceName + " has " + std::to_string(face.size()) +
                               " vertices; a face needs at least 3");
     }
     for (int v : face) {
       if (v < 0 || v >= vertexCount) {
-        throw Error(source, faceName + " uses vertex " + std::to_string(v) + ", but the mesh has " +
+        throw Error(source, faceName + " uses vertex " + number(v) + ", but the mesh has " +
                                 std::to_string(vertexCount) + " vertices");
       }
     }
     for (size_t i = 0; i < face.size(); ++i) {
       for (size_t j = i + 1; j < face.size(); ++j) {
         if (face[i] == face[j]) {
-          throw Error(source, faceName + " is degenerate: it uses vertex " + std::to_string(face[i]) +
+          throw Error(source, faceName + " is degenerate: it uses vertex " + number(face[i]) +
                                   " twice");
         }
       }
@@ -135,22 +134,22 @@ void checkPolygonMesh(const MatrixX3& points, const std::vector<std::vector<int>
   }
   if (repeated) {
     const int to = repeated->from == repeated->low ? repeated->high : repeated->low;
-    throw Error(source, "faces " + std::to_string(before->face) + " and " + std::to_string(repeated->face) +
+    throw Error(source, "faces " + number(before->face) + " and " + number(repeated->face) +
                             " both run along edge " + edgeName(repeated->from, to) +
                             " in the same direction: the orientation is inconsistent (or a face is repeated)");
   }
   for (int v = 0; v < vertexCount; ++v) {
     if (vertexFaces[v].empty()) {
-      throw Error(source, "vertex " + std::to_string(v) + " is isolated: no face uses it");
+      throw Error(source, "vertex " + number(v) + " is isolated: no face uses it");
     }
     const int fans = fanCount(v, vertexFaces[v], faces);
     if (fans > 1) {
-      throw Error(source, "vertex " + std::to_string(v) + " joins " + std::to_string(fans) +
+      throw Error(source, "vertex " + number(v) + " joins " + std::to_string(fans) +
                               " separate fans of faces: the mesh is not manifold there");
     }
     const size_t faceCount = vertexFaces[v].size();
     if (faceCount > static_cast<size_t>(kLargestValence)) {
-      throw Error(source, "vertex " + std::to_string(v) + " has " + std::to_string(faceCount) +
+      throw Error(source, "vertex " + number(v) + " has " + std::to_string(faceCount) +
                               " faces around it; at most " + std::to_string(kLargestValence) +
                               " are supported (the surface's cost near a vertex grows faster than the cube of "
                               "their number). Remesh it with fewer faces around that vertex");

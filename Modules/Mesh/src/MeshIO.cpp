@@ -70,6 +70,7 @@ PolygonData readObj(const std::string& path) {
   std::ifstream in = openForReading(path, std::ios::binary);
   std::vector<Vector3> points;
   PolygonData data;
+  data.firstNumber = 1;
   std::vector<int> faceLines;  // each face's line, to name an index past the last vertex
   std::string text;
   int line = 0;
@@ -398,7 +399,7 @@ PolygonData readPolygonData(const std::string& path) {
 
 ControlMesh readControlMesh(const std::string& path) {
   const PolygonData data = readPolygonData(path);
-  ControlMesh mesh = ControlMesh::fromPolygons(data.points, data.faces, path);
+  ControlMesh mesh = ControlMesh::fromPolygons(data.points, data.faces, path, data.firstNumber);
   mesh.setCreases(data.creases, path);
   return mesh;
 }

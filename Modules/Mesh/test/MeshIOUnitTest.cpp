@@ -127,6 +127,17 @@ TEST(MeshIO, BrokenFilesAreNamed) {
   const std::string pastLast = scratch("past_last.obj").string();
   writeText(pastLast, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 7\n");
   expectError(pastLast, "line 8: vertex index 7 is out of range (the file has 4 vertices)");
+  // The mesh checks count as the file does: from 1 in an OBJ (its 5th vertex,
+  // its 4th face), from 0 in an OFF.
+  const std::string isolated = scratch("isolated.obj").string();
+  writeText(isolated, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 5 5 5\nf 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\n");
+  expectError(isolated, "vertex 5 is isolated");
+  const std::string repeated = scratch("repeated.obj").string();
+  writeText(repeated, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 4\n");
+  expectError(repeated, "face 4 is degenerate: it uses vertex 4 twice");
+  const std::string isolatedOff = scratch("isolated.off").string();
+  writeText(isolatedOff, "OFF\n5 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n5 5 5\n3 0 1 2\n3 0 2 3\n3 0 3 1\n3 1 3 2\n");
+  expectError(isolatedOff, "vertex 4 is isolated");
   const std::string truncated = scratch("truncated.off").string();
   writeText(truncated, "OFF\n4 1 0\n0 0 0\n1 0 0\n");
   expectError(truncated, "truncated");

@@ -28,11 +28,12 @@ class ControlMesh {
  public:
   ControlMesh();
 
-  // Checks the polygons (throws dynsub::Error naming `source` and the problem)
-  // and builds the mesh. Vertex i of the mesh is row i of `points`; face f is
-  // faces[f] with the same vertex order.
+  // Checks the polygons (throws dynsub::Error naming `source` and the problem,
+  // with vertices and faces counted from `firstNumber` as checkPolygonMesh
+  // does) and builds the mesh. Vertex i of the mesh is row i of `points`;
+  // face f is faces[f] with the same vertex order.
   static ControlMesh fromPolygons(const MatrixX3& points, const std::vector<Polygon>& faces,
-                                  const std::string& source = "mesh");
+                                  const std::string& source = "mesh", int firstNumber = 0);
   // A mesh whose topology is already known to be valid: a refinement of a
   // checked mesh (CatmullClark.h) is manifold and consistently oriented by
   // construction, so only the points are checked (finite, one per vertex).

@@ -22,9 +22,11 @@ constexpr int kLargestValence = 64;
 // isolated vertex; an edge with more than two faces (non-manifold edge); a
 // vertex whose faces form more than one fan (non-manifold vertex); two faces
 // traversing an edge in the same direction (inconsistent orientation); a
-// vertex with more than kLargestValence faces around it.
-void checkPolygonMesh(const MatrixX3& points, const std::vector<std::vector<int>>& faces,
-                      const std::string& source);
+// vertex with more than kLargestValence faces around it. The problem names
+// vertices and faces as the file counts them, from `firstNumber` (OBJ's
+// faces number vertices from 1; OFF and PLY from 0).
+void checkPolygonMesh(const MatrixX3& points, const std::vector<std::vector<int>>& faces, const std::string& source,
+                      int firstNumber = 0);
 
 class Topology;
 

@@ -24,6 +24,9 @@ struct PolygonData {
   MatrixX3 points;
   std::vector<Polygon> faces;
   std::vector<Crease> creases;
+  // Where the file's numbering of vertices and faces starts: 1 for OBJ, 0 for
+  // OFF and PLY (its messages, and the checks', count as the file does).
+  int firstNumber = 0;
 };
 
 // Parses the file by extension (.obj, .off, .ply; case-insensitive) without
