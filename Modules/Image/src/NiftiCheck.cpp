@@ -80,14 +80,16 @@ std::vector<unsigned char> readBytes(const std::string& path, std::uintmax_t off
   return bytes;
 }
 
-// ITK represents an orientation by orthonormal axes. A sform whose axes are
-// not perpendicular (sheared, as for a tilted gantry) it passes over for the
-// qform, and DynSub's outputs carry that: where the two place the image far
-// apart, a viewer that takes the sform (FSL, nibabel) would show the outputs
-// off the input. Refused then, saying by how much.
+// A header with both a qform and a sform, read as ITK reads it: ITK 5.2
+// takes the sform only when its code is 1 (scanner) and its axes are
+// perpendicular, and the qform otherwise. FSL and nibabel take the sform
+// whenever its code is above 0. Where ITK takes the qform and the two place
+// the image more than half a voxel apart, DynSub's outputs (which carry the
+// placement ITK read) and points placed in FSL or nibabel would lie that far
+// off each other: refused, saying by how much and which to change.
 template <class Real>
-void requireQformWhereShearedSform(const std::string& path, const Real& real, int version,
-                                   const std::array<std::int64_t, 3>& size) {
+void requireOnePlacement(const std::string& path, const Real& real, int version,
+                         const std::array<std::int64_t, 3>& size, int sformCode) {
   const int realBytes = version == 1 ? 4 : 8;
   // sform: rows srow_x, srow_y, srow_z of 4 values each.
   const int srow = version == 1 ? 280 : 400;
@@ -105,7 +107,8 @@ void requireQformWhereShearedSform(const std::string& path, const Real& real, in
       }
       largestCosine = std::max(largestCosine, std::abs(dot) / std::sqrt(na * nb));
     }
-  if (!(largestCosine > 1e-4)) return;  // perpendicular axes: ITK takes the sform
+  const bool sheared = largestCosine > 1e-4;
+  if (!sheared && sformCode == 1) return;  // ITK takes the sform, as the others do
   // qform: quatern_b, c, d, qoffset_x, y, z, and pixdim[0..3] (qfac, spacing).
   const int quatern = version == 1 ? 256 : 352, pixdim = version == 1 ? 76 : 104;
   // As NIfTI's reference library reads them: b, c, d of a norm above 1 are
@@ -145,11 +148,18 @@ void requireQformWhereShearedSform(const std::string& path, const Real& real, in
   if (!(apart > 0.5 * smallestSpacing)) return;
   char distance[32];
   std::snprintf(distance, sizeof distance, "%.1f", apart);
-  throw Error(path, std::string("a NIfTI header whose sform is sheared (its axes are not perpendicular), which ITK "
-                                "cannot represent; its qform, which would be read instead, places the image up to ") +
-                        distance +
-                        " mm elsewhere. Resample the image onto a grid without shear, or set its sform_code to 0 "
-                        "if the qform is the placement meant");
+  if (sheared)
+    throw Error(path, std::string("a NIfTI header whose sform is sheared (its axes are not perpendicular), which ITK "
+                                  "cannot represent; its qform, which would be read instead, places the image up to ") +
+                          distance +
+                          " mm elsewhere. Resample the image onto a grid without shear, or set its sform_code to 0 "
+                          "if the qform is the placement meant");
+  throw Error(path, "a NIfTI header whose qform and sform place the image up to " + std::string(distance) +
+                        " mm apart: ITK-based tools (DynSub, 3D Slicer, ITK-SNAP) read the qform, as the sform_code is " +
+                        std::to_string(sformCode) +
+                        " (not 1, scanner), while FSL and nibabel read the sform. Make the two agree (FSL: "
+                        "fslorient -copysform2qform if the sform is the placement meant, -copyqform2sform if the "
+                        "qform is)");
 }
 
 }  // namespace
@@ -262,7 +272,7 @@ DataCheck checkNiftiHeader(const std::string& path) {
   if (sformCode > 0) requireFinite(version == 1 ? 280 : 400, 12, "sform (srow_x, srow_y, srow_z)");
   std::array<std::int64_t, 3> size{1, 1, 1};
   for (int a = 0; a < 3 && a < dimensions; ++a) size[a] = dim(a + 1);
-  if (qformCode > 0 && sformCode > 0) requireQformWhereShearedSform(path, real, version, size);
+  if (qformCode > 0 && sformCode > 0) requireOnePlacement(path, real, version, size, sformCode);
   requireMemoryFor(path, count);
   // vox_offset: a float in NIfTI-1, an integer in NIfTI-2.
   const double offset =

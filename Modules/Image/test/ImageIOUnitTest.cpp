@@ -531,6 +531,30 @@ TEST(HostileImages, AShearedSformThatTheQformContradictsIsRefused) {
   EXPECT_EQ(readError(path), "");
 }
 
+// A sform whose code is not 1 (scanner) is passed over by ITK for the qform,
+// where FSL and nibabel read the sform: refused where the two place the image
+// more than half a voxel apart (as after a registration that set only the
+// sform), read where they agree.
+TEST(HostileImages, ASformThatITKPassesOverAndTheQformContradictsIsRefused) {
+  const fs::path path = scratch("two_placements.nii");
+  auto write = [&](std::int16_t sformCode, float shift) {
+    writeNifti(path, {20, 20, 20}, Vector3(1, 1, 1), ramp(8000, 1.0f));
+    patch(path, 252, std::int16_t{1});  // qform_code: scanner (the identity)
+    patch(path, 254, sformCode);
+    patch(path, 280 + 12, shift);  // srow_x[3]
+  };
+  write(4, 10.0f);  // MNI: the sform 10 mm from the qform
+  std::string error = readError(path);
+  EXPECT_NE(error.find("two_placements.nii: a NIfTI header whose qform and sform place the image up to 10.0 mm apart"),
+            std::string::npos)
+      << error;
+  EXPECT_NE(error.find("fslorient -copysform2qform"), std::string::npos) << error;
+  write(2, 0.3f);  // aligned, 0.3 mm apart: within half a voxel
+  EXPECT_EQ(readError(path), "");
+  write(1, 10.0f);  // scanner: ITK reads the sform, as FSL and nibabel do
+  EXPECT_EQ(readError(path), "");
+}
+
 TEST(HostileImages, ADegenerateDirectionIsRefused) {
   // NRRD space directions with two parallel axes.
   std::ofstream(scratch("parallel.nrrd"), std::ios::binary)
