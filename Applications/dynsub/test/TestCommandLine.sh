@@ -663,6 +663,9 @@ expect_error "the atlas's background as a structure" 2 "--atlas-label 0: 0 is th
 expect_error "a reference label list ending in a comma" 2 "--reference-label 71,: expected N" "$work/s9d" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" \
   --reference "$mri/aal.nii.gz" --reference-label 71, --out "$work/s9d"
+expect_error "the background as the reference label" 2 "--reference-label 0: 0 is the reference's background" "$work/s9f" \
+  "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" \
+  --reference "$mri/aal.nii.gz" --reference-label 0 --out "$work/s9f"
 # Stopped by the step limit, the surface had not settled: the run says so.
 "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --max-steps 20 \
   --no-figures --out "$work/s9d" >/dev/null 2>"$work/s9d.err"
