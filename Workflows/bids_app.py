@@ -50,6 +50,8 @@ def _parser(version):
                         help="a Snakemake profile, e.g. Workflows/profiles/slurm to submit each job with sbatch")
     parser.add_argument("--work-dir", metavar="DIR", help="Snakemake's bookkeeping (default OUTPUT_DIR/work)")
     parser.add_argument("--dry-run", action="store_true", help="list the jobs without running them")
+    parser.add_argument("--unlock", action="store_true",
+                        help="remove the lock a killed run left in the work directory, and stop")
     parser.add_argument("--version", action="version", version=f"%(prog)s (DynSub) {version}")
     return parser
 
@@ -83,8 +85,15 @@ def main(argv, snakefile, dynsub):
     if args.profile and not os.path.isfile(os.path.join(args.profile, "config.yaml")):
         parser.error(f"--profile {args.profile}: not a Snakemake profile (no config.yaml in it)")
     bids_dir, out = os.path.abspath(args.bids_dir), os.path.abspath(args.output_dir)
-    if out == bids_dir:
+    # Compared as the files they are: through a symbolic link the output would
+    # overwrite the dataset's own description and .bidsignore.
+    if os.path.realpath(out) == os.path.realpath(bids_dir):
         parser.error(f"{args.output_dir}: the output directory must not be the BIDS dataset itself")
+    work = os.path.abspath(args.work_dir or os.path.join(out, "work"))
+    # Snakemake 7 starts each job with an unquoted `cd WORK`.
+    if any(c.isspace() for c in work):
+        parser.error(f"{work}: Snakemake cannot run jobs in a work directory whose path has a space; "
+                     "give --work-dir a path without one")
 
     # Values go to Snakemake as JSON, which its YAML reading keeps as given:
     # a label "01" stays a string, and a list stays a list.
@@ -105,9 +114,9 @@ def main(argv, snakefile, dynsub):
               file=sys.stderr)
         return 1
 
-    work = os.path.abspath(args.work_dir or os.path.join(out, "work"))
     if not args.dry_run:
         os.makedirs(work, exist_ok=True)
+        os.makedirs(out, exist_ok=True)
         bids.write_dataset_description(os.path.join(out, "dataset_description.json"), version, bids_dir)
         bids.write_bidsignore(os.path.join(out, ".bidsignore"))
 
@@ -116,10 +125,24 @@ def main(argv, snakefile, dynsub):
     command += ["--profile", os.path.abspath(args.profile)] if args.profile else ["--cores", str(args.cores)]
     if args.dry_run:
         command.append("--dry-run")
+    if args.unlock:
+        command.append("--unlock")
     command.append(args.analysis_level)
     try:
-        status = subprocess.run(command).returncode
+        snakemake = subprocess.Popen(command)
     except OSError as error:
         print(f"dynsub-bids: error: cannot run snakemake ({error}); install Debian's snakemake", file=sys.stderr)
         return 1
+    # Ctrl-C reaches Snakemake too (one process group): it is waited for, so
+    # that it stops its jobs and removes its lock, rather than killed.
+    interrupted = False
+    while True:
+        try:
+            status = snakemake.wait()
+            break
+        except KeyboardInterrupt:
+            interrupted = True
+    if interrupted:
+        print("dynsub-bids: interrupted; run the same command again to finish", file=sys.stderr)
+        return 130
     return 0 if status == 0 else 1

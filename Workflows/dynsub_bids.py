@@ -263,7 +263,18 @@ def find_structures(bids, landmarks_dir, seeds_table, reference_dir, warn=_warn)
                                   "(LPS mm)") from None
             if not re.fullmatch(LABEL, name) or not all(abs(v) < float("inf") for v in seed):
                 raise CohortError(f"{where}: structure must be letters and digits, x y z finite numbers")
-            structure_for(subject, session, "", name, where).seed = seed
+            structure = structure_for(subject, session, "", name, where)
+            if structure.seed is not None:
+                raise CohortError(f"{where}: a second seed for {structure.stem} {structure.name}")
+            structure.seed = seed
+
+    # An image nobody placed points in is left out, and said so: a landmark
+    # file in the wrong folder would otherwise drop its subject unseen.
+    covered = {s.t1w for s in structures.values()}
+    for path in images.values():
+        if path not in covered:
+            warn(f"{path}: not segmented: no landmarks for it in {landmarks_dir}/sub-<label>/[ses-<label>/]anat/ "
+                 f"and no seed in {seeds_table or 'a seeds.tsv'}")
 
     if reference_dir and os.path.isdir(reference_dir):
         dataset_table = f"{reference_dir}/dseg.tsv"

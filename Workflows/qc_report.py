@@ -162,7 +162,8 @@ document.querySelectorAll("a.figure").forEach(function (link) {
 viewer.addEventListener("click", function () { viewer.close(); });
 var store = "dynsub-qc " + location.pathname, ratings = {};
 try { ratings = JSON.parse(localStorage.getItem(store) || "{}"); } catch (error) { ratings = {}; }
-function rowKey(row) { return [row.dataset.participant, row.dataset.session, row.dataset.structure].join("\\t"); }
+// A row is a structure in one T1w: a participant's runs and acquisitions are rated apart.
+function rowKey(row) { return [row.dataset.participant, row.dataset.session, row.dataset.structure, row.dataset.t1w].join("\\t"); }
 document.querySelectorAll("#group tbody tr").forEach(function (row) {
   var select = row.querySelector("td.rating select"), cell = select.parentNode;
   select.value = ratings[rowKey(row)] || "";
@@ -174,10 +175,11 @@ document.querySelectorAll("#group tbody tr").forEach(function (row) {
   });
 });
 document.getElementById("export").addEventListener("click", function () {
-  var lines = ["participant_id\tsession_id\tstructure\trating\tflags"];
+  var lines = ["participant_id\tsession_id\tstructure\trating\tflags\tt1w"];
   document.querySelectorAll("#group tbody tr").forEach(function (row) {
     var rating = row.querySelector("td.rating select").value || "n/a";
-    lines.push([rowKey(row), rating, row.dataset.flags || "n/a"].join("\\t"));
+    var d = row.dataset;
+    lines.push([d.participant, d.session, d.structure, rating, d.flags || "n/a", d.t1w].join("\\t"));
   });
   var link = document.createElement("a");
   link.href = URL.createObjectURL(new Blob([lines.join("\\n") + "\\n"], {type: "text/tab-separated-values"}));
@@ -350,7 +352,7 @@ def write_report(jobs, out, path, niivue=None):
     parts.append("</tr></thead><tbody>")
     for row in rows:
         data = {"participant": row["participant_id"], "session": row["session_id"], "structure": row["structure"],
-                "flags": ",".join(row["flags"])}
+                "t1w": row["t1w"], "flags": ",".join(row["flags"])}
         parts.append(f'<tr class="{"flagged" if row["flags"] else ""}" '
                      + " ".join(f'data-{k}="{html.escape(v)}"' for k, v in data.items()) + ">")
         parts += [_cell(row, key, text) for key, _, text in COLUMNS]

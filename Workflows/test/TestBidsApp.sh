@@ -13,9 +13,12 @@
 #    official BIDS validator (npm bids-validator 1.x) finds no error in the
 #    dataset with its derivatives in place, while it does find the outputs
 #    misplaced at the dataset's top level (so the check can fail);
+#  - `group` again, with options that would segment anew and an image
+#    touched, still segments nothing;
 #  - mistakes are refused with a message and nothing written: a label that
 #    selects nothing, the group level before any participant, a missing
-#    dataset, an unknown level.
+#    dataset, an unknown level, the dataset as its own output through a
+#    link, a work directory with a space, a structure seeded twice.
 # Needs DYNSUB_BIDS, DATA, WORKFLOWS, BIDS_VALIDATOR; snakemake, nibabel.
 set -u
 source "$DATA/../Applications/dynsub/test/Checks.sh"
@@ -71,6 +74,16 @@ touch "$work/marker"
 check "rerun of participant 01: exit 0, nothing to be done" grep -q "Nothing to be done" "$work/rerun.log"
 check "rerun of participant 01: no file rewritten" \
   test -z "$(find "$out" -newer "$work/marker" -type f -not -path '*/work/*')"
+# The group level summarizes what is there, whatever options it is given
+# and whatever changed since: options that would make a participant run
+# segment again, and an image touched.
+touch "$bids/sub-02/anat/sub-02_T1w.nii.gz"
+"$DYNSUB_BIDS" "$bids" "$out" group --segment-args "--max-level 0" >"$work/group2.log" 2>&1
+check "group with other options, an image touched: exit 0" test $? -eq 0 || tail -30 "$work/group2.log"
+check "group with other options, an image touched: no segmentation run" \
+  test "$(grep -c 'rule segment' "$work/group2.log")" -eq 0
+check "group with other options, an image touched: no labelmap rewritten" \
+  test -z "$(find "$out" -newer "$work/marker" -name '*_dseg.nii.gz')"
 
 # The official validator, on the raw dataset with the derivatives in place.
 validate() {  # validate DIR: prints the validator's errors and warnings by code; exit 1 on an error
@@ -102,6 +115,22 @@ check "an unknown level: exit 2" test $? -eq 2
 check "a folder that is not a profile: exit 2, named" test $? -eq 2 -a -n "$(grep "not a Snakemake profile" "$work/bad.log")"
 "$DYNSUB_BIDS" "$bids" "$work/fresh" participant --participant-label 0_1 >"$work/bad.log" 2>&1
 check "a malformed label: exit 2" test $? -eq 2
+ln -s "$bids" "$work/link"
+cp "$bids/dataset_description.json" "$work/description"
+"$DYNSUB_BIDS" "$work/link" "$bids" participant >"$work/bad.log" 2>&1
+check "the dataset as its own output through a link: exit 2" \
+  test $? -eq 2 -a -n "$(grep "must not be the BIDS dataset itself" "$work/bad.log")"
+check "the dataset as its own output through a link: its description kept" \
+  cmp -s "$bids/dataset_description.json" "$work/description"
+"$DYNSUB_BIDS" "$bids" "$work/with space" participant >"$work/bad.log" 2>&1
+check "a work directory with a space: exit 2, named" \
+  test $? -eq 2 -a -n "$(grep "path has a space; give --work-dir" "$work/bad.log")"
+cp "$bids/derivatives/seeds.tsv" "$work/seeds.tsv"
+tail -n 1 "$work/seeds.tsv" | awk -F'\t' -v OFS='\t' '{ $NF = $NF + 1; print }' >>"$work/seeds.tsv"
+"$DYNSUB_BIDS" "$bids" "$work/fresh" participant --seeds "$work/seeds.tsv" >"$work/bad.log" 2>&1
+check "a structure seeded twice: exit 1, named" \
+  test $? -eq 1 -a -n "$(grep "seeds.tsv:[0-9]*: a second seed for sub-01 thalamusL" "$work/bad.log")"
+check "a structure seeded twice: nothing written" test ! -e "$work/fresh"
 
 echo "$failures failure(s)"
 exit $((failures > 0))

@@ -100,7 +100,8 @@ async function cohort(context, pagePath, screenshot) {
   check("cohort: export is named qc_ratings.tsv", download.suggestedFilename() === "qc_ratings.tsv",
         download.suggestedFilename());
   check("cohort: export has the header and a row per structure",
-        tsv[0].join(",") === "participant_id,session_id,structure,rating,flags" && tsv.length === 8, tsv.length);
+        tsv[0].join(",") === "participant_id,session_id,structure,rating,flags,t1w" && tsv.length === 8 &&
+          tsv.slice(1).every((r) => r[5].endsWith("_T1w.nii.gz")), tsv.length);
   const exported = Object.fromEntries(tsv.slice(1).map((r) => [r.slice(0, 3).join(" "), r[3]]));
   check("cohort: exported ratings are the ones given, the rest n/a", exported[rated[0]] === "fail" &&
         exported[rated[4]] === "pass" && Object.values(exported).filter((v) => v === "n/a").length === 5,
