@@ -149,6 +149,12 @@ std::vector<Landmark> readFcsv(const std::string& path, std::ifstream& in, Coord
       const auto equals = line.find('=');
       if (equals == std::string::npos) continue;
       const std::string key = line.substr(0, equals), value = splitCsvFields(line.substr(equals + 1), ',')[0];
+      // Slicer writes its header before the points; one after them would
+      // apply to some points and not to others.
+      const bool header = key.find("CoordinateSystem") != std::string::npos || key.find("columns") != std::string::npos;
+      if (header && !landmarks.empty())
+        throw Error(path, "line " + std::to_string(number) + ": a header line ('" + trimmed(key.substr(1)) +
+                              "') after the points: move it above them");
       if (key.find("CoordinateSystem") != std::string::npos) {
         if (value == "LPS" || value == "1")
           system = CoordinateSystem::LPS;
@@ -180,31 +186,52 @@ std::vector<Landmark> readFcsv(const std::string& path, std::ifstream& in, Coord
   return landmarks;
 }
 
-std::vector<Landmark> readCsv(const std::string& path, std::ifstream& in) {
+// A line that holds nothing to read: empty, blank, separators alone (a
+// spreadsheet's formatted but empty row), or a comment.
+bool nothingOn(const std::string& line) {
+  const std::string text = trimmed(line);
+  return text.empty() || text[0] == '#' || text.find_first_not_of(", \t\r") == std::string::npos;
+}
+
+// x, y, z (LPS mm), or 3D Slicer's markups table: l, p, s (LPS) or r, a, s
+// (RAS), with `defined` 0 for a point not yet placed.
+std::vector<Landmark> readCsv(const std::string& path, std::ifstream& in, CoordinateSystem& system) {
   std::string line;
   int number = 0;
   std::vector<std::string> header;
   while (header.empty() && std::getline(in, line)) {
     ++number;
     if (number == 1) line = withoutByteOrderMark(line);
-    if (!line.empty() && line != "\r") header = splitCsvFields(line, ',');
+    if (const auto cr = line.find('\r'); cr != std::string::npos && cr + 1 < line.size())
+      throw Error(path, "its lines end in a carriage return alone (old Mac text): save it with LF or CR LF line ends");
+    if (!nothingOn(line)) header = splitCsvFields(line, ',');
   }
   // Column names in any case: X, Label.
   for (std::string& name : header)
     for (char& ch : name) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-  int x = -1, y = -1, z = -1, label = -1;
-  for (std::size_t c = 0; c < header.size(); ++c) {
-    if (header[c] == "x") x = static_cast<int>(c);
-    if (header[c] == "y") y = static_cast<int>(c);
-    if (header[c] == "z") z = static_cast<int>(c);
-    if (header[c] == "label") label = static_cast<int>(c);
+  const auto column = [&header](const char* name) {
+    const auto at = std::find(header.begin(), header.end(), name);
+    return at == header.end() ? -1 : static_cast<int>(at - header.begin());
+  };
+  int x = column("x"), y = column("y"), z = column("z");
+  const int label = column("label"), defined = column("defined");
+  system = CoordinateSystem::LPS;
+  if (x < 0 && y < 0 && z < 0) {
+    if (column("l") >= 0 || column("p") >= 0) {
+      x = column("l"), y = column("p"), z = column("s");
+    } else if (column("r") >= 0 || column("a") >= 0) {
+      x = column("r"), y = column("a"), z = column("s");
+      system = CoordinateSystem::RAS;
+    }
   }
-  if (x < 0 || y < 0 || z < 0) throw Error(path, "the first line must name the columns x, y and z (LPS mm)");
+  if (x < 0 || y < 0 || z < 0)
+    throw Error(path, "the first line must name the columns x, y and z (LPS mm), or l, p, s or r, a, s as 3D Slicer's "
+                      "markups tables do");
   requireDistinctColumns(path, number, header);
   std::vector<Landmark> landmarks;
   while (std::getline(in, line)) {
     ++number;
-    if (line.empty() || line == "\r") continue;
+    if (nothingOn(line)) continue;
     std::vector<std::string> fields = splitCsvFields(line, ',');
     // A separator that ends a row adds no value.
     while (fields.size() > header.size() && fields.back().empty()) fields.pop_back();
@@ -216,9 +243,14 @@ std::vector<Landmark> readCsv(const std::string& path, std::ifstream& in) {
                             " fields, but the first line names " + std::to_string(header.size()) + " columns");
     if (static_cast<int>(fields.size()) <= std::max({x, y, z}))
       throw Error(path, "line " + std::to_string(number) + ": too few fields");
+    // A point Slicer lists but has not placed: its position is not a click.
+    if (defined >= 0 && defined < static_cast<int>(fields.size()) &&
+        (fields[defined] == "0" || fields[defined] == "false"))
+      continue;
+    const Vector3 p(finiteNumber(fields[x], path, number), finiteNumber(fields[y], path, number),
+                    finiteNumber(fields[z], path, number));
     landmarks.push_back({label >= 0 && label < static_cast<int>(fields.size()) ? fields[label] : "",
-                         Vector3(finiteNumber(fields[x], path, number), finiteNumber(fields[y], path, number),
-                                 finiteNumber(fields[z], path, number))});
+                         system == CoordinateSystem::RAS ? flipXY(p) : p});
   }
   return landmarks;
 }
@@ -246,7 +278,7 @@ std::vector<LandmarkList> readAllLists(const std::string& path) {
   std::ifstream in = openForReading(path);
   if (format == Format::MarkupsJson) return readMarkupsJson(path, in);
   LandmarkList list;
-  list.landmarks = format == Format::Fcsv ? readFcsv(path, in, list.stated) : readCsv(path, in);
+  list.landmarks = format == Format::Fcsv ? readFcsv(path, in, list.stated) : readCsv(path, in, list.stated);
   return {list};
 }
 

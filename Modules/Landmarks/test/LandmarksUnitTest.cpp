@@ -179,6 +179,11 @@ TEST(Landmarks, BadFilesAreRefusedWithTheirName) {
   expectError(written("fourvalues.csv", "x,y,z\n1,2,3\n1,5,2,3\n"),
               "line 3: 4 fields, but the first line names 3 columns");
   expectError(written("twox.fcsv", "# columns = id,x,y,z,x\n1,2,3,4,5\n"), "the column 'x' is named twice");
+  // A header line after points would apply to some of them only.
+  expectError(written("late.fcsv", "1,2,3,4\n# CoordinateSystem = RAS\n5,6,7,8\n"),
+              "line 2: a header line ('CoordinateSystem') after the points: move it above them");
+  // Old Mac text: one line, which names no columns.
+  expectError(written("mac.csv", "x,y,z\r1,2,3\r4,5,6\r"), "a carriage return alone");
   // A markups file's fields of the wrong JSON type and states it does not have.
   expectError(written("numberlabel.mrk.json",
                       R"({"markups": [{"type": "Fiducial", "controlPoints": [{"position": [1, 2, 3], "label": 5}]}]})"),
@@ -202,6 +207,25 @@ TEST(Landmarks, SpreadsheetFilesAreRead) {
   std::ofstream(csv.string()) << "\xEF\xBB\xBFX,Y,Z,Label\n-12,10,12,head\n-14,12,10\n";
   std::ofstream(scratch("trailing.csv").string()) << "x,y,z\n1,2,3,\n4,5,6\n";
   EXPECT_EQ(readLandmarks(scratch("trailing.csv").string()).size(), 2u);
+  // Comments, and rows of separators alone (a spreadsheet's formatted empty
+  // rows), hold no point.
+  std::ofstream(scratch("blank.csv").string()) << "# clicks of rater 2\nx,y,z\n1,2,3\n,,\n  \n# done\n4,5,6\n";
+  EXPECT_EQ(readLandmarks(scratch("blank.csv").string()).size(), 2u);
+  // 3D Slicer's markups table, in LPS (l, p, s) or RAS (r, a, s), its
+  // unplaced points (defined 0) left out.
+  std::ofstream(scratch("slicer_lps.csv").string())
+      << "label,l,p,s,defined,selected,visible,locked,description\nF-1,1,2,3,1,1,1,0,\nF-2,0,0,0,0,1,1,0,\n";
+  CoordinateSystem stated = CoordinateSystem::RAS;
+  const std::vector<Landmark> lps = readLandmarks(scratch("slicer_lps.csv").string(), &stated);
+  ASSERT_EQ(lps.size(), 1u);
+  EXPECT_EQ(lps[0].position, Vector3(1, 2, 3));
+  EXPECT_EQ(stated, CoordinateSystem::LPS);
+  std::ofstream(scratch("slicer_ras.csv").string())
+      << "label,r,a,s,defined,selected,visible,locked,description\nF-1,1,2,3,1,1,1,0,\n";
+  const std::vector<Landmark> ras = readLandmarks(scratch("slicer_ras.csv").string(), &stated);
+  ASSERT_EQ(ras.size(), 1u);
+  EXPECT_EQ(ras[0].position, Vector3(-1, -2, 3));
+  EXPECT_EQ(stated, CoordinateSystem::RAS);
   const std::vector<Landmark> read = readLandmarks(csv.string());
   ASSERT_EQ(read.size(), 2u);
   EXPECT_EQ(read[0].position, Vector3(-12, 10, 12));
