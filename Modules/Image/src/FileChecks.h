@@ -42,7 +42,8 @@ using DataCheck = std::function<void()>;
 constexpr std::uintmax_t kLargestDeflateRatio = 1032;
 
 // A NIfTI file (.nii, or .nii.gz when `path` ends in .gz): its header is
-// NIfTI-1 or NIfTI-2 in either byte order, its sizes and datatype possible,
+// NIfTI-1 in either byte order (NIfTI-2 is named as what ITK 5.2 does not
+// read), its sizes and datatype possible,
 // the image fits in memory, and the file is large enough to hold (or, gzipped,
 // to inflate to) the data announced; then (the DataCheck) its data (inflated) is
 // all there, and its float voxels finite (ITK's reader would turn NaN and

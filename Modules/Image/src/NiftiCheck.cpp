@@ -88,11 +88,11 @@ std::vector<unsigned char> readBytes(const std::string& path, std::uintmax_t off
 // placement ITK read) and points placed in FSL or nibabel would lie that far
 // off each other: refused, saying by how much and which to change.
 template <class Real>
-void requireOnePlacement(const std::string& path, const Real& real, int version,
-                         const std::array<std::int64_t, 3>& size, int sformCode) {
-  const int realBytes = version == 1 ? 4 : 8;
+void requireOnePlacement(const std::string& path, const Real& real, const std::array<std::int64_t, 3>& size,
+                         int sformCode) {
+  const int realBytes = 4;  // a float
   // sform: rows srow_x, srow_y, srow_z of 4 values each.
-  const int srow = version == 1 ? 280 : 400;
+  const int srow = 280;
   double sform[3][4];
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 4; ++c) sform[r][c] = real(srow + (4 * r + c) * realBytes);
@@ -110,7 +110,7 @@ void requireOnePlacement(const std::string& path, const Real& real, int version,
   const bool sheared = largestCosine > 1e-4;
   if (!sheared && sformCode == 1) return;  // ITK takes the sform, as the others do
   // qform: quatern_b, c, d, qoffset_x, y, z, and pixdim[0..3] (qfac, spacing).
-  const int quatern = version == 1 ? 256 : 352, pixdim = version == 1 ? 76 : 104;
+  const int quatern = 256, pixdim = 76;
   // As NIfTI's reference library reads them: b, c, d of a norm above 1 are
   // normalized (a = 0), and a spacing of 0 or less is taken as 1.
   double b = real(quatern), c = real(quatern + realBytes), d = real(quatern + 2 * realBytes);
@@ -164,9 +164,10 @@ void requireOnePlacement(const std::string& path, const Real& real, int version,
 
 }  // namespace
 
-// NIfTI-1 (348-byte header) and NIfTI-2 (540), either byte order. ITK's reader
-// fills a truncated .nii, or a .nii.gz whose gzip stream is cut short, with
-// zeros without complaint, and allocates whatever the header announces.
+// NIfTI-1 (a 348-byte header), either byte order. ITK's reader fills a
+// truncated .nii, or a .nii.gz whose gzip stream is cut short, with zeros
+// without complaint, and allocates whatever the header announces. ITK 5.2
+// does not read NIfTI-2 (a 540-byte header): such a file is named as one.
 DataCheck checkNiftiHeader(const std::string& path) {
   // Compressed or not by its first bytes, as ITK's reader (zlib) takes a
   // .nii.gz that is not compressed; it reads a .nii by its name alone.
@@ -175,7 +176,7 @@ DataCheck checkNiftiHeader(const std::string& path) {
   const bool gzipped = magic[0] == 0x1f && magic[1] == 0x8b;
   if (gzipped && lowerCaseExtension(path) != ".gz")
     throw Error(path, "compressed with gzip, but named as an uncompressed NIfTI file: name it .nii.gz");
-  unsigned char header[540] = {};
+  unsigned char header[348] = {};
   std::uintmax_t got = 0;
   if (gzipped) {
     gzFile file = gzopen(path.c_str(), "rb");
@@ -194,27 +195,16 @@ DataCheck checkNiftiHeader(const std::string& path) {
     for (int b = 0; b < bytes; ++b) v |= std::uint64_t{header[at + (swap ? bytes - 1 - b : b)]} << (8 * b);
     return v;
   };
-  bool swap = false;
-  int version = 0;
-  for (const bool s : {false, true}) {
-    const auto size = number(0, 4, s);
-    if (size == 348) version = 1;
-    if (size == 540) version = 2;
-    if (version) {
-      swap = s;
-      break;
-    }
+  const bool swap = number(0, 4, false) != 348;
+  if (number(0, 4, swap) != 348) {
+    if (number(0, 4, false) == 540 || number(0, 4, true) == 540)
+      throw Error(path, "a NIfTI-2 file, which ITK 5.2 (DynSub's image reader) does not read: save it as NIfTI-1 "
+                        "(nibabel: nibabel.Nifti1Image; FSL and SPM write NIfTI-1)");
+    throw Error(path, "not a NIfTI file (its first four bytes give no header size of 348)");
   }
-  if (!version) throw Error(path, "not a NIfTI file (its first four bytes give no header size of 348 or 540)");
-  if (version == 2 && got < 540) throw Error(path, "truncated: a NIfTI-2 header of " + std::to_string(got) + " bytes");
-  const int headerSize = version == 1 ? 348 : 540;
-  // Offsets of dim[8], datatype and vox_offset in either version.
-  const int dimAt = version == 1 ? 40 : 16, dimBytes = version == 1 ? 2 : 8;
-  const auto datatype = static_cast<int>(static_cast<std::int16_t>(number(version == 1 ? 70 : 12, 2, swap)));
-  auto dim = [&](int i) {
-    const auto raw = number(dimAt + i * dimBytes, dimBytes, swap);
-    return dimBytes == 2 ? static_cast<std::int64_t>(static_cast<std::int16_t>(raw)) : static_cast<std::int64_t>(raw);
-  };
+  const int headerSize = 348;
+  const auto datatype = static_cast<int>(static_cast<std::int16_t>(number(70, 2, swap)));
+  auto dim = [&](int i) { return static_cast<std::int64_t>(static_cast<std::int16_t>(number(40 + 2 * i, 2, swap))); };
   const std::int64_t dimensions = dim(0);
   if (dimensions < 1 || dimensions > 7)
     throw Error(path, "a NIfTI header with " + std::to_string(dimensions) + " dimensions (1 to 7 are possible)");
@@ -241,42 +231,30 @@ DataCheck checkNiftiHeader(const std::string& path) {
       throw Error(path, "a NIfTI image of " + std::to_string(dimensions) + " dimensions, " + std::to_string(dim(i)) +
                             " along axis " + std::to_string(i - 1) + "; give one 3D volume (extract it first)");
   }
-  // A header's real number at byte `at`: a float in NIfTI-1, a double in NIfTI-2.
+  // A header's real number (a float) at byte `at`.
   auto real = [&](int at) {
-    if (version == 2) {
-      const std::uint64_t bits = number(at, 8, swap);
-      double value = 0;
-      std::memcpy(&value, &bits, sizeof value);
-      return value;
-    }
     const auto bits = static_cast<std::uint32_t>(number(at, 4, swap));
     float value = 0;
     std::memcpy(&value, &bits, sizeof value);
     return static_cast<double>(value);
   };
-  const int realBytes = version == 1 ? 4 : 8;
   // The orientation the header declares (qform, sform: whichever has a
   // code above 0) must be finite: ITK 5.2 aborts the process on a NaN there.
-  auto code = [&](int at1, int at2) {  // a short in NIfTI-1, an int in NIfTI-2
-    return version == 1 ? static_cast<int>(static_cast<std::int16_t>(number(at1, 2, swap)))
-                        : static_cast<int>(static_cast<std::int32_t>(number(at2, 4, swap)));
-  };
-  const int qformCode = code(252, 344), sformCode = code(254, 348);
+  auto code = [&](int at) { return static_cast<int>(static_cast<std::int16_t>(number(at, 2, swap))); };
+  const int qformCode = code(252), sformCode = code(254);
   auto requireFinite = [&](int first, int count, const char* what) {
     for (int i = 0; i < count; ++i) {
-      if (!std::isfinite(real(first + i * realBytes)))
+      if (!std::isfinite(real(first + i * 4)))
         throw Error(path, std::string("a NIfTI header whose ") + what + " holds a NaN or infinite value");
     }
   };
-  if (qformCode > 0) requireFinite(version == 1 ? 256 : 352, 6, "qform (quatern_b-d, qoffset_x-z)");
-  if (sformCode > 0) requireFinite(version == 1 ? 280 : 400, 12, "sform (srow_x, srow_y, srow_z)");
+  if (qformCode > 0) requireFinite(256, 6, "qform (quatern_b-d, qoffset_x-z)");
+  if (sformCode > 0) requireFinite(280, 12, "sform (srow_x, srow_y, srow_z)");
   std::array<std::int64_t, 3> size{1, 1, 1};
   for (int a = 0; a < 3 && a < dimensions; ++a) size[a] = dim(a + 1);
-  if (qformCode > 0 && sformCode > 0) requireOnePlacement(path, real, version, size, sformCode);
+  if (qformCode > 0 && sformCode > 0) requireOnePlacement(path, real, size, sformCode);
   requireMemoryFor(path, count);
-  // vox_offset: a float in NIfTI-1, an integer in NIfTI-2.
-  const double offset =
-      version == 1 ? real(108) : static_cast<double>(static_cast<std::int64_t>(number(168, 8, swap)));
+  const double offset = real(108);  // vox_offset
   if (!(offset >= headerSize) || offset > 1e12)
     throw Error(path, "a NIfTI header whose data offset (vox_offset " + std::to_string(offset) + ") is not after it");
   const auto needed = static_cast<std::uintmax_t>(offset) + count * bytesPerVoxel;

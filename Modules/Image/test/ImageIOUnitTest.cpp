@@ -555,6 +555,22 @@ TEST(HostileImages, ASformThatITKPassesOverAndTheQformContradictsIsRefused) {
   EXPECT_EQ(readError(path), "");
 }
 
+// ITK 5.2 does not read NIfTI-2: such a file is named as NIfTI-2, not as an
+// unknown format.
+TEST(HostileImages, NiftiTwoIsNamed) {
+  const fs::path path = scratch("two.nii");
+  {
+    std::ofstream out(path, std::ios::binary);
+    const std::int32_t size = 540;
+    out.write(reinterpret_cast<const char*>(&size), 4);
+    out << std::string(536 + 64, '\0');
+  }
+  const std::string error = readError(path);
+  EXPECT_NE(error.find("two.nii: a NIfTI-2 file, which ITK 5.2 (DynSub's image reader) does not read"),
+            std::string::npos)
+      << error;
+}
+
 TEST(HostileImages, ADegenerateDirectionIsRefused) {
   // NRRD space directions with two parallel axes.
   std::ofstream(scratch("parallel.nrrd"), std::ios::binary)
