@@ -248,7 +248,7 @@ def find_structures(bids, landmarks_dir, seeds_table, reference_dir, warn=_warn)
             structure.landmarks = path
 
     if seeds_table:
-        with open(seeds_table, newline="") as f:
+        with open(seeds_table, newline="", encoding="utf-8-sig") as f:  # Excel writes a byte order mark
             rows = list(csv.DictReader(f, delimiter="\t"))
         for line, row in enumerate(rows, start=2):
             where = f"{seeds_table}:{line}"

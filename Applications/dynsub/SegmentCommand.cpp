@@ -79,8 +79,8 @@ std::vector<int> parseLabelValues(const std::string& text) {
 // The expert's labelmap, on the image's grid.
 Volume readReferenceLabels(const std::string& path, const Volume& image) {
   Volume labels = readLabelMap(path);
-  if (!labels.geometry.sameGridAs(image.geometry))
-    throw Error(path, "the reference is not on the image's grid (size, origin, spacing or direction differ)");
+  if (const std::string difference = labels.geometry.differenceFrom(image.geometry, "image"); !difference.empty())
+    throw Error(path, "the reference is not on the image's grid: " + difference + "; resample it onto that grid");
   return labels;
 }
 

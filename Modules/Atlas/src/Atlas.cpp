@@ -128,8 +128,9 @@ Atlas readAtlas(const std::string& imagePath, const std::string& labelsPath) {
   atlas.labelsPath = labelsPath;
   atlas.image = readVolume(imagePath);
   atlas.labels = readLabelMap(labelsPath);
-  if (!atlas.labels.geometry.sameGridAs(atlas.image.geometry))
-    throw Error(labelsPath, "the atlas's label map is not on its template's grid (" + imagePath + ")");
+  if (const std::string difference = atlas.labels.geometry.differenceFrom(atlas.image.geometry, "template");
+      !difference.empty())
+    throw Error(labelsPath, "the atlas's label map is not on its template's grid (" + imagePath + "): " + difference);
   atlas.names = readNames(labelsPath);
   return atlas;
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 namespace dynsub {
 
@@ -32,6 +33,27 @@ bool ImageGeometry::sameGridAs(const ImageGeometry& other) const {
   return size == other.size && (spacing - other.spacing).norm() <= 1e-6 * spacing.norm() &&
          (origin - other.origin).norm() <= 1e-6 * (1 + origin.norm()) &&
          (direction - other.direction).norm() <= 1e-6;
+}
+
+std::string ImageGeometry::differenceFrom(const ImageGeometry& other, const std::string& otherName) const {
+  if (sameGridAs(other)) return "";
+  const auto vector = [](const Vector3& v) {
+    std::ostringstream text;
+    text << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
+    return text.str();
+  };
+  const std::string where = ", where the " + otherName + "'s is ";
+  if (size != other.size) {
+    const auto sizeText = [](const std::array<int, 3>& n) {
+      return std::to_string(n[0]) + " x " + std::to_string(n[1]) + " x " + std::to_string(n[2]);
+    };
+    return "its size is " + sizeText(size) + " voxels" + where + sizeText(other.size);
+  }
+  if ((spacing - other.spacing).norm() > 1e-6 * spacing.norm())
+    return "its spacing is " + vector(spacing) + " mm" + where + vector(other.spacing);
+  if ((direction - other.direction).norm() > 1e-6)
+    return "its axes point other ways than the " + otherName + "'s (a flipped, permuted or rotated copy)";
+  return "its origin is " + vector(origin) + " mm (LPS)" + where + vector(other.origin);
 }
 
 ImageGeometry ImageGeometry::region(const std::array<int, 3>& first, const std::array<int, 3>& regionSize) const {

@@ -41,6 +41,26 @@ void uvSphere(const Vector3& centre, double radius, MatrixX3& points, std::vecto
   }
 }
 
+// A grid that is not another's says how, so that a user knows what to resample.
+TEST(ImageGeometry, ItsDifferenceFromAnotherGridIsNamed) {
+  ImageGeometry image;
+  image.size = {181, 217, 181};
+  EXPECT_EQ(image.differenceFrom(image, "image"), "");
+  ImageGeometry other = image;
+  other.size = {91, 109, 91};
+  EXPECT_EQ(other.differenceFrom(image, "image"), "its size is 91 x 109 x 91 voxels, where the image's is 181 x 217 x 181");
+  other = image;
+  other.spacing = Vector3(2, 2, 2);
+  EXPECT_EQ(other.differenceFrom(image, "image"), "its spacing is (2, 2, 2) mm, where the image's is (1, 1, 1)");
+  other = image;
+  other.direction(0, 0) = -1;
+  EXPECT_EQ(other.differenceFrom(image, "image"),
+            "its axes point other ways than the image's (a flipped, permuted or rotated copy)");
+  other = image;
+  other.origin = Vector3(-90, 126, -72);
+  EXPECT_EQ(other.differenceFrom(image, "image"), "its origin is (-90, 126, -72) mm (LPS), where the image's is (0, 0, 0)");
+}
+
 TEST(Voxelize, SphereOnAnAnisotropicRotatedGrid) {
   const ImageGeometry g = grid({48, 40, 24}, Vector3(0.6, 0.8, 1.5), Vector3(-14, -15, -16), skewDirection());
   const Vector3 centre = g.toPhysical(Vector3(23.5, 19.5, 11.5));

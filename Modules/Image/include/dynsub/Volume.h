@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "dynsub/Types.h"
@@ -49,6 +50,10 @@ struct ImageGeometry {
   // Same size, and origin, spacing and direction equal to within 1e-6 (relative
   // for origin and spacing): the two images' voxels are the same places.
   bool sameGridAs(const ImageGeometry& other) const;
+  // How this grid differs from `other`, called `otherName`, in words (the
+  // first difference: "its size is 91 x 109 x 91 voxels, where the image's
+  // is 181 x 217 x 181"); empty when sameGridAs.
+  std::string differenceFrom(const ImageGeometry& other, const std::string& otherName) const;
   // The same grid on the index box [first, first + size).
   ImageGeometry region(const std::array<int, 3>& first, const std::array<int, 3>& regionSize) const;
 };
