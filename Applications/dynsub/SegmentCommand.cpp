@@ -70,7 +70,8 @@ std::vector<int> parseLabelValues(const std::string& text) {
     }
     if (used == 0 || used != item.size())
       throw UsageError("--reference-label " + text + ": expected N[,M...] (integers)");
-    if (value == 0) throw UsageError("--reference-label " + text + ": 0 is the reference's background, not a structure");
+    if (value == 0)
+      throw UsageError("--reference-label " + text + ": 0 is the reference's background, not a structure");
     values.push_back(value);
   }
   return values;

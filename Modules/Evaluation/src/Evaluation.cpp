@@ -300,7 +300,8 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
       const std::string where = "structure '" + name + "'";
       std::vector<int> labels;
       for (const auto& label : listOf(required(s, "labels", where), where + ": labels"))
-        labels.push_back(static_cast<int>(wholeNumber(label, where + ": a label (0 is the background)", 1, kLargestSetting)));
+        labels.push_back(
+            static_cast<int>(wholeNumber(label, where + ": a label (0 is the background)", 1, kLargestSetting)));
       if (labels.empty()) throw Error(path, where + " has no labels");
       plan.structures.push_back(
           {name, labels, axisOf(textOf(required(s, "orientation", where), where + ": orientation"), where)});

@@ -154,12 +154,13 @@ void requireOnePlacement(const std::string& path, const Real& real, const std::a
                           distance +
                           " mm elsewhere. Resample the image onto a grid without shear, or set its sform_code to 0 "
                           "if the qform is the placement meant");
-  throw Error(path, "a NIfTI header whose qform and sform place the image up to " + std::string(distance) +
-                        " mm apart: ITK-based tools (DynSub, 3D Slicer, ITK-SNAP) read the qform, as the sform_code is " +
-                        std::to_string(sformCode) +
-                        " (not 1, scanner), while FSL and nibabel read the sform. Make the two agree (FSL: "
-                        "fslorient -copysform2qform if the sform is the placement meant, -copyqform2sform if the "
-                        "qform is)");
+  throw Error(path,
+              "a NIfTI header whose qform and sform place the image up to " + std::string(distance) +
+                  " mm apart: ITK-based tools (DynSub, 3D Slicer, ITK-SNAP) read the qform, as the sform_code is " +
+                  std::to_string(sformCode) +
+                  " (not 1, scanner), while FSL and nibabel read the sform. Make the two agree (FSL: "
+                  "fslorient -copysform2qform if the sform is the placement meant, -copyqform2sform if the "
+                  "qform is)");
 }
 
 }  // namespace
@@ -198,8 +199,9 @@ DataCheck checkNiftiHeader(const std::string& path) {
   const bool swap = number(0, 4, false) != 348;
   if (number(0, 4, swap) != 348) {
     if (number(0, 4, false) == 540 || number(0, 4, true) == 540)
-      throw Error(path, "a NIfTI-2 file, which ITK 5.2 (DynSub's image reader) does not read: save it as NIfTI-1 "
-                        "(nibabel: nibabel.Nifti1Image; FSL and SPM write NIfTI-1)");
+      throw Error(path,
+                  "a NIfTI-2 file, which ITK 5.2 (DynSub's image reader) does not read: save it as NIfTI-1 "
+                  "(nibabel: nibabel.Nifti1Image; FSL and SPM write NIfTI-1)");
     throw Error(path, "not a NIfTI file (its first four bytes give no header size of 348)");
   }
   const int headerSize = 348;

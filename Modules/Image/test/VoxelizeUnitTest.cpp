@@ -48,7 +48,8 @@ TEST(ImageGeometry, ItsDifferenceFromAnotherGridIsNamed) {
   EXPECT_EQ(image.differenceFrom(image, "image"), "");
   ImageGeometry other = image;
   other.size = {91, 109, 91};
-  EXPECT_EQ(other.differenceFrom(image, "image"), "its size is 91 x 109 x 91 voxels, where the image's is 181 x 217 x 181");
+  EXPECT_EQ(other.differenceFrom(image, "image"),
+            "its size is 91 x 109 x 91 voxels, where the image's is 181 x 217 x 181");
   other = image;
   other.spacing = Vector3(2, 2, 2);
   EXPECT_EQ(other.differenceFrom(image, "image"), "its spacing is (2, 2, 2) mm, where the image's is (1, 1, 1)");
@@ -58,7 +59,8 @@ TEST(ImageGeometry, ItsDifferenceFromAnotherGridIsNamed) {
             "its axes point other ways than the image's (a flipped, permuted or rotated copy)");
   other = image;
   other.origin = Vector3(-90, 126, -72);
-  EXPECT_EQ(other.differenceFrom(image, "image"), "its origin is (-90, 126, -72) mm (LPS), where the image's is (0, 0, 0)");
+  EXPECT_EQ(other.differenceFrom(image, "image"),
+            "its origin is (-90, 126, -72) mm (LPS), where the image's is (0, 0, 0)");
 }
 
 TEST(Voxelize, SphereOnAnAnisotropicRotatedGrid) {

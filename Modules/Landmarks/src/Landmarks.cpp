@@ -225,8 +225,9 @@ std::vector<Landmark> readCsv(const std::string& path, std::ifstream& in, Coordi
     }
   }
   if (x < 0 || y < 0 || z < 0)
-    throw Error(path, "the first line must name the columns x, y and z (LPS mm), or l, p, s or r, a, s as 3D Slicer's "
-                      "markups tables do");
+    throw Error(path,
+                "the first line must name the columns x, y and z (LPS mm), or l, p, s or r, a, s as 3D Slicer's "
+                "markups tables do");
   requireDistinctColumns(path, number, header);
   std::vector<Landmark> landmarks;
   while (std::getline(in, line)) {

@@ -89,8 +89,7 @@ void checkPolygonMesh(const MatrixX3& points, const std::vector<std::vector<int>
     for (size_t i = 0; i < face.size(); ++i) {
       for (size_t j = i + 1; j < face.size(); ++j) {
         if (face[i] == face[j]) {
-          throw Error(source, faceName + " is degenerate: it uses vertex " + number(face[i]) +
-                                  " twice");
+          throw Error(source, faceName + " is degenerate: it uses vertex " + number(face[i]) + " twice");
         }
       }
     }
@@ -134,8 +133,8 @@ void checkPolygonMesh(const MatrixX3& points, const std::vector<std::vector<int>
   }
   if (repeated) {
     const int to = repeated->from == repeated->low ? repeated->high : repeated->low;
-    throw Error(source, "faces " + number(before->face) + " and " + number(repeated->face) +
-                            " both run along edge " + edgeName(repeated->from, to) +
+    throw Error(source, "faces " + number(before->face) + " and " + number(repeated->face) + " both run along edge " +
+                            edgeName(repeated->from, to) +
                             " in the same direction: the orientation is inconsistent (or a face is repeated)");
   }
   for (int v = 0; v < vertexCount; ++v) {
@@ -149,8 +148,8 @@ void checkPolygonMesh(const MatrixX3& points, const std::vector<std::vector<int>
     }
     const size_t faceCount = vertexFaces[v].size();
     if (faceCount > static_cast<size_t>(kLargestValence)) {
-      throw Error(source, "vertex " + number(v) + " has " + std::to_string(faceCount) +
-                              " faces around it; at most " + std::to_string(kLargestValence) +
+      throw Error(source, "vertex " + number(v) + " has " + std::to_string(faceCount) + " faces around it; at most " +
+                              std::to_string(kLargestValence) +
                               " are supported (the surface's cost near a vertex grows faster than the cube of "
                               "their number). Remesh it with fewer faces around that vertex");
     }
