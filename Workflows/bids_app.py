@@ -16,6 +16,7 @@ Exit codes: 0 done, 1 a job or the workflow failed, 2 a usage error.
 import argparse
 import json
 import os
+import shlex
 import subprocess
 import sys
 
@@ -91,9 +92,9 @@ def main(argv, snakefile, dynsub):
         parser.error(f"{args.output_dir}: the output directory must not be the BIDS dataset itself")
     work = os.path.abspath(args.work_dir or os.path.join(out, "work"))
     # Snakemake 7 starts each job with an unquoted `cd WORK`.
-    if any(c.isspace() for c in work):
-        parser.error(f"{work}: Snakemake cannot run jobs in a work directory whose path has a space; "
-                     "give --work-dir a path without one")
+    if shlex.quote(work) != work:
+        parser.error(f"{work}: Snakemake cannot run jobs in a work directory whose path has a space or another "
+                     "character a shell would read; give --work-dir a path of letters, digits and ./-_ only")
 
     # Values go to Snakemake as JSON, which its YAML reading keeps as given:
     # a label "01" stays a string, and a list stays a list.
@@ -109,12 +110,18 @@ def main(argv, snakefile, dynsub):
     except (bids.CohortError, OSError) as error:
         print(f"dynsub-bids: error: {error}", file=sys.stderr)
         return 1
-    if args.analysis_level == "group" and not bids.written_reports(jobs, out):
+    if args.analysis_level == "participant" and not args.unlock:
+        landmarks = config.get("landmarks", f"{bids_dir}/derivatives/landmarks")
+        for path in bids.uncovered_images(config, jobs):
+            print(f"dynsub-bids: warning: {path}: not segmented: no landmarks for it in "
+                  f"{landmarks}/sub-<label>/[ses-<label>/]anat/ and no seed in "
+                  f"{config.get('seeds', bids_dir + '/derivatives/seeds.tsv')}", file=sys.stderr)
+    if args.analysis_level == "group" and not args.unlock and not bids.written_reports(jobs, out):
         print(f"dynsub-bids: error: {out}: no segmentation written yet; run the participant level first",
               file=sys.stderr)
         return 1
 
-    if not args.dry_run:
+    if not args.dry_run and not args.unlock:
         os.makedirs(work, exist_ok=True)
         os.makedirs(out, exist_ok=True)
         bids.write_dataset_description(os.path.join(out, "dataset_description.json"), version, bids_dir)

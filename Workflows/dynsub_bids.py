@@ -189,13 +189,9 @@ def _read_names(table):
     return names
 
 
-def find_structures(bids, landmarks_dir, seeds_table, reference_dir, warn=_warn):
-    """Every (image, structure) with landmarks or a seed, keyed by (stem, structure name).
-
-    A T1w whose name has entities other than ENTITIES is skipped with a
-    warning; so is a reference found for a structure its table does not
-    name.
-    """
+def find_images(bids, warn=_warn):
+    """Every T1w image of the dataset, keyed by (subject, session, entities);
+    one whose name has entities other than ENTITIES is skipped with a warning."""
     if not os.path.isdir(bids):
         raise CohortError(f"{bids}: no such BIDS directory")
     images = {}  # (subject, session, entities) -> path
@@ -213,7 +209,17 @@ def find_structures(bids, landmarks_dir, seeds_table, reference_dir, warn=_warn)
         if key in images:  # .nii beside .nii.gz
             raise CohortError(f"{path}: a second file for the same T1w (also {images[key]})")
         images[key] = path
+    return images
 
+
+def find_structures(bids, landmarks_dir, seeds_table, reference_dir, warn=_warn):
+    """Every (image, structure) with landmarks or a seed, keyed by (stem, structure name).
+
+    A T1w whose name has entities other than ENTITIES is skipped with a
+    warning; so is a reference found for a structure its table does not
+    name.
+    """
+    images = find_images(bids, warn)
     structures = {}
 
     def structure_for(subject, session, entities, name, source):
@@ -267,14 +273,6 @@ def find_structures(bids, landmarks_dir, seeds_table, reference_dir, warn=_warn)
             if structure.seed is not None:
                 raise CohortError(f"{where}: a second seed for {structure.stem} {structure.name}")
             structure.seed = seed
-
-    # An image nobody placed points in is left out, and said so: a landmark
-    # file in the wrong folder would otherwise drop its subject unseen.
-    covered = {s.t1w for s in structures.values()}
-    for path in images.values():
-        if path not in covered:
-            warn(f"{path}: not segmented: no landmarks for it in {landmarks_dir}/sub-<label>/[ses-<label>/]anat/ "
-                 f"and no seed in {seeds_table or 'a seeds.tsv'}")
 
     if reference_dir and os.path.isdir(reference_dir):
         dataset_table = f"{reference_dir}/dseg.tsv"
@@ -360,6 +358,18 @@ def configured_jobs(config):
     if not jobs:
         raise CohortError(f"{root}: no landmarks or seeds found for any T1w image")
     return select_jobs(jobs, labels(config.get("participant_label")), labels(config.get("session_label")))
+
+
+def uncovered_images(config, jobs):
+    """The T1w images of the chosen participants and sessions that no job
+    segments (no landmarks and no seed for them): a landmark file in the
+    wrong folder would otherwise leave its image out unseen."""
+    participants, sessions = labels(config.get("participant_label")), labels(config.get("session_label"))
+    covered = {job.t1w for job in jobs.values()}
+    return [path for (subject, session, _), path in find_images(os.path.abspath(str(config["bids"])),
+                                                                  warn=lambda message: None).items()
+            if path not in covered and (not participants or subject in participants)
+            and (not sessions or session in sessions)]
 
 
 def written_reports(jobs, out):

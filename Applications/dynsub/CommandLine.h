@@ -31,8 +31,8 @@ struct SimulationArguments {
 void addSegmentParameterOptions(CLI::App& command, SegmentParameters& parameters);
 
 // Checks for a number on the command line, each refusal saying what is
-// wrong: "--samples-per-face: abc is not a number", "2.5 is not a whole
-// number", "2000 is not between 1 and 1024", "-1 is not a finite number > 0".
+// wrong: "--samples-per-face: 'abc' is not a number", "'2.5' is not a whole
+// number", "'2000' is not between 1 and 1024", "'-1' is not a finite number > 0".
 // A whole number is taken in decimal digits only.
 CLI::Validator numberBetween(double low, double high, bool whole);
 // Finite, > 0 (or >= 0) and at most `largest`.

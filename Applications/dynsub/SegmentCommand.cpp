@@ -410,8 +410,9 @@ void addSegmentCommand(CLI::App& app) {
   command->add_option("--out", o->out, "Output directory (created if missing; its parent must exist)")->required();
   command
       ->add_option("--landmarks", o->landmarks,
-                   "Boundary points: .mrk.json, .fcsv or .csv (x,y,z in LPS mm). Given once per structure, or "
-                   "as a .mrk.json with a point list per structure, the structures are segmented together: they "
+                   "Boundary points: .mrk.json, .fcsv or .csv (x,y,z or l,p,s in LPS mm; r,a,s in RAS). Given "
+                   "once per structure, or as a .mrk.json with a point list per structure, the structures are "
+                   "segmented together: they "
                    "do not overlap, and DIR/dseg.nii.gz with DIR/dseg.tsv names them (each structure's outputs "
                    "in DIR/NAME)")
       ->expected(1)

@@ -18,7 +18,9 @@
 #  - mistakes are refused with a message and nothing written: a label that
 #    selects nothing, the group level before any participant, a missing
 #    dataset, an unknown level, the dataset as its own output through a
-#    link, a work directory with a space, a structure seeded twice.
+#    link, a work directory with a space, a structure seeded twice;
+#  - a seeds table with a byte order mark is read, and a T1w without
+#    landmarks or a seed is warned of once, when its participant is chosen.
 # Needs DYNSUB_BIDS, DATA, WORKFLOWS, BIDS_VALIDATOR; snakemake, nibabel.
 set -u
 source "$DATA/../Applications/dynsub/test/Checks.sh"
@@ -124,13 +126,28 @@ check "the dataset as its own output through a link: its description kept" \
   cmp -s "$bids/dataset_description.json" "$work/description"
 "$DYNSUB_BIDS" "$bids" "$work/with space" participant >"$work/bad.log" 2>&1
 check "a work directory with a space: exit 2, named" \
-  test $? -eq 2 -a -n "$(grep "path has a space; give --work-dir" "$work/bad.log")"
+  test $? -eq 2 -a -n "$(grep "path has a space" "$work/bad.log")"
 cp "$bids/derivatives/seeds.tsv" "$work/seeds.tsv"
 tail -n 1 "$work/seeds.tsv" | awk -F'\t' -v OFS='\t' '{ $NF = $NF + 1; print }' >>"$work/seeds.tsv"
 "$DYNSUB_BIDS" "$bids" "$work/fresh" participant --seeds "$work/seeds.tsv" >"$work/bad.log" 2>&1
 check "a structure seeded twice: exit 1, named" \
   test $? -eq 1 -a -n "$(grep "seeds.tsv:[0-9]*: a second seed for sub-01 thalamusL" "$work/bad.log")"
 check "a structure seeded twice: nothing written" test ! -e "$work/fresh"
+# Excel's "CSV UTF-8" starts the seeds table with a byte order mark.
+printf '\xef\xbb\xbf' | cat - "$bids/derivatives/seeds.tsv" >"$work/bom.tsv"
+"$DYNSUB_BIDS" "$bids" "$work/fresh" participant --seeds "$work/bom.tsv" --dry-run >"$work/bom.log" 2>&1
+check "a seeds table with a byte order mark: read" test $? -eq 0 || tail -5 "$work/bom.log"
+# A T1w with neither landmarks nor a seed is named once, when its
+# participant is chosen.
+cp -r "$bids" "$work/extra"
+mkdir -p "$work/extra/sub-05/anat"
+cp "$bids/sub-02/anat/sub-02_T1w.nii.gz" "$work/extra/sub-05/anat/sub-05_T1w.nii.gz"
+"$DYNSUB_BIDS" "$work/extra" "$work/fresh" participant --dry-run >"$work/extra.log" 2>&1
+check "a T1w without landmarks: warned of once" \
+  test "$(grep -c "sub-05_T1w.nii.gz: not segmented: no landmarks" "$work/extra.log")" -eq 1
+"$DYNSUB_BIDS" "$work/extra" "$work/fresh" participant --participant-label 01 --dry-run >"$work/extra.log" 2>&1
+check "a T1w without landmarks, its participant not chosen: not warned of" \
+  test "$(grep -c "sub-05_T1w.nii.gz: not segmented" "$work/extra.log")" -eq 0
 
 echo "$failures failure(s)"
 exit $((failures > 0))

@@ -704,7 +704,7 @@ expect_error "RAS values in a file that says LPS" 1 \
   "ras_says_lps.mrk.json: these points look like RAS; they are read as LPS.*\"coordinateSystem\" to \"RAS\"" \
   "$work/s15" "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/ras_says_lps.mrk.json" --no-figures \
   --out "$work/s15"
-expect_error "RAS values in a CSV" 1 "ras.csv: these points look like RAS.*a CSV's points are LPS" "$work/s16" \
+expect_error "RAS values in a CSV" 1 "ras.csv: these points look like RAS.*name the columns r, a, s" "$work/s16" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/ras.csv" --no-figures --out "$work/s16"
 expect_error "LPS values in a file that says RAS" 1 "these points look like LPS; they are read as RAS" "$work/s17" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/lps_says_ras.mrk.json" --no-figures --out "$work/s17"

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 
 namespace dynsub {
@@ -38,8 +39,8 @@ bool ImageGeometry::sameGridAs(const ImageGeometry& other) const {
 std::string ImageGeometry::differenceFrom(const ImageGeometry& other, const std::string& otherName) const {
   if (sameGridAs(other)) return "";
   const auto vector = [](const Vector3& v) {
-    std::ostringstream text;
-    text << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
+    std::ostringstream text;  // digits enough to show a difference sameGridAs sees
+    text << std::setprecision(9) << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
     return text.str();
   };
   const std::string where = ", where the " + otherName + "'s is ";
@@ -51,8 +52,18 @@ std::string ImageGeometry::differenceFrom(const ImageGeometry& other, const std:
   }
   if ((spacing - other.spacing).norm() > 1e-6 * spacing.norm())
     return "its spacing is " + vector(spacing) + " mm" + where + vector(other.spacing);
-  if ((direction - other.direction).norm() > 1e-6)
-    return "its axes point other ways than the " + otherName + "'s (a flipped, permuted or rotated copy)";
+  if ((direction - other.direction).norm() > 1e-6) {
+    double degrees = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double cosine =
+          std::clamp(direction.col(a).normalized().dot(other.direction.col(a).normalized()), -1.0, 1.0);
+      degrees = std::max(degrees, std::acos(cosine) * 57.29577951308232);  // degrees per radian
+    }
+    std::ostringstream text;
+    text << std::setprecision(3) << "its axes point other ways than the " << otherName << "'s (up to " << degrees
+         << " degrees apart: a flipped, permuted or rotated copy)";
+    return text.str();
+  }
   return "its origin is " + vector(origin) + " mm (LPS)" + where + vector(other.origin);
 }
 

@@ -56,7 +56,11 @@ TEST(ImageGeometry, ItsDifferenceFromAnotherGridIsNamed) {
   other = image;
   other.direction(0, 0) = -1;
   EXPECT_EQ(other.differenceFrom(image, "image"),
-            "its axes point other ways than the image's (a flipped, permuted or rotated copy)");
+            "its axes point other ways than the image's (up to 180 degrees apart: a flipped, permuted or rotated "
+            "copy)");
+  other.spacing = Vector3(1.000002, 1, 1);  // beyond sameGridAs's 1e-6, and shown
+  other.direction = image.direction;
+  EXPECT_EQ(other.differenceFrom(image, "image"), "its spacing is (1.000002, 1, 1) mm, where the image's is (1, 1, 1)");
   other = image;
   other.origin = Vector3(-90, 126, -72);
   EXPECT_EQ(other.differenceFrom(image, "image"),

@@ -186,12 +186,9 @@ std::vector<Landmark> readFcsv(const std::string& path, std::ifstream& in, Coord
   return landmarks;
 }
 
-// A line that holds nothing to read: empty, blank, separators alone (a
-// spreadsheet's formatted but empty row), or a comment.
-bool nothingOn(const std::string& line) {
-  const std::string text = trimmed(line);
-  return text.empty() || text[0] == '#' || text.find_first_not_of(", \t\r") == std::string::npos;
-}
+// A line that holds nothing to read: empty, blank, or separators alone (a
+// spreadsheet's formatted but empty row).
+bool nothingOn(const std::string& line) { return trimmed(line).find_first_not_of(", \t\r") == std::string::npos; }
 
 // x, y, z (LPS mm), or 3D Slicer's markups table: l, p, s (LPS) or r, a, s
 // (RAS), with `defined` 0 for a point not yet placed.
@@ -204,7 +201,8 @@ std::vector<Landmark> readCsv(const std::string& path, std::ifstream& in, Coordi
     if (number == 1) line = withoutByteOrderMark(line);
     if (const auto cr = line.find('\r'); cr != std::string::npos && cr + 1 < line.size())
       throw Error(path, "its lines end in a carriage return alone (old Mac text): save it with LF or CR LF line ends");
-    if (!nothingOn(line)) header = splitCsvFields(line, ',');
+    // Comments come before the header; after it, a row's label may start with '#'.
+    if (!nothingOn(line) && trimmed(line)[0] != '#') header = splitCsvFields(line, ',');
   }
   // Column names in any case: X, Label.
   for (std::string& name : header)
@@ -217,9 +215,9 @@ std::vector<Landmark> readCsv(const std::string& path, std::ifstream& in, Coordi
   const int label = column("label"), defined = column("defined");
   system = CoordinateSystem::LPS;
   if (x < 0 && y < 0 && z < 0) {
-    if (column("l") >= 0 || column("p") >= 0) {
+    if (column("l") >= 0 && column("p") >= 0 && column("s") >= 0) {
       x = column("l"), y = column("p"), z = column("s");
-    } else if (column("r") >= 0 || column("a") >= 0) {
+    } else if (column("r") >= 0 && column("a") >= 0 && column("s") >= 0) {
       x = column("r"), y = column("a"), z = column("s");
       system = CoordinateSystem::RAS;
     }
@@ -245,9 +243,11 @@ std::vector<Landmark> readCsv(const std::string& path, std::ifstream& in, Coordi
     if (static_cast<int>(fields.size()) <= std::max({x, y, z}))
       throw Error(path, "line " + std::to_string(number) + ": too few fields");
     // A point Slicer lists but has not placed: its position is not a click.
-    if (defined >= 0 && defined < static_cast<int>(fields.size()) &&
-        (fields[defined] == "0" || fields[defined] == "false"))
-      continue;
+    if (defined >= 0 && defined < static_cast<int>(fields.size())) {
+      std::string value = fields[defined];
+      for (char& ch : value) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+      if (value == "0" || value == "false") continue;
+    }
     const Vector3 p(finiteNumber(fields[x], path, number), finiteNumber(fields[y], path, number),
                     finiteNumber(fields[z], path, number));
     landmarks.push_back({label >= 0 && label < static_cast<int>(fields.size()) ? fields[label] : "",

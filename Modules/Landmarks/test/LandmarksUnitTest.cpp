@@ -207,21 +207,25 @@ TEST(Landmarks, SpreadsheetFilesAreRead) {
   std::ofstream(csv.string()) << "\xEF\xBB\xBFX,Y,Z,Label\n-12,10,12,head\n-14,12,10\n";
   std::ofstream(scratch("trailing.csv").string()) << "x,y,z\n1,2,3,\n4,5,6\n";
   EXPECT_EQ(readLandmarks(scratch("trailing.csv").string()).size(), 2u);
-  // Comments, and rows of separators alone (a spreadsheet's formatted empty
-  // rows), hold no point.
-  std::ofstream(scratch("blank.csv").string()) << "# clicks of rater 2\nx,y,z\n1,2,3\n,,\n  \n# done\n4,5,6\n";
-  EXPECT_EQ(readLandmarks(scratch("blank.csv").string()).size(), 2u);
+  // Comments before the header, and rows of separators alone (a
+  // spreadsheet's formatted empty rows), hold no point; after the header a
+  // label may start with '#'.
+  std::ofstream(scratch("blank.csv").string()) << "# clicks of rater 2\nx,y,z,label\n1,2,3\n,,\n  \n4,5,6,#2\n";
+  const std::vector<Landmark> blank = readLandmarks(scratch("blank.csv").string());
+  ASSERT_EQ(blank.size(), 2u);
+  EXPECT_EQ(blank[1].label, "#2");
   // 3D Slicer's markups table, in LPS (l, p, s) or RAS (r, a, s), its
   // unplaced points (defined 0) left out.
   std::ofstream(scratch("slicer_lps.csv").string())
-      << "label,l,p,s,defined,selected,visible,locked,description\nF-1,1,2,3,1,1,1,0,\nF-2,0,0,0,0,1,1,0,\n";
+      << "label,l,p,s,defined,selected,visible,locked,description\nF-1,1,2,3,1,1,1,0,\nF-2,0,0,0,0,1,1,0,\n"
+      << "F-3,0,0,0,FALSE,1,1,0,\n";
   CoordinateSystem stated = CoordinateSystem::RAS;
   const std::vector<Landmark> lps = readLandmarks(scratch("slicer_lps.csv").string(), &stated);
   ASSERT_EQ(lps.size(), 1u);
   EXPECT_EQ(lps[0].position, Vector3(1, 2, 3));
   EXPECT_EQ(stated, CoordinateSystem::LPS);
   std::ofstream(scratch("slicer_ras.csv").string())
-      << "label,r,a,s,defined,selected,visible,locked,description\nF-1,1,2,3,1,1,1,0,\n";
+      << "label,r,a,s,defined,p\nF-1,1,2,3,1,0.5\n";  // r, a, s complete: an extra 'p' column is not an axis
   const std::vector<Landmark> ras = readLandmarks(scratch("slicer_ras.csv").string(), &stated);
   ASSERT_EQ(ras.size(), 1u);
   EXPECT_EQ(ras[0].position, Vector3(-1, -2, 3));

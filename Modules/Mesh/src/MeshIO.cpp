@@ -106,8 +106,7 @@ PolygonData readObj(const std::string& path) {
       data.creases.push_back(parseCreaseTag(record, path, line));
     }
   }
-  // Named here, as the file writes it (from 1), rather than by the mesh
-  // check, which counts vertices and faces from 0.
+  // Named here with its line, which the mesh check does not know.
   for (std::size_t f = 0; f < data.faces.size(); ++f)
     for (const int v : data.faces[f])
       if (v >= static_cast<int>(points.size()))

@@ -328,8 +328,8 @@ std::string conventionFix(const std::string& source, CoordinateSystem meant) {
   if (extension == ".json") return "set the markups' \"coordinateSystem\" to \"" + system + "\"";
   if (extension == ".fcsv") return "set the file's header to '# CoordinateSystem = " + system + "'";
   if (extension == ".csv")
-    return "negate x and y (a CSV's points are LPS), or save the points as a .mrk.json with \"coordinateSystem\": "
-           "\"RAS\"";
+    return meant == CoordinateSystem::RAS ? "name the columns r, a, s (a CSV's x, y, z and l, p, s are LPS)"
+                                          : "name the columns x, y, z or l, p, s (r, a, s are RAS)";
   return "negate x and y (points given as numbers are LPS)";
 }
 

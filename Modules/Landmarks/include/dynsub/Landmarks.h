@@ -8,8 +8,10 @@
 //    left out.
 //  - Legacy 3D Slicer fiducials (.fcsv): the "# CoordinateSystem =" header
 //    gives LPS or RAS (also the old 1 = LPS, 0 = RAS); columns id,x,y,z,...,label.
-//  - CSV (.csv): a header line naming columns x, y, z (and optionally label),
-//    one point per line, LPS mm.
+//  - CSV (.csv): a header line naming columns x, y, z (LPS mm) or, as 3D
+//    Slicer's markups tables do, l, p, s (LPS) or r, a, s (RAS), and
+//    optionally label and defined (0 or false: a point not placed, left
+//    out); one point per line; '#' comments before the header.
 // RAS -> LPS negates x and y.
 #include <string>
 #include <vector>
@@ -29,7 +31,7 @@ struct Landmark {
 // a malformed entry (with its line or index), a markup of an unknown type or
 // a non-finite coordinate.
 // `stated`, when given, receives the system the file says its values are in
-// (a CSV's are LPS; of several markups lists, the first's), for messages
+// (a CSV's by its columns; of several markups lists, the first's), for messages
 // about a file that says one and holds the other.
 std::vector<Landmark> readLandmarks(const std::string& path, CoordinateSystem* stated = nullptr);
 
