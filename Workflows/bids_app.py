@@ -111,11 +111,8 @@ def main(argv, snakefile, dynsub):
         print(f"dynsub-bids: error: {error}", file=sys.stderr)
         return 1
     if args.analysis_level == "participant" and not args.unlock:
-        landmarks = config.get("landmarks", f"{bids_dir}/derivatives/landmarks")
-        for path in bids.uncovered_images(config, jobs):
-            print(f"dynsub-bids: warning: {path}: not segmented: no landmarks for it in "
-                  f"{landmarks}/sub-<label>/[ses-<label>/]anat/ and no seed in "
-                  f"{config.get('seeds', bids_dir + '/derivatives/seeds.tsv')}", file=sys.stderr)
+        for warning in bids.uncovered_warnings(config, jobs):
+            print(f"dynsub-bids: warning: {warning}", file=sys.stderr)
     if args.analysis_level == "group" and not args.unlock and not bids.written_reports(jobs, out):
         print(f"dynsub-bids: error: {out}: no segmentation written yet; run the participant level first",
               file=sys.stderr)

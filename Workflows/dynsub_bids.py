@@ -332,12 +332,17 @@ def labels(value):
     return result
 
 
+def is_chosen(subject, session, participants, sessions):
+    """Whether an image of this subject and session is among the given
+    participants and sessions (all where a list is empty)."""
+    return (not participants or subject in participants) and (not sessions or session in sessions)
+
+
 def select_jobs(jobs, participants, sessions):
     """The jobs of the given participants and sessions (all where a list is
     empty). A label that selects nothing is an error: it is a typing slip more
     often than an intended no-op."""
-    chosen = {key: job for key, job in jobs.items()
-              if (not participants or job.subject in participants) and (not sessions or job.session in sessions)}
+    chosen = {key: job for key, job in jobs.items() if is_chosen(job.subject, job.session, participants, sessions)}
     for label in participants:
         if not any(job.subject == label for job in chosen.values()):
             raise CohortError(f"sub-{label}: no T1w image with landmarks or a seed"
@@ -348,28 +353,35 @@ def select_jobs(jobs, participants, sessions):
     return chosen
 
 
-def configured_jobs(config):
-    """The jobs a workflow configuration names: the Snakefile's --config and
-    the BIDS App's settings, with the same defaults."""
+def _sources(config):
+    """A workflow configuration's dataset and where its landmarks, seeds and
+    references are (the Snakefile's --config and the BIDS App's settings),
+    with the same defaults for both."""
     root = os.path.abspath(str(config["bids"]))
-    jobs = group_jobs(find_structures(root, str(config.get("landmarks", f"{root}/derivatives/landmarks")),
-                                      config.get("seeds", default_seeds(root)),
-                                      str(config.get("reference", f"{root}/derivatives/reference"))))
+    return (root, str(config.get("landmarks", f"{root}/derivatives/landmarks")),
+            config.get("seeds", default_seeds(root)), str(config.get("reference", f"{root}/derivatives/reference")))
+
+
+def configured_jobs(config):
+    """The jobs a workflow configuration names."""
+    root, landmarks, seeds, reference = _sources(config)
+    jobs = group_jobs(find_structures(root, landmarks, seeds, reference))
     if not jobs:
         raise CohortError(f"{root}: no landmarks or seeds found for any T1w image")
     return select_jobs(jobs, labels(config.get("participant_label")), labels(config.get("session_label")))
 
 
-def uncovered_images(config, jobs):
-    """The T1w images of the chosen participants and sessions that no job
-    segments (no landmarks and no seed for them): a landmark file in the
-    wrong folder would otherwise leave its image out unseen."""
+def uncovered_warnings(config, jobs):
+    """A warning for each T1w image of the chosen participants and sessions
+    that no job segments (no landmarks and no seed for it): a landmark file in
+    the wrong folder would otherwise leave its image out unseen."""
+    root, landmarks, seeds, _ = _sources(config)
     participants, sessions = labels(config.get("participant_label")), labels(config.get("session_label"))
     covered = {job.t1w for job in jobs.values()}
-    return [path for (subject, session, _), path in find_images(os.path.abspath(str(config["bids"])),
-                                                                  warn=lambda message: None).items()
-            if path not in covered and (not participants or subject in participants)
-            and (not sessions or session in sessions)]
+    return [f"{path}: not segmented: no landmarks for it in {landmarks}/sub-<label>/[ses-<label>/]anat/ "
+            f"and no seed in {seeds or root + '/derivatives/seeds.tsv'}"
+            for (subject, session, _), path in find_images(root, warn=lambda message: None).items()
+            if path not in covered and is_chosen(subject, session, participants, sessions)]
 
 
 def written_reports(jobs, out):

@@ -58,11 +58,6 @@ std::vector<std::pair<int, std::string>> readNames(const std::string& labelsPath
   return {};
 }
 
-std::string lowered(std::string text) {
-  std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return std::tolower(c); });
-  return text;
-}
-
 itkbridge::AffineArray toArray(const AffineMap& map) {
   itkbridge::AffineArray a{};
   for (int r = 0; r < 3; ++r) {
@@ -152,7 +147,7 @@ std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec, c
       continue;
     }
     const auto named = std::find_if(atlas.names.begin(), atlas.names.end(),
-                                    [&](const auto& entry) { return lowered(entry.second) == lowered(item); });
+                                    [&](const auto& entry) { return lowerCase(entry.second) == lowerCase(item); });
     if (named != atlas.names.end()) {
       values.push_back(named->first);
       continue;

@@ -1,18 +1,14 @@
 #include "dynsub/FileNames.h"
 
-#include <algorithm>
-#include <cctype>
 #include <filesystem>
 
 #include "dynsub/Error.h"
+#include "dynsub/TextFields.h"
 
 namespace dynsub {
 
 std::string lowerCaseExtension(const std::string& path) {
-  std::string extension = std::filesystem::path(path).extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return extension;
+  return lowerCase(std::filesystem::path(path).extension().string());
 }
 
 void requireNotInput(const std::string& output, const std::string& input) {

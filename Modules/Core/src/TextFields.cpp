@@ -57,6 +57,11 @@ std::string afterObjectAddress(const std::string& line) {
   return end == std::string::npos ? line : line.substr(end + 3);
 }
 
+std::string lowerCase(std::string text) {
+  for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return text;
+}
+
 std::string withoutByteOrderMark(const std::string& line) {
   return line.rfind("\xEF\xBB\xBF", 0) == 0 ? line.substr(3) : line;
 }

@@ -19,6 +19,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// A NIfTI-1 header's size, which its first four bytes state, and the size of
+// its real numbers (floats).
+constexpr int kHeaderBytes = 348;
+constexpr int kRealBytes = 4;
+
 // The bytes per voxel of a NIfTI datatype code, 0 for a code NIfTI does not define.
 int niftiBytesPerVoxel(int datatype) {
   switch (datatype) {
@@ -90,12 +95,11 @@ std::vector<unsigned char> readBytes(const std::string& path, std::uintmax_t off
 template <class Real>
 void requireOnePlacement(const std::string& path, const Real& real, const std::array<std::int64_t, 3>& size,
                          int sformCode) {
-  const int realBytes = 4;  // a float
   // sform: rows srow_x, srow_y, srow_z of 4 values each.
   const int srow = 280;
   double sform[3][4];
   for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 4; ++c) sform[r][c] = real(srow + (4 * r + c) * realBytes);
+    for (int c = 0; c < 4; ++c) sform[r][c] = real(srow + (4 * r + c) * kRealBytes);
   double largestCosine = 0;
   for (int a = 0; a < 3; ++a)
     for (int b = a + 1; b < 3; ++b) {
@@ -113,7 +117,7 @@ void requireOnePlacement(const std::string& path, const Real& real, const std::a
   const int quatern = 256, pixdim = 76;
   // As NIfTI's reference library reads them: b, c, d of a norm above 1 are
   // normalized (a = 0), and a spacing of 0 or less is taken as 1.
-  double b = real(quatern), c = real(quatern + realBytes), d = real(quatern + 2 * realBytes);
+  double b = real(quatern), c = real(quatern + kRealBytes), d = real(quatern + 2 * kRealBytes);
   const double squared = b * b + c * c + d * d;
   if (squared > 1.0) {
     const double norm = std::sqrt(squared);
@@ -126,8 +130,8 @@ void requireOnePlacement(const std::string& path, const Real& real, const std::a
   const double rotation[3][3] = {{a * a + b * b - c * c - d * d, 2 * (b * c - a * d), 2 * (b * d + a * c)},
                                  {2 * (b * c + a * d), a * a + c * c - b * b - d * d, 2 * (c * d - a * b)},
                                  {2 * (b * d - a * c), 2 * (c * d + a * b), a * a + d * d - c * c - b * b}};
-  const double spacing[3] = {positive(real(pixdim + realBytes)), positive(real(pixdim + 2 * realBytes)),
-                             (real(pixdim) < 0 ? -1.0 : 1.0) * positive(real(pixdim + 3 * realBytes))};
+  const double spacing[3] = {positive(real(pixdim + kRealBytes)), positive(real(pixdim + 2 * kRealBytes)),
+                             (real(pixdim) < 0 ? -1.0 : 1.0) * positive(real(pixdim + 3 * kRealBytes))};
   // The largest distance between the two placements of a corner voxel.
   double apart = 0;
   for (int corner = 0; corner < 8; ++corner) {
@@ -135,7 +139,7 @@ void requireOnePlacement(const std::string& path, const Real& real, const std::a
                              corner & 4 ? size[2] - 1.0 : 0.0};
     double squared = 0;
     for (int r = 0; r < 3; ++r) {
-      double bySform = sform[r][3], byQform = real(quatern + (3 + r) * realBytes);
+      double bySform = sform[r][3], byQform = real(quatern + (3 + r) * kRealBytes);
       for (int k = 0; k < 3; ++k) {
         bySform += sform[r][k] * index[k];
         byQform += rotation[r][k] * spacing[k] * index[k];
@@ -177,7 +181,7 @@ DataCheck checkNiftiHeader(const std::string& path) {
   const bool gzipped = magic[0] == 0x1f && magic[1] == 0x8b;
   if (gzipped && lowerCaseExtension(path) != ".gz")
     throw Error(path, "compressed with gzip, but named as an uncompressed NIfTI file: name it .nii.gz");
-  unsigned char header[348] = {};
+  unsigned char header[kHeaderBytes] = {};
   std::uintmax_t got = 0;
   if (gzipped) {
     gzFile file = gzopen(path.c_str(), "rb");
@@ -190,21 +194,22 @@ DataCheck checkNiftiHeader(const std::string& path) {
     in.read(reinterpret_cast<char*>(header), sizeof header);
     got = static_cast<std::uintmax_t>(in.gcount());
   }
-  if (got < 348) throw Error(path, "not a NIfTI file: " + std::to_string(got) + " bytes, a header has 348");
+  if (got < kHeaderBytes)
+    throw Error(path,
+                "not a NIfTI file: " + std::to_string(got) + " bytes, a header has " + std::to_string(kHeaderBytes));
   auto number = [&](int at, int bytes, bool swap) {
     std::uint64_t v = 0;
     for (int b = 0; b < bytes; ++b) v |= std::uint64_t{header[at + (swap ? bytes - 1 - b : b)]} << (8 * b);
     return v;
   };
-  const bool swap = number(0, 4, false) != 348;
-  if (number(0, 4, swap) != 348) {
+  const bool swap = number(0, 4, false) != kHeaderBytes;
+  if (number(0, 4, swap) != kHeaderBytes) {
     if (number(0, 4, false) == 540 || number(0, 4, true) == 540)
       throw Error(path,
                   "a NIfTI-2 file, which ITK 5.2 (DynSub's image reader) does not read: save it as NIfTI-1 "
                   "(nibabel: nibabel.Nifti1Image; FSL and SPM write NIfTI-1)");
     throw Error(path, "not a NIfTI file (its first four bytes give no header size of 348)");
   }
-  const int headerSize = 348;
   const auto datatype = static_cast<int>(static_cast<std::int16_t>(number(70, 2, swap)));
   auto dim = [&](int i) { return static_cast<std::int64_t>(static_cast<std::int16_t>(number(40 + 2 * i, 2, swap))); };
   const std::int64_t dimensions = dim(0);
@@ -246,7 +251,7 @@ DataCheck checkNiftiHeader(const std::string& path) {
   const int qformCode = code(252), sformCode = code(254);
   auto requireFinite = [&](int first, int count, const char* what) {
     for (int i = 0; i < count; ++i) {
-      if (!std::isfinite(real(first + i * 4)))
+      if (!std::isfinite(real(first + i * kRealBytes)))
         throw Error(path, std::string("a NIfTI header whose ") + what + " holds a NaN or infinite value");
     }
   };
@@ -257,7 +262,7 @@ DataCheck checkNiftiHeader(const std::string& path) {
   if (qformCode > 0 && sformCode > 0) requireOnePlacement(path, real, size, sformCode);
   requireMemoryFor(path, count);
   const double offset = real(108);  // vox_offset
-  if (!(offset >= headerSize) || offset > 1e12)
+  if (!(offset >= kHeaderBytes) || offset > 1e12)
     throw Error(path, "a NIfTI header whose data offset (vox_offset " + std::to_string(offset) + ") is not after it");
   const auto needed = static_cast<std::uintmax_t>(offset) + count * bytesPerVoxel;
   DataCheck checkData = [=] {

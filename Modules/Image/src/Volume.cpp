@@ -30,10 +30,23 @@ bool ImageGeometry::covers(const Vector3& point) const {
   return true;
 }
 
+namespace {
+
+// sameGridAs's criteria besides the size, each named for differenceFrom.
+bool sameSpacing(const ImageGeometry& a, const ImageGeometry& b) {
+  return (a.spacing - b.spacing).norm() <= 1e-6 * a.spacing.norm();
+}
+bool sameDirection(const ImageGeometry& a, const ImageGeometry& b) {
+  return (a.direction - b.direction).norm() <= 1e-6;
+}
+bool sameOrigin(const ImageGeometry& a, const ImageGeometry& b) {
+  return (a.origin - b.origin).norm() <= 1e-6 * (1 + a.origin.norm());
+}
+
+}  // namespace
+
 bool ImageGeometry::sameGridAs(const ImageGeometry& other) const {
-  return size == other.size && (spacing - other.spacing).norm() <= 1e-6 * spacing.norm() &&
-         (origin - other.origin).norm() <= 1e-6 * (1 + origin.norm()) &&
-         (direction - other.direction).norm() <= 1e-6;
+  return size == other.size && sameSpacing(*this, other) && sameDirection(*this, other) && sameOrigin(*this, other);
 }
 
 std::string ImageGeometry::differenceFrom(const ImageGeometry& other, const std::string& otherName) const {
@@ -50,9 +63,8 @@ std::string ImageGeometry::differenceFrom(const ImageGeometry& other, const std:
     };
     return "its size is " + sizeText(size) + " voxels" + where + sizeText(other.size);
   }
-  if ((spacing - other.spacing).norm() > 1e-6 * spacing.norm())
-    return "its spacing is " + vector(spacing) + " mm" + where + vector(other.spacing);
-  if ((direction - other.direction).norm() > 1e-6) {
+  if (!sameSpacing(*this, other)) return "its spacing is " + vector(spacing) + " mm" + where + vector(other.spacing);
+  if (!sameDirection(*this, other)) {
     double degrees = 0;
     for (int a = 0; a < 3; ++a) {
       const double cosine =

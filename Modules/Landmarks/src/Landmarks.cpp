@@ -37,6 +37,12 @@ void requireDistinctColumns(const std::string& path, int line, const std::vector
         throw Error(path, "line " + std::to_string(line) + ": the column '" + columns[c] + "' is named twice");
 }
 
+// Where `name` stands among `columns`, or -1.
+int columnIndex(const std::vector<std::string>& columns, const std::string& name) {
+  const auto at = std::find(columns.begin(), columns.end(), name);
+  return at == columns.end() ? -1 : static_cast<int>(at - columns.begin());
+}
+
 double finiteNumber(const std::string& text, const std::string& path, int line) {
   double value = 0;
   if (!parseNumber(text, value) || !std::isfinite(value))
@@ -149,32 +155,29 @@ std::vector<Landmark> readFcsv(const std::string& path, std::ifstream& in, Coord
       const auto equals = line.find('=');
       if (equals == std::string::npos) continue;
       const std::string key = line.substr(0, equals), value = splitCsvFields(line.substr(equals + 1), ',')[0];
+      const bool systemLine = key.find("CoordinateSystem") != std::string::npos;
+      const bool columnsLine = key.find("columns") != std::string::npos;
       // Slicer writes its header before the points; one after them would
       // apply to some points and not to others.
-      const bool header = key.find("CoordinateSystem") != std::string::npos || key.find("columns") != std::string::npos;
-      if (header && !landmarks.empty())
+      if ((systemLine || columnsLine) && !landmarks.empty())
         throw Error(path, "line " + std::to_string(number) + ": a header line ('" + trimmed(key.substr(1)) +
                               "') after the points: move it above them");
-      if (key.find("CoordinateSystem") != std::string::npos) {
+      if (systemLine) {
         if (value == "LPS" || value == "1")
           system = CoordinateSystem::LPS;
         else if (value == "RAS" || value == "0")
           system = CoordinateSystem::RAS;
         else
           throw Error(path, "line " + std::to_string(number) + ": unknown coordinate system '" + value + "'");
-      } else if (key.find("columns") != std::string::npos) {
+      } else if (columnsLine) {
         columns = splitCsvFields(line.substr(equals + 1), ',');
         requireDistinctColumns(path, number, columns);
       }
       continue;
     }
     const auto fields = splitCsvFields(line, ',');
-    auto column = [&](const std::string& name) -> int {
-      for (std::size_t c = 0; c < columns.size(); ++c)
-        if (columns[c] == name) return static_cast<int>(c);
-      return -1;
-    };
-    const int x = column("x"), y = column("y"), z = column("z"), label = column("label");
+    const int x = columnIndex(columns, "x"), y = columnIndex(columns, "y"), z = columnIndex(columns, "z"),
+              label = columnIndex(columns, "label");
     if (x < 0 || y < 0 || z < 0) throw Error(path, "the columns header names no x, y and z");
     if (static_cast<int>(fields.size()) <= std::max({x, y, z}))
       throw Error(path, "line " + std::to_string(number) + ": too few fields");
@@ -205,12 +208,8 @@ std::vector<Landmark> readCsv(const std::string& path, std::ifstream& in, Coordi
     if (!nothingOn(line) && trimmed(line)[0] != '#') header = splitCsvFields(line, ',');
   }
   // Column names in any case: X, Label.
-  for (std::string& name : header)
-    for (char& ch : name) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-  const auto column = [&header](const char* name) {
-    const auto at = std::find(header.begin(), header.end(), name);
-    return at == header.end() ? -1 : static_cast<int>(at - header.begin());
-  };
+  for (std::string& name : header) name = lowerCase(name);
+  const auto column = [&header](const char* name) { return columnIndex(header, name); };
   int x = column("x"), y = column("y"), z = column("z");
   const int label = column("label"), defined = column("defined");
   system = CoordinateSystem::LPS;
@@ -243,11 +242,9 @@ std::vector<Landmark> readCsv(const std::string& path, std::ifstream& in, Coordi
     if (static_cast<int>(fields.size()) <= std::max({x, y, z}))
       throw Error(path, "line " + std::to_string(number) + ": too few fields");
     // A point Slicer lists but has not placed: its position is not a click.
-    if (defined >= 0 && defined < static_cast<int>(fields.size())) {
-      std::string value = fields[defined];
-      for (char& ch : value) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-      if (value == "0" || value == "false") continue;
-    }
+    if (defined >= 0 && defined < static_cast<int>(fields.size()) &&
+        (fields[defined] == "0" || lowerCase(fields[defined]) == "false"))
+      continue;
     const Vector3 p(finiteNumber(fields[x], path, number), finiteNumber(fields[y], path, number),
                     finiteNumber(fields[z], path, number));
     landmarks.push_back({label >= 0 && label < static_cast<int>(fields.size()) ? fields[label] : "",

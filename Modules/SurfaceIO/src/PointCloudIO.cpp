@@ -71,8 +71,7 @@ int columnOf(const std::vector<std::string>& names, char axis, const std::functi
   for (std::size_t c = 0; c < names.size(); ++c) {
     if (!namesAxis(names[c], axis)) continue;
     matches.push_back(static_cast<int>(c));
-    std::string lower = names[c];
-    for (char& ch : lower) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    const std::string lower = lowerCase(names[c]);
     if (lower.size() == 1 || lower.find("mm") != std::string::npos) preferred.push_back(static_cast<int>(c));
   }
   if (matches.size() == 1) return matches[0];

@@ -24,6 +24,10 @@ std::vector<std::string> splitCsvFields(const std::string& line, char separator)
 // `text` without the blanks and tabs at its ends.
 std::string trimmed(const std::string& text);
 
+// `text` with its ASCII letters in lower case (column names, extensions,
+// label names: compared case-insensitively).
+std::string lowerCase(std::string text);
+
 // A library's message without the tag it starts with: "[json.exception.
 // parse_error.101] parse error at line 1, column 13: ..." -> "parse error at
 // line 1, column 13: ...".
