@@ -31,8 +31,8 @@ and the job's interactive view for the QC page is figures/..._[desc-<structure>_
 
 `space-orig` is the T1w's own grid; `desc-` carries the structure, so BIDS
 labels (letters and digits only) are required of structure names. The T1w's
-own entities (acq-, ce-, rec-, run-, echo-, part-, chunk-) are carried
-through, so two runs of a session are two jobs; a landmark file or seed
+own entities (acq-, ce-, rec-, run-, echo-, part-) are carried through,
+so two runs of a session are two jobs; a landmark file or seed
 without them serves the session's one T1w. `.bidsignore` lists the files
 the derivatives specification has no rule for.
 """
@@ -52,8 +52,9 @@ import qc_view
 LABEL = r"[A-Za-z0-9]+"
 # The entities a raw T1w's name may carry between ses- and the suffix, in
 # BIDS order; they are carried into the derivatives' names, so that two runs
-# of one subject are two jobs.
-ENTITIES = ("acq", "ce", "rec", "run", "echo", "part", "chunk")
+# of one subject are two jobs. chunk- is left out: BIDS orders it after
+# space-, which the outputs' names add after these.
+ENTITIES = ("acq", "ce", "rec", "run", "echo", "part")
 ENTITY_PATTERN = "".join(rf"(?:_{e}-{LABEL})?" for e in ENTITIES)
 T1W = re.compile(rf"^sub-(?P<sub>{LABEL})(?:_ses-(?P<ses>{LABEL}))?(?P<entities>{ENTITY_PATTERN})_T1w\.nii(?:\.gz)?$")
 LANDMARKS = re.compile(rf"^sub-(?P<sub>{LABEL})(?:_ses-(?P<ses>{LABEL}))?(?P<entities>{ENTITY_PATTERN})"

@@ -65,6 +65,8 @@ assert float(putamen["dice"]) >= 0.88, putamen          # measured 0.890 with th
 assert abs(float(moved["dice"]) - float(original["dice"])) <= 0.01, (moved, original)  # rigid motion changes nothing
 assert abs(float(moved_putamen["dice"]) - float(putamen["dice"])) <= 0.01, (moved_putamen, putamen)
 assert fine["dice"] == "n/a" and abs(float(fine["volume_mm3"]) / float(original["volume_mm3"]) - 1) < 0.15, fine
+# The T1w's entities are carried into its outputs' names.
+assert fine["dseg"] == "sub-03/ses-2/anat/sub-03_ses-2_acq-hires_run-1_space-orig_desc-caudateL_dseg.nii.gz", fine
 assert float(seed["dice"]) >= 0.4, seed                   # one click: measured 0.517
 PY
 check "QC page written" test -s "$work/out/report.html"
@@ -83,7 +85,7 @@ def touch(path, text=""):
     os.makedirs(os.path.dirname(path), exist_ok=True)
     open(path, "w").write(text)
 for name in ("sub-04/anat/sub-04_run-1", "sub-05/anat/sub-05_acq-mprage_run-1", "sub-05/anat/sub-05_acq-mprage_run-2",
-             "sub-06/anat/sub-06_foo-1"):
+             "sub-06/anat/sub-06_foo-1", "sub-06/anat/sub-06_run-1_chunk-1"):
     touch(f"{root}/{name}_T1w.nii.gz")
 landmarks, reference = f"{root}/derivatives/landmarks", f"{root}/derivatives/reference"
 touch(f"{landmarks}/sub-04/anat/sub-04_desc-caudateL_landmarks.csv")  # no entities: the session's one T1w
@@ -100,6 +102,7 @@ jobs = bids.group_jobs(structures)
 assert bids.job_paths("/o", jobs[("sub-04_run-1", "_desc-caudateL")])["dseg"] == \
     "/o/sub-04/anat/sub-04_run-1_space-orig_desc-caudateL_dseg.nii.gz"
 assert any("sub-06_foo-1_T1w.nii.gz: skipped" in w for w in warnings), warnings
+assert any("sub-06_run-1_chunk-1_T1w.nii.gz: skipped" in w for w in warnings), warnings  # chunk- follows space-
 assert any("not used for caudateL" in w for w in warnings), warnings
 # Two structures' landmarks and a third's seed for one image are one job,
 # named by no structure, the structures with landmarks first; a reference
@@ -184,15 +187,15 @@ import os, sys
 sys.path.insert(0, sys.argv[1])
 import dynsub_bids as bids, qc_report
 source, out = sys.argv[2], sys.argv[3]
-def job_of(subject, session=None):
-    return bids.Job([bids.Structure(subject, session, "", "caudateL", f"sub-{subject}_T1w.nii.gz")])
+def job_of(subject, session=None, entities=""):
+    return bids.Job([bids.Structure(subject, session, entities, "caudateL", f"sub-{subject}_T1w.nii.gz")])
 def paths(out, job):
     """Every file of a one-structure job (its report is its structure's too)."""
     files = [bids.job_paths(out, job), bids.structure_paths(out, job.dir, job.stem, "caudateL"),
              bids.figure_paths(out, job.dir, job.stem, "caudateL")]
     return sorted({path for group in files for path in group.values()} |
                   {bids.view_path(out, job.dir, job.stem, job.desc)})
-files = paths(source, job_of("03", "2"))  # the one-structure job of sub-03 ses-2
+files = paths(source, job_of("03", "2", "_acq-hires_run-1"))  # the one-structure job of sub-03 ses-2
 jobs = {}
 for n in range(1000, 1500):
     job = job_of(str(n))

@@ -8,7 +8,9 @@ valid BIDS by the BIDS validator (Debian python3-bids-validator). In
 DERIVATIVES, every file must be one of: dataset_description.json (with
 DatasetType derivative and GeneratedBy), the group table and its sidecar,
 job logs, the BIDS App's work/ folder, or per-subject files named
-sub-<label>[_ses-<label>]_space-orig[_desc-<label>]_<suffix> in sub-<label>/[ses-<label>/]anat
+sub-<label>[_ses-<label>][entities]_space-orig[_desc-<label>]_<suffix> in sub-<label>/[ses-<label>/]anat
+(entities: the T1w's own acq-, ce-, rec-, run-, echo-, part-, in that order,
+its SpatialReference that T1w)
 (figures: ..._desc-<label>_<figure>.png and ..._[desc-<label>_]view.js in
 .../figures), with entities in BIDS order, labels of letters and digits,
 folders matching the entities, every dseg.nii.gz with its .tsv lookup table
@@ -28,11 +30,15 @@ import numpy
 from bids_validator import BIDSValidator
 
 L = r"[A-Za-z0-9]+"
-ANAT = re.compile(rf"^sub-(?P<sub>{L})(?:_ses-(?P<ses>{L}))?_space-orig(?:_desc-(?P<desc>{L}))?_"
+# The entities an anatomical image's name may carry after sub- and ses-, in
+# the specification's order.
+SUBJECT = rf"^(?P<stem>sub-(?P<sub>{L})(?:_ses-(?P<ses>{L}))?" + "".join(
+    rf"(?:_{e}-{L})?" for e in ("acq", "ce", "rec", "run", "echo", "part")) + ")"
+ANAT = re.compile(rf"{SUBJECT}_space-orig(?:_desc-(?P<desc>{L}))?_"
                   r"(?P<suffix>dseg\.nii\.gz|dseg\.tsv|dseg\.json|surface\.vtp|report\.json|convergence\.csv)$")
-FIGURE = re.compile(rf"^sub-(?P<sub>{L})(?:_ses-(?P<ses>{L}))?(?:_desc-(?P<desc>{L})_"
+FIGURE = re.compile(rf"{SUBJECT}(?:_desc-(?P<desc>{L})_"
                     rf"(?P<suffix>(?:slices|surface3d|convergence)\.png|view\.js)|_(?P<view>view\.js))$")
-LOG = re.compile(rf"^sub-(?P<sub>{L})(?:_ses-(?P<ses>{L}))?(?:_desc-(?P<desc>{L}))?\.log$")
+LOG = re.compile(rf"{SUBJECT}(?:_desc-(?P<desc>{L}))?\.log$")
 problems = []
 
 
@@ -129,6 +135,8 @@ def check_dseg(raw, path, match):
     if [s.get("Name") for s in sidecar.get("Structures", [])] != names:
         fail(f"{stem}.json: its Structures are not the table's {names}")
     source = sidecar.get("SpatialReference", "").removeprefix("bids:raw:")
+    if not re.match(rf"{re.escape(match['stem'])}_T1w\.nii(\.gz)?$", os.path.basename(source)):
+        fail(f"{path}: its SpatialReference {source} is not the T1w its name carries ({match['stem']}_T1w)")
     t1w = nibabel.load(os.path.join(raw, source))
     labels = nibabel.load(path)
     if labels.shape != t1w.shape or not numpy.allclose(labels.affine, t1w.affine, atol=1e-4):

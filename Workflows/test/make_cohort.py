@@ -10,7 +10,9 @@ the workflow:
   sub-02          the same MRI moved by a rigid transform (12 degrees about an
                   oblique axis, then 5, -8, 3 mm): its caudate and putamen
                   landmarks (.fcsv, in RAS) and its AAL reference move with it
-  sub-03/ses-2    the 0.5 mm Colin27 (another grid, no reference); landmarks as CSV
+  sub-03/ses-2    the 0.5 mm Colin27 (another grid, no reference), its name with
+                  entities (acq-hires_run-1) that its outputs' names carry;
+                  landmarks as CSV, named without them
   --broken adds only sub-04 to an existing cohort: its T1w is a truncated
   gzip file (the other subjects' files are left as they are).
 
@@ -126,7 +128,7 @@ def main():
         moved = [(transform @ numpy.append(p, 1.0))[:3].tolist() for p in points]
         write_fcsv_ras(moved, f"{anat(marks, '02')}/sub-02_desc-{structure}_landmarks.fcsv")
 
-    shutil.copy(f"{templates}/ch2better.nii.gz", f"{anat(root, '03', '2')}/sub-03_ses-2_T1w.nii.gz")
+    shutil.copy(f"{templates}/ch2better.nii.gz", f"{anat(root, '03', '2')}/sub-03_ses-2_acq-hires_run-1_T1w.nii.gz")
     write_csv(caudate, f"{anat(marks, '03', '2')}/sub-03_ses-2_desc-caudateL_landmarks.csv")
 
 
