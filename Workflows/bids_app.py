@@ -117,6 +117,11 @@ def main(argv, snakefile, dynsub):
         print(f"dynsub-bids: error: {out}: no segmentation written yet; run the participant level first",
               file=sys.stderr)
         return 1
+    if args.analysis_level == "group" and not args.unlock:
+        for path in bids.unclaimed_labelmaps(config, out):
+            print(f"dynsub-bids: warning: {path}: left by an earlier run; the dataset no longer names its subject, "
+                  "image or structure, so the group table leaves it out (delete it and its files if it is stale)",
+                  file=sys.stderr)
 
     if not args.dry_run and not args.unlock:
         os.makedirs(work, exist_ok=True)

@@ -385,6 +385,17 @@ def uncovered_warnings(config, jobs):
             if path not in covered and is_chosen(subject, session, participants, sessions)]
 
 
+def unclaimed_labelmaps(config, out):
+    """The labelmaps in out that no job of the dataset writes, whichever
+    participants are chosen: those of a subject, run or structure the dataset
+    no longer names, which the group table leaves out."""
+    root, landmarks, seeds, reference = _sources(config)
+    jobs = group_jobs(find_structures(root, landmarks, seeds, reference, warn=lambda message: None))
+    claimed = {job_paths(out, job)["dseg"] for job in jobs.values()}
+    found = glob.glob(os.path.join(glob.escape(out), "sub-*", "**", "anat", "*_dseg.nii.gz"), recursive=True)
+    return sorted(path for path in found if path not in claimed)
+
+
 def written_reports(jobs, out):
     """The report.json files of the jobs already segmented in out: what the
     group level summarizes."""

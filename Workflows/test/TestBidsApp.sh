@@ -14,7 +14,8 @@
 #    dataset with its derivatives in place, while it does find the outputs
 #    misplaced at the dataset's top level (so the check can fail);
 #  - `group` again, with options that would segment anew and an image
-#    touched, still segments nothing;
+#    touched, still segments nothing; a labelmap of a subject the dataset
+#    no longer has is warned of;
 #  - mistakes are refused with a message and nothing written: a label that
 #    selects nothing, the group level before any participant, a missing
 #    dataset, an unknown level, the dataset as its own output through a
@@ -101,6 +102,18 @@ check "bids-validator: no error with the outputs in derivatives/dynsub" validate
 cp -r "$bids" "$work/misplaced" && cp -r "$out"/. "$work/misplaced/"
 invalid() { ! validate "$1"; }
 check "bids-validator: the same outputs at the dataset's top level are errors" invalid "$work/misplaced"
+
+# A labelmap of a subject the dataset no longer has is named at the group
+# level, and left out of the table.
+mkdir -p "$out/sub-07/anat"
+cp "$out/sub-02/anat/sub-02_space-orig_dseg.nii.gz" "$out/sub-07/anat/sub-07_space-orig_dseg.nii.gz"
+"$DYNSUB_BIDS" "$bids" "$out" group >"$work/group3.log" 2>&1
+check "group with an earlier run's labelmap: exit 0" test $? -eq 0 || tail -30 "$work/group3.log"
+check "group with an earlier run's labelmap: warned of by name" \
+  grep -q "warning: $out/sub-07/anat/sub-07_space-orig_dseg.nii.gz: left by an earlier run" "$work/group3.log"
+check "group with an earlier run's labelmap: only that one" test "$(grep -c 'left by an earlier run' "$work/group3.log")" -eq 1
+check "group with an earlier run's labelmap: not in the table" test -z "$(grep sub-07 "$out/segmentations.tsv")"
+rm -r "$out/sub-07"
 
 "$DYNSUB_BIDS" "$bids" "$work/fresh" participant --participant-label 09 >"$work/bad.log" 2>&1
 check "an unknown participant: exit 1" test $? -eq 1

@@ -882,6 +882,9 @@ expect_error "segment --init seed: a NaN coordinate" 2 "expected seed:x,y,z" "$w
 printf 'x,y,z\n' >"$work/empty.csv"
 expect_error "segment: a landmark file with no points" 1 "empty.csv: no landmarks" "$work/s48" \
   "$DYNSUB" segment "$work/subject/image.nii.gz" --landmarks "$work/empty.csv" --out "$work/s48"
+printf 'label,l,p,s,defined\nA,1,2,3,0\nB,1,2,4,false\n' >"$work/unplaced.csv"
+expect_error "segment: a Slicer table whose points are not placed" 1 "unplaced.csv: no landmarks.*not placed" "$work/s48c" \
+  "$DYNSUB" segment "$work/subject/image.nii.gz" --landmarks "$work/unplaced.csv" --out "$work/s48c"
 expect_error "segment: nothing to start from" 2 "no landmarks to build the initial model from" "$work/s48b" \
   "$DYNSUB" segment "$work/subject/image.nii.gz" --out "$work/s48b"
 mkdir -p "$work/folder.mrk.json"
