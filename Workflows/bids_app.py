@@ -90,6 +90,11 @@ def main(argv, snakefile, dynsub):
     # overwrite the dataset's own description and .bidsignore.
     if os.path.realpath(out) == os.path.realpath(bids_dir):
         parser.error(f"{args.output_dir}: the output directory must not be the BIDS dataset itself")
+    # Inside the dataset, outputs outside derivatives/ make it invalid BIDS.
+    inside = os.path.relpath(os.path.realpath(out), os.path.realpath(bids_dir))
+    if not inside.startswith("..") and inside.split(os.sep)[0] != "derivatives":
+        parser.error(f"{args.output_dir}: inside the BIDS dataset but not in its derivatives folder, where the "
+                     f"outputs would make the dataset invalid; use {os.path.join(args.bids_dir, 'derivatives', 'dynsub')}")
     work = os.path.abspath(args.work_dir or os.path.join(out, "work"))
     # Snakemake 7 starts each job with an unquoted `cd WORK`.
     if shlex.quote(work) != work:

@@ -19,7 +19,8 @@
 #  - mistakes are refused with a message and nothing written: a label that
 #    selects nothing, the group level before any participant, a missing
 #    dataset, an unknown level, the dataset as its own output through a
-#    link, a work directory with a space, a structure seeded twice;
+#    link, an output folder in the dataset outside derivatives/, a work
+#    directory with a space, a structure seeded twice;
 #  - a seeds table with a byte order mark is read, and a T1w without
 #    landmarks or a seed is warned of once, when its participant is chosen.
 # Needs DYNSUB_BIDS, DATA, WORKFLOWS, BIDS_VALIDATOR; snakemake, nibabel.
@@ -137,6 +138,10 @@ check "the dataset as its own output through a link: exit 2" \
   test $? -eq 2 -a -n "$(grep "must not be the BIDS dataset itself" "$work/bad.log")"
 check "the dataset as its own output through a link: its description kept" \
   cmp -s "$bids/dataset_description.json" "$work/description"
+"$DYNSUB_BIDS" "$bids" "$bids/dynsub" participant >"$work/bad.log" 2>&1
+check "an output folder in the dataset outside derivatives/: exit 2, the fix named" \
+  test $? -eq 2 -a -n "$(grep "not in its derivatives folder.*use $bids/derivatives/dynsub" "$work/bad.log")"
+check "an output folder in the dataset outside derivatives/: nothing written" test ! -e "$bids/dynsub"
 "$DYNSUB_BIDS" "$bids" "$work/with space" participant >"$work/bad.log" 2>&1
 check "a work directory with a space: exit 2, named" \
   test $? -eq 2 -a -n "$(grep "path has a space" "$work/bad.log")"
