@@ -248,6 +248,11 @@ def find_structures(bids, landmarks_dir, seeds_table, reference_dir, warn=_warn)
             if not match:
                 raise CohortError(f"{path}: not handled (expected sub-<label>[_ses-<label>][entities]_desc-<structure>"
                                   "_landmarks.mrk.json|.fcsv|.csv, letters and digits in labels)")
+            # A file copied from another subject's folder and not renamed would serve the subject its name says.
+            folder = f"{landmarks_dir}/sub-{match['sub']}" + (f"/ses-{match['ses']}" if match["ses"] else "") + "/anat"
+            if os.path.dirname(path) != folder:
+                raise CohortError(f"{path}: its name is for {os.path.relpath(folder, landmarks_dir)}, not the folder "
+                                  "it is in; rename it for its folder's subject and session, or move it")
             structure = structure_for(match["sub"], match["ses"], match["entities"], match["structure"], path)
             if structure.landmarks:
                 raise CohortError(f"{path}: a second landmark file for {structure.stem} {structure.name} "

@@ -125,6 +125,13 @@ try:
     sys.exit("a landmark file that fits two T1w images was taken")
 except bids.CohortError as error:
     assert "has 2 T1w images" in str(error), error
+os.remove(f"{landmarks}/sub-05/anat/sub-05_desc-putamenL_landmarks.csv")
+touch(f"{landmarks}/sub-05/anat/sub-04_run-1_desc-pallidumL_landmarks.csv")  # copied, not renamed
+try:
+    bids.find_structures(root, landmarks, None, reference, warn=warnings.append)
+    sys.exit("a landmark file in another subject's folder was taken")
+except bids.CohortError as error:
+    assert "sub-04_run-1_desc-pallidumL_landmarks.csv: its name is for sub-04/anat, not the folder" in str(error), error
 PY
 
 touch "$work/marker"
