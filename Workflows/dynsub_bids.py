@@ -40,6 +40,7 @@ import csv
 import glob
 import json
 import os
+import pathlib
 import re
 import shlex
 import shutil
@@ -667,6 +668,6 @@ def write_dataset_description(path, version, bids):
         "DatasetType": "derivative",
         "GeneratedBy": [{"Name": "DynSub", "Version": version,
                          "Description": "dynamic Catmull-Clark subdivision surfaces (dynsub segment)"}],
-        "DatasetLinks": {"raw": "file://" + os.path.abspath(bids)},
+        "DatasetLinks": {"raw": pathlib.Path(os.path.abspath(bids)).as_uri()},  # a space is %20 in a URI
     }
     _write_if_changed(path, json.dumps(description, indent=2) + "\n")

@@ -132,6 +132,10 @@ try:
     sys.exit("a landmark file in another subject's folder was taken")
 except bids.CohortError as error:
     assert "sub-04_run-1_desc-pallidumL_landmarks.csv: its name is for sub-04/anat, not the folder" in str(error), error
+# The derivatives' link to the raw dataset is a URI, whatever its path holds.
+import json
+bids.write_dataset_description(f"{root}/description.json", "1.0", "/data/my study#2")
+assert json.load(open(f"{root}/description.json"))["DatasetLinks"]["raw"] == "file:///data/my%20study%232"
 PY
 
 touch "$work/marker"
