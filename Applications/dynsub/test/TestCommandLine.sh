@@ -642,9 +642,10 @@ expect_error "landmarks on one slice" 1 "one_slice.mrk.json: all [0-9]* landmark
 printf 'x,y,z\n10,0,10\n10,2,10\n10,4,10\n10,6,10\n10,8,10\n' >"$work/line.csv"
 expect_error "landmarks on one line" 1 "line.csv: the landmarks: all points lie on a line" \
   "$work/s14b" "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/line.csv" --no-figures --out "$work/s14b"
-# Four clicks within 0.1 um: the surface shrinks below a voxel, and an empty
-# labelmap is refused rather than written as a result.
-printf 'x,y,z\n10,0,10\n10.0001,0,10\n10,0.0001,10\n10,0,10.0001\n' >"$work/speck.csv"
+# Four clicks within 1 um (apart by the micrometre that tells clicks apart):
+# the surface shrinks below a voxel, and an empty labelmap is refused rather
+# than written as a result.
+printf 'x,y,z\n10,0,10\n10.001,0,10\n10,0.001,10\n10,0,10.001\n' >"$work/speck.csv"
 expect_error "a result of no voxel" 1 "speck.csv: the result encloses no voxel of the image" \
   "$work/s14c" "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$work/speck.csv" --no-figures --out "$work/s14c"
 expect_error "negative end pressure" 2 "end-pressure" "$work/s13" \
@@ -885,6 +886,9 @@ expect_error "segment: a landmark file with no points" 1 "empty.csv: no landmark
 printf 'label,l,p,s,defined\nA,1,2,3,0\nB,1,2,4,false\n' >"$work/unplaced.csv"
 expect_error "segment: a Slicer table whose points are not placed" 1 "unplaced.csv: no landmarks.*not placed" "$work/s48c" \
   "$DYNSUB" segment "$work/subject/image.nii.gz" --landmarks "$work/unplaced.csv" --out "$work/s48c"
+printf 'x,y,z\n10,2,3\n12,2,3\n11,4,3\n12,2,3\n' >"$work/repeated.csv"
+expect_error "segment: four landmarks, one clicked twice" 1 "4 landmarks, 3 of them at distinct positions, are too few" \
+  "$work/s48d" "$DYNSUB" segment "$work/subject/image.nii.gz" --landmarks "$work/repeated.csv" --out "$work/s48d"
 expect_error "segment: nothing to start from" 2 "no landmarks to build the initial model from" "$work/s48b" \
   "$DYNSUB" segment "$work/subject/image.nii.gz" --out "$work/s48b"
 mkdir -p "$work/folder.mrk.json"

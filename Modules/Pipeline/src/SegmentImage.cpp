@@ -1,6 +1,7 @@
 #include "dynsub/SegmentImage.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -370,6 +371,17 @@ SegmentOptions optionsFor(const SegmentInputs& in, const SegmentParameters& para
   return segmentOptions(parameters, pointsOnBoundary);
 }
 
+// The landmarks at distinct positions (to a micrometre): a point clicked
+// twice outlines nothing more.
+std::size_t distinctPositions(const std::vector<Landmark>& landmarks) {
+  std::vector<std::array<long long, 3>> keys;
+  for (const Landmark& landmark : landmarks)
+    keys.push_back({std::llround(landmark.position.x() * 1e3), std::llround(landmark.position.y() * 1e3),
+                    std::llround(landmark.position.z() * 1e3)});
+  std::sort(keys.begin(), keys.end());
+  return std::unique(keys.begin(), keys.end()) - keys.begin();
+}
+
 void checkStart(const SegmentInputs& in) {
   if (in.inside && in.start.kind != SegmentStart::Kind::Atlas)
     throw UsageError(
@@ -377,11 +389,15 @@ void checkStart(const SegmentInputs& in) {
         "seed:x,y,z");
   if (in.start.kind == SegmentStart::Kind::Atlas && (!in.atlas || in.atlasLabels.empty()))
     throw UsageError("an atlas start needs the structure's labels in the atlas (--atlas-label)");
-  if (in.start.kind != SegmentStart::Kind::FromLandmarks || in.landmarks.size() >= 4) return;
+  if (in.start.kind != SegmentStart::Kind::FromLandmarks) return;
+  const std::size_t distinct = distinctPositions(in.landmarks);
+  if (distinct >= 4) return;
   const std::string alternatives = "give at least 4 on the structure's boundary, or start from one click inside it";
   const std::string none = "no landmarks to build the initial model from: " + alternatives;
   const std::string tooFew =
-      std::to_string(in.landmarks.size()) + " landmarks are too few to outline a structure: " + alternatives;
+      std::to_string(in.landmarks.size()) + " landmarks" +
+      (distinct < in.landmarks.size() ? ", " + std::to_string(distinct) + " of them at distinct positions," : "") +
+      " are too few to outline a structure: " + alternatives;
   // Points given by flags (--seed), or none at all, are the command line's
   // fault: a usage error. A file's are the file's.
   if (in.landmarkSource.empty()) throw UsageError(none);
