@@ -93,6 +93,9 @@ Lattice Lattice::fromCells(MatrixX3 points, std::vector<std::vector<int>> faces,
   const int faceCount = l.faceCount();
 
   std::map<std::pair<int, int>, int> edgeIndex;
+  // A face two cells share is listed once: two copies would each be smoothed
+  // as a boundary, cutting the solid along it.
+  std::map<std::vector<int>, int> loops;
   l.faceEdges_.resize(faceCount);
   for (int f = 0; f < faceCount; ++f) {
     const std::vector<int>& loop = l.faces_[f];
@@ -102,6 +105,9 @@ Lattice Lattice::fromCells(MatrixX3 points, std::vector<std::vector<int>> faces,
       if (p < 0 || p >= n)
         throw Error(source, name + " uses point " + std::to_string(p) + ", but the lattice has " + std::to_string(n));
     if (sortedUnique(loop).size() != loop.size()) throw Error(source, name + " repeats a point");
+    if (const auto [same, added] = loops.try_emplace(sortedUnique(loop), f); !added)
+      throw Error(source, name + " has the points of face " + std::to_string(same->second) +
+                              ": a face two cells share is listed once, and both cells name it");
     if (const std::string noArea = noAreaReason(l.points_, loop, minimumArea); !noArea.empty())
       throw Error(source, name + " is degenerate: " + noArea);
     for (std::size_t i = 0; i < loop.size(); ++i) {
@@ -112,6 +118,7 @@ Lattice Lattice::fromCells(MatrixX3 points, std::vector<std::vector<int>> faces,
     }
   }
 
+  std::map<std::vector<int>, int> shells;
   l.faceCells_.assign(faceCount, {});
   l.cellEdges_.resize(l.cellCount());
   l.cellPoints_.resize(l.cellCount());
@@ -136,6 +143,24 @@ Lattice Lattice::fromCells(MatrixX3 points, std::vector<std::vector<int>> faces,
                                 " of its faces (expected 2)");
       l.cellEdges_[c].push_back(e);
     }
+    if (const auto [same, added] = shells.try_emplace(sortedUnique(shell), c); !added)
+      throw Error(source, name + " has the faces of cell " + std::to_string(same->second));
+    // One shell: every face reached from the first across shared edges.
+    // Two shells listed as one cell would be subdivided as one solid,
+    // bridging the space between them.
+    std::map<int, std::vector<int>> edgeFaces;
+    for (int f : shell)
+      for (int e : l.faceEdges_[f]) edgeFaces[e].push_back(f);
+    std::set<int> reached{shell.front()};
+    for (std::vector<int> next{shell.front()}; !next.empty();) {
+      const int f = next.back();
+      next.pop_back();
+      for (int e : l.faceEdges_[f])
+        for (int g : edgeFaces[e])
+          if (reached.insert(g).second) next.push_back(g);
+    }
+    if (reached.size() != shell.size())
+      throw Error(source, name + " is two or more separate shells: make each closed shell a cell of its own");
     const double volume = enclosedVolume(l.points_, l.faces_, l.faceEdges_, shell);
     if (std::isnan(volume))
       throw Error(source, name + "'s faces cannot be oriented alike: it has no inside and no outside");

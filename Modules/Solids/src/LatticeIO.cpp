@@ -15,6 +15,7 @@
 #include "dynsub/AtomicOutput.h"
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
+#include "dynsub/TextFields.h"
 #include "dynsub/VtkXmlWriter.h"
 
 namespace dynsub {
@@ -47,7 +48,8 @@ class LatticeReader {
     std::istringstream line = next(keyword);
     std::string word;
     long long n = -1;
-    if (!(line >> word >> n) || word != keyword || n < 0 || n > 100000000)
+    std::string extra;
+    if (!(line >> word >> n) || word != keyword || n < 0 || n > 100000000 || line >> extra)
       fail(std::string("expected \"") + keyword + " N\"");
     // Each item is a line of at least two bytes: a count beyond that is a
     // corrupt file, refused before anything is allocated for it.
@@ -105,8 +107,15 @@ Lattice readLattice(const std::string& path) {
   const int n = reader.count("points");
   MatrixX3 points(n, 3);
   for (int i = 0; i < n; ++i) {
+    // Word by word, so that a decimal comma ("0,5") or a stray character is
+    // refused rather than read as the number before it.
     std::istringstream line = reader.next("a point");
-    if (!(line >> points(i, 0) >> points(i, 1) >> points(i, 2))) reader.fail("expected a point \"x y z\"");
+    std::vector<std::string> words;
+    for (std::string word; line >> word;) words.push_back(word);
+    if (words.size() != 3) reader.fail("expected a point \"x y z\", got " + std::to_string(words.size()) + " values");
+    for (int axis = 0; axis < 3; ++axis)
+      if (!parseNumber(words[axis], points(i, axis)))
+        reader.fail("'" + words[axis] + "' is not a number (a point is \"x y z\", with a decimal point)");
     if (!points.row(i).allFinite()) reader.fail("the point is not finite");
   }
   const int f = reader.count("faces");

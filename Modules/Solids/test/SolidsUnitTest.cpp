@@ -285,9 +285,11 @@ TEST_F(LatticeFiles, InvalidLatticesAreNamed) {
   EXPECT_NE(message(file("range.lattice", std::string(text).replace(text.find("3 0 2 1"), 7, "3 0 2 9")))
                 .find("face 0 uses point 9"),
             std::string::npos);
-  // A fifth face nobody uses: dangling.
+  // A fifth face nobody uses, on a fifth point: dangling.
   std::string dangling = std::string(text).replace(text.find("faces 4"), 7, "faces 5");
-  dangling.replace(dangling.find("cells 1"), 7, "3 0 1 2\ncells 1");
+  dangling.replace(dangling.find("points 4"), 8, "points 5");
+  dangling.replace(dangling.find("0 0 1\n"), 6, "0 0 1\n1 1 1\n");
+  dangling.replace(dangling.find("cells 1"), 7, "3 1 2 4\ncells 1");
   EXPECT_NE(message(file("dangling.lattice", dangling)).find("dangles"), std::string::npos);
   // A cell missing a face is open.
   std::string open = std::string(text).replace(text.find("4 0 1 2 3"), 9, "3 0 1 2");
@@ -322,6 +324,43 @@ TEST_F(LatticeFiles, InvalidLatticesAreNamed) {
   std::string far = std::string(text).replace(text.find("1 0 0"), 5, "1e6 0 0");
   EXPECT_NE(message(file("far.lattice", far)).find("is a point far from the others"), std::string::npos)
       << message(file("far.lattice", far));
+}
+
+// A number is read whole: a decimal comma or a stray character is refused,
+// not read as the number before it. A cell is one closed shell, a face two
+// cells share is listed once, and two cells are not the same faces: each
+// would otherwise be subdivided as something else (two tetrahedra bridged
+// across the gap between them, a solid cut along a doubled face).
+TEST_F(LatticeFiles, MistypedNumbersAndMislistedShellsAreRefused) {
+  const std::string text = kTetrahedron;
+  const auto replaced = [&](const std::string& from, const std::string& to) {
+    return std::string(text).replace(text.find(from), from.size(), to);
+  };
+  EXPECT_NE(message(file("comma.lattice", replaced("0 0 1\n", "0 0 0,5\n")))
+                .find("line 6: '0,5' is not a number (a point is \"x y z\", with a decimal point)"),
+            std::string::npos);
+  EXPECT_NE(message(file("dots.lattice", replaced("0 1 0\n", "0 1.5.5\n"))).find("line 5: expected a point"),
+            std::string::npos);
+  EXPECT_NE(message(file("four.lattice", replaced("0 1 0\n", "0 1 0 5\n"))).find("got 4 values"), std::string::npos);
+  EXPECT_NE(message(file("count.lattice", replaced("points 4", "points 4abc"))).find("line 2: expected \"points N\""),
+            std::string::npos);
+
+  const std::string two =
+      "dynsub-lattice 1\npoints 8\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 0\n4 0 0\n3 1 0\n3 0 1\n"
+      "faces 8\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n3 4 6 5\n3 4 5 7\n3 5 6 7\n3 4 7 6\n";
+  EXPECT_NO_THROW(readLattice(file("two.lattice", two + "cells 2\n4 0 1 2 3\n4 4 5 6 7\n")));
+  EXPECT_NE(message(file("bridged.lattice", two + "cells 1\n8 0 1 2 3 4 5 6 7\n"))
+                .find("cell 0 is two or more separate shells"),
+            std::string::npos);
+  // A second tetrahedron on the first's face 1 2 3, which it lists again.
+  const std::string glued =
+      "dynsub-lattice 1\npoints 5\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 1\n"
+      "faces 8\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n3 1 3 2\n3 1 4 3\n3 2 3 4\n3 1 2 4\n"
+      "cells 2\n4 0 1 2 3\n4 4 5 6 7\n";
+  EXPECT_NE(message(file("glued.lattice", glued)).find("face 4 has the points of face 2"), std::string::npos);
+  EXPECT_NE(message(file("twice.lattice", replaced("cells 1\n4 0 1 2 3\n", "cells 2\n4 0 1 2 3\n4 3 2 1 0\n")))
+                .find("cell 1 has the faces of cell 0"),
+            std::string::npos);
 }
 
 // A cell must enclose a volume, though each of its faces has an area: a
