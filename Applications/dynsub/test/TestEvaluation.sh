@@ -138,6 +138,10 @@ bad escaping_name "$(edited "p['splits'][0]['name'] = '../../escaped'")" \
 bad misspelt_key "$(edited "p['protocols'][0]['slice'] = 6")" "a protocol: unknown key 'slice'"
 bad repeated_seed "$(edited "p['splits'][0]['seeds'] = [101, 101]")" "split 'test' lists seed 101 twice"
 bad no_seeds "$(edited "p['splits'][0]['seeds'] = []")" "split 'test' has no seeds"
+# A split that would run nothing: an atlas start is not measured on the
+# atlas's own template, which is the plan's one image.
+bad atlas_on_its_template "$(edited "p['protocols'] = [{'name': 'atlas', 'atlas': True, 'clicks': False}]")" \
+  "split 'test' has no run: its protocols all start from the atlas, and its images are the atlas's template"
 expect_error "an unknown --split" 2 "--split nope: the plan has no such split (its splits: test)" \
   "$work/out_nope/runs.csv" "$DYNSUB" evaluate "$DATA/Evaluation/ci_plan.json" --split nope --out "$work/out_nope"
 # A plan whose every run fails (3 clicks on one slice make no surface) is

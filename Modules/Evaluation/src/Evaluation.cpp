@@ -205,6 +205,7 @@ EvaluationPlan readEvaluationPlan(const std::string& path) {
   }
   const std::filesystem::path base = std::filesystem::absolute(path).parent_path();
   EvaluationPlan plan;
+  plan.path = path;
   try {
     requireKnownKeys(j, {"images", "reference", "atlas", "cohorts", "structures", "protocols", "segment", "splits"},
                      "the plan");
@@ -564,6 +565,17 @@ std::vector<EvaluationRun> runEvaluation(const EvaluationPlan& plan, const Evalu
           }
       }
     }
+  // A split that runs nothing would read as one measured without a failure.
+  for (const EvaluationSplit* split : splits) {
+    if (std::any_of(jobs.begin(), jobs.end(), [&](const Job& job) { return job.run.split == split->name; })) continue;
+    const bool hasImage = std::any_of(inputs.begin(), inputs.end(), [&](const Input& input) {
+      return input.split.empty() || input.split == split->name;
+    });
+    throw Error(plan.path, "split '" + split->name + "' has no run: " +
+                (hasImage ? "its protocols all start from the atlas, and its images are the atlas's template, on "
+                            "which an atlas start is not measured"
+                          : "no image of the plan and no subject of a cohort is in it"));
+  }
 
   std::vector<EvaluationRun> runs(jobs.size());
   std::atomic<size_t> next{0};

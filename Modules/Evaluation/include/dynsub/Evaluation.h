@@ -71,6 +71,7 @@ struct EvaluationSplit {
 };
 
 struct EvaluationPlan {
+  std::string path;  // the plan's file, for messages
   // What every run segments with: the defaults unless the plan's "segment"
   // object sets some (for comparing settings on the tuning split).
   SegmentParameters parameters;
