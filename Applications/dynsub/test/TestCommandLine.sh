@@ -842,6 +842,10 @@ import sys, numpy, nibabel
 nibabel.save(nibabel.Nifti1Image(numpy.zeros((8, 8, 8), numpy.int16), numpy.eye(4)), sys.argv[1])" "$work/nolabel.nii.gz"
 expect_error "subject: a label map without labels" 1 "nolabel.nii.gz: no labelled voxel lies within the image" \
   "$work/s41c" "$DYNSUB" subject "$mri/ch2.nii.gz" "$work/nolabel.nii.gz" --out "$work/s41c"
+expect_error "subject: a realistic subject cleaner than its source" 2 "snr's HIGH must be at most source_snr (70)" \
+  "$work/s41b" "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --set snr=100,100 --out "$work/s41b"
+expect_error "subject: a synthesized subject's setting for a realistic one" 2 "structure_labels and t2_fraction are for synthesized subjects" \
+  "$work/s41b" "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --set structure_labels=71 --out "$work/s41b"
 expect_error "subject: a range the wrong way round" 2 "snr must be LOW,HIGH with 0 < LOW <= HIGH <= 1000" "$work/s41b" \
   "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --set snr=30,10 --out "$work/s41b"
 expect_error "subject: missing labels" 1 "nolabels.nii.gz" "$work/s42" \

@@ -306,6 +306,15 @@ void checkSubjectSettings(const SubjectSettings& s) {
   require(s.snr[0] > 0 && s.snr[0] <= s.snr[1] && s.snr[1] <= 1000,
           "snr must be LOW,HIGH with 0 < LOW <= HIGH <= 1000");
   require(s.sourceSnr > 0, "source_snr must be positive");
+  // A realistic subject keeps the source's own noise: it cannot be cleaner.
+  require(s.synthesized || (s.structureLabels.empty() && s.t2Fraction == 0),
+          "structure_labels and t2_fraction are for synthesized subjects (mode=synthesized): a realistic subject "
+          "keeps the source's intensities");
+  std::ostringstream sourceSnr;
+  sourceSnr << s.sourceSnr;
+  require(s.synthesized || s.snr[1] <= s.sourceSnr,
+          "snr's HIGH must be at most source_snr (" + sourceSnr.str() +
+              "): a realistic subject keeps the source image's own noise, so it is never cleaner than the source");
   require(s.thickFraction >= 0 && s.thickFraction <= 1, "thick_fraction must be in 0..1");
   require(s.thickMm > 0 && s.thickMm <= 10, "thick_mm must be over 0 and at most 10");
   require(s.t2Fraction >= 0 && s.t2Fraction <= 1, "t2_fraction must be in 0..1");
