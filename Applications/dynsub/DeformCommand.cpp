@@ -33,6 +33,10 @@ struct DeformArguments {
   SimulationArguments simulation;
 };
 
+// How much more a surface must have moved than changed shape for its
+// motion to be named as a whole (see runDeform).
+constexpr double kMovedAsAWholeRatio = 4.0;
+
 void runDeform(DeformArguments o) {
   const ControlMesh mesh = readControlMesh(o.mesh);
   const SpringFile springs = readSpringFile(o.springs, o.stiffness);
@@ -43,14 +47,11 @@ void runDeform(DeformArguments o) {
   o.deformation.localRefinement = o.refinement == "local";
   o.deformation.simulation.restShape = o.restShape == "initial";
 
-  std::vector<int> fixed;
-  if (o.fixBoundary) {
-    const Topology& topology = mesh.topology();
-    for (int v = 0; v < mesh.vertexCount(); ++v) {
-      if (topology.isBoundaryVertex(v)) fixed.push_back(v);
-    }
-    if (fixed.empty()) throw Error(o.mesh, "--fix-boundary was given, but the mesh is closed");
-  }
+  std::vector<int> boundary;
+  for (int v = 0; v < mesh.vertexCount(); ++v)
+    if (mesh.topology().isBoundaryVertex(v)) boundary.push_back(v);
+  if (o.fixBoundary && boundary.empty()) throw Error(o.mesh, "--fix-boundary was given, but the mesh is closed");
+  const std::vector<int> fixed = o.fixBoundary ? boundary : std::vector<int>();
   ProgressLine line;
   const DeformationResult result =
       deformSurface(mesh, springs.targets, springs.stiffness, fixed, o.deformation, line.callback());
@@ -78,6 +79,8 @@ void runDeform(DeformArguments o) {
   report.set("mean_spring_length_mm", lengths.size() ? lengths.mean() : 0.0);
   report.set("seconds", seconds);
   report.set("turned_over_percent", result.turnedOverPercent);
+  report.set("common_shift_mm", result.commonShiftMm);
+  report.set("largest_departure_mm", result.largestDepartureMm);
   std::vector<Report> levels;
   for (std::size_t i = 0; i < result.levels.size(); ++i) {
     Report level = levelReport(result.levels[i], -1, -1);
@@ -114,6 +117,22 @@ void runDeform(DeformArguments o) {
     for (std::size_t i = 0; i < fixes.size(); ++i) {
       text << (i == 0 ? "" : i + 1 < fixes.size() ? ", " : " or ") << fixes[i];
     }
+    warnings.push_back(text.str());
+  }
+  // A surface nothing holds moves as a whole toward the springs rather than
+  // changing shape (DeformationResult::commonShiftMm): seldom what was meant.
+  // It is named when the shift exceeds the tolerance and four times the
+  // largest change of shape.
+  const double toleranceMm = o.deformation.tolerancePercent / 100.0 * result.diameter;
+  if (fixed.empty() && result.commonShiftMm > toleranceMm &&
+      result.commonShiftMm > kMovedAsAWholeRatio * result.largestDepartureMm) {
+    std::ostringstream text;
+    text << std::setprecision(3) << "the surface moved as a whole by " << result.commonShiftMm
+         << " mm, changing its shape by at most " << result.largestDepartureMm
+         << " mm: nothing holds it away from the springs, and a translation costs its elasticity nothing. To "
+         << "shape one region, hold the rest: "
+         << (boundary.empty() ? "" : "--fix-boundary, or ")
+         << "springs whose targets lie on the surface where it should stay";
     warnings.push_back(text.str());
   }
   const TriangleSurface surface = outputSurface(result.mesh);
@@ -174,8 +193,9 @@ void addDeformCommand(CLI::App& app) {
   command
       ->add_option("--rest-shape", o->restShape,
                    "initial: the surface's elasticity resists departing from the input mesh's shape, so only the "
-                   "pulled region gives; none: it resists any stretch and bend, as the papers' model does, and a "
-                   "closed surface pulled in one place shrinks elsewhere unless springs anchor it")
+                   "pulled region gives where springs or --fix-boundary hold the rest (else the surface moves as a "
+                   "whole); none: it resists any stretch and bend, as the papers' model does, and a closed surface "
+                   "pulled in one place shrinks elsewhere unless springs anchor it")
       ->default_val("initial")
       ->check(CLI::IsMember({"initial", "none"}));
   o->simulation.addOptions(*command, DeformationOptions::defaultSimulation());

@@ -258,6 +258,19 @@ for name in surface.vtp control_mesh.obj report.json; do check "deform writes $n
 crown=$(awk '$1 == "v" { n++ } n == 41 { print $4; exit }' "$work/hat/control_mesh.obj")  # vertex 41: the centre
 check "the crown rises (z = $crown)" awk -v z="$crown" 'BEGIN { exit !(z > 0.7) }'
 check "the brim stays" grep -q "^v -1 -1 0$" "$work/hat/control_mesh.obj"
+check "the held sheet is not said to move as a whole" test -z "$(grep 'moved as a whole' "$work/stdout")"
+# Without its brim held, the sheet is lifted more than it is shaped; and
+# one spring alone carries the cube along unchanged: both are named.
+"$DYNSUB" deform "$DATA/Meshes/sheet.obj" --springs "$DATA/Deform/sheet_hat.springs" --out "$work/lifted" \
+  >"$work/stdout" 2>&1
+check "an unheld sheet: moved as a whole, --fix-boundary named" \
+  grep -q "warning: the surface moved as a whole by 0.818 mm.*--fix-boundary, or springs" "$work/stdout"
+printf '0 0 10\n' >"$work/one.springs"  # 9 mm above the cube's top
+"$DYNSUB" deform "$DATA/Meshes/cube.obj" --springs "$work/one.springs" --out "$work/carried" >"$work/stdout" 2>&1
+check "one spring on the cube: moved as a whole by 9 mm" \
+  grep -q "warning: the surface moved as a whole by 9 mm.*hold the rest: springs whose targets" "$work/stdout"
+check "one spring on the cube: the shift in report.json (9 mm to 1e-6)" python3 -c \
+  "import json, sys; assert abs(json.load(open(sys.argv[1]))['common_shift_mm'] - 9) < 1e-6" "$work/carried/report.json"
 expect_error "deform: first-order steps without damping" 2 "first-order integration needs a damping > 0" \
   "$work/hat0" "$DYNSUB" deform "$DATA/Meshes/sheet.obj" --springs "$DATA/Deform/sheet_hat.springs" \
   --scheme first-order --damping 0 --out "$work/hat0"

@@ -167,6 +167,12 @@ DeformationResult deformSurface(const ControlMesh& initial, const MatrixX3& targ
   result.toleranceMet = result.maxDistancePercent <= options.tolerancePercent;
   result.springLengths = springs.lengths();
   result.turnedOverPercent = result.levelTurnedOverPercent.back();
+  if (result.mesh.vertexCount() == inputAtLevel.vertexCount()) {
+    const MatrixX3 moved = result.mesh.points() - inputAtLevel.points();
+    const Eigen::RowVector3d shift = moved.colwise().mean();
+    result.commonShiftMm = shift.norm();
+    result.largestDepartureMm = (moved.rowwise() - shift).rowwise().norm().maxCoeff();
+  }
   return result;
 }
 

@@ -72,6 +72,13 @@ struct DeformationResult {
   // over by more than 90 degrees reads here too.
   double turnedOverPercent = 0;
   std::vector<double> levelTurnedOverPercent;  // the same, at each level's end
+  // The mean of the control points' displacements from the input refined to
+  // the final level (mm; its length), and the farthest any point's
+  // displacement lies from that mean: a surface that nothing holds away from
+  // the springs moves as a whole, keeping its shape, since a translation costs
+  // its elasticity nothing (with or without a rest shape).
+  double commonShiftMm = 0;
+  double largestDepartureMm = 0;
   // The levels (indices into `levels`) that started again from the input
   // mesh refined to them, because the level before turned over (see
   // deformSurface); every point of such a level is free.
