@@ -136,6 +136,27 @@ ok = ok and torus['self_intersection'] == {'triangle_pairs': 0, 'area_percent': 
 ok = ok and 'genus 1 but the initial model has genus 0' in open(sys.argv[3]).read()
 sys.exit(0 if ok else 1)" "$work/fitgenus/report.json" "$work/fitgenus1/report.json" "$work/fitgenus.err"
 
+# A long, thin ellipsoid (semi-axes 30, 9, 90 mm): the fit meets its
+# tolerance but folds through itself at the ends, where no point is nearest
+# to its surface; the warning names surface springs, which remove the fold.
+python3 -c "
+import math, random
+draw = random.Random(7)
+with open('$work/thin.xyz', 'w') as f:
+    for _ in range(2000):
+        u = [draw.gauss(0, 1) for _ in range(3)]
+        n = math.sqrt(sum(c * c for c in u))
+        f.write('%.6f %.6f %.6f\\n' % (30 * u[0] / n, 9 * u[1] / n, 90 * u[2] / n))"
+"$DYNSUB" fit "$work/thin.xyz" --no-figures --out "$work/thin" >/dev/null 2>&1
+"$DYNSUB" fit "$work/thin.xyz" --no-figures --surface-springs 0.1 --out "$work/thin_springs" >/dev/null 2>&1
+check "a thin ellipsoid: the fold is warned of, with surface springs named; with them it is gone" python3 -c "
+import json, sys
+plain, springs = (json.load(open(path)) for path in sys.argv[1:3])
+assert plain['self_intersection']['area_percent'] > 0.5, plain['self_intersection']
+assert any('passes through itself' in w and '--surface-springs 0.1' in w for w in plain['warnings']), plain['warnings']
+assert springs['self_intersection']['triangle_pairs'] == 0 and springs['converged'], springs['self_intersection']
+" "$work/thin/report.json" "$work/thin_springs/report.json"
+
 printf '1 2 3\n4 5 6\n7 8 9.5\n' >"$work/three.xyz"
 expect_error "too few points" 1 "at least 4" "$work/o1" "$DYNSUB" fit "$work/three.xyz" --out "$work/o1"
 # Values no fit can mean: a tolerance past the whole diameter, surface
