@@ -156,13 +156,16 @@ void checkPolygonMesh(const MatrixX3& points, const std::vector<std::vector<int>
   }
 }
 
+// Vertices are named as crease tags name them, from 0 (an OBJ's other
+// messages count its vertices from 1, as its faces do), the smaller first.
 void checkCreases(const Topology& topology, const std::string& source) {
   if (!topology.hasCreases()) return;
   for (int e = 0; e < topology.edgeCount(); ++e) {
     const double sharpness = topology.edgeSharpness(e);
     if (sharpness > kLargestSemiSharpness && sharpness < kInfiniteSharpness) {
       const auto [a, b] = topology.edgeVertices(e);
-      throw Error(source, "crease (" + std::to_string(a) + ", " + std::to_string(b) + ") has sharpness " +
+      throw Error(source, "crease (" + std::to_string(std::min(a, b)) + ", " + std::to_string(std::max(a, b)) +
+                              ") has sharpness " +
                               std::to_string(sharpness) + ": semi-sharp creases up to " +
                               std::to_string(static_cast<int>(kLargestSemiSharpness)) +
                               " are supported (each step of sharpness refines the whole surface once), and from " +
@@ -176,7 +179,7 @@ void checkCreases(const Topology& topology, const std::string& source) {
       infinite += !topology.isBoundaryEdge(e) && topology.edgeSharpness(e) >= kInfiniteSharpness;
     }
     if (infinite == 0) continue;
-    const std::string at = "vertex " + std::to_string(v) + ": ";
+    const std::string at = "vertex " + std::to_string(v) + " (counted from 0, as crease tags count): ";
     if (sharp == 1) {
       const std::string below = std::to_string(static_cast<int>(kInfiniteSharpness));
       throw Error(source, at +
