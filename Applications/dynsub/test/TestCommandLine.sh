@@ -286,8 +286,8 @@ check "the held sheet is not said to move as a whole" test -z "$(grep 'moved as 
   >"$work/stdout" 2>&1
 check "an unheld sheet: moved as a whole, --fix-boundary named" \
   grep -q "warning: the surface moved as a whole by 0.818 mm.*--fix-boundary, or springs" "$work/stdout"
-printf '0 0 10\n' >"$work/one.springs"  # 9 mm above the cube's top
-"$DYNSUB" deform "$DATA/Meshes/cube.obj" --springs "$work/one.springs" --out "$work/carried" >"$work/stdout" 2>&1
+printf '0 0 10\n' >"$work/above.springs"  # 9 mm above the cube's top
+"$DYNSUB" deform "$DATA/Meshes/cube.obj" --springs "$work/above.springs" --out "$work/carried" >"$work/stdout" 2>&1
 check "one spring on the cube: moved as a whole by 9 mm" \
   grep -q "warning: the surface moved as a whole by 9 mm.*hold the rest: springs whose targets" "$work/stdout"
 check "one spring on the cube: the shift in report.json (9 mm to 1e-6)" python3 -c \
@@ -376,6 +376,17 @@ assert min(z) < -0.9 and max(z) < 1.6, (min(z), max(z))
 printf '0 0 1 -5\n' >"$work/bad.springs"
 expect_error "negative spring stiffness" 1 "stiffness" "$work/o11" \
   "$DYNSUB" deform "$DATA/Meshes/sheet.obj" --springs "$work/bad.springs" --out "$work/o11"
+# A decimal comma is refused, not split into two values that shift the rest;
+# a byte order mark, CR LF line ends, and rows of commas or semicolons (one
+# kind per row, a spreadsheet's empty row among them) are read.
+printf '0,5 0 1\n' >"$work/comma.springs"
+expect_error "a spring with a decimal comma" 1 "comma.springs: line 1: '5 0 1' is not a number" "$work/o11" \
+  "$DYNSUB" deform "$DATA/Meshes/sheet.obj" --springs "$work/comma.springs" --out "$work/o11"
+printf '\xef\xbb\xbf0 0 0.5\r\n0.5,0,0.5,10\r\n;;;\r\n-0.5;0;0.5\r\n' >"$work/mixed.springs"
+"$DYNSUB" deform "$DATA/Meshes/sheet.obj" --springs "$work/mixed.springs" --fix-boundary --out "$work/mixed" \
+  >/dev/null 2>&1
+check "springs with a byte order mark, CR LF, commas and semicolons: all three read" \
+  grep -q '"springs": 3,' "$work/mixed/report.json"
 expect_error "fix-boundary on a closed mesh" 1 "closed" "$work/o12" \
   "$DYNSUB" deform "$DATA/Meshes/torus.obj" --springs "$DATA/Deform/torus_pull.springs" --fix-boundary --out "$work/o12"
 # An 8-vertex cube and one spring, with no rest shape: tension draws it to a

@@ -1,5 +1,6 @@
 #include "dynsub/SpringFile.h"
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 #include <vector>
@@ -18,18 +19,33 @@ SpringFile readSpringFile(const std::string& path, double defaultStiffness) {
   int number = 0;
   while (std::getline(in, line)) {
     ++number;
+    if (number == 1) line = withoutByteOrderMark(line);
     const size_t comment = line.find('#');
     if (comment != std::string::npos) line.erase(comment);
-    for (char& c : line) {
-      if (c == ',' || c == ';' || c == '\t' || c == '\r') c = ' ';
+    if (!line.empty() && line.back() == '\r') line.pop_back();  // CR LF line ends
+    // One separator per line: semicolons, else commas, else blanks. Read
+    // item by item, a decimal comma ("0,5 1 2", or "0,5;1;2") is refused
+    // rather than split into two values that shift the rest.
+    const char separator = line.find(';') != std::string::npos ? ';' : line.find(',') != std::string::npos ? ',' : 0;
+    std::vector<std::string> items;
+    if (separator) {
+      items = splitItems(line, separator);
+      if (items.size() > 1 && trimmed(items.back()).empty()) items.pop_back();  // a separator that ends the row
+    } else {
+      std::istringstream fields(line);
+      for (std::string field; fields >> field;) items.push_back(field);
     }
-    std::istringstream fields(line);
+    // A row of separators alone (a spreadsheet's empty row) holds nothing.
+    if (std::all_of(items.begin(), items.end(), [](const std::string& item) { return trimmed(item).empty(); }))
+      continue;
     std::vector<double> values;
-    std::string field;
-    while (fields >> field) {
+    for (const std::string& item : items) {
+      const std::string field = trimmed(item);
       double value = 0;
       if (!parseNumber(field, value))
-        throw Error(path, "line " + std::to_string(number) + ": '" + field + "' is not a number");
+        throw Error(path, "line " + std::to_string(number) + ": '" + field +
+                              "' is not a number (values are separated by blanks, or by commas, or by semicolons, one "
+                              "kind per line, with a decimal point)");
       values.push_back(value);
     }
     if (values.empty()) continue;

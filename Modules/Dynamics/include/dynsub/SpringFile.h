@@ -1,7 +1,7 @@
 #pragma once
 // Spring files for modeling by forces (dynsub deform): one spring per line,
-// "x y z" or "x y z stiffness" (mm, N/mm), separated by spaces, tabs, commas
-// or semicolons; '#' starts a comment.
+// "x y z" or "x y z stiffness" (mm, N/mm), separated by spaces and tabs, or
+// by commas, or by semicolons (one kind per line); '#' starts a comment.
 #include <string>
 
 #include "dynsub/Types.h"
