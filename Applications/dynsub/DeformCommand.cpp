@@ -119,6 +119,21 @@ void runDeform(DeformArguments o) {
     }
     warnings.push_back(text.str());
   }
+  // Refinement that ended short of the tolerance before the last level
+  // allowed: a level brought the farthest target too little closer
+  // (kLeastRefinementGain). (At the last level, the printed summary says
+  // that the tolerance was not met.)
+  const std::vector<double>& reached = result.levelDistancesPercent;
+  if (!result.toleranceMet && result.levels.back().level < o.deformation.simulation.maxLevel && reached.size() >= 2) {
+    std::ostringstream text;
+    text << std::setprecision(3) << "the farthest target is " << result.maxDistancePercent
+         << " % of the diameter from the surface, above the tolerance (" << o.deformation.tolerancePercent
+         << " %): refinement stopped at level " << result.levels.back().level << ", which brought it only "
+         << 100.0 * (1.0 - reached.back() / reached[reached.size() - 2]) << " % closer than the level before (under "
+         << 100.0 * kLeastRefinementGain << " %): the springs' pull is balanced by the surface's elasticity, which a "
+         << "finer level does not weaken; stiffer springs (--stiffness, or a spring's fourth value) pull it closer";
+    warnings.push_back(text.str());
+  }
   // A surface nothing holds moves as a whole toward the springs rather than
   // changing shape (DeformationResult::commonShiftMm): seldom what was meant.
   // It is named when the shift exceeds the tolerance and four times the
