@@ -142,6 +142,17 @@ bad no_seeds "$(edited "p['splits'][0]['seeds'] = []")" "split 'test' has no see
 # atlas's own template, which is the plan's one image.
 bad atlas_on_its_template "$(edited "p['protocols'] = [{'name': 'atlas', 'atlas': True, 'clicks': False}]")" \
   "split 'test' has no run: its protocols all start from the atlas, and its images are the atlas's template"
+# A reference placed 500 mm off the image (its header's qoffset_x and
+# srow_x[3] moved) is refused, naming the reference, before any run.
+python3 -c "
+import gzip, struct, sys
+header = bytearray(gzip.open(sys.argv[1]).read())
+for offset in (268, 292):  # qoffset_x, srow_x[3]
+    struct.pack_into('<f', header, offset, struct.unpack_from('<f', header, offset)[0] + 500)
+open(sys.argv[2], 'wb').write(header)" /usr/share/mricron/templates/aal.nii.gz "$work/aal_far.nii"
+edited "p['reference'] = '$work/aal_far.nii'" >"$work/reference_far.json"
+expect_error "a reference off the image" 1 "aal_far.nii: structure '[a-z_]*' lies wholly outside image 'colin27_1mm'" \
+  "$work/out_far/runs.csv" "$DYNSUB" evaluate "$work/reference_far.json" --out "$work/out_far"
 expect_error "an unknown --split" 2 "--split nope: the plan has no such split (its splits: test)" \
   "$work/out_nope/runs.csv" "$DYNSUB" evaluate "$DATA/Evaluation/ci_plan.json" --split nope --out "$work/out_nope"
 # A plan whose every run fails (3 clicks on one slice make no surface) is
