@@ -53,8 +53,8 @@ void runDeform(DeformArguments o) {
   if (o.fixBoundary && boundary.empty()) throw Error(o.mesh, "--fix-boundary was given, but the mesh is closed");
   const std::vector<int> fixed = o.fixBoundary ? boundary : std::vector<int>();
   ProgressLine line;
-  const DeformationResult result =
-      deformSurface(mesh, springs.targets, springs.stiffness, fixed, o.deformation, line.callback());
+  const DeformationResult result = naming(
+      o.mesh, [&] { return deformSurface(mesh, springs.targets, springs.stiffness, fixed, o.deformation, line.callback()); });
   line.finish();
 
   const Eigen::VectorXd& lengths = result.springLengths;

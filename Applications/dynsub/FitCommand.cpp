@@ -207,7 +207,8 @@ void runFit(FitCommandOptions o) {
         return 100.0 * distances.maxCoeff() / diameter;
       },
       5);
-  const FitResult result = fitPointCloud(data, initial, o.fit, recorder.callback(line.callback()));
+  const FitResult result =
+      naming(o.points, [&] { return fitPointCloud(data, initial, o.fit, recorder.callback(line.callback())); });
   line.finish();
   ConvergenceHistory history = recorder.history();
   for (size_t i = 0; i < result.levels.size(); ++i)

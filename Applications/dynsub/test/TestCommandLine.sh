@@ -121,6 +121,10 @@ awk 'NR <= 120 { print $1, $2, $3, ($1 - 5) / 30, ($2 + 2) / 30, ($3 - 7) / 30 }
 check "fit reads .pwn, all 120 points" python3 -c "
 import json, sys
 sys.exit(0 if json.load(open(sys.argv[1]))['points'] == 120 else 1)" "$work/fitpwn/report.json"
+# A fit whose solve fails (too few data springs to hold the finest level)
+# names the points it was fitting.
+expect_error "fit: a failed solve names the points" 1 "sphere.xyz: the static scheme found no finite step" \
+  "$work/fitfail" "$DYNSUB" fit "$work/sphere.xyz" --springs-per-element 0.001 --no-figures --out "$work/fitfail"
 # A closed mesh of genus 1 (the torus's limit surface, above): the automatic
 # (genus 0) initial model is warned about, the torus is not. The sphere folds
 # through itself across the hole (10 % of its area crosses), which is warned of too.

@@ -37,6 +37,20 @@ decltype(auto) asUsageError(Check&& check) {
   }
 }
 
+// Runs `run` and returns what it returns, an Error it throws (not a
+// UsageError) rethrown as "<source>: <message>": for computations on a file's
+// contents whose errors (a divergence, a failed factorization) name no file.
+template <typename Run>
+decltype(auto) naming(const std::string& source, Run&& run) {
+  try {
+    return run();
+  } catch (const UsageError&) {
+    throw;
+  } catch (const Error& error) {
+    throw Error(source, error.what());
+  }
+}
+
 // An Error about landmarks given as points (outside the image, on no edge):
 // a caller that read them from a file catches it to name the file.
 class LandmarkError : public Error {
