@@ -584,7 +584,20 @@ check "fit without a display or Xvfb warns" grep -q "no figures written: DISPLAY
 check "fit without a display or Xvfb writes no figure" test ! -e "$work/noxvfb/slices.png"
 "$DYNSUB" render --surface "$work/caudate/surface.vtp" --image "$mri/ch2.nii.gz" \
   --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --convergence "$work/caudate/convergence.csv" \
-  --out "$work/rendered" >/dev/null
+  --out "$work/rendered" >/dev/null 2>"$work/rendered.err"
+check "render: the run's own landmarks, no warning" test ! -s "$work/rendered.err"
+# The same landmarks mirrored (x and y negated, as RAS read for LPS): drawn,
+# and named as far from the surface.
+python3 -c "
+import json, sys
+points = json.load(open(sys.argv[1]))['markups'][0]['controlPoints']
+print('x,y,z')
+for p in points: print('%r,%r,%r' % (-p['position'][0], -p['position'][1], p['position'][2]))" \
+  "$DATA/Landmarks/caudate_left.mrk.json" >"$work/mirrored.csv"
+"$DYNSUB" render --surface "$work/caudate/surface.vtp" --image "$mri/ch2.nii.gz" --landmarks "$work/mirrored.csv" \
+  --out "$work/rendered_mirrored" >/dev/null 2>"$work/mirrored.err"
+check "render: mirrored landmarks are warned of" \
+  grep -q "mirrored.csv: the landmarks lie a median 2[0-9].[0-9] mm from the surface" "$work/mirrored.err"
 for name in slices.png surface3d.png convergence.png; do
   check "render writes $name" test -s "$work/rendered/$name"
 done
