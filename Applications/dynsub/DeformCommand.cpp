@@ -53,8 +53,9 @@ void runDeform(DeformArguments o) {
   if (o.fixBoundary && boundary.empty()) throw Error(o.mesh, "--fix-boundary was given, but the mesh is closed");
   const std::vector<int> fixed = o.fixBoundary ? boundary : std::vector<int>();
   ProgressLine line;
-  const DeformationResult result = naming(
-      o.mesh, [&] { return deformSurface(mesh, springs.targets, springs.stiffness, fixed, o.deformation, line.callback()); });
+  const DeformationResult result = naming(o.mesh, [&] {
+    return deformSurface(mesh, springs.targets, springs.stiffness, fixed, o.deformation, line.callback());
+  });
   line.finish();
 
   const Eigen::VectorXd& lengths = result.springLengths;
@@ -145,8 +146,7 @@ void runDeform(DeformArguments o) {
     text << std::setprecision(3) << "the surface moved as a whole by " << result.commonShiftMm
          << " mm, changing its shape by at most " << result.largestDepartureMm
          << " mm: nothing holds it away from the springs, and a translation costs its elasticity nothing. To "
-         << "shape one region, hold the rest: "
-         << (boundary.empty() ? "" : "--fix-boundary, or ")
+         << "shape one region, hold the rest: " << (boundary.empty() ? "" : "--fix-boundary, or ")
          << "springs whose targets lie on the surface where it should stay";
     warnings.push_back(text.str());
   }

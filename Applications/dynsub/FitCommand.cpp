@@ -233,7 +233,8 @@ void runFit(FitCommandOptions o) {
   // default: they double the time of a fit that folds a little (the bear's
   // 1.34 % of crossing area becomes 1.07 %).
   if (warnings.size() > warned && o.fit.surfaceSprings == 0.0)
-    warnings.back() += " (--surface-springs 0.1 pulls folds where no data point is nearest to the surface onto the data)";
+    warnings.back() +=
+        " (--surface-springs 0.1 pulls folds where no data point is nearest to the surface onto the data)";
 
   Report report;
   report.set("input", o.points);

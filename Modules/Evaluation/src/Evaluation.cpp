@@ -585,10 +585,11 @@ std::vector<EvaluationRun> runEvaluation(const EvaluationPlan& plan, const Evalu
     const bool hasImage = std::any_of(inputs.begin(), inputs.end(), [&](const Input& input) {
       return input.split.empty() || input.split == split->name;
     });
-    throw Error(plan.path, "split '" + split->name + "' has no run: " +
-                (hasImage ? "its protocols all start from the atlas, and its images are the atlas's template, on "
-                            "which an atlas start is not measured"
-                          : "no image of the plan and no subject of a cohort is in it"));
+    throw Error(plan.path,
+                "split '" + split->name + "' has no run: " +
+                    (hasImage ? "its protocols all start from the atlas, and its images are the atlas's template, on "
+                                "which an atlas start is not measured"
+                              : "no image of the plan and no subject of a cohort is in it"));
   }
 
   std::vector<EvaluationRun> runs(jobs.size());

@@ -165,8 +165,7 @@ void checkCreases(const Topology& topology, const std::string& source) {
     if (sharpness > kLargestSemiSharpness && sharpness < kInfiniteSharpness) {
       const auto [a, b] = topology.edgeVertices(e);
       throw Error(source, "crease (" + std::to_string(std::min(a, b)) + ", " + std::to_string(std::max(a, b)) +
-                              ") has sharpness " +
-                              std::to_string(sharpness) + ": semi-sharp creases up to " +
+                              ") has sharpness " + std::to_string(sharpness) + ": semi-sharp creases up to " +
                               std::to_string(static_cast<int>(kLargestSemiSharpness)) +
                               " are supported (each step of sharpness refines the whole surface once), and from " +
                               std::to_string(static_cast<int>(kInfiniteSharpness)) + " on a crease is sharp");

@@ -217,8 +217,9 @@ TEST(MeshIO, BadCreaseTagsAreNamed) {
       {"t crease 2/1/0 4 5 nan\n", "has sharpness nan"},
       {"t crease 2/1/0 5 4 5\n", "crease (4, 5) has sharpness 5.000000: semi-sharp creases up to 4"},
       // Crease tags count vertices from 0, where the OBJ's other messages count from 1: said where it matters.
-      {"t crease 2/1/0 3 4 10\n", "vertex 4 (counted from 0, as crease tags count): a sharp crease ends inside the "
-                                  "surface (a dart)"},
+      {"t crease 2/1/0 3 4 10\n",
+       "vertex 4 (counted from 0, as crease tags count): a sharp crease ends inside the "
+       "surface (a dart)"},
       {"t crease 2/1/0 4 5 1\nt crease 2/1/0 5 4 2\n", "crease (5, 4) is tagged twice, with sharpness 1 and 2"},
       // Two sharp creases at the centre with one face between them.
       {"t crease 2/1/0 1 4 10\nt crease 2/1/0 4 5 10\n", "single face on one side"},
