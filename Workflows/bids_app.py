@@ -90,9 +90,11 @@ def main(argv, snakefile, dynsub):
     # overwrite the dataset's own description and .bidsignore.
     if os.path.realpath(out) == os.path.realpath(bids_dir):
         parser.error(f"{args.output_dir}: the output directory must not be the BIDS dataset itself")
-    # Inside the dataset, outputs outside derivatives/ make it invalid BIDS.
+    # Inside the dataset, outputs outside the folders BIDS leaves to the user
+    # (derivatives/, sourcedata/, code/, hidden ones) make it invalid BIDS.
     inside = os.path.relpath(os.path.realpath(out), os.path.realpath(bids_dir))
-    if not inside.startswith("..") and inside.split(os.sep)[0] != "derivatives":
+    top = inside.split(os.sep)[0]
+    if top != os.pardir and top not in ("derivatives", "sourcedata", "code") and not top.startswith("."):
         parser.error(f"{args.output_dir}: inside the BIDS dataset but not in its derivatives folder, where the "
                      f"outputs would make the dataset invalid; use {os.path.join(args.bids_dir, 'derivatives', 'dynsub')}")
     work = os.path.abspath(args.work_dir or os.path.join(out, "work"))

@@ -174,6 +174,17 @@ def view_path(out, dir, stem, desc):
     return f"{out}/{dir}/figures/{stem}{desc}_view.js"
 
 
+def _own_folder(subject, session):
+    """Where a file of a subject and session lies, relative to its dataset's root."""
+    return os.path.join(f"sub-{subject}", *([f"ses-{session}"] if session else []), "anat")
+
+
+def _in_own_folder(path, root, subject, session):
+    """Whether path lies in its subject's and session's folder under root
+    (however root is spelt: a trailing slash, a relative path)."""
+    return os.path.relpath(os.path.dirname(path), root) == _own_folder(subject, session)
+
+
 def _relative(path, root):
     return os.path.relpath(os.path.abspath(path), os.path.abspath(root))
 
@@ -204,8 +215,7 @@ def find_images(bids, warn=_warn):
                  "_T1w.nii[.gz], in that order, letters and digits in labels)")
             continue
         subject, session = match["sub"], match["ses"]
-        expected = f"{bids}/sub-{subject}" + (f"/ses-{session}" if session else "") + "/anat"
-        if os.path.dirname(path) != expected:
+        if not _in_own_folder(path, bids, subject, session):
             raise CohortError(f"{path}: its name does not match its folder")
         key = (subject, session, match["entities"])
         if key in images:  # .nii beside .nii.gz
@@ -250,9 +260,8 @@ def find_structures(bids, landmarks_dir, seeds_table, reference_dir, warn=_warn)
                 raise CohortError(f"{path}: not handled (expected sub-<label>[_ses-<label>][entities]_desc-<structure>"
                                   "_landmarks.mrk.json|.fcsv|.csv, letters and digits in labels)")
             # A file copied from another subject's folder and not renamed would serve the subject its name says.
-            folder = f"{landmarks_dir}/sub-{match['sub']}" + (f"/ses-{match['ses']}" if match["ses"] else "") + "/anat"
-            if os.path.dirname(path) != folder:
-                raise CohortError(f"{path}: its name is for {os.path.relpath(folder, landmarks_dir)}, not the folder "
+            if not _in_own_folder(path, landmarks_dir, match["sub"], match["ses"]):
+                raise CohortError(f"{path}: its name is for {_own_folder(match['sub'], match['ses'])}, not the folder "
                                   "it is in; rename it for its folder's subject and session, or move it")
             structure = structure_for(match["sub"], match["ses"], match["entities"], match["structure"], path)
             if structure.landmarks:

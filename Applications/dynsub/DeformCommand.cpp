@@ -129,9 +129,13 @@ void runDeform(DeformArguments o) {
     std::ostringstream text;
     text << std::setprecision(3) << "the farthest target is " << result.maxDistancePercent
          << " % of the diameter from the surface, above the tolerance (" << o.deformation.tolerancePercent
-         << " %): refinement stopped at level " << result.levels.back().level << ", which brought it only "
-         << 100.0 * (1.0 - reached.back() / reached[reached.size() - 2]) << " % closer than the level before (under "
-         << 100.0 * kLeastRefinementGain << " %): the springs' pull is balanced by the surface's elasticity, which a "
+         << " %): refinement stopped at level " << result.levels.back().level << ", which ";
+    const double gain = 1.0 - reached.back() / reached[reached.size() - 2];
+    if (gain >= 0.0)
+      text << "brought it only " << 100.0 * gain << " % closer than the level before";
+    else
+      text << "left it " << -100.0 * gain << " % farther than the level before";
+    text << " (a level must bring it " << 100.0 * kLeastRefinementGain << " % closer): the springs' pull is balanced by the surface's elasticity, which a "
          << "finer level does not weaken; stiffer springs (--stiffness, or a spring's fourth value) pull it closer";
     warnings.push_back(text.str());
   }

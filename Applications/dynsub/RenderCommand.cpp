@@ -2,9 +2,11 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <set>
 #include <string>
@@ -55,8 +57,9 @@ struct RenderCommandOptions {
   FigureOptions figures;
 };
 
-// A median distance from the landmarks to the drawn surface beyond which
-// they are named as not its own. A segmentation's landmarks lie on its
+// A median distance from the landmarks to the drawn surface's vertices
+// (within a tessellation's spacing of the surface) beyond which they are
+// named as not its own; with several lists, the nearest list's. A segmentation's landmarks lie on its
 // boundary, within a voxel or two (the demo's caudate: a median 0.2 mm);
 // mirrored across the midline, tens of mm away.
 constexpr double kFarLandmarksMm = 5.0;
@@ -124,17 +127,22 @@ void runRender(const RenderCommandOptions& o) {
   std::cout << "wrote " << (dir / ("slices" + extension)).string() << ", surface3d" << extension
             << (o.convergence.empty() ? "" : ", convergence" + extension) << '\n';
   // Landmarks drawn far from the surface they outlined are another run's,
-  // or read in the other convention; the figure alone would not say so.
-  if (inputs.landmarks.rows() > 0) {
+  // or read in the other convention; the figure alone would not say so. A
+  // file of several structures' lists outlines this surface with one of them.
+  if (!o.landmarks.empty()) {
     const MatrixX3 vertices = readPointCloud(o.surface).points;
-    std::vector<double> nearest;
-    for (Eigen::Index i = 0; i < inputs.landmarks.rows(); ++i)
-      nearest.push_back((vertices.rowwise() - inputs.landmarks.row(i)).rowwise().norm().minCoeff());
-    std::nth_element(nearest.begin(), nearest.begin() + nearest.size() / 2, nearest.end());
-    const double median = nearest[nearest.size() / 2];
-    if (median > kFarLandmarksMm)
+    double nearestList = std::numeric_limits<double>::infinity();
+    for (const LandmarkList& list : readLandmarkLists(o.landmarks)) {
+      std::vector<double> nearest;
+      for (const Landmark& landmark : list.landmarks)
+        nearest.push_back((vertices.rowwise() - landmark.position.transpose()).rowwise().norm().minCoeff());
+      if (nearest.empty()) continue;
+      std::nth_element(nearest.begin(), nearest.begin() + nearest.size() / 2, nearest.end());
+      nearestList = std::min(nearestList, nearest[nearest.size() / 2]);
+    }
+    if (std::isfinite(nearestList) && nearestList > kFarLandmarksMm)
       std::cerr << "warning: " << o.landmarks << ": the landmarks lie a median " << std::fixed << std::setprecision(1)
-                << median << " mm from the surface " << o.surface
+                << nearestList << " mm from the vertices of the surface " << o.surface
                 << ": are they another image's or run's, or in the other convention (x and y negated)?\n";
   }
 }

@@ -96,6 +96,9 @@ touch(f"{reference}/sub-05/anat/sub-05_acq-mprage_run-2_dseg.nii.gz")  # no tabl
 warnings = []
 structures = bids.find_structures(root, landmarks, None, reference, warn=warnings.append)
 assert sorted(structures) == [("sub-04_run-1", "caudateL"), ("sub-05_acq-mprage_run-2", "caudateL")], sorted(structures)
+# The folders given with a trailing slash find the same.
+again = bids.find_structures(root + "/", landmarks + "/", None, reference + "/", warn=lambda message: None)
+assert sorted(again) == sorted(structures), sorted(again)
 structure = structures[("sub-04_run-1", "caudateL")]
 assert structure.t1w.endswith("sub-04_run-1_T1w.nii.gz") and structure.reference_labels == [3], vars(structure)
 jobs = bids.group_jobs(structures)

@@ -7,6 +7,9 @@
 namespace dynsub {
 
 bool parseNumber(const std::string& field, double& value) {
+  // std::stod reads hexadecimal ("0x1", "0x1p3"), which no file DynSub reads
+  // means: a mistyped value.
+  if (field.find_first_of("xX") != std::string::npos) return false;
   try {
     std::size_t used = 0;
     value = std::stod(field, &used);

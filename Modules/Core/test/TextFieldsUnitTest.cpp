@@ -5,6 +5,16 @@
 namespace dynsub {
 namespace {
 
+// A number is read whole and in decimal: a decimal comma, a second point or
+// a hexadecimal value is no number, where std::stod alone reads one.
+TEST(TextFields, ParseNumberReadsWholeDecimalNumbers) {
+  double value = 0;
+  EXPECT_TRUE(parseNumber("-1.5e3", value));
+  EXPECT_EQ(value, -1500.0);
+  EXPECT_TRUE(parseNumber("nan", value));
+  for (const char* field : {"0,5", "1.5.5", "0x1", "0X1p3", "8abc", ""}) EXPECT_FALSE(parseNumber(field, value)) << field;
+}
+
 TEST(TextFields, EditDistanceIgnoresCase) {
   EXPECT_EQ(editDistance("segmnet", "segment"), 2u);  // two substitutions (a swap)
   EXPECT_EQ(editDistance("Caudate_L", "caudate_l"), 0u);

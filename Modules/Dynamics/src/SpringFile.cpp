@@ -30,7 +30,8 @@ SpringFile readSpringFile(const std::string& path, double defaultStiffness) {
     std::vector<std::string> items;
     if (separator) {
       items = splitItems(line, separator);
-      if (items.size() > 1 && trimmed(items.back()).empty()) items.pop_back();  // a separator that ends the row
+      // Separators that end the row add no value.
+      while (items.size() > 1 && trimmed(items.back()).empty()) items.pop_back();
     } else {
       std::istringstream fields(line);
       for (std::string field; fields >> field;) items.push_back(field);
@@ -41,6 +42,8 @@ SpringFile readSpringFile(const std::string& path, double defaultStiffness) {
     std::vector<double> values;
     for (const std::string& item : items) {
       const std::string field = trimmed(item);
+      if (field.empty())
+        throw Error(path, "line " + std::to_string(number) + ": an empty value (two separators with none between)");
       double value = 0;
       if (!parseNumber(field, value))
         throw Error(path, "line " + std::to_string(number) + ": '" + field +

@@ -306,10 +306,12 @@ void checkSubjectSettings(const SubjectSettings& s) {
   require(s.snr[0] > 0 && s.snr[0] <= s.snr[1] && s.snr[1] <= 1000,
           "snr must be LOW,HIGH with 0 < LOW <= HIGH <= 1000");
   require(s.sourceSnr > 0, "source_snr must be positive");
-  // A realistic subject keeps the source's own noise: it cannot be cleaner.
+  // Settings of synthesized subjects' intensities, which a realistic one
+  // takes from its source.
   require(s.synthesized || (s.structureLabels.empty() && s.t2Fraction == 0),
           "structure_labels and t2_fraction are for synthesized subjects (mode=synthesized): a realistic subject "
           "keeps the source's intensities");
+  // A realistic subject keeps the source's own noise: it cannot be cleaner.
   std::ostringstream sourceSnr;
   sourceSnr << s.sourceSnr;
   require(s.synthesized || s.snr[1] <= s.sourceSnr,

@@ -160,7 +160,8 @@ Lattice Lattice::fromCells(MatrixX3 points, std::vector<std::vector<int>> faces,
           if (reached.insert(g).second) next.push_back(g);
     }
     if (reached.size() != shell.size())
-      throw Error(source, name + " is two or more separate shells: make each closed shell a cell of its own");
+      throw Error(source, name + " is two or more separate shells: a cell is one closed shell (a solid with a cavity "
+                              "is cells around it); make each separate solid's shell a cell of its own");
     const double volume = enclosedVolume(l.points_, l.faces_, l.faceEdges_, shell);
     if (std::isnan(volume))
       throw Error(source, name + "'s faces cannot be oriented alike: it has no inside and no outside");

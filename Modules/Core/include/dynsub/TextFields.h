@@ -6,8 +6,9 @@
 
 namespace dynsub {
 
-// True when the whole of `field` is a number (as std::stod reads it; "nan" and
-// "inf" included: callers decide about finiteness); `value` receives it.
+// True when the whole of `field` is a decimal number (as std::stod reads it,
+// but not hexadecimal; "nan" and "inf" included: callers decide about
+// finiteness); `value` receives it.
 bool parseNumber(const std::string& field, double& value);
 
 // Every item of `text` between `separator`s, as written, the empty ones too
