@@ -59,9 +59,10 @@ struct RenderCommandOptions {
 
 // A median distance from the landmarks to the drawn surface's vertices
 // (within a tessellation's spacing of the surface) beyond which they are
-// named as not its own; with several lists, the nearest list's. A segmentation's landmarks lie on its
-// boundary, within a voxel or two (the demo's caudate: a median 0.2 mm);
-// mirrored across the midline, tens of mm away.
+// named as not its own; with several lists, the nearest list's. A
+// segmentation's landmarks lie on its boundary, within a voxel or two (the
+// demo's caudate: a median 0.2 mm); mirrored across the midline, tens of mm
+// away.
 constexpr double kFarLandmarksMm = 5.0;
 
 void runRender(const RenderCommandOptions& o) {

@@ -60,6 +60,10 @@ std::string afterObjectAddress(const std::string& line) {
   return end == std::string::npos ? line : line.substr(end + 3);
 }
 
+bool holdsNothing(const std::string& line, const std::string& separators) {
+  return line.find_first_not_of(" \t\r" + separators) == std::string::npos;
+}
+
 std::string lowerCase(std::string text) {
   for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return text;

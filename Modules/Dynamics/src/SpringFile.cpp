@@ -1,6 +1,5 @@
 #include "dynsub/SpringFile.h"
 
-#include <algorithm>
 #include <fstream>
 #include <sstream>
 #include <vector>
@@ -27,6 +26,7 @@ SpringFile readSpringFile(const std::string& path, double defaultStiffness) {
     // item by item, a decimal comma ("0,5 1 2", or "0,5;1;2") is refused
     // rather than split into two values that shift the rest.
     const char separator = line.find(';') != std::string::npos ? ';' : line.find(',') != std::string::npos ? ',' : 0;
+    if (holdsNothing(line, separator ? std::string(1, separator) : std::string())) continue;
     std::vector<std::string> items;
     if (separator) {
       items = splitItems(line, separator);
@@ -36,9 +36,6 @@ SpringFile readSpringFile(const std::string& path, double defaultStiffness) {
       std::istringstream fields(line);
       for (std::string field; fields >> field;) items.push_back(field);
     }
-    // A row of separators alone (a spreadsheet's empty row) holds nothing.
-    if (std::all_of(items.begin(), items.end(), [](const std::string& item) { return trimmed(item).empty(); }))
-      continue;
     std::vector<double> values;
     for (const std::string& item : items) {
       const std::string field = trimmed(item);
@@ -51,7 +48,6 @@ SpringFile readSpringFile(const std::string& path, double defaultStiffness) {
                               "kind per line, with a decimal point)");
       values.push_back(value);
     }
-    if (values.empty()) continue;
     if (values.size() != 3 && values.size() != 4) {
       throw Error(path, "line " + std::to_string(number) + ": expected x y z or x y z stiffness");
     }

@@ -499,13 +499,12 @@ std::vector<EvaluationRun> runEvaluation(const EvaluationPlan& plan, const Evalu
       // Scored in physical space, the reference may lie on another grid, but
       // it must lie on the image: else every run fails on clicks outside it.
       for (const auto& [name, mask] : input.references) {
-        const auto [first, size] = occupiedRegion(mask.geometry, mask.voxels, 0);
         bool inside = false;
-        for (int k = first[2]; k < first[2] + size[2] && !inside; ++k)
-          for (int j = first[1]; j < first[1] + size[1] && !inside; ++j)
-            for (int v = first[0]; v < first[0] + size[0] && !inside; ++v)
-              inside = mask.voxels[mask.geometry.offset(v, j, k)] &&
-                       input.volume.geometry.covers(mask.geometry.toPhysical(Vector3(v, j, k)));
+        for (long long offset = 0; offset < mask.geometry.voxelCount() && !inside; ++offset) {
+          if (!mask.voxels[offset]) continue;
+          const auto [v, j, k] = mask.geometry.voxelAt(offset);
+          inside = input.volume.geometry.covers(mask.geometry.toPhysical(Vector3(v, j, k)));
+        }
         if (!inside)
           throw Error(plan.reference, "structure '" + name + "' lies wholly outside image '" + i.name + "' (" + i.path +
                                           "): the reference and the image do not overlap in space");

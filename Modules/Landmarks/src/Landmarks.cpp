@@ -189,10 +189,6 @@ std::vector<Landmark> readFcsv(const std::string& path, std::ifstream& in, Coord
   return landmarks;
 }
 
-// A line that holds nothing to read: empty, blank, or separators alone (a
-// spreadsheet's formatted but empty row).
-bool nothingOn(const std::string& line) { return trimmed(line).find_first_not_of(", \t\r") == std::string::npos; }
-
 // x, y, z (LPS mm), or 3D Slicer's markups table: l, p, s (LPS) or r, a, s
 // (RAS), with `defined` 0 for a point not yet placed.
 std::vector<Landmark> readCsv(const std::string& path, std::ifstream& in, CoordinateSystem& system) {
@@ -205,7 +201,7 @@ std::vector<Landmark> readCsv(const std::string& path, std::ifstream& in, Coordi
     if (const auto cr = line.find('\r'); cr != std::string::npos && cr + 1 < line.size())
       throw Error(path, "its lines end in a carriage return alone (old Mac text): save it with LF or CR LF line ends");
     // Comments come before the header; after it, a row's label may start with '#'.
-    if (!nothingOn(line) && trimmed(line)[0] != '#') header = splitCsvFields(line, ',');
+    if (!holdsNothing(line, ",") && trimmed(line)[0] != '#') header = splitCsvFields(line, ',');
   }
   // Column names in any case: X, Label.
   for (std::string& name : header) name = lowerCase(name);
@@ -229,7 +225,7 @@ std::vector<Landmark> readCsv(const std::string& path, std::ifstream& in, Coordi
   std::vector<Landmark> landmarks;
   while (std::getline(in, line)) {
     ++number;
-    if (nothingOn(line)) continue;
+    if (holdsNothing(line, ",")) continue;
     std::vector<std::string> fields = splitCsvFields(line, ',');
     // A separator that ends a row adds no value.
     while (fields.size() > header.size() && fields.back().empty()) fields.pop_back();

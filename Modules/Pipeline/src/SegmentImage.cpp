@@ -404,7 +404,7 @@ void checkStart(const SegmentInputs& in) {
   if (in.landmarkSource.rfind("--", 0) == 0) throw UsageError(in.landmarkSource, in.landmarks.empty() ? none : tooFew);
   // A file's points that are named but not placed are left out by its reader.
   const std::string unplaced =
-       " (points listed but not placed, Slicer's positionStatus undefined or preview or a table's defined 0, are not "
+      " (points listed but not placed, Slicer's positionStatus undefined or preview or a table's defined 0, are not "
       "counted)";
   throw Error(in.landmarkSource, (in.landmarks.empty() ? none : tooFew) + unplaced);
 }

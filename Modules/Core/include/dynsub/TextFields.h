@@ -25,6 +25,10 @@ std::vector<std::string> splitCsvFields(const std::string& line, char separator)
 // `text` without the blanks and tabs at its ends.
 std::string trimmed(const std::string& text);
 
+// Whether `line` holds nothing to read: it is empty, or blanks, tabs, a CR
+// and `separators` alone (a spreadsheet's formatted but empty row).
+bool holdsNothing(const std::string& line, const std::string& separators);
+
 // `text` with its ASCII letters in lower case (column names, extensions,
 // label names: compared case-insensitively).
 std::string lowerCase(std::string text);
