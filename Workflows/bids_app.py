@@ -95,8 +95,9 @@ def main(argv, snakefile, dynsub):
     inside = os.path.relpath(os.path.realpath(out), os.path.realpath(bids_dir))
     top = inside.split(os.sep)[0]
     if top != os.pardir and top not in ("derivatives", "sourcedata", "code") and not top.startswith("."):
+        suggested = os.path.join(args.bids_dir, "derivatives", "dynsub")
         parser.error(f"{args.output_dir}: inside the BIDS dataset but not in its derivatives folder, where the "
-                     f"outputs would make the dataset invalid; use {os.path.join(args.bids_dir, 'derivatives', 'dynsub')}")
+                     f"outputs would make the dataset invalid; use {suggested}")
     work = os.path.abspath(args.work_dir or os.path.join(out, "work"))
     # Snakemake 7 starts each job with an unquoted `cd WORK`.
     if shlex.quote(work) != work:
@@ -113,7 +114,8 @@ def main(argv, snakefile, dynsub):
     # The dataset is read here first, so that a label that selects nothing or
     # a misnamed file is refused before anything is written.
     try:
-        jobs = bids.configured_jobs(config)
+        everything = bids.dataset_jobs(config)
+        jobs = bids.select_jobs(everything, participants, sessions)
     except (bids.CohortError, OSError) as error:
         print(f"dynsub-bids: error: {error}", file=sys.stderr)
         return 1
@@ -125,7 +127,7 @@ def main(argv, snakefile, dynsub):
               file=sys.stderr)
         return 1
     if args.analysis_level == "group" and not args.unlock:
-        for path in bids.unclaimed_labelmaps(config, out):
+        for path in bids.unclaimed_labelmaps(everything, out):
             print(f"dynsub-bids: warning: {path}: left by an earlier run; the dataset no longer names its subject, "
                   "image or structure, so the group table leaves it out (delete it and its files if it is stale)",
                   file=sys.stderr)

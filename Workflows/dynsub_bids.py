@@ -378,13 +378,20 @@ def _sources(config):
             config.get("seeds", default_seeds(root)), str(config.get("reference", f"{root}/derivatives/reference")))
 
 
-def configured_jobs(config):
-    """The jobs a workflow configuration names."""
+def dataset_jobs(config):
+    """Every job of a workflow configuration's dataset, whichever
+    participants and sessions it chooses."""
     root, landmarks, seeds, reference = _sources(config)
     jobs = group_jobs(find_structures(root, landmarks, seeds, reference))
     if not jobs:
         raise CohortError(f"{root}: no landmarks or seeds found for any T1w image")
-    return select_jobs(jobs, labels(config.get("participant_label")), labels(config.get("session_label")))
+    return jobs
+
+
+def configured_jobs(config):
+    """The jobs a workflow configuration names."""
+    participants, sessions = labels(config.get("participant_label")), labels(config.get("session_label"))
+    return select_jobs(dataset_jobs(config), participants, sessions)
 
 
 def uncovered_warnings(config, jobs):
@@ -400,12 +407,10 @@ def uncovered_warnings(config, jobs):
             if path not in covered and is_chosen(subject, session, participants, sessions)]
 
 
-def unclaimed_labelmaps(config, out):
-    """The labelmaps in out that no job of the dataset writes, whichever
-    participants are chosen: those of a subject, run or structure the dataset
-    no longer names, which the group table leaves out."""
-    root, landmarks, seeds, reference = _sources(config)
-    jobs = group_jobs(find_structures(root, landmarks, seeds, reference, warn=lambda message: None))
+def unclaimed_labelmaps(jobs, out):
+    """The labelmaps in out that none of jobs (the dataset's, whichever
+    participants are chosen: dataset_jobs) writes: those of a subject, run or
+    structure the dataset no longer names, which the group table leaves out."""
     claimed = {job_paths(out, job)["dseg"] for job in jobs.values()}
     found = glob.glob(os.path.join(glob.escape(out), "sub-*", "**", "anat", "*_dseg.nii.gz"), recursive=True)
     return sorted(path for path in found if path not in claimed)

@@ -163,7 +163,10 @@ viewer.addEventListener("click", function () { viewer.close(); });
 var store = "dynsub-qc " + location.pathname, ratings = {};
 try { ratings = JSON.parse(localStorage.getItem(store) || "{}"); } catch (error) { ratings = {}; }
 // A row is a structure in one T1w: a participant's runs and acquisitions are rated apart.
-function rowKey(row) { return [row.dataset.participant, row.dataset.session, row.dataset.structure, row.dataset.t1w].join("\\t"); }
+function rowKey(row) {
+  var d = row.dataset;
+  return [d.participant, d.session, d.structure, d.t1w].join("\\t");
+}
 document.querySelectorAll("#group tbody tr").forEach(function (row) {
   var select = row.querySelector("td.rating select"), cell = select.parentNode;
   select.value = ratings[rowKey(row)] || "";
