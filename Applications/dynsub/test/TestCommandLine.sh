@@ -629,6 +629,11 @@ printf 'x,y,z\n-12,10,12\n400,10,12\n' >"$work/far_landmarks.csv"
 expect_error "render: a landmark outside the image" 1 "landmark 2 of 2 at (400, 10, 12) mm LPS lies outside the image" \
   "$work/r0b" "$DYNSUB" render --surface "$work/caudate/surface.vtp" --image "$mri/ch2.nii.gz" \
   --landmarks "$work/far_landmarks.csv" --out "$work/r0b"
+printf 'v 500 500 500\nv 510 500 500\nv 500 510 500\nv 500 500 510\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n' \
+  >"$work/far_surface.obj"
+expect_error "render: a surface outside the image names both" 1 \
+  "far_surface.obj: the surface lies outside the image $mri/ch2.nii.gz" "$work/r0c" \
+  "$DYNSUB" render --surface "$work/far_surface.obj" --image "$mri/ch2.nii.gz" --out "$work/r0c"
 expect_error "render: unknown coordinate system" 2 "figure-coordinates" "$work/r0" \
   "$DYNSUB" render --surface "$work/caudate/surface.vtp" --figure-coordinates xyz --out "$work/r0"
 expect_error "render: missing surface" 1 "no such file" "$work/r1" \
