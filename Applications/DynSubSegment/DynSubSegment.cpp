@@ -11,6 +11,7 @@
 // Exit codes: 0 success; 1 an error in the inputs or the run (stderr names the
 // file and the problem, and nothing is written); 2 a usage error.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -258,12 +259,48 @@ void writeOutputs(const Arguments& a, const std::function<void(const std::string
   for (auto& output : outputs) output->commit();
 }
 
+// The library's messages name dynsub segment's options; the module's are
+// made from the same parameter table (camelCase, a switch's opposite), and a
+// few others are its own.
+std::string inModuleTerms(std::string message) {
+  std::vector<std::pair<std::string, std::string>> terms = {
+      {"--init atlas --inside", "--atlasLabel with --inside"},
+      {"--init seed:x,y,z", "--inside x,y,z"},
+      {"--init atlas", "--atlasLabel"},
+      {"--atlas-label", "--atlasLabel"},
+      {"give each structure a --name", "give each point list a name of its own"}};
+  for (const Parameter& row : segmentParameters()) {
+    if (row.opposite)
+      terms.emplace_back(row.flag() + " false", "--" + row.opposite->name);
+    else
+      terms.emplace_back(row.flag(), "--" + row.camelName());
+  }
+  // The longest first, so that no flag is taken for the start of another.
+  std::stable_sort(terms.begin(), terms.end(),
+                   [](const auto& a, const auto& b) { return a.first.size() > b.first.size(); });
+  for (const auto& [from, to] : terms) {
+    for (std::size_t at = message.find(from); at != std::string::npos; at = message.find(from, at)) {
+      const std::size_t end = at + from.size();
+      const bool whole = end == message.size() || !(std::isalnum(static_cast<unsigned char>(message[end])) ||
+                                                    message[end] == '-' || message[end] == '_');
+      if (!whole) {
+        at = end;
+        continue;
+      }
+      message.replace(at, from.size(), to);
+      at += to.size();
+    }
+  }
+  return message;
+}
+
 void reportWarnings(const SegmentOutcome& outcome, const std::string& structure) {
   const std::string of = structure.empty() ? "" : structure + ", ";
   for (const std::string& warning : outcome.warnings)
-    std::cerr << "warning" << (structure.empty() ? "" : " (" + structure + ")") << ": " << warning << '\n';
+    std::cerr << "warning" << (structure.empty() ? "" : " (" + structure + ")") << ": " << inModuleTerms(warning)
+              << '\n';
   for (const dynsub::TrustFlag& flag : outcome.trustFlags)
-    std::cerr << "not to trust (" << of << flag.name << "): " << flag.message << '\n';
+    std::cerr << "not to trust (" << of << flag.name << "): " << inModuleTerms(flag.message) << '\n';
 }
 
 // One point cannot outline a structure: it is read as a click inside it, the
@@ -505,7 +542,7 @@ int main(int argc, char** argv) {
     if (!hint.empty()) std::cerr << "DynSubSegment: " << hint << '\n';
     return 2;
   } catch (const dynsub::Error& error) {
-    std::cerr << "DynSubSegment: error: " << dynsub::withoutTemporaryPrefix(error.what()) << '\n';
+    std::cerr << "DynSubSegment: error: " << inModuleTerms(dynsub::withoutTemporaryPrefix(error.what())) << '\n';
     return dynamic_cast<const dynsub::UsageError*>(&error) ? 2 : 1;
   } catch (const std::bad_alloc&) {
     std::cerr << "DynSubSegment: error: out of memory: the run needed more than this machine (or its limit) gives\n";

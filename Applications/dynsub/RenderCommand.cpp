@@ -23,6 +23,7 @@
 #include "dynsub/OutputSet.h"
 #include "dynsub/PointCloudIO.h"
 #include "dynsub/Segmentation.h"
+#include "dynsub/SurfacePolyData.h"
 
 namespace dynsub::app {
 
@@ -112,7 +113,7 @@ void runRender(const RenderCommandOptions& o) {
 
   // The surface's vertices, for the checks against the image and the
   // landmarks (the figures read the file again as VTK's polygons).
-  const MatrixX3 vertices = readPointCloud(o.surface).points;
+  const MatrixX3 vertices = readSurfacePoints(o.surface);
   if (image) {
     // The slices are cut through the middle of the surface's box: another
     // image's surface, or one in other coordinates, has no slice here.

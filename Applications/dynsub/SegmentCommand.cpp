@@ -88,7 +88,11 @@ Volume readReferenceLabels(const std::string& path, const Volume& image) {
 // One structure in the expert's labelmap.
 Mask referenceStructure(const std::string& path, const Volume& labels, const std::vector<int>& values) {
   Mask reference = selectLabels(labels, values);
-  if (reference.count() == 0) throw Error(path, "no voxel has the reference label(s)");
+  if (reference.count() == 0) {
+    std::string list;
+    for (int value : values) list += (list.empty() ? "" : ",") + std::to_string(value);
+    throw Error(path, "no voxel has the reference label(s) " + list);
+  }
   return reference;
 }
 
@@ -138,7 +142,12 @@ void printSummary(const Arguments& o, const SegmentOutcome& outcome, const Volum
             << " control vertices (" << result.levels.back().level << " refinement(s), " << result.steps
             << " steps) in " << outcome.seconds << " s\n";
   const std::string carried = carriedPastSlices(outcome.result);
-  if (!carried.empty())
+  // Without clicks, the march's slices are those of the atlas's points.
+  if (!carried.empty() && o.landmarks.empty())
+    std::cout << "followed the structure's tissue past the ends of the atlas's structure and pulled the surface "
+                 "there: "
+              << carried << " (--slice-ends false to keep to the atlas's ends)\n";
+  else if (!carried.empty())
     std::cout << "followed the structure's tissue past the outermost clicked slices and pulled the surface there: "
               << carried << " (--slice-ends false if your clicks already reach its ends)\n";
   for (const std::string& warning : outcome.warnings) std::cerr << "warning: " << warning << '\n';
@@ -438,8 +447,8 @@ void addSegmentCommand(CLI::App& app) {
   command
       ->add_option("--atlas-label", o->atlasLabel,
                    "With --init atlas: the structure's label value(s) in the atlas, or names from its table "
-                   "(Caudate_L, or Caudate_L,Caudate_R). Given once per structure, the structures are segmented "
-                   "together (with --landmarks, one per point list, in their order)")
+                   "(Caudate_L, or labels that touch: Putamen_L,Pallidum_L). Given once per structure, the structures "
+                   "are segmented together (with --landmarks, one per point list, in their order)")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   command->add_option("--atlas", o->atlas, "With --init atlas: the atlas's template image")

@@ -966,6 +966,15 @@ assert t['trusted'] and t['atlas_outline_distance_mm'] < 4.5 and 0.7 < t['volume
 "
 expect_error "segment --init atlas: a misspelt label" 1 "did you mean 'Putamen_L'" "$work/s43" \
   "$DYNSUB" segment "$work/subject/image.nii.gz" --init atlas --atlas-label Putamn_L --out "$work/s43"
+expect_error "segment --init atlas: the two caudates as one structure" 2 \
+  "the labels lie in 2 separate pieces.*an --atlas-label of its own" "$work/s43b" \
+  "$DYNSUB" segment "$work/subject/image.nii.gz" --init atlas --atlas-label Caudate_L,Caudate_R --out "$work/s43b"
+expect_error "segment --init atlas: a part of a name" 1 "did you mean 'Caudate_L' or 'Caudate_R'" "$work/s43c" \
+  "$DYNSUB" segment "$work/subject/image.nii.gz" --init atlas --atlas-label Caudate --out "$work/s43c"
+# Refused before the registration, naming the point and the image.
+expect_error "segment --init atlas: a click inside past the image" 1 \
+  "image.nii.gz: the click inside the structure (--inside 500,0,0, LPS mm) lies outside the image" "$work/s43d" \
+  "$DYNSUB" segment "$work/subject/image.nii.gz" --init atlas --atlas-label Putamen_L --inside=500,0,0 --out "$work/s43d"
 expect_error "segment --init atlas: no label" 2 "needs --atlas-label" "$work/s44" \
   "$DYNSUB" segment "$work/subject/image.nii.gz" --init atlas --out "$work/s44"
 expect_error "segment --inside without an atlas start" 2 "serves an atlas start" "$work/s45" \

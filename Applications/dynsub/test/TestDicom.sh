@@ -13,7 +13,8 @@
 # And a broken series gets a clear error, exit code 1 and no output (not the
 # abort Debian's GDCM gives for some): a truncated slice (in its header, in a
 # sequence of undefined length, after its meta header, in its pixels), a
-# missing slice, two series, no series. Needs DYNSUB, TOOLS and dump2dcm/dcmodify (Debian package dcmtk).
+# missing slice, a slice without its position or of another orientation, two
+# slices at one position, two series, no series. Needs DYNSUB, TOOLS and dump2dcm/dcmodify (Debian package dcmtk).
 set -u
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
@@ -80,6 +81,19 @@ rejects "a missing slice" "not evenly spaced" gap
 broken two
 dcmodify -nb -m "(0020,000e)=1.2.826.0.1.3680043.10.1347.9" "$work/two/slice_005.dcm"
 rejects "two series" "holds 2 DICOM series" two
+# A slice ITK would place by guesswork or read in another's geometry.
+broken noposition
+dcmodify -nb -e "(0020,0032)" "$work/noposition/slice_009.dcm"
+rejects "a slice without its position" "slice_009.dcm: a slice of the DICOM series states no Image Position" noposition
+broken tilted
+dcmodify -nb -m "(0020,0037)=1\\0\\0\\0\\0.9\\0.43589" "$work/tilted/slice_009.dcm"
+rejects "a slice of another orientation" "slice_009.dcm: a slice of the DICOM series has another Image Orientation" tilted
+broken twice
+cp "$work/twice/slice_009.dcm" "$work/twice/slice_009b.dcm"
+dcmodify -nb -m "(0008,0018)=1.2.826.0.1.3680043.10.1347.99" "$work/twice/slice_009b.dcm"
+rejects "two slices at one position" "two slices of the DICOM series lie at one position" twice
+check "two slices at one position: GDCM's own notice is not printed" \
+  bash -c "! grep -q 'not unique' '$work/stderr'"
 # One file of the series: read (by GDCM) and refused as the 2D image it is.
 expect_error "one slice file" "slice_007.dcm: not a 3D image (1 voxel(s) along axis 2)" "$work/out_one" \
   "$DYNSUB" segment "$work/phantom/series/slice_007.dcm" --landmarks "$work/phantom/ball.csv" --out "$work/out_one"

@@ -22,6 +22,52 @@ using Clock = std::chrono::steady_clock;
 
 constexpr double kFieldVoxels = 40000;
 
+// A piece of a structure's labels apart from its largest, at least this share
+// of its voxels, is a structure of its own. AAL's labels each lie in one
+// piece but for islands of at most 0.2 % of their voxels; the two caudates
+// given together are two pieces of about half each.
+constexpr double kSeparatePiece = 0.05;
+
+std::string joined(const std::vector<std::string>& items, const std::string& separator) {
+  std::string text;
+  for (const std::string& item : items) text += (text.empty() ? "" : separator) + item;
+  return text;
+}
+
+std::string labelList(const std::vector<int>& labels) {
+  std::vector<std::string> values;
+  for (int label : labels) values.push_back(std::to_string(label));
+  return joined(values, ",");
+}
+
+// The sizes (voxels) of the mask's face-connected pieces, largest first.
+std::vector<long long> pieceSizes(const Mask& mask) {
+  const ImageGeometry& grid = mask.geometry;
+  std::vector<std::uint8_t> seen(mask.voxels.size(), 0);
+  std::vector<long long> sizes, queue;
+  for (std::size_t start = 0; start < mask.voxels.size(); ++start) {
+    if (!mask.voxels[start] || seen[start]) continue;
+    seen[start] = 1;
+    queue.assign(1, static_cast<long long>(start));
+    for (std::size_t next = 0; next < queue.size(); ++next) {
+      const std::array<int, 3> at = grid.voxelAt(queue[next]);
+      for (int a = 0; a < 3; ++a)
+        for (int step : {-1, 1}) {
+          std::array<int, 3> n = at;
+          n[a] += step;
+          if (!grid.contains(n[0], n[1], n[2])) continue;
+          const long long o = grid.offset(n[0], n[1], n[2]);
+          if (!mask.voxels[o] || seen[o]) continue;
+          seen[o] = 1;
+          queue.push_back(o);
+        }
+    }
+    sizes.push_back(static_cast<long long>(queue.size()));
+  }
+  std::sort(sizes.rbegin(), sizes.rend());
+  return sizes;
+}
+
 double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -30,14 +76,19 @@ bool endsWith(const std::string& text, const std::string& end) {
   return text.size() >= end.size() && text.compare(text.size() - end.size(), end.size(), end) == 0;
 }
 
-// The name table beside a label map: labels.nii.gz -> labels.nii.txt, then labels.txt.
-std::vector<std::pair<int, std::string>> readNames(const std::string& labelsPath) {
+// Where a label map's table of names may be: labels.nii.gz -> labels.nii.txt, then labels.txt.
+std::vector<std::string> nameTables(const std::string& labelsPath) {
   std::string base = labelsPath;
   if (endsWith(base, ".gz")) base.resize(base.size() - 3);
   std::vector<std::string> candidates = {base + ".txt"};
   if (const auto dot = base.rfind('.'); dot != std::string::npos && dot > base.find_last_of('/') + 1)
     candidates.push_back(base.substr(0, dot) + ".txt");
-  for (const std::string& path : candidates) {
+  return candidates;
+}
+
+// The table of names beside a label map, the first of nameTables that exists.
+std::vector<std::pair<int, std::string>> readNames(const std::string& labelsPath) {
+  for (const std::string& path : nameTables(labelsPath)) {
     std::ifstream in(path);
     if (!in) continue;
     std::vector<std::pair<int, std::string>> names;
@@ -45,12 +96,29 @@ std::vector<std::pair<int, std::string>> readNames(const std::string& labelsPath
     int number = 0;
     while (std::getline(in, line)) {
       ++number;
+      const std::size_t start = line.find_first_not_of(" \t\r");
+      if (start == std::string::npos || line[start] == '#') continue;
+      // "VALUE NAME" and whatever numbers tables add before or after the
+      // name (mricron's a code after it, ITK-SNAP's colours before it, in
+      // quotes, FreeSurfer's colours after it); a name may hold spaces.
       std::istringstream fields(line);
       int value = 0;
-      std::string name;
-      if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-      if (!(fields >> value >> name))
+      std::vector<std::string> words;
+      for (std::string word; fields >> word;) words.push_back(word);
+      const auto isNumber = [](const std::string& word) {
+        double number = 0;
+        std::istringstream read(word);
+        return static_cast<bool>(read >> number) && read.eof();
+      };
+      if (words.empty() || !isNumber(words.front()) || !(std::istringstream(words.front()) >> value))
         throw Error(path, "line " + std::to_string(number) + ": expected a label value and its name");
+      auto first = words.begin() + 1, last = words.end();
+      while (first != last && isNumber(*first)) ++first;
+      while (last != first && isNumber(*(last - 1))) --last;
+      std::string name;
+      for (auto word = first; word != last; ++word) name += (name.empty() ? "" : " ") + *word;
+      if (name.size() >= 2 && name.front() == '"' && name.back() == '"') name = trimmed(name.substr(1, name.size() - 2));
+      if (name.empty()) throw Error(path, "line " + std::to_string(number) + ": expected a label value and its name");
       names.emplace_back(value, name);
     }
     return names;
@@ -146,23 +214,61 @@ std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec, c
       values.push_back(static_cast<int>(number));
       continue;
     }
-    const auto named = std::find_if(atlas.names.begin(), atlas.names.end(),
-                                    [&](const auto& entry) { return lowerCase(entry.second) == lowerCase(item); });
+    // The name as written, else the one name that matches it whatever the
+    // case: two labels can differ by case alone.
+    auto named = std::find_if(atlas.names.begin(), atlas.names.end(),
+                              [&](const auto& entry) { return entry.second == item; });
+    if (named == atlas.names.end()) {
+      std::vector<std::string> matches;
+      for (const auto& entry : atlas.names)
+        if (lowerCase(entry.second) == lowerCase(item)) {
+          if (matches.empty()) named = std::find(atlas.names.begin(), atlas.names.end(), entry);
+          matches.push_back("'" + entry.second + "' (" + std::to_string(entry.first) + ")");
+        }
+      if (matches.size() > 1)
+        throw UsageError(option + " " + spec + ": '" + item + "' matches " + std::to_string(matches.size()) +
+                         " labels of " + atlas.labelsPath + " that differ by case alone: " + joined(matches, ", ") +
+                         "; write it as one of them is written");
+    }
     if (named != atlas.names.end()) {
+      if (named->first == 0)
+        throw UsageError(option + " " + spec + ": '" + named->second + "' is label 0, the atlas's background, not a "
+                         "structure");
       values.push_back(named->first);
       continue;
     }
     if (atlas.names.empty())
-      throw Error(atlas.labelsPath,
-                  "no table of label names beside it: give " + option + " as numbers, not '" + item + "'");
-    const auto nearest = std::min_element(atlas.names.begin(), atlas.names.end(), [&](const auto& a, const auto& b) {
-      return editDistance(a.second, item) < editDistance(b.second, item);
-    });
-    throw Error(atlas.labelsPath, "no label named '" + item + "' (did you mean '" + nearest->second + "'?)");
+      throw Error(atlas.labelsPath, "no table of label names beside it (" + joined(nameTables(atlas.labelsPath), " or ") +
+                                        "): give " + option + " as numbers, not '" + item + "'");
+    // The names that hold it ("Caudate": both sides), else the nearest.
+    std::vector<std::string> holding;
+    for (const auto& entry : atlas.names)
+      if (lowerCase(entry.second).find(lowerCase(item)) != std::string::npos) holding.push_back("'" + entry.second + "'");
+    if (holding.empty() || holding.size() > 4) {
+      const auto nearest = std::min_element(atlas.names.begin(), atlas.names.end(), [&](const auto& a, const auto& b) {
+        return editDistance(a.second, item) < editDistance(b.second, item);
+      });
+      holding.assign(1, "'" + nearest->second + "'");
+    }
+    throw Error(atlas.labelsPath, "no label named '" + item + "' (did you mean " + joined(holding, " or ") + "?)");
   }
   for (int value : values)
     if (selectLabels(atlas.labels, {value}).count() == 0)
       throw Error(atlas.labelsPath, "no voxel has the label " + std::to_string(value));
+  // One surface is one piece: labels that lie apart (the two caudates) would
+  // be joined by a bridge through whatever lies between them.
+  const std::vector<long long> sizes = pieceSizes(selectLabels(atlas.labels, values));
+  long long total = 0;
+  for (long long size : sizes) total += size;
+  if (sizes.size() > 1 && static_cast<double>(sizes[1]) >= kSeparatePiece * static_cast<double>(total)) {
+    std::vector<std::string> voxels;
+    for (std::size_t p = 0; p < sizes.size() && p < 4; ++p) voxels.push_back(std::to_string(sizes[p]));
+    throw UsageError(option + " " + spec + ": the labels lie in " + std::to_string(sizes.size()) +
+                     " separate pieces in " + atlas.labelsPath + " (" + joined(voxels, ", ") +
+                     (sizes.size() > 4 ? ", ..." : "") +
+                     " voxels), and one surface cannot hold separate pieces: give each structure an --atlas-label "
+                     "of its own (segmented together, they do not overlap)");
+  }
   return values;
 }
 
@@ -221,8 +327,12 @@ CarriedLabel carryLabel(const Volume& subject, const Atlas& atlas, const std::ve
                         const AtlasRegistrationOptions& options) {
   checkAtlasRegistrationOptions(options);
   const auto started = Clock::now();
-  if (inside && (!inside->allFinite() || !subject.geometry.covers(*inside)))
-    throw LandmarkError("the click inside the structure lies outside the image");
+  if (inside && (!inside->allFinite() || !subject.geometry.covers(*inside))) {
+    std::ostringstream message;
+    message << "the click inside the structure (" << inside->x() << ", " << inside->y() << ", " << inside->z()
+            << ") mm LPS lies outside the image";
+    throw LandmarkError(message.str());
+  }
   const Mask structure = selectLabels(atlas.labels, labels);
   const ImageGeometry& atlasGrid = atlas.labels.geometry;
   const auto [atlasFirst, atlasSize] = occupiedRegion(atlasGrid, structure.voxels, 0);
@@ -243,7 +353,9 @@ CarriedLabel carryLabel(const Volume& subject, const Atlas& atlas, const std::ve
   }
   const auto [first, size] = boundingRegion(subject.geometry, corners, options.marginMm);
   if (std::min({size[0], size[1], size[2]}) < 4)
-    throw Error(atlas.imagePath, "the atlas's structure falls outside the image after registration");
+    throw Error(atlas.labelsPath, "the structure's labels (" + labelList(labels) +
+                                      ") fall outside the image after its registration to the template " +
+                                      atlas.imagePath + ": does the image hold the structure?");
   const Volume region = cropVolume(subject, first, size);
 
   itkbridge::DeformableSettings settings;
@@ -290,7 +402,9 @@ CarriedLabel carryLabel(const Volume& subject, const Atlas& atlas, const std::ve
         in[o] = share >= 0.5;
       }
   if (std::none_of(in.begin(), in.end(), [](std::uint8_t v) { return v != 0; }))
-    throw Error(atlas.imagePath, "the atlas's structure falls outside the image after registration");
+    throw Error(atlas.labelsPath, "the structure's labels (" + labelList(labels) +
+                                      ") fall outside the image after its registration to the template " +
+                                      atlas.imagePath + ": does the image hold the structure?");
 
   if (inside) {
     // The click's voxel on the region's grid.

@@ -2,9 +2,12 @@
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 
 #include "dynsub/Atlas.h"
 #include "dynsub/Error.h"
+#include "dynsub/ImageIO.h"
 #include "dynsub/Metrics.h"
 #include "dynsub/SegmentImage.h"
 #include "dynsub/SubjectGenerator.h"
@@ -48,7 +51,15 @@ const Atlas& croppedAtlas() {
 TEST(Atlas, NamesAndValuesSelectLabels) {
   const Atlas& atlas = croppedAtlas();
   EXPECT_EQ(atlasLabelValues(atlas, "71"), std::vector<int>{71});
-  EXPECT_EQ(atlasLabelValues(atlas, "Caudate_L,caudate_r"), (std::vector<int>{71, 72}));
+  EXPECT_EQ(atlasLabelValues(atlas, "Putamen_L,pallidum_l"), (std::vector<int>{73, 75}));
+  // The two caudates lie apart: one surface would bridge them.
+  try {
+    atlasLabelValues(atlas, "Caudate_L,caudate_r");
+    FAIL() << "labels in two separate pieces were accepted";
+  } catch (const UsageError& e) {
+    EXPECT_NE(std::string(e.what()).find("2 separate pieces"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("an --atlas-label of its own"), std::string::npos) << e.what();
+  }
   try {
     atlasLabelValues(atlas, "Caudat_L");
     FAIL() << "a misspelt name was accepted";
@@ -61,6 +72,48 @@ TEST(Atlas, NamesAndValuesSelectLabels) {
   EXPECT_THROW(atlasLabelValues(atlas, "7.5"), UsageError);
   // The calcarine cortex lies outside the cropped box: no voxel has it.
   EXPECT_THROW(atlasLabelValues(atlas, "Calcarine_L"), Error);
+}
+
+// A label map's table as other tools write it: names with spaces, in
+// quotes after colours (ITK-SNAP), colours after them (FreeSurfer), a code
+// after them (mricron), comments, and names that differ by case alone.
+TEST(Atlas, NameTablesOfOtherToolsAreRead) {
+  const std::string dir = ::testing::TempDir() + "atlas_names";
+  std::filesystem::create_directories(dir);
+  Volume labels;
+  labels.geometry.size = {12, 4, 4};
+  labels.voxels.assign(12 * 4 * 4, 0.0f);
+  // Labels 1..6 in blocks along i: 1 apart from the rest, 2 to 6 touching.
+  const int block[12] = {1, 1, 0, 0, 2, 2, 3, 3, 4, 5, 6, 6};
+  for (int k = 0; k < 4; ++k)
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 12; ++i) labels.voxels[labels.geometry.offset(i, j, k)] = static_cast<float>(block[i]);
+  writeVolume(labels, dir + "/labels.nii.gz", VoxelType::Label16);
+  writeVolume(labels, dir + "/template.nii.gz", VoxelType::Float32);
+  {
+    std::ofstream table(dir + "/labels.nii.txt");
+    table << "# a comment\n"
+             "0 Background\n"
+             "1 Left Caudate 7001\n"
+             "2    255 0 0 1 1 1 \"Left Putamen\"\n"
+             "3 Left-Pallidum 220 216 20 0\n"
+             "4 hippocampus_L\n"
+             "5 Hippocampus_L\n"
+             "\n"
+             "6\tThalamus_L\n";
+  }
+  const Atlas atlas = readAtlas(dir + "/template.nii.gz", dir + "/labels.nii.gz");
+  EXPECT_EQ(atlasLabelValues(atlas, "left caudate"), std::vector<int>{1});
+  EXPECT_EQ(atlasStructureName(atlas, {1}, "left caudate"), "Left Caudate");
+  EXPECT_EQ(atlasLabelValues(atlas, "Left Putamen,left-pallidum"), (std::vector<int>{2, 3}));
+  EXPECT_EQ(atlasLabelValues(atlas, "Thalamus_L"), std::vector<int>{6});
+  // Written as one of them is written, a name that differs by case alone is that one.
+  EXPECT_EQ(atlasLabelValues(atlas, "Hippocampus_L"), std::vector<int>{5});
+  EXPECT_EQ(atlasLabelValues(atlas, "hippocampus_L"), std::vector<int>{4});
+  EXPECT_THROW(atlasLabelValues(atlas, "HIPPOCAMPUS_L"), UsageError);
+  EXPECT_THROW(atlasLabelValues(atlas, "background"), UsageError);  // label 0
+  EXPECT_THROW(atlasLabelValues(atlas, "1,2"), UsageError);         // two pieces
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Atlas, MissingLabelMapIsNamed) {

@@ -2,11 +2,14 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <cmath>
 #include <iostream>
+#include <map>
 #include <sstream>
 #include <vector>
 
 #include <gdcmReader.h>
+#include <gdcmScanner.h>
 #include <gdcmTrace.h>
 
 #include <itkGDCMImageIO.h>
@@ -38,6 +41,93 @@ class WarningsOff {
   bool was_;
 };
 
+
+// GDCM's own messages held for a scope: what they say (a slice position
+// that is not unique) the checks here report as errors, naming the files.
+class GdcmMessagesHeld {
+ public:
+  GdcmMessagesHeld() : warnings_(gdcm::Trace::GetWarningFlag()), errors_(gdcm::Trace::GetErrorFlag()) {
+    gdcm::Trace::SetWarningStream(held_);
+    gdcm::Trace::SetErrorStream(held_);
+  }
+  ~GdcmMessagesHeld() {
+    gdcm::Trace::SetWarningStream(std::cerr);
+    gdcm::Trace::SetErrorStream(std::cerr);
+    gdcm::Trace::SetWarning(warnings_);
+    gdcm::Trace::SetError(errors_);
+  }
+  GdcmMessagesHeld(const GdcmMessagesHeld&) = delete;
+  GdcmMessagesHeld& operator=(const GdcmMessagesHeld&) = delete;
+
+ private:
+  std::ostringstream held_;
+  bool warnings_, errors_;
+};
+
+// The numbers of a DICOM multi-valued string ("0.5\\0.5"); empty when it
+// holds none or something else.
+std::vector<double> dicomNumbers(const char* text) {
+  std::vector<double> numbers;
+  if (!text) return numbers;
+  std::string item;
+  std::istringstream in(text);
+  while (std::getline(in, item, '\\')) {
+    std::istringstream value(item);
+    double number = 0;
+    if (!(value >> number) || !std::isfinite(number)) return {};
+    value >> std::ws;
+    if (!value.eof()) return {};
+    numbers.push_back(number);
+  }
+  return numbers;
+}
+
+bool near(const std::vector<double>& a, const std::vector<double>& b, double tolerance) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (std::abs(a[i] - b[i]) > tolerance) return false;
+  return true;
+}
+
+// ITK places a series' slices by each one's position and the first one's
+// orientation and pixel spacing: a slice without a position would be placed
+// by guesswork, one of another orientation or spacing read as if it had the
+// first one's, and two at one position (a repeated acquisition, or echoes
+// left in one series) read as a slice of its own each. Each slice must state
+// a position of its own and the first one's orientation and spacing.
+void requireOneSliceGeometry(const std::vector<std::string>& files) {
+  if (files.size() < 2) return;
+  const gdcm::Tag position(0x0020, 0x0032), orientation(0x0020, 0x0037), spacing(0x0028, 0x0030);
+  gdcm::Scanner scanner;
+  scanner.AddTag(position);
+  scanner.AddTag(orientation);
+  scanner.AddTag(spacing);
+  if (!scanner.Scan(files)) throw Error(files.front(), "cannot read the headers of the DICOM series' slices");
+  const std::string& first = files.front();
+  const std::vector<double> firstOrientation = dicomNumbers(scanner.GetValue(first.c_str(), orientation)),
+                            firstSpacing = dicomNumbers(scanner.GetValue(first.c_str(), spacing));
+  std::vector<std::pair<std::vector<double>, std::string>> placed;
+  for (const std::string& file : files) {
+    const std::vector<double> at = dicomNumbers(scanner.GetValue(file.c_str(), position));
+    if (at.size() != 3)
+      throw Error(file, "a slice of the DICOM series states no Image Position (Patient) (0020,0032): where it lies "
+                        "in the volume is unknown");
+    if (!near(dicomNumbers(scanner.GetValue(file.c_str(), orientation)), firstOrientation, 1e-4))
+      throw Error(file, "a slice of the DICOM series has another Image Orientation (Patient) (0020,0037) than " +
+                            first + ": slices of one volume share one orientation");
+    const std::vector<double> pixels = dicomNumbers(scanner.GetValue(file.c_str(), spacing));
+    if (!near(pixels, firstSpacing, 1e-4 * (firstSpacing.empty() ? 1.0 : firstSpacing.front())))
+      throw Error(file, "a slice of the DICOM series has another Pixel Spacing (0028,0030) than " + first +
+                            ": slices of one volume share one spacing");
+    for (const auto& [other, otherFile] : placed)
+      if (near(at, other, 1e-3))
+        throw Error(file, "two slices of the DICOM series lie at one position (0020,0032), this one and " +
+                              otherFile +
+                              ": a repeated acquisition, or several echoes or phases in one series; give a folder of "
+                              "one volume's slices");
+    placed.emplace_back(at, file);
+  }
+}
 
 // The files of a directory that say they are DICOM, each walked (DicomWalk)
 // before GDCM sees any of them.
@@ -110,14 +200,36 @@ FloatImage::Pointer readSeries(const std::string& directory) {
   // clearly, what the checks here report as errors.
   const WarningsOff quiet;
   auto names = itk::GDCMSeriesFileNames::New();
-  names->SetUseSeriesDetails(true);
-  names->SetDirectory(directory);
-  const auto series = names->GetSeriesUIDs();
-  if (series.empty()) throw Error(directory, "directory holds no DICOM series");
-  if (series.size() > 1)
-    throw Error(directory, "directory holds " + std::to_string(series.size()) + " DICOM series; give one series");
-  const std::vector<std::string> files = names->GetFileNames(series.front());
+  std::vector<std::string> files;
+  {
+    const GdcmMessagesHeld held;
+    names->SetUseSeriesDetails(true);
+    names->SetDirectory(directory);
+    const auto series = names->GetSeriesUIDs();
+    if (series.empty()) {
+      bool folders = false;
+      for (const auto& entry : fs::directory_iterator(directory)) folders = folders || entry.is_directory();
+      throw Error(directory, std::string("directory holds no DICOM series") +
+                                 (folders ? " (its subfolders are not searched: give the folder that holds the "
+                                            "series' files)"
+                                          : ""));
+    }
+    if (series.size() > 1) {
+      // Each named by one of its files, so that the user can tell them apart.
+      std::string listed;
+      for (std::size_t s = 0; s < series.size() && s < 4; ++s) {
+        const std::vector<std::string> its = names->GetFileNames(series[s]);
+        listed += std::string(listed.empty() ? "" : ", ") + "that of " +
+                  (its.empty() ? series[s] : fs::path(its.front()).filename().string()) + " (" +
+                  std::to_string(its.size()) + (its.size() == 1 ? " file)" : " files)");
+      }
+      throw Error(directory, "directory holds " + std::to_string(series.size()) + " DICOM series (" + listed +
+                                 (series.size() > 4 ? ", ..." : "") + "); give a folder of one series");
+    }
+    files = names->GetFileNames(series.front());
+  }
   requireWholeSeries(files, dicomFiles);
+  requireOneSliceGeometry(files);
   // A colour or vector series is refused as such a file is (the series
   // reader would make one value of each voxel's several).
   auto header = itk::GDCMImageIO::New();

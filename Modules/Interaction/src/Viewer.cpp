@@ -79,6 +79,9 @@ struct Viewer::Impl {
   vtkNew<vtkCallbackCommand> timerCommand;
   vtkNew<vtkCellPicker> picker;
   int updates = 0;  // times liveSurface took a new surface
+  // Whether the fit ran at the last redraw: the one after it ends shows how
+  // it ended (done, or why it failed).
+  bool fitWasRunning = false;
 
   LandmarkEdits edits;
   // The pull as the hand holds it.
@@ -135,7 +138,15 @@ struct Viewer::Impl {
   void clickSlice(int view, int x, int y) {
     const int hit = landmarkNear(view, x, y);
     if (hit < 0) {
-      edits.add(views[view]->pointAt(x, y));
+      // The margin around a slice is no place in the image: segment would
+      // refuse such a landmark.
+      const Vector3 point = views[view]->pointAt(x, y);
+      if (!slices.geometry().covers(point)) {
+        message = "outside the image: no landmark placed";
+        showLandmarks();
+        return;
+      }
+      edits.add(point);
       message = "placed " + edits.landmarks.back().label;
       edits.moved = true;
     } else {
@@ -147,7 +158,9 @@ struct Viewer::Impl {
   }
 
   void dragLandmarkTo(int x, int y) {
-    edits.landmarks[edits.selected].position = views[edits.dragView]->pointAt(x, y);
+    const Vector3 point = views[edits.dragView]->pointAt(x, y);
+    if (!slices.geometry().covers(point)) return;  // held at the image's edge
+    edits.landmarks[edits.selected].position = point;
     edits.moved = true;
     showLandmarks();
   }
@@ -510,8 +523,9 @@ Viewer::Impl::Impl(ViewerInput in)
       interactor, timerCommand,
       [](void* client) {
         auto* self = static_cast<Viewer::Impl*>(client);
-        const bool updated = self->takeUpdate();
-        if (updated || self->fit.running()) self->render();
+        const bool updated = self->takeUpdate(), running = self->fit.running();
+        if (updated || running || self->fitWasRunning) self->render();
+        self->fitWasRunning = running;
       },
       this);
   updateStatus();

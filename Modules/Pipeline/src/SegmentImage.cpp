@@ -247,6 +247,7 @@ TrustEvidence trustEvidence(const Volume& image, const SegmentInputs& in, const 
     for (const Landmark& l : outcome.prior) e.outline.push_back(l.position);
     e.volume = carriedVolume(*outcome.carried);
     e.clicksToAtlas = distancesToCarried(*outcome.carried, e.clicks);
+    if (in.inside) e.insideShift = outcome.carried->shift.norm();
   }
   e.oneClick = outcome.seed && in.landmarks.empty();
   const SliceEnds& ends = outcome.result.sliceEnds;
@@ -270,6 +271,7 @@ Report trustReport(const TrustMeasures& m, const std::vector<TrustFlag>& flags) 
   set("clicks_to_atlas_mm", m.clicksToAtlas);
   set("farthest_from_evidence_mm", m.farthestFromEvidence);
   set("march_share", m.marchShare);
+  set("inside_shift_mm", m.insideShift);
   std::vector<Report> listed;
   for (const TrustFlag& flag : flags) {
     Report f;
@@ -425,6 +427,13 @@ SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& in, const 
                             const ProgressCallback& progress, const std::vector<ForceModel*>& forces) {
   SegmentOptions options = optionsFor(in, parameters);
   checkStart(in);
+  // Before an atlas's registration, which takes seconds.
+  if (in.inside && !(in.inside->allFinite() && image.geometry.covers(*in.inside))) {
+    std::ostringstream message;
+    message << "the click inside the structure (--inside " << in.inside->x() << "," << in.inside->y() << ","
+            << in.inside->z() << ", LPS mm) lies outside the image";
+    throw Error(in.image, message.str());
+  }
 
   SegmentOutcome outcome;
   const auto started = std::chrono::steady_clock::now();

@@ -120,6 +120,20 @@ TEST(Trust, EachFlagComesFromItsOwnMeasure) {
     e.clicksToAtlas[8] = 1.0;  // one far click of ten is not a tenth beyond
     EXPECT_FALSE(has(trustFlags(measureTrust(result, kBall, e), e), "atlas_clicks_apart"));
   }
+  {  // a click inside that moved the atlas's structure: 2 mm is a click near
+     // its boundary, 22 mm one in the other hemisphere (RAS read as LPS)
+    TrustEvidence e;
+    e.volume = kBall;
+    e.insideShift = 2.0;
+    EXPECT_TRUE(trustFlags(measureTrust(result, kBall, e), e).empty());
+    e.insideShift = 22.0;
+    const TrustMeasures m = measureTrust(result, kBall, e);
+    EXPECT_DOUBLE_EQ(m.insideShift, 22.0);
+    const std::vector<TrustFlag> flags = trustFlags(m, e);
+    ASSERT_EQ(flags.size(), 1u);
+    EXPECT_EQ(flags[0].name, "moved_to_click");
+    EXPECT_NE(flags[0].message.find("moved 22.0 mm"), std::string::npos) << flags[0].message;
+  }
   {  // one click and nothing else; a leak out of the region
     TrustEvidence e;
     e.oneClick = true;

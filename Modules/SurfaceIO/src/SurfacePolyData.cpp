@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 
 #include <vtkCellArray.h>
 #include <vtkCellArrayIterator.h>
@@ -17,6 +18,7 @@
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
+#include <vtkStringArray.h>
 #include <vtkUnsignedCharArray.h>
 #include <vtkXMLPolyDataReader.h>
 
@@ -116,34 +118,102 @@ vtkSmartPointer<vtkPolyData> readWith(vtkAlgorithm* reader, const std::string& p
   return polyData;
 }
 
+// The coordinate system a text says with "SPACE=" (3D Slicer's mark in a
+// surface file's header or comments): "RAS", "LPS", or empty for none.
+std::string statedSpace(const std::string& path, const std::string& text) {
+  const std::size_t at = text.find("SPACE=");
+  if (at == std::string::npos) return "";
+  std::string space;
+  for (std::size_t i = at + 6; i < text.size() && std::isalpha(static_cast<unsigned char>(text[i])); ++i)
+    space += static_cast<char>(std::toupper(static_cast<unsigned char>(text[i])));
+  if (space != "RAS" && space != "LPS")
+    throw Error(path, "unknown coordinate system 'SPACE=" + space + "' (expected SPACE=LPS or SPACE=RAS)");
+  return space;
+}
+
+// The comment lines an OBJ file begins with, joined.
+std::string objComments(const std::string& path) {
+  std::ifstream in(path);
+  std::string comments, line;
+  while (std::getline(in, line)) {
+    const std::size_t start = line.find_first_not_of(" \t\r");
+    if (start == std::string::npos) continue;
+    if (line[start] != '#') break;
+    comments += line + "\n";
+  }
+  return comments;
+}
+
+// RAS to LPS: x and y negated, for the points and the normals (a half turn
+// about z, so that the polygons keep their orientation).
+void toLps(vtkPolyData* polyData) {
+  vtkPoints* points = polyData->GetPoints();
+  for (vtkIdType i = 0; i < points->GetNumberOfPoints(); ++i) {
+    double p[3];
+    points->GetPoint(i, p);
+    points->SetPoint(i, -p[0], -p[1], p[2]);
+  }
+  points->Modified();
+  if (vtkDataArray* normals = polyData->GetPointData()->GetNormals()) {
+    for (vtkIdType i = 0; i < normals->GetNumberOfTuples(); ++i) {
+      double n[3];
+      normals->GetTuple(i, n);
+      normals->SetTuple3(i, -n[0], -n[1], n[2]);
+    }
+    normals->Modified();
+  }
+}
+
 }  // namespace
 
 vtkSmartPointer<vtkPolyData> readSurfacePolyData(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw Error(path, "no such file");
   const std::string extension = lowerCaseExtension(path);
   vtkSmartPointer<vtkPolyData> polyData;
+  // 3D Slicer marks the coordinate system of the surfaces it writes, as
+  // "SPACE=RAS" or "SPACE=LPS": in the header of a .vtk or .stl file, a
+  // comment of a .ply or .obj file, a field array SPACE of a .vtp file. Such
+  // a file in RAS is turned into LPS; without a mark a file is LPS, as Slicer
+  // reads it.
+  std::string space;
   if (extension == ".vtp") {
     vtkNew<vtkXMLPolyDataReader> reader;
     reader->SetFileName(path.c_str());
     polyData = readWith(reader.GetPointer(), path);
+    if (auto* array = vtkStringArray::SafeDownCast(polyData->GetFieldData()->GetAbstractArray("SPACE")))
+      if (array->GetNumberOfValues() > 0) space = statedSpace(path, "SPACE=" + array->GetValue(0));
   } else if (extension == ".vtk") {
     vtkNew<vtkPolyDataReader> reader;
     reader->SetFileName(path.c_str());
     polyData = readWith(reader.GetPointer(), path);
+    if (reader->GetHeader()) space = statedSpace(path, reader->GetHeader());
   } else if (extension == ".obj") {
     // DynSub's own OBJ reader: VTK's reads "v nan 1 0" as the origin without
     // a word, where this one names the line.
     polyData = toPolyData(readPolygonData(path));
-  } else if (extension == ".ply" || extension == ".stl") {
-    vtkSmartPointer<vtkAbstractPolyDataReader> reader;
-    if (extension == ".ply") reader = vtkSmartPointer<vtkPLYReader>::New();
-    if (extension == ".stl") reader = vtkSmartPointer<vtkSTLReader>::New();
+    space = statedSpace(path, objComments(path));
+  } else if (extension == ".ply") {
+    vtkNew<vtkPLYReader> reader;
     reader->SetFileName(path.c_str());
-    polyData = readWith(reader, path);
+    polyData = readWith(reader.GetPointer(), path);
+    for (vtkIdType c = 0; reader->GetComments() && c < reader->GetComments()->GetNumberOfValues() && space.empty();
+         ++c)
+      space = statedSpace(path, reader->GetComments()->GetValue(c));
+  } else if (extension == ".stl") {
+    vtkNew<vtkSTLReader> reader;
+    reader->SetFileName(path.c_str());
+    polyData = readWith(reader.GetPointer(), path);
+    if (reader->GetHeader()) space = statedSpace(path, reader->GetHeader());
+    if (vtkUnsignedCharArray* header = reader->GetBinaryHeader(); header && space.empty()) {
+      std::string text;
+      for (vtkIdType i = 0; i < header->GetNumberOfValues(); ++i) text += static_cast<char>(header->GetValue(i));
+      space = statedSpace(path, text);
+    }
   } else {
     throw Error(path, "unknown surface format '" + extension + "' (expected .vtp, .vtk, .obj, .ply or .stl)");
   }
   if (polyData->GetNumberOfPolys() == 0) throw Error(path, "the file holds no surface polygons");
+  if (space == "RAS") toLps(polyData);
   for (vtkIdType i = 0; i < polyData->GetNumberOfPoints(); ++i) {
     double p[3];
     polyData->GetPoint(i, p);
@@ -172,6 +242,17 @@ vtkSmartPointer<vtkPolyData> readSurfacePolyData(const std::string& path) {
     }
   }
   return polyData;
+}
+
+MatrixX3 readSurfacePoints(const std::string& path) {
+  const vtkSmartPointer<vtkPolyData> polyData = readSurfacePolyData(path);
+  MatrixX3 points(polyData->GetNumberOfPoints(), 3);
+  for (vtkIdType i = 0; i < polyData->GetNumberOfPoints(); ++i) {
+    double p[3];
+    polyData->GetPoint(i, p);
+    points.row(i) << p[0], p[1], p[2];
+  }
+  return points;
 }
 
 }  // namespace dynsub

@@ -6,6 +6,7 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -204,6 +205,57 @@ TEST(SurfaceWriter, ObjPlyStlReadBack) {
   stlReader->SetFileName(stl.c_str());
   stlReader->Update();
   expectTriangles(stlReader->GetOutput(), "STL");
+}
+
+// 3D Slicer marks a surface's coordinate system ("SPACE=RAS") in a .vtk or
+// .stl header or a .ply or .obj comment: a file in RAS is read into LPS, x
+// and y negated; one marked LPS, or not at all, as written.
+TEST(SurfacePolyData, ReadsSlicersRasSurfacesIntoLps) {
+  const dynsub::TriangleSurface surface = cubeSurface();
+  const auto expectPoints = [&](const std::string& path, double sx, double sy) {
+    SCOPED_TRACE(path);
+    const dynsub::MatrixX3 read = dynsub::readSurfacePoints(path);
+    ASSERT_EQ(read.rows(), surface.points.rows());
+    for (Eigen::Index i = 0; i < read.rows(); ++i) {
+      ASSERT_NEAR(read(i, 0), sx * surface.points(i, 0), 1e-6);
+      ASSERT_NEAR(read(i, 1), sy * surface.points(i, 1), 1e-6);
+      ASSERT_NEAR(read(i, 2), surface.points(i, 2), 1e-6);
+    }
+  };
+  dynsub::writeTriangleSurface(surface, scratch("ras.vtk"), {}, "RAS");
+  expectPoints(scratch("ras.vtk"), -1, -1);
+  dynsub::writeTriangleSurface(surface, scratch("lps.vtk"), {}, "LPS");
+  expectPoints(scratch("lps.vtk"), 1, 1);
+  dynsub::writeTriangleSurface(surface, scratch("plain.obj"));
+  const std::string objText = [&] {
+    std::ifstream in(scratch("plain.obj"));
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  }();
+  { std::ofstream(scratch("ras.obj")) << "# 3D Slicer output. SPACE=RAS\n" << objText; }
+  expectPoints(scratch("ras.obj"), -1, -1);
+  expectPoints(scratch("plain.obj"), 1, 1);
+
+  const std::string ply =
+      "ply\nformat ascii 1.0\ncomment SPACE=RAS\nelement vertex 4\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n1 2 3\n4 5 6\n7 8 9\n"
+      "1 1 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 0 3 2\n";
+  { std::ofstream(scratch("ras.ply")) << ply; }
+  EXPECT_EQ(dynsub::readSurfacePoints(scratch("ras.ply")).row(1), Eigen::RowVector3d(-4, -5, 6));
+  const std::string stl =
+      "solid 3D Slicer output. SPACE=RAS\nfacet normal 0 0 1\nouter loop\nvertex 1 2 3\nvertex 4 5 6\n"
+      "vertex 7 8 10\nendloop\nendfacet\nendsolid\n";
+  { std::ofstream(scratch("ras.stl")) << stl; }
+  EXPECT_EQ(dynsub::readSurfacePoints(scratch("ras.stl")).row(0), Eigen::RowVector3d(-1, -2, 3));
+  std::string other = ply;
+  other.replace(other.find("SPACE=RAS"), 9, "SPACE=XYZ");
+  { std::ofstream(scratch("xyz.ply")) << other; }
+  try {
+    dynsub::readSurfacePolyData(scratch("xyz.ply"));
+    FAIL() << "an unknown coordinate system was accepted";
+  } catch (const dynsub::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("xyz.ply: unknown coordinate system 'SPACE=XYZ'"), std::string::npos)
+        << e.what();
+  }
 }
 
 // readSurfacePolyData reads OBJ with DynSub's own reader: the written

@@ -26,6 +26,9 @@ struct TrustEvidence {
   bool oneClick = false;              // a start from one click inside with nothing else: no clicks, no atlas
   double march = 0;                   // mm: the longest the slice-end march carried past the clicked slices
   double outsideRegion = 0;           // the share of the result outside the region of interest
+  // mm: how far the atlas's structure was moved so that the click inside
+  // (--inside) lies in it; NaN without such a click.
+  double insideShift = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct TrustMeasures {
@@ -40,6 +43,7 @@ struct TrustMeasures {
   double clicksToAtlas = kNone;         // mm: 90th percentile of evidence.clicksToAtlas
   double farthestFromEvidence = kNone;  // mm: the result's point farthest from every click and prior point
   double marchShare = kNone;            // the march over the span between the outermost clicked slices
+  double insideShift = kNone;           // mm: evidence.insideShift
   double outsideRegion = 0;
 };
 
@@ -51,9 +55,16 @@ struct TrustMeasures {
 constexpr double kTrustSmallBelow = 0.7;        // volumeRatio
 constexpr double kTrustAtlasClicksApart = 6.0;  // mm, clicksToAtlas
 constexpr double kTrustMovedFromAtlas = 4.5;    // mm, outlineDistance
+// A click inside within the structure needs the atlas's structure moved 2 mm
+// at most (single-scan tuning subjects 1-5, 201-202: none of 56 clicks at
+// least half as deep as the deepest, 2 of 56 at least a tenth as deep, by
+// 2.0 mm); twice that is a click elsewhere.
+constexpr double kTrustMovedToClick = 4.0;  // mm, insideShift
 
 struct TrustFlag {
-  std::string name;     // a stable key: one_click, small, atlas_clicks_apart, moved_from_atlas, leaked
+  // A stable key: one_click, small, atlas_clicks_apart, moved_from_atlas,
+  // moved_to_click, leaked.
+  std::string name;
   std::string message;  // what it means, and what to do
 };
 

@@ -25,9 +25,13 @@ std::string farName(const std::string& scalars);
 void addFarDistance(vtkPolyData* polyData, const std::string& name, double far);
 
 // Reads a triangle surface (.vtp, .vtk, .obj, .ply or .stl, by extension; .obj
-// through DynSub's own reader, MeshIO.h, which names a bad record's line). Throws
+// through DynSub's own reader, MeshIO.h, which names a bad record's line), in
+// LPS: a file 3D Slicer marked "SPACE=RAS" is turned into LPS. Throws
 // dynsub::Error naming the file when it is missing, unreadable, has no
-// triangles, or has non-finite coordinates.
+// triangles, has non-finite coordinates or marks another coordinate system.
 vtkSmartPointer<vtkPolyData> readSurfacePolyData(const std::string& path);
+
+// The points of readSurfacePolyData's surface.
+MatrixX3 readSurfacePoints(const std::string& path);
 
 }  // namespace dynsub
