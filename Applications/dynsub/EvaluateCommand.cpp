@@ -104,7 +104,8 @@ std::ostream& operator<<(std::ostream& out, CsvNumber n) {
 
 void writeRunsCsv(const std::vector<EvaluationRun>& runs, const std::string& path) {
   std::ofstream out(path);
-  out << "split,image,subject,subject_snr,thick_axis,contrast,structure,protocol,seed,format,landmarks,dice,jaccard,mean_surface_distance_mm,hd95_mm,"
+  out << "split,image,subject,subject_snr,thick_axis,contrast,structure,protocol,seed,format,landmarks,dice,jaccard,"
+         "mean_surface_distance_mm,hd95_mm,"
          "volume_mm3,reference_volume_mm3,leak_mm3,miss_mm3,collapsed,surface_on_edges,"
          "edge_strength_as_read,edge_strength_flipped,edge_strength_mirrored,edge_alignment_as_read,"
          "edge_alignment_flipped,edge_alignment_mirrored,seconds,steps,control_vertices,outside_region,"
@@ -130,8 +131,7 @@ void writeRunsCsv(const std::vector<EvaluationRun>& runs, const std::string& pat
     out << N{r.seconds} << ',' << r.steps << ',' << r.controlVertices << ',' << N{t.outsideRegion} << ','
         << N{t.volumeRatio} << ',' << N{t.outlineDistance} << ',' << N{t.clicksToAtlas} << ','
         << N{t.farthestFromEvidence} << ',' << N{t.marchShare} << ',' << N{t.insideShift} << ','
-        << csvField(r.trustFlags) << ','
-        << csvField(r.warnings) << ',' << csvField(r.error) << '\n';
+        << csvField(r.trustFlags) << ',' << csvField(r.warnings) << ',' << csvField(r.error) << '\n';
   }
   out.close();
   if (!out) throw writeFailure(path);

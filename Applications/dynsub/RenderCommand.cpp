@@ -117,8 +117,7 @@ void runRender(const RenderCommandOptions& o) {
   if (image) {
     // The slices are cut through the middle of the surface's box: another
     // image's surface, or one in other coordinates, has no slice here.
-    const Vector3 centre =
-        0.5 * (vertices.colwise().minCoeff() + vertices.colwise().maxCoeff()).transpose();
+    const Vector3 centre = 0.5 * (vertices.colwise().minCoeff() + vertices.colwise().maxCoeff()).transpose();
     const Vector3 index = image->geometry.toIndex(centre);
     for (int a = 0; a < 3; ++a)
       if (index[a] < -0.5 || index[a] > image->geometry.size[a] - 0.5)

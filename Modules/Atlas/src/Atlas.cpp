@@ -117,7 +117,8 @@ std::vector<std::pair<int, std::string>> readNames(const std::string& labelsPath
       while (last != first && isNumber(*(last - 1))) --last;
       std::string name;
       for (auto word = first; word != last; ++word) name += (name.empty() ? "" : " ") + *word;
-      if (name.size() >= 2 && name.front() == '"' && name.back() == '"') name = trimmed(name.substr(1, name.size() - 2));
+      if (name.size() >= 2 && name.front() == '"' && name.back() == '"')
+        name = trimmed(name.substr(1, name.size() - 2));
       if (name.empty()) throw Error(path, "line " + std::to_string(number) + ": expected a label value and its name");
       names.emplace_back(value, name);
     }
@@ -216,8 +217,8 @@ std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec, c
     }
     // The name as written, else the one name that matches it whatever the
     // case: two labels can differ by case alone.
-    auto named = std::find_if(atlas.names.begin(), atlas.names.end(),
-                              [&](const auto& entry) { return entry.second == item; });
+    auto named =
+        std::find_if(atlas.names.begin(), atlas.names.end(), [&](const auto& entry) { return entry.second == item; });
     if (named == atlas.names.end()) {
       std::vector<std::string> matches;
       for (const auto& entry : atlas.names)
@@ -232,18 +233,20 @@ std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec, c
     }
     if (named != atlas.names.end()) {
       if (named->first == 0)
-        throw UsageError(option + " " + spec + ": '" + named->second + "' is label 0, the atlas's background, not a "
-                         "structure");
+        throw UsageError(option + " " + spec + ": '" + named->second +
+                         "' is label 0, the atlas's background, not a structure");
       values.push_back(named->first);
       continue;
     }
     if (atlas.names.empty())
-      throw Error(atlas.labelsPath, "no table of label names beside it (" + joined(nameTables(atlas.labelsPath), " or ") +
-                                        "): give " + option + " as numbers, not '" + item + "'");
+      throw Error(atlas.labelsPath, "no table of label names beside it (" +
+                                        joined(nameTables(atlas.labelsPath), " or ") + "): give " + option +
+                                        " as numbers, not '" + item + "'");
     // The names that hold it ("Caudate": both sides), else the nearest.
     std::vector<std::string> holding;
     for (const auto& entry : atlas.names)
-      if (lowerCase(entry.second).find(lowerCase(item)) != std::string::npos) holding.push_back("'" + entry.second + "'");
+      if (lowerCase(entry.second).find(lowerCase(item)) != std::string::npos)
+        holding.push_back("'" + entry.second + "'");
     if (holding.empty() || holding.size() > 4) {
       const auto nearest = std::min_element(atlas.names.begin(), atlas.names.end(), [&](const auto& a, const auto& b) {
         return editDistance(a.second, item) < editDistance(b.second, item);

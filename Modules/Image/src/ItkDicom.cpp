@@ -1,10 +1,9 @@
 // DICOM read through ITK and GDCM, for the ITK bridge (ItkBridge.h).
 #include <algorithm>
 #include <cctype>
-#include <filesystem>
 #include <cmath>
+#include <filesystem>
 #include <iostream>
-#include <map>
 #include <sstream>
 #include <vector>
 
@@ -110,8 +109,9 @@ void requireOneSliceGeometry(const std::vector<std::string>& files) {
   for (const std::string& file : files) {
     const std::vector<double> at = dicomNumbers(scanner.GetValue(file.c_str(), position));
     if (at.size() != 3)
-      throw Error(file, "a slice of the DICOM series states no Image Position (Patient) (0020,0032): where it lies "
-                        "in the volume is unknown");
+      throw Error(file,
+                  "a slice of the DICOM series states no Image Position (Patient) (0020,0032): where it lies "
+                  "in the volume is unknown");
     if (!near(dicomNumbers(scanner.GetValue(file.c_str(), orientation)), firstOrientation, 1e-4))
       throw Error(file, "a slice of the DICOM series has another Image Orientation (Patient) (0020,0037) than " +
                             first + ": slices of one volume share one orientation");
@@ -121,8 +121,7 @@ void requireOneSliceGeometry(const std::vector<std::string>& files) {
                             ": slices of one volume share one spacing");
     for (const auto& [other, otherFile] : placed)
       if (near(at, other, 1e-3))
-        throw Error(file, "two slices of the DICOM series lie at one position (0020,0032), this one and " +
-                              otherFile +
+        throw Error(file, "two slices of the DICOM series lie at one position (0020,0032), this one and " + otherFile +
                               ": a repeated acquisition, or several echoes or phases in one series; give a folder of "
                               "one volume's slices");
     placed.emplace_back(at, file);

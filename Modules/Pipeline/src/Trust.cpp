@@ -133,11 +133,13 @@ std::vector<TrustFlag> trustFlags(const TrustMeasures& m, const TrustEvidence& e
                                              " mm or more from the result: the image's edges pulled it away from "
                                              "the atlas (check it there, or add clicks)"});
   if (m.insideShift > kTrustMovedToClick)
-    flags.push_back({"moved_to_click", "the click inside (--inside) lay outside the atlas's structure carried to "
-                                           "the image, which was moved " + fixed(m.insideShift, 1) +
-                                           " mm to hold it: a click in a neighbouring structure, the other "
-                                           "hemisphere or the other convention (RAS read as LPS) moves it there; "
-                                           "check the click"});
+    flags.push_back({"moved_to_click",
+                     "the click inside (--inside) lay outside the atlas's structure carried to "
+                     "the image, which was moved " +
+                         fixed(m.insideShift, 1) +
+                         " mm to hold it: a click in a neighbouring structure, the other "
+                         "hemisphere or the other convention (RAS read as LPS) moves it there; "
+                         "check the click"});
   if (m.outsideRegion > kLeakedAbove)
     flags.push_back({"leaked", fixed(100 * m.outsideRegion, 0) +
                                    " % of the surface left the region of interest, where no image force holds it"});

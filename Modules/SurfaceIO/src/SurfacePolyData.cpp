@@ -196,8 +196,7 @@ vtkSmartPointer<vtkPolyData> readSurfacePolyData(const std::string& path) {
     vtkNew<vtkPLYReader> reader;
     reader->SetFileName(path.c_str());
     polyData = readWith(reader.GetPointer(), path);
-    for (vtkIdType c = 0; reader->GetComments() && c < reader->GetComments()->GetNumberOfValues() && space.empty();
-         ++c)
+    for (vtkIdType c = 0; reader->GetComments() && c < reader->GetComments()->GetNumberOfValues() && space.empty(); ++c)
       space = statedSpace(path, reader->GetComments()->GetValue(c));
   } else if (extension == ".stl") {
     vtkNew<vtkSTLReader> reader;
