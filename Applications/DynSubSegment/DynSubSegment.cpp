@@ -150,9 +150,9 @@ slicer::Module describe(Arguments& a) {
                            &a.inside, "", "", "", "", {}, -1});
   io.parameters.push_back({"string", "", "atlasLabel", "atlasLabel", "Atlas structure",
                            "The structure's label value(s) or name(s) in Colin27's AAL atlas (Caudate_L, or "
-                           "Putamen_L,Putamen_R): the atlas, registered to the volume, starts the surface and "
-                           "holds it softly where the points and the edges say nothing. The point inside, if "
-                           "given, says where the structure is. Several structures, separated by ';' "
+                           "Putamen_L,Pallidum_L, labels that touch): the atlas, registered to the volume, starts "
+                           "the surface and holds it softly where the points and the edges say nothing. The point "
+                           "inside, if given, says where the structure is. Several structures, separated by ';' "
                            "(Caudate_L;Putamen_L), are segmented together, each paired in order with a list "
                            "of the points file when it has several.",
                            &a.atlasLabel, "", "", "", "", {}, -1});
@@ -268,7 +268,8 @@ std::string inModuleTerms(std::string message) {
       {"--init seed:x,y,z", "--inside x,y,z"},
       {"--init atlas", "--atlasLabel"},
       {"--atlas-label", "--atlasLabel"},
-      {"give each structure a --name", "give each point list a name of its own"}};
+      {"give each structure a --name", "give each point list a name of its own"},
+      {"give each structure an --atlas-label of its own", "separate the structures' labels with ';'"}};
   for (const Parameter& row : segmentParameters()) {
     if (row.opposite)
       terms.emplace_back(row.flag() + " false", "--" + row.opposite->name);

@@ -5,6 +5,7 @@
 
 #include "dynsub/FileNames.h"
 #include "dynsub/SegmentStructures.h"
+#include "dynsub/TextFields.h"
 
 namespace dynsub::app {
 
@@ -26,6 +27,8 @@ std::vector<LandmarkSource> landmarkSources(const std::vector<std::string>& file
   for (const std::string& path : files) {
     std::vector<LandmarkList> lists = readLandmarkLists(path);
     for (std::size_t k = 0; k < lists.size(); ++k) {
+      // A name of blanks alone names nothing.
+      lists[k].name = trimmed(lists[k].name);
       LandmarkSource source;
       source.path = path;
       if (lists.size() == 1)

@@ -118,12 +118,10 @@ void runRender(const RenderCommandOptions& o) {
     // The slices are cut through the middle of the surface's box: another
     // image's surface, or one in other coordinates, has no slice here.
     const Vector3 centre = 0.5 * (vertices.colwise().minCoeff() + vertices.colwise().maxCoeff()).transpose();
-    const Vector3 index = image->geometry.toIndex(centre);
-    for (int a = 0; a < 3; ++a)
-      if (index[a] < -0.5 || index[a] > image->geometry.size[a] - 0.5)
-        throw Error(o.surface, "the surface lies outside the image " + o.image +
-                                   " (the middle of its box is outside): nothing to show on its slices; is it "
-                                   "another image's surface?");
+    if (!image->geometry.covers(centre))
+      throw Error(o.surface, "the surface lies outside the image " + o.image +
+                                 " (the middle of its box is outside): nothing to show on its slices; is it "
+                                 "another image's surface?");
   }
 
   const std::filesystem::path dir(o.out);

@@ -142,8 +142,8 @@ void printSummary(const Arguments& o, const SegmentOutcome& outcome, const Volum
             << " control vertices (" << result.levels.back().level << " refinement(s), " << result.steps
             << " steps) in " << outcome.seconds << " s\n";
   const std::string carried = carriedPastSlices(outcome.result);
-  // Without clicks, the march's slices are those of the atlas's points.
-  if (!carried.empty() && o.landmarks.empty())
+  // An atlas start without clicks marches from its own points' slices.
+  if (!carried.empty() && outcome.carried && o.landmarks.empty())
     std::cout << "followed the structure's tissue past the ends of the atlas's structure and pulled the surface "
                  "there: "
               << carried << " (--slice-ends false to keep to the atlas's ends)\n";

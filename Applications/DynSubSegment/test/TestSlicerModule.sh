@@ -76,6 +76,10 @@ check "points short of the ends: says how far it followed the tissue, and what t
   >"$work/inside.out" 2>&1
 check "one point: exit 0" test $? -eq 0
 check "one point: read as a click inside" grep -q '"springs": "boundary points"' "$work/inside.json"
+# The flag's advice names the module's options, not dynsub segment's.
+check "one point: flagged one_click, advising the module's own options" \
+  grep -q -- "not to trust (one_click).*(--atlasLabel with --inside)" "$work/inside.out"
+check "one point: no dynsub segment option in the advice" bash -c "! grep -q -- '--init' '$work/inside.out'"
 check "one point: a caudate-sized region (Dice >= 0.5)" \
   "$python" "$here/slicer_module_check.py" dice "$work/inside.nrrd" 1 "$templates/aal.nii.gz" 71 0.5
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <set>
 #include <sstream>
 
 #include "BridgeGeometry.h"
@@ -91,7 +92,19 @@ std::vector<std::pair<int, std::string>> readNames(const std::string& labelsPath
   for (const std::string& path : nameTables(labelsPath)) {
     std::ifstream in(path);
     if (!in) continue;
-    std::vector<std::pair<int, std::string>> names;
+    // Each line's value, its words, and where its name's words begin; the
+    // name's end is decided for the whole table below.
+    struct Line {
+      int value;
+      std::vector<std::string> words;
+      std::size_t first;
+    };
+    std::vector<Line> lines;
+    const auto isNumber = [](const std::string& word) {
+      double number = 0;
+      std::istringstream read(word);
+      return static_cast<bool>(read >> number) && read.eof();
+    };
     std::string line;
     int number = 0;
     while (std::getline(in, line)) {
@@ -105,23 +118,33 @@ std::vector<std::pair<int, std::string>> readNames(const std::string& labelsPath
       int value = 0;
       std::vector<std::string> words;
       for (std::string word; fields >> word;) words.push_back(word);
-      const auto isNumber = [](const std::string& word) {
-        double number = 0;
-        std::istringstream read(word);
-        return static_cast<bool>(read >> number) && read.eof();
-      };
       if (words.empty() || !isNumber(words.front()) || !(std::istringstream(words.front()) >> value))
         throw Error(path, "line " + std::to_string(number) + ": expected a label value and its name");
-      auto first = words.begin() + 1, last = words.end();
-      while (first != last && isNumber(*first)) ++first;
-      while (last != first && isNumber(*(last - 1))) --last;
-      std::string name;
-      for (auto word = first; word != last; ++word) name += (name.empty() ? "" : " ") + *word;
-      if (name.size() >= 2 && name.front() == '"' && name.back() == '"')
-        name = trimmed(name.substr(1, name.size() - 2));
-      if (name.empty()) throw Error(path, "line " + std::to_string(number) + ": expected a label value and its name");
-      names.emplace_back(value, name);
+      std::size_t first = 1;
+      while (first < words.size() && isNumber(words[first])) ++first;
+      if (first == words.size())
+        throw Error(path, "line " + std::to_string(number) + ": expected a label value and its name");
+      lines.push_back({value, std::move(words), first});
     }
+    // A name's trailing numbers are the table's own (a code, colours) unless
+    // leaving them out would give two labels one name ("Brodmann area 17").
+    const auto namesOf = [&](bool trailingNumbers) {
+      std::vector<std::pair<int, std::string>> names;
+      for (const Line& l : lines) {
+        std::size_t last = l.words.size();
+        while (!trailingNumbers && last > l.first + 1 && isNumber(l.words[last - 1])) --last;
+        std::string name;
+        for (std::size_t w = l.first; w < last; ++w) name += (name.empty() ? "" : " ") + l.words[w];
+        if (name.size() >= 2 && name.front() == '"' && name.back() == '"')
+          name = trimmed(name.substr(1, name.size() - 2));
+        names.emplace_back(l.value, name);
+      }
+      return names;
+    };
+    std::vector<std::pair<int, std::string>> names = namesOf(false);
+    std::set<std::string> seen;
+    for (const auto& [value, name] : names)
+      if (!seen.insert(name).second) return namesOf(true);
     return names;
   }
   return {};
@@ -219,6 +242,11 @@ std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec, c
     // case: two labels can differ by case alone.
     auto named =
         std::find_if(atlas.names.begin(), atlas.names.end(), [&](const auto& entry) { return entry.second == item; });
+    if (named != atlas.names.end() && std::count_if(atlas.names.begin(), atlas.names.end(), [&](const auto& entry) {
+                                        return entry.second == item && entry.first != named->first;
+                                      }) > 0)
+      throw UsageError(option + " " + spec + ": '" + item + "' names more than one label of " + atlas.labelsPath +
+                       "; give the label value instead");
     if (named == atlas.names.end()) {
       std::vector<std::string> matches;
       for (const auto& entry : atlas.names)
@@ -259,7 +287,10 @@ std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec, c
     if (selectLabels(atlas.labels, {value}).count() == 0)
       throw Error(atlas.labelsPath, "no voxel has the label " + std::to_string(value));
   // One surface is one piece: labels that lie apart (the two caudates) would
-  // be joined by a bridge through whatever lies between them.
+  // be joined by a bridge through whatever lies between them. A label of its
+  // own is the atlas's structure as the atlas draws it (a click inside picks
+  // its piece).
+  if (values.size() < 2) return values;
   const std::vector<long long> sizes = pieceSizes(selectLabels(atlas.labels, values));
   long long total = 0;
   for (long long size : sizes) total += size;

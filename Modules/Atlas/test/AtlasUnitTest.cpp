@@ -113,6 +113,15 @@ TEST(Atlas, NameTablesOfOtherToolsAreRead) {
   EXPECT_THROW(atlasLabelValues(atlas, "HIPPOCAMPUS_L"), UsageError);
   EXPECT_THROW(atlasLabelValues(atlas, "background"), UsageError);  // label 0
   EXPECT_THROW(atlasLabelValues(atlas, "1,2"), UsageError);         // two pieces
+  EXPECT_EQ(atlasLabelValues(atlas, "1"), std::vector<int>{1});     // one label is the atlas's own piece
+  // Names whose trailing numbers tell them apart keep them.
+  {
+    std::ofstream table(dir + "/labels.nii.txt");
+    table << "1 Brodmann area 17\n2 Brodmann area 18\n3 Other 3001\n";
+  }
+  const Atlas numbered = readAtlas(dir + "/template.nii.gz", dir + "/labels.nii.gz");
+  EXPECT_EQ(atlasLabelValues(numbered, "Brodmann area 18"), std::vector<int>{2});
+  EXPECT_THROW(atlasLabelValues(numbered, "Brodmann area"), Error);
   std::filesystem::remove_all(dir);
 }
 

@@ -40,7 +40,6 @@ class WarningsOff {
   bool was_;
 };
 
-
 // GDCM's own messages held for a scope: what they say (a slice position
 // that is not unique) the checks here report as errors, naming the files.
 class GdcmMessagesHeld {
@@ -96,8 +95,10 @@ bool near(const std::vector<double>& a, const std::vector<double>& b, double tol
 // a position of its own and the first one's orientation and spacing.
 void requireOneSliceGeometry(const std::vector<std::string>& files) {
   if (files.size() < 2) return;
-  const gdcm::Tag position(0x0020, 0x0032), orientation(0x0020, 0x0037), spacing(0x0028, 0x0030);
+  const gdcm::Tag position(0x0020, 0x0032), orientation(0x0020, 0x0037), spacing(0x0028, 0x0030),
+      frames(0x0028, 0x0008);
   gdcm::Scanner scanner;
+  scanner.AddTag(frames);
   scanner.AddTag(position);
   scanner.AddTag(orientation);
   scanner.AddTag(spacing);
@@ -108,6 +109,11 @@ void requireOneSliceGeometry(const std::vector<std::string>& files) {
   std::vector<std::pair<std::vector<double>, std::string>> placed;
   for (const std::string& file : files) {
     const std::vector<double> at = dicomNumbers(scanner.GetValue(file.c_str(), position));
+    const std::vector<double> frameCount = dicomNumbers(scanner.GetValue(file.c_str(), frames));
+    if (!frameCount.empty() && frameCount.front() > 1)
+      throw Error(file, "a file of " + std::to_string(static_cast<long long>(frameCount.front())) +
+                            " frames in a series of several files: a multi-frame file holds a volume of its own; "
+                            "give it alone");
     if (at.size() != 3)
       throw Error(file,
                   "a slice of the DICOM series states no Image Position (Patient) (0020,0032): where it lies "

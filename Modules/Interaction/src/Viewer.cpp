@@ -159,7 +159,7 @@ struct Viewer::Impl {
 
   void dragLandmarkTo(int x, int y) {
     const Vector3 point = views[edits.dragView]->pointAt(x, y);
-    if (!slices.geometry().covers(point)) return;  // held at the image's edge
+    if (!slices.geometry().covers(point)) return;  // it stays where it last lay in the image
     edits.landmarks[edits.selected].position = point;
     edits.moved = true;
     showLandmarks();

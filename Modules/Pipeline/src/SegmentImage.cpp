@@ -418,6 +418,15 @@ Vector3 parsePoint(const std::string& text, const std::string& option) {
   return Vector3(v[0], v[1], v[2]);
 }
 
+void requireInsideClickInImage(const Volume& image, const SegmentInputs& in) {
+  if (in.inside && !(in.inside->allFinite() && image.geometry.covers(*in.inside))) {
+    std::ostringstream message;
+    message << "the click inside the structure (--inside " << in.inside->x() << "," << in.inside->y() << ","
+            << in.inside->z() << ", LPS mm) lies outside the image";
+    throw Error(in.image, message.str());
+  }
+}
+
 void checkSegmentInputs(const SegmentInputs& in, const SegmentParameters& parameters) {
   optionsFor(in, parameters);
   checkStart(in);
@@ -427,13 +436,7 @@ SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& in, const 
                             const ProgressCallback& progress, const std::vector<ForceModel*>& forces) {
   SegmentOptions options = optionsFor(in, parameters);
   checkStart(in);
-  // Before an atlas's registration, which takes seconds.
-  if (in.inside && !(in.inside->allFinite() && image.geometry.covers(*in.inside))) {
-    std::ostringstream message;
-    message << "the click inside the structure (--inside " << in.inside->x() << "," << in.inside->y() << ","
-            << in.inside->z() << ", LPS mm) lies outside the image";
-    throw Error(in.image, message.str());
-  }
+  requireInsideClickInImage(image, in);
 
   SegmentOutcome outcome;
   const auto started = std::chrono::steady_clock::now();

@@ -191,6 +191,13 @@ void checkStructures(const std::vector<StructureInputs>& structures, const Segme
 StructuresOutcome segmentStructures(const Volume& image, const std::vector<StructureInputs>& structures,
                                     const SegmentParameters& parameters, const ProgressCallback& progress) {
   checkStructures(structures, parameters);
+  for (const StructureInputs& s : structures) {
+    try {
+      requireInsideClickInImage(image, s.inputs);
+    } catch (const Error& error) {
+      throw Error("structure " + s.name, error.what());
+    }
+  }
   const auto started = std::chrono::steady_clock::now();
   StructuresOutcome out;
   const std::size_t n = structures.size();

@@ -126,6 +126,10 @@ TEST(Trust, EachFlagComesFromItsOwnMeasure) {
     e.volume = kBall;
     e.insideShift = 2.0;
     EXPECT_TRUE(trustFlags(measureTrust(result, kBall, e), e).empty());
+    e.insideShift = 4.0;  // the threshold itself: not beyond it
+    EXPECT_TRUE(trustFlags(measureTrust(result, kBall, e), e).empty());
+    e.insideShift = 4.1;
+    EXPECT_TRUE(has(trustFlags(measureTrust(result, kBall, e), e), "moved_to_click"));
     e.insideShift = 22.0;
     const TrustMeasures m = measureTrust(result, kBall, e);
     EXPECT_DOUBLE_EQ(m.insideShift, 22.0);

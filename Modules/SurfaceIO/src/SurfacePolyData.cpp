@@ -118,17 +118,19 @@ vtkSmartPointer<vtkPolyData> readWith(vtkAlgorithm* reader, const std::string& p
   return polyData;
 }
 
-// The coordinate system a text says with "SPACE=" (3D Slicer's mark in a
-// surface file's header or comments): "RAS", "LPS", or empty for none.
-std::string statedSpace(const std::string& path, const std::string& text) {
-  const std::size_t at = text.find("SPACE=");
-  if (at == std::string::npos) return "";
-  std::string space;
-  for (std::size_t i = at + 6; i < text.size() && std::isalpha(static_cast<unsigned char>(text[i])); ++i)
-    space += static_cast<char>(std::toupper(static_cast<unsigned char>(text[i])));
-  if (space != "RAS" && space != "LPS")
-    throw Error(path, "unknown coordinate system 'SPACE=" + space + "' (expected SPACE=LPS or SPACE=RAS)");
-  return space;
+// The coordinate system a text states as 3D Slicer marks it in a surface
+// file's header or comments, "SPACE=RAS" or "SPACE=LPS" (a word of its own:
+// not COLORSPACE=...): "RAS", "LPS", or empty for none. Slicer reads any
+// other value as no mark.
+std::string statedSpace(const std::string& text) {
+  for (std::size_t at = text.find("SPACE="); at != std::string::npos; at = text.find("SPACE=", at + 1)) {
+    if (at > 0 && (std::isalnum(static_cast<unsigned char>(text[at - 1])) || text[at - 1] == '_')) continue;
+    const std::string space = text.substr(at + 6, 3);
+    const std::size_t end = at + 9;
+    const bool whole = end >= text.size() || !std::isalnum(static_cast<unsigned char>(text[end]));
+    if ((space == "RAS" || space == "LPS") && whole) return space;
+  }
+  return "";
 }
 
 // The comment lines an OBJ file begins with, joined.
@@ -144,24 +146,29 @@ std::string objComments(const std::string& path) {
   return comments;
 }
 
-// RAS to LPS: x and y negated, for the points and the normals (a half turn
-// about z, so that the polygons keep their orientation).
-void toLps(vtkPolyData* polyData) {
-  vtkPoints* points = polyData->GetPoints();
-  for (vtkIdType i = 0; i < points->GetNumberOfPoints(); ++i) {
-    double p[3];
-    points->GetPoint(i, p);
-    points->SetPoint(i, -p[0], -p[1], p[2]);
+// x and y negated in a 3-vector array.
+void halfTurn(vtkDataArray* array) {
+  if (!array || array->GetNumberOfComponents() != 3) return;
+  for (vtkIdType i = 0; i < array->GetNumberOfTuples(); ++i) {
+    double v[3];
+    array->GetTuple(i, v);
+    array->SetTuple3(i, -v[0], -v[1], v[2]);
   }
-  points->Modified();
-  if (vtkDataArray* normals = polyData->GetPointData()->GetNormals()) {
-    for (vtkIdType i = 0; i < normals->GetNumberOfTuples(); ++i) {
-      double n[3];
-      normals->GetTuple(i, n);
-      normals->SetTuple3(i, -n[0], -n[1], n[2]);
-    }
-    normals->Modified();
+  array->Modified();
+}
+
+// RAS to LPS: x and y negated, a half turn about z, for the points and the
+// point and cell normals and vectors, as Slicer turns them; the polygons
+// keep their orientation.
+vtkSmartPointer<vtkPolyData> toLps(vtkPolyData* polyData) {
+  halfTurn(polyData->GetPoints()->GetData());
+  polyData->GetPoints()->Modified();
+  for (vtkDataSetAttributes* data : {static_cast<vtkDataSetAttributes*>(polyData->GetPointData()),
+                                     static_cast<vtkDataSetAttributes*>(polyData->GetCellData())}) {
+    halfTurn(data->GetNormals());
+    if (data->GetVectors() != data->GetNormals()) halfTurn(data->GetVectors());
   }
+  return polyData;
 }
 
 }  // namespace
@@ -181,38 +188,38 @@ vtkSmartPointer<vtkPolyData> readSurfacePolyData(const std::string& path) {
     reader->SetFileName(path.c_str());
     polyData = readWith(reader.GetPointer(), path);
     if (auto* array = vtkStringArray::SafeDownCast(polyData->GetFieldData()->GetAbstractArray("SPACE")))
-      if (array->GetNumberOfValues() > 0) space = statedSpace(path, "SPACE=" + array->GetValue(0));
+      if (array->GetNumberOfValues() > 0) space = statedSpace("SPACE=" + array->GetValue(0));
   } else if (extension == ".vtk") {
     vtkNew<vtkPolyDataReader> reader;
     reader->SetFileName(path.c_str());
     polyData = readWith(reader.GetPointer(), path);
-    if (reader->GetHeader()) space = statedSpace(path, reader->GetHeader());
+    if (reader->GetHeader()) space = statedSpace(reader->GetHeader());
   } else if (extension == ".obj") {
     // DynSub's own OBJ reader: VTK's reads "v nan 1 0" as the origin without
     // a word, where this one names the line.
     polyData = toPolyData(readPolygonData(path));
-    space = statedSpace(path, objComments(path));
+    space = statedSpace(objComments(path));
   } else if (extension == ".ply") {
     vtkNew<vtkPLYReader> reader;
     reader->SetFileName(path.c_str());
     polyData = readWith(reader.GetPointer(), path);
     for (vtkIdType c = 0; reader->GetComments() && c < reader->GetComments()->GetNumberOfValues() && space.empty(); ++c)
-      space = statedSpace(path, reader->GetComments()->GetValue(c));
+      space = statedSpace(reader->GetComments()->GetValue(c));
   } else if (extension == ".stl") {
     vtkNew<vtkSTLReader> reader;
     reader->SetFileName(path.c_str());
     polyData = readWith(reader.GetPointer(), path);
-    if (reader->GetHeader()) space = statedSpace(path, reader->GetHeader());
+    if (reader->GetHeader()) space = statedSpace(reader->GetHeader());
     if (vtkUnsignedCharArray* header = reader->GetBinaryHeader(); header && space.empty()) {
       std::string text;
       for (vtkIdType i = 0; i < header->GetNumberOfValues(); ++i) text += static_cast<char>(header->GetValue(i));
-      space = statedSpace(path, text);
+      space = statedSpace(text);
     }
   } else {
     throw Error(path, "unknown surface format '" + extension + "' (expected .vtp, .vtk, .obj, .ply or .stl)");
   }
   if (polyData->GetNumberOfPolys() == 0) throw Error(path, "the file holds no surface polygons");
-  if (space == "RAS") toLps(polyData);
+  if (space == "RAS") polyData = toLps(polyData);
   for (vtkIdType i = 0; i < polyData->GetNumberOfPoints(); ++i) {
     double p[3];
     polyData->GetPoint(i, p);

@@ -42,10 +42,12 @@ struct Atlas {
 // the label map is not on the template's grid.
 Atlas readAtlas(const std::string& imagePath, const std::string& labelsPath);
 
-// "71", "71,72", "Caudate_L" or "Caudate_L,Caudate_R": the label values.
+// "73", "73,75", "Putamen_L" or "Putamen_L,Pallidum_L": the label values.
 // Throws dynsub::Error for a name the table does not hold (naming the
-// nearest), or a value no voxel of the label map has. `option` is the flag
-// the spec came from, for messages.
+// nearest), or a value no voxel of the label map has; dynsub::UsageError for
+// a malformed spec, label 0, a name that matches several labels, and several
+// labels that lie in separate pieces (one surface cannot hold them). `option`
+// is the flag the spec came from, for messages.
 std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec,
                                   const std::string& option = "--atlas-label");
 

@@ -109,6 +109,10 @@ struct SegmentOutcome {
 // this first; a command checks it before it writes anything.
 void checkSegmentInputs(const SegmentInputs& inputs, const SegmentParameters& parameters);
 
+// Throws dynsub::Error naming the image when the click inside (--inside)
+// lies outside it: checked before an atlas's registration, which takes seconds.
+void requireInsideClickInImage(const Volume& image, const SegmentInputs& inputs);
+
 // Throws dynsub::Error naming the landmark source when the landmarks cannot
 // be used (among them, landmarks that look read in the wrong convention,
 // unless parameters.checkConvention is off), and for impossible parameters; `progress` (may be empty) sees
