@@ -28,7 +28,7 @@ void addFarDistance(vtkPolyData* polyData, const std::string& name, double far);
 // through DynSub's own reader, MeshIO.h, which names a bad record's line), in
 // LPS: a file 3D Slicer marked "SPACE=RAS" is turned into LPS. Throws
 // dynsub::Error naming the file when it is missing, unreadable, has no
-// triangles, has non-finite coordinates or marks another coordinate system.
+// triangles, or has non-finite coordinates.
 vtkSmartPointer<vtkPolyData> readSurfacePolyData(const std::string& path);
 
 // The points of readSurfacePolyData's surface.
