@@ -70,7 +70,8 @@ void runRender(const RenderCommandOptions& o) {
   requireFigureFormat(o.figures.format);
   std::string why;
   if (!figureDisplay(&why)) throw Error("rendering needs an X display: " + why);
-  // Every input is read and checked before anything is written.
+  // Every input is read and checked before anything is written (the surface
+  // file when the figures are drawn: a bad one leaves nothing behind).
   FigureInputs inputs;
   inputs.surfaceFile = o.surface;
   inputs.coordinates = o.figures.coordinates;
@@ -78,6 +79,7 @@ void runRender(const RenderCommandOptions& o) {
   if (!o.image.empty()) {
     image = std::make_unique<Volume>(readVolume(o.image));
     inputs.image = image.get();
+    inputs.imageFile = o.image;
   }
   if (!o.landmarks.empty()) {
     const std::vector<Landmark> landmarks = readLandmarks(o.landmarks);
@@ -111,19 +113,6 @@ void runRender(const RenderCommandOptions& o) {
     inputs.history = &history;
   }
 
-  // The surface's vertices, for the checks against the image and the
-  // landmarks (the figures read the file again as VTK's polygons).
-  const MatrixX3 vertices = readSurfacePoints(o.surface);
-  if (image) {
-    // The slices are cut through the middle of the surface's box: another
-    // image's surface, or one in other coordinates, has no slice here.
-    const Vector3 centre = 0.5 * (vertices.colwise().minCoeff() + vertices.colwise().maxCoeff()).transpose();
-    if (!image->geometry.covers(centre))
-      throw Error(o.surface, "the surface lies outside the image " + o.image +
-                                 " (the middle of its box is outside): nothing to show on its slices; is it "
-                                 "another image's surface?");
-  }
-
   const std::filesystem::path dir(o.out);
   // render writes only figures: a run's other files, its convergence table
   // too, may be its inputs.
@@ -144,6 +133,7 @@ void runRender(const RenderCommandOptions& o) {
   // or read in the other convention; the figure alone would not say so. A
   // file of several structures' lists outlines this surface with one of them.
   if (!o.landmarks.empty()) {
+    const MatrixX3 vertices = readSurfacePoints(o.surface);
     double nearestList = std::numeric_limits<double>::infinity();
     for (const LandmarkList& list : readLandmarkLists(o.landmarks)) {
       std::vector<double> nearest;

@@ -41,34 +41,6 @@ std::string labelList(const std::vector<int>& labels) {
   return joined(values, ",");
 }
 
-// The sizes (voxels) of the mask's face-connected pieces, largest first.
-std::vector<long long> pieceSizes(const Mask& mask) {
-  const ImageGeometry& grid = mask.geometry;
-  std::vector<std::uint8_t> seen(mask.voxels.size(), 0);
-  std::vector<long long> sizes, queue;
-  for (std::size_t start = 0; start < mask.voxels.size(); ++start) {
-    if (!mask.voxels[start] || seen[start]) continue;
-    seen[start] = 1;
-    queue.assign(1, static_cast<long long>(start));
-    for (std::size_t next = 0; next < queue.size(); ++next) {
-      const std::array<int, 3> at = grid.voxelAt(queue[next]);
-      for (int a = 0; a < 3; ++a)
-        for (int step : {-1, 1}) {
-          std::array<int, 3> n = at;
-          n[a] += step;
-          if (!grid.contains(n[0], n[1], n[2])) continue;
-          const long long o = grid.offset(n[0], n[1], n[2]);
-          if (!mask.voxels[o] || seen[o]) continue;
-          seen[o] = 1;
-          queue.push_back(o);
-        }
-    }
-    sizes.push_back(static_cast<long long>(queue.size()));
-  }
-  std::sort(sizes.rbegin(), sizes.rend());
-  return sizes;
-}
-
 double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -102,8 +74,7 @@ std::vector<std::pair<int, std::string>> readNames(const std::string& labelsPath
     std::vector<Line> lines;
     const auto isNumber = [](const std::string& word) {
       double number = 0;
-      std::istringstream read(word);
-      return static_cast<bool>(read >> number) && read.eof();
+      return parseNumber(word, number) && std::isfinite(number);
     };
     std::string line;
     int number = 0;
@@ -291,7 +262,8 @@ std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec, c
   // own is the atlas's structure as the atlas draws it (a click inside picks
   // its piece).
   if (values.size() < 2) return values;
-  const std::vector<long long> sizes = pieceSizes(selectLabels(atlas.labels, values));
+  const Mask selected = selectLabels(atlas.labels, values);
+  const std::vector<long long> sizes = pieceSizes(selected.voxels, selected.geometry);
   long long total = 0;
   for (long long size : sizes) total += size;
   if (sizes.size() > 1 && static_cast<double>(sizes[1]) >= kSeparatePiece * static_cast<double>(total)) {

@@ -22,6 +22,7 @@
 #include "ItkHeader.h"
 #include "ItkImages.h"
 #include "dynsub/Error.h"
+#include "dynsub/TextFields.h"
 
 namespace dynsub::itkbridge {
 namespace {
@@ -40,11 +41,16 @@ class WarningsOff {
   bool was_;
 };
 
-// GDCM's own messages held for a scope: what they say (a slice position
-// that is not unique) the checks here report as errors, naming the files.
+// GDCM's warnings and errors held for a scope instead of printed: to read
+// (a slice cut short: "Incomplete Pixel Data"), or to drop where the checks
+// here report what they say (a slice position that is not unique) as errors
+// naming the files. `warningsOn`: GDCM's warnings, which ITK turns off, are on
+// for the scope.
 class GdcmMessagesHeld {
  public:
-  GdcmMessagesHeld() : warnings_(gdcm::Trace::GetWarningFlag()), errors_(gdcm::Trace::GetErrorFlag()) {
+  explicit GdcmMessagesHeld(bool warningsOn = false)
+      : warnings_(gdcm::Trace::GetWarningFlag()), errors_(gdcm::Trace::GetErrorFlag()) {
+    if (warningsOn) gdcm::Trace::WarningOn();
     gdcm::Trace::SetWarningStream(held_);
     gdcm::Trace::SetErrorStream(held_);
   }
@@ -56,6 +62,7 @@ class GdcmMessagesHeld {
   }
   GdcmMessagesHeld(const GdcmMessagesHeld&) = delete;
   GdcmMessagesHeld& operator=(const GdcmMessagesHeld&) = delete;
+  std::string text() const { return held_.str(); }
 
  private:
   std::ostringstream held_;
@@ -66,15 +73,10 @@ class GdcmMessagesHeld {
 // holds none or something else.
 std::vector<double> dicomNumbers(const char* text) {
   std::vector<double> numbers;
-  if (!text) return numbers;
-  std::string item;
-  std::istringstream in(text);
-  while (std::getline(in, item, '\\')) {
-    std::istringstream value(item);
+  if (!text || !*text) return numbers;
+  for (const std::string& item : splitItems(text, '\\')) {
     double number = 0;
-    if (!(value >> number) || !std::isfinite(number)) return {};
-    value >> std::ws;
-    if (!value.eof()) return {};
+    if (!parseNumber(trimmed(item), number) || !std::isfinite(number)) return {};
     numbers.push_back(number);
   }
   return numbers;
@@ -161,17 +163,10 @@ void requireWholeSeries(const std::vector<std::string>& files, const std::vector
     const auto known = std::find_if(dicomFiles.begin(), dicomFiles.end(),
                                     [&](const DicomFile& d) { return d.canonical == inSeries.back(); });
     if (known != dicomFiles.end() && known->walked) continue;
-    // ITK turns GDCM's warnings off; they are on, and caught, while checking.
-    const bool warningsWereOn = gdcm::Trace::GetWarningFlag();
-    std::ostringstream warnings;
-    gdcm::Trace::WarningOn();
-    gdcm::Trace::SetWarningStream(warnings);
+    const GdcmMessagesHeld held(true);
     gdcm::Reader reader;
     reader.SetFileName(file.c_str());
-    const bool read = reader.Read();
-    gdcm::Trace::SetWarningStream(std::cerr);
-    gdcm::Trace::SetWarning(warningsWereOn);
-    if (!read || warnings.str().find("Incomplete Pixel Data") != std::string::npos)
+    if (!reader.Read() || held.text().find("Incomplete Pixel Data") != std::string::npos)
       throw Error(file, "a DICOM file of the series is truncated or corrupt");
   }
   for (const DicomFile& d : dicomFiles) {

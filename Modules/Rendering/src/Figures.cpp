@@ -145,16 +145,6 @@ void requireSurface(const FigureScene& scene) {
   if (!scene.surface || scene.surface->GetNumberOfPoints() == 0) throw Error("the figure has no surface to show");
 }
 
-MatrixX3 surfacePoints(vtkPolyData* surface) {
-  MatrixX3 p(surface->GetNumberOfPoints(), 3);
-  for (vtkIdType i = 0; i < surface->GetNumberOfPoints(); ++i) {
-    double x[3];
-    surface->GetPoint(i, x);
-    p.row(i) << x[0], x[1], x[2];
-  }
-  return p;
-}
-
 }  // namespace
 
 std::string coordinatesName(FigureCoordinates coordinates) {
@@ -175,15 +165,18 @@ namespace {
 // are the caller's to have removed).
 void drawSlices(const FigureScene& scene, vtkRenderWindow* window) {
   requireSurface(scene);
-  const MatrixX3 points = surfacePoints(scene.surface);
+  const MatrixX3 points = pointsOf(scene.surface);
   const Vector3 low = points.colwise().minCoeff().transpose(), high = points.colwise().maxCoeff().transpose();
   const Vector3 centre = 0.5 * (low + high);
   const ImageSlices* image = scene.image;
-  if (image) {
-    const Vector3 index = image->geometry().toIndex(centre);
-    for (int a = 0; a < 3; ++a)
-      if (index[a] < -0.5 || index[a] > image->geometry().size[a] - 0.5)
-        throw Error("the surface lies outside the image: nothing to show on its slices");
+  // The slices are cut through the middle of the surface's box: another
+  // image's surface, or one in other coordinates, has no slice there.
+  if (image && !image->geometry().covers(centre)) {
+    const std::string what =
+        "the surface lies outside the image" + (scene.imageName.empty() ? "" : " " + scene.imageName) +
+        " (the middle of its box is outside): nothing to show on its slices; is it another image's surface?";
+    if (scene.surfaceName.empty()) throw Error(what);
+    throw Error(scene.surfaceName, what);
   }
   const double diagonal = (high - low).norm();
   // The grey window of the structure's neighbourhood, shared by all slices.
@@ -561,6 +554,8 @@ void writeFigures(const FigureInputs& inputs, const FigureFiles& files) {
                   "its field array " + farName(kScanDistanceScalars) + " is not one positive number of mm");
     scene.distances = scanDistanceColours(far->GetTuple1(0));
   }
+  scene.surfaceName = inputs.surfaceFile;
+  scene.imageName = inputs.imageFile;
   scene.landmarks = inputs.landmarks;
   scene.dataPoints = inputs.dataPoints;
   scene.outliers = inputs.outliers;

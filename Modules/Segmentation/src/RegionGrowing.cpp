@@ -9,10 +9,14 @@
 
 namespace dynsub {
 
-std::vector<std::uint8_t> connectedTo(const std::vector<std::uint8_t>& allowed, const ImageGeometry& g,
-                                      std::vector<long long> starts) {
-  std::vector<std::uint8_t> reached(allowed.size(), 0);
-  for (long long start : starts) reached[start] = 1;
+namespace {
+
+// Marks in `reached` the voxels of `allowed` 6-connected to `starts` (marked
+// already) that it has not marked; returns how many it marked, the starts
+// included.
+long long flood(const std::vector<std::uint8_t>& allowed, const ImageGeometry& g, std::vector<long long> starts,
+                std::vector<std::uint8_t>& reached) {
+  long long marked = static_cast<long long>(starts.size());
   std::vector<long long> stack = std::move(starts);
   const long long sx = 1, sy = g.size[0], sz = static_cast<long long>(g.size[0]) * g.size[1];
   while (!stack.empty()) {
@@ -26,10 +30,33 @@ std::vector<std::uint8_t> connectedTo(const std::vector<std::uint8_t>& allowed, 
     for (const auto& [inside, n] : neighbours)
       if (inside && allowed[n] && !reached[n]) {
         reached[n] = 1;
+        ++marked;
         stack.push_back(n);
       }
   }
+  return marked;
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> connectedTo(const std::vector<std::uint8_t>& allowed, const ImageGeometry& g,
+                                      std::vector<long long> starts) {
+  std::vector<std::uint8_t> reached(allowed.size(), 0);
+  for (long long start : starts) reached[start] = 1;
+  flood(allowed, g, std::move(starts), reached);
   return reached;
+}
+
+std::vector<long long> pieceSizes(const std::vector<std::uint8_t>& region, const ImageGeometry& grid) {
+  std::vector<std::uint8_t> reached(region.size(), 0);
+  std::vector<long long> sizes;
+  for (std::size_t v = 0; v < region.size(); ++v) {
+    if (!region[v] || reached[v]) continue;
+    reached[v] = 1;
+    sizes.push_back(flood(region, grid, {static_cast<long long>(v)}, reached));
+  }
+  std::sort(sizes.rbegin(), sizes.rend());
+  return sizes;
 }
 
 namespace {

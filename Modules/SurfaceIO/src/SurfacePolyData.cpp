@@ -250,8 +250,7 @@ vtkSmartPointer<vtkPolyData> readSurfacePolyData(const std::string& path) {
   return polyData;
 }
 
-MatrixX3 readSurfacePoints(const std::string& path) {
-  const vtkSmartPointer<vtkPolyData> polyData = readSurfacePolyData(path);
+MatrixX3 pointsOf(vtkPolyData* polyData) {
   MatrixX3 points(polyData->GetNumberOfPoints(), 3);
   for (vtkIdType i = 0; i < polyData->GetNumberOfPoints(); ++i) {
     double p[3];
@@ -260,5 +259,7 @@ MatrixX3 readSurfacePoints(const std::string& path) {
   }
   return points;
 }
+
+MatrixX3 readSurfacePoints(const std::string& path) { return pointsOf(readSurfacePolyData(path)); }
 
 }  // namespace dynsub

@@ -46,6 +46,7 @@ struct FigureInputs {
   const TriangleSurface* surface = nullptr;
   std::string surfaceFile;                   // any file SurfacePolyData.h reads
   const Volume* image = nullptr;             // optional
+  std::string imageFile;                     // the image's file, for messages (optional)
   const ControlMesh* controlMesh = nullptr;  // optional wireframe, 3D figure only
   MatrixX3 landmarks;                        // #landmarks x 3, LPS mm
   MatrixX3 dataPoints;                       // range data, mm

@@ -49,6 +49,7 @@ struct FigureScene {
   // type.
   std::optional<DistanceColours> distances;
   FigureCoordinates coordinates = FigureCoordinates::Lps;  // the ones the slice captions print
+  std::string surfaceName, imageName;  // their files, for messages (empty: none)
 };
 
 // Throws dynsub::Error when the scene has no surface, or (slices) when the

@@ -13,6 +13,9 @@ namespace dynsub {
 std::vector<std::uint8_t> connectedTo(const std::vector<std::uint8_t>& allowed, const ImageGeometry& grid,
                                       std::vector<long long> starts);
 
+// The sizes (voxels) of `region`'s 6-connected pieces, largest first.
+std::vector<long long> pieceSizes(const std::vector<std::uint8_t>& region, const ImageGeometry& grid);
+
 // Each voxel of `grown`'s distance (mm, exact Euclidean) to the nearest voxel
 // outside it; computed once, it serves the cores of every opening.
 std::vector<float> depthInside(const std::vector<std::uint8_t>& grown, const ImageGeometry& grid);

@@ -31,6 +31,9 @@ void addFarDistance(vtkPolyData* polyData, const std::string& name, double far);
 // triangles, or has non-finite coordinates.
 vtkSmartPointer<vtkPolyData> readSurfacePolyData(const std::string& path);
 
+// The points of `polyData`, mm.
+MatrixX3 pointsOf(vtkPolyData* polyData);
+
 // The points of readSurfacePolyData's surface.
 MatrixX3 readSurfacePoints(const std::string& path);
 
