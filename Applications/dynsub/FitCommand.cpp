@@ -238,6 +238,7 @@ void runFit(FitCommandOptions o) {
 
   Report report;
   report.set("input", o.points);
+  report.set("input_turned_from_ras", input.space == "RAS");
   report.set("points", data.rows());
   report.set("max_error_percent", result.error.maxPercent);
   report.set("rms_error_percent", result.error.rmsPercent);
@@ -345,6 +346,9 @@ void runFit(FitCommandOptions o) {
               << 100.0 * noise.scatter / diameter << " % with " << kNoiseNeighbours
               << ": it is the shape's detail at this sampling, not noise, and the scan was fitted as clean data\n";
   }
+  if (input.space == "RAS")
+    std::cout << o.points << " is marked SPACE=RAS (3D Slicer's mark): its x and y were negated to LPS, "
+                 "the coordinates of the outputs\n";
   if (exactVertices) {
     std::cout << "the points are a mesh's vertices, taken as exact: no noise and no outliers (--noise measure "
                  "measures their scatter)\n";

@@ -26,6 +26,7 @@
 #include "dynsub/MeshIO.h"
 #include "dynsub/TextFields.h"
 #include "dynsub/VtkErrors.h"
+#include "SlicerSpace.h"
 
 namespace dynsub {
 
@@ -206,6 +207,7 @@ PointCloud readVtp(const std::string& path) {
     data->GetPoint(i, p);
     result.points.row(i) << p[0], p[1], p[2];
   }
+  result.space = fieldSpace(data);
   result.meshVertices = data->GetNumberOfPolys() > 0 || data->GetNumberOfStrips() > 0;
   // Triangle strips are not unpacked into faces (the points are read all
   // the same); a file with strips gets no genus (closedMeshGenus).
@@ -225,13 +227,11 @@ PointCloud readVtp(const std::string& path) {
   return result;
 }
 
-}  // namespace
-
-PointCloud readPointCloud(const std::string& path) {
-  if (!std::filesystem::exists(path)) throw Error(path, "no such file");
+// The cloud as read, before a turn from RAS.
+PointCloud readAsWritten(const std::string& path) {
   const std::string extension = lowerCaseExtension(path);
-  if (extension == ".xyz" || extension == ".txt" || extension == ".pwn") return {readText(path, false), false, {}};
-  if (extension == ".csv") return {readText(path, true), false, {}};
+  if (extension == ".xyz" || extension == ".txt" || extension == ".pwn") return {readText(path, false), false, {}, ""};
+  if (extension == ".csv") return {readText(path, true), false, {}, ""};
   if (extension == ".vtp") return readVtp(path);
   if (extension == ".ply" || extension == ".off" || extension == ".obj") {
     PolygonData data = readPolygonData(path);
@@ -244,10 +244,22 @@ PointCloud readPointCloud(const std::string& path) {
       }
     }
     const bool faces = !data.faces.empty();
-    return {std::move(data.points), faces, std::move(data.faces)};
+    return {std::move(data.points), faces, std::move(data.faces), commentSpace(path)};
   }
   throw Error(path, "unknown point-cloud format '" + extension +
                         "' (expected .xyz, .txt, .pwn, .csv, .ply, .off, .obj or .vtp)");
+}
+
+}  // namespace
+
+PointCloud readPointCloud(const std::string& path) {
+  if (!std::filesystem::exists(path)) throw Error(path, "no such file");
+  PointCloud cloud = readAsWritten(path);
+  if (cloud.space == "RAS") {
+    cloud.points.col(0) = -cloud.points.col(0);
+    cloud.points.col(1) = -cloud.points.col(1);
+  }
+  return cloud;
 }
 
 int closedMeshGenus(const PointCloud& cloud, const std::string& source) {

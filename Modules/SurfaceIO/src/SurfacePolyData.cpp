@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 
 #include <vtkCellArray.h>
 #include <vtkCellArrayIterator.h>
@@ -18,7 +17,6 @@
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
-#include <vtkStringArray.h>
 #include <vtkUnsignedCharArray.h>
 #include <vtkXMLPolyDataReader.h>
 
@@ -26,6 +24,7 @@
 #include "dynsub/FileNames.h"
 #include "dynsub/MeshIO.h"
 #include "dynsub/VtkErrors.h"
+#include "SlicerSpace.h"
 
 namespace dynsub {
 
@@ -118,34 +117,6 @@ vtkSmartPointer<vtkPolyData> readWith(vtkAlgorithm* reader, const std::string& p
   return polyData;
 }
 
-// The coordinate system a text states as 3D Slicer marks it in a surface
-// file's header or comments, "SPACE=RAS" or "SPACE=LPS" (a word of its own:
-// not COLORSPACE=...): "RAS", "LPS", or empty for none. Slicer reads any
-// other value as no mark.
-std::string statedSpace(const std::string& text) {
-  for (std::size_t at = text.find("SPACE="); at != std::string::npos; at = text.find("SPACE=", at + 1)) {
-    if (at > 0 && (std::isalnum(static_cast<unsigned char>(text[at - 1])) || text[at - 1] == '_')) continue;
-    const std::string space = text.substr(at + 6, 3);
-    const std::size_t end = at + 9;
-    const bool whole = end >= text.size() || !std::isalnum(static_cast<unsigned char>(text[end]));
-    if ((space == "RAS" || space == "LPS") && whole) return space;
-  }
-  return "";
-}
-
-// The comment lines an OBJ file begins with, joined.
-std::string objComments(const std::string& path) {
-  std::ifstream in(path);
-  std::string comments, line;
-  while (std::getline(in, line)) {
-    const std::size_t start = line.find_first_not_of(" \t\r");
-    if (start == std::string::npos) continue;
-    if (line[start] != '#') break;
-    comments += line + "\n";
-  }
-  return comments;
-}
-
 // x and y negated in a 3-vector array.
 void halfTurn(vtkDataArray* array) {
   if (!array || array->GetNumberOfComponents() != 3) return;
@@ -177,18 +148,13 @@ vtkSmartPointer<vtkPolyData> readSurfacePolyData(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw Error(path, "no such file");
   const std::string extension = lowerCaseExtension(path);
   vtkSmartPointer<vtkPolyData> polyData;
-  // 3D Slicer marks the coordinate system of the surfaces it writes, as
-  // "SPACE=RAS" or "SPACE=LPS": in the header of a .vtk or .stl file, a
-  // comment of a .ply or .obj file, a field array SPACE of a .vtp file. Such
-  // a file in RAS is turned into LPS; without a mark a file is LPS, as Slicer
-  // reads it.
+  // A file 3D Slicer marked as RAS is turned into LPS (SlicerSpace.h).
   std::string space;
   if (extension == ".vtp") {
     vtkNew<vtkXMLPolyDataReader> reader;
     reader->SetFileName(path.c_str());
     polyData = readWith(reader.GetPointer(), path);
-    if (auto* array = vtkStringArray::SafeDownCast(polyData->GetFieldData()->GetAbstractArray("SPACE")))
-      if (array->GetNumberOfValues() > 0) space = statedSpace("SPACE=" + array->GetValue(0));
+    space = fieldSpace(polyData);
   } else if (extension == ".vtk") {
     vtkNew<vtkPolyDataReader> reader;
     reader->SetFileName(path.c_str());
@@ -198,13 +164,12 @@ vtkSmartPointer<vtkPolyData> readSurfacePolyData(const std::string& path) {
     // DynSub's own OBJ reader: VTK's reads "v nan 1 0" as the origin without
     // a word, where this one names the line.
     polyData = toPolyData(readPolygonData(path));
-    space = statedSpace(objComments(path));
+    space = commentSpace(path);
   } else if (extension == ".ply") {
     vtkNew<vtkPLYReader> reader;
     reader->SetFileName(path.c_str());
     polyData = readWith(reader.GetPointer(), path);
-    for (vtkIdType c = 0; reader->GetComments() && c < reader->GetComments()->GetNumberOfValues() && space.empty(); ++c)
-      space = statedSpace(reader->GetComments()->GetValue(c));
+    space = commentSpace(path);
   } else if (extension == ".stl") {
     vtkNew<vtkSTLReader> reader;
     reader->SetFileName(path.c_str());

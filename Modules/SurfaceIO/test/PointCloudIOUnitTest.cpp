@@ -49,6 +49,44 @@ TEST(PointCloudIO, SurfaceFilesAreMeshVertices) {
   }
 }
 
+// A .ply, .obj or .vtp that 3D Slicer marked "SPACE=RAS" (a comment, the
+// field array SPACE) is read into LPS, x and y negated, and says so; a file
+// marked LPS, or not at all, is read as written. The PLY is DynSub's binary
+// one with the comment put in its header.
+TEST(PointCloudIO, SlicersRasFilesAreReadIntoLps) {
+  const dynsub::ControlMesh cube = dynsub::makeCube98();
+  const dynsub::TriangleSurface surface = dynsub::tessellate(dynsub::LimitSurface(cube), cube.points(), 1);
+  const auto expectPoints = [&](const std::string& path, const std::string& space, double sign) {
+    SCOPED_TRACE(path);
+    const dynsub::PointCloud cloud = dynsub::readPointCloud(path);
+    EXPECT_EQ(cloud.space, space);
+    ASSERT_EQ(cloud.points.rows(), surface.points.rows());
+    // PLY holds floats: 1e-6 mm is float's rounding on this unit cube.
+    for (Eigen::Index i = 0; i < cloud.points.rows(); ++i)
+      ASSERT_LT((cloud.points.row(i) - surface.points.row(i).cwiseProduct(Eigen::RowVector3d(sign, sign, 1))).norm(),
+                1e-6);
+  };
+  const auto marked = [&](const std::string& extension, const std::string& after, const std::string& mark) {
+    const std::string plain = scratch("plain" + extension);
+    dynsub::writeTriangleSurface(surface, plain);
+    std::ifstream in(plain, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::size_t at = after.empty() ? 0 : bytes.find(after) + after.size();
+    bytes.insert(at, mark);
+    const std::string path = scratch("marked" + extension);
+    std::ofstream(path, std::ios::binary) << bytes;
+    return path;
+  };
+  expectPoints(marked(".ply", "\n", "comment 3D Slicer SPACE=RAS\n"), "RAS", -1);
+  expectPoints(marked(".ply", "\n", "comment SPACE=LPS\n"), "LPS", 1);
+  expectPoints(marked(".obj", "", "# SPACE=RAS\n"), "RAS", -1);
+  expectPoints(scratch("plain.obj"), "", 1);
+  dynsub::writeTriangleSurface(surface, scratch("ras.vtp"), {}, "RAS");
+  expectPoints(scratch("ras.vtp"), "RAS", -1);
+  dynsub::writeTriangleSurface(surface, scratch("plain.vtp"));
+  expectPoints(scratch("plain.vtp"), "", 1);
+}
+
 // A .vtp cut short: one error that names the file and VTK's reason, and
 // nothing of VTK's own log on stderr (its XML parser's line, an executive's
 // dump).

@@ -7,6 +7,8 @@
 //               header line of names is skipped
 //   .ply .off .obj  the vertices
 //   .vtp        the points of VTK XML polydata
+// In LPS: a .ply, .obj or .vtp file 3D Slicer marked "SPACE=RAS" has its x
+// and y negated (SurfacePolyData.h reads surfaces so too).
 #include <string>
 #include <vector>
 
@@ -22,6 +24,9 @@ struct PointCloud {
   // Its polygons, vertex indices from 0 (.off, .obj, .ply, and a .vtp's
   // polys); empty for a cloud.
   std::vector<std::vector<int>> faces;
+  // The coordinate system the file states as 3D Slicer marks it ("RAS",
+  // "LPS", empty for none); the points are LPS whatever it says.
+  std::string space;
 };
 
 // Throws dynsub::Error naming the file (and line) for a missing, empty,
