@@ -8,7 +8,10 @@
 # thalamus's caudate, the hippocampus's amygdala). Prints, per run, the Dice
 # against the subject's own label, how far the click moved the atlas's
 # structure (report.json's trust.inside_shift_mm) and the trust flags.
-# Usage: [SEEDS="101 102"] [DYNSUB=BINARY] Tools/wrong_inside_clicks.sh [WORKDIR]
+# SETTINGS are the generator's (`dynsub subject --set`, one per word; the
+# thick-slice test subjects: SEEDS="301 302 303 304" SETTINGS="snr=20,30
+# thick_fraction=1").
+# Usage: [SEEDS="101 102"] [SETTINGS=...] [DYNSUB=BINARY] Tools/wrong_inside_clicks.sh [WORKDIR]
 # (from the repository; build first; needs python3-nibabel and python3-scipy)
 set -eu
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -16,11 +19,13 @@ dynsub=${DYNSUB:-$root/build/bin/dynsub}
 templates=/usr/share/mricron/templates
 work=${1:-$(mktemp -d)}
 mkdir -p "$work"
+sets=()
+for setting in ${SETTINGS:-snr=20,30}; do sets+=(--set "$setting"); done
 negate() { awk -v v="$1" 'BEGIN { print -v }'; }
 for seed in ${SEEDS:-101 102 103 104}; do
   subject=$work/s$seed
   [ -f "$subject/image.nii.gz" ] ||
-    "$dynsub" subject "$templates/ch2.nii.gz" "$templates/aal.nii.gz" --seed "$seed" --set snr=20,30 \
+    "$dynsub" subject "$templates/ch2.nii.gz" "$templates/aal.nii.gz" --seed "$seed" "${sets[@]}" \
       --out "$subject" >/dev/null
   for pair in "71 73 Caudate_L" "73 75 Putamen_L" "77 71 Thalamus_L" "37 41 Hippocampus_L"; do
     set -- $pair
@@ -48,13 +53,28 @@ PY
       esac
       out=$work/run_${seed}_$3_$kind
       if "$dynsub" segment "$subject/image.nii.gz" --init atlas --atlas-label "$3" --inside="$click" \
-        --reference "$subject/labels.nii.gz" --reference-label "$1" --no-figures --out "$out" >"$out.log" 2>&1; then
-        /usr/bin/python3 -c "
+        --no-figures --out "$out" >"$out.log" 2>&1; then
+        # Dice on the image's grid, the label read at each voxel's centre (the
+        # labels are on the fine grid, the image may have thick slices).
+        /usr/bin/python3 - "$out" "$subject/labels.nii.gz" "$1" "s$seed $3 $kind" <<'PY'
 import json
-report = json.load(open('$out/report.json'))
-trust = report['trust']
-print('s$seed $3 $kind: Dice %.3f, moved %.1f mm, flags %s' % (report['dice'], trust.get('inside_shift_mm', 0),
-      ','.join(f['name'] for f in trust.get('flags', [])) or '-'))"
+import sys
+import nibabel
+import numpy
+from scipy import ndimage
+out, labels_path, value, name = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4]
+result = nibabel.load(out + "/labelmap.nii.gz")
+labels = nibabel.load(labels_path)
+inside = numpy.asarray(result.dataobj) > 0
+to_fine = numpy.linalg.inv(labels.affine) @ result.affine
+grid = numpy.indices(inside.shape).reshape(3, -1)
+at = to_fine[:3, :3] @ grid + to_fine[:3, 3:]
+truth = ndimage.map_coordinates(numpy.asarray(labels.dataobj), at, order=0).reshape(inside.shape) == value
+dice = 2 * (inside & truth).sum() / (inside.sum() + truth.sum())
+trust = json.load(open(out + "/report.json"))["trust"]
+print("%s: Dice %.3f, moved %.1f mm, flags %s" % (name, dice, trust.get("inside_shift_mm", 0),
+      ",".join(f["name"] for f in trust.get("flags", [])) or "-"))
+PY
       else
         echo "s$seed $3 $kind: failed: $(tail -1 "$out.log")"
       fi
