@@ -224,6 +224,9 @@ void runSegmentOne(const Arguments& o, const LandmarkSource* landmarks) {
     inputs.reference = [reference]() -> const Mask& { return reference.get(); };
     inputs.referencePath = o.reference;
     inputs.referenceLabels = referenceLabels;
+    // An atlas start registers for seconds first: a reference that cannot
+    // score the result (another grid, no such label) is refused before that.
+    if (inputs.start.kind == SegmentStart::Kind::Atlas) reference.get();
   }
   prepareOutputDirectory(dir);
   o.figures.prepare();

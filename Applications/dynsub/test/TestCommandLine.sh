@@ -971,6 +971,13 @@ expect_error "segment --init atlas: the two caudates as one structure" 2 \
   "$DYNSUB" segment "$work/subject/image.nii.gz" --init atlas --atlas-label Caudate_L,Caudate_R --out "$work/s43b"
 expect_error "segment --init atlas: a part of a name" 1 "did you mean 'Caudate_L' or 'Caudate_R'" "$work/s43c" \
   "$DYNSUB" segment "$work/subject/image.nii.gz" --init atlas --atlas-label Caudate --out "$work/s43c"
+# A reference that cannot score the result is refused before the
+# registration: before even the click past the image, which segmentImage
+# refuses first thing.
+expect_error "segment --init atlas: a reference label the reference lacks" 1 \
+  "labels.nii.gz: no voxel has the reference label(s) 9999" "$work/s43d" \
+  "$DYNSUB" segment "$work/subject/image.nii.gz" --init atlas --atlas-label Putamen_L --inside=1000,0,0 \
+  --reference "$work/subject/labels.nii.gz" --reference-label 9999 --out "$work/s43d"
 # Refused before the registration, naming the point and the image.
 expect_error "segment --init atlas: a click inside past the image" 1 \
   "image.nii.gz: the click inside the structure (--inside 500,0,0, LPS mm) lies outside the image" "$work/s43d" \
