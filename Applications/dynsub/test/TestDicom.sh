@@ -94,8 +94,11 @@ dcmodify -nb -m "(0008,0018)=1.2.826.0.1.3680043.10.1347.99" "$work/twice/slice_
 rejects "two slices at one position" "two slices of the DICOM series lie at one position" twice
 check "two slices at one position: GDCM's own notice is not printed" \
   bash -c "! grep -q 'not unique' '$work/stderr'"
-# One file of the series: read (by GDCM) and refused as the 2D image it is.
-expect_error "one slice file" "slice_007.dcm: not a 3D image (1 voxel(s) along axis 2)" "$work/out_one" \
+# One file of the series: read (by GDCM) and refused as the 2D image it is,
+# naming the series' folder to give instead.
+expect_error "one slice file" \
+  "slice_007.dcm: not a 3D image (1 voxel(s) along axis 2): a DICOM file holds one slice of its series; give the series' folder ($work/phantom/series)" \
+  "$work/out_one" \
   "$DYNSUB" segment "$work/phantom/series/slice_007.dcm" --landmarks "$work/phantom/ball.csv" --out "$work/out_one"
 # One file cut short is walked before GDCM sees it, as a series's files are.
 expect_error "one file cut short in its header" "slice_007.dcm: a truncated DICOM file" "$work/out_cut" \

@@ -31,7 +31,9 @@ Volume readVolume(const std::string& path) {
   std::error_code ignored;
   Volume volume;
   itkbridge::Geometry raw;
-  if (std::filesystem::is_directory(path, ignored) || (!filechecks::isNiftiName(path) && filechecks::isDicomFile(path))) {
+  const bool directory = std::filesystem::is_directory(path, ignored);
+  const bool dicomFile = !directory && !filechecks::isNiftiName(path) && filechecks::isDicomFile(path);
+  if (directory || dicomFile) {
     itkbridge::readDicom(path, raw, volume.voxels);
   } else {
     // The header's checks guard the reader's allocation. The data's (a
@@ -49,9 +51,15 @@ Volume readVolume(const std::string& path) {
   }
   volume.geometry = fromBridge(raw);
   for (int a = 0; a < 3; ++a)
-    if (volume.geometry.size[a] < 2)
+    if (volume.geometry.size[a] < 2) {
+      // A DICOM series stores one slice a file: the series is its folder.
+      const std::string folder = std::filesystem::absolute(path).parent_path().string();
       throw Error(path, "not a 3D image (" + std::to_string(volume.geometry.size[a]) + " voxel(s) along axis " +
-                            std::to_string(a) + ")");
+                            std::to_string(a) + ")" +
+                            (dicomFile ? ": a DICOM file holds one slice of its series; give the series' folder (" +
+                                             folder + ")"
+                                       : ""));
+    }
   const ImageGeometry& g = volume.geometry;
   if (!g.origin.allFinite()) throw Error(path, "the origin is not finite");
   // Options, tolerances and reports are in mm, chosen for voxels of tenths of
