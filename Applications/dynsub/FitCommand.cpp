@@ -347,8 +347,9 @@ void runFit(FitCommandOptions o) {
               << ": it is the shape's detail at this sampling, not noise, and the scan was fitted as clean data\n";
   }
   if (input.space == "RAS")
-    std::cout << o.points << " is marked SPACE=RAS (3D Slicer's mark): its x and y were negated to LPS, "
-                 "the coordinates of the outputs\n";
+    std::cout << o.points
+              << " is marked SPACE=RAS (3D Slicer's mark): its x and y were negated to LPS, the coordinates of "
+                 "the outputs\n";
   if (exactVertices) {
     std::cout << "the points are a mesh's vertices, taken as exact: no noise and no outliers (--noise measure "
                  "measures their scatter)\n";

@@ -34,8 +34,8 @@ std::string commentSpace(const std::string& path) {
     if (start == std::string::npos) continue;
     if (extension == ".obj" && line[start] != '#') break;
     if (extension == ".ply" && line.compare(start, 10, "end_header") == 0) break;
-    const bool comment = extension == ".obj" || line.compare(start, 8, "comment ") == 0 ||
-                         line.compare(start, 9, "obj_info ") == 0;
+    const bool comment =
+        extension == ".obj" || line.compare(start, 8, "comment ") == 0 || line.compare(start, 9, "obj_info ") == 0;
     if (comment)
       if (const std::string space = statedSpace(line); !space.empty()) return space;
   }
