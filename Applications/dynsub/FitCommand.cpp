@@ -151,7 +151,8 @@ void runFit(FitCommandOptions o) {
     message << "--noise " << o.noise << ": more than the whole scan, " << extent << " mm across its bounding box";
     throw UsageError(o.points, message.str());
   }
-  const MatrixX3 reference = o.reference.empty() ? MatrixX3() : readPointCloud(o.reference).points;
+  const PointCloud referenceCloud = o.reference.empty() ? PointCloud() : readPointCloud(o.reference);
+  const MatrixX3& reference = referenceCloud.points;
   if (!o.reference.empty()) checkPointCloud(reference, o.reference);
   // A mesh's vertices are where its maker put the surface: their scatter
   // about their neighbours' quadric is the mesh's own detail, which the fit
@@ -188,6 +189,14 @@ void runFit(FitCommandOptions o) {
                        std::to_string(initial.genus()) + ": " + why + " (give " + builtIn +
                        "a closed control mesh of genus " + g + " with --init MESH)");
   }
+  // Files of one scene that disagree on the mark end mirrored against each
+  // other: the fit's error against the reference would measure the mirror.
+  if (!o.reference.empty() && (input.space == "RAS") != (referenceCloud.space == "RAS"))
+    warnings.push_back((input.space == "RAS" ? o.points : o.reference) +
+                       " is marked SPACE=RAS and was turned to LPS, " +
+                       (input.space == "RAS" ? o.reference : o.points) +
+                       " is not: if both are in RAS, the reference's errors measure a mirror image (mark both, or "
+                       "neither)");
   prepareOutputDirectory(dir);
   o.fit.simulation = o.simulation.apply(o.fit.simulation);
   o.figures.prepare();
@@ -270,6 +279,7 @@ void runFit(FitCommandOptions o) {
     const FitError e = measureFitError(*result.surface, result.mesh.points(), reference, diameter);
     Report against;
     against.set("points", o.reference);
+    against.set("turned_from_ras", referenceCloud.space == "RAS");
     against.set("max_error_percent", e.maxPercent);
     against.set("rms_error_percent", e.rmsPercent);
     report.set("reference", against);
@@ -346,10 +356,11 @@ void runFit(FitCommandOptions o) {
               << 100.0 * noise.scatter / diameter << " % with " << kNoiseNeighbours
               << ": it is the shape's detail at this sampling, not noise, and the scan was fitted as clean data\n";
   }
-  if (input.space == "RAS")
-    std::cout << o.points
-              << " is marked SPACE=RAS (3D Slicer's mark): its x and y were negated to LPS, the coordinates of "
-                 "the outputs\n";
+  for (const auto& [path, cloud] : {std::pair{&o.points, &input}, std::pair{&o.reference, &referenceCloud}})
+    if (cloud->space == "RAS")
+      std::cout << *path
+                << " is marked SPACE=RAS (3D Slicer's mark): its x and y were negated to LPS, the coordinates of "
+                   "the outputs\n";
   if (exactVertices) {
     std::cout << "the points are a mesh's vertices, taken as exact: no noise and no outliers (--noise measure "
                  "measures their scatter)\n";

@@ -185,27 +185,11 @@ void runSegmentOne(const Arguments& o, const LandmarkSource* landmarks) {
   const std::filesystem::path dir(o.out);
   requireInputsOutsideRun(dir, {o.image, landmarks ? landmarks->path : "", o.reference, o.atlas, o.atlasLabels});
   const Volume image = readVolume(o.image);
-  if (landmarks) {
-    inputs.landmarks = landmarks->list.landmarks;
-    inputs.landmarkSystem = landmarks->list.stated;
-    inputs.landmarkSource = landmarks->path;
-  }
-  inputs.image = o.image;
-  if (!o.inside.empty()) inputs.inside = parsePoint(o.inside.front(), "--inside");
-  if (inputs.start.kind == SegmentStart::Kind::Atlas) {
-    if (o.atlasLabel.empty())
-      throw UsageError("--init atlas needs --atlas-label N[,M...] or a name from the atlas's table (e.g. Caudate_L)");
-    inputs.atlas = std::make_shared<const Atlas>(readAtlas(o.atlas, o.atlasLabels));
-    inputs.atlasLabels = atlasLabelValues(*inputs.atlas, o.atlasLabel.front());
-  } else if (!o.atlasLabel.empty()) {
-    throw UsageError("--atlas-label serves an atlas start: add --init atlas");
-  }
-  checkSegmentInputs(inputs, o.parameters);
   // The reference is needed only to score the result, and reading it
   // (a whole labelmap, inflated and converted) took a fifth of the caudate
-  // demo's command: it is read on a second thread while the segmentation
-  // runs, and its errors (a missing file at once) still come before any
-  // output is written.
+  // demo's command: it is read on a second thread while the atlas is read
+  // and the segmentation runs, and its errors (a missing file at once) still
+  // come before any output is written.
   std::shared_future<Mask> reference;
   // The thread reads `image` and `referenceLabels`: whatever ends this run,
   // an error included, it ends before they are destroyed (`inputs`, declared
@@ -224,10 +208,26 @@ void runSegmentOne(const Arguments& o, const LandmarkSource* landmarks) {
     inputs.reference = [reference]() -> const Mask& { return reference.get(); };
     inputs.referencePath = o.reference;
     inputs.referenceLabels = referenceLabels;
-    // An atlas start registers for seconds first: a reference that cannot
-    // score the result (another grid, no such label) is refused before that.
-    if (inputs.start.kind == SegmentStart::Kind::Atlas) reference.get();
   }
+  if (landmarks) {
+    inputs.landmarks = landmarks->list.landmarks;
+    inputs.landmarkSystem = landmarks->list.stated;
+    inputs.landmarkSource = landmarks->path;
+  }
+  inputs.image = o.image;
+  if (!o.inside.empty()) inputs.inside = parsePoint(o.inside.front(), "--inside");
+  if (inputs.start.kind == SegmentStart::Kind::Atlas) {
+    if (o.atlasLabel.empty())
+      throw UsageError("--init atlas needs --atlas-label N[,M...] or a name from the atlas's table (e.g. Caudate_L)");
+    inputs.atlas = std::make_shared<const Atlas>(readAtlas(o.atlas, o.atlasLabels));
+    inputs.atlasLabels = atlasLabelValues(*inputs.atlas, o.atlasLabel.front());
+  } else if (!o.atlasLabel.empty()) {
+    throw UsageError("--atlas-label serves an atlas start: add --init atlas");
+  }
+  checkSegmentInputs(inputs, o.parameters);
+  // An atlas start registers for seconds first: a reference that cannot
+  // score the result (another grid, no such label) is refused before that.
+  if (reference.valid() && inputs.start.kind == SegmentStart::Kind::Atlas) reference.get();
   prepareOutputDirectory(dir);
   o.figures.prepare();
 

@@ -22,6 +22,20 @@ done
 "$DYNSUB" fit "$work/torus.vtp" --init torus --max-level 0 --max-steps 2 --no-figures --out "$work/fit-vtp" \
   >/dev/null 2>&1
 check "fit reads a .vtp point cloud" test -s "$work/fit-vtp/report.json"
+# A file 3D Slicer marked SPACE=RAS is turned into LPS, and fit says so; a
+# reference left unmarked beside it is warned about.
+"$DYNSUB" limit "$DATA/Meshes/torus.obj" --samples-per-face 4 --out "$work/torus_surface.obj" >/dev/null
+{ echo "# 3D Slicer SPACE=RAS"; cat "$work/torus_surface.obj"; } >"$work/torus_ras.obj"
+"$DYNSUB" fit "$work/torus_ras.obj" --reference "$work/torus_surface.obj" --init torus --max-level 0 --max-steps 2 \
+  --no-figures --out "$work/fit-ras" >"$work/stdout" 2>"$work/stderr"
+check "fit says it turned a RAS file" grep -q "torus_ras.obj is marked SPACE=RAS (3D Slicer's mark)" "$work/stdout"
+check "fit warns of a reference without the mark" grep -q "torus_surface.obj is not: if both are in RAS" \
+  "$work/stderr"
+check "fit reports which files were turned" python3 -c "
+import json
+r = json.load(open('$work/fit-ras/report.json'))
+assert r['input_turned_from_ras'] is True and r['reference']['turned_from_ras'] is False, r
+"
 
 expect_error "missing mesh" 1 "no such file" "$work/a.vtp" "$DYNSUB" limit "$work/none.obj" --out "$work/a.vtp"
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 0 -1 0\nf 1 2 3\nf 2 1 4\nf 1 2 5\n' >"$work/fin.obj"

@@ -10,6 +10,7 @@
 #include "dynsub/ImageIO.h"
 #include "dynsub/Metrics.h"
 #include "dynsub/SegmentImage.h"
+#include "dynsub/SelfIntersection.h"
 #include "dynsub/SubjectGenerator.h"
 
 namespace dynsub {
@@ -191,7 +192,8 @@ TEST(Atlas, InsideClickMovesAMisplacedLabel) {
 // with the subject's own label (0.9 when written; the reference is the
 // atlas's label itself, moved, so this checks the start's machinery, not
 // accuracy on another brain). The affine registration made for the first
-// run serves the second.
+// run serves the second, and a third, the left caudate, whose start must be
+// refitted stiffer so as not to cross itself.
 TEST(Atlas, SegmentsFromTheAtlasEndToEnd) {
   const Atlas& atlas = croppedAtlas();
   const Subject subject = makeSubject(atlas.image, atlas.labels, SubjectSettings{}, 11);
@@ -212,6 +214,16 @@ TEST(Atlas, SegmentsFromTheAtlasEndToEnd) {
   const SegmentOutcome clicked = segmentImage(subject.image, inputs, parameters);
   EXPECT_GE(dice(clicked.labelmap, truth), 0.80);
   EXPECT_EQ(clicked.atlasAffine, alone.atlasAffine);
+
+  // The caudate's C: the start fitted with the default elasticity folds its
+  // concave side through itself; the start refitted stiffer does not, and
+  // neither does the result.
+  inputs.inside.reset();
+  inputs.atlasLabels = atlasLabelValues(atlas, "Caudate_L");
+  const SegmentOutcome caudate = segmentImage(subject.image, inputs, parameters);
+  EXPECT_GT(caudate.atlasStartElasticity, 1.0);
+  EXPECT_EQ(findSelfIntersections(caudate.result.surface).trianglePairs, 0);
+  EXPECT_GE(dice(caudate.labelmap, selectLabels(subject.labels, {71})), 0.80);
 }
 
 // --inside serves the atlas start only; the atlas start needs its labels.

@@ -84,12 +84,8 @@ void setStart(LevelModel& model, const MatrixX3& points) {
 void assembleMatrices(LevelModel& model, double elasticity, const SimulationOptions& options) {
   AssemblyOptions assembly = options.assembly;
   assembly.elementSize = model.elementSize;
-  Material material = options.material;
-  for (double* m : {&material.tensionU, &material.tensionV, &material.rigidityUU, &material.rigidityUV,
-                    &material.rigidityVV}) {
-    *m *= elasticity;
-  }
-  PhysicalMatrices built = assemblePhysicalMatrices(*model.surface, material, assembly);
+  PhysicalMatrices built =
+      assemblePhysicalMatrices(*model.surface, options.material.withElasticity(elasticity), assembly);
   model.matrices.mass.swap(built.mass);
   model.matrices.damping.swap(built.damping);
   model.matrices.stiffness.swap(built.stiffness);

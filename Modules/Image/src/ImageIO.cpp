@@ -52,13 +52,15 @@ Volume readVolume(const std::string& path) {
   volume.geometry = fromBridge(raw);
   for (int a = 0; a < 3; ++a)
     if (volume.geometry.size[a] < 2) {
+      std::string hint;
       // A DICOM series stores one slice a file: the series is its folder.
-      const std::string folder = std::filesystem::absolute(path).parent_path().string();
+      if (dicomFile && a == 2) {
+        const std::filesystem::path absolute = std::filesystem::absolute(path, ignored);
+        hint = ": a DICOM file holds one slice of its series; give the series' folder (" +
+               (absolute.empty() ? std::filesystem::path(path) : absolute).parent_path().string() + ")";
+      }
       throw Error(path, "not a 3D image (" + std::to_string(volume.geometry.size[a]) + " voxel(s) along axis " +
-                            std::to_string(a) + ")" +
-                            (dicomFile ? ": a DICOM file holds one slice of its series; give the series' folder (" +
-                                             folder + ")"
-                                       : ""));
+                            std::to_string(a) + ")" + hint);
     }
   const ImageGeometry& g = volume.geometry;
   if (!g.origin.allFinite()) throw Error(path, "the origin is not finite");

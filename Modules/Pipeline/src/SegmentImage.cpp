@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <iomanip>
+#include <limits>
 #include <sstream>
 
 #include "dynsub/ClosestPoint.h"
@@ -15,6 +16,7 @@
 #include "dynsub/Labelmap.h"
 #include "dynsub/MeshIO.h"
 #include "dynsub/ModelOutputs.h"
+#include "dynsub/SelfIntersection.h"
 #include "dynsub/ShapeRecovery.h"
 #include "dynsub/Trust.h"
 
@@ -132,7 +134,44 @@ Report atlasReport(const SegmentInputs& in, const SegmentOutcome& outcome, bool 
     r.set("inside_shift_mm", carried.shift);
   }
   r.set("prior_points", outcome.prior.size());
+  r.set("start_elasticity_factor", outcome.atlasStartElasticity);
+  r.set("start_crossing_pairs", outcome.atlasStartCrossings);
   return r;
+}
+
+// The initial level's control mesh fitted to the carried label's boundary
+// points; `elasticity` and `crossings` receive the factor on the fit's
+// tension and rigidity it was fitted with, and its triangle pairs that cross.
+// With the fit's weak default elasticity, a thin curved structure (a
+// caudate's C) folds its concave side through itself, and the segmentation
+// keeps the crossing (its labelmap fills the overlap). A start that crosses
+// itself is fitted again with stiffer tension and rigidity until one does
+// not; failing that, the one that crosses least (Documentation/Segmentation.md,
+// "Atlas start").
+ControlMesh fitAtlasStart(const std::vector<Landmark>& boundary, double initialFraction, double& elasticity,
+                          int& crossings) {
+  FitOptions fit;
+  fit.simulation.maxLevel = 0;
+  // The start is the initial level's surface nearest the carried boundary,
+  // not the first one within the fit's tolerance.
+  fit.toEquilibrium = true;
+  const Material material = fit.simulation.material;
+  const MatrixX3 points = landmarkPositions(boundary);
+  const ControlMesh initial = initialFromLandmarks(boundary, initialFraction);
+  ControlMesh best;
+  crossings = std::numeric_limits<int>::max();
+  for (const double factor : {1.0, 10.0, 30.0, 100.0}) {
+    fit.simulation.material = material.withElasticity(factor);
+    ControlMesh mesh = fitPointCloud(points, initial, fit).mesh;
+    const int crossing = findSelfIntersections(outputSurface(mesh)).trianglePairs;
+    if (crossing < crossings) {
+      best = std::move(mesh);
+      elasticity = factor;
+      crossings = crossing;
+    }
+    if (crossing == 0) break;
+  }
+  return best;
 }
 
 // The atlas's start: its structure carried to the image, the prior's points
@@ -152,14 +191,8 @@ ControlMesh atlasStart(const Volume& image, const SegmentInputs& in, const Segme
   const std::vector<Landmark> boundary = carriedBoundary(*outcome.carried, 4 * parameters.priorPoints);
   const std::size_t priorCount = std::min<std::size_t>(boundary.size(), parameters.priorPoints);
   outcome.prior.assign(boundary.begin(), boundary.begin() + static_cast<std::ptrdiff_t>(priorCount));
-  FitOptions fit;
-  fit.simulation.maxLevel = 0;
-  // The start is the initial level's surface nearest the carried boundary,
-  // not the first one within the fit's tolerance.
-  fit.toEquilibrium = true;
   ControlMesh mesh =
-      fitPointCloud(landmarkPositions(boundary), initialFromLandmarks(boundary, parameters.initialFraction), fit)
-          .mesh;
+      fitAtlasStart(boundary, parameters.initialFraction, outcome.atlasStartElasticity, outcome.atlasStartCrossings);
   // A structure the image's side cuts (the cerebellum at the foot of a
   // scan) gives a fitted surface that bulges past the side: it is shrunk
   // about its centre, 5 % at a time, until its limit surface lies inside.

@@ -2,6 +2,7 @@
 
 #include <cctype>
 #include <fstream>
+#include <sstream>
 
 #include <vtkFieldData.h>
 #include <vtkPolyData.h>
@@ -16,7 +17,7 @@ std::string statedSpace(const std::string& text) {
     if (at > 0 && (std::isalnum(static_cast<unsigned char>(text[at - 1])) || text[at - 1] == '_')) continue;
     const std::string space = text.substr(at + 6, 3);
     const std::size_t end = at + 9;
-    const bool whole = end >= text.size() || !std::isalnum(static_cast<unsigned char>(text[end]));
+    const bool whole = end >= text.size() || !(std::isalnum(static_cast<unsigned char>(text[end])) || text[end] == '_');
     if ((space == "RAS" || space == "LPS") && whole) return space;
   }
   return "";
@@ -30,13 +31,11 @@ std::string commentSpace(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::string line;
   for (int number = 0; number < 1000 && std::getline(in, line); ++number) {
-    const std::size_t start = line.find_first_not_of(" \t\r");
-    if (start == std::string::npos) continue;
-    if (extension == ".obj" && line[start] != '#') break;
-    if (extension == ".ply" && line.compare(start, 10, "end_header") == 0) break;
-    const bool comment =
-        extension == ".obj" || line.compare(start, 8, "comment ") == 0 || line.compare(start, 9, "obj_info ") == 0;
-    if (comment)
+    std::string word;
+    if (!(std::istringstream(line) >> word)) continue;
+    if (extension == ".obj" && word[0] != '#') break;
+    if (extension == ".ply" && word == "end_header") break;
+    if (extension == ".obj" || word == "comment" || word == "obj_info")
       if (const std::string space = statedSpace(line); !space.empty()) return space;
   }
   return "";

@@ -77,10 +77,17 @@ TEST(PointCloudIO, SlicersRasFilesAreReadIntoLps) {
     std::ofstream(path, std::ios::binary) << bytes;
     return path;
   };
-  expectPoints(marked(".ply", "\n", "comment 3D Slicer SPACE=RAS\n"), "RAS", -1);
+  expectPoints(marked(".ply", "\n", "comment 3D Slicer SPACE=RAS\r\n"), "RAS", -1);
+  expectPoints(marked(".ply", "\n", "comment\tSPACE=RAS\n"), "RAS", -1);
   expectPoints(marked(".ply", "\n", "comment SPACE=LPS\n"), "LPS", 1);
+  expectPoints(marked(".ply", "\n", "comment COLORSPACE=RAS SPACE=RAS_2\n"), "", 1);  // no mark
   expectPoints(marked(".obj", "", "# SPACE=RAS\n"), "RAS", -1);
   expectPoints(scratch("plain.obj"), "", 1);
+  // An OBJ's mark is among the comments it begins with, not after its data.
+  const dynsub::PointCloud late = dynsub::readPointCloud(
+      writeText("late.obj", "v 1 2 3\n# SPACE=RAS\nv 4 5 6\nv 7 8 10\nv 1 1 1\nf 1 2 3\nf 1 3 4\n"));
+  EXPECT_EQ(late.space, "");
+  EXPECT_EQ(late.points.row(0), Eigen::RowVector3d(1, 2, 3));
   dynsub::writeTriangleSurface(surface, scratch("ras.vtp"), {}, "RAS");
   expectPoints(scratch("ras.vtp"), "RAS", -1);
   dynsub::writeTriangleSurface(surface, scratch("plain.vtp"));

@@ -53,6 +53,13 @@ struct Material {
   double rigidityUU = 0.1;  // beta11
   double rigidityUV = 0.2;  // beta12 (2 beta11 makes the plate energy rotation-invariant)
   double rigidityVV = 0.1;  // beta22
+
+  // This material with its tension and rigidity times `factor`.
+  Material withElasticity(double factor) const {
+    Material m = *this;
+    for (double* k : {&m.tensionU, &m.tensionV, &m.rigidityUU, &m.rigidityUV, &m.rigidityVV}) *k *= factor;
+    return m;
+  }
 };
 
 struct AssemblyOptions {

@@ -90,6 +90,12 @@ struct SegmentOutcome {
   std::shared_ptr<const AtlasAffine> atlasAffine;
   std::optional<CarriedLabel> carried;
   std::vector<Landmark> prior;
+  // The atlas start's fit (SegmentImage.cpp, fitAtlasStart): the factor on
+  // the fit's tension and rigidity of the start kept (the first whose
+  // surface does not cross itself, else the one that crosses least; 1 when
+  // the default's does not), and the pairs of its triangles that cross.
+  double atlasStartElasticity = 1.0;
+  int atlasStartCrossings = 0;
   std::vector<Landmark> springs;     // what the springs pulled to
   OverlapMetrics metrics;            // against the reference, when given
   ConvergenceHistory history;
