@@ -224,9 +224,7 @@ void requireExtension(const std::string& path, const std::vector<std::string>& k
   if (extension == ".gz") extension = lowerCaseExtension(std::filesystem::path(path).stem().string()) + extension;
   for (const std::string& k : known)
     if (extension == k) return;
-  std::string list;
-  for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
-  throw UsageError(path, "unknown " + what + " format '" + extension + "' (expected " + list + ")");
+  throw UsageError(path, "unknown " + what + " format '" + extension + "' (expected " + joined(known, ", ") + ")");
 }
 
 // A structure's segment in the .seg.nrrd: its label value, its name (a

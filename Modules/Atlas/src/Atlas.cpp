@@ -29,12 +29,6 @@ constexpr double kFieldVoxels = 40000;
 // given together are two pieces of about half each.
 constexpr double kSeparatePiece = 0.05;
 
-std::string joined(const std::vector<std::string>& items, const std::string& separator) {
-  std::string text;
-  for (const std::string& item : items) text += (text.empty() ? "" : separator) + item;
-  return text;
-}
-
 std::string labelList(const std::vector<int>& labels) {
   std::vector<std::string> values;
   for (int label : labels) values.push_back(std::to_string(label));

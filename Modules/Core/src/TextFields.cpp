@@ -49,6 +49,12 @@ std::string trimmed(const std::string& text) {
   return first == std::string::npos ? std::string() : text.substr(first, text.find_last_not_of(" \t") + 1 - first);
 }
 
+std::string joined(const std::vector<std::string>& items, const std::string& separator) {
+  std::string text;
+  for (const std::string& item : items) text += (text.empty() ? "" : separator) + item;
+  return text;
+}
+
 std::string withoutLibraryTag(const std::string& message) {
   const std::size_t end = message.find("] ");
   return message.rfind('[', 0) == 0 && end != std::string::npos ? message.substr(end + 2) : message;

@@ -162,10 +162,10 @@ ControlMesh fitAtlasStart(const std::vector<Landmark>& boundary, double initialF
   crossings = std::numeric_limits<int>::max();
   for (const double factor : {1.0, 10.0, 30.0, 100.0}) {
     fit.simulation.material = material.withElasticity(factor);
-    ControlMesh mesh = fitPointCloud(points, initial, fit).mesh;
-    const int crossing = findSelfIntersections(outputSurface(mesh)).trianglePairs;
+    FitResult fitted = fitPointCloud(points, initial, fit);
+    const int crossing = findSelfIntersections(outputSurface(fitted.mesh, *fitted.surface)).trianglePairs;
     if (crossing < crossings) {
-      best = std::move(mesh);
+      best = std::move(fitted.mesh);
       elasticity = factor;
       crossings = crossing;
     }

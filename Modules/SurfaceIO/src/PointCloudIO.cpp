@@ -24,6 +24,7 @@
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
 #include "dynsub/MeshIO.h"
+#include "dynsub/SurfacePolyData.h"
 #include "dynsub/TextFields.h"
 #include "dynsub/VtkErrors.h"
 #include "SlicerSpace.h"
@@ -201,12 +202,7 @@ PointCloud readVtp(const std::string& path) {
   vtkPolyData* data = reader->GetOutput();
   if (!data || !data->GetPoints() || data->GetNumberOfPoints() == 0) throw Error(path, "has no points");
   PointCloud result;
-  result.points.resize(static_cast<Eigen::Index>(data->GetNumberOfPoints()), 3);
-  for (vtkIdType i = 0; i < data->GetNumberOfPoints(); ++i) {
-    double p[3];
-    data->GetPoint(i, p);
-    result.points.row(i) << p[0], p[1], p[2];
-  }
+  result.points = pointsOf(data);
   result.space = fieldSpace(data);
   result.meshVertices = data->GetNumberOfPolys() > 0 || data->GetNumberOfStrips() > 0;
   // Triangle strips are not unpacked into faces (the points are read all

@@ -25,6 +25,9 @@ std::vector<std::string> splitCsvFields(const std::string& line, char separator)
 // `text` without the blanks and tabs at its ends.
 std::string trimmed(const std::string& text);
 
+// `items` one after another with `separator` between them (lists in messages).
+std::string joined(const std::vector<std::string>& items, const std::string& separator);
+
 // Whether `line` holds nothing to read: it is empty, or blanks, tabs, a CR
 // and `separators` alone (a spreadsheet's formatted but empty row).
 bool holdsNothing(const std::string& line, const std::string& separators);
