@@ -195,7 +195,7 @@ struct Viewer::Impl {
 
   void save() {
     try {
-      writeLandmarks(edits.landmarks, input.landmarksPath, CoordinateSystem::LPS);
+      updateLandmarks(edits.landmarks, input.landmarksPath);
       message = "saved " + std::to_string(edits.landmarks.size()) + " landmarks to " + input.landmarksPath;
     } catch (const std::exception& e) {
       message = std::string("not saved: ") + e.what();

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -73,8 +74,8 @@ bool onStructure(const std::string& path, const std::string& type) {
                         "left out)");
 }
 
-// Every point list and curve of the file, in order, with or without points.
-std::vector<LandmarkList> readMarkupsJson(const std::string& path, std::ifstream& in) {
+// A markups file's document, with its "markups" list.
+nlohmann::json readMarkupsDocument(const std::string& path, std::ifstream& in) {
   nlohmann::json document;
   try {
     // Read to the end: text after the document (a file pasted twice, a
@@ -85,6 +86,12 @@ std::vector<LandmarkList> readMarkupsJson(const std::string& path, std::ifstream
   }
   if (!document.contains("markups") || !document["markups"].is_array())
     throw Error(path, "no \"markups\" list (not a 3D Slicer markups file)");
+  return document;
+}
+
+// Every point list and curve of the file, in order, with or without points.
+std::vector<LandmarkList> readMarkupsJson(const std::string& path, std::ifstream& in) {
+  const nlohmann::json document = readMarkupsDocument(path, in);
   std::vector<LandmarkList> lists;
   std::vector<std::string> leftOut;  // the types of the markups that give no landmarks
   int markupNumber = 0;
@@ -253,6 +260,42 @@ std::string labelOf(const std::vector<Landmark>& landmarks, std::size_t i) {
   return landmarks[i].label.empty() ? "F-" + std::to_string(i + 1) : landmarks[i].label;
 }
 
+// A placed control point of a markups file, with 3D Slicer's defaults for
+// the fields a point needs.
+nlohmann::json markupsPoint(const std::string& id, const std::string& label, const Vector3& p) {
+  return {{"id", id},
+          {"label", label},
+          {"description", ""},
+          {"position", {p.x(), p.y(), p.z()}},
+          {"orientation", {-1.0, -0.0, -0.0, -0.0, -1.0, -0.0, 0.0, 0.0, 1.0}},
+          {"selected", true},
+          {"locked", false},
+          {"visibility", true},
+          {"positionStatus", "defined"}};
+}
+
+// The index in `markups` of the one point list or curve with placed points,
+// else of the first point list or curve (as readLandmarkLists picks), or -1.
+int editedMarkup(const std::string& path, const nlohmann::json& markups) {
+  int first = -1, placed = -1, lists = 0;
+  for (std::size_t m = 0; m < markups.size(); ++m) {
+    const nlohmann::json& markup = markups[m];
+    if (!onStructure(path, markup.value("type", std::string("Fiducial")))) continue;
+    if (first < 0) first = static_cast<int>(m);
+    const nlohmann::json points = markup.value("controlPoints", nlohmann::json::array());
+    const bool hasPlaced = std::any_of(points.begin(), points.end(), [](const nlohmann::json& point) {
+      return point.value("positionStatus", std::string("defined")) == "defined";
+    });
+    if (!hasPlaced) continue;
+    ++lists;
+    placed = static_cast<int>(m);
+  }
+  if (lists > 1)
+    throw Error(path, "holds " + std::to_string(lists) +
+                          " lists of points; only a file with one list can take one list's edited points");
+  return placed >= 0 ? placed : first;
+}
+
 // A label as a field of a .csv or .fcsv row: quoted when it holds a comma,
 // so that the row keeps its columns (the readers take no quote inside a
 // field: one becomes ').
@@ -320,18 +363,8 @@ void writeLandmarks(const std::vector<Landmark>& landmarks, const std::string& p
     out.precision(17);
     if (format == Format::MarkupsJson) {
       nlohmann::json points = nlohmann::json::array();
-      for (std::size_t i = 0; i < landmarks.size(); ++i) {
-        const Vector3 p = stored(landmarks[i]);
-        points.push_back({{"id", std::to_string(i + 1)},
-                          {"label", labelOf(landmarks, i)},
-                          {"description", ""},
-                          {"position", {p.x(), p.y(), p.z()}},
-                          {"orientation", {-1.0, -0.0, -0.0, -0.0, -1.0, -0.0, 0.0, 0.0, 1.0}},
-                          {"selected", true},
-                          {"locked", false},
-                          {"visibility", true},
-                          {"positionStatus", "defined"}});
-      }
+      for (std::size_t i = 0; i < landmarks.size(); ++i)
+        points.push_back(markupsPoint(std::to_string(i + 1), labelOf(landmarks, i), stored(landmarks[i])));
       nlohmann::json document = {
           {"@schema",
            "https://raw.githubusercontent.com/slicer/slicer/master/Modules/Loadable/Markups/Resources/Schema/"
@@ -357,6 +390,67 @@ void writeLandmarks(const std::vector<Landmark>& landmarks, const std::string& p
         out << p.x() << ',' << p.y() << ',' << p.z() << ',' << csvField(labelOf(landmarks, i)) << '\n';
       }
     }
+    out.close();
+    if (!out) throw writeFailure(path);
+  }
+  output.commit();
+}
+
+void updateLandmarks(const std::vector<Landmark>& landmarks, const std::string& path) {
+  if (!std::filesystem::exists(path)) return writeLandmarks(landmarks, path);
+  const Format format = formatOf(path);
+  if (format != Format::MarkupsJson) {
+    CoordinateSystem stated = CoordinateSystem::LPS;
+    readLandmarks(path, &stated);
+    return writeLandmarks(landmarks, path, stated);
+  }
+  readLandmarkLists(path);  // the reader's checks: a file it refuses is not rewritten
+  std::ifstream in = openForReading(path);
+  nlohmann::json document = readMarkupsDocument(path, in);
+  in.close();
+  nlohmann::json& markups = document["markups"];
+  const int edited = editedMarkup(path, markups);
+  if (edited < 0) return writeLandmarks(landmarks, path);
+  nlohmann::json& markup = markups[static_cast<std::size_t>(edited)];
+  const bool ras = markup.value("coordinateSystem", std::string("LPS")) == "RAS";
+  const nlohmann::json before = markup.value("controlPoints", nlohmann::json::array());
+
+  // A point whose label is kept keeps its id, description and flags; the
+  // names Slicer lists but has not placed stay, after the placed points.
+  std::vector<bool> taken(before.size(), false);
+  std::vector<std::string> ids;
+  for (const nlohmann::json& point : before)
+    if (point.contains("id") && point["id"].is_string()) ids.push_back(point["id"].get<std::string>());
+  nlohmann::json points = nlohmann::json::array();
+  for (std::size_t i = 0; i < landmarks.size(); ++i) {
+    if (!landmarks[i].position.allFinite()) throw Error(path, "landmark '" + landmarks[i].label + "' is not finite");
+    const std::string label = labelOf(landmarks, i);
+    const Vector3 p = ras ? flipXY(landmarks[i].position) : landmarks[i].position;
+    std::size_t match = 0;
+    while (match < before.size() && (taken[match] || before[match].value("label", std::string()) != label ||
+                                     before[match].value("positionStatus", std::string("defined")) != "defined"))
+      ++match;
+    if (match < before.size()) {
+      taken[match] = true;
+      nlohmann::json point = before[match];
+      point["position"] = {p.x(), p.y(), p.z()};
+      points.push_back(point);
+      continue;
+    }
+    std::size_t number = ids.size() + 1;
+    while (std::find(ids.begin(), ids.end(), std::to_string(number)) != ids.end()) ++number;
+    ids.push_back(std::to_string(number));
+    points.push_back(markupsPoint(ids.back(), label, p));
+  }
+  for (const nlohmann::json& point : before)
+    if (point.value("positionStatus", std::string("defined")) == "undefined") points.push_back(point);
+  markup["controlPoints"] = points;
+
+  requireWritableDirectoryFor(path);
+  AtomicOutput output(path);
+  {
+    std::ofstream out(output.temporaryPath());
+    out << document.dump(4) << '\n';
     out.close();
     if (!out) throw writeFailure(path);
   }

@@ -201,6 +201,74 @@ TEST(Landmarks, BadFilesAreRefusedWithTheirName) {
       "its markups (ROI, Plane) are measurements or regions");
 }
 
+std::string contents(const fs::path& path) {
+  std::ifstream in(path.string());
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// What the viewer's save does to a file 3D Slicer wrote: its points change,
+// nothing else does.
+TEST(Landmarks, UpdatingAMarkupsFileKeepsWhatElseItHolds) {
+  const fs::path json = scratch("slicer.mrk.json");
+  std::ofstream(json.string()) << R"({"@schema": "x", "markups": [
+    {"type": "ROI", "name": "box", "coordinateSystem": "LPS", "controlPoints": []},
+    {"type": "Fiducial", "name": "caudate", "coordinateSystem": "RAS", "coordinateUnits": "mm",
+     "controlPoints": [
+       {"id": "7", "label": "head", "description": "checked twice", "position": [1, 2, 3], "locked": true,
+        "positionStatus": "defined"},
+       {"id": "8", "label": "gone", "position": [4, 5, 6], "positionStatus": "defined"},
+       {"id": "9", "label": "tail", "position": [0, 0, 0], "positionStatus": "undefined"}],
+     "measurements": [], "display": {"selectedColor": [0.1, 0.9, 0.2], "glyphScale": 2.5}}]})";
+  // "head" moved (LPS), "gone" deleted, "new" placed.
+  updateLandmarks({{"head", Vector3(-10, -20, 30)}, {"new", Vector3(-1, -1, 1)}}, json.string());
+
+  const std::vector<LandmarkList> lists = readLandmarkLists(json.string());
+  ASSERT_EQ(lists.size(), 1u);
+  EXPECT_EQ(lists[0].name, "caudate");
+  EXPECT_EQ(lists[0].stated, CoordinateSystem::RAS);
+  ASSERT_EQ(lists[0].landmarks.size(), 2u);
+  EXPECT_EQ(lists[0].landmarks[0].label, "head");
+  EXPECT_LT((lists[0].landmarks[0].position - Vector3(-10, -20, 30)).norm(), 1e-12);
+  EXPECT_EQ(lists[0].landmarks[1].label, "new");
+  EXPECT_LT((lists[0].landmarks[1].position - Vector3(-1, -1, 1)).norm(), 1e-12);
+  const std::string text = contents(json);
+  EXPECT_NE(text.find("\"box\""), std::string::npos);             // the other markup
+  EXPECT_NE(text.find("\"glyphScale\": 2.5"), std::string::npos);  // the list's display
+  EXPECT_NE(text.find("\"checked twice\""), std::string::npos);    // the moved point's description
+  EXPECT_NE(text.find("\"label\": \"tail\""), std::string::npos);  // the name not yet placed
+  EXPECT_EQ(text.find("\"gone\""), std::string::npos);
+  EXPECT_EQ(text.find("\"id\": \"8\""), std::string::npos);  // a new point takes no id the list used
+
+  // A legacy file keeps its coordinate system; a missing one is written.
+  const fs::path fcsv = scratch("slicer.fcsv");
+  writeLandmarks(sample(), fcsv.string(), CoordinateSystem::RAS);
+  updateLandmarks({sample()[1]}, fcsv.string());
+  CoordinateSystem stated = CoordinateSystem::LPS;
+  const auto read = readLandmarks(fcsv.string(), &stated);
+  EXPECT_EQ(stated, CoordinateSystem::RAS);
+  ASSERT_EQ(read.size(), 1u);
+  EXPECT_LT((read[0].position - sample()[1].position).norm(), 1e-9);
+  const fs::path fresh = scratch("fresh.mrk.json");
+  fs::remove(fresh);
+  updateLandmarks(sample(), fresh.string());
+  EXPECT_EQ(readLandmarks(fresh.string()).size(), 3u);
+
+  // A file of two structures cannot take one structure's points.
+  const fs::path two = scratch("two.mrk.json");
+  std::ofstream(two.string()) << R"({"markups": [
+    {"type": "Fiducial", "name": "a", "controlPoints": [{"position": [1, 2, 3]}]},
+    {"type": "Fiducial", "name": "b", "controlPoints": [{"position": [4, 5, 6]}]}]})";
+  const std::string before = contents(two);
+  try {
+    updateLandmarks(sample(), two.string());
+    ADD_FAILURE() << "a file of two lists was rewritten";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("two.mrk.json"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("2 lists"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(contents(two), before);
+}
+
 TEST(Landmarks, SpreadsheetFilesAreRead) {
   // Excel's "CSV UTF-8" starts with a byte order mark.
   const fs::path csv = scratch("excel.csv");
