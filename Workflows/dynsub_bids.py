@@ -576,7 +576,8 @@ GROUP_COLUMNS = {
     "seconds": "Wall-clock seconds of the structure's segmentation (its last pass, when segmented with others).",
     "warnings": "dynsub's warnings (a collapse, a leak, landmarks off edges), separated by '; '.",
     "trust_flags": "Why not to trust the result (report.json's trust flags: one_click, small, "
-                   "atlas_clicks_apart, moved_from_atlas, moved_to_click, leaked), separated by spaces, or n/a.",
+                   "atlas_clicks_apart, moved_from_atlas, moved_to_click, cut_by_image_side, leaked), separated by spaces, "
+                   "or n/a.",
     "message": "Why a job failed.",
     "dseg": "The labelmap holding the structure, relative to the dataset root.",
     "index": "The structure's value in that labelmap (its dseg.tsv's index).",

@@ -291,6 +291,7 @@ TrustEvidence trustEvidence(const Volume& image, const SegmentInputs& in, const 
     e.onSlice = kOnSliceVoxels * image.geometry.spacing(ends.axis);
   }
   e.outsideRegion = outcome.result.outsideRegion;
+  e.atImageSide = outcome.result.atImageSide;
   return e;
 }
 
@@ -607,6 +608,7 @@ SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& in, const 
   report.set("initial_volume_mm3", result.initialVolume);
   report.set("surface_volume_mm3", result.volume);
   report.set("surface_outside_region", result.outsideRegion);
+  report.set("surface_at_image_side", result.atImageSide);
   if (std::isfinite(result.surfaceOnEdges)) report.set("surface_on_edges", result.surfaceOnEdges);
   report.set("self_intersection", crossing);
   report.set("warnings", outcome.warnings);

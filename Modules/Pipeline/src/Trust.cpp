@@ -90,6 +90,7 @@ std::string fixed(double value, int digits) {
 TrustMeasures measureTrust(const TriangleSurface& result, double resultVolume, const TrustEvidence& evidence) {
   TrustMeasures m;
   m.outsideRegion = evidence.outsideRegion;
+  m.atImageSide = evidence.atImageSide;
   m.insideShift = evidence.insideShift;
   const MatrixX3 clicks = rows(evidence.clicks), outline = rows(evidence.outline);
   const double volume = evidence.volume > 0 ? evidence.volume : slicesVolume(evidence);
@@ -140,7 +141,14 @@ std::vector<TrustFlag> trustFlags(const TrustMeasures& m, const TrustEvidence& e
                          " mm to hold it: a click in a neighbouring structure, the other "
                          "hemisphere or the other convention (RAS read as LPS) moves it there; "
                          "check the click"});
-  if (m.outsideRegion > kLeakedAbove)
+  // A structure the scan cuts also leaves the region, at the image's side,
+  // where a wider region cannot follow: that is said, and not a leak.
+  if (m.atImageSide > kAtImageSideAbove)
+    flags.push_back({"cut_by_image_side", fixed(100 * m.atImageSide, 1) +
+                                              " % of the surface lies at the image's side or beyond it: the "
+                                              "structure probably continues past the scan, and its volume is a "
+                                              "lower bound"});
+  else if (m.outsideRegion > kLeakedAbove)
     flags.push_back({"leaked", fixed(100 * m.outsideRegion, 0) +
                                    " % of the surface left the region of interest, where no image force holds it"});
   return flags;

@@ -147,6 +147,15 @@ TEST(Trust, EachFlagComesFromItsOwnMeasure) {
     EXPECT_TRUE(has(flags, "leaked"));
     EXPECT_EQ(flags.size(), 2u);
   }
+  {  // a structure the image's side cuts is said to be, not to have leaked
+    TrustEvidence e;
+    e.outsideRegion = 0.2;
+    e.atImageSide = 0.15;
+    const std::vector<TrustFlag> flags = trustFlags(measureTrust(result, kBall, e), e);
+    ASSERT_EQ(flags.size(), 1u);
+    EXPECT_EQ(flags[0].name, "cut_by_image_side");
+    EXPECT_NE(flags[0].message.find("15.0 %"), std::string::npos) << flags[0].message;
+  }
 }
 
 }  // namespace

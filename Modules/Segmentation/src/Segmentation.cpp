@@ -208,6 +208,7 @@ SegmentationRegion::SegmentationRegion(const Volume& image, const std::vector<La
   checkSegmentOptions(options);
   if (!initial.isClosed()) throw Error("the initial model must be a closed control mesh");
   const ImageGeometry& grid = image.geometry;
+  wholeImage_ = grid;
   requireLandmarksInside(grid, landmarks);
   if (!limitSurfaceInside(initial, grid)) throw Error("the initial model reaches outside the image");
   const MatrixX3 start = limitPoints(initial, 2);
@@ -337,10 +338,18 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
   const TriangleSurface& triangles = result.surface;
   result.initialVolume = initialVolume.get();
   result.volume = enclosedVolume(triangles);
-  Eigen::Index outside = 0;
-  for (Eigen::Index p = 0; p < triangles.points.rows(); ++p)
-    outside += !region.covers(Vector3(triangles.points.row(p).transpose()));
-  result.outsideRegion = static_cast<double>(outside) / std::max<Eigen::Index>(triangles.points.rows(), 1);
+  Eigen::Index outside = 0, atSide = 0;
+  const ImageGeometry& whole = region.wholeImage();
+  const Eigen::Array3d sideAt = Eigen::Array3d(whole.size[0], whole.size[1], whole.size[2]) - 1.5;
+  for (Eigen::Index p = 0; p < triangles.points.rows(); ++p) {
+    const Vector3 point = triangles.points.row(p).transpose();
+    outside += !region.covers(point);
+    const Eigen::Array3d index = whole.toIndex(point).array();
+    atSide += (index < 0.5).any() || (index > sideAt).any();
+  }
+  const double points = static_cast<double>(std::max<Eigen::Index>(triangles.points.rows(), 1));
+  result.outsideRegion = static_cast<double>(outside) / points;
+  result.atImageSide = static_cast<double>(atSide) / points;
   std::ostringstream warning;
   warning << std::fixed << std::setprecision(0);
   const bool collapsed = result.volume < kCollapsedBelow * result.initialVolume;
@@ -383,7 +392,16 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
       warning.str("");
     }
   }
-  if (result.outsideRegion > kLeakedAbove) {
+  // At the image's side, raising the margin cannot help: the scan ends there.
+  if (result.atImageSide > kAtImageSideAbove) {
+    warning << std::setprecision(1) << 100 * result.atImageSide
+            << " % of the surface lies at the image's side or beyond it: the structure probably continues past "
+               "the scan's field of view, and its labelmap stops at the image's side (or the surface leaked there: "
+               "add landmarks where it ends)"
+            << std::setprecision(0);
+    result.warnings.push_back(warning.str());
+    warning.str("");
+  } else if (result.outsideRegion > kLeakedAbove) {
     warning << 100 * result.outsideRegion
             << " % of the surface left the region of interest, where no image force holds it: it has "
                "probably leaked (add landmarks where it escaped, or raise --margin)";

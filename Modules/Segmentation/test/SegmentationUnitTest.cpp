@@ -246,6 +246,42 @@ TEST(Segment, RefusesLandmarksAndModelsOutsideTheImage) {
   EXPECT_THROW(segment(phantom.image, landmarks, initial, nan), Error);
 }
 
+// A ball the scan's field of view cuts at x = 2 mm (it reaches x = 10): the
+// surface runs to the image's side, and the warning says so instead of
+// asking for a larger margin. The same ball inside its image gets neither.
+TEST(Segment, AStructureCutByTheImageSideIsSaidToBe) {
+  const Ellipsoid shape{Vector3(0, 0, 0), Vector3(10, 10, 10)};
+  for (const bool cut : {true, false}) {
+    const ImageGeometry grid = cut ? gridAround(Vector3(-10, 0, 0), Vector3(24, 34, 34), Vector3(1, 1, 1),
+                                                Matrix3::Identity())
+                                   : gridAround(shape.centre, Vector3(34, 34, 34), Vector3(1, 1, 1),
+                                                Matrix3::Identity());
+    const Phantom phantom = makePhantom(grid, [&](const Vector3& x) { return shape.inside(x); }, 2.0, 3);
+    // Eight clicks on each of four sagittal slices, the last one the
+    // image's last (x = 2 mm), as a user clicks a structure to the scan's end.
+    std::vector<Vector3> points;
+    for (const double x : {-8.0, -4.0, 0.0, 2.0})
+      for (int q = 0; q < 8; ++q) {
+        const double r = std::sqrt(100.0 - x * x), angle = 2.0 * M_PI * (q + 0.5 * x) / 8;
+        points.push_back(Vector3(x, r * std::cos(angle), r * std::sin(angle)));
+      }
+    const std::vector<Landmark> landmarks = named(points);
+    const SegmentResult result = segment(phantom.image, landmarks, initialFromLandmarks(landmarks), SegmentOptions());
+    std::string warnings;
+    for (const std::string& w : result.warnings) warnings += w + "\n";
+    if (cut) {
+      // The cut face is a disc of radius 9.8 mm, about a fifth of the
+      // surface (0.24 measured), against the 1 % that warns.
+      EXPECT_GT(result.atImageSide, 0.10);
+      EXPECT_NE(warnings.find("at the image's side"), std::string::npos) << warnings;
+      EXPECT_EQ(warnings.find("raise --margin"), std::string::npos) << warnings;
+    } else {
+      EXPECT_EQ(result.atImageSide, 0.0);
+      EXPECT_EQ(warnings.find("image's side"), std::string::npos) << warnings;
+    }
+  }
+}
+
 // Hostile numbers: each ends in a clear error or a correct result, never in
 // NaN. The ball of RefusesLandmarksAndModelsOutsideTheImage, with noise.
 struct HostileCase {

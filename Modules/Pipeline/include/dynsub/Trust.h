@@ -26,6 +26,7 @@ struct TrustEvidence {
   bool oneClick = false;              // a start from one click inside with nothing else: no clicks, no atlas
   double march = 0;                   // mm: the longest the slice-end march carried past the clicked slices
   double outsideRegion = 0;           // the share of the result outside the region of interest
+  double atImageSide = 0;             // the share within a voxel of the image's side or beyond it
   // mm: how far the atlas's structure was moved so that the click inside
   // (--inside) lies in it; NaN without such a click.
   double insideShift = std::numeric_limits<double>::quiet_NaN();
@@ -45,6 +46,7 @@ struct TrustMeasures {
   double marchShare = kNone;            // the march over the span between the outermost clicked slices
   double insideShift = kNone;           // mm: evidence.insideShift
   double outsideRegion = 0;
+  double atImageSide = 0;
 };
 
 // The thresholds, set on the tuning subjects of both generated groups

@@ -82,6 +82,9 @@ struct SegmentResult {
   // kLeakedAbove of its surface left the region).
   double initialVolume = 0, volume = 0;
   double outsideRegion = 0;  // fraction of the tessellation's points
+  // Fraction of the tessellation's points within a voxel of the image's
+  // side or beyond it: where the scan's field of view may cut the structure.
+  double atImageSide = 0;
   // With the edge potential: the share of the surface within a voxel of an
   // edge (held by the image rather than by tension and landmarks alone), and
   // each landmark's distance to the nearest edge (mm; a click beyond the
@@ -101,6 +104,10 @@ struct SegmentResult {
 
 constexpr double kCollapsedBelow = 0.5;
 constexpr double kLeakedAbove = 0.05;
+// A surface with more of its points than this within a voxel of the image's
+// side is warned of as cut by the field of view: a structure well inside
+// the scan keeps every point away from it.
+constexpr double kAtImageSideAbove = 0.01;
 
 // Throws LandmarkError ("landmark 2 of 36 ('F-2') at (x, y, z) mm LPS lies
 // outside the image") for the first landmark `grid` does not cover.
@@ -126,6 +133,7 @@ class SegmentationRegion {
 
   const EdgeField& edgeField() const { return *edgeField_; }
   const Volume& image() const { return image_; }  // the image cropped to the region
+  const ImageGeometry& wholeImage() const { return wholeImage_; }  // the grid of the image it was cropped from
   // The region as asked for along image axis `axis`, in mm along its
   // direction: the box's points projected, grown by the margin. The grid's
   // whole voxels reach up to a voxel beyond it.
@@ -138,7 +146,7 @@ class SegmentationRegion {
  private:
   std::array<int, 3> first_{}, size_{};
   std::array<std::pair<double, double>, 3> span_;
-  ImageGeometry geometry_;
+  ImageGeometry geometry_, wholeImage_;
   Volume image_;
   double cropSeconds_ = 0, potentialSeconds_ = 0;
   std::unique_ptr<const EdgeField> edgeField_;
