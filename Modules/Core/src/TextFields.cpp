@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <sstream>
 #include <stdexcept>
 
 namespace dynsub {
@@ -53,6 +54,26 @@ std::string joined(const std::vector<std::string>& items, const std::string& sep
   std::string text;
   for (const std::string& item : items) text += (text.empty() ? "" : separator) + item;
   return text;
+}
+
+std::string wrapped(const std::string& text, std::size_t columns) {
+  columns = std::max<std::size_t>(columns, 1);
+  std::string out, line;
+  std::istringstream lines(text);
+  bool first = true;
+  while (std::getline(lines, line)) {
+    if (!first) out += '\n';
+    first = false;
+    while (line.size() > columns) {
+      const std::size_t space = line.rfind(' ', columns);
+      const std::size_t end = space == std::string::npos || space == 0 ? columns : space;
+      out += line.substr(0, end) + '\n';
+      const std::size_t next = line.find_first_not_of(' ', end);
+      line = next == std::string::npos ? std::string() : line.substr(next);
+    }
+    out += line;
+  }
+  return out;
 }
 
 std::string withoutLibraryTag(const std::string& message) {

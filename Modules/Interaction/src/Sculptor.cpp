@@ -19,6 +19,7 @@
 #include "dynsub/Error.h"
 #include "dynsub/Figures.h"
 #include "dynsub/SolidView.h"
+#include "dynsub/TextFields.h"
 
 namespace dynsub {
 
@@ -89,7 +90,8 @@ struct Sculptor::Impl {
          << "  |  stiffness " << std::defaultfloat << std::setprecision(3) << m.springStiffness << " / " << m.virtualStiffness
          << " N/mm, damping " << m.damping << " N s/mm";
     if (selected >= 0) text << "  |  face " << selected << " selected";
-    if (!message.empty()) text << "\n" << message;
+    // A message naming a long path breaks into lines within the window.
+    if (!message.empty()) text << "\n" << wrapped(message, style::textColumns(0.98 * window->GetSize()[0], 13));
     statusText->SetInput(text.str().c_str());
   }
 

@@ -1,5 +1,6 @@
 #include "dynsub/Viewer.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -28,6 +29,7 @@
 #include "dynsub/Error.h"
 #include "dynsub/Figures.h"
 #include "dynsub/SliceView.h"
+#include "dynsub/TextFields.h"
 #include "dynsub/SurfacePolyData.h"
 #include "dynsub/SurfaceView.h"
 #include "dynsub/Tessellation.h"
@@ -290,7 +292,9 @@ struct Viewer::Impl {
     std::ostringstream text;
     const std::string fitting = fit.status();
     text << edits.landmarks.size() << " landmarks  |  " << (fitting.empty() ? "not fitting (space starts)" : fitting);
-    if (!message.empty()) text << "\n" << message;
+    // The status has the window's right half: a message naming a long path
+    // breaks into lines instead of running off the window.
+    if (!message.empty()) text << "\n" << wrapped(message, style::textColumns(0.48 * window->GetSize()[0], 13));
     statusText->SetInput(text.str().c_str());
   }
 

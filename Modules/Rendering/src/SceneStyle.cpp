@@ -174,6 +174,10 @@ vtkSmartPointer<vtkRenderWindow> offScreenWindow(int width, int height) {
   return window;
 }
 
+std::size_t textColumns(double pixels, int fontSize) {
+  return static_cast<std::size_t>(std::max(20.0, pixels / (0.55 * fontSize)));
+}
+
 void cornerText(vtkTextActor* text, double x, double y, Corner corner, int fontSize) {
   text->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
   text->SetPosition(x, y);

@@ -25,6 +25,11 @@ std::vector<std::string> splitCsvFields(const std::string& line, char separator)
 // `text` without the blanks and tabs at its ends.
 std::string trimmed(const std::string& text);
 
+// `text` with each line longer than `columns` characters broken at its last
+// space that keeps the first part within them (cut at `columns` where it
+// has none), and the break's spaces dropped; the spaces within a line stay.
+std::string wrapped(const std::string& text, std::size_t columns);
+
 // `items` one after another with `separator` between them (lists in messages).
 std::string joined(const std::vector<std::string>& items, const std::string& separator);
 

@@ -3,6 +3,7 @@
 // conversions between world and display points, for the Rendering module's
 // views and the Interaction module's windows.
 #include <array>
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -79,6 +80,9 @@ vtkSmartPointer<vtkRenderWindow> offScreenWindow(int width, int height);
 enum class Corner { TopLeft, TopRight, BottomLeft, BottomRight, Left, Right, Top, Bottom };
 // White text at a normalized viewport position, justified towards `corner`.
 void cornerText(vtkTextActor* text, double x, double y, Corner corner, int fontSize = kFontSize);
+// How many characters of cornerText's font at `fontSize` fit in `pixels`
+// (Arial averages about 0.55 of its size a character), at least 20.
+std::size_t textColumns(double pixels, int fontSize);
 
 // The interactive windows' help: `help` in a dark box at (x, y), hidden
 // until `h` shows it, added to `overlay`.
