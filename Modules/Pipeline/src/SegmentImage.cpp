@@ -231,6 +231,11 @@ ControlMesh chooseStart(const Volume& image, const SegmentInputs& in, const Segm
     }
     case SegmentStart::Kind::Atlas: {
       ControlMesh mesh = atlasStart(image, in, parameters, outcome);
+      // The atlas's structure reaches the ends the march would look for,
+      // and its prior holds the surface there. Marching as well, from the
+      // clicks or (on thick slices, whose prior points lie on the slices)
+      // from the prior's points, lowered Dice on the tuning subjects.
+      options.sliceEnds.enabled = false;
       if (in.landmarks.empty()) {
         outcome.springs = outcome.prior;
         options.landmarkStiffness = parameters.priorStiffness;

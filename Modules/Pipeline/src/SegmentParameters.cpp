@@ -122,14 +122,15 @@ std::vector<Parameter> table() {
   Parameter sliceEnds = row("slice_ends", "Slice ends", "", "Slice ends",
                       "For landmarks on slices: follow the tissue between the clicked slices beyond them and add "
                       "soft springs where it ends, so that the structure's unclicked ends are reached (off when "
-                      "the clicks reach both ends: the march can then go on into like tissue)",
+                      "the clicks reach both ends: the march can then go on into like tissue; an atlas start "
+                      "does not march: its atlas gives the ends)",
                       [](P& p) -> bool& { return p.segment.sliceEnds.enabled; });
   sliceEnds.opposite = Parameter::Opposite{
       "pointsReachEnds", "Points reach both ends",
       "Check when the boundary points include the structure's first and last slices. Unchecked, the surface "
       "is carried past the outermost slices with points to where the structure's tissue ends, since experts "
       "seldom place points there; when the points already reach the ends, that can carry it on into like "
-      "tissue."};
+      "tissue. An atlas start never does: its atlas gives the ends."};
   add(sliceEnds);
   add(row("end_pressure", "End pressure", "N/mm^2", "Slice ends",
        "With slice ends: the pressure beyond the outermost clicked slices, at full strength, that grows the "
