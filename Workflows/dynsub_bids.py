@@ -574,7 +574,8 @@ GROUP_COLUMNS = {
     "control_vertices": "Control vertices of the final surface.",
     "iterations": "Time steps of the evolution.",
     "seconds": "Wall-clock seconds of the structure's segmentation (its last pass, when segmented with others).",
-    "warnings": "dynsub's warnings (a collapse, a leak, landmarks off edges), separated by '; '.",
+    "warnings": "dynsub's warnings (a collapse, a leak, a cut by the image's side, landmarks off edges), "
+                "separated by '; '.",
     "trust_flags": "Why not to trust the result (report.json's trust flags: one_click, small, "
                    "atlas_clicks_apart, moved_from_atlas, moved_to_click, cut_by_image_side, leaked), separated by spaces, "
                    "or n/a.",

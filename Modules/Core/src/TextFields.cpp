@@ -66,8 +66,12 @@ std::string wrapped(const std::string& text, std::size_t columns) {
     first = false;
     while (line.size() > columns) {
       const std::size_t space = line.rfind(' ', columns);
-      const std::size_t end = space == std::string::npos || space == 0 ? columns : space;
-      out += line.substr(0, end) + '\n';
+      std::size_t end = space == std::string::npos || space == 0 ? columns : space;
+      // A cut inside a word does not split a UTF-8 character's bytes.
+      while (end > 1 && (static_cast<unsigned char>(line[end]) & 0xC0) == 0x80) --end;
+      std::size_t kept = end;
+      while (kept > 0 && line[kept - 1] == ' ') --kept;
+      out += line.substr(0, kept) + '\n';
       const std::size_t next = line.find_first_not_of(' ', end);
       line = next == std::string::npos ? std::string() : line.substr(next);
     }

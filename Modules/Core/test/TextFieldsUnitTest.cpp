@@ -53,7 +53,6 @@ TEST(TextFields, SplitCsvFieldsKeepsQuotedSeparators) {
   EXPECT_EQ(splitCsvFields("", ','), (Fields{""}));
 }
 
-// ITK's and VTK's messages name the object that failed by its address.
 TEST(TextFields, WrappedBreaksLongLinesAtSpaces) {
   EXPECT_EQ(wrapped("short  |  line", 20), "short  |  line");  // inner spaces kept
   EXPECT_EQ(wrapped("not saved: /a/long/path.mrk.json holds 2 lists", 22),
@@ -61,8 +60,11 @@ TEST(TextFields, WrappedBreaksLongLinesAtSpaces) {
   EXPECT_EQ(wrapped("abcdefghij", 4), "abcd\nefgh\nij");  // no space: cut
   EXPECT_EQ(wrapped("one\ntwo three", 5), "one\ntwo\nthree");
   EXPECT_EQ(wrapped("", 5), "");
+  EXPECT_EQ(wrapped("abc    def", 5), "abc\ndef");  // the break's spaces dropped
+  EXPECT_EQ(wrapped("/home/jos\xc3\xa9/x", 10), "/home/jos\n\xc3\xa9/x");  // not inside a character
 }
 
+// ITK's and VTK's messages name the object that failed by its address.
 TEST(TextFields, AfterObjectAddressKeepsTheReason) {
   EXPECT_EQ(afterObjectAddress("vtkXMLDataParser (0x55bb834416e0): Error parsing XML"), "Error parsing XML");
   EXPECT_EQ(afterObjectAddress("itk::ERROR: NrrdImageIO(0x5561): Read: Error reading x.nrrd:"),

@@ -59,9 +59,31 @@ struct LandmarkEdits {
   int dragView = -1;    // slice view a landmark is being dragged in
   bool moved = false;   // the dragged landmark moved
 
+  // A placed landmark's name takes a number no landmark of the file or of
+  // this session has had, so that saving never gives it the file entry
+  // (id, description) of one deleted (updateLandmarks matches by name).
   void add(const Vector3& p) {
-    landmarks.push_back({"P-" + std::to_string(landmarks.size() + 1), p});
+    nextNumber = std::max(nextNumber, numberAfter(landmarks));
+    landmarks.push_back({"P-" + std::to_string(nextNumber++), p});
     selected = static_cast<int>(landmarks.size()) - 1;
+  }
+  void replace(std::vector<Landmark> loaded) {
+    landmarks = std::move(loaded);
+    nextNumber = std::max(nextNumber, numberAfter(landmarks));
+  }
+  int nextNumber = 1;
+
+  // One past the largest n of the names "P-n" and "F-n" among `marks`.
+  static int numberAfter(const std::vector<Landmark>& marks) {
+    int after = 1;
+    for (const Landmark& l : marks) {
+      if (l.label.size() < 3 || (l.label[0] != 'P' && l.label[0] != 'F') || l.label[1] != '-') continue;
+      const std::string digits = l.label.substr(2);
+      if (digits.size() > 6 || !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+        continue;
+      after = std::max(after, std::stoi(digits) + 1);
+    }
+    return after;
   }
 };
 
@@ -206,7 +228,7 @@ struct Viewer::Impl {
 
   void load() {
     try {
-      edits.landmarks = readLandmarks(input.landmarksPath);
+      edits.replace(readLandmarks(input.landmarksPath));
       edits.selected = -1;
       message = "loaded " + std::to_string(edits.landmarks.size()) + " landmarks from " + input.landmarksPath;
       landmarksChanged();
@@ -452,7 +474,7 @@ vtkStandardNewMacro(ViewerStyle);
 
 Viewer::Impl::Impl(ViewerInput in)
     : input(std::move(in)), slices(input.image), fit(input.image, input.segment, input.initialFraction, input.pullStiffness) {
-  edits.landmarks = input.landmarks;
+  edits.replace(input.landmarks);
   window->SetSize(1200, 900);
   window->SetMultiSamples(0);
   window->SetWindowName("DynSub");

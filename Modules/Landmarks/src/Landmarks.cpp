@@ -274,26 +274,40 @@ nlohmann::json markupsPoint(const std::string& id, const std::string& label, con
           {"positionStatus", "defined"}};
 }
 
-// The index in `markups` of the one point list or curve with placed points,
-// else of the first point list or curve (as readLandmarkLists picks), or -1.
+// A control point's positionStatus and label as the reader takes them (it
+// has checked them on placed points): "defined" when absent, and for a
+// point without a label the name the reader gives it ("F-" and its number).
+std::string statusOf(const nlohmann::json& point) {
+  const auto at = point.find("positionStatus");
+  return at != point.end() && at->is_string() ? at->get<std::string>() : "defined";
+}
+std::string readerLabel(const nlohmann::json& point, std::size_t index) {
+  const auto at = point.find("label");
+  return at != point.end() && at->is_string() ? at->get<std::string>() : "F-" + std::to_string(index + 1);
+}
+
+// The index in `markups` of the one point list or curve with placed points;
+// else of the first with any control point, else of the first (as
+// readLandmarkLists picks); -1 when there is none.
 int editedMarkup(const std::string& path, const nlohmann::json& markups) {
-  int first = -1, placed = -1, lists = 0;
+  int first = -1, listed = -1, placed = -1, lists = 0;
   for (std::size_t m = 0; m < markups.size(); ++m) {
     const nlohmann::json& markup = markups[m];
     if (!onStructure(path, markup.value("type", std::string("Fiducial")))) continue;
     if (first < 0) first = static_cast<int>(m);
-    const nlohmann::json points = markup.value("controlPoints", nlohmann::json::array());
-    const bool hasPlaced = std::any_of(points.begin(), points.end(), [](const nlohmann::json& point) {
-      return point.value("positionStatus", std::string("defined")) == "defined";
-    });
-    if (!hasPlaced) continue;
+    const auto points = markup.find("controlPoints");
+    if (points == markup.end() || points->empty()) continue;
+    if (listed < 0) listed = static_cast<int>(m);
+    if (std::none_of(points->begin(), points->end(),
+                     [](const nlohmann::json& point) { return statusOf(point) == "defined"; }))
+      continue;
     ++lists;
     placed = static_cast<int>(m);
   }
   if (lists > 1)
     throw Error(path, "holds " + std::to_string(lists) +
                           " lists of points; only a file with one list can take one list's edited points");
-  return placed >= 0 ? placed : first;
+  return placed >= 0 ? placed : listed >= 0 ? listed : first;
 }
 
 // A label as a field of a .csv or .fcsv row: quoted when it holds a comma,
@@ -416,19 +430,20 @@ void updateLandmarks(const std::vector<Landmark>& landmarks, const std::string& 
   const nlohmann::json before = markup.value("controlPoints", nlohmann::json::array());
 
   // A point whose label is kept keeps its id, description and flags; the
-  // names Slicer lists but has not placed stay, after the placed points.
+  // names Slicer lists but has not placed (or is placing) stay, after the
+  // placed points.
   std::vector<bool> taken(before.size(), false);
   std::vector<std::string> ids;
   for (const nlohmann::json& point : before)
-    if (point.contains("id") && point["id"].is_string()) ids.push_back(point["id"].get<std::string>());
+    if (point.contains("id")) ids.push_back(point["id"].is_string() ? point["id"].get<std::string>() : point["id"].dump());
   nlohmann::json points = nlohmann::json::array();
   for (std::size_t i = 0; i < landmarks.size(); ++i) {
     if (!landmarks[i].position.allFinite()) throw Error(path, "landmark '" + landmarks[i].label + "' is not finite");
     const std::string label = labelOf(landmarks, i);
     const Vector3 p = ras ? flipXY(landmarks[i].position) : landmarks[i].position;
     std::size_t match = 0;
-    while (match < before.size() && (taken[match] || before[match].value("label", std::string()) != label ||
-                                     before[match].value("positionStatus", std::string("defined")) != "defined"))
+    while (match < before.size() &&
+           (taken[match] || statusOf(before[match]) != "defined" || readerLabel(before[match], match) != label))
       ++match;
     if (match < before.size()) {
       taken[match] = true;
@@ -443,7 +458,7 @@ void updateLandmarks(const std::vector<Landmark>& landmarks, const std::string& 
     points.push_back(markupsPoint(ids.back(), label, p));
   }
   for (const nlohmann::json& point : before)
-    if (point.value("positionStatus", std::string("defined")) == "undefined") points.push_back(point);
+    if (statusOf(point) != "defined") points.push_back(point);
   markup["controlPoints"] = points;
 
   requireWritableDirectoryFor(path);

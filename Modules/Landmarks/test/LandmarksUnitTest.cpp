@@ -217,16 +217,21 @@ TEST(Landmarks, UpdatingAMarkupsFileKeepsWhatElseItHolds) {
        {"id": "7", "label": "head", "description": "checked twice", "position": [1, 2, 3], "locked": true,
         "positionStatus": "defined"},
        {"id": "8", "label": "gone", "position": [4, 5, 6], "positionStatus": "defined"},
-       {"id": "9", "label": "tail", "position": [0, 0, 0], "positionStatus": "undefined"}],
+       {"id": "9", "label": "tail", "position": [0, 0, 0], "positionStatus": "undefined"},
+       {"id": 10, "label": 5, "positionStatus": "undefined"},
+       {"id": "11", "description": "no label", "position": [7, 8, 9]}],
      "measurements": [], "display": {"selectedColor": [0.1, 0.9, 0.2], "glyphScale": 2.5}}]})";
-  // "head" moved (LPS), "gone" deleted, "new" placed.
-  updateLandmarks({{"head", Vector3(-10, -20, 30)}, {"new", Vector3(-1, -1, 1)}}, json.string());
+  // The unlabelled point reads as F-5 (its place in the list) and keeps its
+  // entry under that name. "head" moved (LPS), "gone" deleted, "new" placed.
+  ASSERT_EQ(readLandmarks(json.string()).back().label, "F-5");
+  updateLandmarks({{"head", Vector3(-10, -20, 30)}, {"new", Vector3(-1, -1, 1)}, {"F-5", Vector3(-7, -8, 9)}},
+                  json.string());
 
   const std::vector<LandmarkList> lists = readLandmarkLists(json.string());
   ASSERT_EQ(lists.size(), 1u);
   EXPECT_EQ(lists[0].name, "caudate");
   EXPECT_EQ(lists[0].stated, CoordinateSystem::RAS);
-  ASSERT_EQ(lists[0].landmarks.size(), 2u);
+  ASSERT_EQ(lists[0].landmarks.size(), 3u);
   EXPECT_EQ(lists[0].landmarks[0].label, "head");
   EXPECT_LT((lists[0].landmarks[0].position - Vector3(-10, -20, 30)).norm(), 1e-12);
   EXPECT_EQ(lists[0].landmarks[1].label, "new");
@@ -237,7 +242,9 @@ TEST(Landmarks, UpdatingAMarkupsFileKeepsWhatElseItHolds) {
   EXPECT_NE(text.find("\"checked twice\""), std::string::npos);    // the moved point's description
   EXPECT_NE(text.find("\"label\": \"tail\""), std::string::npos);  // the name not yet placed
   EXPECT_EQ(text.find("\"gone\""), std::string::npos);
+  EXPECT_NE(text.find("\"no label\""), std::string::npos);         // the unlabelled point's description
   EXPECT_EQ(text.find("\"id\": \"8\""), std::string::npos);  // a new point takes no id the list used
+  EXPECT_EQ(text.find("\"id\": \"10\""), std::string::npos);  // nor a number one
 
   // A legacy file keeps its coordinate system; a missing one is written.
   const fs::path fcsv = scratch("slicer.fcsv");

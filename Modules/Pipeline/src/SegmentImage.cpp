@@ -295,7 +295,7 @@ TrustEvidence trustEvidence(const Volume& image, const SegmentInputs& in, const 
     e.sliceNormal = image.geometry.direction.col(ends.axis).normalized();
     e.onSlice = kOnSliceVoxels * image.geometry.spacing(ends.axis);
   }
-  e.outsideRegion = outcome.result.outsideRegion;
+  e.outsideRegion = outcome.result.leakedInImage;
   e.atImageSide = outcome.result.atImageSide;
   return e;
 }

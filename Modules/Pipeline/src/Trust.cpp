@@ -142,13 +142,14 @@ std::vector<TrustFlag> trustFlags(const TrustMeasures& m, const TrustEvidence& e
                          "hemisphere or the other convention (RAS read as LPS) moves it there; "
                          "check the click"});
   // A structure the scan cuts also leaves the region, at the image's side,
-  // where a wider region cannot follow: that is said, and not a leak.
+  // where a wider region cannot follow: that is said, and not counted as a
+  // leak (evidence.outsideRegion leaves it out).
   if (m.atImageSide > kAtImageSideAbove)
     flags.push_back({"cut_by_image_side", fixed(100 * m.atImageSide, 1) +
                                               " % of the surface lies at the image's side or beyond it: the "
                                               "structure probably continues past the scan, and its volume is a "
                                               "lower bound"});
-  else if (m.outsideRegion > kLeakedAbove)
+  if (m.outsideRegion > kLeakedAbove)
     flags.push_back({"leaked", fixed(100 * m.outsideRegion, 0) +
                                    " % of the surface left the region of interest, where no image force holds it"});
   return flags;

@@ -149,7 +149,7 @@ TEST(Trust, EachFlagComesFromItsOwnMeasure) {
   }
   {  // a structure the image's side cuts is said to be, not to have leaked
     TrustEvidence e;
-    e.outsideRegion = 0.2;
+    e.outsideRegion = 0.01;  // away from the side
     e.atImageSide = 0.15;
     const std::vector<TrustFlag> flags = trustFlags(measureTrust(result, kBall, e), e);
     ASSERT_EQ(flags.size(), 1u);

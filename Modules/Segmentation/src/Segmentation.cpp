@@ -338,18 +338,21 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
   const TriangleSurface& triangles = result.surface;
   result.initialVolume = initialVolume.get();
   result.volume = enclosedVolume(triangles);
-  Eigen::Index outside = 0, atSide = 0;
+  Eigen::Index outside = 0, atSide = 0, leaked = 0;
   const ImageGeometry& whole = region.wholeImage();
   const Eigen::Array3d sideAt = Eigen::Array3d(whole.size[0], whole.size[1], whole.size[2]) - 1.5;
   for (Eigen::Index p = 0; p < triangles.points.rows(); ++p) {
     const Vector3 point = triangles.points.row(p).transpose();
-    outside += !region.covers(point);
     const Eigen::Array3d index = whole.toIndex(point).array();
-    atSide += (index < 0.5).any() || (index > sideAt).any();
+    const bool out = !region.covers(point), side = (index < 0.5).any() || (index > sideAt).any();
+    outside += out;
+    atSide += side;
+    leaked += out && !side;
   }
   const double points = static_cast<double>(std::max<Eigen::Index>(triangles.points.rows(), 1));
   result.outsideRegion = static_cast<double>(outside) / points;
   result.atImageSide = static_cast<double>(atSide) / points;
+  result.leakedInImage = static_cast<double>(leaked) / points;
   std::ostringstream warning;
   warning << std::fixed << std::setprecision(0);
   const bool collapsed = result.volume < kCollapsedBelow * result.initialVolume;
@@ -401,8 +404,9 @@ SegmentResult segment(const Volume& image, const std::vector<Landmark>& landmark
             << std::setprecision(0);
     result.warnings.push_back(warning.str());
     warning.str("");
-  } else if (result.outsideRegion > kLeakedAbove) {
-    warning << 100 * result.outsideRegion
+  }
+  if (result.leakedInImage > kLeakedAbove) {
+    warning << 100 * result.leakedInImage
             << " % of the surface left the region of interest, where no image force holds it: it has "
                "probably leaked (add landmarks where it escaped, or raise --margin)";
     result.warnings.push_back(warning.str());

@@ -25,9 +25,10 @@ std::vector<std::string> splitCsvFields(const std::string& line, char separator)
 // `text` without the blanks and tabs at its ends.
 std::string trimmed(const std::string& text);
 
-// `text` with each line longer than `columns` characters broken at its last
+// `text` with each line longer than `columns` bytes broken at its last
 // space that keeps the first part within them (cut at `columns` where it
-// has none), and the break's spaces dropped; the spaces within a line stay.
+// has none, never inside a UTF-8 character), and the break's spaces
+// dropped; the spaces within a line stay.
 std::string wrapped(const std::string& text, std::size_t columns);
 
 // `items` one after another with `separator` between them (lists in messages).

@@ -58,9 +58,11 @@ void writeLandmarks(const std::vector<Landmark>& landmarks, const std::string& p
 // keeping what else the file holds, so that a file 3D Slicer wrote goes back
 // to Slicer whole: a .mrk.json's other markups, the list's name, display
 // (colour), coordinate system and measurements, and the names Slicer lists
-// but has not placed; a point whose label is unchanged keeps its id,
-// description and flags. A .fcsv or .csv keeps its coordinate system. A
-// file that does not exist is written as writeLandmarks writes it (LPS).
+// but has not placed (after the placed points); a point whose label is
+// unchanged keeps its id, description and flags. A .fcsv keeps its
+// coordinate system; a .csv is written as writeLandmarks writes one (x, y,
+// z in LPS). A file that does not exist is written as writeLandmarks writes
+// it (LPS).
 // Throws dynsub::Error naming the file as readLandmarks does, and for a file
 // with more than one list of points.
 void updateLandmarks(const std::vector<Landmark>& landmarks, const std::string& path);

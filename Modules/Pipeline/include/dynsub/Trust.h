@@ -25,7 +25,9 @@ struct TrustEvidence {
   std::vector<double> clicksToAtlas;  // mm: each click's distance to the carried label's boundary
   bool oneClick = false;              // a start from one click inside with nothing else: no clicks, no atlas
   double march = 0;                   // mm: the longest the slice-end march carried past the clicked slices
-  double outsideRegion = 0;           // the share of the result outside the region of interest
+  // The share of the result outside the region of interest, away from the
+  // image's side (SegmentResult::leakedInImage).
+  double outsideRegion = 0;
   double atImageSide = 0;             // the share within a voxel of the image's side or beyond it
   // mm: how far the atlas's structure was moved so that the click inside
   // (--inside) lies in it; NaN without such a click.
@@ -65,7 +67,7 @@ constexpr double kTrustMovedToClick = 4.0;  // mm, insideShift (flagged beyond i
 
 struct TrustFlag {
   // A stable key: one_click, small, atlas_clicks_apart, moved_from_atlas,
-  // moved_to_click, leaked.
+  // moved_to_click, cut_by_image_side, leaked.
   std::string name;
   std::string message;  // what it means, and what to do
 };

@@ -78,13 +78,18 @@ struct SegmentResult {
   // enclosed by the initial model and by the result (mm^3), the share of the
   // result's surface outside the region of interest, where no image force
   // acts, and a warning for each of: a collapse (the result encloses less
-  // than kCollapsedBelow of the initial model's volume), a leak (more than
-  // kLeakedAbove of its surface left the region).
+  // than kCollapsedBelow of the initial model's volume), a cut by the
+  // image's side (more than kAtImageSideAbove of the surface within a voxel
+  // of it), a leak (more than kLeakedAbove of the surface left the region
+  // elsewhere than at the image's side, where a wider region cannot follow).
   double initialVolume = 0, volume = 0;
   double outsideRegion = 0;  // fraction of the tessellation's points
   // Fraction of the tessellation's points within a voxel of the image's
   // side or beyond it: where the scan's field of view may cut the structure.
   double atImageSide = 0;
+  // Fraction of the tessellation's points outside the region but not at
+  // the image's side: the leak.
+  double leakedInImage = 0;
   // With the edge potential: the share of the surface within a voxel of an
   // edge (held by the image rather than by tension and landmarks alone), and
   // each landmark's distance to the nearest edge (mm; a click beyond the
