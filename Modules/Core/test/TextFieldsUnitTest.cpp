@@ -60,7 +60,7 @@ TEST(TextFields, WrappedBreaksLongLinesAtSpaces) {
   EXPECT_EQ(wrapped("abcdefghij", 4), "abcd\nefgh\nij");  // no space: cut
   EXPECT_EQ(wrapped("one\ntwo three", 5), "one\ntwo\nthree");
   EXPECT_EQ(wrapped("", 5), "");
-  EXPECT_EQ(wrapped("abc    def", 5), "abc\ndef");  // the break's spaces dropped
+  EXPECT_EQ(wrapped("abc    def", 5), "abc\ndef");                         // the break's spaces dropped
   EXPECT_EQ(wrapped("/home/jos\xc3\xa9/x", 10), "/home/jos\n\xc3\xa9/x");  // not inside a character
 }
 

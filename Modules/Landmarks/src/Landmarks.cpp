@@ -435,7 +435,8 @@ void updateLandmarks(const std::vector<Landmark>& landmarks, const std::string& 
   std::vector<bool> taken(before.size(), false);
   std::vector<std::string> ids;
   for (const nlohmann::json& point : before)
-    if (point.contains("id")) ids.push_back(point["id"].is_string() ? point["id"].get<std::string>() : point["id"].dump());
+    if (point.contains("id"))
+      ids.push_back(point["id"].is_string() ? point["id"].get<std::string>() : point["id"].dump());
   nlohmann::json points = nlohmann::json::array();
   for (std::size_t i = 0; i < landmarks.size(); ++i) {
     if (!landmarks[i].position.allFinite()) throw Error(path, "landmark '" + landmarks[i].label + "' is not finite");

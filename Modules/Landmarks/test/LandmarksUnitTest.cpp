@@ -237,13 +237,13 @@ TEST(Landmarks, UpdatingAMarkupsFileKeepsWhatElseItHolds) {
   EXPECT_EQ(lists[0].landmarks[1].label, "new");
   EXPECT_LT((lists[0].landmarks[1].position - Vector3(-1, -1, 1)).norm(), 1e-12);
   const std::string text = contents(json);
-  EXPECT_NE(text.find("\"box\""), std::string::npos);             // the other markup
+  EXPECT_NE(text.find("\"box\""), std::string::npos);              // the other markup
   EXPECT_NE(text.find("\"glyphScale\": 2.5"), std::string::npos);  // the list's display
   EXPECT_NE(text.find("\"checked twice\""), std::string::npos);    // the moved point's description
   EXPECT_NE(text.find("\"label\": \"tail\""), std::string::npos);  // the name not yet placed
   EXPECT_EQ(text.find("\"gone\""), std::string::npos);
-  EXPECT_NE(text.find("\"no label\""), std::string::npos);         // the unlabelled point's description
-  EXPECT_EQ(text.find("\"id\": \"8\""), std::string::npos);  // a new point takes no id the list used
+  EXPECT_NE(text.find("\"no label\""), std::string::npos);    // the unlabelled point's description
+  EXPECT_EQ(text.find("\"id\": \"8\""), std::string::npos);   // a new point takes no id the list used
   EXPECT_EQ(text.find("\"id\": \"10\""), std::string::npos);  // nor a number one
 
   // A legacy file keeps its coordinate system; a missing one is written.

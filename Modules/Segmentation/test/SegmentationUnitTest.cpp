@@ -252,10 +252,9 @@ TEST(Segment, RefusesLandmarksAndModelsOutsideTheImage) {
 TEST(Segment, AStructureCutByTheImageSideIsSaidToBe) {
   const Ellipsoid shape{Vector3(0, 0, 0), Vector3(10, 10, 10)};
   for (const bool cut : {true, false}) {
-    const ImageGeometry grid = cut ? gridAround(Vector3(-10, 0, 0), Vector3(24, 34, 34), Vector3(1, 1, 1),
-                                                Matrix3::Identity())
-                                   : gridAround(shape.centre, Vector3(34, 34, 34), Vector3(1, 1, 1),
-                                                Matrix3::Identity());
+    const ImageGeometry grid =
+        cut ? gridAround(Vector3(-10, 0, 0), Vector3(24, 34, 34), Vector3(1, 1, 1), Matrix3::Identity())
+            : gridAround(shape.centre, Vector3(34, 34, 34), Vector3(1, 1, 1), Matrix3::Identity());
     const Phantom phantom = makePhantom(grid, [&](const Vector3& x) { return shape.inside(x); }, 2.0, 3);
     // Eight clicks on each of four sagittal slices, the last one the
     // image's last (x = 2 mm), as a user clicks a structure to the scan's end.

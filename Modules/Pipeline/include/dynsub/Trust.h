@@ -28,7 +28,7 @@ struct TrustEvidence {
   // The share of the result outside the region of interest, away from the
   // image's side (SegmentResult::leakedInImage).
   double outsideRegion = 0;
-  double atImageSide = 0;             // the share within a voxel of the image's side or beyond it
+  double atImageSide = 0;  // the share within a voxel of the image's side or beyond it
   // mm: how far the atlas's structure was moved so that the click inside
   // (--inside) lies in it; NaN without such a click.
   double insideShift = std::numeric_limits<double>::quiet_NaN();
