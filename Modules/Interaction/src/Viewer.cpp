@@ -63,7 +63,6 @@ struct LandmarkEdits {
   // this session has had, so that saving never gives it the file entry
   // (id, description) of one deleted (updateLandmarks matches by name).
   void add(const Vector3& p) {
-    nextNumber = std::max(nextNumber, numberAfter(landmarks));
     landmarks.push_back({"P-" + std::to_string(nextNumber++), p});
     selected = static_cast<int>(landmarks.size()) - 1;
   }

@@ -89,9 +89,9 @@ nlohmann::json readMarkupsDocument(const std::string& path, std::ifstream& in) {
   return document;
 }
 
-// Every point list and curve of the file, in order, with or without points.
-std::vector<LandmarkList> readMarkupsJson(const std::string& path, std::ifstream& in) {
-  const nlohmann::json document = readMarkupsDocument(path, in);
+// Every point list and curve of a markups file's document, in order, with
+// or without points.
+std::vector<LandmarkList> markupsLists(const std::string& path, const nlohmann::json& document) {
   std::vector<LandmarkList> lists;
   std::vector<std::string> leftOut;  // the types of the markups that give no landmarks
   int markupNumber = 0;
@@ -327,7 +327,7 @@ namespace {
 std::vector<LandmarkList> readAllLists(const std::string& path) {
   const Format format = formatOf(path);
   std::ifstream in = openForReading(path);
-  if (format == Format::MarkupsJson) return readMarkupsJson(path, in);
+  if (format == Format::MarkupsJson) return markupsLists(path, readMarkupsDocument(path, in));
   LandmarkList list;
   list.landmarks = format == Format::Fcsv ? readFcsv(path, in, list.stated) : readCsv(path, in, list.stated);
   return {list};
@@ -418,10 +418,10 @@ void updateLandmarks(const std::vector<Landmark>& landmarks, const std::string& 
     readLandmarks(path, &stated);
     return writeLandmarks(landmarks, path, stated);
   }
-  readLandmarkLists(path);  // the reader's checks: a file it refuses is not rewritten
   std::ifstream in = openForReading(path);
   nlohmann::json document = readMarkupsDocument(path, in);
   in.close();
+  markupsLists(path, document);  // the reader's checks: a file it refuses is not rewritten
   nlohmann::json& markups = document["markups"];
   const int edited = editedMarkup(path, markups);
   if (edited < 0) return writeLandmarks(landmarks, path);

@@ -295,8 +295,9 @@ TrustEvidence trustEvidence(const Volume& image, const SegmentInputs& in, const 
     e.sliceNormal = image.geometry.direction.col(ends.axis).normalized();
     e.onSlice = kOnSliceVoxels * image.geometry.spacing(ends.axis);
   }
-  e.outsideRegion = outcome.result.leakedInImage;
+  e.outsideRegion = outcome.result.outsideRegion;
   e.atImageSide = outcome.result.atImageSide;
+  e.leakedInImage = outcome.result.leakedInImage;
   return e;
 }
 

@@ -91,6 +91,7 @@ TrustMeasures measureTrust(const TriangleSurface& result, double resultVolume, c
   TrustMeasures m;
   m.outsideRegion = evidence.outsideRegion;
   m.atImageSide = evidence.atImageSide;
+  m.leakedInImage = evidence.leakedInImage;
   m.insideShift = evidence.insideShift;
   const MatrixX3 clicks = rows(evidence.clicks), outline = rows(evidence.outline);
   const double volume = evidence.volume > 0 ? evidence.volume : slicesVolume(evidence);
@@ -143,14 +144,14 @@ std::vector<TrustFlag> trustFlags(const TrustMeasures& m, const TrustEvidence& e
                          "check the click"});
   // A structure the scan cuts also leaves the region, at the image's side,
   // where a wider region cannot follow: that is said, and not counted as a
-  // leak (evidence.outsideRegion leaves it out).
+  // leak.
   if (m.atImageSide > kAtImageSideAbove)
     flags.push_back({"cut_by_image_side", fixed(100 * m.atImageSide, 1) +
                                               " % of the surface lies at the image's side or beyond it: the "
                                               "structure probably continues past the scan, and its volume is a "
                                               "lower bound"});
-  if (m.outsideRegion > kLeakedAbove)
-    flags.push_back({"leaked", fixed(100 * m.outsideRegion, 0) +
+  if (m.leakedInImage > kLeakedAbove)
+    flags.push_back({"leaked", fixed(100 * m.leakedInImage, 0) +
                                    " % of the surface left the region of interest, where no image force holds it"});
   return flags;
 }

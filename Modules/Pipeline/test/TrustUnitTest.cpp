@@ -141,7 +141,7 @@ TEST(Trust, EachFlagComesFromItsOwnMeasure) {
   {  // one click and nothing else; a leak out of the region
     TrustEvidence e;
     e.oneClick = true;
-    e.outsideRegion = 0.2;
+    e.outsideRegion = e.leakedInImage = 0.2;
     const std::vector<TrustFlag> flags = trustFlags(measureTrust(result, kBall, e), e);
     EXPECT_TRUE(has(flags, "one_click"));
     EXPECT_TRUE(has(flags, "leaked"));
@@ -149,7 +149,8 @@ TEST(Trust, EachFlagComesFromItsOwnMeasure) {
   }
   {  // a structure the image's side cuts is said to be, not to have leaked
     TrustEvidence e;
-    e.outsideRegion = 0.01;  // away from the side
+    e.outsideRegion = 0.2;  // most of it beyond the side
+    e.leakedInImage = 0.01;
     e.atImageSide = 0.15;
     const std::vector<TrustFlag> flags = trustFlags(measureTrust(result, kBall, e), e);
     ASSERT_EQ(flags.size(), 1u);

@@ -6,7 +6,8 @@
 // Bindings: the on-screen help behind `h` (kHelp in Viewer.cpp) is their one
 // list. In short: clicks on a slice place, select, move and delete
 // landmarks (saved in place of the file's points, updateLandmarks); Ctrl +
-// drag on the 3D surface pulls it with an interactive spring; space starts, pauses and resumes fitting.
+// drag on the 3D surface pulls it with an interactive spring; space starts,
+// pauses and resumes fitting.
 // Fitting runs on a worker thread: the first fit starts from the landmarks'
 // initial model (at least 4 landmarks), and the surface is redrawn in every
 // view as it moves (about 25 times a second). Editing the landmarks while

@@ -25,10 +25,9 @@ struct TrustEvidence {
   std::vector<double> clicksToAtlas;  // mm: each click's distance to the carried label's boundary
   bool oneClick = false;              // a start from one click inside with nothing else: no clicks, no atlas
   double march = 0;                   // mm: the longest the slice-end march carried past the clicked slices
-  // The share of the result outside the region of interest, away from the
-  // image's side (SegmentResult::leakedInImage).
-  double outsideRegion = 0;
-  double atImageSide = 0;  // the share within a voxel of the image's side or beyond it
+  double outsideRegion = 0;           // the share of the result outside the region of interest
+  double atImageSide = 0;             // the share within a voxel of the image's side or beyond it
+  double leakedInImage = 0;           // the share outside the region away from the image's side
   // mm: how far the atlas's structure was moved so that the click inside
   // (--inside) lies in it; NaN without such a click.
   double insideShift = std::numeric_limits<double>::quiet_NaN();
@@ -49,6 +48,7 @@ struct TrustMeasures {
   double insideShift = kNone;           // mm: evidence.insideShift
   double outsideRegion = 0;
   double atImageSide = 0;
+  double leakedInImage = 0;
 };
 
 // The thresholds, set on the tuning subjects of both generated groups
