@@ -576,8 +576,8 @@ GROUP_COLUMNS = {
     "seconds": "Wall-clock seconds of the structure's segmentation (its last pass, when segmented with others).",
     "warnings": "dynsub's warnings (a collapse, a leak, a cut by the image's side, landmarks off edges), "
                 "separated by '; '.",
-    "trust_flags": "Why not to trust the result (report.json's trust flags: one_click, small, "
-                   "atlas_clicks_apart, moved_from_atlas, moved_to_click, cut_by_image_side, leaked), separated by spaces, "
+    "trust_flags": "Why not to trust the result (report.json's trust flags: one_click, collapsed, "
+                   "small, atlas_clicks_apart, moved_from_atlas, moved_to_click, cut_by_image_side, leaked), separated by spaces, "
                    "or n/a.",
     "message": "Why a job failed.",
     "dseg": "The labelmap holding the structure, relative to the dataset root.",

@@ -115,6 +115,28 @@ ok = r["dice"] >= 0.58 and r["seed"]["springs"] == "boundary points" and not r["
 ok = ok and not r["trust"]["trusted"] and [f["name"] for f in r["trust"]["flags"]] == ["one_click"]
 sys.exit(0 if ok and r["seed"]["region_volume_mm3"] > 1000 and r["landmark_count"] == 0 else 1)
 PY
+# Four of the demo's clicks, two on each of two slices, outline no volume:
+# the surface collapses (Dice 0.007), and the report must not call it trusted.
+python3 - "$DATA/Landmarks/caudate_left.mrk.json" "$work/four.mrk.json" <<'PY'
+import json, sys
+document = json.load(open(sys.argv[1]))
+points = document["markups"][0]["controlPoints"]
+slices = sorted({round(p["position"][1], 1) for p in points})
+chosen = [p for s in (slices[1], slices[-2]) for p in [q for q in points if round(q["position"][1], 1) == s][:2]]
+document["markups"][0]["controlPoints"] = chosen
+json.dump(document, open(sys.argv[2], "w"))
+PY
+"$DYNSUB" segment "$templates/ch2.nii.gz" --landmarks "$work/four.mrk.json" --no-figures --out "$work/four" \
+  >"$work/four.log" 2>&1
+check "four clicks: segment succeeds" test $? -eq 0
+check "four clicks: the collapse is flagged" python3 - "$work/four" <<'PY'
+import json, sys
+trust = json.load(open(sys.argv[1] + "/report.json"))["trust"]
+print(trust)
+sys.exit(0 if not trust["trusted"] and "collapsed" in [f["name"] for f in trust["flags"]]
+         and trust["initial_volume_ratio"] < 0.5 else 1)
+PY
+
 for bad in seed:15.4,-1.5 seed:15.4,-1.5,16,2 seed:a,b,c seed:1500,0,0; do
   "$DYNSUB" segment "$templates/ch2.nii.gz" --init "$bad" --no-figures --out "$work/bad_seed" >"$work/bad.log" 2>&1
   check "--init $bad: a clear error, no output" bash -c "test $? -ne 0 && grep -q 'seed' '$work/bad.log' && test ! -e '$work/bad_seed'"

@@ -287,6 +287,7 @@ TrustEvidence trustEvidence(const Volume& image, const SegmentInputs& in, const 
     e.clicksToAtlas = distancesToCarried(*outcome.carried, e.clicks);
     if (in.inside) e.insideShift = outcome.carried->shift.norm();
   }
+  e.initialVolume = outcome.result.initialVolume;
   e.oneClick = outcome.seed && in.landmarks.empty();
   const SliceEnds& ends = outcome.result.sliceEnds;
   for (const SliceEnd& end : ends.ends)
@@ -307,6 +308,7 @@ Report trustReport(const TrustMeasures& m, const std::vector<TrustFlag>& flags) 
     if (std::isfinite(value)) r.set(key, value);
   };
   set("volume_ratio", m.volumeRatio);
+  set("initial_volume_ratio", m.initialRatio);
   set("atlas_outline_distance_mm", m.outlineDistance);
   set("clicks_to_atlas_mm", m.clicksToAtlas);
   set("farthest_from_evidence_mm", m.farthestFromEvidence);

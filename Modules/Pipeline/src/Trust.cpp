@@ -96,6 +96,7 @@ TrustMeasures measureTrust(const TriangleSurface& result, double resultVolume, c
   const MatrixX3 clicks = rows(evidence.clicks), outline = rows(evidence.outline);
   const double volume = evidence.volume > 0 ? evidence.volume : slicesVolume(evidence);
   if (volume > 0) m.volumeRatio = resultVolume / volume;
+  if (evidence.initialVolume > 0) m.initialRatio = resultVolume / evidence.initialVolume;
   MatrixX3 points(clicks.rows() + outline.rows(), 3);
   points << clicks, outline;
   if (points.rows() > 0 && result.points.rows() > 0) {
@@ -121,6 +122,11 @@ std::vector<TrustFlag> trustFlags(const TrustMeasures& m, const TrustEvidence& e
                      "one click inside and nothing else: only the click's tissue bounds the result, which on the "
                      "evaluation's subjects is wrong (Dice under 0.7) more often than not; add boundary clicks on "
                      "a few slices, or an atlas (--init atlas --inside)"});
+  // The threshold of segment()'s own warning (Segmentation.h).
+  if (m.initialRatio < kCollapsedBelow)
+    flags.push_back({"collapsed", "the result encloses " + fixed(100 * m.initialRatio, 0) +
+                                      " % of the initial model's volume: it has collapsed (give clicks on more "
+                                      "slices, or start closer to the structure's boundary)"});
   if (m.volumeRatio < kTrustSmallBelow)
     flags.push_back(
         {"small", "the result encloses " + fixed(100 * m.volumeRatio, 0) + " % of the volume of " +

@@ -157,6 +157,27 @@ TEST(Trust, EachFlagComesFromItsOwnMeasure) {
     EXPECT_EQ(flags[0].name, "cut_by_image_side");
     EXPECT_NE(flags[0].message.find("15.0 %"), std::string::npos) << flags[0].message;
   }
+  {  // four clicks outline no volume, but a surface that shrank from its start has collapsed
+    TrustEvidence e;
+    e.sliceNormal = Vector3::UnitZ();
+    e.onSlice = 0.25;
+    e.clicks = {{10, 0, -5}, {-10, 0, -5}, {0, 10, 5}, {0, -10, 5}};
+    e.initialVolume = kBall;
+    TrustMeasures m = measureTrust(result, 0.2 * kBall, e);
+    EXPECT_TRUE(std::isnan(m.volumeRatio));
+    EXPECT_DOUBLE_EQ(m.initialRatio, 0.2);
+    const std::vector<TrustFlag> flags = trustFlags(m, e);
+    ASSERT_EQ(flags.size(), 1u);
+    EXPECT_EQ(flags[0].name, "collapsed");
+    EXPECT_NE(flags[0].message.find("20 % of the initial model's volume"), std::string::npos) << flags[0].message;
+    // Half the start's volume is segment()'s own threshold: not below it.
+    EXPECT_TRUE(trustFlags(measureTrust(result, 0.5 * kBall, e), e).empty());
+    // Without the start's volume there is nothing to measure.
+    e.initialVolume = 0;
+    m = measureTrust(result, 0.2 * kBall, e);
+    EXPECT_TRUE(std::isnan(m.initialRatio));
+    EXPECT_TRUE(trustFlags(m, e).empty());
+  }
 }
 
 }  // namespace

@@ -22,6 +22,7 @@ struct TrustEvidence {
   double onSlice = 0;
   std::vector<Vector3> outline;       // the atlas prior's points on the carried label's boundary (may be empty)
   double volume = 0;                  // mm^3: the carried label's (0 without an atlas)
+  double initialVolume = 0;           // mm^3: the initial model's (0 when unknown)
   std::vector<double> clicksToAtlas;  // mm: each click's distance to the carried label's boundary
   bool oneClick = false;              // a start from one click inside with nothing else: no clicks, no atlas
   double march = 0;                   // mm: the longest the slice-end march carried past the clicked slices
@@ -41,6 +42,11 @@ struct TrustMeasures {
   // result encloses between the outermost clicked slices, if it follows the
   // clicks; the parts beyond them add to the result's).
   double volumeRatio = kNone;
+  // The result's volume over the initial model's. The clicks outline no
+  // volume when no two slices hold three clicks each (four clicks, or clicks
+  // off slices), but a surface that shrank to a fraction of where it started
+  // has collapsed whatever started it.
+  double initialRatio = kNone;
   double outlineDistance = kNone;       // mm: 90th percentile of the prior's points' distance to the result
   double clicksToAtlas = kNone;         // mm: 90th percentile of evidence.clicksToAtlas
   double farthestFromEvidence = kNone;  // mm: the result's point farthest from every click and prior point
@@ -66,8 +72,8 @@ constexpr double kTrustMovedFromAtlas = 4.5;    // mm, outlineDistance
 constexpr double kTrustMovedToClick = 4.0;  // mm, insideShift (flagged beyond it)
 
 struct TrustFlag {
-  // A stable key: one_click, small, atlas_clicks_apart, moved_from_atlas,
-  // moved_to_click, cut_by_image_side, leaked.
+  // A stable key: one_click, collapsed, small, atlas_clicks_apart,
+  // moved_from_atlas, moved_to_click, cut_by_image_side, leaked.
   std::string name;
   std::string message;  // what it means, and what to do
 };
