@@ -973,6 +973,8 @@ a = r['atlas']
 assert a['label_values'] == [73] and a['registration']['affine_iterations'] > 0, a
 assert len(a['inside_lps_mm']) == 3 and a['prior_points'] == 100, a
 assert r['dice'] > 0.7, r['dice']
+# An atlas start does not march: the report says what ran, not the option's default.
+assert r['parameters']['slice_ends'] is False and 'slice_ends' not in r, r['parameters']['slice_ends']
 # The atlas's start, on a subject it registers to, is trusted; its outline
 # lies near the result (the flag's threshold is 4.5 mm).
 t = r['trust']

@@ -38,10 +38,11 @@ std::vector<double> numbersAfter(const std::string& value, std::size_t prefix, i
   return v;
 }
 
-// Every row of the table with its value, then what the edge detector used
-// in the end: the reference (the image's when there were no points on the
-// boundary) and its thresholds.
-Report parametersReport(const SegmentParameters& parameters, const SegmentResult& result) {
+// Every row of the table with its value, then what the run used in the end:
+// whether the slice-end march ran (never from an atlas start, whatever the
+// option says), and the edge detector's reference (the image's when there
+// were no points on the boundary) and its thresholds.
+Report parametersReport(const SegmentParameters& parameters, const SegmentOptions& used, const SegmentResult& result) {
   Report r;
   for (const Parameter& row : segmentParameters()) {
     std::visit(
@@ -51,6 +52,7 @@ Report parametersReport(const SegmentParameters& parameters, const SegmentResult
         },
         parameterValue(parameters, row));
   }
+  r.set("slice_ends", used.sliceEnds.enabled);
   if (parameters.segment.edges.method == EdgeMethod::MongaDeriche) {
     const EdgeScale& scale = result.edgeScale;
     r.set("edge_reference", scale.reference == EdgeReference::Landmarks ? "landmarks" : "image");
@@ -635,7 +637,7 @@ SegmentOutcome segmentImage(const Volume& image, const SegmentInputs& in, const 
   std::vector<Report> levels;
   for (const auto& level : result.levels) levels.push_back(levelReport(level, -1, -1));  // no fit error in segmentation
   report.set("per_level", levels);
-  report.set("parameters", parametersReport(parameters, result));
+  report.set("parameters", parametersReport(parameters, options, result));
   return outcome;
 }
 
