@@ -20,6 +20,7 @@
 #include "EarlierRuns.h"
 #include "FigureOutputs.h"
 #include "LandmarkSources.h"
+#include "dynsub/Atlas.h"
 #include "dynsub/Error.h"
 #include "dynsub/FileNames.h"
 #include "dynsub/ImageIO.h"
@@ -57,22 +58,18 @@ struct Arguments {
   FigureOptions figures;
 };
 
-// "71" or "71,72": a structure's label values in --reference.
-std::vector<int> parseLabelValues(const std::string& text) {
+// "71", "71,72" or "Caudate_L": a structure's labels in --reference, by
+// value or by name in the table beside it (Atlas.h's readLabelNames), which
+// is read only when a name is given.
+std::vector<int> parseLabelValues(const std::string& text, const std::string& reference) {
   std::vector<int> values;
-  for (const std::string& item : splitItems(text, ',')) {  // "71," and "71,,72" have an empty item
-    std::size_t used = 0;
-    int value = 0;
-    try {
-      value = std::stoi(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used == 0 || used != item.size())
-      throw UsageError("--reference-label " + text + ": expected N[,M...] (integers)");
-    if (value == 0)
-      throw UsageError("--reference-label " + text + ": 0 is the reference's background, not a structure");
-    values.push_back(value);
+  std::optional<LabelNames> names;
+  for (const std::string& written : splitItems(text, ',')) {  // "71," and "71,,72" have an empty item
+    const std::string item = trimmed(written);
+    if (item.empty()) throw UsageError("--reference-label " + text + ": an empty label");
+    double number = 0;
+    if (!parseNumber(item, number) && !names) names = readLabelNames(reference);
+    values.push_back(labelValue(names ? *names : LabelNames{}, reference, item, text, "--reference-label"));
   }
   return values;
 }
@@ -169,7 +166,7 @@ std::string firstStart(const Arguments& o) { return o.init.empty() ? "auto" : o.
 void runSegmentOne(const Arguments& o, const LandmarkSource* landmarks) {
   // Every input is read and checked before anything is written.
   if (!o.reference.empty() && o.referenceLabels.empty())
-    throw UsageError("--reference needs --reference-label N[,M...]: the label value(s) of the structure");
+    throw UsageError("--reference needs --reference-label N[,M...]: the label value(s) or name(s) of the structure");
   if (o.inside.size() > 1)
     throw UsageError("--inside is given " + std::to_string(o.inside.size()) +
                      " times for one structure: give one click inside it");
@@ -179,9 +176,10 @@ void runSegmentOne(const Arguments& o, const LandmarkSource* landmarks) {
   SegmentInputs inputs;
   inputs.start = parseSegmentStart(firstStart(o), "--init");
   // One structure's values, as N[,M...] or as several values (71 72).
+  if (!o.reference.empty()) requireExisting(o.reference);
   std::vector<int> referenceLabels;
   for (const std::string& values : o.referenceLabels)
-    for (const int value : parseLabelValues(values)) referenceLabels.push_back(value);
+    for (const int value : parseLabelValues(values, o.reference)) referenceLabels.push_back(value);
   const std::filesystem::path dir(o.out);
   requireInputsOutsideRun(dir, {o.image, landmarks ? landmarks->path : "", o.reference, o.atlas, o.atlasLabels});
   const Volume image = readVolume(o.image);
@@ -201,7 +199,6 @@ void runSegmentOne(const Arguments& o, const LandmarkSource* landmarks) {
     }
   } waitForReference{reference};
   if (!o.reference.empty()) {
-    requireExisting(o.reference);  // before the segmentation; its other errors come with its reading
     reference = std::async(std::launch::async, [&o, &image, &referenceLabels] {
                   return referenceStructure(o.reference, readReferenceLabels(o.reference, image), referenceLabels);
                 }).share();
@@ -308,6 +305,7 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
       atlas ? std::make_shared<const Atlas>(readAtlas(o.atlas, o.atlasLabels)) : nullptr;
   std::vector<StructureInputs> structures =
       structuresToSegment(o.image, sources, atlasData, o.atlasLabel, "--atlas-label");
+  if (!o.reference.empty()) requireExisting(o.reference);
   structures.resize(n);  // those without landmarks after the lists
   for (std::size_t s = 0; s < n; ++s) {
     StructureInputs& structure = structures[s];
@@ -318,7 +316,7 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
     if (!o.names.empty()) structure.name = o.names[s];
     if (!o.reference.empty()) {
       in.referencePath = o.reference;
-      in.referenceLabels = parseLabelValues(o.referenceLabels[s]);
+      in.referenceLabels = parseLabelValues(o.referenceLabels[s], o.reference);
     }
   }
   const Volume image = readVolume(o.image);
@@ -471,8 +469,9 @@ void addSegmentCommand(CLI::App& app) {
                                                "Reference labelmap on the image's grid, for Dice and distances");
   command
       ->add_option("--reference-label", o->referenceLabels,
-                   "Label value(s) of the structure in --reference, N[,M...]; with several --landmarks, once per "
-                   "structure in their order")
+                   "Label value(s) of the structure in --reference, N[,M...], or names in the table beside it "
+                   "(REF.txt or a BIDS REF.tsv for REF.nii.gz); with several --landmarks, once per structure in "
+                   "their order")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
       ->needs(reference);

@@ -761,14 +761,24 @@ expect_error "edge thresholds the wrong way round" 2 "edge_low (--edge-low) is 5
   --edge-high 1 --out "$work/s9b"
 expect_error "an atlas label list ending in a comma" 2 "--atlas-label Caudate_L,: an empty label" "$work/s9c" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --init atlas --atlas-label Caudate_L, --out "$work/s9c"
-expect_error "the atlas's background as a structure" 2 "--atlas-label 0: 0 is the atlas's background" "$work/s9e" \
+expect_error "the atlas's background as a structure" 2 "--atlas-label 0: 0 is the label map's background" "$work/s9e" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --init atlas --atlas-label 0 --out "$work/s9e"
-expect_error "a reference label list ending in a comma" 2 "--reference-label 71,: expected N" "$work/s9d" \
+expect_error "a reference label list ending in a comma" 2 "--reference-label 71,: an empty label" "$work/s9d" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" \
   --reference "$mri/aal.nii.gz" --reference-label 71, --out "$work/s9d"
-expect_error "the background as the reference label" 2 "--reference-label 0: 0 is the reference's background" "$work/s9f" \
+expect_error "the background as the reference label" 2 "--reference-label 0: 0 is the label map's background" "$work/s9f" \
   "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" \
   --reference "$mri/aal.nii.gz" --reference-label 0 --out "$work/s9f"
+# A reference label by name, in the table beside the reference (AAL's aal.nii.txt).
+"$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --reference "$mri/aal.nii.gz" \
+  --reference-label Caudate_L --no-figures --out "$work/s9g" >/dev/null 2>&1
+check "a reference label by name: its value is scored" python3 -c "
+import json
+r = json.load(open('$work/s9g/report.json'))
+assert r['reference_labels'] == [71] and r['dice'] > 0.8, (r['reference_labels'], r['dice'])"
+expect_error "a misspelt reference label" 1 "aal.nii.gz: no label named 'Caudat_L' (did you mean 'Caudate_L'?)" \
+  "$work/s9h" "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" \
+  --reference "$mri/aal.nii.gz" --reference-label Caudat_L --out "$work/s9h"
 # Stopped by the step limit, the surface had not settled: the run says so.
 "$DYNSUB" segment "$mri/ch2.nii.gz" --landmarks "$DATA/Landmarks/caudate_left.mrk.json" --max-steps 20 \
   --no-figures --out "$work/s9d" >/dev/null 2>"$work/s9d.err"
@@ -980,6 +990,18 @@ assert r['parameters']['slice_ends'] is False and 'slice_ends' not in r, r['para
 t = r['trust']
 assert t['trusted'] and t['atlas_outline_distance_mm'] < 4.5 and 0.7 < t['volume_ratio'] < 1.5, t
 "
+# The subject's labels with a BIDS table of names beside them (labels.tsv:
+# index and name, as a dseg.tsv has them), and one without a table.
+printf 'index\tname\tabbreviation\n73\tPutamen left\tPL\n' >"$work/subject/labels.tsv"
+"$DYNSUB" segment "$work/subject/image.nii.gz" --init seed:22,-8,4 --reference "$work/subject/labels.nii.gz" \
+  --reference-label "Putamen left" --no-figures --out "$work/bids_name" >/dev/null 2>&1
+check "a reference label named in a BIDS table" python3 -c "
+import json, sys
+sys.exit(0 if json.load(open('$work/bids_name/report.json'))['reference_labels'] == [73] else 1)"
+rm "$work/subject/labels.tsv"
+expect_error "a reference label by name without a table" 1 "no table of label names beside it" "$work/bids_none" \
+  "$DYNSUB" segment "$work/subject/image.nii.gz" --init seed:22,-8,4 --reference "$work/subject/labels.nii.gz" \
+  --reference-label Putamen_L --out "$work/bids_none"
 expect_error "segment --init atlas: a misspelt label" 1 "did you mean 'Putamen_L'" "$work/s43" \
   "$DYNSUB" segment "$work/subject/image.nii.gz" --init atlas --atlas-label Putamn_L --out "$work/s43"
 expect_error "segment --init atlas: the two caudates as one structure" 2 \

@@ -43,78 +43,6 @@ bool endsWith(const std::string& text, const std::string& end) {
   return text.size() >= end.size() && text.compare(text.size() - end.size(), end.size(), end) == 0;
 }
 
-// Where a label map's table of names may be: labels.nii.gz -> labels.nii.txt, then labels.txt.
-std::vector<std::string> nameTables(const std::string& labelsPath) {
-  std::string base = labelsPath;
-  if (endsWith(base, ".gz")) base.resize(base.size() - 3);
-  std::vector<std::string> candidates = {base + ".txt"};
-  if (const auto dot = base.rfind('.'); dot != std::string::npos && dot > base.find_last_of('/') + 1)
-    candidates.push_back(base.substr(0, dot) + ".txt");
-  return candidates;
-}
-
-// The table of names beside a label map, the first of nameTables that exists.
-std::vector<std::pair<int, std::string>> readNames(const std::string& labelsPath) {
-  for (const std::string& path : nameTables(labelsPath)) {
-    std::ifstream in(path);
-    if (!in) continue;
-    // Each line's value, its words, and where its name's words begin; the
-    // name's end is decided for the whole table below.
-    struct Line {
-      int value;
-      std::vector<std::string> words;
-      std::size_t first;
-    };
-    std::vector<Line> lines;
-    const auto isNumber = [](const std::string& word) {
-      double number = 0;
-      return parseNumber(word, number) && std::isfinite(number);
-    };
-    std::string line;
-    int number = 0;
-    while (std::getline(in, line)) {
-      ++number;
-      const std::size_t start = line.find_first_not_of(" \t\r");
-      if (start == std::string::npos || line[start] == '#') continue;
-      // "VALUE NAME" and whatever numbers tables add before or after the
-      // name (mricron's a code after it, ITK-SNAP's colours before it, in
-      // quotes, FreeSurfer's colours after it); a name may hold spaces.
-      std::istringstream fields(line);
-      int value = 0;
-      std::vector<std::string> words;
-      for (std::string word; fields >> word;) words.push_back(word);
-      if (words.empty() || !isNumber(words.front()) || !(std::istringstream(words.front()) >> value))
-        throw Error(path, "line " + std::to_string(number) + ": expected a label value and its name");
-      std::size_t first = 1;
-      while (first < words.size() && isNumber(words[first])) ++first;
-      if (first == words.size())
-        throw Error(path, "line " + std::to_string(number) + ": expected a label value and its name");
-      lines.push_back({value, std::move(words), first});
-    }
-    // A name's trailing numbers are the table's own (a code, colours) unless
-    // leaving them out would give two labels one name ("Brodmann area 17").
-    const auto namesOf = [&](bool trailingNumbers) {
-      std::vector<std::pair<int, std::string>> names;
-      for (const Line& l : lines) {
-        std::size_t last = l.words.size();
-        while (!trailingNumbers && last > l.first + 1 && isNumber(l.words[last - 1])) --last;
-        std::string name;
-        for (std::size_t w = l.first; w < last; ++w) name += (name.empty() ? "" : " ") + l.words[w];
-        if (name.size() >= 2 && name.front() == '"' && name.back() == '"')
-          name = trimmed(name.substr(1, name.size() - 2));
-        names.emplace_back(l.value, name);
-      }
-      return names;
-    };
-    std::vector<std::pair<int, std::string>> names = namesOf(false);
-    std::set<std::string> seen;
-    for (const auto& [value, name] : names)
-      if (!seen.insert(name).second) return namesOf(true);
-    return names;
-  }
-  return {};
-}
-
 itkbridge::AffineArray toArray(const AffineMap& map) {
   itkbridge::AffineArray a{};
   for (int r = 0; r < 3; ++r) {
@@ -165,7 +93,116 @@ AffineMap fromArray(const itkbridge::AffineArray& a) {
   return map;
 }
 
+// Where a label map's table of names may be: labels.nii.gz -> labels.nii.txt,
+// then labels.txt, then labels.tsv.
+std::vector<std::string> nameTables(const std::string& labelsPath) {
+  std::string base = labelsPath;
+  if (endsWith(base, ".gz")) base.resize(base.size() - 3);
+  std::vector<std::string> candidates = {base + ".txt"};
+  std::string stem = base;
+  if (const auto dot = base.rfind('.'); dot != std::string::npos && dot > base.find_last_of('/') + 1)
+    stem = base.substr(0, dot);
+  if (stem != base) candidates.push_back(stem + ".txt");
+  candidates.push_back(stem + ".tsv");
+  return candidates;
+}
+
+// A BIDS table (dseg.tsv): tab-separated columns, `index` and `name` among
+// them, named on the first line.
+LabelNames readTsvNames(std::istream& in, const std::string& path) {
+  const auto cells = [](const std::string& line) {
+    std::vector<std::string> fields = splitItems(line, '\t');
+    for (std::string& field : fields) field = trimmed(field);
+    return fields;
+  };
+  std::string line;
+  if (!std::getline(in, line)) return {};
+  const std::vector<std::string> header = cells(line);
+  const auto column = [&](const char* name) {
+    const auto at = std::find(header.begin(), header.end(), name);
+    if (at == header.end()) throw Error(path, std::string("no column '") + name + "' on its first line (a BIDS label table has 'index' and 'name')");
+    return static_cast<std::size_t>(at - header.begin());
+  };
+  const std::size_t index = column("index"), name = column("name");
+  LabelNames names;
+  int number = 1;
+  while (std::getline(in, line)) {
+    ++number;
+    if (trimmed(line).empty()) continue;
+    const std::vector<std::string> row = cells(line);
+    double value = 0;
+    if (row.size() <= std::max(index, name) || !parseNumber(row[index], value) || value != std::floor(value) ||
+        row[name].empty())
+      throw Error(path, "line " + std::to_string(number) + ": expected a label value under 'index' and its name under 'name'");
+    names.emplace_back(static_cast<int>(value), row[name]);
+  }
+  return names;
+}
+
+
 }  // namespace
+
+LabelNames readLabelNames(const std::string& labelsPath) {
+  for (const std::string& path : nameTables(labelsPath)) {
+    std::ifstream in(path);
+    if (!in) continue;
+    if (endsWith(path, ".tsv")) return readTsvNames(in, path);
+    // Each line's value, its words, and where its name's words begin; the
+    // name's end is decided for the whole table below.
+    struct Line {
+      int value;
+      std::vector<std::string> words;
+      std::size_t first;
+    };
+    std::vector<Line> lines;
+    const auto isNumber = [](const std::string& word) {
+      double number = 0;
+      return parseNumber(word, number) && std::isfinite(number);
+    };
+    std::string line;
+    int number = 0;
+    while (std::getline(in, line)) {
+      ++number;
+      const std::size_t start = line.find_first_not_of(" \t\r");
+      if (start == std::string::npos || line[start] == '#') continue;
+      // "VALUE NAME" and whatever numbers tables add before or after the
+      // name (mricron's a code after it, ITK-SNAP's colours before it, in
+      // quotes, FreeSurfer's colours after it); a name may hold spaces.
+      std::istringstream fields(line);
+      int value = 0;
+      std::vector<std::string> words;
+      for (std::string word; fields >> word;) words.push_back(word);
+      if (words.empty() || !isNumber(words.front()) || !(std::istringstream(words.front()) >> value))
+        throw Error(path, "line " + std::to_string(number) + ": expected a label value and its name");
+      std::size_t first = 1;
+      while (first < words.size() && isNumber(words[first])) ++first;
+      if (first == words.size())
+        throw Error(path, "line " + std::to_string(number) + ": expected a label value and its name");
+      lines.push_back({value, std::move(words), first});
+    }
+    // A name's trailing numbers are the table's own (a code, colours) unless
+    // leaving them out would give two labels one name ("Brodmann area 17").
+    const auto namesOf = [&](bool trailingNumbers) {
+      LabelNames names;
+      for (const Line& l : lines) {
+        std::size_t last = l.words.size();
+        while (!trailingNumbers && last > l.first + 1 && isNumber(l.words[last - 1])) --last;
+        std::string name;
+        for (std::size_t w = l.first; w < last; ++w) name += (name.empty() ? "" : " ") + l.words[w];
+        if (name.size() >= 2 && name.front() == '"' && name.back() == '"')
+          name = trimmed(name.substr(1, name.size() - 2));
+        names.emplace_back(l.value, name);
+      }
+      return names;
+    };
+    LabelNames names = namesOf(false);
+    std::set<std::string> seen;
+    for (const auto& [value, name] : names)
+      if (!seen.insert(name).second) return namesOf(true);
+    return names;
+  }
+  return {};
+}
 
 AffineMap AffineMap::inverse() const {
   AffineMap inverse;
@@ -183,8 +220,61 @@ Atlas readAtlas(const std::string& imagePath, const std::string& labelsPath) {
   if (const std::string difference = atlas.labels.geometry.differenceFrom(atlas.image.geometry, "template");
       !difference.empty())
     throw Error(labelsPath, "the atlas's label map is not on its template's grid (" + imagePath + "): " + difference);
-  atlas.names = readNames(labelsPath);
+  atlas.names = readLabelNames(labelsPath);
   return atlas;
+}
+
+int labelValue(const LabelNames& names, const std::string& labelsPath, const std::string& item,
+               const std::string& spec, const std::string& option) {
+  double number = 0;
+  std::istringstream asNumber(item);
+  if (asNumber >> number && asNumber.eof()) {
+    if (number != std::floor(number) || std::abs(number) > 32767)
+      throw UsageError(option + " " + spec + ": " + item + " is not a label value");
+    // 0 is every label map's background, no structure.
+    if (number == 0) throw UsageError(option + " " + spec + ": 0 is the label map's background, not a structure");
+    return static_cast<int>(number);
+  }
+  // The name as written, else the one name that matches it whatever the
+  // case: two labels can differ by case alone.
+  auto named = std::find_if(names.begin(), names.end(), [&](const auto& entry) { return entry.second == item; });
+  if (named != names.end() && std::count_if(names.begin(), names.end(), [&](const auto& entry) {
+                                return entry.second == item && entry.first != named->first;
+                              }) > 0)
+    throw UsageError(option + " " + spec + ": '" + item + "' names more than one label of " + labelsPath +
+                     "; give the label value instead");
+  if (named == names.end()) {
+    std::vector<std::string> matches;
+    for (const auto& entry : names)
+      if (lowerCase(entry.second) == lowerCase(item)) {
+        if (matches.empty()) named = std::find(names.begin(), names.end(), entry);
+        matches.push_back("'" + entry.second + "' (" + std::to_string(entry.first) + ")");
+      }
+    if (matches.size() > 1)
+      throw UsageError(option + " " + spec + ": '" + item + "' matches " + std::to_string(matches.size()) +
+                       " labels of " + labelsPath + " that differ by case alone: " + joined(matches, ", ") +
+                       "; write it as one of them is written");
+  }
+  if (named != names.end()) {
+    if (named->first == 0)
+      throw UsageError(option + " " + spec + ": '" + named->second +
+                       "' is label 0, the label map's background, not a structure");
+    return named->first;
+  }
+  if (names.empty())
+    throw Error(labelsPath, "no table of label names beside it (" + joined(nameTables(labelsPath), " or ") +
+                                "): give " + option + " as numbers, not '" + item + "'");
+  // The names that hold it ("Caudate": both sides), else the nearest.
+  std::vector<std::string> holding;
+  for (const auto& entry : names)
+    if (lowerCase(entry.second).find(lowerCase(item)) != std::string::npos) holding.push_back("'" + entry.second + "'");
+  if (holding.empty() || holding.size() > 4) {
+    const auto nearest = std::min_element(names.begin(), names.end(), [&](const auto& a, const auto& b) {
+      return editDistance(a.second, item) < editDistance(b.second, item);
+    });
+    holding.assign(1, "'" + nearest->second + "'");
+  }
+  throw Error(labelsPath, "no label named '" + item + "' (did you mean " + joined(holding, " or ") + "?)");
 }
 
 std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec, const std::string& option) {
@@ -193,60 +283,7 @@ std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec, c
   for (const std::string& written : splitItems(spec, ',')) {
     const std::string item = trimmed(written);
     if (item.empty()) throw UsageError(option + " " + spec + ": an empty label");
-    double number = 0;
-    std::istringstream asNumber(item);
-    if (asNumber >> number && asNumber.eof()) {
-      if (number != std::floor(number) || std::abs(number) > 32767)
-        throw UsageError(option + " " + spec + ": " + item + " is not a label value");
-      // 0 is every label map's background, no structure.
-      if (number == 0) throw UsageError(option + " " + spec + ": 0 is the atlas's background, not a structure");
-      values.push_back(static_cast<int>(number));
-      continue;
-    }
-    // The name as written, else the one name that matches it whatever the
-    // case: two labels can differ by case alone.
-    auto named =
-        std::find_if(atlas.names.begin(), atlas.names.end(), [&](const auto& entry) { return entry.second == item; });
-    if (named != atlas.names.end() && std::count_if(atlas.names.begin(), atlas.names.end(), [&](const auto& entry) {
-                                        return entry.second == item && entry.first != named->first;
-                                      }) > 0)
-      throw UsageError(option + " " + spec + ": '" + item + "' names more than one label of " + atlas.labelsPath +
-                       "; give the label value instead");
-    if (named == atlas.names.end()) {
-      std::vector<std::string> matches;
-      for (const auto& entry : atlas.names)
-        if (lowerCase(entry.second) == lowerCase(item)) {
-          if (matches.empty()) named = std::find(atlas.names.begin(), atlas.names.end(), entry);
-          matches.push_back("'" + entry.second + "' (" + std::to_string(entry.first) + ")");
-        }
-      if (matches.size() > 1)
-        throw UsageError(option + " " + spec + ": '" + item + "' matches " + std::to_string(matches.size()) +
-                         " labels of " + atlas.labelsPath + " that differ by case alone: " + joined(matches, ", ") +
-                         "; write it as one of them is written");
-    }
-    if (named != atlas.names.end()) {
-      if (named->first == 0)
-        throw UsageError(option + " " + spec + ": '" + named->second +
-                         "' is label 0, the atlas's background, not a structure");
-      values.push_back(named->first);
-      continue;
-    }
-    if (atlas.names.empty())
-      throw Error(atlas.labelsPath, "no table of label names beside it (" +
-                                        joined(nameTables(atlas.labelsPath), " or ") + "): give " + option +
-                                        " as numbers, not '" + item + "'");
-    // The names that hold it ("Caudate": both sides), else the nearest.
-    std::vector<std::string> holding;
-    for (const auto& entry : atlas.names)
-      if (lowerCase(entry.second).find(lowerCase(item)) != std::string::npos)
-        holding.push_back("'" + entry.second + "'");
-    if (holding.empty() || holding.size() > 4) {
-      const auto nearest = std::min_element(atlas.names.begin(), atlas.names.end(), [&](const auto& a, const auto& b) {
-        return editDistance(a.second, item) < editDistance(b.second, item);
-      });
-      holding.assign(1, "'" + nearest->second + "'");
-    }
-    throw Error(atlas.labelsPath, "no label named '" + item + "' (did you mean " + joined(holding, " or ") + "?)");
+    values.push_back(labelValue(atlas.names, atlas.labelsPath, item, spec, option));
   }
   for (int value : values)
     if (selectLabels(atlas.labels, {value}).count() == 0)
