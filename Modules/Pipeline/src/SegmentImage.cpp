@@ -88,6 +88,7 @@ Report sliceEndsReport(const SliceEnds& ends) {
     r.set("length_mm", end.length);
     r.set("window", std::vector<double>{end.low, end.high});
     r.set("stopped_by_reach", end.stoppedByReach);
+    r.set("marched_again", end.marchedAgain);
     r.set("tapered", end.tapered);
     r.set("pressure", end.pressed);
     if (end.pressed) r.set("pressure_reach_mm", end.pressureReach);

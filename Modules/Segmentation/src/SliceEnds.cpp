@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "RobustStatistics.h"
 #include "dynsub/Error.h"
@@ -69,6 +70,8 @@ void checkSliceEndOptions(const SliceEndOptions& o) {
       throw Error(std::string("the slice ends' ") + name + " must be a finite number > 0");
   if (!(o.gap >= 0) || !std::isfinite(o.gap)) throw Error("the slice ends' gap must be a finite number >= 0");
   if (!(o.endLevel >= 0 && o.endLevel <= 1)) throw Error("the slice ends' end level must be a number in [0, 1]");
+  if (!(o.endLevelAtReach >= 0 && o.endLevelAtReach <= 1))
+    throw Error("the slice ends' end level at reach must be a number in [0, 1]");
   if (!(o.pressure >= 0) || !std::isfinite(o.pressure))
     throw Error("the pressure beyond the end slices must be a finite number >= 0");
 }
@@ -139,8 +142,10 @@ SliceEnds findSliceEnds(const Volume& image, const std::vector<Landmark>& landma
       end.sliceRadius = std::max(end.sliceRadius, across.norm());
     }
     const double longest = options.reach * span;
-    double level = inside->median;
-    if (options.endLevel > 0) {
+    // The end's own level: the median of the disks on the end slice and two
+    // steps inward, where it lies within the window of the model's median.
+    std::optional<double> ownLevel;
+    {
       std::vector<double> own;
       for (int k = 0; k < 3; ++k) {
         const double m = diskMedian(image, centre - outward * k * step * along, u, v, radius, step);
@@ -148,24 +153,35 @@ SliceEnds findSliceEnds(const Volume& image, const std::vector<Landmark>& landma
       }
       if (!own.empty()) {
         const double median = robustStatistics(std::move(own)).median;
-        if (std::abs(median - inside->median) <= halfWidth) level += options.endLevel * (median - inside->median);
+        if (std::abs(median - inside->median) <= halfWidth) ownLevel = median;
       }
     }
-    end.low = level - halfWidth;
-    end.high = level + halfWidth;
+    // Step 3's march with the window's centre `share` of the way to the end's level.
     int outside = 0;
     double reached = 0;
-    for (double t = step; t <= longest; t += step) {
-      const double m = diskMedian(image, centre + outward * t * along, u, v, radius, step);
-      if (!std::isfinite(m)) break;
-      if (m < end.low || m > end.high) {
-        if (++outside == 2) break;
-      } else {
-        outside = 0;
-        reached = t;
+    const auto march = [&](double share) {
+      const double level = inside->median + (ownLevel ? share * (*ownLevel - inside->median) : 0.0);
+      end.low = level - halfWidth;
+      end.high = level + halfWidth;
+      outside = 0;
+      reached = 0;
+      for (double t = step; t <= longest; t += step) {
+        const double m = diskMedian(image, centre + outward * t * along, u, v, radius, step);
+        if (!std::isfinite(m)) break;
+        if (m < end.low || m > end.high) {
+          if (++outside == 2) break;
+        } else {
+          outside = 0;
+          reached = t;
+        }
       }
+      end.stoppedByReach = outside < 2 && reached + 2 * step > longest;
+    };
+    march(options.endLevel);
+    if (end.stoppedByReach && ownLevel && options.endLevelAtReach != options.endLevel) {
+      march(options.endLevelAtReach);
+      end.marchedAgain = true;
     }
-    end.stoppedByReach = outside < 2 && reached + 2 * step > longest;
     end.length = reached;
     end.end = centre + outward * reached * along;
     // Step 4.

@@ -187,6 +187,45 @@ TEST(SliceEnds, TheWindowFollowsTheEndsOwnLevel) {
   EXPECT_FALSE(whole.ends[0].stoppedByReach || own.ends[0].stoppedByReach);
 }
 
+// A cigar that darkens gently toward its +y tip (100 to 90 from its middle),
+// with tissue of 108 going on past that tip within 8 mm of its axis, noise 4.
+// The window about the whole structure's median holds 108: the march from
+// the last clicked slice finds no end. The second, about the end's own
+// level (about 94), leaves it where the 108 begins.
+TEST(SliceEnds, WhereTheMarchSawNoEndItMarchesAgainAboutTheEndsLevel) {
+  const Cigar shape;
+  Tissue tissue;
+  tissue.inside = [&](const Vector3& x) { return 100.0 - 0.5 * std::max(0.0, x.y() - shape.centre.y()); };
+  tissue.outside = [&](const Vector3& x) {
+    const Vector3 d = x - shape.centre;
+    return d.y() > 0 && std::hypot(d.x(), d.z()) < 8 ? 108.0 : 20.0;
+  };
+  tissue.noise = 4.0;
+  Mask truth;
+  const Volume image = cigarImage(shape, &truth, 1, tissue);
+  const std::vector<Landmark> landmarks = clicks(shape, 6);
+  const Vector3 tip = shape.centre + Vector3(0, 20, 0);
+  SliceEndOptions options;
+  options.reach = 0.6;  // 14.4 mm, past the tip 8 mm beyond the last clicked slice
+  options.endLevel = 0;
+  options.endLevelAtReach = 0;  // no second march
+  const SliceEnds once = findSliceEnds(image, landmarks, initialFromLandmarks(landmarks), options);
+  ASSERT_EQ(once.ends.size(), 2u);
+  EXPECT_TRUE(once.ends[1].stoppedByReach) << once.ends[1].low << " " << once.ends[1].high;
+  EXPECT_FALSE(once.ends[1].marchedAgain);
+  EXPECT_GT(once.ends[1].high, 108.0);
+  options.endLevelAtReach = 1;
+  const SliceEnds again = findSliceEnds(image, landmarks, initialFromLandmarks(landmarks), options);
+  ASSERT_EQ(again.ends.size(), 2u);
+  EXPECT_TRUE(again.ends[1].marchedAgain);
+  EXPECT_FALSE(again.ends[1].stoppedByReach) << again.ends[1].low << " " << again.ends[1].high;
+  EXPECT_LT(again.ends[1].high, 108.0);
+  EXPECT_LT((again.ends[1].end - tip).norm(), 2.0) << again.ends[1].end.transpose();
+  // The -y end, past which the tissue is unlike, was found by the first march.
+  EXPECT_FALSE(again.ends[0].marchedAgain || again.ends[0].stoppedByReach);
+  EXPECT_EQ(again.ends[0].end, once.ends[0].end);
+}
+
 // The cigar segmented from clicks on its 5 middle slices, and its Dice.
 struct SegmentedCigar {
   SegmentResult result;
@@ -410,7 +449,9 @@ TEST(SliceEnds, RefusesImpossibleOptions) {
                    +[](SliceEndOptions& o) { o.stiffness = 0; }, +[](SliceEndOptions& o) { o.gap = -0.5; },
                    +[](SliceEndOptions& o) { o.pressure = -0.1; },
                    +[](SliceEndOptions& o) { o.pressure = std::nan(""); },
-                   +[](SliceEndOptions& o) { o.endLevel = 1.5; }, +[](SliceEndOptions& o) { o.endLevel = -0.1; }}) {
+                   +[](SliceEndOptions& o) { o.endLevel = 1.5; }, +[](SliceEndOptions& o) { o.endLevel = -0.1; },
+                   +[](SliceEndOptions& o) { o.endLevelAtReach = 1.5; },
+                   +[](SliceEndOptions& o) { o.endLevelAtReach = std::nan(""); }}) {
     SliceEndOptions options;
     bad(options);
     EXPECT_THROW(checkSliceEndOptions(options), Error);

@@ -22,6 +22,11 @@
 //     c is m). A structure's intensity drifts along it (a putamen's head is
 //     darker than its middle): a window about the whole structure's median
 //     can hold the tissue past a dark end, or leave out the end itself.
+//     Where the march reaches its limit without leaving the window (no end
+//     seen), it marches again with c moved `endLevelAtReach` of the way to
+//     e: a window about the whole structure's median that holds the tissue
+//     past an end darker than the rest (a putamen's head) is the commonest
+//     reason for seeing none.
 //     Experts leave some 10-20 % of a structure unclicked at each end, but
 //     the clicked span is shorter than the slices' coverage: three slices
 //     over 60 % of a caudate span 40 % of it, and its head reaches a
@@ -85,6 +90,12 @@ struct SliceEndOptions {
   // 2.5 mm, past `gap`, to an end its clicks reach, and its Dice below the
   // 0.85 that Colin27's rows are held to; so 0 (Documentation/Segmentation.md).
   double endLevel = 0;
+  // Step 3's second march, where the first saw no end: how far its window's
+  // centre moves to the end's own level. Chosen on the tuning subjects of
+  // all three generated groups over 0.5 and over none (Documentation/Segmentation.md);
+  // a march that found an end is not made again, so the ends a first march
+  // found (Colin27's rows) keep it.
+  double endLevelAtReach = 1.0;
 };
 
 struct SliceEnd {
@@ -95,6 +106,7 @@ struct SliceEnd {
   double low = 0, high = 0;         // the intensities the march followed (step 3)
   double length = 0;                // mm
   bool stoppedByReach = false;      // the intensity never left the window
+  bool marchedAgain = false;        // the first march saw no end; the second's window is about the end's level
   bool sprung = false;              // step 4 put springs at this end (it went more than `gap`)
   bool widening = false;            // the end slice's clicks are kTaperWidening times as wide as the next's
   bool tapered = false;             // step 4 also put taper springs here (sprung, `taper`, not widening)
