@@ -62,13 +62,17 @@ struct Arguments {
 // value or by name in the table beside it (Atlas.h's readLabelNames), which
 // is read only when a name is given.
 std::vector<int> parseLabelValues(const std::string& text, const std::string& reference) {
+  if (text.empty()) throw UsageError("--reference-label: no label given");
   std::vector<int> values;
   std::optional<LabelNames> names;
   for (const std::string& written : splitItems(text, ',')) {  // "71," and "71,,72" have an empty item
     const std::string item = trimmed(written);
     if (item.empty()) throw UsageError("--reference-label " + text + ": an empty label");
     double number = 0;
-    if (!parseNumber(item, number) && !names) names = readLabelNames(reference);
+    if (!(parseNumber(item, number) && std::isfinite(number)) && !names) {
+      requireExisting(reference);  // a missing reference, not a missing table
+      names = readLabelNames(reference);
+    }
     values.push_back(labelValue(names ? *names : LabelNames{}, reference, item, text, "--reference-label"));
   }
   return values;
@@ -176,7 +180,6 @@ void runSegmentOne(const Arguments& o, const LandmarkSource* landmarks) {
   SegmentInputs inputs;
   inputs.start = parseSegmentStart(firstStart(o), "--init");
   // One structure's values, as N[,M...] or as several values (71 72).
-  if (!o.reference.empty()) requireExisting(o.reference);
   std::vector<int> referenceLabels;
   for (const std::string& values : o.referenceLabels)
     for (const int value : parseLabelValues(values, o.reference)) referenceLabels.push_back(value);
@@ -199,6 +202,7 @@ void runSegmentOne(const Arguments& o, const LandmarkSource* landmarks) {
     }
   } waitForReference{reference};
   if (!o.reference.empty()) {
+    requireExisting(o.reference);  // before the segmentation; its other errors come with its reading
     reference = std::async(std::launch::async, [&o, &image, &referenceLabels] {
                   return referenceStructure(o.reference, readReferenceLabels(o.reference, image), referenceLabels);
                 }).share();
@@ -305,7 +309,6 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
       atlas ? std::make_shared<const Atlas>(readAtlas(o.atlas, o.atlasLabels)) : nullptr;
   std::vector<StructureInputs> structures =
       structuresToSegment(o.image, sources, atlasData, o.atlasLabel, "--atlas-label");
-  if (!o.reference.empty()) requireExisting(o.reference);
   structures.resize(n);  // those without landmarks after the lists
   for (std::size_t s = 0; s < n; ++s) {
     StructureInputs& structure = structures[s];
@@ -468,10 +471,11 @@ void addSegmentCommand(CLI::App& app) {
   CLI::Option* reference = command->add_option("--reference", o->reference,
                                                "Reference labelmap on the image's grid, for Dice and distances");
   command
-      ->add_option("--reference-label", o->referenceLabels,
-                   "Label value(s) of the structure in --reference, N[,M...], or names in the table beside it "
-                   "(REF.txt or a BIDS REF.tsv for REF.nii.gz); with several --landmarks, once per structure in "
-                   "their order")
+      ->add_option(
+          "--reference-label", o->referenceLabels,
+          "Label value(s) of the structure in --reference, N[,M...], or names in the table beside it "
+          "(REF.nii.txt, REF.txt or a BIDS REF.tsv for REF.nii.gz); with several --landmarks, once per structure in "
+          "their order")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
       ->needs(reference);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -107,38 +108,32 @@ std::vector<std::string> nameTables(const std::string& labelsPath) {
   return candidates;
 }
 
-// A BIDS table (dseg.tsv): tab-separated columns, `index` and `name` among
-// them, named on the first line.
-LabelNames readTsvNames(std::istream& in, const std::string& path) {
-  const auto cells = [](const std::string& line) {
-    std::vector<std::string> fields = splitItems(line, '\t');
-    for (std::string& field : fields) field = trimmed(field);
-    return fields;
-  };
+// A BIDS table (dseg.tsv): tab-separated columns named on the first line,
+// `index` and `name` among them. Nothing when they are not there: such a
+// .tsv beside a label map is some other table.
+std::optional<LabelNames> readTsvNames(std::istream& in, const std::string& path) {
   std::string line;
-  if (!std::getline(in, line)) return {};
-  const std::vector<std::string> header = cells(line);
-  const auto column = [&](const char* name) {
-    const auto at = std::find(header.begin(), header.end(), name);
-    if (at == header.end()) throw Error(path, std::string("no column '") + name + "' on its first line (a BIDS label table has 'index' and 'name')");
-    return static_cast<std::size_t>(at - header.begin());
-  };
-  const std::size_t index = column("index"), name = column("name");
+  if (!std::getline(in, line)) return std::nullopt;
+  std::vector<std::string> header = splitCsvFields(withoutByteOrderMark(line), '\t');
+  for (std::string& cell : header) cell = lowerCase(cell);
+  const auto index = std::find(header.begin(), header.end(), "index");
+  const auto name = std::find(header.begin(), header.end(), "name");
+  if (index == header.end() || name == header.end()) return std::nullopt;
+  const std::size_t indexColumn = static_cast<std::size_t>(index - header.begin()),
+                    nameColumn = static_cast<std::size_t>(name - header.begin());
   LabelNames names;
-  int number = 1;
-  while (std::getline(in, line)) {
-    ++number;
-    if (trimmed(line).empty()) continue;
-    const std::vector<std::string> row = cells(line);
+  for (int number = 2; std::getline(in, line); ++number) {
+    if (holdsNothing(line, "\t")) continue;
+    const std::vector<std::string> row = splitCsvFields(line, '\t');
     double value = 0;
-    if (row.size() <= std::max(index, name) || !parseNumber(row[index], value) || value != std::floor(value) ||
-        row[name].empty())
-      throw Error(path, "line " + std::to_string(number) + ": expected a label value under 'index' and its name under 'name'");
-    names.emplace_back(static_cast<int>(value), row[name]);
+    if (row.size() <= std::max(indexColumn, nameColumn) || !parseNumber(row[indexColumn], value) ||
+        !(std::abs(value) <= 32767) || value != std::floor(value) || row[nameColumn].empty())
+      throw Error(path, "line " + std::to_string(number) +
+                            ": expected a label value (a whole number) under 'index' and its name under 'name'");
+    names.emplace_back(static_cast<int>(value), row[nameColumn]);
   }
   return names;
 }
-
 
 }  // namespace
 
@@ -146,7 +141,10 @@ LabelNames readLabelNames(const std::string& labelsPath) {
   for (const std::string& path : nameTables(labelsPath)) {
     std::ifstream in(path);
     if (!in) continue;
-    if (endsWith(path, ".tsv")) return readTsvNames(in, path);
+    if (endsWith(path, ".tsv")) {
+      if (std::optional<LabelNames> names = readTsvNames(in, path)) return *names;
+      continue;
+    }
     // Each line's value, its words, and where its name's words begin; the
     // name's end is decided for the whole table below.
     struct Line {
@@ -224,11 +222,10 @@ Atlas readAtlas(const std::string& imagePath, const std::string& labelsPath) {
   return atlas;
 }
 
-int labelValue(const LabelNames& names, const std::string& labelsPath, const std::string& item,
-               const std::string& spec, const std::string& option) {
+int labelValue(const LabelNames& names, const std::string& labelsPath, const std::string& item, const std::string& spec,
+               const std::string& option) {
   double number = 0;
-  std::istringstream asNumber(item);
-  if (asNumber >> number && asNumber.eof()) {
+  if (parseNumber(item, number) && std::isfinite(number)) {
     if (number != std::floor(number) || std::abs(number) > 32767)
       throw UsageError(option + " " + spec + ": " + item + " is not a label value");
     // 0 is every label map's background, no structure.

@@ -126,6 +126,42 @@ TEST(Atlas, NameTablesOfOtherToolsAreRead) {
   std::filesystem::remove_all(dir);
 }
 
+// A BIDS label table beside a label map (dseg.tsv's columns, in any order,
+// with others beside them), as a spreadsheet may save it: a byte order mark,
+// CRLF line ends, an empty row. A .tsv without `index` and `name` is some
+// other table, not one of names; a row without its cells is refused, naming
+// the file.
+TEST(Atlas, BidsLabelTablesAreRead) {
+  const std::string dir = ::testing::TempDir() + "bids_names";
+  std::filesystem::create_directories(dir);
+  const std::string labels = dir + "/sub-01_dseg.nii.gz", table = dir + "/sub-01_dseg.tsv";
+  const auto write = [&table](const std::string& text) { std::ofstream(table, std::ios::binary) << text; };
+  write("\xEF\xBB\xBFname\tabbreviation\tindex\r\nCaudate left\tCL\t71\r\n\r\nPutamen left\tPL\t73\r\n");
+  const LabelNames names = readLabelNames(labels);
+  EXPECT_EQ(names, (LabelNames{{71, "Caudate left"}, {73, "Putamen left"}}));
+  EXPECT_EQ(labelValue(names, labels, "putamen left", "putamen left", "--reference-label"), 73);
+  EXPECT_EQ(labelValue(names, labels, "71", "71", "--reference-label"), 71);
+  EXPECT_THROW(labelValue(names, labels, "0", "0", "--reference-label"), UsageError);
+  try {
+    labelValue(names, labels, "Caudate", "Caudate", "--reference-label");
+    ADD_FAILURE() << "a name the table lacks";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("did you mean 'Caudate left'"), std::string::npos) << e.what();
+  }
+  write("participant_id\tage\nsub-01\t31\n");
+  EXPECT_TRUE(readLabelNames(labels).empty());
+  write("index\tname\n71\n");
+  try {
+    readLabelNames(labels);
+    ADD_FAILURE() << "a row without its name";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(table + ": line 2"), std::string::npos) << e.what();
+  }
+  write("index\tname\ninf\tEverywhere\n");
+  EXPECT_THROW(readLabelNames(labels), Error);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(Atlas, MissingLabelMapIsNamed) {
   try {
     readAtlas(kDefaultAtlasImage, "/nonexistent/labels.nii.gz");

@@ -162,10 +162,11 @@ std::vector<Parameter> table() {
        "How far the march's window moves from the initial model's median intensity to the end slice's own "
        "(0: not at all, 1: centred on the end's; where the two are within the window of each other)",
        [](P& p) -> double& { return p.segment.sliceEnds.endLevel; }, 0, 1, 0.1));
-  add(row("slice_ends_end_level_at_reach", "End level at reach", "", "Slice ends",
-       "Where the march found no end within its reach, it marches again with its window this far from the "
-       "initial model's median to the end slice's own (as --slice-ends-end-level)",
-       [](P& p) -> double& { return p.segment.sliceEnds.endLevelAtReach; }, 0, 1, 0.1));
+  add(row(
+      "slice_ends_end_level_at_reach", "End level at reach", "", "Slice ends",
+      "Where the march found no end within its reach, it marches again with its window this far from the "
+      "initial model's median to the end slice's own (as End level; equal to it: no second march)",
+      [](P& p) -> double& { return p.segment.sliceEnds.endLevelAtReach; }, 0, 1, 0.1));
   add(row("slice_ends_spring_at_reach", "Spring at reach", "", "Slice ends",
        "A spring also where the march ended at its reach, not at an intensity change",
        [](P& p) -> bool& { return p.segment.sliceEnds.springAtReach; }));

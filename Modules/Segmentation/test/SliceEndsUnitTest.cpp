@@ -157,17 +157,27 @@ TEST(SliceEnds, NoSpringWhereTheMarchFoundNoEnd) {
 // slice (y = +12, about 88) leaves the window within a few mm, where the
 // cigar darkens past 85, well short of the tip; about the end's own level
 // it follows the cigar to its tip and stops at the brighter tissue beyond.
-TEST(SliceEnds, TheWindowFollowsTheEndsOwnLevel) {
-  const Cigar shape;
+// A cigar whose intensity falls by `slope` per mm along y from 100 at its
+// centre (from its centre on only, with `fromCentre`), with tissue of
+// `beyond` going on past its +y tip within 8 mm of its axis, noise 4.
+Volume driftingCigar(const Cigar& shape, double slope, bool fromCentre, double beyond) {
   Tissue tissue;
-  tissue.inside = [&](const Vector3& x) { return 100.0 - (x.y() - shape.centre.y()); };
-  tissue.outside = [&](const Vector3& x) {
+  tissue.inside = [&shape, slope, fromCentre](const Vector3& x) {
+    const double along = x.y() - shape.centre.y();
+    return 100.0 - slope * (fromCentre ? std::max(0.0, along) : along);
+  };
+  tissue.outside = [&shape, beyond](const Vector3& x) {
     const Vector3 d = x - shape.centre;
-    return d.y() > 0 && std::hypot(d.x(), d.z()) < 8 ? 109.0 : 20.0;
+    return d.y() > 0 && std::hypot(d.x(), d.z()) < 8 ? beyond : 20.0;
   };
   tissue.noise = 4.0;
   Mask truth;
-  const Volume image = cigarImage(shape, &truth, 1, tissue);
+  return cigarImage(shape, &truth, 1, tissue);
+}
+
+TEST(SliceEnds, TheWindowFollowsTheEndsOwnLevel) {
+  const Cigar shape;
+  const Volume image = driftingCigar(shape, 1.0, false, 109.0);
   const std::vector<Landmark> landmarks = clicks(shape, 6);
   const Vector3 tip = shape.centre + Vector3(0, 20, 0);
   SliceEndOptions options;
@@ -194,15 +204,7 @@ TEST(SliceEnds, TheWindowFollowsTheEndsOwnLevel) {
 // level (about 94), leaves it where the 108 begins.
 TEST(SliceEnds, WhereTheMarchSawNoEndItMarchesAgainAboutTheEndsLevel) {
   const Cigar shape;
-  Tissue tissue;
-  tissue.inside = [&](const Vector3& x) { return 100.0 - 0.5 * std::max(0.0, x.y() - shape.centre.y()); };
-  tissue.outside = [&](const Vector3& x) {
-    const Vector3 d = x - shape.centre;
-    return d.y() > 0 && std::hypot(d.x(), d.z()) < 8 ? 108.0 : 20.0;
-  };
-  tissue.noise = 4.0;
-  Mask truth;
-  const Volume image = cigarImage(shape, &truth, 1, tissue);
+  const Volume image = driftingCigar(shape, 0.5, true, 108.0);
   const std::vector<Landmark> landmarks = clicks(shape, 6);
   const Vector3 tip = shape.centre + Vector3(0, 20, 0);
   SliceEndOptions options;
@@ -444,14 +446,13 @@ TEST(SliceEnds, ThickVoxelsAcrossTheSlicesDoNotMakeSlices) {
 }
 
 TEST(SliceEnds, RefusesImpossibleOptions) {
-  for (auto bad : {+[](SliceEndOptions& o) { o.window = 0; }, +[](SliceEndOptions& o) { o.reach = -1; },
-                   +[](SliceEndOptions& o) { o.disk = std::nan(""); },
-                   +[](SliceEndOptions& o) { o.stiffness = 0; }, +[](SliceEndOptions& o) { o.gap = -0.5; },
-                   +[](SliceEndOptions& o) { o.pressure = -0.1; },
-                   +[](SliceEndOptions& o) { o.pressure = std::nan(""); },
-                   +[](SliceEndOptions& o) { o.endLevel = 1.5; }, +[](SliceEndOptions& o) { o.endLevel = -0.1; },
-                   +[](SliceEndOptions& o) { o.endLevelAtReach = 1.5; },
-                   +[](SliceEndOptions& o) { o.endLevelAtReach = std::nan(""); }}) {
+  for (auto bad :
+       {+[](SliceEndOptions& o) { o.window = 0; }, +[](SliceEndOptions& o) { o.reach = -1; },
+        +[](SliceEndOptions& o) { o.disk = std::nan(""); }, +[](SliceEndOptions& o) { o.stiffness = 0; },
+        +[](SliceEndOptions& o) { o.gap = -0.5; }, +[](SliceEndOptions& o) { o.pressure = -0.1; },
+        +[](SliceEndOptions& o) { o.pressure = std::nan(""); }, +[](SliceEndOptions& o) { o.endLevel = 1.5; },
+        +[](SliceEndOptions& o) { o.endLevel = -0.1; }, +[](SliceEndOptions& o) { o.endLevelAtReach = 1.5; },
+        +[](SliceEndOptions& o) { o.endLevelAtReach = std::nan(""); }}) {
     SliceEndOptions options;
     bad(options);
     EXPECT_THROW(checkSliceEndOptions(options), Error);

@@ -31,25 +31,26 @@ inline const char* const kDefaultAtlasLabels = "/usr/share/mricron/templates/aal
 // A label map's names (value, name), from the first table beside it that
 // exists: for labels.nii.gz, labels.nii.txt or labels.txt, one "VALUE NAME
 // ..." per line (mricron's, ITK-SNAP's and FreeSurfer's tables), or
-// labels.tsv with the columns `index` and `name` (a BIDS dseg.tsv). Empty
-// when there is none; throws dynsub::Error naming the table for a line it
-// cannot read.
+// labels.tsv with the columns `index` and `name` (a BIDS dseg.tsv; a .tsv
+// without them is not taken for one). Empty when there is none; throws
+// dynsub::Error naming the table for a line it cannot read.
 using LabelNames = std::vector<std::pair<int, std::string>>;
 LabelNames readLabelNames(const std::string& labelsPath);
 
-// The value of one label written as a number ("73") or a name
-// ("Putamen_L") in `names`, the table of the label map at `labelsPath`.
+// The value of one label written as a number ("73", whatever parseNumber
+// reads as a finite number) or a name ("Putamen_L") in `names`, the table of
+// the label map at `labelsPath`.
 // Throws dynsub::UsageError for label 0, a value that is not a label, and a
 // name several labels share; dynsub::Error naming the map for a name its
 // table does not hold (naming the nearest) or a map with no table. `spec`
 // is the whole option value and `option` its flag, for messages.
-int labelValue(const LabelNames& names, const std::string& labelsPath, const std::string& item,
-               const std::string& spec, const std::string& option);
+int labelValue(const LabelNames& names, const std::string& labelsPath, const std::string& item, const std::string& spec,
+               const std::string& option);
 
 struct Atlas {
   std::string imagePath, labelsPath;
   Volume image;
-  Volume labels;      // on the image's grid
+  Volume labels;     // on the image's grid
   LabelNames names;  // readLabelNames(labelsPath)
 };
 

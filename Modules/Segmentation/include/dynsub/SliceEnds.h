@@ -91,10 +91,10 @@ struct SliceEndOptions {
   // 0.85 that Colin27's rows are held to; so 0 (Documentation/Segmentation.md).
   double endLevel = 0;
   // Step 3's second march, where the first saw no end: how far its window's
-  // centre moves to the end's own level. Chosen on the tuning subjects of
-  // all three generated groups over 0.5 and over none (Documentation/Segmentation.md);
-  // a march that found an end is not made again, so the ends a first march
-  // found (Colin27's rows) keep it.
+  // centre moves to the end's own level (no second march when it equals
+  // endLevel). Chosen on the tuning subjects of the three generated groups
+  // over 0.5 and over none (Documentation/Segmentation.md). An end the first
+  // march found is kept.
   double endLevelAtReach = 1.0;
 };
 
