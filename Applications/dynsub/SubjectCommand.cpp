@@ -46,7 +46,7 @@ void runSubject(const Arguments& arguments) {
   prepareOutputDirectory(arguments.out);
   const Volume image = readVolume(arguments.image);
   const Volume labels = readLabelMap(arguments.labels);
-  const Subject subject = makeSubject(image, labels, settings, arguments.seed);
+  const Subject subject = makeSubject(image, labels, settings, arguments.seed, {arguments.image, arguments.labels});
   // A ground truth with no label scores nothing: say so now, not when a
   // plan's structures find no voxel.
   if (std::none_of(subject.labels.voxels.begin(), subject.labels.voxels.end(), [](float v) { return v != 0; }))

@@ -970,6 +970,9 @@ expect_error "subject: a seed past 2^64-1" 2 "got '99999999999999999999'" "$work
   "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --seed 99999999999999999999 --out "$work/s45"
 expect_error "subject: a seed with a leading 0 (read as octal)" 2 "got '010'" "$work/s45" \
   "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --seed 010 --out "$work/s45"
+expect_error "subject: a structure label the label map lacks" 1 "aal.nii.gz: no voxel has the label 9999" "$work/s46" \
+  "$DYNSUB" subject "$mri/ch2.nii.gz" "$mri/aal.nii.gz" --seed 1 --set mode=synthesized --set structure_labels=71,9999 \
+  --out "$work/s46"
 
 # The atlas start on that subject: Colin27 and AAL registered to it, the left
 # putamen carried there by name, with a click inside it.

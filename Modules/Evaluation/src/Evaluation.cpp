@@ -518,7 +518,7 @@ std::vector<EvaluationRun> runEvaluation(const EvaluationPlan& plan, const Evalu
       for (const EvaluationSplit* s : splits) wanted = wanted || s->name == split;
       if (!wanted) continue;
       for (const std::uint64_t seed : seeds) {
-        Subject subject = makeSubject(image, labels, cohort.settings, seed);
+        Subject subject = makeSubject(image, labels, cohort.settings, seed, {cohort.image, cohort.labels});
         Input& input = inputs.emplace_back();
         input.image = cohort.name;
         input.subject = "s" + std::to_string(seed);

@@ -154,11 +154,11 @@ Volume thickSlices(const Volume& image, int axis, int factor) {
 // The two thresholds between a head's three tissue classes (dark, grey and
 // white in a T1 image): one-dimensional k-means over a 512-bin histogram of
 // `head`, started at its 10th, 50th and 90th percentiles.
-std::array<double, 2> tissueThresholds(const std::vector<float>& head) {
+std::array<double, 2> tissueThresholds(const std::vector<float>& head, const std::string& source) {
   const auto [lowest, highest] = std::minmax_element(head.begin(), head.end());
   const double low = *lowest, high = *highest;
   std::array<double, 3> centre{percentile(head, 0.1), percentile(head, 0.5), percentile(head, 0.9)};
-  if (!(high > low)) throw Error("subject", "the source image's head has one intensity: no tissue classes");
+  if (!(high > low)) throw Error(source, "the head has one intensity: no tissue classes");
   constexpr int kBins = 512;
   std::vector<double> count(kBins, 0);
   const double width = (high - low) / kBins;
@@ -184,11 +184,11 @@ std::array<double, 2> tissueThresholds(const std::vector<float>& head) {
 
 // The labels of a label map in increasing order; synthesized subjects need
 // them to be whole numbers in 0..65535, as label maps are written.
-std::vector<int> labelValues(const Volume& labels) {
+std::vector<int> labelValues(const Volume& labels, const std::string& source) {
   std::vector<char> seen(65536, 0);
   for (const float l : labels.voxels) {
     if (!(l >= 0 && l <= 65535 && l == std::floor(l)))
-      throw Error("subject",
+      throw Error(source,
                   "a synthesized subject needs labels that are whole numbers in 0..65535, found " + std::to_string(l));
     seen[static_cast<int>(l)] = 1;
   }
@@ -324,7 +324,8 @@ void checkSubjectSettings(const SubjectSettings& s) {
           "label_spread must be in 0..0.1 (grey structures would reach white matter's intensities)");
 }
 
-Subject makeSubject(const Volume& image, const Volume& labels, const SubjectSettings& settings, std::uint64_t seed) {
+Subject makeSubject(const Volume& image, const Volume& labels, const SubjectSettings& settings, std::uint64_t seed,
+                    const SubjectSources& sources) {
   checkSubjectSettings(settings);
   const ImageGeometry& grid = image.geometry;
   Draw draw(seed);
@@ -375,7 +376,7 @@ Subject makeSubject(const Volume& image, const Volume& labels, const SubjectSett
   for (const float v : anatomy.voxels)
     if (v > 0) positive.push_back(v);
   const float bright = percentile(positive, 0.995);
-  if (!(bright > 0)) throw Error("subject", "the source image has no positive intensities");
+  if (!(bright > 0)) throw Error(sources.image, "no positive intensities: no head to make a subject of");
   std::optional<double> whiteMatter;  // known exactly for synthesized subjects
   if (!settings.synthesized) {
     // Contrast: the head's intensities scaled to 0..1 by its bright end,
@@ -389,12 +390,12 @@ Subject makeSubject(const Volume& image, const Volume& labels, const SubjectSett
     std::vector<float> head;
     for (const float v : positive)
       if (v > 0.1f * bright) head.push_back(v);
-    const std::array<double, 2> threshold = tissueThresholds(head);
-    const std::vector<int> present = labelValues(labels);
+    const std::array<double, 2> threshold = tissueThresholds(head, sources.image);
+    const std::vector<int> present = labelValues(labels, sources.labels);
     std::vector<char> structure(present.empty() ? 0 : present.back() + 1, settings.structureLabels.empty());
     for (const int l : settings.structureLabels) {
       if (!std::binary_search(present.begin(), present.end(), l))
-        throw Error("subject", "structure_labels names label " + std::to_string(l) + ", which the label map lacks");
+        throw Error(sources.labels, "no voxel has the label " + std::to_string(l) + ", which structure_labels names");
       structure[l] = 1;
     }
     const Contrast contrast = drawContrast(draw, settings, present);

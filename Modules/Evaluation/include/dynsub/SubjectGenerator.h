@@ -108,11 +108,20 @@ void setSubjectSetting(SubjectSettings& settings, const std::string& key, const 
 // Throws dynsub::Error for impossible settings (naming the setting).
 void checkSubjectSettings(const SubjectSettings& settings);
 
+// What the image and the label map a subject is made from are called in
+// its errors: their files, when they come from files.
+struct SubjectSources {
+  std::string image = "the source image", labels = "the label map";
+};
+
 // One subject from `image` and `labels` (any grids that overlap in physical
 // space), on `image`'s grid; deterministic in `seed`. The anatomy's map
 // depends only on the seed and the map's settings, so a realistic and a
-// synthesized subject of one seed share their anatomy.
-Subject makeSubject(const Volume& image, const Volume& labels, const SubjectSettings& settings, std::uint64_t seed);
+// synthesized subject of one seed share their anatomy. Throws dynsub::Error
+// naming the source at fault for an image or label map no subject can be
+// made from.
+Subject makeSubject(const Volume& image, const Volume& labels, const SubjectSettings& settings, std::uint64_t seed,
+                    const SubjectSources& sources = {});
 
 // The record of a draw as JSON text (one object), for subject.json.
 std::string subjectRecord(const SubjectDraw& draw);
