@@ -59,23 +59,21 @@ struct Arguments {
 };
 
 // "71", "71,72" or "Caudate_L": a structure's labels in --reference, by
-// value or by name in the table beside it (Atlas.h's readLabelNames), which
-// is read only when a name is given.
-std::vector<int> parseLabelValues(const std::string& text, const std::string& reference) {
-  if (text.empty()) throw UsageError("--reference-label: no label given");
-  std::vector<int> values;
-  std::optional<LabelNames> names;
-  for (const std::string& written : splitItems(text, ',')) {  // "71," and "71,,72" have an empty item
-    const std::string item = trimmed(written);
-    if (item.empty()) throw UsageError("--reference-label " + text + ": an empty label");
-    double number = 0;
-    if (!(parseNumber(item, number) && std::isfinite(number)) && !names) {
-      requireExisting(reference);  // a missing reference, not a missing table
-      names = readLabelNames(reference);
-    }
-    values.push_back(labelValue(names ? *names : LabelNames{}, reference, item, text, "--reference-label"));
-  }
-  return values;
+// value or by name in the table beside it (Atlas.h's labelSpecValues). The
+// table is read into `names` when a name is first given, and serves every
+// structure of the run after that.
+std::vector<int> parseLabelValues(const std::string& text, const std::string& reference,
+                                  std::optional<LabelNames>& names) {
+  return labelSpecValues(
+      text, reference,
+      [&]() -> const LabelNames& {
+        if (!names) {
+          requireExisting(reference);  // a missing reference, not a missing table
+          names = readLabelNames(reference);
+        }
+        return *names;
+      },
+      "--reference-label");
 }
 
 // The expert's labelmap, on the image's grid.
@@ -181,8 +179,9 @@ void runSegmentOne(const Arguments& o, const LandmarkSource* landmarks) {
   inputs.start = parseSegmentStart(firstStart(o), "--init");
   // One structure's values, as N[,M...] or as several values (71 72).
   std::vector<int> referenceLabels;
+  std::optional<LabelNames> referenceNames;
   for (const std::string& values : o.referenceLabels)
-    for (const int value : parseLabelValues(values, o.reference)) referenceLabels.push_back(value);
+    for (const int value : parseLabelValues(values, o.reference, referenceNames)) referenceLabels.push_back(value);
   const std::filesystem::path dir(o.out);
   requireInputsOutsideRun(dir, {o.image, landmarks ? landmarks->path : "", o.reference, o.atlas, o.atlasLabels});
   const Volume image = readVolume(o.image);
@@ -310,6 +309,7 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
   std::vector<StructureInputs> structures =
       structuresToSegment(o.image, sources, atlasData, o.atlasLabel, "--atlas-label");
   structures.resize(n);  // those without landmarks after the lists
+  std::optional<LabelNames> referenceNames;
   for (std::size_t s = 0; s < n; ++s) {
     StructureInputs& structure = structures[s];
     SegmentInputs& in = structure.inputs;
@@ -319,7 +319,7 @@ void runSegmentTogether(const Arguments& o, const std::vector<LandmarkSource>& s
     if (!o.names.empty()) structure.name = o.names[s];
     if (!o.reference.empty()) {
       in.referencePath = o.reference;
-      in.referenceLabels = parseLabelValues(o.referenceLabels[s], o.reference);
+      in.referenceLabels = parseLabelValues(o.referenceLabels[s], o.reference, referenceNames);
     }
   }
   const Volume image = readVolume(o.image);

@@ -222,8 +222,11 @@ Atlas readAtlas(const std::string& imagePath, const std::string& labelsPath) {
   return atlas;
 }
 
-int labelValue(const LabelNames& names, const std::string& labelsPath, const std::string& item, const std::string& spec,
-               const std::string& option) {
+namespace {
+
+// One item of a label spec (labelSpecValues).
+int labelValue(const std::string& item, const std::string& spec, const std::string& labelsPath,
+               const std::function<const LabelNames&()>& table, const std::string& option) {
   double number = 0;
   if (parseNumber(item, number) && std::isfinite(number)) {
     if (number != std::floor(number) || std::abs(number) > 32767)
@@ -232,6 +235,7 @@ int labelValue(const LabelNames& names, const std::string& labelsPath, const std
     if (number == 0) throw UsageError(option + " " + spec + ": 0 is the label map's background, not a structure");
     return static_cast<int>(number);
   }
+  const LabelNames& names = table();
   // The name as written, else the one name that matches it whatever the
   // case: two labels can differ by case alone.
   auto named = std::find_if(names.begin(), names.end(), [&](const auto& entry) { return entry.second == item; });
@@ -274,14 +278,23 @@ int labelValue(const LabelNames& names, const std::string& labelsPath, const std
   throw Error(labelsPath, "no label named '" + item + "' (did you mean " + joined(holding, " or ") + "?)");
 }
 
-std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec, const std::string& option) {
-  std::vector<int> values;
+}  // namespace
+
+std::vector<int> labelSpecValues(const std::string& spec, const std::string& labelsPath,
+                                 const std::function<const LabelNames&()>& names, const std::string& option) {
   if (spec.empty()) throw UsageError(option + ": no label given");
-  for (const std::string& written : splitItems(spec, ',')) {
+  std::vector<int> values;
+  for (const std::string& written : splitItems(spec, ',')) {  // "71," and "71,,72" have an empty item
     const std::string item = trimmed(written);
     if (item.empty()) throw UsageError(option + " " + spec + ": an empty label");
-    values.push_back(labelValue(atlas.names, atlas.labelsPath, item, spec, option));
+    values.push_back(labelValue(item, spec, labelsPath, names, option));
   }
+  return values;
+}
+
+std::vector<int> atlasLabelValues(const Atlas& atlas, const std::string& spec, const std::string& option) {
+  const std::vector<int> values = labelSpecValues(
+      spec, atlas.labelsPath, [&atlas]() -> const LabelNames& { return atlas.names; }, option);
   for (int value : values)
     if (selectLabels(atlas.labels, {value}).count() == 0)
       throw Error(atlas.labelsPath, "no voxel has the label " + std::to_string(value));

@@ -139,11 +139,25 @@ TEST(Atlas, BidsLabelTablesAreRead) {
   write("\xEF\xBB\xBFname\tabbreviation\tindex\r\nCaudate left\tCL\t71\r\n\r\nPutamen left\tPL\t73\r\n");
   const LabelNames names = readLabelNames(labels);
   EXPECT_EQ(names, (LabelNames{{71, "Caudate left"}, {73, "Putamen left"}}));
-  EXPECT_EQ(labelValue(names, labels, "putamen left", "putamen left", "--reference-label"), 73);
-  EXPECT_EQ(labelValue(names, labels, "71", "71", "--reference-label"), 71);
-  EXPECT_THROW(labelValue(names, labels, "0", "0", "--reference-label"), UsageError);
+  // The table is asked for only when a label is given by name.
+  int asked = 0;
+  const auto values = [&](const std::string& spec) {
+    return labelSpecValues(
+        spec, labels,
+        [&]() -> const LabelNames& {
+          ++asked;
+          return names;
+        },
+        "--reference-label");
+  };
+  EXPECT_EQ(values("71"), std::vector<int>{71});
+  EXPECT_EQ(asked, 0);
+  EXPECT_EQ(values("putamen left,71"), (std::vector<int>{73, 71}));
+  EXPECT_EQ(asked, 1);
+  EXPECT_THROW(values("0"), UsageError);
+  EXPECT_THROW(values(""), UsageError);
   try {
-    labelValue(names, labels, "Caudate", "Caudate", "--reference-label");
+    values("Caudate");
     ADD_FAILURE() << "a name the table lacks";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("did you mean 'Caudate left'"), std::string::npos) << e.what();

@@ -156,15 +156,15 @@ SliceEnds findSliceEnds(const Volume& image, const std::vector<Landmark>& landma
         if (std::abs(median - inside->median) <= halfWidth) ownLevel = median;
       }
     }
-    // Step 3's march with the window's centre `share` of the way to the end's level.
-    int outside = 0;
-    double reached = 0;
+    // Step 3's march with the window's centre `share` of the way to the
+    // end's level: how far it went (mm), its window and whether it saw no end
+    // in `end`.
     const auto march = [&](double share) {
       const double level = inside->median + (ownLevel ? share * (*ownLevel - inside->median) : 0.0);
       end.low = level - halfWidth;
       end.high = level + halfWidth;
-      outside = 0;
-      reached = 0;
+      int outside = 0;
+      double reached = 0;
       for (double t = step; t <= longest; t += step) {
         const double m = diskMedian(image, centre + outward * t * along, u, v, radius, step);
         if (!std::isfinite(m)) break;
@@ -176,10 +176,11 @@ SliceEnds findSliceEnds(const Volume& image, const std::vector<Landmark>& landma
         }
       }
       end.stoppedByReach = outside < 2 && reached + 2 * step > longest;
+      return reached;
     };
-    march(options.endLevel);
+    double reached = march(options.endLevel);
     if (end.stoppedByReach && ownLevel && options.endLevelAtReach != options.endLevel) {
-      march(options.endLevelAtReach);
+      reached = march(options.endLevelAtReach);
       end.marchedAgain = true;
     }
     end.length = reached;

@@ -150,6 +150,38 @@ TEST(SliceEnds, NoSpringWhereTheMarchFoundNoEnd) {
   EXPECT_EQ(findSliceEnds(image, landmarks, initialFromLandmarks(landmarks), options).springs.size(), 14u);
 }
 
+// A cigar whose intensity falls by `slope` per mm along y from 100 at its
+// centre (from its centre on only, with `fromCentre`), with tissue of
+// `beyond` going on past its +y tip within 8 mm of its axis, noise 4;
+// clicked on its 5 middle slices, and marched from them as far as 0.6 of
+// the clicked span (14.4 mm, past the tip 8 mm beyond the last clicked
+// slice) with the window about the model's median (`endLevel` 0).
+struct DriftingCigar {
+  Cigar shape;
+  Volume image;
+  std::vector<Landmark> landmarks = clicks(shape, 6);
+  Vector3 tip = shape.centre + Vector3(0, 20, 0);
+  SliceEndOptions options;
+
+  DriftingCigar(double slope, bool fromCentre, double beyond) {
+    Tissue tissue;
+    tissue.inside = [this, slope, fromCentre](const Vector3& x) {
+      const double along = x.y() - shape.centre.y();
+      return 100.0 - slope * (fromCentre ? std::max(0.0, along) : along);
+    };
+    tissue.outside = [this, beyond](const Vector3& x) {
+      const Vector3 d = x - shape.centre;
+      return d.y() > 0 && std::hypot(d.x(), d.z()) < 8 ? beyond : 20.0;
+    };
+    tissue.noise = 4.0;
+    Mask truth;
+    image = cigarImage(shape, &truth, 1, tissue);
+    options.reach = 0.6;
+    options.endLevel = 0;
+  }
+  SliceEnds ends() const { return findSliceEnds(image, landmarks, initialFromLandmarks(landmarks), options); }
+};
+
 // A structure whose intensity drifts along it (the cigar darkens from 120
 // at y = -20 mm to 80 at +20 mm, noise 4), with like tissue (109) going on
 // past its +y tip within 8 mm of its axis. About the whole structure's
@@ -157,42 +189,18 @@ TEST(SliceEnds, NoSpringWhereTheMarchFoundNoEnd) {
 // slice (y = +12, about 88) leaves the window within a few mm, where the
 // cigar darkens past 85, well short of the tip; about the end's own level
 // it follows the cigar to its tip and stops at the brighter tissue beyond.
-// A cigar whose intensity falls by `slope` per mm along y from 100 at its
-// centre (from its centre on only, with `fromCentre`), with tissue of
-// `beyond` going on past its +y tip within 8 mm of its axis, noise 4.
-Volume driftingCigar(const Cigar& shape, double slope, bool fromCentre, double beyond) {
-  Tissue tissue;
-  tissue.inside = [&shape, slope, fromCentre](const Vector3& x) {
-    const double along = x.y() - shape.centre.y();
-    return 100.0 - slope * (fromCentre ? std::max(0.0, along) : along);
-  };
-  tissue.outside = [&shape, beyond](const Vector3& x) {
-    const Vector3 d = x - shape.centre;
-    return d.y() > 0 && std::hypot(d.x(), d.z()) < 8 ? beyond : 20.0;
-  };
-  tissue.noise = 4.0;
-  Mask truth;
-  return cigarImage(shape, &truth, 1, tissue);
-}
-
 TEST(SliceEnds, TheWindowFollowsTheEndsOwnLevel) {
-  const Cigar shape;
-  const Volume image = driftingCigar(shape, 1.0, false, 109.0);
-  const std::vector<Landmark> landmarks = clicks(shape, 6);
-  const Vector3 tip = shape.centre + Vector3(0, 20, 0);
-  SliceEndOptions options;
-  options.reach = 0.6;  // 14.4 mm, past the tip 8 mm beyond the last clicked slice
-  options.endLevel = 0;
-  const SliceEnds whole = findSliceEnds(image, landmarks, initialFromLandmarks(landmarks), options);
+  DriftingCigar cigar(1.0, false, 109.0);
+  const SliceEnds whole = cigar.ends();
   ASSERT_EQ(whole.ends.size(), 2u);
-  EXPECT_GT((whole.ends[1].end - tip).norm(), 3.0) << whole.ends[1].end.transpose();
-  options.endLevel = 1;
-  const SliceEnds own = findSliceEnds(image, landmarks, initialFromLandmarks(landmarks), options);
+  EXPECT_GT((whole.ends[1].end - cigar.tip).norm(), 3.0) << whole.ends[1].end.transpose();
+  cigar.options.endLevel = 1;
+  const SliceEnds own = cigar.ends();
   ASSERT_EQ(own.ends.size(), 2u);
   EXPECT_LT(own.ends[1].low, 80.0);
   EXPECT_LT(own.ends[1].high, 109.0);
   EXPECT_FALSE(own.ends[1].stoppedByReach);
-  EXPECT_LT((own.ends[1].end - tip).norm(), 2.0) << own.ends[1].end.transpose();
+  EXPECT_LT((own.ends[1].end - cigar.tip).norm(), 2.0) << own.ends[1].end.transpose();
   // The other end, past which the tissue is unlike, is found either way.
   EXPECT_FALSE(whole.ends[0].stoppedByReach || own.ends[0].stoppedByReach);
 }
@@ -203,26 +211,20 @@ TEST(SliceEnds, TheWindowFollowsTheEndsOwnLevel) {
 // the last clicked slice finds no end. The second, about the end's own
 // level (about 94), leaves it where the 108 begins.
 TEST(SliceEnds, WhereTheMarchSawNoEndItMarchesAgainAboutTheEndsLevel) {
-  const Cigar shape;
-  const Volume image = driftingCigar(shape, 0.5, true, 108.0);
-  const std::vector<Landmark> landmarks = clicks(shape, 6);
-  const Vector3 tip = shape.centre + Vector3(0, 20, 0);
-  SliceEndOptions options;
-  options.reach = 0.6;  // 14.4 mm, past the tip 8 mm beyond the last clicked slice
-  options.endLevel = 0;
-  options.endLevelAtReach = 0;  // no second march
-  const SliceEnds once = findSliceEnds(image, landmarks, initialFromLandmarks(landmarks), options);
+  DriftingCigar cigar(0.5, true, 108.0);
+  cigar.options.endLevelAtReach = 0;  // no second march
+  const SliceEnds once = cigar.ends();
   ASSERT_EQ(once.ends.size(), 2u);
   EXPECT_TRUE(once.ends[1].stoppedByReach) << once.ends[1].low << " " << once.ends[1].high;
   EXPECT_FALSE(once.ends[1].marchedAgain);
   EXPECT_GT(once.ends[1].high, 108.0);
-  options.endLevelAtReach = 1;
-  const SliceEnds again = findSliceEnds(image, landmarks, initialFromLandmarks(landmarks), options);
+  cigar.options.endLevelAtReach = 1;
+  const SliceEnds again = cigar.ends();
   ASSERT_EQ(again.ends.size(), 2u);
   EXPECT_TRUE(again.ends[1].marchedAgain);
   EXPECT_FALSE(again.ends[1].stoppedByReach) << again.ends[1].low << " " << again.ends[1].high;
   EXPECT_LT(again.ends[1].high, 108.0);
-  EXPECT_LT((again.ends[1].end - tip).norm(), 2.0) << again.ends[1].end.transpose();
+  EXPECT_LT((again.ends[1].end - cigar.tip).norm(), 2.0) << again.ends[1].end.transpose();
   // The -y end, past which the tissue is unlike, was found by the first march.
   EXPECT_FALSE(again.ends[0].marchedAgain || again.ends[0].stoppedByReach);
   EXPECT_EQ(again.ends[0].end, once.ends[0].end);

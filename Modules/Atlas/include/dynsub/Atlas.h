@@ -14,6 +14,7 @@
 // One affine registration serves every structure of a subject (evaluations
 // and several structures reuse it); the displacement field is the structure's own.
 #include <array>
+#include <functional>
 #include <optional>
 #include <string>
 #include <utility>
@@ -37,15 +38,17 @@ inline const char* const kDefaultAtlasLabels = "/usr/share/mricron/templates/aal
 using LabelNames = std::vector<std::pair<int, std::string>>;
 LabelNames readLabelNames(const std::string& labelsPath);
 
-// The value of one label written as a number ("73", whatever parseNumber
-// reads as a finite number) or a name ("Putamen_L") in `names`, the table of
-// the label map at `labelsPath`.
-// Throws dynsub::UsageError for label 0, a value that is not a label, and a
-// name several labels share; dynsub::Error naming the map for a name its
-// table does not hold (naming the nearest) or a map with no table. `spec`
-// is the whole option value and `option` its flag, for messages.
-int labelValue(const LabelNames& names, const std::string& labelsPath, const std::string& item, const std::string& spec,
-               const std::string& option);
+// The label values of `spec`, "73", "73,75", "Putamen_L" or
+// "Putamen_L,Pallidum_L", in the label map at `labelsPath`: each item a
+// number (whatever parseNumber reads as a finite number) or a name in the
+// table `names()` gives, which is asked for only when an item is a name (a
+// caller can read it then, and once). Throws dynsub::UsageError for an empty
+// spec or item, label 0, a value that is not a label, and a name several
+// labels share; dynsub::Error naming the map for a name its table does not
+// hold (naming the nearest) or a map with no table. `option` is the flag the
+// spec came from, for messages.
+std::vector<int> labelSpecValues(const std::string& spec, const std::string& labelsPath,
+                                 const std::function<const LabelNames&()>& names, const std::string& option);
 
 struct Atlas {
   std::string imagePath, labelsPath;
