@@ -65,6 +65,23 @@ def _version(dynsub):
         return None
 
 
+def _description_problem(path):
+    """What makes a dataset's description invalid BIDS, or None: a JSON
+    object with Name and BIDSVersion. The validator would refuse the dataset
+    only after every subject was segmented."""
+    try:
+        with open(path, encoding="utf-8-sig") as file:
+            description = json.load(file)
+    except (OSError, UnicodeDecodeError, ValueError) as error:
+        return f"not readable as JSON ({error})"
+    if not isinstance(description, dict):
+        return "not a JSON object"
+    missing = [key for key in ("Name", "BIDSVersion") if not isinstance(description.get(key), str)]
+    if missing:
+        return f"no {' or '.join(missing)} (BIDS requires both, as text)"
+    return None
+
+
 def main(argv, snakefile, dynsub):
     """Runs the BIDS App; snakefile and dynsub are where the build put them."""
     version = _version(dynsub)
@@ -81,8 +98,12 @@ def main(argv, snakefile, dynsub):
         parser.error(f"--cores {args.cores}: at least 1")
     if not os.path.isdir(args.bids_dir):
         parser.error(f"{args.bids_dir}: no such BIDS directory")
-    if not os.path.isfile(os.path.join(args.bids_dir, "dataset_description.json")):
+    description = os.path.join(args.bids_dir, "dataset_description.json")
+    if not os.path.isfile(description):
         parser.error(f"{args.bids_dir}: not a BIDS dataset (no dataset_description.json)")
+    problem = _description_problem(description)
+    if problem:
+        parser.error(f"{description}: {problem}")
     if args.profile and not os.path.isfile(os.path.join(args.profile, "config.yaml")):
         parser.error(f"--profile {args.profile}: not a Snakemake profile (no config.yaml in it)")
     bids_dir, out = os.path.abspath(args.bids_dir), os.path.abspath(args.output_dir)

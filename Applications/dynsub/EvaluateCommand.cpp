@@ -110,7 +110,7 @@ void writeRunsCsv(const std::vector<EvaluationRun>& runs, const std::string& pat
          "edge_strength_as_read,edge_strength_flipped,edge_strength_mirrored,edge_alignment_as_read,"
          "edge_alignment_flipped,edge_alignment_mirrored,seconds,steps,control_vertices,outside_region,"
          "trust_volume_ratio,trust_atlas_outline_distance_mm,trust_clicks_to_atlas_mm,trust_farthest_mm,"
-         "trust_march_share,trust_inside_shift_mm,trust_flags,warnings,error\n";
+         "trust_march_share,trust_inside_shift_mm,trust_initial_volume_ratio,trust_flags,warnings,error\n";
   out << std::setprecision(6);
   for (const EvaluationRun& r : runs) {
     using N = CsvNumber;
@@ -130,7 +130,7 @@ void writeRunsCsv(const std::vector<EvaluationRun>& runs, const std::string& pat
     const TrustMeasures& t = r.trust;
     out << N{r.seconds} << ',' << r.steps << ',' << r.controlVertices << ',' << N{t.outsideRegion} << ','
         << N{t.volumeRatio} << ',' << N{t.outlineDistance} << ',' << N{t.clicksToAtlas} << ','
-        << N{t.farthestFromEvidence} << ',' << N{t.marchShare} << ',' << N{t.insideShift} << ','
+        << N{t.farthestFromEvidence} << ',' << N{t.marchShare} << ',' << N{t.insideShift} << ',' << N{t.initialRatio} << ','
         << csvField(r.trustFlags) << ',' << csvField(r.warnings) << ',' << csvField(r.error) << '\n';
   }
   out.close();

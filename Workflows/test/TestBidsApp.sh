@@ -18,7 +18,7 @@
 #    no longer has is warned of;
 #  - mistakes are refused with a message and nothing written: a label that
 #    selects nothing, the group level before any participant, a missing
-#    dataset, an unknown level, the dataset as its own output through a
+#    dataset, a malformed dataset_description.json, an unknown level, the dataset as its own output through a
 #    link, an output folder in the dataset outside derivatives/, a work
 #    directory with a space, a structure seeded twice;
 #  - a seeds table with a byte order mark is read, and a T1w without
@@ -125,6 +125,16 @@ check "group before participant: exit 1, says so" grep -q "run the participant l
 check "group before participant: nothing written" test ! -e "$work/fresh"
 "$DYNSUB_BIDS" "$work/nowhere" "$work/fresh" participant >"$work/bad.log" 2>&1
 check "a missing dataset: exit 2, named" test $? -eq 2 -a -n "$(grep "nowhere: no such BIDS directory" "$work/bad.log")"
+mkdir "$work/broken"
+printf '{"Name": "cohort", "BIDSVersion": "1.9.0",' >"$work/broken/dataset_description.json"
+"$DYNSUB_BIDS" "$work/broken" "$work/fresh" participant >"$work/bad.log" 2>&1
+check "a truncated dataset_description.json: exit 2, named" \
+  test $? -eq 2 -a -n "$(grep "broken/dataset_description.json: not readable as JSON" "$work/bad.log")"
+printf '{"Name": "cohort"}' >"$work/broken/dataset_description.json"
+"$DYNSUB_BIDS" "$work/broken" "$work/fresh" participant >"$work/bad.log" 2>&1
+check "a dataset_description.json without BIDSVersion: exit 2, named" \
+  test $? -eq 2 -a -n "$(grep "dataset_description.json: no BIDSVersion" "$work/bad.log")"
+check "a malformed dataset_description.json: nothing written" test ! -e "$work/fresh"
 "$DYNSUB_BIDS" "$bids" "$work/fresh" subject >"$work/bad.log" 2>&1
 check "an unknown level: exit 2" test $? -eq 2
 "$DYNSUB_BIDS" "$bids" "$work/fresh" participant --profile "$work" >"$work/bad.log" 2>&1

@@ -53,6 +53,9 @@ for r in rows:
         print("one_click flag wrong:", r); ok = False
     if r["protocol"] != "seed" and not float(r["trust_volume_ratio"]) > 0:
         print("no volume ratio for clicks on slices:", r); ok = False
+    # Every run starts from a model with a volume, whatever started it.
+    if not float(r["trust_initial_volume_ratio"]) > 0:
+        print("no ratio to the initial model's volume:", r); ok = False
     # A measure not taken (the atlas's: this plan has none) is empty, as the README says.
     if any(v.strip().lower().lstrip("-") in ("nan", "inf") for v in r.values()):
         print("a field reads nan or inf:", r); ok = False
