@@ -66,19 +66,26 @@ def _version(dynsub):
 
 
 def _description_problem(path):
-    """What makes a dataset's description invalid BIDS, or None: a JSON
-    object with Name and BIDSVersion. The validator would refuse the dataset
-    only after every subject was segmented."""
+    """What makes a dataset's description invalid BIDS, or None: BIDS asks
+    for a JSON object with Name and BIDSVersion as text. Found here, before
+    any job starts, rather than by the validator or another BIDS tool after
+    every subject is segmented."""
     try:
         with open(path, encoding="utf-8-sig") as file:
-            description = json.load(file)
-    except (OSError, UnicodeDecodeError, ValueError) as error:
+            text = file.read()
+    except (OSError, UnicodeDecodeError) as error:
+        return f"cannot be read ({error.strerror if isinstance(error, OSError) else error})"
+    try:
+        description = json.loads(text)
+    except ValueError as error:
         return f"not readable as JSON ({error})"
     if not isinstance(description, dict):
         return "not a JSON object"
-    missing = [key for key in ("Name", "BIDSVersion") if not isinstance(description.get(key), str)]
-    if missing:
-        return f"no {' or '.join(missing)} (BIDS requires both, as text)"
+    for key in ("Name", "BIDSVersion"):
+        if key not in description:
+            return f"no {key} (BIDS requires Name and BIDSVersion)"
+        if not isinstance(description[key], str):
+            return f"{key} is {json.dumps(description[key])}, not text (BIDS requires a string)"
     return None
 
 

@@ -18,9 +18,10 @@
 #    no longer has is warned of;
 #  - mistakes are refused with a message and nothing written: a label that
 #    selects nothing, the group level before any participant, a missing
-#    dataset, a malformed dataset_description.json, an unknown level, the dataset as its own output through a
-#    link, an output folder in the dataset outside derivatives/, a work
-#    directory with a space, a structure seeded twice;
+#    dataset, a malformed dataset_description.json, an unknown level, the
+#    dataset as its own output through a link, an output folder in the
+#    dataset outside derivatives/, a work directory with a space, a
+#    structure seeded twice;
 #  - a seeds table with a byte order mark is read, and a T1w without
 #    landmarks or a seed is warned of once, when its participant is chosen.
 # Needs DYNSUB_BIDS, DATA, WORKFLOWS, BIDS_VALIDATOR; snakemake, nibabel.
@@ -134,6 +135,14 @@ printf '{"Name": "cohort"}' >"$work/broken/dataset_description.json"
 "$DYNSUB_BIDS" "$work/broken" "$work/fresh" participant >"$work/bad.log" 2>&1
 check "a dataset_description.json without BIDSVersion: exit 2, named" \
   test $? -eq 2 -a -n "$(grep "dataset_description.json: no BIDSVersion" "$work/bad.log")"
+printf '{"Name": "cohort", "BIDSVersion": 1.9}' >"$work/broken/dataset_description.json"
+"$DYNSUB_BIDS" "$work/broken" "$work/fresh" participant >"$work/bad.log" 2>&1
+check "a dataset_description.json with a number for BIDSVersion: exit 2, named" \
+  test $? -eq 2 -a -n "$(grep "dataset_description.json: BIDSVersion is 1.9, not text" "$work/bad.log")"
+printf '["cohort"]' >"$work/broken/dataset_description.json"
+"$DYNSUB_BIDS" "$work/broken" "$work/fresh" participant >"$work/bad.log" 2>&1
+check "a dataset_description.json that is a list: exit 2, named" \
+  test $? -eq 2 -a -n "$(grep "dataset_description.json: not a JSON object" "$work/bad.log")"
 check "a malformed dataset_description.json: nothing written" test ! -e "$work/fresh"
 "$DYNSUB_BIDS" "$bids" "$work/fresh" subject >"$work/bad.log" 2>&1
 check "an unknown level: exit 2" test $? -eq 2
