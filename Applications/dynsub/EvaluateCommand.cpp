@@ -130,9 +130,8 @@ void writeRunsCsv(const std::vector<EvaluationRun>& runs, const std::string& pat
     const TrustMeasures& t = r.trust;
     out << N{r.seconds} << ',' << r.steps << ',' << r.controlVertices << ',' << N{t.outsideRegion} << ','
         << N{t.volumeRatio} << ',' << N{t.outlineDistance} << ',' << N{t.clicksToAtlas} << ','
-        << N{t.farthestFromEvidence} << ',' << N{t.marchShare} << ',' << N{t.insideShift} << ','
-        << N{t.initialRatio} << ','
-        << csvField(r.trustFlags) << ',' << csvField(r.warnings) << ',' << csvField(r.error) << '\n';
+        << N{t.farthestFromEvidence} << ',' << N{t.marchShare} << ',' << N{t.insideShift} << ',' << N{t.initialRatio}
+        << ',' << csvField(r.trustFlags) << ',' << csvField(r.warnings) << ',' << csvField(r.error) << '\n';
   }
   out.close();
   if (!out) throw writeFailure(path);
