@@ -44,6 +44,10 @@ bool endsWith(const std::string& text, const std::string& end) {
   return text.size() >= end.size() && text.compare(text.size() - end.size(), end.size(), end) == 0;
 }
 
+// A value a label map can hold: a whole number within a signed 16-bit
+// map's range (false for NaN and infinities).
+bool isLabelValue(double value) { return std::abs(value) <= 32767 && value == std::floor(value); }
+
 itkbridge::AffineArray toArray(const AffineMap& map) {
   itkbridge::AffineArray a{};
   for (int r = 0; r < 3; ++r) {
@@ -127,7 +131,7 @@ std::optional<LabelNames> readTsvNames(std::istream& in, const std::string& path
     const std::vector<std::string> row = splitCsvFields(line, '\t');
     double value = 0;
     if (row.size() <= std::max(indexColumn, nameColumn) || !parseNumber(row[indexColumn], value) ||
-        !(std::abs(value) <= 32767) || value != std::floor(value) || row[nameColumn].empty())
+        !isLabelValue(value) || row[nameColumn].empty())
       throw Error(path, "line " + std::to_string(number) +
                             ": expected a label value (a whole number) under 'index' and its name under 'name'");
     names.emplace_back(static_cast<int>(value), row[nameColumn]);
@@ -229,8 +233,7 @@ int labelValue(const std::string& item, const std::string& spec, const std::stri
                const std::function<const LabelNames&()>& table, const std::string& option) {
   double number = 0;
   if (parseNumber(item, number) && std::isfinite(number)) {
-    if (number != std::floor(number) || std::abs(number) > 32767)
-      throw UsageError(option + " " + spec + ": " + item + " is not a label value");
+    if (!isLabelValue(number)) throw UsageError(option + " " + spec + ": " + item + " is not a label value");
     // 0 is every label map's background, no structure.
     if (number == 0) throw UsageError(option + " " + spec + ": 0 is the label map's background, not a structure");
     return static_cast<int>(number);
