@@ -83,7 +83,7 @@ Report sliceEndsReport(const SliceEnds& ends) {
   std::vector<Report> marched;
   for (const SliceEnd& end : ends.ends) {
     Report r;
-    r.set("from_lps_mm", end.start);
+    r.set("from_lps_mm", end.marchStart);
     r.set("to_lps_mm", end.end);
     r.set("length_mm", end.length);
     r.set("window", std::vector<double>{end.low, end.high});

@@ -136,29 +136,30 @@ SliceEnds findSliceEnds(const Volume& image, const std::vector<Landmark>& landma
     const std::vector<Vector3> innerClicks = clicksOn(inner);
     SliceEnd end;
     end.side = outward < 0 ? -1 : 1;
-    end.start = end.end = centre;
+    end.start = end.marchStart = end.end = centre;
     for (const Vector3& p : onSlice) {
       const Vector3 across = (p - centre) - (p - centre).dot(along) * along;
       end.sliceRadius = std::max(end.sliceRadius, across.norm());
     }
     const double longest = options.reach * span;
-    // The end's own level: the median of the disks on the end slice and two
-    // steps inward, where it lies within the window of the model's median.
-    std::optional<double> ownLevel;
-    {
+    // The end's own level at a point of the end slice: the median of the
+    // disks there and two steps inward, where it lies within the window of
+    // the model's median.
+    const auto ownLevelAt = [&](const Vector3& point) -> std::optional<double> {
       std::vector<double> own;
       for (int k = 0; k < 3; ++k) {
-        const double m = diskMedian(image, centre - outward * k * step * along, u, v, radius, step);
+        const double m = diskMedian(image, point - outward * k * step * along, u, v, radius, step);
         if (std::isfinite(m)) own.push_back(m);
       }
-      if (!own.empty()) {
-        const double median = robustStatistics(std::move(own)).median;
-        if (std::abs(median - inside->median) <= halfWidth) ownLevel = median;
-      }
-    }
-    // Step 3's march with the window's centre `share` of the way to the
-    // end's level: how far it went (mm), its window and whether it saw no end
-    // in `end`.
+      if (own.empty()) return std::nullopt;
+      const double median = robustStatistics(std::move(own)).median;
+      if (std::abs(median - inside->median) > halfWidth) return std::nullopt;
+      return median;
+    };
+    std::optional<double> ownLevel = ownLevelAt(centre);
+    // Step 3's march from end.marchStart with the window's centre `share` of
+    // the way to the end's level: how far it went (mm), its window and
+    // whether it saw no end in `end`.
     const auto march = [&](double share) {
       const double level = inside->median + (ownLevel ? share * (*ownLevel - inside->median) : 0.0);
       end.low = level - halfWidth;
@@ -166,7 +167,7 @@ SliceEnds findSliceEnds(const Volume& image, const std::vector<Landmark>& landma
       int outside = 0;
       double reached = 0;
       for (double t = step; t <= longest; t += step) {
-        const double m = diskMedian(image, centre + outward * t * along, u, v, radius, step);
+        const double m = diskMedian(image, end.marchStart + outward * t * along, u, v, radius, step);
         if (!std::isfinite(m)) break;
         if (m < end.low || m > end.high) {
           if (++outside == 2) break;
@@ -179,12 +180,31 @@ SliceEnds findSliceEnds(const Volume& image, const std::vector<Landmark>& landma
       return reached;
     };
     double reached = march(options.endLevel);
+    // A section can wrap around other tissue (a cerebellum's near the midline
+    // around its white matter and the fourth ventricle): where the centroid's
+    // disks are not the structure's tissue and the march from there stopped
+    // within `gap`, as if the clicks reached the end, it starts again from a
+    // point inside the section whose level is nearest the model's median: a
+    // third or two thirds of the way to one of the clicks, which lie on the
+    // boundary, where a disk would straddle it.
+    if (!ownLevel && reached <= options.gap && !end.stoppedByReach) {
+      for (const Vector3& p : onSlice)
+        for (const double toClick : {1.0 / 3.0, 2.0 / 3.0}) {
+          const Vector3 point = centre + toClick * (p - centre);
+          const std::optional<double> level = ownLevelAt(point);
+          if (level && (!ownLevel || std::abs(*level - inside->median) < std::abs(*ownLevel - inside->median))) {
+            ownLevel = level;
+            end.marchStart = point;
+          }
+        }
+      if (ownLevel) reached = march(options.endLevel);
+    }
     if (end.stoppedByReach && ownLevel && options.endLevelAtReach != options.endLevel) {
       reached = march(options.endLevelAtReach);
       end.marchedAgain = true;
     }
     end.length = reached;
-    end.end = centre + outward * reached * along;
+    end.end = end.marchStart + outward * reached * along;
     // Step 4.
     end.sprung = reached > options.gap && (!end.stoppedByReach || options.springAtReach);
     // A structure whose clicked cross-sections still widen fast toward this

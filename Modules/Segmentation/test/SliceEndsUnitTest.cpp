@@ -96,6 +96,7 @@ TEST(SliceEnds, FindBothEndsOfAStructureClickedOnSlices) {
   for (int e = 0; e < 2; ++e) {
     EXPECT_LT((ends.ends[e].end - tips[e]).norm(), 2.0) << ends.ends[e].end.transpose();
     EXPECT_FALSE(ends.ends[e].stoppedByReach);
+    EXPECT_EQ(ends.ends[e].marchStart, ends.ends[e].start);  // the centroid is the structure's tissue
   }
   // Per end: the tip, and the end slice's 6 clicks drawn in halfway (the taper).
   EXPECT_EQ(ends.springs.size(), 2u * (1 + 6));
@@ -228,6 +229,35 @@ TEST(SliceEnds, WhereTheMarchSawNoEndItMarchesAgainAboutTheEndsLevel) {
   // The -y end, past which the tissue is unlike, was found by the first march.
   EXPECT_FALSE(again.ends[0].marchedAgain || again.ends[0].stoppedByReach);
   EXPECT_EQ(again.ends[0].end, once.ends[0].end);
+}
+
+// A cigar with a core of the outside's intensity (20) within 2.5 mm of its
+// axis, as a cerebellum's section near the midline wraps around its white
+// matter: the end slices' centroids lie in the core, where the march stops
+// at once. It is made again from a point toward a click in the cigar's own
+// tissue (outside the core), and stops within 2 mm of where the cigar ends
+// on that line (20 sqrt(1 - (r / 8)^2) mm from the centre along y, at r mm
+// from the axis): the line meets the boundary at a shallow angle, so the
+// disk's median falls over a millimetre or two before leaving the window.
+TEST(SliceEnds, AMarchFromACentroidOutsideTheTissueStartsTowardAClick) {
+  const Cigar shape;
+  Tissue tissue;
+  tissue.inside = [&shape](const Vector3& x) {
+    return std::hypot(x.x() - shape.centre.x(), x.z() - shape.centre.z()) < 2.5 ? 20.0 : 100.0;
+  };
+  Mask truth;
+  const Volume image = cigarImage(shape, &truth, 1, tissue);
+  const std::vector<Landmark> landmarks = clicks(shape, 6);
+  const SliceEnds ends = findSliceEnds(image, landmarks, initialFromLandmarks(landmarks), SliceEndOptions());
+  ASSERT_EQ(ends.ends.size(), 2u);
+  for (const SliceEnd& end : ends.ends) {
+    const double r = std::hypot(end.marchStart.x() - shape.centre.x(), end.marchStart.z() - shape.centre.z());
+    EXPECT_GT(r, 2.5) << end.marchStart.transpose();
+    EXPECT_TRUE(end.sprung);
+    EXPECT_FALSE(end.stoppedByReach);
+    const double tip = shape.centre.y() + end.side * shape.axes.y() * std::sqrt(1.0 - (r / 8.0) * (r / 8.0));
+    EXPECT_NEAR(end.end.y(), tip, 2.0) << end.end.transpose();
+  }
 }
 
 // The cigar segmented from clicks on its 5 middle slices, and its Dice.

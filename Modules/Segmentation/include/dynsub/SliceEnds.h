@@ -19,9 +19,13 @@
 //     clicked span beyond the slice. c is m moved `endLevel` of the way to
 //     the end's own level e, the median of the disks on the end slice and
 //     the two steps inward from it (where e lies within m +- window s; else
-//     c is m). A structure's intensity drifts along it (a putamen's head is
-//     darker than its middle): a window about the whole structure's median
-//     can hold the tissue past a dark end, or leave out the end itself.
+//     c is m). Where e is not within the window and the march stopped
+//     within `gap`, the centroid may lie in other tissue that the section
+//     wraps around: the march is made again from a point toward a click
+//     whose e is (SliceEnd::marchStart). A structure's intensity drifts
+//     along it (a putamen's head is darker than its middle): a window about
+//     the whole structure's median can hold the tissue past a dark end, or
+//     leave out the end itself.
 //     Where the march reaches its limit without leaving the window (no end
 //     seen), it marches again with c moved `endLevelAtReach` of the way to
 //     e: a window about the whole structure's median that holds the tissue
@@ -101,6 +105,7 @@ struct SliceEndOptions {
 struct SliceEnd {
   int side = 1;                     // -1: towards lower indices along the axis, +1: higher
   Vector3 start = Vector3::Zero();  // the outermost slice's centroid (LPS mm)
+  Vector3 marchStart = Vector3::Zero();  // where the march began: the centroid, or a point toward a click (step 3)
   double sliceRadius = 0;           // mm: that slice's farthest click from the centroid, across the axis
   Vector3 end = Vector3::Zero();    // the march's last step inside
   double low = 0, high = 0;         // the intensities the march followed (step 3)
