@@ -171,16 +171,17 @@ LabelNames readLabelNames(const std::string& labelsPath) {
       // name (mricron's a code after it, ITK-SNAP's colours before it, in
       // quotes, FreeSurfer's colours after it); a name may hold spaces.
       std::istringstream fields(line);
-      int value = 0;
       std::vector<std::string> words;
       for (std::string word; fields >> word;) words.push_back(word);
-      if (words.empty() || !isNumber(words.front()) || !(std::istringstream(words.front()) >> value))
-        throw Error(path, "line " + std::to_string(number) + ": expected a label value and its name");
+      double value = 0;
+      if (words.empty() || !parseNumber(words.front(), value) || !isLabelValue(value))
+        throw Error(path, "line " + std::to_string(number) +
+                              ": expected a label value (a whole number within 16 bits) and its name");
       std::size_t first = 1;
       while (first < words.size() && isNumber(words[first])) ++first;
       if (first == words.size())
         throw Error(path, "line " + std::to_string(number) + ": expected a label value and its name");
-      lines.push_back({value, std::move(words), first});
+      lines.push_back({static_cast<int>(value), std::move(words), first});
     }
     // A name's trailing numbers are the table's own (a code, colours) unless
     // leaving them out would give two labels one name ("Brodmann area 17").

@@ -123,6 +123,20 @@ TEST(Atlas, NameTablesOfOtherToolsAreRead) {
   const Atlas numbered = readAtlas(dir + "/template.nii.gz", dir + "/labels.nii.gz");
   EXPECT_EQ(atlasLabelValues(numbered, "Brodmann area 18"), std::vector<int>{2});
   EXPECT_THROW(atlasLabelValues(numbered, "Brodmann area"), Error);
+  // A value no label map holds is refused on its line, not read as another
+  // label (1.5 as 1, 40000 beyond 16 bits).
+  for (const std::string value : {"1.5", "40000", "1e9", "nan"}) {
+    {
+      std::ofstream table(dir + "/labels.nii.txt");
+      table << "1 Left Caudate\n" << value << " Left Putamen\n";
+    }
+    try {
+      readAtlas(dir + "/template.nii.gz", dir + "/labels.nii.gz");
+      ADD_FAILURE() << "label value " << value << " was accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("labels.nii.txt: line 2"), std::string::npos) << e.what();
+    }
+  }
   std::filesystem::remove_all(dir);
 }
 
