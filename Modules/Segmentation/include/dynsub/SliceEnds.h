@@ -72,8 +72,8 @@ constexpr double kOnSliceVoxels = 0.25;
 // radius more than this times the next slice's: a structure widening that
 // fast at its last clicked slice (a caudate's head) is still far from its
 // widest there, and an ellipsoid's taper pulls it in. Chosen on the tuning
-// subjects of both generated groups (1.0, 1.15 and 1.3 tried;
-// Documentation/Segmentation.md).
+// subjects of both generated groups; lower, the putamina, which widen slowly
+// toward an end near their widest, lose their taper (Documentation/Segmentation.md).
 constexpr double kTaperWidening = 1.3;
 
 // The defaults were chosen on the evaluation plan's tuning split
@@ -89,16 +89,14 @@ struct SliceEndOptions {
   bool springAtReach = false;  // a spring also where the march ended at its reach, not at an intensity change
   double pressure = 0.2;       // N/mm^2 beyond the end slices (step 5; 0: none), chosen on the tuning split
   // Step 3: how far the window's centre moves to the end's own level, 0-1.
-  // 0.5 raised the generated subjects' means (by 0.000-0.008 on the test
-  // subjects), but it carries the bundled caudate's first march from 2 to
-  // 2.5 mm, past `gap`, to an end its clicks reach, and its Dice below the
-  // 0.85 that Colin27's rows are held to; so 0 (Documentation/Segmentation.md).
+  // 0, because 0.5 carries the bundled caudate's first march from 2 to 2.5 mm,
+  // past `gap`, to an end its clicks reach, and its Dice below the 0.85 that
+  // Colin27's rows are held to (Documentation/Segmentation.md).
   double endLevel = 0;
   // Step 3's second march, where the first saw no end: how far its window's
   // centre moves to the end's own level (no second march when it equals
   // endLevel). Chosen on the tuning subjects of the three generated groups
-  // over 0.5 and over none (Documentation/Segmentation.md). An end the first
-  // march found is kept.
+  // (Documentation/Segmentation.md). An end the first march found is kept.
   double endLevelAtReach = 1.0;
 };
 
