@@ -133,7 +133,7 @@ std::optional<LabelNames> readTsvNames(std::istream& in, const std::string& path
     if (row.size() <= std::max(indexColumn, nameColumn) || !parseNumber(row[indexColumn], value) ||
         !isLabelValue(value) || row[nameColumn].empty())
       throw Error(path, "line " + std::to_string(number) +
-                            ": expected a label value (a whole number) under 'index' and its name under 'name'");
+                            ": expected a label value (a whole number from -32767 to 32767) under 'index' and its name under 'name'");
     names.emplace_back(static_cast<int>(value), row[nameColumn]);
   }
   return names;
@@ -176,7 +176,7 @@ LabelNames readLabelNames(const std::string& labelsPath) {
       double value = 0;
       if (words.empty() || !parseNumber(words.front(), value) || !isLabelValue(value))
         throw Error(path, "line " + std::to_string(number) +
-                              ": expected a label value (a whole number within 16 bits) and its name");
+                              ": expected a label value (a whole number from -32767 to 32767) and its name");
       std::size_t first = 1;
       while (first < words.size() && isNumber(words[first])) ++first;
       if (first == words.size())

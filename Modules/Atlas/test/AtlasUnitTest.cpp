@@ -124,7 +124,7 @@ TEST(Atlas, NameTablesOfOtherToolsAreRead) {
   EXPECT_EQ(atlasLabelValues(numbered, "Brodmann area 18"), std::vector<int>{2});
   EXPECT_THROW(atlasLabelValues(numbered, "Brodmann area"), Error);
   // A value no label map holds is refused on its line, not read as another
-  // label (1.5 as 1, 40000 beyond 16 bits).
+  // label (1.5 as 1, 40000 beyond a signed 16-bit label).
   for (const std::string value : {"1.5", "40000", "1e9", "nan"}) {
     {
       std::ofstream table(dir + "/labels.nii.txt");

@@ -72,7 +72,7 @@ constexpr double kOnSliceVoxels = 0.25;
 // radius more than this times the next slice's: a structure widening that
 // fast at its last clicked slice (a caudate's head) is still far from its
 // widest there, and an ellipsoid's taper pulls it in. Chosen on the tuning
-// subjects of both generated groups; lower, the putamina, which widen slowly
+// subjects of both generated groups; at 1.0 the putamina, which widen slowly
 // toward an end near their widest, lose their taper (Documentation/Segmentation.md).
 constexpr double kTaperWidening = 1.3;
 
