@@ -133,7 +133,8 @@ std::optional<LabelNames> readTsvNames(std::istream& in, const std::string& path
     if (row.size() <= std::max(indexColumn, nameColumn) || !parseNumber(row[indexColumn], value) ||
         !isLabelValue(value) || row[nameColumn].empty())
       throw Error(path, "line " + std::to_string(number) +
-                            ": expected a label value (a whole number from -32767 to 32767) under 'index' and its name under 'name'");
+                            ": expected a label value (a whole number from -32767 to 32767) under 'index' and its "
+                            "name under 'name'");
     names.emplace_back(static_cast<int>(value), row[nameColumn]);
   }
   return names;
